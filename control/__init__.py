@@ -1,0 +1,39 @@
+"""Vehicle control: Stanley + PID steering (ICCAS 2020 Eq. 1), speed PID, wheel torques.
+
+Imports only `planner.messages`; returns a plain `VehicleCommand`.
+"""
+
+from __future__ import annotations
+
+from control.actuation import VehicleParams, WheelTorques, longitudinal_force, wheel_torques
+from control.command import VehicleCommand
+from control.longitudinal import SpeedCommand, SpeedController, SpeedParams
+from control.pid import Pid, PidParams
+from control.stanley import (
+    FrontAxleError,
+    StanleyParams,
+    StanleyPid,
+    front_axle_error,
+    wrap_angle,
+)
+from control.vehicle_controller import VehicleController, VehicleControllerParams
+
+__all__ = [
+    "FrontAxleError",
+    "Pid",
+    "PidParams",
+    "SpeedCommand",
+    "SpeedController",
+    "SpeedParams",
+    "StanleyParams",
+    "StanleyPid",
+    "VehicleCommand",
+    "VehicleController",
+    "VehicleControllerParams",
+    "VehicleParams",
+    "WheelTorques",
+    "front_axle_error",
+    "longitudinal_force",
+    "wheel_torques",
+    "wrap_angle",
+]

@@ -1,0 +1,64 @@
+"""Read the car's geometry back from its URDF, so everyone uses the URDF's own numbers."""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass
+from pathlib import Path
+
+from vehicle_urdf.builder import URDF_PATH
+
+WHEELS = ("front_left", "front_right", "rear_left", "rear_right")  # joint/link name prefixes
+
+
+@dataclass(frozen=True, slots=True)
+class CarGeometry:
+    wheelbase: float  # [m] front to rear axle
+    track: float  # [m] left to right wheel centre
+    wheel_radius: float  # [m]
+    body_length: float  # [m]
+    body_width: float  # [m]
+    front_axle: float  # [m] ahead of the car's centre (base origin)
+    rear_axle: float  # [m] behind the car's centre, as a positive distance
+    mass: float  # [kg] total
+    max_steer: float  # [rad] road-wheel hinge limit
+
+    @property
+    def front_overhang(self) -> float:
+        """[m] car centre to front bumper."""
+        return self.body_length / 2
+
+
+def _xyz(element: ET.Element | None) -> tuple[float, float, float]:
+    if element is None:
+        raise ValueError("URDF element without <origin>")
+    x, y, z = (float(v) for v in element.attrib["xyz"].split())
+    return x, y, z
+
+
+def read_geometry(path: Path = URDF_PATH) -> CarGeometry:
+    """Parse wheel joint origins, the wheel cylinder, the lower body box and all masses."""
+    root = ET.parse(path).getroot()
+    joints = {j.attrib["name"]: j for j in root.iter("joint")}
+    links = {link.attrib["name"]: link for link in root.iter("link")}
+    fl = _xyz(joints["front_left_steer_joint"].find("origin"))
+    fr = _xyz(joints["front_right_steer_joint"].find("origin"))
+    rl = _xyz(joints["rear_left_wheel_joint"].find("origin"))
+    cylinder = links["front_left_wheel"].find("visual/geometry/cylinder")
+    body = links["base_link"].find("visual[@name='lower_body']/geometry/box")
+    limit = joints["front_left_steer_joint"].find("limit")
+    if cylinder is None or body is None or limit is None:
+        raise ValueError(f"{path}: not an avsim car URDF")
+    length, width, _ = (float(v) for v in body.attrib["size"].split())
+    mass = sum(float(m.attrib["value"]) for m in root.iter("mass"))
+    return CarGeometry(
+        wheelbase=fl[0] - rl[0],
+        track=fl[1] - fr[1],
+        wheel_radius=float(cylinder.attrib["radius"]),
+        body_length=length,
+        body_width=width,
+        front_axle=fl[0],
+        rear_axle=-rl[0],
+        mass=mass,
+        max_steer=float(limit.attrib["upper"]),
+    )

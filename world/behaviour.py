@@ -1,0 +1,168 @@
+"""Scripted NPC behaviour in route coordinates: triggers fire actions, motion is integrated.
+
+Pure (no PyBullet): `NpcMotion` holds one actor's state along the route (station, lateral
+offset from the reference line, speed, lateral speed) and its pending actions; `step()`
+advances it by dt. Motion is smooth by construction: speed changes at a bounded
+acceleration, lateral moves follow a trapezoidal lateral-speed profile (bounded lateral
+acceleration), so positions and headings never jump.
+
+Actions (scenario format): `speed` (to a speed at an acceleration), `lane_change` (to a
+lane's centre at a lateral speed), `stop` (brake to rest). Triggers: `time`, `ego_s`,
+`gap` (bumper-to-bumper distance to the ego along the route), `after` (an earlier action
+ended, plus a delay). Each action fires once, when its trigger first holds.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+from world.spec import (
+    ActionSpec,
+    AfterTrigger,
+    EgoStationTrigger,
+    GapTrigger,
+    LaneChangeAction,
+    SpeedAction,
+    StopAction,
+    TimeTrigger,
+    Trigger,
+    WalkAction,
+)
+
+LATERAL_ACCEL = 1.5  # [m/s^2] ramp of the lateral speed at the start and end of a lane change
+ARRIVED = 1e-3  # [m] lateral distance that counts as arrived
+
+LaneOffset = Callable[[int, float], float]
+"""(lane index, station) -> lateral offset [m] of that lane's centre from the reference line."""
+
+
+@dataclass(frozen=True, slots=True)
+class TriggerContext:
+    t: float  # [s] sim time
+    ego_s: float  # [m] the ego's centre station
+    gap: float  # [m] bumper-to-bumper distance between this actor and the ego along the route
+
+
+class NpcMotion:
+    """One actor's kinematic state in route coordinates and its scripted actions."""
+
+    def __init__(
+        self, s: float, offset: float, speed: float, direction: int, actions: tuple[ActionSpec, ...]
+    ) -> None:
+        self.s = s  # [m] station of the actor's centre
+        self.offset = offset  # [m] lateral offset of its centre from the reference line, left +
+        self.speed = speed  # [m/s] along its travel direction
+        self.lateral_speed = 0.0  # [m/s] d(offset)/dt
+        self.direction = direction  # +1 with the route, -1 against
+        self.actions = actions
+        self.fired_at: list[float | None] = [None] * len(actions)  # [s]
+        self.ended_at: list[float | None] = [None] * len(actions)  # [s]
+        self._target_speed = speed  # [m/s]
+        self._accel = 0.0  # [m/s^2] magnitude towards the target speed
+        self._speed_action: int | None = None
+        self._target_offset = offset  # [m]
+        self._lateral_max = 0.0  # [m/s] cruise lateral speed of the running lateral move
+        self._lateral_action: int | None = None
+
+    # -- triggers --------------------------------------------------------------------------
+
+    def _holds(self, trigger: Trigger, ctx: TriggerContext) -> bool:
+        if isinstance(trigger, TimeTrigger):
+            return ctx.t >= trigger.time
+        if isinstance(trigger, EgoStationTrigger):
+            return ctx.ego_s >= trigger.s
+        if isinstance(trigger, GapTrigger):
+            return ctx.gap <= trigger.gap
+        if isinstance(trigger, AfterTrigger):
+            ended = self.ended_at[trigger.index]
+            return ended is not None and ctx.t >= ended + trigger.delay
+        raise TypeError(f"unknown trigger {trigger!r}")
+
+    def fire_due(self, ctx: TriggerContext, lane_offset: LaneOffset) -> list[int]:
+        """Start every action whose trigger holds now; returns their indices."""
+        started = []
+        for i, spec in enumerate(self.actions):
+            if self.fired_at[i] is None and self._holds(spec.trigger, ctx):
+                self.fired_at[i] = ctx.t
+                self._start(i, spec, lane_offset)
+                started.append(i)
+        return started
+
+    def _start(self, i: int, spec: ActionSpec, lane_offset: LaneOffset) -> None:
+        action = spec.action
+        if isinstance(action, SpeedAction):
+            self._target_speed, self._accel, self._speed_action = action.speed, action.accel, i
+        elif isinstance(action, StopAction):
+            self._target_speed, self._accel, self._speed_action = 0.0, action.decel, i
+        elif isinstance(action, LaneChangeAction):
+            self._target_offset = lane_offset(action.to_lane, self.s)
+            self._lateral_max, self._lateral_action = action.lateral_speed, i
+        elif isinstance(action, WalkAction):
+            self._target_offset = self.offset + (action.to_offset - self._lane_relative_offset())
+            self._lateral_max, self._lateral_action = action.speed, i
+        # an action replacing a running one of the same kind ends the old one now
+        for j in range(len(self.actions)):
+            running = self.fired_at[j] is not None and self.ended_at[j] is None
+            if j != i and running and _same_kind(self.actions[j].action, action):
+                self.ended_at[j] = self.fired_at[i]
+
+    def _lane_relative_offset(self) -> float:
+        return 0.0  # walking targets are relative to the actor's spawn lane centre (issue D)
+
+    # -- motion ------------------------------------------------------------------------------
+
+    def step(self, t: float, dt: float, curvature: float) -> None:
+        """Advance by dt [s]. `curvature` [1/m] is the reference line's at the actor's station
+        (the station rate of a body at lateral offset r is v / (1 - k r))."""
+        self._step_speed(t, dt)
+        self._step_lateral(t, dt)
+        scale = 1.0 - curvature * self.offset
+        self.s += self.direction * self.speed * dt / max(scale, 1e-3)
+        self.offset += self.lateral_speed * dt
+
+    def _step_speed(self, t: float, dt: float) -> None:
+        error = self._target_speed - self.speed
+        change = self._accel * dt
+        if abs(error) <= change:
+            self.speed = self._target_speed
+            if self._speed_action is not None:
+                self.ended_at[self._speed_action] = t
+                self._speed_action = None
+        else:
+            self.speed += math.copysign(change, error)
+
+    def _step_lateral(self, t: float, dt: float) -> None:
+        if self._lateral_action is None:
+            self.lateral_speed = 0.0
+            return
+        remaining = self._target_offset - self.offset
+        if abs(remaining) < ARRIVED and abs(self.lateral_speed) <= LATERAL_ACCEL * dt:
+            self.lateral_speed = 0.0
+            self.ended_at[self._lateral_action] = t
+            self._lateral_action = None
+            return
+        # trapezoidal profile: the fastest lateral speed from which a ramp-down at
+        # LATERAL_ACCEL still stops on the target, capped at the action's lateral speed
+        allowed = min(self._lateral_max, math.sqrt(2.0 * LATERAL_ACCEL * abs(remaining)))
+        wanted = math.copysign(allowed, remaining)
+        step = LATERAL_ACCEL * dt
+        self.lateral_speed += max(-step, min(step, wanted - self.lateral_speed))
+        if abs(self.lateral_speed) * dt > abs(remaining):  # land on the target, no overshoot
+            self.lateral_speed = remaining / dt
+
+    @property
+    def heading_offset(self) -> float:
+        """[rad] the body's yaw relative to its travel direction along the route."""
+        if self.speed <= 0.1:
+            return 0.0
+        return math.atan2(self.lateral_speed, self.speed) * self.direction
+
+
+def _same_kind(a: object, b: object) -> bool:
+    longitudinal = (SpeedAction, StopAction)
+    lateral = (LaneChangeAction, WalkAction)
+    return (isinstance(a, longitudinal) and isinstance(b, longitudinal)) or (
+        isinstance(a, lateral) and isinstance(b, lateral)
+    )

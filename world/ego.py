@@ -1,0 +1,197 @@
+"""The ego car's body in the physics world: joints by name, Ackermann steering, drive, brake.
+
+The car drives through its joints only: the steering hinges get position targets (Ackermann
+split of a bicycle angle), the wheel joints get drive torque and a brake. Nothing here sets
+the body's pose or velocity after spawn.
+
+Actuator model (per wheel, every physics step):
+- drive: `TORQUE_CONTROL` with a quarter of the total drive torque (all-wheel drive, so the
+  5 m/s^2 the ICCAS car is allowed stays well inside the tyres' grip);
+- brake and rolling resistance: a velocity motor with target 0 whose force limit is the brake
+  torque plus the rolling-resistance torque. A velocity motor with a force limit is a Coulomb
+  friction torque: it opposes the wheel's spin up to the limit and holds the car at rest;
+- aerodynamic drag `0.5 rho CdA v^2` as an external force at the centre of mass;
+- a top-speed governor: no drive torque above the vehicle's maximum speed.
+Bullet's default link damping (0.04, applied as m v (k + k |v|), about 4 kN at 8 m/s) is
+switched off: drag and rolling resistance are modelled explicitly instead.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import pybullet
+from numpy.typing import NDArray
+from pybullet_utils.bullet_client import BulletClient
+
+from vehicle_urdf import URDF_PATH, WHEELS, CarGeometry, read_geometry
+from world.client import GRAVITY
+
+AIR_DENSITY = 1.2  # [kg/m^3]
+STEER_TORQUE = 4000.0  # [N m] steering hinge servo force limit
+STEER_RATE = 1.2  # [rad/s] steering hinge servo speed limit (actuator, not the controller's)
+MAX_WHEEL_SPIN = 200.0  # [rad/s] joint velocity cap (Bullet's default 100 rad/s is 33 m/s)
+
+
+@dataclass(frozen=True, slots=True)
+class EgoParams:
+    max_speed: float = 15.0  # [m/s] vehicle limit (the ICCAS car: 15 m/s)
+    max_accel: float = 5.0  # [m/s^2] the drive torque is capped to give this on the flat
+    rolling_resistance: float = 0.012  # [-] coefficient, F = c m g
+    drag_area: float = 0.7  # [m^2] Cd * A
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class EgoTruth:
+    """Ground truth of the ego body (for sensors, criteria and the recording only)."""
+
+    position: NDArray[np.float64]  # [m] (3,) map frame, the base link origin (car centre)
+    quaternion: NDArray[np.float64]  # (4,) x, y, z, w, map frame
+    yaw: float  # [rad]
+    velocity: NDArray[np.float64]  # [m/s] (3,) map frame, at the centre of mass
+    speed: float  # [m/s] forward (body x) component
+    yaw_rate: float  # [rad/s]
+    wheel_spin: NDArray[np.float64]  # [rad/s] (4,) FL, FR, RL, RR
+    steering_angle: float  # [rad] bicycle-equivalent road-wheel angle from the hinges
+
+
+def ackermann(delta: float, wheelbase: float, track: float) -> tuple[float, float]:
+    """(left, right) hinge angles [rad] for a bicycle road-wheel angle `delta` [rad], left +.
+
+    Both front wheels point at the same turn centre on the rear axle's line:
+    tan(delta_side) = L / (R -+ T/2) with R = L / tan(delta).
+    """
+    if abs(delta) < 1e-9:
+        return 0.0, 0.0
+    radius = wheelbase / math.tan(delta)  # signed, > 0 turning left
+    left = math.atan(wheelbase / (radius - track / 2))
+    right = math.atan(wheelbase / (radius + track / 2))
+    return left, right
+
+
+class EgoBody:
+    """The URDF car in a world; joints looked up by name, geometry read from the URDF."""
+
+    def __init__(
+        self,
+        client: BulletClient,
+        x: float,
+        y: float,
+        yaw: float,
+        speed: float,
+        params: EgoParams,
+    ) -> None:
+        self._c = client
+        self.params = params
+        self.geometry: CarGeometry = read_geometry(URDF_PATH)
+        g = self.geometry
+        quat = client.getQuaternionFromEuler([0.0, 0.0, yaw])
+        self.body = int(
+            client.loadURDF(str(URDF_PATH), [x, y, g.wheel_radius], quat, useFixedBase=False)
+        )
+        joints = {
+            client.getJointInfo(self.body, j)[1].decode(): j
+            for j in range(client.getNumJoints(self.body))
+        }
+        self.joints = joints
+        self.wheel_joints = [joints[f"{w}_wheel_joint"] for w in WHEELS]
+        self.steer_joints = [joints["front_left_steer_joint"], joints["front_right_steer_joint"]]
+        self.links = {client.getJointInfo(self.body, j)[12].decode(): j for j in joints.values()}
+        for link in range(-1, client.getNumJoints(self.body)):
+            client.changeDynamics(self.body, link, linearDamping=0.0, angularDamping=0.0)
+        for j in self.wheel_joints:
+            client.changeDynamics(self.body, j, maxJointVelocity=MAX_WHEEL_SPIN)
+        self._com_offset = np.array(client.getDynamicsInfo(self.body, -1)[3])
+        self.mass = g.mass
+        self._roll_torque = params.rolling_resistance * g.mass * GRAVITY * g.wheel_radius / 4
+        self._max_drive = g.mass * params.max_accel * g.wheel_radius
+        self.drive_torque = 0.0  # [N m] last applied, total
+        self.brake_torque = 0.0  # [N m] last applied, total
+        self.steer_command = 0.0  # [rad] last commanded bicycle angle
+        self._spawn_speed(yaw, speed)
+        self.apply(0.0, 0.0, 0.0)
+
+    def _spawn_speed(self, yaw: float, speed: float) -> None:
+        """At spawn only: the body and its wheels start rolling at `speed`."""
+        if speed == 0.0:
+            return
+        v = [speed * math.cos(yaw), speed * math.sin(yaw), 0.0]
+        self._c.resetBaseVelocity(self.body, v, [0.0, 0.0, 0.0])
+        spin = speed / self.geometry.wheel_radius
+        for j in self.wheel_joints:
+            self._c.resetJointState(self.body, j, 0.0, spin)
+
+    def apply(self, steering_angle: float, drive_torque: float, brake_torque: float) -> None:
+        """Command the joints: bicycle steering angle [rad], total drive and brake torque [N m].
+
+        Held until the next call (the world applies it at every physics step).
+        """
+        g, c = self.geometry, self._c
+        delta = float(np.clip(steering_angle, -g.max_steer, g.max_steer))
+        left, right = ackermann(delta, g.wheelbase, g.track)
+        for joint, target in zip(self.steer_joints, (left, right), strict=True):
+            c.setJointMotorControl2(
+                self.body, joint, pybullet.POSITION_CONTROL, targetPosition=target,
+                force=STEER_TORQUE, maxVelocity=STEER_RATE,
+            )
+        self.steer_command = delta
+        self.drive_torque = float(np.clip(drive_torque, 0.0, self._max_drive))
+        self.brake_torque = max(0.0, float(brake_torque))
+
+    def pre_step(self) -> None:
+        """Forces for the coming physics step: drive, brake + rolling resistance, drag."""
+        c = self._c
+        com, quat = c.getBasePositionAndOrientation(self.body)
+        velocity = c.getBaseVelocity(self.body)[0]
+        yaw = c.getEulerFromQuaternion(quat)[2]
+        forward_speed = velocity[0] * math.cos(yaw) + velocity[1] * math.sin(yaw)
+        drive = 0.0 if forward_speed >= self.params.max_speed else self.drive_torque
+        hold = self.brake_torque / 4 + self._roll_torque
+        c.setJointMotorControlArray(
+            self.body, self.wheel_joints, pybullet.VELOCITY_CONTROL,
+            targetVelocities=[0.0] * 4, forces=[hold] * 4,
+        )
+        c.setJointMotorControlArray(
+            self.body, self.wheel_joints, pybullet.TORQUE_CONTROL, forces=[drive / 4] * 4
+        )
+        v2 = float(velocity[0] ** 2 + velocity[1] ** 2)
+        if v2 > 1e-6:
+            k = -0.5 * AIR_DENSITY * self.params.drag_area * math.sqrt(v2)
+            c.applyExternalForce(
+                self.body, -1, [k * velocity[0], k * velocity[1], 0.0], com, pybullet.WORLD_FRAME
+            )
+
+    def truth(self) -> EgoTruth:
+        """Read the body's true state (link frame origin, not Bullet's centre-of-mass frame)."""
+        c = self._c
+        com, quat = c.getBasePositionAndOrientation(self.body)
+        lin, ang = c.getBaseVelocity(self.body)
+        rot = np.array(c.getMatrixFromQuaternion(quat)).reshape(3, 3)
+        position = np.asarray(com) - rot @ self._com_offset
+        yaw = math.atan2(rot[1, 0], rot[0, 0])
+        velocity = np.asarray(lin)
+        states = c.getJointStates(self.body, self.wheel_joints + self.steer_joints)
+        spin = np.array([s[1] for s in states[:4]])
+        hinge_l, hinge_r = states[4][0], states[5][0]
+        steering = bicycle_angle(hinge_l, hinge_r)
+        return EgoTruth(
+            position=position,
+            quaternion=np.asarray(quat),
+            yaw=yaw,
+            velocity=velocity,
+            speed=float(velocity @ rot[:, 0]),
+            yaw_rate=float(ang[2]),
+            wheel_spin=spin,
+            steering_angle=steering,
+        )
+
+
+def bicycle_angle(left: float, right: float) -> float:
+    """The bicycle angle [rad] whose Ackermann split is (left, right): the inverse of
+    `ackermann`, from cot(delta) = (cot(left) + cot(right)) / 2."""
+    tl, tr = math.tan(left), math.tan(right)
+    if tl * tr <= 0.0:  # straight ahead, or hinges passing through zero
+        return 0.5 * (left + right)
+    return math.atan(2.0 * tl * tr / (tl + tr))

@@ -1,0 +1,267 @@
+"""The world's description of a scenario: validated, resolved, in SI units.
+
+`avsim.scenario` parses and validates the user's YAML (the public format, with `*_kph` and
+`*_deg` keys and defaults) and converts it into these frozen dataclasses. Everything in
+`world/` builds from them; nothing here knows about files or YAML.
+
+Conventions: metres, seconds, radians, m/s. Stations `s` are metres along the route's
+reference line (the centre line of lane 0, the rightmost lane of the ego's direction) from
+its start. Lateral offsets `r` are metres, left positive, from the centre of the named lane.
+"""
+
+from __future__ import annotations
+
+import enum
+from dataclasses import dataclass, field
+
+# ---------------------------------------------------------------------------------------
+# Road
+# ---------------------------------------------------------------------------------------
+
+
+class Zone(enum.Enum):
+    """Scenery style of a segment; it changes what is built beside the road, not the rules."""
+
+    HIGHWAY = "highway"
+    RAMP = "ramp"
+    CITY = "city"
+
+
+class Side(enum.Enum):
+    RIGHT = "right"
+    LEFT = "left"
+
+
+@dataclass(frozen=True, slots=True)
+class SegmentSpec:
+    """One piece of the route's reference line, laid after the previous one.
+
+    A straight has `curvature == 0`; an arc has a signed constant curvature `1 / radius`
+    (> 0 turns left). `length` is measured along the reference line (lane 0's centre).
+    The lane layout fields are resolved (road defaults already applied).
+    """
+
+    length: float  # [m] along the reference line, > 0
+    curvature: float  # [1/m] signed, > 0 turns left, 0 for a straight
+    lanes: int  # driving lanes in the ego's direction, >= 1; lane 0 is the rightmost
+    oncoming_lanes: int  # lanes in the other direction, left of the yellow centre line
+    lane_width: float  # [m]
+    shoulder: float  # [m] paved right shoulder
+    speed_limit: float | None = None  # [m/s] posted at the segment's start; None: unchanged
+    zone: Zone | None = None  # scenery style; None: as the segment before (highway at start)
+    exit: Side | None = None  # this segment leaves the previous road by an exit (issue D)
+
+
+@dataclass(frozen=True, slots=True)
+class SpeedLimitSign:
+    s: float  # [m] station of the sign; the limit applies from here on
+    limit: float  # [m/s]
+
+
+@dataclass(frozen=True, slots=True)
+class StopSign:
+    s: float  # [m] station of the stop line; the sign stands on the right
+
+
+@dataclass(frozen=True, slots=True)
+class Crosswalk:
+    s: float  # [m] station of the near edge of the zebra
+    width: float  # [m] along the route
+
+
+@dataclass(frozen=True, slots=True)
+class SpeedBump:
+    s: float  # [m] station of the bump's centre
+    height: float  # [m]
+    length: float  # [m] along the route
+    pass_speed: float  # [m/s] the speed to take it at
+
+
+@dataclass(frozen=True, slots=True)
+class TrafficLight:
+    s: float  # [m] station of the stop line
+    green: float  # [s]
+    yellow: float  # [s]
+    red: float  # [s]
+    phase: float  # [s] time into the cycle at t = 0
+
+
+Feature = SpeedLimitSign | StopSign | Crosswalk | SpeedBump | TrafficLight
+
+
+@dataclass(frozen=True, slots=True)
+class BuildingsSpec:
+    density: float  # [-] 0..1, fraction of the roadside frontage that is built up
+    setback: float  # [m] from the road's outer edge to the building front
+
+
+@dataclass(frozen=True, slots=True)
+class RoadSpec:
+    segments: tuple[SegmentSpec, ...]
+    speed_limit: float  # [m/s] posted at s = 0
+    features: tuple[Feature, ...] = ()
+    buildings: BuildingsSpec | None = None
+
+
+# ---------------------------------------------------------------------------------------
+# Triggers, actions and events
+# ---------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True, slots=True)
+class TimeTrigger:
+    time: float  # [s] simulated time
+
+
+@dataclass(frozen=True, slots=True)
+class EgoStationTrigger:
+    s: float  # [m] the ego's centre station reached
+
+
+@dataclass(frozen=True, slots=True)
+class GapTrigger:
+    gap: float  # [m] bumper-to-bumper distance actor -> ego along the route falls to <= gap
+
+
+@dataclass(frozen=True, slots=True)
+class AfterTrigger:
+    index: int  # an earlier action of the same actor (or event list)
+    delay: float  # [s] after that action ended
+
+
+Trigger = TimeTrigger | EgoStationTrigger | GapTrigger | AfterTrigger
+
+
+@dataclass(frozen=True, slots=True)
+class SpeedAction:
+    speed: float  # [m/s] target
+    accel: float  # [m/s^2] magnitude used to reach it (> 0)
+
+
+@dataclass(frozen=True, slots=True)
+class LaneChangeAction:
+    to_lane: int
+    lateral_speed: float  # [m/s] > 0
+
+
+@dataclass(frozen=True, slots=True)
+class WalkAction:
+    to_offset: float  # [m] lateral offset from the actor's lane centre to walk to
+    speed: float  # [m/s]
+
+
+@dataclass(frozen=True, slots=True)
+class StopAction:
+    decel: float = 6.0  # [m/s^2]
+
+
+Action = SpeedAction | LaneChangeAction | WalkAction | StopAction
+
+
+@dataclass(frozen=True, slots=True)
+class ActionSpec:
+    trigger: Trigger
+    action: Action
+
+
+class ActorType(enum.Enum):
+    CAR = "car"
+    TRUCK = "truck"
+    PEDESTRIAN = "pedestrian"
+    OBSTACLE = "obstacle"
+
+
+@dataclass(frozen=True, slots=True)
+class ActorSpec:
+    id: str
+    type: ActorType
+    lane: int  # lane index on the route (pedestrians: the lane their offset is measured from)
+    s: float  # [m] station of the actor's centre
+    offset: float  # [m] lateral, left positive, from the lane centre
+    speed: float  # [m/s] initial speed
+    actions: tuple[ActionSpec, ...] = ()
+
+
+@dataclass(frozen=True, slots=True)
+class AcceleratorOverride:
+    pedal: float  # [-] 0..1
+    duration: float  # [s]
+
+
+class Wheel(enum.Enum):
+    FRONT_LEFT = "front_left"
+    FRONT_RIGHT = "front_right"
+    REAR_LEFT = "rear_left"
+    REAR_RIGHT = "rear_right"
+
+
+@dataclass(frozen=True, slots=True)
+class FlatTire:
+    wheel: Wheel
+
+
+EgoEvent = AcceleratorOverride | FlatTire
+
+
+@dataclass(frozen=True, slots=True)
+class EventSpec:
+    trigger: Trigger
+    event: EgoEvent
+
+
+# ---------------------------------------------------------------------------------------
+# Ego, sensors, criteria, the whole scenario
+# ---------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True, slots=True)
+class EgoSpec:
+    lane: int
+    s: float  # [m] station of the car's centre
+    speed: float  # [m/s] initial speed
+    set_speed: float  # [m/s] the driver's desired (cruise) speed
+    max_speed: float  # [m/s] vehicle limit
+
+
+@dataclass(frozen=True, slots=True)
+class GnssSpec:
+    sigma: float = 0.05  # [m] 1-sigma horizontal position noise
+    heading_sigma: float = 0.0034906585  # [rad] 1-sigma heading noise (0.2 deg)
+    bias: tuple[float, float] = (0.0, 0.0)  # [m] constant (x, y) offset
+
+
+@dataclass(frozen=True, slots=True)
+class LidarNoiseSpec:
+    range_sigma: float = 0.02  # [m]
+    dropout: float = 0.0  # [-] fraction of rays lost
+
+
+@dataclass(frozen=True, slots=True)
+class SensorsSpec:
+    gnss: GnssSpec = field(default_factory=GnssSpec)
+    lidar: LidarNoiseSpec = field(default_factory=LidarNoiseSpec)
+
+
+R157 = "r157"
+
+
+@dataclass(frozen=True, slots=True)
+class CriteriaSpec:
+    min_gap: float | str | None = None  # [m] or "r157"; None: criterion off
+    max_decel: float | None = None  # [m/s^2]; None: criterion off
+    reach_s: float | None = None  # [m]; None: end of route less 30 m
+
+
+@dataclass(frozen=True, slots=True)
+class ScenarioSpec:
+    name: str
+    description: str
+    situation: str
+    duration: float  # [s]
+    seed: int
+    road: RoadSpec
+    ego: EgoSpec
+    actors: tuple[ActorSpec, ...] = ()
+    sensors: SensorsSpec = field(default_factory=SensorsSpec)
+    events: tuple[EventSpec, ...] = ()
+    criteria: CriteriaSpec = field(default_factory=CriteriaSpec)

@@ -1,0 +1,210 @@
+"""The physics world of one scenario: road, scenery, the ego car, NPCs and the GNSS/odometry.
+
+`World(spec)` builds everything from a `ScenarioSpec` into its own `BulletClient`; `step()`
+advances physics by one fixed 240 Hz step (ego forces, Bullet step, NPC behaviours).
+Ground truth for criteria and the recording is in `world.truth`; the stack only ever sees
+what `world.gnss` measures.
+"""
+
+from __future__ import annotations
+
+import math
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pybullet
+from numpy.typing import NDArray
+
+from world.actors import ActorSet
+from world.client import Clock, Rate, add_ground, make_client
+from world.ego import EgoBody, EgoParams, EgoTruth
+from world.gnss import GnssSensor, OdometrySensor
+from world.hdmap import RoadMap
+from world.road_mesh import TexturedMesh, build_road_surface
+from world.scenery import (
+    BuildingBox,
+    SignPlacement,
+    layout_buildings,
+    layout_speed_limit_signs,
+    speed_limit_sign_image,
+)
+from world.spec import ScenarioSpec
+
+TRIGGER_RATE = Rate("npc_triggers", 40)
+ACTOR_PLACEMENT_RATE = Rate("npc_placement", 120)  # bodies moved; motion integrates at 240 Hz
+SIGN_POLE_RADIUS = 0.04  # [m]
+SIGN_SEGMENTS = 24  # triangles in a round sign plate
+
+
+@dataclass(frozen=True, slots=True)
+class StaticScene:
+    """What was built once: for the recording and the collision criterion."""
+
+    road_meshes: tuple[TexturedMesh, ...]
+    buildings: tuple[BuildingBox, ...]
+    signs: tuple[SignPlacement, ...]
+    ground: int  # body id
+    obstacle_bodies: frozenset[int]  # buildings and sign poles: touching one is a collision
+
+
+class World:
+    """One scenario's world in its own physics client."""
+
+    def __init__(self, spec: ScenarioSpec) -> None:
+        self.spec = spec
+        seeds = np.random.SeedSequence(spec.seed).spawn(3)
+        self.client = make_client()
+        self.clock = Clock()
+        self.road = RoadMap.from_spec(spec.road)
+        self._tmp = tempfile.TemporaryDirectory(prefix="avsim-textures-")
+        self.scene = self._build_scene(np.random.default_rng(seeds[0]))
+        lane = self.road.lane(spec.ego.lane)
+        xy = lane.position(spec.ego.s, 0.0)
+        yaw = float(lane.heading_at(spec.ego.s))
+        self.ego = EgoBody(
+            self.client, float(xy[0]), float(xy[1]), yaw, spec.ego.speed,
+            EgoParams(max_speed=spec.ego.max_speed),
+        )
+        self.actors = ActorSet(self.client, self.road, spec.actors)
+        self.gnss = GnssSensor(spec.sensors.gnss, np.random.default_rng(seeds[1]))
+        self.odometry = OdometrySensor(
+            self.ego.geometry.wheel_radius, np.random.default_rng(seeds[2])
+        )
+        self._truth: EgoTruth | None = None
+        self.ego_s = self._station(self.ego_truth)
+        self.started_actions: list[tuple[str, int]] = []  # (actor id, action) at the last check
+
+    # -- building ----------------------------------------------------------------------------
+
+    def _build_scene(self, rng: np.random.Generator) -> StaticScene:
+        ground = add_ground(self.client)
+        meshes = tuple(build_road_surface(self.road))
+        for mesh in meshes:
+            self._add_textured_mesh(mesh.name, mesh.vertices, mesh.indices, mesh.uvs,
+                                    mesh.normals, mesh.texture)
+        buildings: tuple[BuildingBox, ...] = ()
+        if self.spec.road.buildings is not None:
+            buildings = tuple(layout_buildings(self.road, self.spec.road.buildings, rng))
+        obstacles = {self._add_building(b) for b in buildings}
+        signs = tuple(layout_speed_limit_signs(self.road))
+        obstacles |= {self._add_sign(sign) for sign in signs}
+        return StaticScene(meshes, buildings, signs, ground, frozenset(obstacles))
+
+    def _texture(self, name: str, rgb: NDArray[np.uint8]) -> int:
+        path = Path(self._tmp.name) / f"{name}.png"
+        cv2.imwrite(str(path), cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR))
+        return int(self.client.loadTexture(str(path)))
+
+    def _add_textured_mesh(
+        self,
+        name: str,
+        vertices: NDArray[np.float64],
+        indices: NDArray[np.int32],
+        uvs: NDArray[np.float64],
+        normals: NDArray[np.float64],
+        texture: NDArray[np.uint8],
+    ) -> int:
+        """A visual-only body (no collision: the ground plane carries the car)."""
+        c = self.client
+        visual = c.createVisualShape(
+            pybullet.GEOM_MESH,
+            vertices=vertices.tolist(),
+            indices=indices.reshape(-1).tolist(),
+            uvs=uvs.tolist(),
+            normals=normals.tolist(),
+        )
+        body = int(c.createMultiBody(0.0, -1, visual))
+        c.changeVisualShape(body, -1, textureUniqueId=self._texture(name, texture),
+                            rgbaColor=[1, 1, 1, 1])
+        return body
+
+    def _add_building(self, b: BuildingBox) -> int:
+        c = self.client
+        shape = c.createCollisionShape(pybullet.GEOM_BOX, halfExtents=list(b.half_extents))
+        visual = c.createVisualShape(
+            pybullet.GEOM_BOX, halfExtents=list(b.half_extents), rgbaColor=[*b.rgb, 1.0]
+        )
+        quat = c.getQuaternionFromEuler([0.0, 0.0, b.yaw])
+        return int(c.createMultiBody(0.0, shape, visual, list(b.centre), quat))
+
+    def _add_sign(self, sign: SignPlacement) -> int:
+        """A pole (with collision) and a round textured plate facing the traffic."""
+        c = self.client
+        top = sign.plate_height + sign.plate_diameter / 2
+        shape = c.createCollisionShape(pybullet.GEOM_CYLINDER, radius=SIGN_POLE_RADIUS,
+                                       height=top)
+        visual = c.createVisualShape(pybullet.GEOM_CYLINDER, radius=SIGN_POLE_RADIUS,
+                                     length=top, rgbaColor=[0.6, 0.6, 0.62, 1.0])
+        pole = int(c.createMultiBody(0.0, shape, visual, [*sign.pole_xy, top / 2]))
+        vertices, indices, uvs, normals = _disc_mesh(sign, offset=2 * SIGN_POLE_RADIUS)
+        rgba = speed_limit_sign_image(sign.kph)
+        self._add_textured_mesh(f"sign_{sign.kph}_{sign.s:.0f}", vertices, indices, uvs,
+                                normals, np.ascontiguousarray(rgba[..., :3]))
+        return pole
+
+    # -- stepping ----------------------------------------------------------------------------
+
+    @property
+    def t(self) -> float:
+        """[s] simulated time."""
+        return self.clock.t
+
+    @property
+    def ego_truth(self) -> EgoTruth:
+        """The ego's true state after the last step (read once per step, when asked)."""
+        if self._truth is None:
+            self._truth = self.ego.truth()
+        return self._truth
+
+    def _station(self, truth: EgoTruth) -> float:
+        s, _ = self.road.lane(0).local_coordinates(truth.position[:2])
+        return float(s)
+
+    def step(self) -> None:
+        """One physics step: ego forces from the held command, Bullet, then the NPCs.
+
+        NPC triggers are checked at `TRIGGER_RATE` against the ego's true station; NPC
+        motion is integrated every step.
+        """
+        self.ego.pre_step()
+        self.client.stepSimulation()
+        self.clock.advance()
+        self._truth = None
+        if self.clock.step % TRIGGER_RATE.every == 0:
+            self.ego_s = self._station(self.ego_truth)
+            self.started_actions = self.actors.fire_triggers(
+                self.clock.t, self.ego_s, self.ego.geometry.body_length
+            )
+        self.actors.step(self.clock.t, self.clock.dt,
+                         place=self.clock.step % ACTOR_PLACEMENT_RATE.every == 0)
+
+    def close(self) -> None:
+        if self.client is not None:
+            self.client.disconnect()
+        self._tmp.cleanup()
+
+
+def _disc_mesh(
+    sign: SignPlacement, offset: float
+) -> tuple[NDArray[np.float64], NDArray[np.int32], NDArray[np.float64], NDArray[np.float64]]:
+    """A two-sided triangle fan for a round plate, `offset` [m] in front of the pole."""
+    n = SIGN_SEGMENTS
+    normal = np.array([math.cos(sign.yaw), math.sin(sign.yaw), 0.0])
+    across = np.array([-math.sin(sign.yaw), math.cos(sign.yaw), 0.0])  # plate's left
+    centre = np.array([*sign.pole_xy, sign.plate_height]) + offset * normal
+    angles = np.linspace(0.0, 2 * math.pi, n, endpoint=False)
+    radius = sign.plate_diameter / 2
+    ring = centre + radius * (
+        np.cos(angles)[:, None] * -across + np.sin(angles)[:, None] * np.array([0, 0, 1.0])
+    )
+    vertices = np.vstack([centre, ring])
+    uvs = np.vstack([[0.5, 0.5], np.column_stack([0.5 + 0.5 * np.cos(angles),
+                                                   0.5 - 0.5 * np.sin(angles)])])
+    front = [(0, 1 + i, 1 + (i + 1) % n) for i in range(n)]
+    back = [(0, 1 + (i + 1) % n, 1 + i) for i in range(n)]
+    indices = np.array(front + back, dtype=np.int32)
+    normals = np.tile(normal, (n + 1, 1))
+    return vertices, indices, uvs, normals
