@@ -138,8 +138,12 @@ def _knuckle_link(name: str, d: CarDimensions) -> str:
     return f'  <link name="{name}">\n' + _inertial(d.knuckle_mass, i, i, i) + "  </link>\n"
 
 
+SENSOR_MASS = 0.05  # [kg] a sensor link's own mass (Bullet invents 1 kg for a bare link)
+
+
 def _sensor_link(name: str) -> str:
-    return f'  <link name="{name}"/>\n'
+    i = SENSOR_MASS * 0.05**2 / 6.0
+    return f'  <link name="{name}">\n' + _inertial(SENSOR_MASS, i, i, i) + "  </link>\n"
 
 
 def _joint(

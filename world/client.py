@@ -13,6 +13,7 @@ from pybullet_utils.bullet_client import BulletClient
 
 PHYSICS_RATE = 240  # [Hz] fixed physics step
 GRAVITY = 9.81  # [m/s^2]
+GROUND_EXTENT = 2000.0  # [m] half size of the visible ground
 GROUND_FRICTION = 1.0  # [-] dry asphalt; Bullet multiplies it with the tyre's (URDF) friction
 
 
@@ -28,8 +29,9 @@ def make_client() -> BulletClient:
 def add_ground(client: BulletClient) -> int:
     """An infinite flat ground plane at z = 0 (the road meshes are painted on top of it)."""
     shape = client.createCollisionShape(pybullet.GEOM_PLANE)
-    visual = client.createVisualShape(
-        pybullet.GEOM_PLANE, rgbaColor=[0.33, 0.45, 0.25, 1.0]  # grass
+    visual = client.createVisualShape(  # grass, a thin 4 km square just below z = 0
+        pybullet.GEOM_BOX, halfExtents=[GROUND_EXTENT, GROUND_EXTENT, 0.01],
+        visualFramePosition=[0.0, 0.0, -0.011], rgbaColor=[0.33, 0.45, 0.25, 1.0],
     )
     body = client.createMultiBody(0.0, shape, visual)
     client.changeDynamics(body, -1, lateralFriction=GROUND_FRICTION)

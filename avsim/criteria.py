@@ -1,0 +1,215 @@
+"""Criteria: objects that watch ground truth and give a verdict with a value, threshold and unit.
+
+Each criterion sees a `TruthSample` at the criteria rate (and `no_collision` sees every
+contact onset) and keeps what it needs; `result()` returns a `CriterionResult`. The run's
+verdict is the conjunction. Definitions follow SCENARIO_FORMAT.md (default criteria) and
+the ICCAS normal-driving rule (tyres must not leave the lane).
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+
+from world.hdmap import RoadMap
+
+KPH = 1 / 3.6  # [m/s] per km/h
+SPEED_TOLERANCE_KPH = 1.0  # [km/h] the speed_limit rule's tolerance
+LINE_HALF_WIDTH = 0.075  # [m] half a painted lane line: a tyre touching paint is out
+DECEL_WINDOW = 0.2  # [s] moving average of the max_decel criterion
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class TruthSample:
+    """What the criteria see at one instant (all ground truth)."""
+
+    t: float  # [s]
+    speed: float  # [m/s] ego forward speed
+    station: float  # [m] ego centre station on the route
+    front_station: float  # [m] front bumper station
+    tyres: NDArray[np.float64]  # [m] (4, 2) tyre patch centres, map frame
+    touching: frozenset[int]  # body ids in contact with the ego (ground excluded)
+
+
+@dataclass(frozen=True, slots=True)
+class CriterionResult:
+    name: str
+    passed: bool
+    value: float
+    threshold: float
+    unit: str
+    first_failure: float | None = None  # [s] sim time it first failed, if it did
+
+    def as_json(self) -> dict[str, object]:
+        out: dict[str, object] = {
+            "name": self.name, "passed": self.passed, "value": _round(self.value),
+            "threshold": _round(self.threshold), "unit": self.unit,
+        }
+        if self.first_failure is not None:
+            out["first_failure"] = round(self.first_failure, 3)
+        return out
+
+
+def _round(x: float) -> float:
+    return round(x, 4) if math.isfinite(x) else x
+
+
+class Criterion:
+    """Base of the criteria: a name, a unit, `update` per sample and a `result`."""
+
+    name = ""
+    unit = ""
+
+    def __init__(self) -> None:
+        self.first_failure: float | None = None
+
+    def update(self, sample: TruthSample) -> None:
+        raise NotImplementedError
+
+    def result(self) -> CriterionResult:
+        raise NotImplementedError
+
+    def _fail(self, t: float) -> None:
+        if self.first_failure is None:
+            self.first_failure = t
+
+
+class NoCollision(Criterion):
+    """The ego touches no actor, building or roadside object: counts contact onsets."""
+
+    name, unit = "no_collision", "contacts"
+
+    def __init__(self, names: dict[int, str]) -> None:
+        super().__init__()
+        self.names = names  # body id -> what it is (for the event log)
+        self.count = 0
+        self._touching: frozenset[int] = frozenset()
+        self.events: list[tuple[float, str]] = []
+
+    def update(self, sample: TruthSample) -> None:
+        for body in sorted(sample.touching - self._touching):
+            self.count += 1
+            self.events.append((sample.t, self.names.get(body, f"body {body}")))
+            self._fail(sample.t)
+        self._touching = sample.touching
+
+    def result(self) -> CriterionResult:
+        return CriterionResult(self.name, self.count == 0, self.count, 0, self.unit,
+                               self.first_failure)
+
+
+class TyresInLane(Criterion):
+    """Every tyre stays inside the ego's lane markings: value = least margin [m] of a tyre's
+    outer edge to the inner edge of the painted line (negative: on or over the paint)."""
+
+    name, unit = "tyres_in_lane", "m"
+
+    def __init__(self, road: RoadMap, lane: int, tyre_half_width: float) -> None:
+        super().__init__()
+        self.lane = road.lane(lane)
+        self.tyre_half_width = tyre_half_width
+        self.margin = math.inf
+
+    def update(self, sample: TruthSample) -> None:
+        s, r = self.lane.local_coordinates(sample.tyres)
+        half = np.asarray(self.lane.width_at(s)) / 2 - LINE_HALF_WIDTH
+        margin = float(np.min(half - np.abs(r) - self.tyre_half_width))
+        self.margin = min(self.margin, margin)
+        if margin < 0:
+            self._fail(sample.t)
+
+    def result(self) -> CriterionResult:
+        return CriterionResult(self.name, self.margin >= 0, self.margin, 0.0, self.unit,
+                               self.first_failure)
+
+
+class SpeedLimit(Criterion):
+    """Speed never exceeds the posted limit at the front bumper by more than 1 km/h:
+    value = the largest excess [km/h]."""
+
+    name, unit = "speed_limit", "km/h"
+
+    def __init__(self, road: RoadMap) -> None:
+        super().__init__()
+        self.road = road
+        self.excess = -math.inf
+
+    def update(self, sample: TruthSample) -> None:
+        limit = float(self.road.speed_limit_at(sample.front_station))
+        excess = (sample.speed - limit) / KPH
+        self.excess = max(self.excess, excess)
+        if excess > SPEED_TOLERANCE_KPH:
+            self._fail(sample.t)
+
+    def result(self) -> CriterionResult:
+        return CriterionResult(self.name, self.excess <= SPEED_TOLERANCE_KPH, self.excess,
+                               SPEED_TOLERANCE_KPH, self.unit, self.first_failure)
+
+
+class Completes(Criterion):
+    """The ego's centre reaches `reach_s` before the end: value = farthest station [m]."""
+
+    name, unit = "completes", "m"
+
+    def __init__(self, reach_s: float) -> None:
+        super().__init__()
+        self.reach_s = reach_s
+        self.farthest = -math.inf
+
+    def update(self, sample: TruthSample) -> None:
+        self.farthest = max(self.farthest, sample.station)
+
+    @property
+    def done(self) -> bool:
+        return self.farthest >= self.reach_s
+
+    def result(self) -> CriterionResult:
+        return CriterionResult(self.name, self.done, self.farthest, self.reach_s, self.unit)
+
+
+class MaxDecel(Criterion):
+    """The ego's deceleration (0.2 s moving average) never exceeds the threshold [m/s^2]."""
+
+    name, unit = "max_decel", "m/s^2"
+
+    def __init__(self, threshold: float, rate: float) -> None:
+        super().__init__()
+        self.threshold = threshold
+        self._speeds: deque[float] = deque(maxlen=max(2, round(DECEL_WINDOW * rate) + 1))
+        self._window = (self._speeds.maxlen or 2) - 1
+        self._rate = rate
+        self.peak = 0.0
+
+    def update(self, sample: TruthSample) -> None:
+        self._speeds.append(sample.speed)
+        if len(self._speeds) == self._speeds.maxlen:
+            decel = (self._speeds[0] - self._speeds[-1]) * self._rate / self._window
+            self.peak = max(self.peak, decel)
+            if decel > self.threshold:
+                self._fail(sample.t)
+
+    def result(self) -> CriterionResult:
+        return CriterionResult(self.name, self.peak <= self.threshold, self.peak,
+                               self.threshold, self.unit, self.first_failure)
+
+
+@dataclass
+class CriteriaSet:
+    """All criteria of a run; `verdict` is their conjunction."""
+
+    items: list[Criterion] = field(default_factory=list)
+
+    def update(self, sample: TruthSample) -> None:
+        for c in self.items:
+            c.update(sample)
+
+    def results(self) -> list[CriterionResult]:
+        return [c.result() for c in self.items]
+
+    @property
+    def passed(self) -> bool:
+        return all(r.passed for r in self.results())

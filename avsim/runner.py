@@ -1,0 +1,275 @@
+"""The closed loop: world -> sensors -> stack -> joints, criteria on ground truth, recording.
+
+Rates (all divide the 240 Hz physics rate; checked by `Rate`):
+- GNSS 10 Hz, odometry and the stack (decide-then-apply) 40 Hz;
+- criteria sample ground truth at 60 Hz, collisions (contact onsets) every physics step;
+- the recording logs the ego pose, scalars and the plan at 20 Hz, NPC boxes at 10 Hz.
+
+Each control tick decides on one snapshot (the sensor frames of this tick), then the
+command is held on the joints for the next 6 physics steps.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+from avsim.criteria import (
+    Completes,
+    CriteriaSet,
+    CriterionResult,
+    MaxDecel,
+    NoCollision,
+    SpeedLimit,
+    TruthSample,
+    TyresInLane,
+)
+from avsim.recorder import Recorder
+from avsim.stack import Stack, StackOutput
+from world.client import PHYSICS_RATE, Rate
+from world.spec import ScenarioSpec
+from world.truth import front_axle_point, touching, tyre_patches
+from world.world import World
+
+GNSS_RATE = Rate("gnss", 10)
+CONTROL_RATE = Rate("control", 40)
+CRITERIA_RATE = Rate("criteria", 60)
+RECORD_RATE = Rate("record", 20)
+ACTOR_RECORD_RATE = Rate("record_actors", 10)
+END_MARGIN = 30.0  # [m] default `completes` station: the route's end less this
+SETTLE_AFTER_DONE = 1.0  # [s] the run goes on this long after `completes` is reached
+
+ProgressCallback = Callable[[float, float], None]  # (sim time, duration) [s]
+
+
+@dataclass
+class TrajectoryLog:
+    """Per control tick: the ego's true and estimated state and what the stack did."""
+
+    t: list[float] = field(default_factory=list)  # [s]
+    x: list[float] = field(default_factory=list)  # [m] true, car centre
+    y: list[float] = field(default_factory=list)  # [m]
+    yaw: list[float] = field(default_factory=list)  # [rad]
+    speed: list[float] = field(default_factory=list)  # [m/s] true forward speed
+    station: list[float] = field(default_factory=list)  # [m] true centre station
+    cross_track: list[float] = field(default_factory=list)  # [m] true centre offset, left +
+    front_axle_error: list[float] = field(default_factory=list)  # [m] true, at front axle
+    target_speed: list[float] = field(default_factory=list)  # [m/s]
+    speed_limit: list[float] = field(default_factory=list)  # [m/s] at the front bumper
+    steering: list[float] = field(default_factory=list)  # [rad] commanded
+    wheel_spin: list[NDArray[np.float64]] = field(default_factory=list)  # [rad/s] (4,)
+
+    def array(self, name: str) -> NDArray[np.float64]:
+        return np.asarray(getattr(self, name), dtype=np.float64)
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class RunResult:
+    spec: ScenarioSpec
+    criteria: list[CriterionResult]
+    metrics: dict[str, float]
+    sim_time: float  # [s]
+    wall_time: float  # [s]
+    log: TrajectoryLog
+    recording: Path | None
+
+    @property
+    def passed(self) -> bool:
+        return all(c.passed for c in self.criteria)
+
+
+class Runner:
+    """Runs one scenario to its end (duration, or `completes` reached) and judges it."""
+
+    def __init__(self, spec: ScenarioSpec, recording: Path | None = None) -> None:
+        self.spec = spec
+        self.world = World(spec)
+        w = self.world
+        self.car = w.ego.geometry
+        self.stack = Stack(w.road, spec.ego, self.car)
+        self.log = TrajectoryLog()
+        names = {b: "building or sign" for b in w.scene.obstacle_bodies}
+        names.update({b: f"actor {a.id}" for b, a in zip(w.actors.bodies, spec.actors,
+                                                          strict=True)})
+        reach = spec.criteria.reach_s
+        self.completes = Completes(reach if reach is not None else w.road.length - END_MARGIN)
+        self.collisions = NoCollision(names)
+        items = [self.collisions, TyresInLane(w.road, spec.ego.lane, 0.105),
+                 SpeedLimit(w.road), self.completes]
+        if spec.criteria.max_decel is not None:
+            items.append(MaxDecel(spec.criteria.max_decel, CRITERIA_RATE.hz))
+        self.criteria = CriteriaSet(items)
+        self.recorder = Recorder(recording, recording_name=spec.name) if recording else None
+        self._touching: frozenset[int] = frozenset()
+        self._last: StackOutput | None = None
+
+    # -- the loop ------------------------------------------------------------------------------
+
+    def run(self, progress: ProgressCallback | None = None) -> RunResult:
+        start = time.perf_counter()
+        w = self.world
+        if self.recorder is not None:
+            self._record_static()
+        steps = round(self.spec.duration * PHYSICS_RATE)
+        done_at: float | None = None
+        try:
+            for step in range(steps):
+                self._tick(step)
+                w.step()
+                self._watch(w.clock.step)
+                if done_at is None and self.completes.done:
+                    done_at = w.t
+                if done_at is not None and w.t >= done_at + SETTLE_AFTER_DONE:
+                    break
+                if progress is not None and step % PHYSICS_RATE == 0:
+                    progress(w.t, self.spec.duration)
+        finally:
+            if self.recorder is not None:
+                self._record_criteria()
+                self.recorder.close()
+            sim_time = w.t
+            w.close()
+        return RunResult(
+            spec=self.spec, criteria=self.criteria.results(), metrics=self._metrics(),
+            sim_time=sim_time, wall_time=time.perf_counter() - start, log=self.log,
+            recording=self.recorder.path if self.recorder else None,
+        )
+
+    def _tick(self, step: int) -> None:
+        """Sensors at their rates, then (at the control rate) decide and apply."""
+        w = self.world
+        if not CONTROL_RATE.fires(step):
+            return
+        truth = w.ego_truth
+        if GNSS_RATE.fires(step):
+            self.stack.on_gnss(w.gnss.measure(w.t, truth))
+        self.stack.on_odometry(w.odometry.measure(w.t, truth))
+        out = self.stack.tick(w.t, CONTROL_RATE.every / PHYSICS_RATE)
+        cmd = out.command
+        w.ego.apply(cmd.steering_angle, cmd.drive_torque, cmd.brake_torque)
+        self._last = out
+        self._log_tick(out)
+
+    def _log_tick(self, out: StackOutput) -> None:
+        w, log = self.world, self.log
+        truth = w.ego_truth
+        lane = w.road.lane(self.spec.ego.lane)
+        s, r = lane.local_coordinates(truth.position[:2])
+        _, r_fa = lane.local_coordinates(front_axle_point(truth, self.car))
+        log.t.append(w.t)
+        log.x.append(float(truth.position[0]))
+        log.y.append(float(truth.position[1]))
+        log.yaw.append(truth.yaw)
+        log.speed.append(truth.speed)
+        log.station.append(float(s))
+        log.cross_track.append(float(r))
+        log.front_axle_error.append(float(r_fa))
+        log.target_speed.append(out.plan.target_speed)
+        log.speed_limit.append(out.plan.speed_limit)
+        log.steering.append(out.command.steering_angle)
+        log.wheel_spin.append(truth.wheel_spin.copy())
+        if self.recorder is not None and RECORD_RATE.fires(w.clock.step):
+            self._record_tick(out)
+
+    def _watch(self, step: int) -> None:
+        """Criteria: contact onsets every step, the rest at the criteria rate."""
+        w = self.world
+        now = frozenset(touching(w.client, w.ego.body, w.scene.ground))
+        if now != self._touching:
+            self._touching = now
+            self._sample()
+            for t, what in self.collisions.events[len(self._seen_events()):]:
+                if self.recorder is not None:
+                    self.recorder.log_event(t, f"collision with {what}", "ERROR")
+        elif CRITERIA_RATE.fires(step):
+            self._sample()
+
+    def _seen_events(self) -> list[tuple[float, str]]:
+        return self.collisions.events[:-1] if self.collisions.events else []
+
+    def _sample(self) -> None:
+        w = self.world
+        truth = w.ego_truth
+        s, _ = w.road.lane(0).local_coordinates(truth.position[:2])
+        self.criteria.update(TruthSample(
+            t=w.t, speed=truth.speed, station=float(s),
+            front_station=float(s) + self.car.front_overhang,
+            tyres=tyre_patches(truth, self.car), touching=self._touching,
+        ))
+
+    # -- results -------------------------------------------------------------------------------
+
+    def _metrics(self) -> dict[str, float]:
+        xte = self.log.array("cross_track")
+        speed = self.log.array("speed")
+        dt = CONTROL_RATE.every / PHYSICS_RATE
+        decel = -np.diff(speed) / dt if len(speed) > 1 else np.zeros(1)
+        window = max(1, round(0.2 / dt))
+        smooth = np.convolve(decel, np.ones(window) / window, mode="valid") if len(decel) else decel
+        return {
+            "max_lateral_error": float(np.max(np.abs(xte))) if len(xte) else math.nan,
+            "rms_lateral_error": float(np.sqrt(np.mean(xte**2))) if len(xte) else math.nan,
+            "max_front_axle_error": float(np.max(np.abs(self.log.array("front_axle_error"))))
+            if len(xte) else math.nan,
+            "max_decel": float(max(0.0, np.max(smooth))) if len(smooth) else 0.0,
+            "max_speed": float(np.max(speed)) if len(speed) else 0.0,
+            "distance": float(self.log.station[-1] - self.log.station[0]) if xte.size else 0.0,
+            "collisions": float(self.collisions.count),
+        }
+
+    # -- recording -----------------------------------------------------------------------------
+
+    def _record_static(self) -> None:
+        rec, w = self.recorder, self.world
+        assert rec is not None
+        rec.log_road_meshes(w.scene.road_meshes)
+        if w.scene.buildings:
+            b = w.scene.buildings
+            quats = [[0.0, 0.0, math.sin(x.yaw / 2), math.cos(x.yaw / 2)] for x in b]
+            rec.log_static_boxes("/world/buildings", [x.centre for x in b],
+                                 [x.half_extents for x in b], quats,
+                                 (np.array([x.rgb for x in b]) * 255).astype(np.uint8))
+        g = self.car
+        r = g.wheel_radius
+        wheels = [[g.front_axle, g.track / 2, 0.0], [g.front_axle, -g.track / 2, 0.0],
+                  [-g.rear_axle, g.track / 2, 0.0], [-g.rear_axle, -g.track / 2, 0.0]]
+        rec.log_ego_body(body_half_size=(g.body_length / 2, g.body_width / 2, 0.55),
+                         body_center=(0.0, 0.0, 0.55 + 0.16 - r), wheel_centers=wheels,
+                         wheel_radius=r, wheel_half_width=0.105)
+        lanes = [np.column_stack([lane.position(np.linspace(0, w.road.length, 400), 0.0),
+                                  np.full(400, 0.02)]) for lane in w.road.lanes]
+        rec.log_static_lines("/world/map/lanes", lanes, (90, 160, 255), 0.03)
+
+    def _record_tick(self, out: StackOutput) -> None:
+        rec, w = self.recorder, self.world
+        assert rec is not None
+        truth, log = w.ego_truth, self.log
+        rec.log_ego_pose(w.t, truth.position, truth.quaternion)
+        rec.log_scalars(w.t, {
+            "speed": truth.speed, "target_speed": out.plan.target_speed,
+            "speed_limit": out.plan.speed_limit, "steering": out.command.steering_angle,
+            "cross_track_error": log.cross_track[-1],
+        })
+        rec.log_path(w.t, out.plan.path.xy)
+        if ACTOR_RECORD_RATE.fires(w.clock.step):
+            p = w.actors.poses
+            quats = np.column_stack([np.zeros((len(p.yaws), 2)), np.sin(p.yaws / 2),
+                                     np.cos(p.yaws / 2)])
+            rec.log_actors(w.t, p.ids, p.centres, p.half_sizes, quats,
+                           [k.value for k in p.kinds])
+
+    def _record_criteria(self) -> None:
+        rec = self.recorder
+        assert rec is not None
+        for r in self.criteria.results():
+            level = "INFO" if r.passed else "ERROR"
+            t = r.first_failure if r.first_failure is not None else self.world.t
+            rec.log_event(t, f"criterion {r.name}: {'pass' if r.passed else 'FAIL'} "
+                             f"(value {r.value:.3f} {r.unit}, threshold {r.threshold} {r.unit})",
+                          level)

@@ -1,0 +1,111 @@
+"""Speed control: feed-forward acceleration plus a speed PID, clamped and jerk limited.
+
+Steps of `SpeedController.update` (all along the car's forward axis):
+
+1. Hold guard: when the target speed is ~0 (<= `stop_target_speed`) and the car is slower
+   than `standstill_speed`, the car is holding at a stop: the PID is reset (no windup while
+   parked) and the request is -`hold_decel`, flagged `hold` so that actuation applies brake
+   only.
+2. Otherwise accel = target_accel (the planner's feed-forward) + PID(target_speed - speed).
+   Conditional integration (anti-windup on top of the PID's clamp): the integrator runs only
+   within |error| <= `integration_band`, and is frozen while the previous request was cut by
+   the limits in the direction the error pushes. Without the band, a step from 0 to
+   13.9 m/s charges the integrator on the way up and overshoots by ~0.5 m/s; with it, ~0.1.
+3. Clamp to [-max_decel, max_accel] (defaults 6 and 5 m/s^2; ICCAS 2020 drives with at most
+   5 m/s^2 acceleration).
+4. Jerk limit: the request moves by at most max_jerk * dt per step. The default 10 m/s^3 is
+   an actuator guard, not a comfort setting (ride comfort is the planner's job, through
+   target_accel): it keeps torque steps and PID noise off the drivetrain while still letting
+   an emergency stop reach the full 6 m/s^2 in 0.6 s.
+
+The first step after `reset()` ramps from 0 m/s^2.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from control.pid import Pid, PidParams
+
+__all__ = ["SpeedCommand", "SpeedController", "SpeedParams"]
+
+TAU_V = 0.8  # [s] time constant of the speed error (P action)
+KP_V = 1.0 / TAU_V  # [1/s]
+TAU_I = 4.0  # [s] integral time (Ti): the I action matches the P action after TAU_I
+KI_V = KP_V / TAU_I  # [1/s^2]
+
+
+@dataclass(frozen=True, slots=True)
+class SpeedParams:
+    """Gains and limits of the speed loop."""
+
+    kp: float = KP_V  # [1/s] (m/s^2 per m/s of speed error)
+    ki: float = KI_V  # [1/s^2]
+    kd: float = 0.0  # [-] (m/s^2 per m/s^2 of error rate)
+    integral_limit: float = 1.0  # [m/s^2] |integral term| clamp (grades, drag-model error)
+    integration_band: float = 1.0  # [m/s] the integrator only runs within this speed error
+    derivative_tau: float = 0.2  # [s] low-pass on the error derivative
+    max_accel: float = 5.0  # [m/s^2] ICCAS 2020: max 5 m/s^2
+    max_decel: float = 6.0  # [m/s^2] positive number, braking limit
+    max_jerk: float = 10.0  # [m/s^3] rate limit on the request (see module doc)
+    stop_target_speed: float = 0.05  # [m/s] a target at or below this means "stop"
+    standstill_speed: float = 0.3  # [m/s] below this (with a stop target) the car holds
+    hold_decel: float = 3.0  # [m/s^2] positive, the request while holding (brake only)
+
+    @property
+    def pid(self) -> PidParams:
+        """The speed PID: error [m/s], output [m/s^2]."""
+        return PidParams(
+            kp=self.kp,
+            ki=self.ki,
+            kd=self.kd,
+            integral_limit=self.integral_limit,
+            derivative_tau=self.derivative_tau,
+        )
+
+
+@dataclass(frozen=True, slots=True)
+class SpeedCommand:
+    """The longitudinal request of one tick."""
+
+    accel: float  # [m/s^2] along the car's x axis, clamped and jerk limited
+    hold: bool  # the car is holding at a stop: brake only, no drive torque
+
+
+class SpeedController:
+    """Speed PID with feed-forward, accel clamp, jerk limit and standstill hold."""
+
+    def __init__(self, params: SpeedParams | None = None) -> None:
+        self.params = SpeedParams() if params is None else params
+        self._pid = Pid(self.params.pid)
+        self._accel = 0.0  # [m/s^2] previous request, for the jerk limit
+        self._excess = 0.0  # [m/s^2] previous desired minus limited request
+
+    def reset(self) -> None:
+        """Clear the PID and start the jerk limit from 0 m/s^2."""
+        self._pid.reset()
+        self._accel = 0.0
+        self._excess = 0.0
+
+    def update(
+        self, target_speed: float, target_accel: float, speed: float, dt: float
+    ) -> SpeedCommand:
+        """One step: target_speed [m/s], target_accel [m/s^2] feed-forward, speed [m/s]
+        measured forward speed, dt [s] -> the acceleration request."""
+        p = self.params
+        stop_requested = target_speed <= p.stop_target_speed
+        at_standstill = speed < p.standstill_speed
+        hold = stop_requested and at_standstill
+        if hold:
+            self._pid.reset()
+            desired = -p.hold_decel
+        else:
+            error = target_speed - speed
+            integrate = self._excess * error <= 0.0 and abs(error) <= p.integration_band
+            desired = target_accel + self._pid.update(error, dt, integrate=integrate)
+        clamped = min(max(desired, -p.max_decel), p.max_accel)
+        max_step = p.max_jerk * dt
+        accel = self._accel + min(max(clamped - self._accel, -max_step), max_step)
+        self._excess = desired - accel
+        self._accel = accel
+        return SpeedCommand(accel=accel, hold=hold)

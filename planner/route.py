@@ -1,0 +1,66 @@
+"""Lane-keeping reference paths sampled from the HD map.
+
+The path runs with the route (increasing station) whatever the lane's travel direction: the
+ego always drives with the route, also when it borrows an oncoming lane to overtake.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from planner.messages import ReferencePath
+from world.hdmap import FloatArray, Lane
+
+
+def path_stations(
+    s: float, behind: float, ahead: float, spacing: float, length: float
+) -> FloatArray:
+    """Stations [m] from ``s - behind`` to ``s + ahead``, clamped to the route [0, length].
+
+    Samples are ``spacing`` [m] apart from the start, and the (clamped) end station is the
+    last sample, so the final gap may be shorter. At least two samples are returned: if the
+    clamped window is shorter than ``spacing`` (the car beyond the route end), it is extended
+    backwards to ``spacing``. Shape (N,), N >= 2, increasing.
+    """
+    if spacing <= 0.0 or behind < 0.0 or ahead < 0.0:
+        raise ValueError("spacing must be > 0, behind and ahead >= 0")
+    if length <= 0.0:
+        raise ValueError("the route has no length")
+    start = min(max(s - behind, 0.0), length)
+    end = min(max(s + ahead, 0.0), length)
+    if end - start < spacing:
+        if end < spacing:
+            start, end = 0.0, min(spacing, length)
+        else:
+            start = end - spacing
+    n = math.floor((end - start) / spacing + 1e-9)
+    stations = start + spacing * np.arange(n + 1, dtype=np.float64)
+    if end - stations[-1] > 1e-9 * spacing:
+        stations = np.append(stations, end)
+    return stations
+
+
+def lane_path(
+    lane: Lane,
+    s: float,
+    behind: float,
+    ahead: float,
+    spacing: float,
+    *,
+    length: float,
+) -> ReferencePath:
+    """The centre line (r = 0) of ``lane`` from ``s - behind`` to ``s + ahead``.
+
+    ``s``, ``behind``, ``ahead``, ``spacing`` [m] are stations / station distances along the
+    route's reference line; on an offset lane in a curve the points are about ``spacing``
+    apart (scaled by ``1 - k * offset``). ``length`` [m] is the route length
+    (`RoadMap.length`): lanes end at the route end, so the window is clamped to [0, length].
+    Headings [rad] and signed curvatures [1/m] come from the map, not from differencing.
+    """
+    stations = path_stations(s, behind, ahead, spacing, length)
+    xy = np.asarray(lane.position(stations, np.zeros_like(stations)), dtype=np.float64)
+    heading = np.asarray(lane.heading_at(stations), dtype=np.float64)
+    curvature = np.asarray(lane.curvature_at(stations), dtype=np.float64)
+    return ReferencePath(xy=xy.reshape(-1, 2), heading=heading, curvature=curvature)

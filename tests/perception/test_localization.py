@@ -1,0 +1,177 @@
+"""Localization EKF on a synthetic drive: straight, then a full circle, at 12 m/s."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import pytest
+
+from perception.localization import (
+    Localizer,
+    LocalizerParams,
+    NotInitialisedError,
+    motion,
+    wrap_angle,
+)
+from world.frames import GnssFix, Odometry
+
+DEG = math.pi / 180.0
+ODO_RATE = 40.0  # [Hz]
+GNSS_EVERY = 4  # odometry samples per GNSS fix (10 Hz)
+WHEEL_RADIUS = 0.33  # [m]
+SPEED = 12.0  # [m/s]
+RADIUS = 40.0  # [m]
+T_STRAIGHT = 8.0  # [s]
+HEADING0 = 2.8  # [rad] close to pi, so the circle crosses the +-pi wrap
+SETTLE = 1.0  # [s] ignored at the start of the error statistics
+
+
+@dataclass(frozen=True)
+class Truth:
+    x: float
+    y: float
+    heading: float
+    speed: float
+    yaw_rate: float
+
+
+def truth_at(t: float) -> Truth:
+    """Straight along HEADING0 for T_STRAIGHT, then a left circle of RADIUS, from (10, -5)."""
+    x0, y0 = 10.0, -5.0
+    if t <= T_STRAIGHT:
+        d = SPEED * t
+        return Truth(x0 + d * math.cos(HEADING0), y0 + d * math.sin(HEADING0), HEADING0, SPEED, 0.0)
+    w = SPEED / RADIUS
+    x1 = x0 + SPEED * T_STRAIGHT * math.cos(HEADING0)
+    y1 = y0 + SPEED * T_STRAIGHT * math.sin(HEADING0)
+    psi = HEADING0 + w * (t - T_STRAIGHT)
+    x = x1 + RADIUS * (math.sin(psi) - math.sin(HEADING0))
+    y = y1 + RADIUS * (-math.cos(psi) + math.cos(HEADING0))
+    return Truth(x, y, wrap_angle(psi), SPEED, w)
+
+
+def run(
+    seed: int,
+    duration: float,
+    bias: tuple[float, float] = (0.0, 0.0),
+    gnss_sigma: float = 0.05,
+    heading_sigma: float = 0.2 * DEG,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Position and heading errors [m], [rad] of the estimate after each tick past SETTLE.
+
+    Errors are against the truth shifted by the GNSS bias (what the filter can observe).
+    """
+    rng = np.random.default_rng(seed)
+    loc = Localizer()
+    spin_sigma = 0.05 * math.sqrt(2.0) / WHEEL_RADIUS  # rear-wheel mean -> 0.05 m/s
+    pos_err: list[float] = []
+    head_err: list[float] = []
+    for k in range(int(duration * ODO_RATE) + 1):
+        t = k / ODO_RATE
+        tr = truth_at(t)
+        spins = tr.speed / WHEEL_RADIUS + rng.normal(0.0, spin_sigma, 4)
+        loc.on_odometry(
+            Odometry(
+                t=t,
+                wheel_speeds=(spins[0], spins[1], spins[2], spins[3]),
+                wheel_radius=WHEEL_RADIUS,
+                yaw_rate=tr.yaw_rate + rng.normal(0.0, 0.005),
+                steering_angle=0.0,
+            )
+        )
+        if k % GNSS_EVERY == 0:
+            loc.on_gnss(
+                GnssFix(
+                    t=t,
+                    x=tr.x + bias[0] + rng.normal(0.0, gnss_sigma),
+                    y=tr.y + bias[1] + rng.normal(0.0, gnss_sigma),
+                    heading=wrap_angle(tr.heading + rng.normal(0.0, heading_sigma)),
+                    sigma=gnss_sigma,
+                    heading_sigma=heading_sigma,
+                )
+            )
+        if t < SETTLE:
+            continue
+        est = loc.estimate(t)
+        pos_err.append(math.hypot(est.x - tr.x - bias[0], est.y - tr.y - bias[1]))
+        head_err.append(wrap_angle(est.heading - tr.heading))
+    return np.array(pos_err), np.array(head_err)
+
+
+def rms(a: np.ndarray) -> float:
+    return float(np.sqrt(np.mean(np.square(a))))
+
+
+DURATION = T_STRAIGHT + 2.0 * math.pi * RADIUS / SPEED + 2.0  # [s] a full circle and more
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_rms_errors_on_straight_then_circle(seed: int) -> None:
+    pos_err, head_err = run(seed, DURATION)
+    assert rms(pos_err) < 0.03
+    assert rms(head_err) < 0.15 * DEG
+    # the error never blows up at the straight -> circle step or the +-pi wrap
+    assert float(np.max(pos_err)) < 0.12
+    assert float(np.max(np.abs(head_err))) < 0.6 * DEG
+
+
+def test_estimate_follows_constant_gnss_bias() -> None:
+    """A constant bias cannot be observed from odometry: the estimate follows the fixes."""
+    pos_err, head_err = run(seed=7, duration=20.0, bias=(1.5, -0.8))
+    assert rms(pos_err) < 0.03
+    assert rms(head_err) < 0.15 * DEG
+
+
+def test_speed_and_yaw_rate_estimated() -> None:
+    loc = Localizer()
+    for k in range(int(15.0 * ODO_RATE)):
+        t = k / ODO_RATE
+        tr = truth_at(t)
+        spin = tr.speed / WHEEL_RADIUS
+        loc.on_odometry(Odometry(t, (spin, spin, spin, spin), WHEEL_RADIUS, tr.yaw_rate, 0.1))
+        if k % GNSS_EVERY == 0:
+            loc.on_gnss(GnssFix(t, tr.x, tr.y, tr.heading, 0.05, 0.2 * DEG))
+    est = loc.estimate(t)
+    assert est.speed == pytest.approx(SPEED, abs=0.01)
+    assert est.yaw_rate == pytest.approx(SPEED / RADIUS, abs=0.002)
+    assert est.steering_angle == 0.1
+    assert 0.0 < est.position_sigma < 0.05
+
+
+def test_not_initialised_until_first_fix_and_reset() -> None:
+    loc = Localizer()
+    loc.on_odometry(Odometry(0.0, (30.0, 30.0, 30.0, 30.0), WHEEL_RADIUS, 0.1, 0.0))
+    assert not loc.initialised
+    with pytest.raises(NotInitialisedError):
+        loc.estimate(0.0)
+    loc.on_gnss(GnssFix(0.0, 1.0, 2.0, math.pi, 0.05, 0.2 * DEG))
+    est = loc.estimate(0.0)
+    assert (est.x, est.y, est.heading) == (1.0, 2.0, math.pi)
+    assert est.speed == pytest.approx(30.0 * WHEEL_RADIUS)  # from the odometry before it
+    assert est.yaw_rate == pytest.approx(0.1)
+    loc.reset()
+    assert not loc.initialised
+
+
+def test_heading_innovation_wrapped() -> None:
+    """A fix at -pi + eps after a state at pi - eps moves the heading by 2 eps, not 2 pi."""
+    loc = Localizer(LocalizerParams())
+    loc.on_gnss(GnssFix(0.0, 0.0, 0.0, math.pi - 0.001, 0.05, 0.2 * DEG))
+    loc.on_gnss(GnssFix(0.1, 0.0, 0.0, -math.pi + 0.001, 0.05, 0.2 * DEG))
+    h = loc.estimate(0.1).heading
+    assert abs(wrap_angle(h - math.pi)) < 0.002
+    assert -math.pi < h <= math.pi
+
+
+def test_motion_jacobian_matches_finite_differences() -> None:
+    x = np.array([3.0, -2.0, 0.7, 11.0, 0.3])
+    dt = 0.025
+    _, f = motion(x, dt)
+    eps = 1e-6
+    for j in range(5):
+        dx = np.zeros(5)
+        dx[j] = eps
+        num = (motion(x + dx, dt)[0] - motion(x - dx, dt)[0]) / (2 * eps)
+        np.testing.assert_allclose(f[:, j], num, atol=1e-7)

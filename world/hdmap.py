@@ -1,0 +1,457 @@
+"""The static HD map: the route's reference line, its lanes, limits and features.
+
+API CONTRACT: signatures and semantics below are fixed; other modules (planner, road mesh
+builder, actors, criteria) code against them.
+
+Geometry: the route's reference line is the centre line of lane 0 (the rightmost lane of the
+ego's direction), a chain of straight and constant-curvature arc pieces laid end to end from
+the origin, heading +x. Every lane shares the route's station `s` (metres along the
+reference line); a lane is the reference line shifted sideways by the lane's `offset_at(s)`.
+Lateral `r` is metres from the lane's centre, left of the route direction positive (for
+oncoming lanes too: their travel `direction` is -1 but s and r stay in route coordinates).
+
+Across, on a segment with `lanes` ego lanes of width w and `oncoming_lanes` oncoming lanes
+(offsets from the reference line, left +):
+
+- ego lane i: centre at i * w;
+- yellow centre line: (lanes - 0.5) * w;
+- oncoming lane -j (j = 1 next to the centre line): centre at (lanes + j - 1) * w;
+- paved edges: right -(w / 2 + shoulder), left (lanes + oncoming_lanes - 0.5) * w.
+
+Lane layout is per segment: a value changes in a step at the segment's start station.
+An arc turns at most 360 degrees. Beyond the route's ends the reference line goes on
+straight (the extension of the first and last piece) with the first / last segment's layout.
+`heading_at` is continuous along the route (not wrapped to (-pi, pi]).
+
+No PyBullet here: the planner reads this module.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from world.spec import Feature, RoadSpec, SpeedLimitSign, Zone
+
+FloatArray = NDArray[np.float64]
+IntArray = NDArray[np.intp]
+
+HALF_PI = 0.5 * np.pi  # [rad]
+TWO_PI = 2.0 * np.pi  # [rad]
+
+
+class MapError(ValueError):
+    """The spec cannot be built into a map (e.g. a lane offset beyond an arc's radius)."""
+
+
+@dataclass(frozen=True, slots=True)
+class Piece:
+    """One straight or arc piece of the reference line."""
+
+    s0: float  # [m] station at its start
+    length: float  # [m]
+    curvature: float  # [1/m] signed, 0 for straight
+    x0: float  # [m] map frame start point
+    y0: float  # [m]
+    heading0: float  # [rad] heading at its start
+
+
+@dataclass(frozen=True, slots=True)
+class CrossSection:
+    """The road's layout across, on one segment."""
+
+    lanes: int
+    oncoming_lanes: int
+    lane_width: float  # [m]
+    shoulder: float  # [m]
+    zone: Zone
+
+    @property
+    def right_edge(self) -> float:
+        """[m] offset of the right paved edge (outer edge of the shoulder), negative."""
+        return -(0.5 * self.lane_width + self.shoulder)
+
+    @property
+    def left_edge(self) -> float:
+        """[m] offset of the left paved edge (left edge of the outermost lane)."""
+        return (self.lanes + self.oncoming_lanes - 0.5) * self.lane_width
+
+    @property
+    def centre_line(self) -> float:
+        """[m] offset of the boundary between ego and oncoming lanes (the left road edge
+        when there are no oncoming lanes)."""
+        return (self.lanes - 0.5) * self.lane_width
+
+    @property
+    def paved_width(self) -> float:
+        """[m] width of the paved road, shoulder included."""
+        return self.left_edge - self.right_edge
+
+
+@dataclass(frozen=True, slots=True)
+class SpeedLimitPosting:
+    s: float  # [m] station where the limit starts to apply
+    limit: float  # [m/s]
+
+
+class ReferenceLine:
+    """The chain of pieces as arrays, with a straight extension before s = 0 and after the
+    end. Internal piece index 0 is the extension before the start, 1..P the route's pieces,
+    P + 1 the extension after the end. All methods are vectorised over stations / points."""
+
+    def __init__(self, pieces: tuple[Piece, ...]) -> None:
+        first, last = pieces[0], pieces[-1]
+        end_xy, end_heading = _piece_end(last)
+        length = last.s0 + last.length
+        before = Piece(0.0, 0.0, 0.0, first.x0, first.y0, first.heading0)
+        after = Piece(length, 0.0, 0.0, float(end_xy[0]), float(end_xy[1]), end_heading)
+        ext = [before, *pieces, after]
+        self.length = length  # [m]
+        self.n_pieces = len(pieces)
+        # station boundaries between the route's pieces, shape (P + 1,): 0 .. length
+        self.bounds: FloatArray = np.array([p.s0 for p in pieces] + [length])
+        self.inner_bounds = self.bounds[1:-1]  # [m] joints between the route's pieces
+        self.s0: FloatArray = np.array([p.s0 for p in ext])
+        self.len: FloatArray = np.array([p.length for p in ext])
+        # range of t = s - s0 per piece; the extensions reach to infinity
+        self.t_lo = np.zeros(len(ext))
+        self.t_lo[0] = -np.inf
+        self.t_hi = self.len.copy()
+        self.t_hi[-1] = np.inf
+        self.k: FloatArray = np.array([p.curvature for p in ext])
+        self.x0: FloatArray = np.array([p.x0 for p in ext])
+        self.y0: FloatArray = np.array([p.y0 for p in ext])
+        self.h0: FloatArray = np.array([p.heading0 for p in ext])
+        self.is_arc = self.k != 0.0
+        safe_k = np.where(self.is_arc, self.k, 1.0)
+        radius0 = np.where(self.is_arc, 1.0 / safe_k, 0.0)
+        self.cx = self.x0 - radius0 * np.sin(self.h0)  # [m] arc centres (start for straights)
+        self.cy = self.y0 + radius0 * np.cos(self.h0)
+        self.half_len = 0.5 * self.len
+        self.straight = np.where(self.is_arc, 0.0, 1.0)
+        self.sign_k = np.sign(self.k)
+        self.inv_k = np.where(self.is_arc, 1.0 / safe_k, 0.0)  # [m] signed radius, 0 straight
+        self.cos_h0 = np.cos(self.h0)
+        self.sin_h0 = np.sin(self.h0)
+        # projection onto an arc: the heading at the point's angle, relative to the arc's
+        # middle heading (so arcs up to a full turn wrap correctly), shifted by +pi
+        h_mid = self.h0 + 0.5 * self.k * self.len
+        self.angle_shift = self.sign_k * HALF_PI - h_mid + np.pi
+
+    def piece_index(self, s: FloatArray) -> IntArray:
+        """Internal piece index (0 .. P + 1) of stations s; a joint belongs to the later."""
+        return np.searchsorted(self.bounds, s, side="right")
+
+    def segment_index(self, s: FloatArray) -> IntArray:
+        """Route piece (= segment) index 0 .. P - 1 of stations s, clipped at the ends."""
+        return np.searchsorted(self.inner_bounds, s, side="right")
+
+    def heading(self, s: FloatArray) -> FloatArray:
+        i = self.piece_index(s)
+        return self.h0[i] + self.k[i] * (s - self.s0[i])
+
+    def curvature(self, s: FloatArray) -> FloatArray:
+        return self.k[self.piece_index(s)]
+
+    def point(self, s: FloatArray, d: FloatArray) -> FloatArray:
+        """[m] map-frame points, shape s.shape + (2,), at stations s and offsets d (left +)
+        from the reference line."""
+        # arcs: at radius (1/k - d) from the centre; straights: p0 + u t + d n (their
+        # "centre" is p0 and 1/k is 0, so the same radial term gives d n)
+        i = self.piece_index(s)
+        t = s - self.s0[i]
+        h = self.h0[i] + self.k[i] * t
+        along = t * self.straight[i]
+        radial = self.inv_k[i] - d
+        x = self.cx[i] + along * self.cos_h0[i] + radial * np.sin(h)
+        y = self.cy[i] + along * self.sin_h0[i] - radial * np.cos(h)
+        return np.stack([x, y], axis=-1)
+
+    def project(self, xy: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """(s, d) of points xy, shape (N, 2): station and offset from the reference line.
+
+        Every piece projects each point in closed form (straights: dot / cross product;
+        arcs: the angle around the centre, wrapped about the arc's middle); the station is
+        clipped to the piece, and the piece nearest to the point wins.
+        """
+        px = xy[:, 0:1]  # (N, 1) against pieces (1, P + 2)
+        py = xy[:, 1:2]
+        dx = px - self.x0
+        dy = py - self.y0
+        t_line = dx * self.cos_h0 + dy * self.sin_h0
+        d_line = dy * self.cos_h0 - dx * self.sin_h0
+        vx = px - self.cx
+        vy = py - self.cy
+        dh = np.mod(np.arctan2(vy, vx) + self.angle_shift, TWO_PI) - np.pi
+        t_arc = self.half_len + dh * self.inv_k
+        d_arc = self.inv_k - self.sign_k * np.hypot(vx, vy)
+        t = np.where(self.is_arc, t_arc, t_line)
+        d = np.where(self.is_arc, d_arc, d_line)
+        t_clip = np.clip(t, self.t_lo, self.t_hi)
+        # beyond a piece's end: the distance along at the point's own radius
+        excess = (t - t_clip) * np.abs(1.0 - self.k * d)
+        best = np.argmin(excess * excess + d * d, axis=1)
+        rows = np.arange(xy.shape[0])
+        s = self.s0[best] + t_clip[rows, best]
+        return s, d[rows, best]
+
+
+def _piece_end(piece: Piece) -> tuple[FloatArray, float]:
+    """([m] end point (2,), [rad] end heading) of a piece."""
+    k, t, h0 = piece.curvature, piece.length, piece.heading0
+    theta = k * t
+    along = t * float(np.sinc(theta / np.pi))
+    side = 0.5 * theta * t * float(np.sinc(theta / (2.0 * np.pi))) ** 2
+    x = piece.x0 + np.cos(h0) * along - np.sin(h0) * side
+    y = piece.y0 + np.sin(h0) * along + np.cos(h0) * side
+    return np.array([x, y]), float(h0 + theta)
+
+
+def _as_float(a: ArrayLike) -> FloatArray:
+    return np.asarray(a, dtype=np.float64)
+
+
+class Lane:
+    """One lane: the reference line shifted by the lane's offset. Vectorised over arrays."""
+
+    index: int  # ego-direction lanes 0.. (0 rightmost); oncoming lanes -1, -2, ... (-1 next
+    #             to the centre line)
+    direction: int  # +1 travels with increasing s, -1 against
+
+    def __init__(
+        self,
+        index: int,
+        line: ReferenceLine,
+        offsets: FloatArray,
+        exists: NDArray[np.bool_],
+        widths: FloatArray,
+    ) -> None:
+        """`offsets`, `exists`, `widths`: per segment, shape (P,) ([m], -, [m])."""
+        self.index = index
+        self.direction = 1 if index >= 0 else -1
+        self._line = line
+        self._offsets = offsets
+        self._exists = exists
+        self._widths = widths
+
+    def __repr__(self) -> str:
+        return f"Lane(index={self.index}, direction={self.direction})"
+
+    def offset_at(self, s: ArrayLike) -> FloatArray:
+        """[m] lateral offset of this lane's centre from the reference line at stations s."""
+        return self._offsets[self._line.segment_index(_as_float(s))]
+
+    def exists_at(self, s: ArrayLike) -> NDArray[np.bool_]:
+        """Whether the lane exists at stations s (a segment may drop lanes)."""
+        return self._exists[self._line.segment_index(_as_float(s))]
+
+    def position(self, s: ArrayLike, r: ArrayLike) -> FloatArray:
+        """[m] map-frame point(s) at station s, lateral r from this lane's centre.
+
+        Scalars give shape (2,); arrays (broadcast together) give shape (N, 2).
+        """
+        s_arr, r_arr = np.broadcast_arrays(_as_float(s), _as_float(r))
+        return self._line.point(s_arr, self.offset_at(s_arr) + r_arr)
+
+    def local_coordinates(self, xy: ArrayLike) -> tuple[FloatArray, FloatArray]:
+        """(s, r) of map-frame point(s) xy, shape (2,) or (N, 2): station and offset from
+        this lane's centre (left +). Exact for arcs (closed-form projection per piece, the
+        nearest piece wins). Points beyond the route's ends project onto its extension."""
+        pts = _as_float(xy)
+        s, d = self._line.project(pts.reshape(-1, 2))
+        r = d - self.offset_at(s)
+        shape = pts.shape[:-1]
+        return s.reshape(shape), r.reshape(shape)
+
+    def heading_at(self, s: ArrayLike) -> FloatArray:
+        """[rad] the route tangent at s (not flipped for oncoming lanes). Continuous along
+        the route, not wrapped to (-pi, pi]: wrap differences before comparing."""
+        return self._line.heading(_as_float(s))
+
+    def width_at(self, s: ArrayLike) -> FloatArray:
+        """[m] lane width at s."""
+        return self._widths[self._line.segment_index(_as_float(s))]
+
+    def curvature_at(self, s: ArrayLike) -> FloatArray:
+        """[1/m] signed curvature of this lane's centre line at s: k / (1 - k * offset)."""
+        s_arr = _as_float(s)
+        k = self._line.curvature(s_arr)
+        return k / (1.0 - k * self.offset_at(s_arr))
+
+
+class RoadMap:
+    """The HD map of one `road` scenario."""
+
+    pieces: tuple[Piece, ...]
+    length: float  # [m] route length (end station)
+    lanes: tuple[Lane, ...]  # ego-direction lanes by index, as many as the widest segment
+    oncoming: tuple[Lane, ...]  # oncoming lanes, [0] next to the centre line
+    features: tuple[Feature, ...]  # sorted by station
+    speed_limits: tuple[SpeedLimitPosting, ...]  # sorted by station, first at s = 0
+    sections: tuple[CrossSection, ...]  # per segment (= piece)
+
+    def __init__(
+        self,
+        pieces: tuple[Piece, ...],
+        sections: tuple[CrossSection, ...],
+        features: tuple[Feature, ...],
+        speed_limits: tuple[SpeedLimitPosting, ...],
+    ) -> None:
+        """Use `from_spec`; this takes the already laid pieces, one section per piece."""
+        self.pieces = pieces
+        self.sections = sections
+        self.features = features
+        self.speed_limits = speed_limits
+        self.line = ReferenceLine(pieces)
+        self.length = self.line.length
+        w = np.array([c.lane_width for c in sections])
+        n_ego = np.array([c.lanes for c in sections])
+        n_onc = np.array([c.oncoming_lanes for c in sections])
+        self._right: FloatArray = np.array([c.right_edge for c in sections])
+        self._left: FloatArray = np.array([c.left_edge for c in sections])
+        self.lanes = tuple(Lane(i, self.line, i * w, n_ego > i, w) for i in range(int(n_ego.max())))
+        self.oncoming = tuple(
+            Lane(-j, self.line, (n_ego + j - 1) * w, n_onc >= j, w)
+            for j in range(1, int(n_onc.max()) + 1)
+        )
+        self._limit_s: FloatArray = np.array([p.s for p in speed_limits])
+        self._limit_v: FloatArray = np.array([p.limit for p in speed_limits])
+
+    @classmethod
+    def from_spec(cls, spec: RoadSpec) -> RoadMap:
+        if not spec.segments:
+            raise MapError("road: no segments")
+        pieces: list[Piece] = []
+        sections: list[CrossSection] = []
+        s, xy, heading = 0.0, np.zeros(2), 0.0
+        zone = Zone.HIGHWAY
+        for i, seg in enumerate(spec.segments):
+            zone = seg.zone if seg.zone is not None else zone
+            section = CrossSection(
+                seg.lanes, seg.oncoming_lanes, seg.lane_width, seg.shoulder, zone
+            )
+            _check_segment(i, seg.length, seg.curvature, section)
+            piece = Piece(
+                s, float(seg.length), float(seg.curvature), float(xy[0]), float(xy[1]), heading
+            )
+            pieces.append(piece)
+            sections.append(section)
+            xy, heading = _piece_end(piece)
+            s += float(seg.length)
+        return cls(
+            tuple(pieces),
+            tuple(sections),
+            tuple(sorted(spec.features, key=lambda f: f.s)),
+            _speed_limit_postings(spec, [p.s0 for p in pieces]),
+        )
+
+    def lane(self, index: int) -> Lane:
+        """Ego-direction lane `index` >= 0, or oncoming lane for index < 0 (-1 is nearest)."""
+        if 0 <= index < len(self.lanes):
+            return self.lanes[index]
+        if -len(self.oncoming) <= index < 0:
+            return self.oncoming[-index - 1]
+        raise IndexError(f"no lane {index} on this road")
+
+    def cross_section_at(self, s: float) -> CrossSection:
+        return self.sections[int(self.line.segment_index(_as_float(s)))]
+
+    def lanes_at(self, s: float) -> int:
+        """Number of ego-direction lanes at station s."""
+        return self.cross_section_at(s).lanes
+
+    def curvature_at(self, s: ArrayLike) -> FloatArray:
+        """[1/m] signed curvature of the reference line at s."""
+        return self.line.curvature(_as_float(s))
+
+    def heading_at(self, s: ArrayLike) -> FloatArray:
+        """[rad] the route tangent at s, continuous (not wrapped)."""
+        return self.line.heading(_as_float(s))
+
+    def position(self, s: ArrayLike, d: ArrayLike) -> FloatArray:
+        """[m] map-frame point(s) at station s, offset d from the reference line (left +);
+        shapes as `Lane.position`."""
+        s_arr, d_arr = np.broadcast_arrays(_as_float(s), _as_float(d))
+        return self.line.point(s_arr, d_arr)
+
+    def local_coordinates(self, xy: ArrayLike) -> tuple[FloatArray, FloatArray]:
+        """(s, d) of point(s) xy, shape (2,) or (N, 2): station and offset from the
+        reference line (lane 0's centre), left +."""
+        pts = _as_float(xy)
+        s, d = self.line.project(pts.reshape(-1, 2))
+        shape = pts.shape[:-1]
+        return s.reshape(shape), d.reshape(shape)
+
+    def paved_edges(self, s: ArrayLike) -> tuple[FloatArray, FloatArray]:
+        """([m] right, [m] left) offsets of the paved edges from the reference line at s:
+        right is the shoulder's outer edge -(w / 2 + shoulder), left the outermost lane's
+        left edge (oncoming lanes included)."""
+        seg = self.line.segment_index(_as_float(s))
+        return self._right[seg], self._left[seg]
+
+    def speed_limit_at(self, s: ArrayLike) -> FloatArray:
+        """[m/s] the posted limit in force at station s (the last posting at or before s)."""
+        i = np.searchsorted(self._limit_s, _as_float(s), side="right") - 1
+        return self._limit_v[np.maximum(i, 0)]
+
+    def lane_at(self, xy: ArrayLike) -> tuple[int | None, float, float]:
+        """(lane index or None if off every lane, s, r from that lane's centre) of a point.
+
+        Lanes are half-open bands [right boundary, left boundary) across; a point before
+        the route's start or after its end is off every lane. With None, r is the offset
+        from the reference line (lane 0's centre).
+        """
+        s_arr, d_arr = self.local_coordinates(_as_float(xy).reshape(2))
+        s, d = float(s_arr), float(d_arr)
+        c = self.cross_section_at(s)
+        w = c.lane_width
+        if not 0.0 <= s <= self.length:
+            return None, s, d
+        band = int(np.floor((d + 0.5 * w) / w))  # 0 .. lanes - 1 ego, then oncoming
+        if 0 <= band < c.lanes:
+            return band, s, d - band * w
+        if c.lanes <= band < c.lanes + c.oncoming_lanes:
+            return c.lanes - 1 - band, s, d - band * w
+        return None, s, d
+
+
+def _check_segment(i: int, length: float, curvature: float, c: CrossSection) -> None:
+    """Raise MapError if the segment is empty, its arc turns more than a full circle, or
+    the arc is tighter than the road's inner half (the inner paved edge would cross the
+    arc's centre)."""
+    if not length > 0.0:
+        raise MapError(f"road.segments[{i}]: length {length} m must be > 0")
+    if curvature == 0.0:
+        return
+    if abs(curvature) * length > TWO_PI + 1e-9:
+        raise MapError(
+            f"road.segments[{i}]: an arc may turn at most 360 degrees (it would lie on itself)"
+        )
+    radius = 1.0 / abs(curvature)
+    inner = c.left_edge if curvature > 0.0 else -c.right_edge
+    if not radius > inner:
+        side = "left" if curvature > 0.0 else "right"
+        raise MapError(
+            f"road.segments[{i}]: arc radius {radius:g} m is not larger than the road's "
+            f"{side} (inner) edge offset {inner:g} m"
+        )
+
+
+def _speed_limit_postings(
+    spec: RoadSpec, segment_starts: list[float]
+) -> tuple[SpeedLimitPosting, ...]:
+    """Postings sorted by station: the road's limit at 0, each segment's at its start,
+    each speed-limit sign. Of several postings at one station the last listed wins."""
+    postings = [SpeedLimitPosting(0.0, spec.speed_limit)]
+    postings += [
+        SpeedLimitPosting(s0, seg.speed_limit)
+        for s0, seg in zip(segment_starts, spec.segments, strict=True)
+        if seg.speed_limit is not None
+    ]
+    postings += [
+        SpeedLimitPosting(f.s, f.limit) for f in spec.features if isinstance(f, SpeedLimitSign)
+    ]
+    by_station = {p.s: p for p in sorted(postings, key=lambda p: p.s)}  # later ones win
+    return tuple(by_station.values())

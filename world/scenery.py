@@ -1,0 +1,268 @@
+"""Roadside scenery as pure layout data: building boxes and speed-limit signs (no PyBullet).
+
+The world builder turns `BuildingBox` into box bodies and `SignPlacement` into a pole with a
+textured plate (`speed_limit_sign_image`). Every placement is checked against the HD map,
+so it holds on arcs and where the cross-section changes too.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+from numpy.typing import NDArray
+
+from world.hdmap import RoadMap
+from world.spec import BuildingsSpec
+
+FloatArray = NDArray[np.float64]
+
+MPS_TO_KPH = 3.6  # [km/h per m/s]
+
+# -- buildings ----------------------------------------------------------------------------
+FRONTAGE_RANGE = (10.0, 30.0)  # [m] along the road
+DEPTH_RANGE = (8.0, 20.0)  # [m] away from the road
+HEIGHT_RANGE = (6.0, 30.0)  # [m]
+MIN_BUILDING_GAP = 1.0  # [m] least gap drawn between neighbours along one side
+GAP_JITTER = (0.5, 1.5)  # [-] factor on the mean gap, so the rhythm is not regular
+FOOTPRINT_STEP = 0.5  # [m] spacing of the footprint outline samples checked against the road
+SHIFT_ITERATIONS = 4  # attempts to move a building out of the setback on an inner curve
+SHIFT_MARGIN = 0.01  # [m] extra shift beyond the measured intrusion
+FACADE_RGB = (
+    (0.62, 0.60, 0.56),  # concrete
+    (0.72, 0.66, 0.55),  # sandstone
+    (0.55, 0.35, 0.28),  # brick
+    (0.45, 0.50, 0.56),  # blue-grey glass
+    (0.80, 0.78, 0.72),  # plaster
+)
+FACADE_JITTER = 0.05  # [-] 1-sigma per-channel colour variation
+
+# -- speed-limit signs --------------------------------------------------------------------
+SIGN_CLEARANCE = 0.5  # [m] from the right paved edge to the pole
+SIGN_PLATE_HEIGHT = 2.0  # [m] plate centre above the ground
+SIGN_PLATE_DIAMETER = 0.75  # [m]
+SIGN_RING_FRACTION = 0.12  # [-] red ring width / plate diameter (Vienna convention ~1/8)
+SIGN_TEXT_WIDTH = 0.70  # [-] of the white disc's diameter, for the widest (3-digit) number
+SIGN_TEXT_HEIGHT = 0.48  # [-] of the white disc's diameter
+SIGN_SUPERSAMPLE = 4  # drawn this much larger, then area-averaged down (anti-aliasing)
+RED_RGB = (200, 16, 30)  # [0..255]
+BLACK_RGB = (10, 10, 10)  # [0..255]
+WHITE_RGB = (250, 250, 250)  # [0..255]
+
+
+@dataclass(frozen=True, slots=True)
+class BuildingBox:
+    """A box-shaped building standing on the ground."""
+
+    centre: tuple[float, float, float]  # [m] map frame; z = half the height
+    half_extents: tuple[float, float, float]  # [m] along the road, across, up (box frame)
+    yaw: float  # [rad] of the box's x axis (along the road), ccw from map +x, (-pi, pi]
+    rgb: tuple[float, float, float]  # [-] 0..1
+
+    def footprint(self) -> FloatArray:
+        """(4, 2) [m] map-frame ground corners, counter-clockwise."""
+        hx, hy = self.half_extents[0], self.half_extents[1]
+        local: FloatArray = np.array([[hx, hy], [-hx, hy], [-hx, -hy], [hx, -hy]])
+        centre: FloatArray = np.array(self.centre[:2])
+        return local @ _rotation(self.yaw).T + centre
+
+
+@dataclass(frozen=True, slots=True)
+class SignPlacement:
+    """A speed-limit sign on the right of the route, its plate facing ego traffic."""
+
+    s: float  # [m] station of the posting
+    kph: int  # the number on the plate [km/h]
+    limit: float  # [m/s]
+    pole_xy: tuple[float, float]  # [m] map frame, foot of the pole
+    yaw: float  # [rad] direction the plate's front (its normal) faces: route heading + pi
+    plate_height: float = SIGN_PLATE_HEIGHT  # [m] plate centre above the ground
+    plate_diameter: float = SIGN_PLATE_DIAMETER  # [m]
+
+
+def _rotation(yaw: float) -> FloatArray:
+    c, s = math.cos(yaw), math.sin(yaw)
+    return np.array([[c, -s], [s, c]])
+
+
+def _wrap(angle: float) -> float:
+    """[rad] angle wrapped to (-pi, pi]."""
+    return math.pi - (math.pi - angle) % (2.0 * math.pi)
+
+
+# -- buildings ----------------------------------------------------------------------------
+
+
+def _outline(box: BuildingBox) -> FloatArray:
+    """(K, 2) [m] points along the footprint's outline, corners included."""
+    corners = box.footprint()
+    points = []
+    for a, b in zip(corners, np.roll(corners, -1, axis=0), strict=True):
+        n = max(1, math.ceil(float(np.linalg.norm(b - a)) / FOOTPRINT_STEP))
+        t = np.arange(n)[:, None] / n
+        points.append(a + t * (b - a))
+    return np.concatenate(points)
+
+
+def road_intrusion(road_map: RoadMap, points: FloatArray, setback: float, side: int) -> float:
+    """[m] how far points (K, 2) reach into the paved area widened by `setback`, measured
+    from its edge on `side` (+1 left, -1 right of the route); 0 when all are clear of it.
+
+    A point is clear when its offset from the reference line (at its own station, on the
+    piece nearest to it) is right of the right paved edge less the setback or left of the
+    left paved edge plus the setback.
+    """
+    s, d = road_map.local_coordinates(points)
+    right, left = road_map.paved_edges(s)
+    clear = (d <= right - setback) | (d >= left + setback)
+    if bool(np.all(clear)):
+        return 0.0
+    reach = (left + setback - d) if side > 0 else (d - (right - setback))
+    return float(np.max(reach[~clear]))
+
+
+def _overlaps(box: BuildingBox, others: list[BuildingBox]) -> bool:
+    """Whether the box's footprint overlaps any other's (separating-axis test)."""
+    a = box.footprint()
+    for other in others:
+        gap = math.dist(box.centre[:2], other.centre[:2])
+        if gap >= math.hypot(*box.half_extents[:2]) + math.hypot(*other.half_extents[:2]):
+            continue
+        b = other.footprint()
+        axes = np.concatenate([a[1:3] - a[0:2], b[1:3] - b[0:2]])
+        proj_a, proj_b = a @ axes.T, b @ axes.T  # (4, 4): corner x axis
+        separated = (proj_a.max(0) <= proj_b.min(0)) | (proj_b.max(0) <= proj_a.min(0))
+        if not bool(np.any(separated)):
+            return True
+    return False
+
+
+def _place(
+    road_map: RoadMap,
+    side: int,
+    s_mid: float,
+    size: tuple[float, float, float],
+    setback: float,
+    rgb: tuple[float, float, float],
+) -> BuildingBox | None:
+    """A box with its front `setback` beyond the paved edge on `side` (+1 left, -1 right)
+    at station s_mid, moved further out while its outline intrudes (inner side of an arc,
+    a wider segment next door); None if it cannot be cleared."""
+    frontage, depth, height = size
+    stations = np.linspace(s_mid - 0.5 * frontage, s_mid + 0.5 * frontage, 9)
+    right, left = road_map.paved_edges(stations)
+    edge = float(np.max(left)) if side > 0 else float(np.min(right))
+    offset = edge + side * (setback + 0.5 * depth)
+    heading = float(road_map.heading_at(s_mid))
+    for _ in range(SHIFT_ITERATIONS):
+        x, y = road_map.position(s_mid, offset)
+        box = BuildingBox(
+            (float(x), float(y), 0.5 * height),
+            (0.5 * frontage, 0.5 * depth, 0.5 * height),
+            _wrap(heading),
+            rgb,
+        )
+        intrusion = road_intrusion(road_map, _outline(box), setback, side)
+        if intrusion == 0.0:
+            return box
+        offset += side * (intrusion + SHIFT_MARGIN)
+    return None
+
+
+def _facade(rng: np.random.Generator) -> tuple[float, float, float]:
+    base = np.asarray(FACADE_RGB[int(rng.integers(len(FACADE_RGB)))])
+    r, g, b = np.clip(base + rng.normal(0.0, FACADE_JITTER, 3), 0.0, 1.0)
+    return float(r), float(g), float(b)
+
+
+def layout_buildings(
+    road_map: RoadMap, spec: BuildingsSpec, rng: np.random.Generator
+) -> list[BuildingBox]:
+    """Boxes along both sides of the route (right side first, then left), deterministic
+    for the rng's state.
+
+    Walking each side from s = 0 to the route's end: draw a frontage, depth, height and
+    facade colour, then a gap so that built frontage / (frontage + gap) averages
+    `spec.density`. The box stands `spec.setback` beyond the paved edge (right: the
+    shoulder's outer edge; left: the outermost lane's edge), square to the route at its
+    middle station. It is moved out if its outline intrudes into the paved area plus
+    setback (inner curves), and dropped if it still does or overlaps a placed building.
+    """
+    if spec.density <= 0.0:
+        return []
+    gap_factor = (1.0 - min(spec.density, 1.0)) / min(spec.density, 1.0)
+    boxes: list[BuildingBox] = []
+    for side in (-1, 1):
+        s = float(rng.uniform(0.0, FRONTAGE_RANGE[0]))
+        while s < road_map.length:
+            size = (
+                float(rng.uniform(*FRONTAGE_RANGE)),
+                float(rng.uniform(*DEPTH_RANGE)),
+                float(rng.uniform(*HEIGHT_RANGE)),
+            )
+            rgb = _facade(rng)
+            gap = max(MIN_BUILDING_GAP, size[0] * gap_factor * float(rng.uniform(*GAP_JITTER)))
+            s_mid = s + 0.5 * size[0]
+            if s_mid <= road_map.length:
+                box = _place(road_map, side, s_mid, size, spec.setback, rgb)
+                if box is not None and not _overlaps(box, boxes):
+                    boxes.append(box)
+            s += size[0] + gap
+    return boxes
+
+
+# -- speed-limit signs --------------------------------------------------------------------
+
+
+def layout_speed_limit_signs(road_map: RoadMap) -> list[SignPlacement]:
+    """A sign for every speed-limit posting (s = 0 included), in station order: the pole
+    SIGN_CLEARANCE beyond the right paved edge at the posting's station, the plate's front
+    facing the approaching ego traffic (yaw = route heading + pi)."""
+    signs = []
+    for posting in road_map.speed_limits:
+        right, _ = road_map.paved_edges(posting.s)
+        x, y = road_map.position(posting.s, float(right) - SIGN_CLEARANCE)
+        heading = float(road_map.heading_at(posting.s))
+        signs.append(
+            SignPlacement(
+                s=posting.s,
+                kph=round(posting.limit * MPS_TO_KPH),
+                limit=posting.limit,
+                pole_xy=(float(x), float(y)),
+                yaw=_wrap(heading + math.pi),
+            )
+        )
+    return signs
+
+
+def speed_limit_sign_image(kph: int, size: int = 128) -> NDArray[np.uint8]:
+    """(size, size, 4) uint8 RGBA picture of a European speed-limit plate: a white disc
+    with a red ring and the black number, transparent outside the disc. Drawn with OpenCV
+    SIGN_SUPERSAMPLE times larger, then area-averaged down for smooth edges."""
+    big = size * SIGN_SUPERSAMPLE
+    centre = (big // 2, big // 2)
+    radius = big // 2 - SIGN_SUPERSAMPLE  # keep a texel of transparent margin
+    inner = round(radius * (1.0 - 2.0 * SIGN_RING_FRACTION))
+    rgb = np.full((big, big, 3), WHITE_RGB, dtype=np.uint8)
+    alpha = np.zeros((big, big), dtype=np.uint8)
+    cv2.circle(alpha, centre, radius, 255, thickness=-1, lineType=cv2.LINE_AA)
+    cv2.circle(rgb, centre, radius, RED_RGB, thickness=-1, lineType=cv2.LINE_AA)
+    cv2.circle(rgb, centre, inner, WHITE_RGB, thickness=-1, lineType=cv2.LINE_AA)
+    _draw_number(rgb, str(kph), centre, 2 * inner)
+    rgba = np.dstack([rgb, alpha])
+    small = cv2.resize(rgba, (size, size), interpolation=cv2.INTER_AREA)
+    return np.asarray(small, dtype=np.uint8)
+
+
+def _draw_number(rgb: NDArray[np.uint8], text: str, centre: tuple[int, int], disc: int) -> None:
+    """Black `text` centred on `centre`, scaled to fit SIGN_TEXT_WIDTH / HEIGHT of a disc
+    `disc` pixels across (the width budget is that of three digits)."""
+    font = cv2.FONT_HERSHEY_DUPLEX
+    (w3, h), _ = cv2.getTextSize("888", font, 1.0, 1)
+    scale = min(SIGN_TEXT_WIDTH * disc / w3, SIGN_TEXT_HEIGHT * disc / h)
+    thickness = max(1, round(scale * 2.2))
+    (w, h), _ = cv2.getTextSize(text, font, scale, thickness)
+    origin = (centre[0] - w // 2, centre[1] + h // 2)
+    cv2.putText(rgb, text, origin, font, scale, BLACK_RGB, thickness, cv2.LINE_AA)
