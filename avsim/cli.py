@@ -35,11 +35,14 @@ def _bad_input(message: str) -> NoReturn:
 
 
 def _writable(path: Path, what: str) -> None:
-    parent = path.parent if str(path.parent) else Path()
-    if parent.exists() and not parent.is_dir():
-        _bad_input(f"{path}: {what}: {parent} is not a directory")
+    """Bad input unless `path` can be created: its nearest existing ancestor is a directory."""
     if path.is_dir():
         _bad_input(f"{path}: {what}: is a directory")
+    for ancestor in path.absolute().parents:
+        if ancestor.exists():
+            if not ancestor.is_dir():
+                _bad_input(f"{path}: {what}: {ancestor} is not a directory")
+            return
 
 
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})

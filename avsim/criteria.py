@@ -32,6 +32,8 @@ class TruthSample:
     station: float  # [m] ego centre station on the route
     front_station: float  # [m] front bumper station
     tyres: NDArray[np.float64]  # [m] (4, 2) tyre patch centres, map frame
+    tyre_stations: NDArray[np.float64]  # [m] (4,) their stations
+    tyre_offsets: NDArray[np.float64]  # [m] (4,) their offsets from the reference line, left +
     touching: frozenset[int]  # body ids in contact with the ego (ground excluded)
 
 
@@ -115,7 +117,8 @@ class TyresInLane(Criterion):
         self.margin = math.inf
 
     def update(self, sample: TruthSample) -> None:
-        s, r = self.lane.local_coordinates(sample.tyres)
+        s = sample.tyre_stations
+        r = sample.tyre_offsets - self.lane.offset_at(s)
         half = np.asarray(self.lane.width_at(s)) / 2 - LINE_HALF_WIDTH
         margin = float(np.min(half - np.abs(r) - self.tyre_half_width))
         self.margin = min(self.margin, margin)

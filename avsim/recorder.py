@@ -7,9 +7,12 @@ are *buffered* in numpy arrays and sent as columns (`RecordingStream.send_column
 the ego's body, series styles) are logged once. Events are rare and logged directly.
 
 All temporal data sits on one duration timeline, `sim_time` [s] (converted to integer
-nanoseconds by rounding, exactly like `RecordingStream.set_time(duration=...)`). Log time is
-disabled, so two runs with the same inputs and recording id give recordings that
-`rerun rrd compare` finds equal.
+nanoseconds by rounding, exactly like `RecordingStream.set_time(duration=...)`).
+
+Reproducible files: log time is disabled, and the SDK's chunk batcher never flushes on its
+own (`ChunkBatcherConfig.NEVER`); the recorder flushes it at the same sim-time points as the
+columns. So chunk boundaries depend on sim time only, never on wall-clock speed, and two runs
+with the same inputs and recording id give recordings that `rerun rrd compare` finds equal.
 
 Entity paths (constants in `avsim.blueprint`), map frame z up, SI units:
 

@@ -2,7 +2,7 @@
 
 Rates (all divide the 240 Hz physics rate; checked by `Rate`):
 - GNSS 10 Hz, odometry and the stack (decide-then-apply) 40 Hz;
-- criteria sample ground truth at 60 Hz, collisions (contact onsets) every physics step;
+- criteria sample ground truth at 60 Hz, collisions (contact onsets) at 120 Hz;
 - the recording logs the ego pose, scalars and the plan at 20 Hz, NPC boxes at 10 Hz.
 
 Each control tick decides on one snapshot (the sensor frames of this tick), then the
@@ -40,6 +40,7 @@ from world.world import World
 GNSS_RATE = Rate("gnss", 10)
 CONTROL_RATE = Rate("control", 40)
 CRITERIA_RATE = Rate("criteria", 60)
+CONTACT_RATE = Rate("contacts", 120)
 RECORD_RATE = Rate("record", 20)
 ACTOR_RECORD_RATE = Rate("record_actors", 10)
 END_MARGIN = 30.0  # [m] default `completes` station: the route's end less this
@@ -160,8 +161,8 @@ class Runner:
         w, log = self.world, self.log
         truth = w.ego_truth
         lane = w.road.lane(self.spec.ego.lane)
-        s, r = lane.local_coordinates(truth.position[:2])
-        _, r_fa = lane.local_coordinates(front_axle_point(truth, self.car))
+        points = np.vstack([truth.position[:2], front_axle_point(truth, self.car)])
+        (s, _), (r, r_fa) = lane.local_coordinates(points)
         log.t.append(w.t)
         log.x.append(float(truth.position[0]))
         log.y.append(float(truth.position[1]))
@@ -180,6 +181,8 @@ class Runner:
     def _watch(self, step: int) -> None:
         """Criteria: contact onsets every step, the rest at the criteria rate."""
         w = self.world
+        if not CONTACT_RATE.fires(step):
+            return
         now = frozenset(touching(w.client, w.ego.body, w.scene.ground))
         if now != self._touching:
             self._touching = now
@@ -196,11 +199,12 @@ class Runner:
     def _sample(self) -> None:
         w = self.world
         truth = w.ego_truth
-        s, _ = w.road.lane(0).local_coordinates(truth.position[:2])
+        tyres = tyre_patches(truth, self.car)
+        s, r = w.road.lane(0).local_coordinates(np.vstack([truth.position[:2], tyres]))
         self.criteria.update(TruthSample(
-            t=w.t, speed=truth.speed, station=float(s),
-            front_station=float(s) + self.car.front_overhang,
-            tyres=tyre_patches(truth, self.car), touching=self._touching,
+            t=w.t, speed=truth.speed, station=float(s[0]),
+            front_station=float(s[0]) + self.car.front_overhang,
+            tyres=tyres, tyre_stations=s[1:], tyre_offsets=r[1:], touching=self._touching,
         ))
 
     # -- results -------------------------------------------------------------------------------

@@ -80,6 +80,9 @@ class ActorSet:
         ).reshape(-1, 3)
         self._last_speed = np.array([a.speed for a in specs])
         self.accels = np.zeros(len(specs))  # [m/s^2]
+        self._ids = tuple(a.id for a in specs)
+        self._kinds = tuple(a.type for a in specs)
+        self._flip = np.array([math.pi if m.direction < 0 else 0.0 for m in self.motions])
         self.poses = self._compute_poses()
         self._place(force=True)
 
@@ -129,15 +132,13 @@ class ActorSet:
         m = self.motions
         s = np.array([x.s for x in m])
         offsets = np.array([x.offset for x in m])
-        lane0 = self._road.lane(0)
-        xy = lane0.position(s, offsets).reshape(-1, 2)
-        heading = np.asarray(lane0.heading_at(s)).reshape(-1)
-        flip = np.array([math.pi if x.direction < 0 else 0.0 for x in m])
-        yaws = heading + flip + np.array([x.heading_offset for x in m])
+        line = self._road.line  # the reference line: offsets are from it
+        xy = line.point(s, offsets).reshape(-1, 2)
+        yaws = line.heading(s) + self._flip + np.array([x.heading_offset for x in m])
         centres = np.column_stack([xy, self.half_sizes[:, 2]]) if m else np.zeros((0, 3))
         return ActorPoses(
-            ids=tuple(a.id for a in self.specs),
-            kinds=tuple(a.type for a in self.specs),
+            ids=self._ids,
+            kinds=self._kinds,
             centres=centres,
             yaws=yaws,
             half_sizes=self.half_sizes,
@@ -149,8 +150,9 @@ class ActorSet:
 
     def _place(self, force: bool) -> None:
         p = self.poses
+        half = p.yaws / 2
         for i, body in enumerate(self.bodies):
             moving = self.motions[i].speed != 0.0 or self.motions[i].lateral_speed != 0.0
             if force or moving:
-                quat = self._c.getQuaternionFromEuler([0.0, 0.0, float(p.yaws[i])])
+                quat = (0.0, 0.0, math.sin(half[i]), math.cos(half[i]))
                 self._c.resetBasePositionAndOrientation(body, p.centres[i].tolist(), quat)

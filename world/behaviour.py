@@ -143,14 +143,16 @@ class NpcMotion:
             self.ended_at[self._lateral_action] = t
             self._lateral_action = None
             return
-        # trapezoidal profile: the fastest lateral speed from which a ramp-down at
-        # LATERAL_ACCEL still stops on the target, capped at the action's lateral speed
-        allowed = min(self._lateral_max, math.sqrt(2.0 * LATERAL_ACCEL * abs(remaining)))
-        wanted = math.copysign(allowed, remaining)
-        step = LATERAL_ACCEL * dt
-        self.lateral_speed += max(-step, min(step, wanted - self.lateral_speed))
-        if abs(self.lateral_speed) * dt > abs(remaining):  # land on the target, no overshoot
+        # trapezoidal profile in discrete time: the fastest lateral speed k * a dt from which
+        # slowing by a dt per step (k + (k-1) + ... + 1 steps of a dt^2) still stops on the
+        # target, capped at the action's lateral speed
+        step = LATERAL_ACCEL * dt  # [m/s] speed change per step
+        k = math.floor((math.sqrt(1.0 + 8.0 * abs(remaining) / (step * dt)) - 1.0) / 2.0)
+        if k == 0:  # closer than one step at the slowest speed: land on the target
             self.lateral_speed = remaining / dt
+            return
+        wanted = math.copysign(min(self._lateral_max, k * step), remaining)
+        self.lateral_speed += max(-step, min(step, wanted - self.lateral_speed))
 
     @property
     def heading_offset(self) -> float:

@@ -4,14 +4,17 @@ The car drives through its joints only: the steering hinges get position targets
 split of a bicycle angle), the wheel joints get drive torque and a brake. Nothing here sets
 the body's pose or velocity after spawn.
 
-Actuator model (per wheel, every physics step):
-- drive: `TORQUE_CONTROL` with a quarter of the total drive torque (all-wheel drive, so the
-  5 m/s^2 the ICCAS car is allowed stays well inside the tyres' grip);
-- brake and rolling resistance: a velocity motor with target 0 whose force limit is the brake
-  torque plus the rolling-resistance torque. A velocity motor with a force limit is a Coulomb
-  friction torque: it opposes the wheel's spin up to the limit and holds the car at rest;
-- aerodynamic drag `0.5 rho CdA v^2` as an external force at the centre of mass;
-- a top-speed governor: no drive torque above the vehicle's maximum speed.
+Actuator model (per wheel): one joint velocity motor, set when the command changes (at the
+control rate) and held by Bullet between commands, so the ego costs no Python per step:
+- driving (drive torque above the resistances): target spin +MAX_WHEEL_SPIN with the net
+  torque as the motor's force limit, i.e. a constant forward torque (all-wheel drive, a
+  quarter each, so the 5 m/s^2 the ICCAS car is allowed stays well inside the tyres' grip);
+- otherwise: target spin 0 with brake + rolling resistance + aerodynamic drag (less any
+  drive torque) as the force limit. A velocity motor with a force limit is a Coulomb
+  friction torque: it opposes the wheel's spin up to the limit and holds the car at rest.
+  Drag `0.5 rho CdA v^2` is taken at the speed of the command and acts through the wheels
+  (for a rolling car the longitudinal effect is the same as at the body);
+- a top-speed governor: no drive torque at or above the vehicle's maximum speed.
 Bullet's default link damping (0.04, applied as m v (k + k |v|), about 4 kN at 8 m/s) is
 switched off: drag and rolling resistance are modelled explicitly instead.
 """
@@ -105,7 +108,7 @@ class EgoBody:
             client.changeDynamics(self.body, j, maxJointVelocity=MAX_WHEEL_SPIN)
         self._com_offset = np.array(client.getDynamicsInfo(self.body, -1)[3])
         self.mass = g.mass
-        self._roll_torque = params.rolling_resistance * g.mass * GRAVITY * g.wheel_radius / 4
+        self._roll_torque = params.rolling_resistance * g.mass * GRAVITY * g.wheel_radius
         self._max_drive = g.mass * params.max_accel * g.wheel_radius
         self.drive_torque = 0.0  # [N m] last applied, total
         self.brake_torque = 0.0  # [N m] last applied, total
@@ -126,7 +129,7 @@ class EgoBody:
     def apply(self, steering_angle: float, drive_torque: float, brake_torque: float) -> None:
         """Command the joints: bicycle steering angle [rad], total drive and brake torque [N m].
 
-        Held until the next call (the world applies it at every physics step).
+        Held by the joint motors until the next call.
         """
         g, c = self.geometry, self._c
         delta = float(np.clip(steering_angle, -g.max_steer, g.max_steer))
@@ -139,29 +142,17 @@ class EgoBody:
         self.steer_command = delta
         self.drive_torque = float(np.clip(drive_torque, 0.0, self._max_drive))
         self.brake_torque = max(0.0, float(brake_torque))
-
-    def pre_step(self) -> None:
-        """Forces for the coming physics step: drive, brake + rolling resistance, drag."""
-        c = self._c
-        com, quat = c.getBasePositionAndOrientation(self.body)
         velocity = c.getBaseVelocity(self.body)[0]
-        yaw = c.getEulerFromQuaternion(quat)[2]
-        forward_speed = velocity[0] * math.cos(yaw) + velocity[1] * math.sin(yaw)
-        drive = 0.0 if forward_speed >= self.params.max_speed else self.drive_torque
-        hold = self.brake_torque / 4 + self._roll_torque
+        speed = math.hypot(velocity[0], velocity[1])
+        if speed >= self.params.max_speed:
+            self.drive_torque = 0.0
+        drag = 0.5 * AIR_DENSITY * self.params.drag_area * speed**2 * g.wheel_radius
+        net = self.drive_torque - self.brake_torque - self._roll_torque - drag  # [N m]
+        spin = MAX_WHEEL_SPIN if net > 0.0 else 0.0
         c.setJointMotorControlArray(
             self.body, self.wheel_joints, pybullet.VELOCITY_CONTROL,
-            targetVelocities=[0.0] * 4, forces=[hold] * 4,
+            targetVelocities=[spin] * 4, forces=[abs(net) / 4] * 4,
         )
-        c.setJointMotorControlArray(
-            self.body, self.wheel_joints, pybullet.TORQUE_CONTROL, forces=[drive / 4] * 4
-        )
-        v2 = float(velocity[0] ** 2 + velocity[1] ** 2)
-        if v2 > 1e-6:
-            k = -0.5 * AIR_DENSITY * self.params.drag_area * math.sqrt(v2)
-            c.applyExternalForce(
-                self.body, -1, [k * velocity[0], k * velocity[1], 0.0], com, pybullet.WORLD_FRAME
-            )
 
     def truth(self) -> EgoTruth:
         """Read the body's true state (link frame origin, not Bullet's centre-of-mass frame)."""

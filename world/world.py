@@ -164,12 +164,11 @@ class World:
         return float(s)
 
     def step(self) -> None:
-        """One physics step: ego forces from the held command, Bullet, then the NPCs.
+        """One physics step (the ego's joint motors hold the last command), then the NPCs.
 
         NPC triggers are checked at `TRIGGER_RATE` against the ego's true station; NPC
         motion is integrated every step.
         """
-        self.ego.pre_step()
         self.client.stepSimulation()
         self.clock.advance()
         self._truth = None

@@ -29,6 +29,7 @@ EVENT_EVERY = 40  # ticks: two events between two flushes
 ACTOR_IDS = ("npc_0", "npc_1", "ped_0")
 ACTOR_KINDS = ("car", "truck", "pedestrian")
 ACTOR_HALF_SIZES = np.array([[2.4, 0.9, 0.75], [4.0, 1.2, 1.5], [0.3, 0.3, 0.9]])  # [m]
+LANES = [[[0.0, 1.75, 0.01], [200.0, 1.75, 0.01]], [[0.0, -1.75, 0.01], [200.0, -1.75, 0.01]]]
 WHEEL_CENTERS = [[1.35, 0.8, 0.0], [1.35, -0.8, 0.0], [-1.35, 0.8, 0.0], [-1.35, -0.8, 0.0]]
 
 
@@ -91,6 +92,7 @@ def write_run(
             [[0.0, 0.0, 0.0, 1.0]] * 2,
             [[180, 170, 160]] * 2,
         )
+        rec.log_static_lines("/world/map/lanes", LANES, color=(250, 250, 250), radius=0.05)
         rec.log_ego_body(
             body_half_size=(2.4, 0.8, 0.45),
             body_center=(0.0, 0.0, 0.3),
@@ -224,6 +226,12 @@ def test_static_world_is_present(run: tuple[Path, Logged]) -> None:
     wheels = column(path, bp.EGO_WHEELS, "Boxes3D:centers")
     assert wheels.times is None
     np.testing.assert_array_equal(wheels.values[0], np.array(WHEEL_CENTERS, np.float32))
+    lanes = column(path, "/world/map/lanes", "LineStrips3D:strips")
+    assert lanes.times is None
+    np.testing.assert_array_equal(lanes.values[0], np.array(LANES, np.float32))
+    style = column(path, f"{bp.METRICS}/speed", "SeriesLines:names")
+    assert style.times is None
+    assert style.values == [["speed [m/s]"]]
 
 
 def test_actors_path_and_events(run: tuple[Path, Logged]) -> None:

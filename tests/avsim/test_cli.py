@@ -1,0 +1,249 @@
+"""Tests of the `avsim` command line (`avsim.cli`) as a user runs it: a subprocess.
+
+SCENARIO_FORMAT.md, "Command line": bad input exits 2 with one line on stderr naming the
+file and the key, no traceback, and no output file; `list`, `schema`; the commands that come
+later say so. No scenario is run here: every `run` below is rejected before the simulator
+starts: PyBullet prints a "pybullet build time" banner when it is imported (on stderr, from
+C), so bad input must leave stdout empty and stderr one line without that banner.
+
+The subprocesses start at once in a module fixture (each in its own working directory); every
+bad fixture file goes through the command in-process (click's runner), a representative few
+also through a real subprocess (each costs ~0.3 s of imports).
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
+from pathlib import Path
+
+import jsonschema  # type: ignore[import-untyped]
+import pytest
+import yaml
+from click.testing import CliRunner
+
+from avsim.cli import main
+from tests.avsim.test_scenario import BAD
+
+HERE = Path(__file__).parent
+BAD_DIR = HERE / "bad_scenarios"
+REPO = HERE.parents[1]
+SCENARIOS = REPO / "scenarios"
+TIMEOUT = 60.0  # [s] per subprocess; a bad input that is not rejected would start a long run
+EXIT_BAD_INPUT = 2
+
+VALID = """\
+format: avsim/1
+name: minimal
+duration: 10
+road:
+  speed_limit_kph: 50
+  segments:
+    - straight: 100
+ego: {s: 10, set_speed_kph: 40}
+"""
+
+
+@dataclass(frozen=True)
+class Case:
+    """One `avsim` invocation: its arguments and what a bad input must name."""
+
+    args: tuple[str, ...]
+    file: str = ""  # the file (or name) the message must contain; "" for other commands
+    key: str = ""  # the key the message must contain; "" when there is none
+
+
+@dataclass(frozen=True)
+class Outcome:
+    cwd: Path  # the working directory it ran in (a `tmp/` directory was made there first)
+    returncode: int
+    stdout: str
+    stderr: str
+
+
+def _run_args(scenario: str) -> tuple[str, ...]:
+    return ("run", scenario, "--out", "tmp/x.rrd", "--json", "tmp/x.json", "--no-progress")
+
+
+# bad_scenarios/ fixtures that also go through a real subprocess: one per kind of check
+# (YAML, file shape, model validation, cross-key checks, unsupported features)
+SUBPROCESS_FIXTURES = (
+    "bad_yaml_syntax", "duplicate_key", "not_a_mapping", "unknown_nested_key", "wrong_type",
+    "actor_lane_out_of_range", "after_forward", "unsupported_town",
+)
+
+
+def _fixture_case(stem: str) -> Case:
+    path = BAD_DIR / f"{stem}.yaml"
+    return Case(_run_args(str(path)), str(path), BAD[stem][0])
+
+
+def _inputs(directory: Path) -> dict[str, Case]:
+    """Bad-input cases for subprocesses: a few fixtures plus inputs made here."""
+    cases = {f"fixture_{stem}": _fixture_case(stem) for stem in SUBPROCESS_FIXTURES}
+    missing = directory / "does_not_exist.yaml"
+    cases["missing_file"] = Case(_run_args(str(missing)), str(missing), "(file)")
+    cases["missing_bundled_name"] = Case(_run_args("no_such_scenario"), "no_such_scenario",
+                                         "(file)")
+    empty = directory / "empty_here.yaml"
+    empty.write_text("", encoding="utf-8")
+    cases["empty_file"] = Case(_run_args(str(empty)), str(empty), "(file)")
+    comments = directory / "only_comments.yaml"
+    comments.write_text("# nothing here\n\n", encoding="utf-8")
+    cases["only_comments"] = Case(_run_args(str(comments)), str(comments), "(file)")
+    unknown = directory / "unknown_key.yaml"
+    unknown.write_text(VALID.replace("set_speed_kph: 40}", "set_speed_kph: 40, colour: red}"),
+                       encoding="utf-8")
+    cases["unknown_key"] = Case(_run_args(str(unknown)), str(unknown), "ego.colour")
+    cases["out_is_a_directory"] = Case(
+        ("run", "normal_driving", "--out", "tmp", "--json", "tmp/x.json", "--no-progress"),
+        "tmp", "--out")
+    a_file = directory / "a_file.txt"
+    a_file.write_text("not a directory\n", encoding="utf-8")
+    below_file = str(a_file / "sub" / "x.rrd")
+    cases["out_below_a_file"] = Case(
+        ("run", "normal_driving", "--out", below_file, "--json", "tmp/x.json", "--no-progress"),
+        below_file, "--out")
+    return cases
+
+
+def _launch(case: Case, cwd: Path) -> Outcome:
+    (cwd / "tmp").mkdir()
+    proc = subprocess.run([sys.executable, "-m", "avsim.cli", *case.args], cwd=cwd,
+                          capture_output=True, text=True, timeout=TIMEOUT, check=False)
+    return Outcome(cwd, proc.returncode, proc.stdout, proc.stderr)
+
+
+OTHER: dict[str, Case] = {
+    "list": Case(("list",)),
+    "schema": Case(("schema",)),
+    "suite": Case(("suite", str(SCENARIOS), "--jobs", "2")),
+    "sweep": Case(("sweep", "normal_driving", "--set", "seed=1,2")),
+    "snapshot": Case(("snapshot", "runs/x.rrd", "--at", "3")),
+    "bogus_profile": Case(("run", "--profile", "bogus", "normal_driving")),
+}
+
+BAD_CASE_NAMES = [f"fixture_{stem}" for stem in SUBPROCESS_FIXTURES] + [
+    "missing_file", "missing_bundled_name", "empty_file", "only_comments", "unknown_key",
+    "out_is_a_directory", "out_below_a_file",
+]
+
+
+@pytest.fixture(scope="module")
+def cases(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Case]:
+    return {**_inputs(tmp_path_factory.mktemp("inputs")), **OTHER}
+
+
+@pytest.fixture(scope="module")
+def outcomes(cases: dict[str, Case], tmp_path_factory: pytest.TempPathFactory,
+             ) -> dict[str, Outcome]:
+    dirs = {name: tmp_path_factory.mktemp(f"cwd_{name}") for name in cases}
+    with ThreadPoolExecutor(max_workers=8) as pool:
+        futures = {name: pool.submit(_launch, case, dirs[name]) for name, case in cases.items()}
+        return {name: future.result() for name, future in futures.items()}
+
+
+BANNER = "pybullet build time"  # printed by `import pybullet`
+
+
+def _assert_one_line_error(out: Outcome) -> str:
+    assert "Traceback" not in out.stderr, out.stderr
+    assert BANNER not in out.stderr + out.stdout, "PyBullet was imported before the input check"
+    assert out.stderr.endswith("\n") and out.stderr.count("\n") == 1, (
+        f"stderr is not exactly one line: {out.stderr!r}"
+    )
+    line = out.stderr.strip()
+    assert line
+    return line
+
+
+def test_every_bad_case_is_listed(cases: dict[str, Case]) -> None:
+    assert set(BAD_CASE_NAMES) == set(cases) - set(OTHER)
+
+
+@pytest.mark.parametrize("name", BAD_CASE_NAMES)
+def test_bad_input_exits_2_with_one_line_and_writes_nothing(
+    name: str, cases: dict[str, Case], outcomes: dict[str, Outcome]
+) -> None:
+    case, out = cases[name], outcomes[name]
+    assert out.returncode == EXIT_BAD_INPUT, (out.returncode, out.stderr)
+    line = _assert_one_line_error(out)
+    assert case.file in line
+    assert case.key in line
+    assert out.stdout == ""
+    assert not (out.cwd / "tmp" / "x.rrd").exists()
+    assert not (out.cwd / "tmp" / "x.json").exists()
+    assert list((out.cwd / "tmp").iterdir()) == [], "a partial file was left in tmp/"
+    assert [p.name for p in out.cwd.iterdir()] == ["tmp"], "something was written (runs/?)"
+
+
+@pytest.mark.parametrize("stem", sorted(p.stem for p in BAD_DIR.glob("*.yaml")))
+def test_every_bad_fixture_is_rejected_in_process(
+    stem: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    case = _fixture_case(stem)
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "tmp").mkdir()
+    result = CliRunner().invoke(main, list(case.args))
+    assert isinstance(result.exception, SystemExit), result.exception  # not a crash
+    assert result.exit_code == EXIT_BAD_INPUT, (result.exit_code, result.stderr)
+    line = _assert_one_line_error(Outcome(tmp_path, result.exit_code, result.stdout,
+                                          result.stderr))
+    assert case.file in line
+    assert case.key in line
+    assert result.stdout == ""
+    assert [p.name for p in tmp_path.iterdir()] == ["tmp"]
+    assert list((tmp_path / "tmp").iterdir()) == []
+
+
+def test_list_prints_one_line_per_bundled_scenario(outcomes: dict[str, Outcome]) -> None:
+    out = outcomes["list"]
+    assert out.returncode == 0, out.stderr
+    files = sorted(SCENARIOS.glob("*.yaml"))
+    expected = {yaml.safe_load(path.read_text(encoding="utf-8"))["name"] for path in files}
+    lines = out.stdout.splitlines()
+    assert len(lines) == len(files)
+    rows = [line.split("\t") for line in lines]
+    assert all(len(row) == 3 for row in rows), lines  # name, situation, description
+    assert {row[0] for row in rows} == expected
+    assert "normal_driving" in expected
+    assert all(row[1] != "(invalid)" for row in rows), lines
+
+
+def test_schema_is_a_json_schema_that_accepts_the_bundled_scenario(
+    outcomes: dict[str, Outcome],
+) -> None:
+    out = outcomes["schema"]
+    assert out.returncode == 0, out.stderr
+    schema = json.loads(out.stdout)
+    jsonschema.Draft202012Validator.check_schema(schema)
+    assert schema["$schema"] == "https://json-schema.org/draft/2020-12/schema"
+    validator = jsonschema.Draft202012Validator(schema)
+    scenario = yaml.safe_load((SCENARIOS / "normal_driving.yaml").read_text(encoding="utf-8"))
+    validator.validate(scenario)
+    # and it can say no: an unknown key is rejected by the schema too
+    assert not validator.is_valid({**scenario, "colour": "red"})
+
+
+@pytest.mark.parametrize("command", ["suite", "sweep", "snapshot"])
+def test_later_commands_say_not_supported_yet(
+    command: str, outcomes: dict[str, Outcome]
+) -> None:
+    out = outcomes[command]
+    assert out.returncode == EXIT_BAD_INPUT, (out.returncode, out.stderr)
+    line = _assert_one_line_error(out)
+    assert "not supported yet" in line
+    assert out.stdout == ""
+
+
+def test_unknown_profile_is_a_usage_error(outcomes: dict[str, Outcome]) -> None:
+    out = outcomes["bogus_profile"]
+    assert out.returncode == EXIT_BAD_INPUT, (out.returncode, out.stderr)
+    assert "Traceback" not in out.stderr and BANNER not in out.stderr
+    assert "Usage:" in out.stderr
+    assert "--profile" in out.stderr and "bogus" in out.stderr
+    assert out.stdout == ""
+    assert [p.name for p in out.cwd.iterdir()] == ["tmp"]
