@@ -108,6 +108,7 @@ class Runner:
         self.criteria = CriteriaSet(items)
         self.recorder = Recorder(recording, recording_name=spec.name) if recording else None
         self._touching: frozenset[int] = frozenset()
+        self._logged_events = 0  # collision events already sent to the recording
         self._last: StackOutput | None = None
 
     # -- the loop ------------------------------------------------------------------------------
@@ -187,14 +188,13 @@ class Runner:
         if now != self._touching:
             self._touching = now
             self._sample()
-            for t, what in self.collisions.events[len(self._seen_events()):]:
+            new = self.collisions.events[self._logged_events:]
+            self._logged_events = len(self.collisions.events)
+            for t, what in new:
                 if self.recorder is not None:
                     self.recorder.log_event(t, f"collision with {what}", "ERROR")
         elif CRITERIA_RATE.fires(step):
             self._sample()
-
-    def _seen_events(self) -> list[tuple[float, str]]:
-        return self.collisions.events[:-1] if self.collisions.events else []
 
     def _sample(self) -> None:
         w = self.world
