@@ -34,6 +34,7 @@ test-quick: lint
 
 bench: $(STAMP)
 	$(BIN)/python -m bench.bench_rtf
+	$(BIN)/python -m bench.bench_components
 
 clean:
 	rm -rf runs .pytest_cache .mypy_cache .ruff_cache

@@ -2,7 +2,9 @@
 
 Rates (all divide the 240 Hz physics rate; checked by `Rate`):
 - GNSS 10 Hz, odometry and the stack (decide-then-apply) 40 Hz;
-- criteria sample ground truth at 60 Hz, collisions (contact onsets) at 120 Hz;
+- criteria sample ground truth at 40 Hz (the control ticks' snapshots, so the log, the
+  criteria and the NPC triggers share one projection of the ego onto the route), collisions
+  (contact onsets) at 120 Hz;
 - the recording logs the ego pose, scalars and the plan at 20 Hz, NPC boxes at 10 Hz.
 
 Each control tick decides on one snapshot (the sensor frames of this tick), then the
@@ -34,15 +36,17 @@ from avsim.recorder import Recorder
 from avsim.stack import Stack, StackOutput
 from world.client import PHYSICS_RATE, Rate
 from world.spec import ScenarioSpec
-from world.truth import front_axle_point, touching, tyre_patches
+from world.truth import touching
 from world.world import World
 
 GNSS_RATE = Rate("gnss", 10)
 CONTROL_RATE = Rate("control", 40)
-CRITERIA_RATE = Rate("criteria", 60)
+CRITERIA_RATE = Rate("criteria", 40)
 CONTACT_RATE = Rate("contacts", 120)
 RECORD_RATE = Rate("record", 20)
 ACTOR_RECORD_RATE = Rate("record_actors", 10)
+# criteria samples are taken at contact checks
+assert CRITERIA_RATE.every % CONTACT_RATE.every == 0, "criteria rate must divide the contacts'"
 END_MARGIN = 30.0  # [m] default `completes` station: the route's end less this
 SETTLE_AFTER_DONE = 1.0  # [s] the run goes on this long after `completes` is reached
 
@@ -64,6 +68,8 @@ class TrajectoryLog:
     target_speed: list[float] = field(default_factory=list)  # [m/s]
     speed_limit: list[float] = field(default_factory=list)  # [m/s] at the front bumper
     steering: list[float] = field(default_factory=list)  # [rad] commanded
+    drive_torque: list[float] = field(default_factory=list)  # [N m] commanded, total
+    brake_torque: list[float] = field(default_factory=list)  # [N m] commanded, total
     wheel_spin: list[NDArray[np.float64]] = field(default_factory=list)  # [rad/s] (4,)
 
     def array(self, name: str) -> NDArray[np.float64]:
@@ -110,6 +116,7 @@ class Runner:
         self._touching: frozenset[int] = frozenset()
         self._logged_events = 0  # collision events already sent to the recording
         self._last: StackOutput | None = None
+        self._lane_offset = w.road.lane(spec.ego.lane).offset_at
 
     # -- the loop ------------------------------------------------------------------------------
 
@@ -121,15 +128,19 @@ class Runner:
         steps = round(self.spec.duration * PHYSICS_RATE)
         done_at: float | None = None
         try:
-            for step in range(steps):
-                self._tick(step)
-                w.step()
-                self._watch(w.clock.step)
+            # one control period per pass: decide on this snapshot, then hold the command
+            # on the joints for the period's physics steps (contacts watched at their rate)
+            while w.clock.step < steps:
+                self._tick()
+                for _ in range(min(CONTROL_RATE.every, steps - w.clock.step)):
+                    w.step()
+                    if w.clock.step % CONTACT_RATE.every == 0:
+                        self._watch(w.clock.step)
                 if done_at is None and self.completes.done:
                     done_at = w.t
                 if done_at is not None and w.t >= done_at + SETTLE_AFTER_DONE:
                     break
-                if progress is not None and step % PHYSICS_RATE == 0:
+                if progress is not None and w.clock.step % PHYSICS_RATE == 0:
                     progress(w.t, self.spec.duration)
         finally:
             if self.recorder is not None:
@@ -143,13 +154,11 @@ class Runner:
             recording=self.recorder.path if self.recorder else None,
         )
 
-    def _tick(self, step: int) -> None:
-        """Sensors at their rates, then (at the control rate) decide and apply."""
+    def _tick(self) -> None:
+        """A control tick: sensors at their rates, then decide and apply."""
         w = self.world
-        if not CONTROL_RATE.fires(step):
-            return
         truth = w.ego_truth
-        if GNSS_RATE.fires(step):
+        if GNSS_RATE.fires(w.clock.step):
             self.stack.on_gnss(w.gnss.measure(w.t, truth))
         self.stack.on_odometry(w.odometry.measure(w.t, truth))
         out = self.stack.tick(w.t, CONTROL_RATE.every / PHYSICS_RATE)
@@ -160,30 +169,29 @@ class Runner:
 
     def _log_tick(self, out: StackOutput) -> None:
         w, log = self.world, self.log
-        truth = w.ego_truth
-        lane = w.road.lane(self.spec.ego.lane)
-        points = np.vstack([truth.position[:2], front_axle_point(truth, self.car)])
-        (s, _), (r, r_fa) = lane.local_coordinates(points)
+        truth, route = w.ego_truth, w.ego_route
+        s = route.station
+        r, r_fa = (route.offsets[:2] - self._lane_offset(route.stations[:2])).tolist()
         log.t.append(w.t)
         log.x.append(float(truth.position[0]))
         log.y.append(float(truth.position[1]))
         log.yaw.append(truth.yaw)
         log.speed.append(truth.speed)
-        log.station.append(float(s))
-        log.cross_track.append(float(r))
-        log.front_axle_error.append(float(r_fa))
+        log.station.append(s)
+        log.cross_track.append(r)
+        log.front_axle_error.append(r_fa)
         log.target_speed.append(out.plan.target_speed)
         log.speed_limit.append(out.plan.speed_limit)
         log.steering.append(out.command.steering_angle)
+        log.drive_torque.append(out.command.drive_torque)
+        log.brake_torque.append(out.command.brake_torque)
         log.wheel_spin.append(truth.wheel_spin.copy())
         if self.recorder is not None and RECORD_RATE.fires(w.clock.step):
             self._record_tick(out)
 
     def _watch(self, step: int) -> None:
-        """Criteria: contact onsets every step, the rest at the criteria rate."""
+        """Criteria: contact onsets at the contact rate, the rest at the criteria rate."""
         w = self.world
-        if not CONTACT_RATE.fires(step):
-            return
         now = frozenset(touching(w.client, w.ego.body, w.scene.ground))
         if now != self._touching:
             self._touching = now
@@ -198,13 +206,12 @@ class Runner:
 
     def _sample(self) -> None:
         w = self.world
-        truth = w.ego_truth
-        tyres = tyre_patches(truth, self.car)
-        s, r = w.road.lane(0).local_coordinates(np.vstack([truth.position[:2], tyres]))
+        truth, route = w.ego_truth, w.ego_route
         self.criteria.update(TruthSample(
-            t=w.t, speed=truth.speed, station=float(s[0]),
-            front_station=float(s[0]) + self.car.front_overhang,
-            tyres=tyres, tyre_stations=s[1:], tyre_offsets=r[1:], touching=self._touching,
+            t=w.t, speed=truth.speed, station=route.station,
+            front_station=route.station + self.car.front_overhang,
+            tyres=route.tyres, tyre_stations=route.tyre_stations,
+            tyre_offsets=route.tyre_offsets, touching=self._touching,
         ))
 
     # -- results -------------------------------------------------------------------------------

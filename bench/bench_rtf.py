@@ -1,7 +1,9 @@
 """Real-time factor of normal_driving, measured in one run against the raw physics floor.
 
 Three figures for the same scene (`scenarios/normal_driving.yaml`, the same simulated span):
-- floor: the world built, the ego given a constant drive torque, `stepSimulation()` only;
+- floor: the world built and the stack's own joint commands of a full run replayed at the
+  control rate (so the car drives the same path, through the same curves and speeds), with
+  `stepSimulation()` and nothing else: the cost of the physics alone;
 - stack: the full closed loop (GNSS/odometry, localisation, planner, control, criteria),
   no recording;
 - stack + recording: the same, writing the `.rrd`.
@@ -19,7 +21,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from avsim.runner import Runner
+from avsim.runner import CONTROL_RATE, Runner, RunResult, TrajectoryLog
 from avsim.scenario import load_scenario
 from world.client import PHYSICS_RATE
 from world.world import World
@@ -27,22 +29,26 @@ from world.world import World
 SCENARIO = "normal_driving"
 
 
-def floor_rtf(sim_seconds: float) -> float:
-    """Raw PyBullet stepping of the same scene."""
+def floor_rtf(log: TrajectoryLog) -> float:
+    """Raw PyBullet stepping of the same scene, the run's joint commands replayed."""
     world = World(load_scenario(SCENARIO))
     try:
-        world.ego.apply(0.0, 400.0, 0.0)
-        steps = round(sim_seconds * PHYSICS_RATE)
+        step, apply = world.client.stepSimulation, world.ego.apply
+        every = CONTROL_RATE.every
+        commands = list(zip(log.steering, log.drive_torque, log.brake_torque, strict=True))
         start = time.perf_counter()
-        for _ in range(steps):
-            world.client.stepSimulation()
-        return sim_seconds / (time.perf_counter() - start)
+        for steering, drive, brake in commands:
+            apply(steering, drive, brake)
+            for _ in range(every):
+                step()
+        wall = time.perf_counter() - start
+        return len(commands) * every / PHYSICS_RATE / wall
     finally:
         world.close()
 
 
-def stack_rtf(record: bool) -> tuple[float, float]:
-    """(RTF, simulated seconds) of a full run, with or without the recording."""
+def stack_rtf(record: bool) -> tuple[float, RunResult]:
+    """(RTF, the run) of a full run, with or without the recording."""
     spec = load_scenario(SCENARIO)
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp) / "bench.rrd" if record else None
@@ -50,7 +56,7 @@ def stack_rtf(record: bool) -> tuple[float, float]:
         start = time.perf_counter()
         result = runner.run()
         wall = time.perf_counter() - start
-    return result.sim_time / wall, result.sim_time
+    return result.sim_time / wall, result
 
 
 def main() -> None:
@@ -61,11 +67,12 @@ def main() -> None:
     best: dict[str, float] = {}
     sim = 0.0
     for _ in range(args.repeat):
-        rtf, sim = stack_rtf(record=False)
+        rtf, run = stack_rtf(record=False)
         best["stack"] = max(best.get("stack", 0.0), rtf)
-        rtf, sim = stack_rtf(record=True)
+        rtf, run = stack_rtf(record=True)
         best["stack_recording"] = max(best.get("stack_recording", 0.0), rtf)
-        best["floor"] = max(best.get("floor", 0.0), floor_rtf(min(sim, 60.0)))
+        best["floor"] = max(best.get("floor", 0.0), floor_rtf(run.log))
+        sim = run.sim_time
     print(f"{SCENARIO}: {sim:.0f} s simulated, best of {args.repeat}")
     print(f"  {'raw physics floor':<28} RTF {best['floor']:6.1f}")
     for key, label in (("stack", "full stack, no recording"),

@@ -105,11 +105,16 @@ def process_noise(x: FloatArray, dt: float, p: LocalizerParams) -> FloatArray:
             [0.0, dt],
         ]
     )
-    q: FloatArray = g @ np.diag([p.accel_sigma**2, p.yaw_accel_sigma**2]) @ g.T
+    q: FloatArray = (g * [p.accel_sigma**2, p.yaw_accel_sigma**2]) @ g.T
     q[IX, IX] += p.position_walk**2 * dt
     q[IY, IY] += p.position_walk**2 * dt
     q[IPSI, IPSI] += p.heading_walk**2 * dt
     return q
+
+
+def _largest_eigenvalue(a: float, b: float, c: float) -> float:
+    """The larger eigenvalue of the symmetric 2 x 2 matrix [[a, b], [b, c]] (closed form)."""
+    return float(0.5 * (a + c) + math.hypot(0.5 * (a - c), b))
 
 
 def _gnss_residual(z: FloatArray, hx: FloatArray) -> FloatArray:
@@ -139,6 +144,8 @@ class Localizer:
 
     def __init__(self, params: LocalizerParams | None = None) -> None:
         self.params = params if params is not None else LocalizerParams()
+        p = self.params
+        self._r_odo = np.diag([p.wheel_speed_sigma**2, p.gyro_sigma**2])  # (2, 2) constant
         self._ekf = ExtendedKalmanFilter(dim_x=DIM_X, dim_z=3)
         self._t = 0.0  # [s] time the filter state refers to
         self._initialised = False
@@ -171,9 +178,7 @@ class Localizer:
         if not self._initialised:
             return
         self._predict_to(odo.t)
-        p = self.params
-        r = np.diag([p.wheel_speed_sigma**2, p.gyro_sigma**2])
-        self._ekf.update(np.array([odo.speed, odo.yaw_rate]), _h_odo, _hx_odo, R=r)
+        self._ekf.update(np.array([odo.speed, odo.yaw_rate]), _h_odo, _hx_odo, R=self._r_odo)
 
     def on_gnss(self, fix: GnssFix) -> None:
         """Initialise from the first fix; later, predict to ``fix.t`` and update with it.
@@ -206,7 +211,7 @@ class Localizer:
         x0 = self.state
         x, f = motion(x0, dt)
         cov = f @ self._ekf.P @ f.T + process_noise(x0, abs(dt), self.params)
-        pos_var = float(np.max(np.linalg.eigvalsh(cov[:2, :2])))
+        pos_var = _largest_eigenvalue(cov[0, 0], cov[0, 1], cov[1, 1])
         steering = self._last_odo.steering_angle if self._last_odo is not None else 0.0
         return EgoState(
             t=t,

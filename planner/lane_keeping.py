@@ -2,7 +2,7 @@
 
 Each tick: project the ego estimate onto the lane (station, lateral error), sample the lane
 centre around it (`planner.route.lane_path`), and plan the target speed
-(`planner.speed_planning.speed_target`). The path and the speed target are computed
+(`planner.speed_planning.SpeedPlanner`). The path and the speed target are computed
 separately (`path_for`, `speed_for`) so that the motion / control FSM planners built on this
 can swap either one (a lane-change path, an ACC speed) and keep the other.
 """
@@ -16,7 +16,7 @@ import numpy as np
 from perception.messages import EgoState
 from planner.messages import Plan, ReferencePath
 from planner.route import lane_path
-from planner.speed_planning import SpeedPlanningParams, SpeedTarget, speed_target
+from planner.speed_planning import SpeedPlanner, SpeedPlanningParams, SpeedTarget
 from world.hdmap import RoadMap
 
 
@@ -41,6 +41,7 @@ class LaneKeepingPlanner:
         self.road = road
         self.params = params
         self.lane = road.lane(params.lane)
+        self.speed_planner = SpeedPlanner(road, self.lane, params.speed)
 
     def reset(self) -> None:
         """Nothing lives between ticks: the map projection is exact, so no station hint."""
@@ -61,14 +62,7 @@ class LaneKeepingPlanner:
     def speed_for(self, station: float) -> SpeedTarget:
         """The speed target for the car's centre at ``station`` [m]."""
         p = self.params
-        return speed_target(
-            self.road,
-            self.lane,
-            station,
-            set_speed=p.set_speed,
-            max_speed=p.max_speed,
-            params=p.speed,
-        )
+        return self.speed_planner.target(station, set_speed=p.set_speed, max_speed=p.max_speed)
 
     def update(self, ego: EgoState) -> Plan:
         """The plan for this tick, made from ``ego`` (map frame, car centre)."""

@@ -22,26 +22,33 @@ limit: aiming 0.3 km/h below gives the ripple 1.3 km/h of room above the target 
 
 Distances along the lane are metres of the lane's centre line: a station step ``ds`` on a
 lane offset from the reference line is ``(1 - k_ref * offset) ds = ds / (1 + kappa * offset)``
-metres long (``kappa`` the lane's own curvature). The work is vectorised over the samples
-(about 1 000 - 2 000 per call at highway speeds), as it runs every planner tick (40 Hz).
+metres long (``kappa`` the lane's own curvature).
+
+The map's constraints are static, so `SpeedPlanner` samples the lane once, on a grid fixed
+to the map (every ``sample_spacing`` metres plus every piece start, where curvature and lane
+offset step): curvature speed ``v_j`` and lane distance ``D_j`` from the route's start. The
+braking curves of all curve samples beyond the brake margin reduce to one lookup: with
+``d_j = D_j - D_axle``,
+
+    min_j sqrt(v_j^2 + 2 a (d_j - m)) = sqrt(min_j (v_j^2 + 2 a D_j) - 2 a (D_axle + m)),
+
+and the suffix minimum of ``v_j^2 + 2 a D_j`` (with its nearest arg-min) is precomputed. A
+tick costs a few bisections, whatever the horizon: there is no horizon to choose, and a
+constraint too far away to bind simply never does.
 """
 
 from __future__ import annotations
 
+import bisect
 import enum
 import math
 from dataclasses import dataclass
 
 import numpy as np
 
-from world.hdmap import FloatArray, Lane, RoadMap
+from world.hdmap import FloatArray, IntArray, Lane, RoadMap
 
 KPH = 1.0 / 3.6  # [m/s per km/h]
-
-# Stations sampled ahead per metre of horizon: the lane may be shorter than the reference
-# line (the inside lane of a curve), so sample a little further in stations.
-STATION_SPAN_FACTOR = 1.25  # [-]
-
 
 class Binding(enum.Enum):
     """Which constraint sets the target speed."""
@@ -55,8 +62,6 @@ class Binding(enum.Enum):
 
 
 _AHEAD = (Binding.LIMIT_AHEAD, Binding.CURVE_AHEAD)
-_KINDS = tuple(Binding)
-_CODE = {b: i for i, b in enumerate(_KINDS)}
 
 
 @dataclass(frozen=True, slots=True)
@@ -65,7 +70,6 @@ class SpeedPlanningParams:
     a_lat_max: float = 3.0  # [m/s^2] lateral acceleration allowed in curves
     limit_margin: float = 0.3 * KPH  # [m/s] target below a posted limit (see module doc)
     brake_margin: float = 3.0  # [m] the braking curve reaches v_c this far before d = 0
-    horizon_extra: float = 20.0  # [m] look-ahead beyond the stopping distance from max speed
     sample_spacing: float = 0.5  # [m] station step of the curvature samples (map-fixed grid)
     front_overhang: float = 2.4  # [m] car centre -> front bumper
     front_axle: float = 1.35  # [m] car centre -> front axle
@@ -79,11 +83,6 @@ class SpeedTarget:
     limit_at_front: float  # [m/s] posted limit in force at the front bumper
     binding: Binding  # the constraint that sets `speed`
     distance: float  # [m] along the lane to the binding constraint (0 for those in force)
-
-
-def horizon(max_speed: float, params: SpeedPlanningParams) -> float:
-    """[m] look-ahead: the stopping distance from ``max_speed`` at ``a_comf``, plus extra."""
-    return max_speed**2 / (2.0 * params.a_comf) + params.horizon_extra
 
 
 def braking_speed(v_c: FloatArray, d: FloatArray, params: SpeedPlanningParams) -> FloatArray:
@@ -102,37 +101,6 @@ def curve_speed(curvature: FloatArray, params: SpeedPlanningParams) -> FloatArra
     return out
 
 
-@dataclass(frozen=True, slots=True)
-class _Samples:
-    """Stations ahead of the car and the lane distance to each, from the car's centre."""
-
-    stations: FloatArray  # [m] (N,) from the car's centre station, clamped to the route
-    distance: FloatArray  # [m] (N,) along the lane centre from the first sample
-
-    def distance_at(self, s: FloatArray) -> FloatArray:
-        """[m] lane distance from the first sample to stations ``s`` [m], shape of ``s``."""
-        out: FloatArray = np.asarray(np.interp(s, self.stations, self.distance))
-        return out
-
-
-def _sample_ahead(
-    road: RoadMap, lane: Lane, s: float, s_axle: float, span: float, spacing: float
-) -> _Samples:
-    """Stations from ``s`` to ``s + span`` [m]: a grid fixed on the map (multiples of
-    ``spacing``, so a constraint's samples do not slide with the car from tick to tick), the
-    start of every map piece (where curvature and lane offsets step, so an arc's start is
-    exact) and the car's own ``s`` and front axle ``s_axle``; clamped to the route."""
-    first, last = math.ceil(s / spacing), math.floor((s + span) / spacing)
-    grid = spacing * np.arange(first, last + 1, dtype=np.float64)
-    starts = np.array([p.s0 for p in road.pieces], dtype=np.float64)
-    starts = starts[(starts > s) & (starts < s + span)]
-    stations = np.unique(np.clip(np.concatenate(([s, s_axle], grid, starts)), 0.0, road.length))
-    # the lane's metric is constant between pieces starts, and those are samples: the
-    # left-point rule is exact
-    steps = _lane_metric(lane, stations[:-1]) * np.diff(stations)
-    return _Samples(stations, np.concatenate(([0.0], np.cumsum(steps))))
-
-
 def _lane_metric(lane: Lane, s: FloatArray) -> FloatArray:
     """[m/m] lane centre length per station metre: 1 / (1 + kappa_lane * offset)."""
     kappa = np.asarray(lane.curvature_at(s), dtype=np.float64)
@@ -141,80 +109,118 @@ def _lane_metric(lane: Lane, s: FloatArray) -> FloatArray:
     return out
 
 
-def _station_ahead(lane: Lane, s: float, metres: float) -> float:
-    """[m] station ``metres`` [m] ahead of station ``s`` along the lane (local metric)."""
-    return s + metres / float(_lane_metric(lane, np.array([s]))[0])
+def _suffix_argmin(values: FloatArray) -> IntArray:
+    """Per index i, the index of the least value in ``values[i:]``; ties to the nearest."""
+    n = len(values)
+    rev = values[::-1]
+    running = np.minimum.accumulate(rev)
+    attained = np.where(rev == running, np.arange(n), 0)  # reversed index where a min is set
+    latest = np.maximum.accumulate(attained)  # in reversed order: the last (nearest) one
+    out: IntArray = (n - 1 - latest)[::-1]
+    return out
 
 
-def speed_target(
-    road: RoadMap,
-    lane: Lane,
-    s: float,
-    *,
-    set_speed: float,
-    max_speed: float,
-    params: SpeedPlanningParams,
-) -> SpeedTarget:
-    """The target speed for a car whose centre is at station ``s`` [m] of ``lane``.
+class SpeedPlanner:
+    """The target speed along one lane of a map (see the module doc for the rule)."""
 
-    ``set_speed`` and ``max_speed`` [m/s]. Postings come from ``road.speed_limits``, curves
-    from ``lane.curvature_at``; everything beyond ``road.length`` is ignored. Ties go to the
-    first of: set speed, max speed, limit, curve now, curve ahead, limit ahead.
-    """
-    s_front = _station_ahead(lane, s, params.front_overhang)
-    s_axle = _station_ahead(lane, s, params.front_axle)
-    span = STATION_SPAN_FACTOR * (params.front_overhang + horizon(max_speed, params))
-    samples = _sample_ahead(road, lane, s, s_axle, span, params.sample_spacing)
-    limit_at_front = float(np.asarray(road.speed_limit_at(s_front)))
+    def __init__(self, road: RoadMap, lane: Lane, params: SpeedPlanningParams) -> None:
+        self.road, self.lane, self.params = road, lane, params
+        spacing = params.sample_spacing
+        grid = spacing * np.arange(math.floor(road.length / spacing) + 1, dtype=np.float64)
+        starts = np.array([p.s0 for p in road.pieces], dtype=np.float64)
+        stations = np.unique(np.concatenate((grid, starts[starts < road.length],
+                                             [road.length])))
+        # the metric is constant between piece starts, which are samples: left-point rule
+        metric = _lane_metric(lane, stations)
+        distance = np.concatenate(([0.0], np.cumsum(metric[:-1] * np.diff(stations))))
+        v_curve = curve_speed(np.asarray(lane.curvature_at(stations), np.float64), params)
+        key = np.square(v_curve) + 2.0 * params.a_comf * distance  # +inf on straights
+        self._stations: list[float] = stations.tolist()
+        self._metric: list[float] = metric.tolist()
+        self._distance: list[float] = distance.tolist()
+        self._v_curve = v_curve
+        self._key: list[float] = key.tolist()
+        self._best_ahead: list[int] = _suffix_argmin(key).tolist()
+        self._post_s = [p.s for p in road.speed_limits]
+        self._post_v = [p.limit for p in road.speed_limits]
 
-    fixed_v = np.array([set_speed, max_speed, limit_at_front - params.limit_margin])
-    fixed_k = np.array([_CODE[Binding.SET_SPEED], _CODE[Binding.MAX_SPEED], _CODE[Binding.LIMIT]])
+    # -- lane geometry on the grid --------------------------------------------------------------
 
-    curve_v, curve_d, curve_k = _curve_constraints(lane, samples, s_axle, params)
-    limit_v, limit_d, limit_k = _limit_constraints(road, samples, s_front, params)
+    def _index(self, s: float) -> int:
+        """The last sample at or before station ``s`` (clamped to the grid)."""
+        i = bisect.bisect_right(self._stations, s) - 1
+        return min(max(i, 0), len(self._stations) - 1)
 
-    v = np.concatenate((fixed_v, curve_v, limit_v))
-    d = np.concatenate((np.zeros(3), curve_d, limit_d))
-    k = np.concatenate((fixed_k, curve_k, limit_k))
-    i = int(np.argmin(v))
-    binding = _KINDS[int(k[i])]
-    braking = binding in _AHEAD and d[i] > params.brake_margin
-    return SpeedTarget(
-        speed=max(float(v[i]), 0.0),
-        accel=-params.a_comf if braking else 0.0,
-        limit_at_front=limit_at_front,
-        binding=binding,
-        distance=float(d[i]),
-    )
+    def _distance_at(self, s: float) -> float:
+        """[m] lane distance from the route's start to station ``s`` (exact: linear between
+        samples)."""
+        i = self._index(s)
+        return self._distance[i] + self._metric[i] * (s - self._stations[i])
 
+    def _station_ahead(self, s: float, metres: float) -> float:
+        """[m] station ``metres`` [m] ahead of station ``s`` along the lane (local metric)."""
+        return s + metres / self._metric[self._index(s)]
 
-def _curve_constraints(
-    lane: Lane, samples: _Samples, s_axle: float, params: SpeedPlanningParams
-) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """(allowed speed [m/s], distance [m], binding code) per curvature sample.
+    # -- the target -----------------------------------------------------------------------------
 
-    Samples up to the front axle are in force now (CURVE, d = 0); beyond it they are
-    CURVE_AHEAD at their lane distance from the front axle.
-    """
-    kappa = np.asarray(lane.curvature_at(samples.stations), dtype=np.float64)
-    v_c = curve_speed(kappa, params)
-    d = np.maximum(samples.distance - samples.distance_at(np.array(s_axle)), 0.0)
-    now = samples.stations <= s_axle
-    code = np.where(now, _CODE[Binding.CURVE], _CODE[Binding.CURVE_AHEAD])
-    return braking_speed(v_c, d, params), d, code
+    def target(self, s: float, *, set_speed: float, max_speed: float) -> SpeedTarget:
+        """The target speed for a car whose centre is at station ``s`` [m] of the lane.
 
+        ``set_speed`` and ``max_speed`` [m/s]. Ties go to the first of: set speed, max
+        speed, limit, curve now, curve ahead, limit ahead.
+        """
+        p = self.params
+        s_front = self._station_ahead(s, p.front_overhang)
+        s_axle = self._station_ahead(s, p.front_axle)
+        limit_at_front = float(self.road.speed_limit_at(s_front))
+        candidates = [
+            (set_speed, Binding.SET_SPEED, 0.0),
+            (max_speed, Binding.MAX_SPEED, 0.0),
+            (limit_at_front - p.limit_margin, Binding.LIMIT, 0.0),
+            *self._curve_constraints(s, s_axle),
+            *self._limit_constraints(s_front),
+        ]
+        v, binding, d = min(candidates, key=lambda c: c[0])  # the first of equal minima
+        braking = binding in _AHEAD and d > p.brake_margin
+        return SpeedTarget(
+            speed=max(v, 0.0),
+            accel=-p.a_comf if braking else 0.0,
+            limit_at_front=limit_at_front,
+            binding=binding,
+            distance=d,
+        )
 
-def _limit_constraints(
-    road: RoadMap, samples: _Samples, s_front: float, params: SpeedPlanningParams
-) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """(allowed speed [m/s], distance [m], binding code) per posting ahead of the bumper.
+    def _curve_constraints(self, s: float, s_axle: float) -> list[tuple[float, Binding, float]]:
+        """(speed, binding, distance) of the curve now, within the brake margin ahead of the
+        front axle, and beyond it (the suffix minimum)."""
+        p, st = self.params, self._stations
+        i_now, i_axle = self._index(s), self._index(s_axle)
+        out = [(float(self._v_curve[i_now:i_axle + 1].min()), Binding.CURVE, 0.0)]
+        d_axle = self._distance_at(s_axle)
+        i_margin = bisect.bisect_right(self._distance, d_axle + p.brake_margin) - 1
+        first_ahead = bisect.bisect_right(st, s_axle)
+        if first_ahead <= i_margin:  # samples ahead but within the margin: v_c itself
+            near = self._v_curve[first_ahead:i_margin + 1]
+            j = first_ahead + int(np.argmin(near))
+            out.append((float(near.min()), Binding.CURVE_AHEAD, self._distance[j] - d_axle))
+        beyond = max(i_margin + 1, first_ahead)
+        if beyond < len(st):
+            j = self._best_ahead[beyond]
+            room = self._key[j] - 2.0 * p.a_comf * (d_axle + p.brake_margin)
+            if math.isfinite(room):
+                out.append((math.sqrt(room), Binding.CURVE_AHEAD, self._distance[j] - d_axle))
+        return out
 
-    Only postings beyond the front bumper and within the sampled stations count; higher
-    postings never bind (their braking speed exceeds the limit in force) and cost nothing.
-    """
-    post_s = np.array([p.s for p in road.speed_limits], dtype=np.float64)
-    post_v = np.array([p.limit for p in road.speed_limits], dtype=np.float64)
-    ahead = (post_s > s_front) & (post_s <= samples.stations[-1])
-    d = samples.distance_at(post_s[ahead]) - samples.distance_at(np.array(s_front))
-    v = braking_speed(post_v[ahead] - params.limit_margin, d, params)
-    return v, d, np.full(d.shape, _CODE[Binding.LIMIT_AHEAD])
+    def _limit_constraints(self, s_front: float) -> list[tuple[float, Binding, float]]:
+        """(speed, binding, distance) per posting beyond the front bumper, up to the route's
+        end; a higher posting never binds (its braking speed exceeds the limit in force)."""
+        p = self.params
+        d_front = self._distance_at(s_front)
+        out = []
+        for s_p, v_p in zip(self._post_s, self._post_v, strict=True):
+            if s_front < s_p <= self.road.length:
+                d = self._distance_at(s_p) - d_front
+                v = math.sqrt((v_p - p.limit_margin) ** 2
+                              + 2.0 * p.a_comf * max(d - p.brake_margin, 0.0))
+                out.append((v, Binding.LIMIT_AHEAD, d))
+        return out

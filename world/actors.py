@@ -1,9 +1,10 @@
 """NPC bodies in the physics world, moved along the route by their scripted behaviour.
 
-NPCs are kinematic: static (mass 0) boxes placed every physics step from their
+NPCs are kinematic: static (mass 0) boxes placed at `world.ACTOR_RATE` from their
 `NpcMotion` in route coordinates. The ego collides with them like with a wall, and contact
 queries see them. (Only the ego must drive through its joints; NPCs are scripted traffic.)
-All NPC poses come from one vectorised map call per step.
+Bodies are placed with one scalar map lookup per moving actor; `poses` (all of them, for
+criteria, scoring and the recording) is one vectorised map call, when asked.
 """
 
 from __future__ import annotations
@@ -62,6 +63,7 @@ class ActorSet:
 
     def __init__(self, client: BulletClient, road: RoadMap, specs: tuple[ActorSpec, ...]) -> None:
         self._c = client
+        self._reset_pose = client.resetBasePositionAndOrientation  # bound once: hot path
         self._road = road
         self.specs = specs
         self.motions: list[NpcMotion] = []
@@ -78,12 +80,14 @@ class ActorSet:
             [[SIZES[a.type].length / 2, SIZES[a.type].width / 2, SIZES[a.type].height / 2]
              for a in specs]
         ).reshape(-1, 3)
-        self._last_speed = np.array([a.speed for a in specs])
-        self.accels = np.zeros(len(specs))  # [m/s^2]
+        self._last_speed = [a.speed for a in specs]  # [m/s] before the last step
+        self._dt = 1.0  # [s] the last step
         self._ids = tuple(a.id for a in specs)
         self._kinds = tuple(a.type for a in specs)
-        self._flip = np.array([math.pi if m.direction < 0 else 0.0 for m in self.motions])
-        self.poses = self._compute_poses()
+        self._flip_list = [math.pi if m.direction < 0 else 0.0 for m in self.motions]
+        self._flip = np.array(self._flip_list)
+        self._heights = self.half_sizes[:, 2].tolist()  # [m] box centre above the ground
+        self._poses: ActorPoses | None = None
         self._place(force=True)
 
     def _make_body(self, kind: ActorType) -> int:
@@ -93,7 +97,8 @@ class ActorSet:
         visual = self._c.createVisualShape(
             pybullet.GEOM_BOX, halfExtents=half, rgbaColor=list(COLOURS[kind])
         )
-        return int(self._c.createMultiBody(0.0, shape, visual, [0.0, 0.0, -10.0]))
+        return int(self._c.createMultiBody(0.0, shape, visual, [0.0, 0.0, -10.0],
+                                         useMaximalCoordinates=True))
 
     def lane_offset(self, lane: int, s: float) -> float:
         return float(self._road.lane(lane).offset_at(s))
@@ -113,29 +118,37 @@ class ActorSet:
             started += [(spec.id, i) for i in motion.fire_due(ctx, self.lane_offset)]
         return started
 
-    def step(self, t: float, dt: float, place: bool = True) -> None:
-        """Advance every motion by dt [s]; with `place`, move the bodies to the new poses."""
-        if not self.motions:
-            return
-        s = np.array([m.s for m in self.motions])
-        curvature = self._road.curvature_at(s)
-        for motion, k in zip(self.motions, curvature, strict=True):
-            motion.step(t, dt, float(k))
-        speeds = np.array([m.speed for m in self.motions])
-        self.accels = (speeds - self._last_speed) / dt
-        self._last_speed = speeds
-        if place:
-            self.poses = self._compute_poses()
-            self._place(force=False)
+    def step(self, t: float, dt: float) -> None:
+        """Advance every motion by dt [s] and move the moving bodies to their new poses."""
+        line = self._road.line
+        self._last_speed = [m.speed for m in self.motions]
+        self._dt = dt
+        for motion in self.motions:
+            motion.step(t, dt, line.curvature_one(motion.s))
+        self._poses = None
+        self._place(force=False)
+
+    @property
+    def accels(self) -> NDArray[np.float64]:
+        """[m/s^2] (N,) each actor's longitudinal acceleration over the last step."""
+        speeds = np.array([m.speed for m in self.motions], dtype=np.float64)
+        out: NDArray[np.float64] = (speeds - np.array(self._last_speed)) / self._dt
+        return out
+
+    @property
+    def poses(self) -> ActorPoses:
+        """Ground truth of every actor now (computed when asked, once per step)."""
+        if self._poses is None:
+            self._poses = self._compute_poses()
+        return self._poses
 
     def _compute_poses(self) -> ActorPoses:
         m = self.motions
         s = np.array([x.s for x in m])
         offsets = np.array([x.offset for x in m])
-        line = self._road.line  # the reference line: offsets are from it
-        xy = line.point(s, offsets).reshape(-1, 2)
-        yaws = line.heading(s) + self._flip + np.array([x.heading_offset for x in m])
-        centres = np.column_stack([xy, self.half_sizes[:, 2]]) if m else np.zeros((0, 3))
+        x, y, heading = self._road.line.pose(s, offsets)  # offsets are from the reference line
+        yaws = heading + self._flip + np.array([x.heading_offset for x in m])
+        centres = np.column_stack([x, y, self.half_sizes[:, 2]]) if m else np.zeros((0, 3))
         return ActorPoses(
             ids=self._ids,
             kinds=self._kinds,
@@ -149,10 +162,12 @@ class ActorSet:
         )
 
     def _place(self, force: bool) -> None:
-        p = self.poses
-        half = p.yaws / 2
-        for i, body in enumerate(self.bodies):
-            moving = self.motions[i].speed != 0.0 or self.motions[i].lateral_speed != 0.0
-            if force or moving:
-                quat = (0.0, 0.0, math.sin(half[i]), math.cos(half[i]))
-                self._c.resetBasePositionAndOrientation(body, p.centres[i].tolist(), quat)
+        """Move the bodies of the actors that move (all of them with `force`): one scalar
+        map lookup each, the hot path of the NPCs."""
+        line = self._road.line
+        for body, m, flip, z in zip(self.bodies, self.motions, self._flip_list,
+                                    self._heights, strict=True):
+            if force or m.speed != 0.0 or m.lateral_speed != 0.0:
+                x, y, heading = line.pose_one(m.s, m.offset)
+                half = 0.5 * (heading + flip + m.heading_offset)
+                self._reset_pose(body, (x, y, z), (0.0, 0.0, math.sin(half), math.cos(half)))

@@ -107,6 +107,13 @@ class EgoBody:
         for j in self.wheel_joints:
             client.changeDynamics(self.body, j, maxJointVelocity=MAX_WHEEL_SPIN)
         self._com_offset = np.array(client.getDynamicsInfo(self.body, -1)[3])
+        # bound once: these run at the control rate
+        self._base_pose = client.getBasePositionAndOrientation
+        self._base_velocity = client.getBaseVelocity
+        self._joint_states = client.getJointStates
+        self._rotation = client.getMatrixFromQuaternion
+        self._motor = client.setJointMotorControl2
+        self._motors = client.setJointMotorControlArray
         self.mass = g.mass
         self._roll_torque = params.rolling_resistance * g.mass * GRAVITY * g.wheel_radius
         self._max_drive = g.mass * params.max_accel * g.wheel_radius
@@ -131,39 +138,38 @@ class EgoBody:
 
         Held by the joint motors until the next call.
         """
-        g, c = self.geometry, self._c
-        delta = float(np.clip(steering_angle, -g.max_steer, g.max_steer))
+        g = self.geometry
+        delta = min(max(float(steering_angle), -g.max_steer), g.max_steer)
         left, right = ackermann(delta, g.wheelbase, g.track)
         for joint, target in zip(self.steer_joints, (left, right), strict=True):
-            c.setJointMotorControl2(
+            self._motor(
                 self.body, joint, pybullet.POSITION_CONTROL, targetPosition=target,
                 force=STEER_TORQUE, maxVelocity=STEER_RATE,
             )
         self.steer_command = delta
-        self.drive_torque = float(np.clip(drive_torque, 0.0, self._max_drive))
+        self.drive_torque = min(max(float(drive_torque), 0.0), self._max_drive)
         self.brake_torque = max(0.0, float(brake_torque))
-        velocity = c.getBaseVelocity(self.body)[0]
+        velocity = self._base_velocity(self.body)[0]
         speed = math.hypot(velocity[0], velocity[1])
         if speed >= self.params.max_speed:
             self.drive_torque = 0.0
         drag = 0.5 * AIR_DENSITY * self.params.drag_area * speed**2 * g.wheel_radius
         net = self.drive_torque - self.brake_torque - self._roll_torque - drag  # [N m]
         spin = MAX_WHEEL_SPIN if net > 0.0 else 0.0
-        c.setJointMotorControlArray(
+        self._motors(
             self.body, self.wheel_joints, pybullet.VELOCITY_CONTROL,
             targetVelocities=[spin] * 4, forces=[abs(net) / 4] * 4,
         )
 
     def truth(self) -> EgoTruth:
         """Read the body's true state (link frame origin, not Bullet's centre-of-mass frame)."""
-        c = self._c
-        com, quat = c.getBasePositionAndOrientation(self.body)
-        lin, ang = c.getBaseVelocity(self.body)
-        rot = np.array(c.getMatrixFromQuaternion(quat)).reshape(3, 3)
+        com, quat = self._base_pose(self.body)
+        lin, ang = self._base_velocity(self.body)
+        rot = np.array(self._rotation(quat)).reshape(3, 3)
         position = np.asarray(com) - rot @ self._com_offset
         yaw = math.atan2(rot[1, 0], rot[0, 0])
         velocity = np.asarray(lin)
-        states = c.getJointStates(self.body, self.wheel_joints + self.steer_joints)
+        states = self._joint_states(self.body, self.wheel_joints + self.steer_joints)
         spin = np.array([s[1] for s in states[:4]])
         hinge_l, hinge_r = states[4][0], states[5][0]
         steering = bicycle_angle(hinge_l, hinge_r)

@@ -28,6 +28,8 @@ No PyBullet here: the planner reads this module.
 
 from __future__ import annotations
 
+import bisect
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -139,6 +141,11 @@ class ReferenceLine:
         # middle heading (so arcs up to a full turn wrap correctly), shifted by +pi
         h_mid = self.h0 + 0.5 * self.k * self.len
         self.angle_shift = self.sign_k * HALF_PI - h_mid + np.pi
+        # the same per piece as plain floats, for the scalar `pose_one` and `curvature_one`
+        self._scalar: list[tuple[float, ...]] = list(zip(*(a.tolist() for a in (
+            self.s0, self.h0, self.k, self.straight, self.inv_k, self.cx, self.cy,
+            self.cos_h0, self.sin_h0)), strict=True))
+        self._bounds_list: list[float] = self.bounds.tolist()
 
     def piece_index(self, s: FloatArray) -> IntArray:
         """Internal piece index (0 .. P + 1) of stations s; a joint belongs to the later."""
@@ -154,6 +161,36 @@ class ReferenceLine:
 
     def curvature(self, s: FloatArray) -> FloatArray:
         return self.k[self.piece_index(s)]
+
+    def pose(self, s: FloatArray, d: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """(x, y, heading) of stations s at offsets d from the line: `point` and `heading`
+        in one pass (one piece lookup), for callers that need both every step."""
+        i = self.piece_index(s)
+        t = s - self.s0[i]
+        h = self.h0[i] + self.k[i] * t
+        along = t * self.straight[i]
+        radial = self.inv_k[i] - d
+        sin_h, cos_h = np.sin(h), np.cos(h)
+        x = self.cx[i] + along * self.cos_h0[i] + radial * sin_h
+        y = self.cy[i] + along * self.sin_h0[i] - radial * cos_h
+        return x, y, h
+
+    def curvature_one(self, s: float) -> float:
+        """[1/m] `curvature` at one station, in plain floats."""
+        k: float = self._scalar[bisect.bisect_right(self._bounds_list, s)][2]
+        return k
+
+    def pose_one(self, s: float, d: float) -> tuple[float, float, float]:
+        """(x, y, heading) at one station s and offset d: `pose` for a single point in plain
+        floats (a few microseconds, where numpy's per-call cost would dominate)."""
+        s0, h0, k, straight, inv_k, cx, cy, cos_h0, sin_h0 = self._scalar[
+            bisect.bisect_right(self._bounds_list, s)]
+        t = s - s0
+        h = h0 + k * t
+        along = t * straight
+        radial = inv_k - d
+        return (cx + along * cos_h0 + radial * math.sin(h),
+                cy + along * sin_h0 - radial * math.cos(h), h)
 
     def point(self, s: FloatArray, d: FloatArray) -> FloatArray:
         """[m] map-frame points, shape s.shape + (2,), at stations s and offsets d (left +)

@@ -2,12 +2,15 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 from numpy.typing import NDArray
 from pybullet_utils.bullet_client import BulletClient
 
 from vehicle_urdf import CarGeometry
 from world.ego import EgoTruth
+from world.hdmap import ReferenceLine
 
 
 def body_axes(truth: EgoTruth) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -27,6 +30,43 @@ def tyre_patches(truth: EgoTruth, g: CarGeometry) -> NDArray[np.float64]:
 def front_axle_point(truth: EgoTruth, g: CarGeometry) -> NDArray[np.float64]:
     fwd, _ = body_axes(truth)
     return np.asarray(truth.position[:2] + g.front_axle * fwd)
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class RouteTruth:
+    """The ego's true points on the route: centre, front axle and the four tyre patches,
+    with their stations and offsets from the reference line (left +), from one projection."""
+
+    points: NDArray[np.float64]  # [m] (6, 2) map frame: centre, front axle, FL, FR, RL, RR
+    stations: NDArray[np.float64]  # [m] (6,)
+    offsets: NDArray[np.float64]  # [m] (6,) from the reference line, left +
+
+    @property
+    def station(self) -> float:
+        """[m] the car centre's station."""
+        return float(self.stations[0])
+
+    @property
+    def tyres(self) -> NDArray[np.float64]:
+        return self.points[2:]
+
+    @property
+    def tyre_stations(self) -> NDArray[np.float64]:
+        return self.stations[2:]
+
+    @property
+    def tyre_offsets(self) -> NDArray[np.float64]:
+        return self.offsets[2:]
+
+
+def route_truth(truth: EgoTruth, g: CarGeometry, line: ReferenceLine) -> RouteTruth:
+    """Project the ego's centre, front axle and tyre patches onto the route in one call."""
+    fwd, left = body_axes(truth)
+    x = np.array([0.0, g.front_axle, g.front_axle, g.front_axle, -g.rear_axle, -g.rear_axle])
+    y = np.array([0.0, 0.0, g.track / 2, -g.track / 2, g.track / 2, -g.track / 2])
+    points = truth.position[:2] + x[:, None] * fwd + y[:, None] * left
+    s, d = line.project(points)
+    return RouteTruth(points, s, d)
 
 
 def touching(client: BulletClient, body: int, ignore: int) -> set[int]:

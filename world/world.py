@@ -32,9 +32,10 @@ from world.scenery import (
     speed_limit_sign_image,
 )
 from world.spec import ScenarioSpec
+from world.truth import RouteTruth, route_truth
 
 TRIGGER_RATE = Rate("npc_triggers", 40)
-ACTOR_PLACEMENT_RATE = Rate("npc_placement", 120)  # bodies moved; motion integrates at 240 Hz
+ACTOR_RATE = Rate("npc_motion", 120)  # NPC motion integrated and bodies moved
 SIGN_POLE_RADIUS = 0.04  # [m]
 SIGN_SEGMENTS = 24  # triangles in a round sign plate
 
@@ -58,6 +59,7 @@ class World:
         seeds = np.random.SeedSequence(spec.seed).spawn(3)
         self.client = make_client()
         self.clock = Clock()
+        self._step_physics = self.client.stepSimulation  # bound once: called every step
         self.road = RoadMap.from_spec(spec.road)
         self._tmp = tempfile.TemporaryDirectory(prefix="avsim-textures-")
         self.scene = self._build_scene(np.random.default_rng(seeds[0]))
@@ -74,7 +76,8 @@ class World:
             self.ego.geometry.wheel_radius, np.random.default_rng(seeds[2])
         )
         self._truth: EgoTruth | None = None
-        self.ego_s = self._station(self.ego_truth)
+        self._route: RouteTruth | None = None
+        self.ego_s = self.ego_route.station
         self.started_actions: list[tuple[str, int]] = []  # (actor id, action) at the last check
 
     # -- building ----------------------------------------------------------------------------
@@ -116,7 +119,7 @@ class World:
             uvs=uvs.tolist(),
             normals=normals.tolist(),
         )
-        body = int(c.createMultiBody(0.0, -1, visual))
+        body = int(c.createMultiBody(0.0, -1, visual, useMaximalCoordinates=True))
         c.changeVisualShape(body, -1, textureUniqueId=self._texture(name, texture),
                             rgbaColor=[1, 1, 1, 1])
         return body
@@ -128,7 +131,8 @@ class World:
             pybullet.GEOM_BOX, halfExtents=list(b.half_extents), rgbaColor=[*b.rgb, 1.0]
         )
         quat = c.getQuaternionFromEuler([0.0, 0.0, b.yaw])
-        return int(c.createMultiBody(0.0, shape, visual, list(b.centre), quat))
+        return int(c.createMultiBody(0.0, shape, visual, list(b.centre), quat,
+                                     useMaximalCoordinates=True))
 
     def _add_sign(self, sign: SignPlacement) -> int:
         """A pole (with collision) and a round textured plate facing the traffic."""
@@ -138,7 +142,8 @@ class World:
                                        height=top)
         visual = c.createVisualShape(pybullet.GEOM_CYLINDER, radius=SIGN_POLE_RADIUS,
                                      length=top, rgbaColor=[0.6, 0.6, 0.62, 1.0])
-        pole = int(c.createMultiBody(0.0, shape, visual, [*sign.pole_xy, top / 2]))
+        pole = int(c.createMultiBody(0.0, shape, visual, [*sign.pole_xy, top / 2],
+                                     useMaximalCoordinates=True))
         vertices, indices, uvs, normals = _disc_mesh(sign, offset=2 * SIGN_POLE_RADIUS)
         rgba = speed_limit_sign_image(sign.kph)
         self._add_textured_mesh(f"sign_{sign.kph}_{sign.s:.0f}", vertices, indices, uvs,
@@ -159,26 +164,32 @@ class World:
             self._truth = self.ego.truth()
         return self._truth
 
-    def _station(self, truth: EgoTruth) -> float:
-        s, _ = self.road.lane(0).local_coordinates(truth.position[:2])
-        return float(s)
+    @property
+    def ego_route(self) -> RouteTruth:
+        """The ego's true centre, front axle and tyres on the route after the last step (one
+        projection per step, shared by the NPC triggers, the criteria and the log)."""
+        if self._route is None:
+            self._route = route_truth(self.ego_truth, self.ego.geometry, self.road.line)
+        return self._route
 
     def step(self) -> None:
         """One physics step (the ego's joint motors hold the last command), then the NPCs.
 
         NPC triggers are checked at `TRIGGER_RATE` against the ego's true station; NPC
-        motion is integrated every step.
+        motion is integrated and the bodies are moved at `ACTOR_RATE` (kinematic bodies:
+        the contact query between moves sees the last placed pose, 1/120 s old at most).
         """
-        self.client.stepSimulation()
+        self._step_physics()
         self.clock.advance()
         self._truth = None
+        self._route = None
         if self.clock.step % TRIGGER_RATE.every == 0:
-            self.ego_s = self._station(self.ego_truth)
+            self.ego_s = self.ego_route.station
             self.started_actions = self.actors.fire_triggers(
                 self.clock.t, self.ego_s, self.ego.geometry.body_length
             )
-        self.actors.step(self.clock.t, self.clock.dt,
-                         place=self.clock.step % ACTOR_PLACEMENT_RATE.every == 0)
+        if self.clock.step % ACTOR_RATE.every == 0:
+            self.actors.step(self.clock.t, ACTOR_RATE.every * self.clock.dt)
 
     def close(self) -> None:
         if self.client is not None:

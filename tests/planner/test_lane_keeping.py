@@ -9,7 +9,7 @@ import pytest
 
 from perception.messages import EgoState
 from planner.lane_keeping import LaneKeepingParams, LaneKeepingPlanner
-from planner.speed_planning import Binding, speed_target
+from planner.speed_planning import Binding, SpeedPlanner
 from tests.planner.maps import KPH, needs_hdmap, real_map, road_spec, segment, straight_road
 from world.hdmap import RoadMap
 
@@ -43,8 +43,8 @@ def test_plan_on_an_arc() -> None:
     assert s[0] == pytest.approx(145.0)
     assert s[-1] == pytest.approx(150.0 + 2.5 * 20.0)  # 2.5 s at 20 m/s > 25 m
     # the speed target is the speed planner's, for the same station
-    expected = speed_target(
-        road, lane, 150.0, set_speed=80.0 * KPH, max_speed=180.0 * KPH, params=p.params.speed
+    expected = SpeedPlanner(road, lane, p.params.speed).target(
+        150.0, set_speed=80.0 * KPH, max_speed=180.0 * KPH
     )
     assert plan.target_speed == pytest.approx(expected.speed)
     assert plan.target_speed == pytest.approx(math.sqrt(3.0 * 56.5))

@@ -9,12 +9,12 @@ import pytest
 
 from planner.speed_planning import (
     Binding,
+    SpeedPlanner,
     SpeedPlanningParams,
     SpeedTarget,
+    _suffix_argmin,
     braking_speed,
     curve_speed,
-    horizon,
-    speed_target,
 )
 from tests.planner.maps import KPH, needs_hdmap, real_map, road_spec, segment, straight_road
 from world.hdmap import RoadMap
@@ -30,12 +30,17 @@ SIGN = 500.0  # [m] station of the lower posting
 KINDS = ["double", "real"]
 
 
+_PLANNERS: dict[tuple[int, int], SpeedPlanner] = {}
+
+
 def target(
     road: RoadMap, s: float, set_kph: float, max_kph: float = 200.0, lane: int = 0
 ) -> SpeedTarget:
-    return speed_target(
-        road, road.lane(lane), s, set_speed=set_kph * KPH, max_speed=max_kph * KPH, params=P
-    )
+    """The target at ``s``, from one planner per (road, lane) (the map is sampled once)."""
+    key = (id(road), lane)
+    if key not in _PLANNERS or _PLANNERS[key].road is not road:
+        _PLANNERS[key] = SpeedPlanner(road, road.lane(lane), P)
+    return _PLANNERS[key].target(s, set_speed=set_kph * KPH, max_speed=max_kph * KPH)
 
 
 def limit_road(kind: str, before: float = 100.0, after: float = 50.0) -> RoadMap:
@@ -117,16 +122,21 @@ def test_higher_limit_ahead_never_binds(kind: str) -> None:
 
 
 @pytest.mark.parametrize("kind", KINDS)
-def test_posting_near_the_horizon(kind: str) -> None:
-    """The horizon is the stopping distance from max speed plus 20 m: a 10 km/h posting
-    there is still seen (braking curve just above max speed), none beyond it can bind."""
-    h = horizon(100.0 * KPH, P)
-    assert h == pytest.approx((100.0 * KPH) ** 2 / 3.0 + 20.0)
+def test_far_posting_binds_exactly_when_its_braking_curve_falls_below_max_speed(
+    kind: str,
+) -> None:
+    """No horizon: a 10 km/h posting 2.2 km ahead is taken into account, and binds from the
+    distance where braking at a_comf from max speed must begin (plus the brake margin)."""
+    v_max, v_c = 100.0 * KPH, (10.0 - 0.3) * KPH
+    start = (v_max**2 - v_c**2) / (2.0 * A) + MARGIN  # [m] bumper -> sign where it binds
     road = straight_road(kind, 3000.0, 130.0, ((2500.0, 10.0),))
-    t = target(road, 2500.0 - FRONT - (h - 10.0), 120.0, 100.0)
-    assert t.binding is Binding.MAX_SPEED
-    t = target(road, 2500.0 - FRONT - (h - 30.0), 120.0, 100.0)
+    assert target(road, 2500.0 - FRONT - 2200.0, 120.0, 100.0).binding is Binding.MAX_SPEED
+    assert target(road, 2500.0 - FRONT - (start + 1.0), 120.0, 100.0).binding \
+        is Binding.MAX_SPEED
+    t = target(road, 2500.0 - FRONT - (start - 1.0), 120.0, 100.0)
     assert t.binding is Binding.LIMIT_AHEAD
+    assert t.distance == pytest.approx(start - 1.0)
+    assert t.speed < v_max
 
 
 # ---- curves (real map) -------------------------------------------------------------------
@@ -248,3 +258,57 @@ def test_drive_into_r60_curve() -> None:
     assert in_curve.any()
     assert float(v[in_curve].max()) <= V_R60 + 1e-9
     assert float((-np.diff(v) / DT).max()) <= A + 0.02
+
+
+# ---- the precomputed envelope against brute force ------------------------------------------
+
+
+def test_suffix_argmin_takes_the_nearest_of_equal_minima() -> None:
+    values = np.array([3.0, 1.0, 2.0, 1.0, np.inf, 5.0, np.inf])
+    np.testing.assert_array_equal(_suffix_argmin(values), [1, 1, 3, 3, 5, 5, 6])
+
+
+@needs_hdmap
+def test_planner_equals_brute_force_over_every_sample() -> None:
+    """At many stations of a winding road with postings, the target equals the plain rule
+    evaluated over every map sample and posting ahead (no suffix minimum, no shortcuts)."""
+    road = real_map(road_spec(
+        [segment(120.0), segment(80.0, 45.0), segment(60.0), segment(90.0, 120.0, False),
+         segment(40.0, 30.0), segment(150.0)],
+        90.0, ((150.0, 60.0), (330.0, 30.0), (420.0, 70.0)),
+    ))
+    seen = set()
+    for lane_index in (0, 1):
+        lane = road.lane(lane_index)
+        planner = SpeedPlanner(road, lane, P)
+        samples = np.array(planner._stations)
+        kappa = np.asarray(lane.curvature_at(samples))
+        metric = 1.0 / (1.0 + kappa * np.asarray(lane.offset_at(samples)))
+        dist = np.concatenate(([0.0], np.cumsum(metric[:-1] * np.diff(samples))))
+
+        def lane_distance(x: float, metric=metric, dist=dist, samples=samples) -> float:
+            i = max(int(np.searchsorted(samples, x, side="right")) - 1, 0)
+            return float(dist[i] + metric[i] * (x - samples[i]))
+
+        for s in np.linspace(0.0, road.length - 5.0, 157):
+            got = planner.target(float(s), set_speed=120 * KPH, max_speed=130 * KPH)
+            seen.add(got.binding)
+            i = max(int(np.searchsorted(samples, s, side="right")) - 1, 0)
+            s_axle = s + AXLE / metric[i]
+            s_front = s + FRONT / metric[i]
+            d = np.array([lane_distance(x) for x in samples]) - lane_distance(s_axle)
+            v_c = curve_speed(kappa, P)
+            now = (samples <= s_axle) & (np.arange(len(samples)) >= i)
+            ahead = samples > s_axle
+            best = min(120 * KPH, 130 * KPH,
+                       float(road.speed_limit_at(s_front)) - P.limit_margin,
+                       float(v_c[now].min()),
+                       float(braking_speed(v_c[ahead], d[ahead], P).min(initial=np.inf)))
+            for post in road.speed_limits:
+                if s_front < post.s <= road.length:
+                    dp = lane_distance(post.s) - lane_distance(s_front)
+                    best = min(best, float(braking_speed(
+                        np.array(post.limit - P.limit_margin), np.array(dp), P)))
+            assert got.speed == pytest.approx(best, rel=1e-9, abs=1e-9), (lane_index, s)
+    # every kind of map constraint was exercised
+    assert {Binding.CURVE, Binding.CURVE_AHEAD, Binding.LIMIT, Binding.LIMIT_AHEAD} <= seen
