@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import enum
+import math
 from dataclasses import dataclass
 
 
@@ -17,3 +19,104 @@ class EgoState:
     yaw_rate: float  # [rad/s]
     steering_angle: float  # [rad] measured road-wheel angle (bicycle), left +
     position_sigma: float  # [m] 1-sigma of the position estimate
+
+
+# ---- lanes (camera) ------------------------------------------------------------------------
+
+
+@dataclass(frozen=True, slots=True)
+class LaneBoundary:
+    """One painted boundary line, fitted in the vehicle frame as y = c0 + c1 x + c2 x^2."""
+
+    coefficients: tuple[float, float, float]  # (c0 [m], c1 [-], c2 [1/m])
+    x_min: float  # [m] nearest forward distance the fit is supported by pixels
+    x_max: float  # [m] farthest
+    pixels: int  # [-] bird's-eye-view pixels behind the fit
+
+    def y_at(self, x: float) -> float:
+        """[m] lateral position (left +) of the line at forward distance x [m]."""
+        c0, c1, c2 = self.coefficients
+        return c0 + c1 * x + c2 * x * x
+
+
+@dataclass(frozen=True, slots=True)
+class LaneEstimate:
+    """The ego lane as the front camera sees it, in the vehicle frame at time ``t``.
+
+    The lane centre is y = c0 + c1 x + c2 x^2 (vehicle frame: x forward from the car's
+    centre, y left). ``offset`` is where the car's centre is relative to that centre line
+    (left +: the car is left of the lane centre), ``heading_error`` the car's heading minus
+    the lane's (left +), ``curvature`` the lane's (left turn +). With ``confidence`` below the
+    consumer's threshold the numbers are the filter's prediction, not a measurement.
+    """
+
+    t: float  # [s] sim time of the camera frame
+    offset: float  # [m] car centre relative to the lane centre, left +
+    heading_error: float  # [rad] car heading minus lane heading, left +
+    curvature: float  # [1/m] lane curvature at the car, left turn +
+    width: float  # [m] lane width
+    confidence: float  # [0, 1] how much of the lane was seen (both lines, length, fit)
+    left: LaneBoundary | None  # the left boundary fit, if found in this frame
+    right: LaneBoundary | None  # the right boundary fit, if found in this frame
+
+    def centre_y(self, x: float) -> float:
+        """[m] lateral position (left +) of the lane centre at forward distance x [m], from
+        the car's centre, in the vehicle frame (second-order: offset, heading, curvature)."""
+        return -self.offset - math.tan(self.heading_error) * x + 0.5 * self.curvature * x * x
+
+
+# ---- objects (LiDAR) -----------------------------------------------------------------------
+
+
+class ObjectClass(enum.Enum):
+    """A coarse class from the box size."""
+
+    CAR = "car"
+    TRUCK = "truck"
+    PEDESTRIAN = "pedestrian"
+    OTHER = "other"
+
+
+@dataclass(frozen=True, slots=True)
+class Detection:
+    """One object found in one LiDAR scan: an oriented box in the vehicle frame."""
+
+    x: float  # [m] box centre, vehicle frame (forward)
+    y: float  # [m] box centre, vehicle frame (left)
+    z: float  # [m] box centre height above the ground
+    length: float  # [m] along the box's heading
+    width: float  # [m]
+    height: float  # [m]
+    yaw: float  # [rad] box heading in the vehicle frame, in (-pi/2, pi/2] (no front/back)
+    cls: ObjectClass
+    points: int  # [-] LiDAR returns in the cluster
+
+
+@dataclass(frozen=True, slots=True)
+class Track:
+    """A tracked object: filtered position and velocity over ground, in the map frame, and
+    the same relative to the ego (vehicle frame at the track's time)."""
+
+    id: int  # stable while the track lives
+    t: float  # [s] time of the state
+    x: float  # [m] map frame, box centre
+    y: float  # [m]
+    vx: float  # [m/s] map frame, over ground
+    vy: float  # [m/s]
+    rel_x: float  # [m] vehicle frame: ahead of the car's centre
+    rel_y: float  # [m] vehicle frame: left of the car's centre
+    rel_vx: float  # [m/s] vehicle frame: relative velocity (object minus ego), forward
+    rel_vy: float  # [m/s] vehicle frame, left
+    length: float  # [m]
+    width: float  # [m]
+    height: float  # [m]
+    yaw: float  # [rad] map frame box heading
+    cls: ObjectClass
+    hits: int  # [-] scans this track was updated in
+    misses: int  # [-] consecutive scans without a detection (coasting)
+    position_sigma: float  # [m] 1-sigma of the position (largest axis)
+
+    @property
+    def speed(self) -> float:
+        """[m/s] speed over ground."""
+        return math.hypot(self.vx, self.vy)

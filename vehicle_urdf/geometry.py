@@ -62,3 +62,31 @@ def read_geometry(path: Path = URDF_PATH) -> CarGeometry:
         mass=mass,
         max_steer=float(limit.attrib["upper"]),
     )
+
+
+@dataclass(frozen=True, slots=True)
+class MountPose:
+    """A sensor link's fixed joint: its origin in the base link frame."""
+
+    xyz: tuple[float, float, float]  # [m] from the base link origin (x fwd, y left, z up)
+    rpy: tuple[float, float, float]  # [rad] roll, pitch, yaw
+
+
+SENSOR_LINKS = ("lidar_link", "camera_front_link", "camera_left_link", "camera_right_link")
+
+
+def read_sensor_mounts(path: Path = URDF_PATH) -> dict[str, MountPose]:
+    """The fixed joints of the sensor links, by child link name (`SENSOR_LINKS`)."""
+    root = ET.parse(path).getroot()
+    out = {}
+    for joint in root.iter("joint"):
+        child = joint.find("child")
+        origin = joint.find("origin")
+        if child is None or origin is None or child.attrib["link"] not in SENSOR_LINKS:
+            continue
+        r, p, y = (float(v) for v in origin.attrib.get("rpy", "0 0 0").split())
+        out[child.attrib["link"]] = MountPose(_xyz(origin), (r, p, y))
+    missing = set(SENSOR_LINKS) - set(out)
+    if missing:
+        raise ValueError(f"{path}: no fixed joint for sensor links {sorted(missing)}")
+    return out

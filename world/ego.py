@@ -52,6 +52,7 @@ class EgoTruth:
 
     position: NDArray[np.float64]  # [m] (3,) map frame, the base link origin (car centre)
     quaternion: NDArray[np.float64]  # (4,) x, y, z, w, map frame
+    rotation: NDArray[np.float64]  # (3, 3) body -> map frame
     yaw: float  # [rad]
     velocity: NDArray[np.float64]  # [m/s] (3,) map frame, at the centre of mass
     speed: float  # [m/s] forward (body x) component
@@ -107,6 +108,7 @@ class EgoBody:
         for j in self.wheel_joints:
             client.changeDynamics(self.body, j, maxJointVelocity=MAX_WHEEL_SPIN)
         self._com_offset = np.array(client.getDynamicsInfo(self.body, -1)[3])
+        self._all_joints = list(range(client.getNumJoints(self.body)))
         # bound once: these run at the control rate
         self._base_pose = client.getBasePositionAndOrientation
         self._base_velocity = client.getBaseVelocity
@@ -161,6 +163,21 @@ class EgoBody:
             targetVelocities=[spin] * 4, forces=[abs(net) / 4] * 4,
         )
 
+    def base_state(self) -> tuple[tuple[float, ...], tuple[float, ...], list[float]]:
+        """Bullet's raw base pose (centre-of-mass frame position, quaternion) and the joint
+        positions in joint order: what a mirror of this body needs to look the same."""
+        com, quat = self._base_pose(self.body)
+        joints = [s[0] for s in self._joint_states(self.body, self._all_joints)]
+        return tuple(com), tuple(quat), joints
+
+    def set_base_state(self, com: tuple[float, ...], quat: tuple[float, ...],
+                       joints: list[float]) -> None:
+        """Pose a MIRROR body (a sensor world's copy, never the simulated ego) as
+        `base_state` read it."""
+        self._c.resetBasePositionAndOrientation(self.body, com, quat)
+        for j, q in zip(self._all_joints, joints, strict=True):
+            self._c.resetJointState(self.body, j, q)
+
     def truth(self) -> EgoTruth:
         """Read the body's true state (link frame origin, not Bullet's centre-of-mass frame)."""
         com, quat = self._base_pose(self.body)
@@ -176,6 +193,7 @@ class EgoBody:
         return EgoTruth(
             position=position,
             quaternion=np.asarray(quat),
+            rotation=rot,
             yaw=yaw,
             velocity=velocity,
             speed=float(velocity @ rot[:, 0]),

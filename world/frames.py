@@ -1,13 +1,23 @@
 """Sensor data types: what the car's sensors hand to the stack.
 
-This is a leaf module (no PyBullet, no numpy-heavy imports beyond types) so that
-`perception/` may import it without reaching into the simulator.
-Frames: the map frame is ENU-like, x east, y north, z up, yaw counter-clockwise from +x.
+This is a leaf module (dataclasses and numpy types only, no PyBullet) so that `perception/`
+may import it without reaching into the simulator.
+
+Frames:
+- map: ENU-like, x east, y north, z up, yaw counter-clockwise from +x;
+- vehicle: the car's footprint frame, origin on the ground below the car's centre (the base
+  link origin), x forward, y left, z up; it moves with the body (pitch and roll included);
+- sensor: a sensor's own frame, placed on the vehicle by its `SensorMount`; x along the
+  sensor's axis (a camera's optical axis), y left, z up.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
 
 
 @dataclass(frozen=True, slots=True)
@@ -36,3 +46,122 @@ class Odometry:
     def speed(self) -> float:
         """[m/s] forward speed from the mean rear-wheel spin (the undriven-by-steer axle)."""
         return 0.5 * (self.wheel_speeds[2] + self.wheel_speeds[3]) * self.wheel_radius
+
+
+@dataclass(frozen=True, slots=True)
+class SensorMount:
+    """Where a sensor sits on the car: its frame in the vehicle frame (calibration data)."""
+
+    x: float  # [m] forward of the car's centre
+    y: float  # [m] left of the car's centre
+    z: float  # [m] above the ground
+    roll: float = 0.0  # [rad] about the sensor's x
+    pitch: float = 0.0  # [rad] about y, positive looks DOWN (right-handed about +y)
+    yaw: float = 0.0  # [rad] about z, counter-clockwise from the car's forward axis
+
+    def rotation(self) -> NDArray[np.float64]:
+        """(3, 3) sensor-to-vehicle rotation R = Rz(yaw) Ry(pitch) Rx(roll)."""
+        cr, sr = math.cos(self.roll), math.sin(self.roll)
+        cp, sp = math.cos(self.pitch), math.sin(self.pitch)
+        cy, sy = math.cos(self.yaw), math.sin(self.yaw)
+        return np.array([
+            [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+            [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+            [-sp, cp * sr, cp * cr],
+        ])
+
+    def to_vehicle(self, points: NDArray[np.floating]) -> NDArray[np.float64]:
+        """(N, 3) points in the sensor frame -> the vehicle frame."""
+        out: NDArray[np.float64] = points @ self.rotation().T + np.array([self.x, self.y, self.z])
+        return out
+
+
+@dataclass(frozen=True, slots=True)
+class CameraInfo:
+    """A pinhole camera: resolution, field of view and mounting (static calibration).
+
+    Pixel (u, v): u to the right, v down, continuous, pixel i covering [i, i + 1). A point
+    (X, Y, Z) in the camera's sensor frame (X along the optical axis, Y left, Z up, X > 0)
+    images at ``u = cx - fx Y / X``, ``v = cy - fy Z / X``.
+    """
+
+    name: str  # "front", "left", "right"
+    width: int  # [px]
+    height: int  # [px]
+    fov_x: float  # [rad] horizontal field of view
+    mount: SensorMount
+    rate: float  # [Hz] frames per second
+    near: float = 0.1  # [m] clipping distance of the renderer
+    far: float = 250.0  # [m]
+
+    @property
+    def fx(self) -> float:
+        """[px] focal length (square pixels: fy = fx)."""
+        return 0.5 * self.width / math.tan(0.5 * self.fov_x)
+
+    @property
+    def fy(self) -> float:
+        return self.fx
+
+    @property
+    def cx(self) -> float:
+        """[px] principal point, the image centre."""
+        return 0.5 * self.width
+
+    @property
+    def cy(self) -> float:
+        return 0.5 * self.height
+
+    @property
+    def fov_y(self) -> float:
+        """[rad] vertical field of view."""
+        return 2.0 * math.atan(0.5 * self.height / self.fy)
+
+    def matrix(self) -> NDArray[np.float64]:
+        """(3, 3) the intrinsic matrix K for OpenCV-style (x right, y down, z forward) rays."""
+        return np.array([[self.fx, 0.0, self.cx], [0.0, self.fy, self.cy], [0.0, 0.0, 1.0]])
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class CameraFrame:
+    """One camera image."""
+
+    t: float  # [s] sim time of the exposure
+    info: CameraInfo
+    rgb: NDArray[np.uint8]  # (height, width, 3)
+
+
+@dataclass(frozen=True, slots=True)
+class LidarInfo:
+    """A spinning multi-channel LiDAR (VLP-16-like): the beam layout and mounting."""
+
+    elevations: tuple[float, ...]  # [rad] per channel (ring), ascending
+    azimuth_steps: int  # [-] columns per revolution
+    max_range: float  # [m]
+    rate: float  # [Hz] revolutions per second
+    mount: SensorMount
+    range_sigma: float = 0.02  # [m] range noise, 1-sigma
+    dropout: float = 0.0  # [-] fraction of returns lost
+
+    @property
+    def channels(self) -> int:
+        return len(self.elevations)
+
+    @property
+    def rays(self) -> int:
+        return self.channels * self.azimuth_steps
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class LidarScan:
+    """One revolution's returns (rays without a return, or dropped, are absent).
+
+    The revolution is taken at one instant ``t`` (no motion skew). Azimuth 0 is the sensor's
+    forward axis, increasing counter-clockwise.
+    """
+
+    t: float  # [s] sim time of the revolution
+    info: LidarInfo
+    points: NDArray[np.float32]  # [m] (N, 3) in the sensor frame
+    ring: NDArray[np.uint8]  # (N,) channel index into info.elevations
+    column: NDArray[np.uint16]  # (N,) azimuth step, 0 .. info.azimuth_steps - 1

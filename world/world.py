@@ -23,6 +23,8 @@ from world.client import Clock, Rate, add_ground, make_client
 from world.ego import EgoBody, EgoParams, EgoTruth
 from world.gnss import GnssSensor, OdometrySensor
 from world.hdmap import RoadMap
+from world.lidar import EGO_RAY_GROUP
+from world.rendering import attach_renderer
 from world.road_mesh import TexturedMesh, build_road_surface
 from world.scenery import (
     BuildingBox,
@@ -31,6 +33,8 @@ from world.scenery import (
     layout_speed_limit_signs,
     speed_limit_sign_image,
 )
+from world.sensor_setup import SensorSetup
+from world.sensors import SensorRig
 from world.spec import ScenarioSpec
 from world.truth import RouteTruth, route_truth
 
@@ -51,13 +55,27 @@ class StaticScene:
     obstacle_bodies: frozenset[int]  # buildings and sign poles: touching one is a collision
 
 
+@dataclass(frozen=True, slots=True)
+class WorldSnapshot:
+    """The poses of everything that moves, at one physics step (picklable)."""
+
+    step: int
+    ego_com: tuple[float, ...]  # Bullet's base (centre-of-mass) position
+    ego_quat: tuple[float, ...]  # x, y, z, w
+    ego_joints: list[float]  # joint positions in joint order (wheel spin, steering hinges)
+    actors: tuple[tuple[tuple[float, ...], tuple[float, ...]], ...]  # (position, quaternion)
+
+
 class World:
     """One scenario's world in its own physics client."""
 
-    def __init__(self, spec: ScenarioSpec) -> None:
+    def __init__(self, spec: ScenarioSpec, sensors: SensorSetup | None = None) -> None:
+        """`sensors`: build the camera and LiDAR rig in this client too (the renderer is
+        attached before anything else, as EGL requires)."""
         self.spec = spec
-        seeds = np.random.SeedSequence(spec.seed).spawn(3)
+        seeds = np.random.SeedSequence(spec.seed).spawn(4)
         self.client = make_client()
+        self.renderer = attach_renderer(self.client) if sensors is not None else None
         self.clock = Clock()
         self._step_physics = self.client.stepSimulation  # bound once: called every step
         self.road = RoadMap.from_spec(spec.road)
@@ -70,10 +88,16 @@ class World:
             self.client, float(xy[0]), float(xy[1]), yaw, spec.ego.speed,
             EgoParams(max_speed=spec.ego.max_speed),
         )
+        for link in range(-1, self.client.getNumJoints(self.ego.body)):
+            self.client.setCollisionFilterGroupMask(self.ego.body, link, EGO_RAY_GROUP, 0xFFFF)
         self.actors = ActorSet(self.client, self.road, spec.actors)
         self.gnss = GnssSensor(spec.sensors.gnss, np.random.default_rng(seeds[1]))
         self.odometry = OdometrySensor(
             self.ego.geometry.wheel_radius, np.random.default_rng(seeds[2])
+        )
+        self.rig = None if sensors is None or self.renderer is None else SensorRig(
+            self.client, sensors, self.renderer, self.ego.geometry.wheel_radius,
+            np.random.default_rng(seeds[3]),
         )
         self._truth: EgoTruth | None = None
         self._route: RouteTruth | None = None
@@ -96,11 +120,6 @@ class World:
         obstacles |= {self._add_sign(sign) for sign in signs}
         return StaticScene(meshes, buildings, signs, ground, frozenset(obstacles))
 
-    def _texture(self, name: str, rgb: NDArray[np.uint8]) -> int:
-        path = Path(self._tmp.name) / f"{name}.png"
-        cv2.imwrite(str(path), cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR))
-        return int(self.client.loadTexture(str(path)))
-
     def _add_textured_mesh(
         self,
         name: str,
@@ -110,19 +129,17 @@ class World:
         normals: NDArray[np.float64],
         texture: NDArray[np.uint8],
     ) -> int:
-        """A visual-only body (no collision: the ground plane carries the car)."""
+        """A visual-only body (no collision: the ground plane carries the car).
+
+        The mesh goes through a Wavefront OBJ file whose material names the texture PNG:
+        both renderers load that (the EGL plugin drops meshes given as vertex arrays, and
+        ignores textures attached afterwards with `changeVisualShape`)."""
         c = self.client
-        visual = c.createVisualShape(
-            pybullet.GEOM_MESH,
-            vertices=vertices.tolist(),
-            indices=indices.reshape(-1).tolist(),
-            uvs=uvs.tolist(),
-            normals=normals.tolist(),
-        )
-        body = int(c.createMultiBody(0.0, -1, visual, useMaximalCoordinates=True))
-        c.changeVisualShape(body, -1, textureUniqueId=self._texture(name, texture),
-                            rgbaColor=[1, 1, 1, 1])
-        return body
+        folder = Path(self._tmp.name)
+        cv2.imwrite(str(folder / f"{name}.png"), cv2.cvtColor(texture, cv2.COLOR_RGB2BGR))
+        _write_obj(folder / f"{name}.obj", vertices, indices, uvs, normals, f"{name}.png")
+        visual = c.createVisualShape(pybullet.GEOM_MESH, fileName=str(folder / f"{name}.obj"))
+        return int(c.createMultiBody(0.0, -1, visual, useMaximalCoordinates=True))
 
     def _add_building(self, b: BuildingBox) -> int:
         c = self.client
@@ -191,10 +208,40 @@ class World:
         if self.clock.step % ACTOR_RATE.every == 0:
             self.actors.step(self.clock.t, ACTOR_RATE.every * self.clock.dt)
 
+    def snapshot(self) -> WorldSnapshot:
+        """The moving bodies' poses now (for a mirror world that only renders)."""
+        com, quat, joints = self.ego.base_state()
+        actors = tuple(self.client.getBasePositionAndOrientation(b) for b in self.actors.bodies)
+        return WorldSnapshot(self.clock.step, com, quat, joints, actors)
+
+    def apply_snapshot(self, snap: WorldSnapshot) -> None:
+        """Pose this world as `snap` says: for a MIRROR world, never one being simulated."""
+        self.clock.step = snap.step
+        self.ego.set_base_state(snap.ego_com, snap.ego_quat, snap.ego_joints)
+        for body, (position, quat) in zip(self.actors.bodies, snap.actors, strict=True):
+            self.client.resetBasePositionAndOrientation(body, position, quat)
+        self._truth = None
+        self._route = None
+
     def close(self) -> None:
         if self.client is not None:
             self.client.disconnect()
         self._tmp.cleanup()
+
+
+def _write_obj(path: Path, vertices: NDArray[np.float64], indices: NDArray[np.int32],
+               uvs: NDArray[np.float64], normals: NDArray[np.float64], texture: str) -> None:
+    """A triangle mesh as a Wavefront OBJ (one index per vertex for position, texture
+    coordinate and normal) with a material file that maps `texture` (a file name beside it)."""
+    material = path.with_suffix(".mtl")
+    material.write_text(f"newmtl painted\nKa 1 1 1\nKd 1 1 1\nKs 0 0 0\nmap_Kd {texture}\n")
+    faces = indices.reshape(-1, 3) + 1
+    with path.open("w") as f:
+        f.write(f"mtllib {material.name}\nusemtl painted\n")
+        np.savetxt(f, vertices, fmt="v %.6f %.6f %.6f")
+        np.savetxt(f, uvs, fmt="vt %.6f %.6f")
+        np.savetxt(f, normals, fmt="vn %.6f %.6f %.6f")
+        np.savetxt(f, np.repeat(faces, 3, axis=1), fmt="f %d/%d/%d %d/%d/%d %d/%d/%d")
 
 
 def _disc_mesh(

@@ -1,0 +1,91 @@
+"""The car's sensor set-up: cameras and LiDAR built from a profile and the URDF's mounts.
+
+Profiles (`--profile`):
+
+| profile   | front camera       | side cameras        | LiDAR (16 channels, 10 Hz) |
+|-----------|--------------------|---------------------|----------------------------|
+| `fast`    | 640x480 @ 10 Hz    | none                | 900 columns (0.4 deg)      |
+| `default` | 640x480 @ 10 Hz    | 320x240 @ 2 Hz      | 1800 columns (0.2 deg)     |
+| `paper`   | 1280x960 @ 10 Hz   | 1280x960 @ 10 Hz    | 1800 columns (0.2 deg)     |
+
+Cameras have an 80 deg horizontal field of view. The LiDAR is VLP-16-like: channels from
+-15 to +15 deg every 2 deg, 360 deg, 100 m. Mounts come from the URDF's sensor links (the
+vehicle frame's origin is on the ground, the base link's origin a wheel radius above it).
+The scenario's `sensors.lidar` block sets range noise and dropout.
+"""
+
+from __future__ import annotations
+
+import enum
+import math
+from dataclasses import dataclass, replace
+
+from vehicle_urdf import MountPose, read_geometry, read_sensor_mounts
+from world.frames import CameraInfo, LidarInfo, SensorMount
+from world.spec import LidarNoiseSpec
+
+CAMERA_FOV = math.radians(80.0)  # [rad] horizontal
+LIDAR_ELEVATIONS = tuple(math.radians(e) for e in range(-15, 16, 2))  # [rad] 16 channels
+LIDAR_RANGE = 100.0  # [m]
+LIDAR_RATE = 10.0  # [Hz]
+
+
+class Profile(enum.Enum):
+    FAST = "fast"
+    DEFAULT = "default"
+    PAPER = "paper"
+
+
+@dataclass(frozen=True, slots=True)
+class SensorSetup:
+    """Every sensor of the car for one run."""
+
+    profile: Profile
+    cameras: tuple[CameraInfo, ...]  # front first
+    lidar: LidarInfo
+
+    def camera(self, name: str) -> CameraInfo:
+        for c in self.cameras:
+            if c.name == name:
+                return c
+        raise KeyError(f"no camera {name!r} in profile {self.profile.value}")
+
+
+@dataclass(frozen=True, slots=True)
+class _CameraSpec:
+    name: str
+    width: int
+    height: int
+    rate: float
+
+
+_PROFILES: dict[Profile, tuple[tuple[_CameraSpec, ...], int]] = {
+    Profile.FAST: ((_CameraSpec("front", 640, 480, 10.0),), 900),
+    Profile.DEFAULT: ((_CameraSpec("front", 640, 480, 10.0), _CameraSpec("left", 320, 240, 2.0),
+                       _CameraSpec("right", 320, 240, 2.0)), 1800),
+    Profile.PAPER: ((_CameraSpec("front", 1280, 960, 10.0), _CameraSpec("left", 1280, 960, 10.0),
+                     _CameraSpec("right", 1280, 960, 10.0)), 1800),
+}
+
+
+def _mount(pose: MountPose, ride_height: float) -> SensorMount:
+    x, y, z = pose.xyz
+    roll, pitch, yaw = pose.rpy
+    return SensorMount(x, y, z + ride_height, roll, pitch, yaw)
+
+
+def sensor_setup(profile: Profile, lidar_noise: LidarNoiseSpec | None = None) -> SensorSetup:
+    """The profile's sensors on the URDF's mounts, with the scenario's LiDAR noise."""
+    mounts = read_sensor_mounts()
+    ride_height = read_geometry().wheel_radius  # [m] base link origin above the ground
+    cams_spec, columns = _PROFILES[profile]
+    cameras = tuple(
+        CameraInfo(name=c.name, width=c.width, height=c.height, fov_x=CAMERA_FOV,
+                   mount=_mount(mounts[f"camera_{c.name}_link"], ride_height), rate=c.rate)
+        for c in cams_spec
+    )
+    lidar = LidarInfo(elevations=LIDAR_ELEVATIONS, azimuth_steps=columns, max_range=LIDAR_RANGE,
+                      rate=LIDAR_RATE, mount=_mount(mounts["lidar_link"], ride_height))
+    if lidar_noise is not None:
+        lidar = replace(lidar, range_sigma=lidar_noise.range_sigma, dropout=lidar_noise.dropout)
+    return SensorSetup(profile, cameras, lidar)
