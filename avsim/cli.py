@@ -25,7 +25,8 @@ from avsim.schema import scenario_json_schema
 if TYPE_CHECKING:
     from avsim.runner import Runner, RunResult
 
-PROFILES = ("fast", "default", "paper")
+PROFILES = ("fast", "default", "paper", "none")
+SENSING = ("auto", "inline", "process")
 EXIT_FAILED, EXIT_BAD_INPUT = 1, 2
 
 
@@ -57,10 +58,12 @@ def main() -> None:
 @click.option("--json", "json_path", type=click.Path(path_type=Path), default=None,
               help="Result file. Default: next to the recording, <name>.json")
 @click.option("--profile", type=click.Choice(PROFILES), default="default", show_default=True,
-              help="Sensor profile (cameras and LiDAR come with issue B).")
+              help="Sensor profile: cameras and LiDAR (none: GNSS + odometry on the map).")
+@click.option("--sensing", type=click.Choice(SENSING), default="auto", show_default=True,
+              help="Where cameras render: a worker process (auto on 2+ cores) or inline.")
 @click.option("--seed", type=int, default=None, help="Override the scenario's seed.")
 @click.option("--no-progress", is_flag=True, help="No progress bar.")
-def run(scenario: str, out: Path | None, json_path: Path | None, profile: str,
+def run(scenario: str, out: Path | None, json_path: Path | None, profile: str, sensing: str,
         seed: int | None, no_progress: bool) -> None:
     """Run SCENARIO (a file or a bundled name) and judge it."""
     overrides = {"seed": seed} if seed is not None else None
@@ -72,11 +75,16 @@ def run(scenario: str, out: Path | None, json_path: Path | None, profile: str,
     json_path = json_path if json_path is not None else out.with_suffix(".json")
     _writable(out, "--out")
     _writable(json_path, "--json")
-    from avsim.runner import Runner  # heavy (PyBullet): after the input is known good
+    from world.quiet import quiet_c_output
+
+    with quiet_c_output():  # PyBullet's build banner
+        from avsim.runner import Runner  # heavy: only once the input is known good
+        from world.sensor_setup import Profile
 
     out.parent.mkdir(parents=True, exist_ok=True)
     partial = out.with_name(f".{out.name}.partial")
-    result = _run_with_progress(Runner(spec, partial), spec.duration, not no_progress)
+    runner = Runner(spec, partial, None if profile == "none" else Profile(profile), sensing)
+    result = _run_with_progress(runner, spec.duration, not no_progress)
     partial.replace(out)
     payload = result_json(result, scenario, out, profile)
     _write_atomic(json_path, json.dumps(payload, indent=2) + "\n")
@@ -114,8 +122,9 @@ def _print_verdict(payload: dict[str, object]) -> None:
         table.add_row(c["name"], "pass" if c["passed"] else "[red]FAIL[/red]",
                       f"{c['value']:.3f}", f"{c['threshold']}", c["unit"])
     console.print(table)
-    console.print(f"sim {payload['sim_time']:.1f} s in {payload['wall_time']:.1f} s wall; "
-                  f"recording {payload['recording']}")
+    renderer = f", cameras by {payload['renderer']}" if payload.get("renderer") else ""
+    console.print(f"sim {payload['sim_time']:.1f} s in {payload['wall_time']:.1f} s wall "
+                  f"(profile {payload['profile']}{renderer}); recording {payload['recording']}")
 
 
 @main.command(name="list")

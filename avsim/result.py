@@ -23,10 +23,16 @@ def result_json(result: RunResult, file: str | Path, recording: Path, profile: s
         "file": str(file),
         "seed": spec.seed,
         "profile": profile,
+        "renderer": result.renderer,
         "passed": result.passed,
         "sim_time": round(result.sim_time, 4),
         "wall_time": round(result.wall_time, 3),
         "criteria": [c.as_json() for c in result.criteria],
         "metrics": {k: _clean(v) for k, v in result.metrics.items()},
+        "state_changes": [
+            {"t": round(c.t, 4), "machine": c.machine, "from": c.source, "to": c.target,
+             "reason": c.reason}
+            for c in result.state_changes
+        ],
         "recording": str(recording),
     }

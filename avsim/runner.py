@@ -33,8 +33,11 @@ from avsim.criteria import (
     TyresInLane,
 )
 from avsim.recorder import Recorder
+from avsim.sensor_loop import FrameHook, SensorLoop, sensing_mode
 from avsim.stack import Stack, StackOutput
+from planner.messages import StateChange
 from world.client import PHYSICS_RATE, Rate
+from world.sensor_setup import Profile, sensor_setup
 from world.spec import ScenarioSpec
 from world.truth import touching
 from world.world import World
@@ -85,6 +88,9 @@ class RunResult:
     wall_time: float  # [s]
     log: TrajectoryLog
     recording: Path | None
+    state_changes: tuple[StateChange, ...] = ()  # every FSM change, in time order
+    profile: str | None = None  # the sensor profile (None: map + GNSS only)
+    renderer: str | None = None  # "egl" or "tiny" when cameras rendered
 
     @property
     def passed(self) -> bool:
@@ -94,12 +100,21 @@ class RunResult:
 class Runner:
     """Runs one scenario to its end (duration, or `completes` reached) and judges it."""
 
-    def __init__(self, spec: ScenarioSpec, recording: Path | None = None) -> None:
+    def __init__(self, spec: ScenarioSpec, recording: Path | None = None,
+                 profile: Profile | None = Profile.DEFAULT, sensing: str = "auto",
+                 frame_hook: FrameHook | None = None) -> None:
+        """`profile`: the sensor set-up (None: no cameras or LiDAR, the stack drives on
+        GNSS + odometry and the map); `sensing`: where cameras render ('auto', 'inline' or
+        'process', see `world.sensing`); `frame_hook`: alters the camera frames the stack
+        gets (fault injection in tests)."""
         self.spec = spec
-        self.world = World(spec)
+        self.setup = sensor_setup(profile, spec.sensors.lidar) if profile is not None else None
+        mode = sensing_mode(sensing)
+        self.world = World(spec, self.setup, cameras=mode == "inline")
         w = self.world
         self.car = w.ego.geometry
-        self.stack = Stack(w.road, spec.ego, self.car)
+        front = self.setup.camera("front") if self.setup is not None else None
+        self.stack = Stack(w.road, spec.ego, self.car, front)
         self.log = TrajectoryLog()
         names = {b: "building or sign" for b in w.scene.obstacle_bodies}
         names.update({b: f"actor {a.id}" for b, a in zip(w.actors.bodies, spec.actors,
@@ -113,6 +128,9 @@ class Runner:
             items.append(MaxDecel(spec.criteria.max_decel, CRITERIA_RATE.hz))
         self.criteria = CriteriaSet(items)
         self.recorder = Recorder(recording, recording_name=spec.name) if recording else None
+        self.sensors = None if self.setup is None else SensorLoop(
+            w, self.setup, self.stack, mode, self.recorder, frame_hook)
+        self.state_changes: list[StateChange] = []
         self._touching: frozenset[int] = frozenset()
         self._logged_events = 0  # collision events already sent to the recording
         self._last: StackOutput | None = None
@@ -143,6 +161,8 @@ class Runner:
                 if progress is not None and w.clock.step % PHYSICS_RATE == 0:
                     progress(w.t, self.spec.duration)
         finally:
+            if self.sensors is not None:
+                self.sensors.close()
             if self.recorder is not None:
                 self._record_criteria()
                 self.recorder.close()
@@ -152,11 +172,16 @@ class Runner:
             spec=self.spec, criteria=self.criteria.results(), metrics=self._metrics(),
             sim_time=sim_time, wall_time=time.perf_counter() - start, log=self.log,
             recording=self.recorder.path if self.recorder else None,
+            state_changes=tuple(self.state_changes),
+            profile=self.setup.profile.value if self.setup is not None else None,
+            renderer=self.sensors.sensing.renderer.value if self.sensors is not None else None,
         )
 
     def _tick(self) -> None:
         """A control tick: sensors at their rates, then decide and apply."""
         w = self.world
+        if self.sensors is not None:
+            self.sensors.tick()
         truth = w.ego_truth
         if GNSS_RATE.fires(w.clock.step):
             self.stack.on_gnss(w.gnss.measure(w.t, truth))
@@ -166,6 +191,10 @@ class Runner:
         w.ego.apply(cmd.steering_angle, cmd.drive_torque, cmd.brake_torque)
         self._last = out
         self._log_tick(out)
+        for change in out.plan.changes:
+            self.state_changes.append(change)
+            if self.recorder is not None:
+                self.recorder.log_state(change.t, change.machine, change.target, change.reason)
 
     def _log_tick(self, out: StackOutput) -> None:
         w, log = self.world, self.log
@@ -232,7 +261,7 @@ class Runner:
             "max_speed": float(np.max(speed)) if len(speed) else 0.0,
             "distance": float(self.log.station[-1] - self.log.station[0]) if xte.size else 0.0,
             "collisions": float(self.collisions.count),
-        }
+        } | (self.sensors.metrics() if self.sensors is not None else {})
 
     # -- recording -----------------------------------------------------------------------------
 

@@ -1,23 +1,42 @@
-"""The minimal planner: keep one lane of the map at the target speed.
+"""Lane keeping: follow the ego lane as the camera sees it, at the planned speed.
 
-Each tick: project the ego estimate onto the lane (station, lateral error), sample the lane
-centre around it (`planner.route.lane_path`), and plan the target speed
-(`planner.speed_planning.SpeedPlanner`). The path and the speed target are computed
-separately (`path_for`, `speed_for`) so that the motion / control FSM planners built on this
-can swap either one (a lane-change path, an ACC speed) and keep the other.
+Each tick: project the ego estimate onto the map lane (station, for the speed plan and
+events; the map is the paper's HD map), choose the lateral reference with the lane-source
+FSM (`planner.lane_source`): the camera's lane (`planner.camera_lane`) when it is seen,
+the map lane (`planner.route.lane_path`, placed by the GNSS + odometry estimate) while it is
+acquired or lost. The target speed is the map's (`planner.speed_planning.SpeedPlanner`),
+capped behind a lead vehicle from the tracks (`planner.lead`) and, when the lane is lost,
+ramped down at ``a_comf`` to the hold speed, then to a stop in lane.
+
+The path and the speed target are computed separately (`path_for`, `speed_for`) so that
+the motion / control FSM planners built on this can swap either one (a lane-change path, an
+ACC speed) and keep the other.
 """
 
 from __future__ import annotations
 
+import math
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from perception.messages import EgoState
-from planner.messages import Plan, ReferencePath
+from perception.messages import EgoState, LaneEstimate, Track
+from planner.camera_lane import camera_lane_path
+from planner.lane_source import LaneSource, LaneSourceInput, LaneSourceParams, transition
+from planner.lead import LeadParams, select_lead
+from planner.messages import Lead, Plan, ReferencePath, StateChange
 from planner.route import lane_path
 from planner.speed_planning import SpeedPlanner, SpeedPlanningParams, SpeedTarget
 from world.hdmap import RoadMap
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class LaneView:
+    """The camera's latest lane estimate and the ego estimate at its frame's time."""
+
+    estimate: LaneEstimate
+    pose: EgoState
 
 
 @dataclass(frozen=True, slots=True)
@@ -29,7 +48,11 @@ class LaneKeepingParams:
     path_ahead_min: float = 25.0  # [m] shortest path ahead of the car's centre
     path_ahead_time: float = 2.5  # [s] path ahead = max(path_ahead_min, this * speed)
     path_spacing: float = 0.5  # [m] station step of the path samples
+    camera: bool = True  # False: no camera in this stack, the map lane only (state MAP)
+    camera_ahead: float = 30.0  # [m] the camera's lane is used this far ahead of its frame
     speed: SpeedPlanningParams = field(default_factory=SpeedPlanningParams)
+    source: LaneSourceParams = field(default_factory=LaneSourceParams)
+    lead: LeadParams = field(default_factory=LeadParams)
 
 
 class LaneKeepingPlanner:
@@ -42,9 +65,14 @@ class LaneKeepingPlanner:
         self.params = params
         self.lane = road.lane(params.lane)
         self.speed_planner = SpeedPlanner(road, self.lane, params.speed)
+        self.reset()
 
     def reset(self) -> None:
-        """Nothing lives between ticks: the map projection is exact, so no station hint."""
+        """Back to ACQUIRING the lane (MAP without a camera), with no speed cap."""
+        self.source = LaneSource.ACQUIRING if self.params.camera else LaneSource.MAP
+        self._since: float | None = None  # [s] time of the last lane-source change
+        self._cap = math.inf  # [m/s] the ramped speed cap of the degraded modes
+        self._last_t: float | None = None
 
     def localise(self, ego: EgoState) -> tuple[float, float]:
         """(station [m], lateral offset [m], left +) of the ego's centre on the lane."""
@@ -64,17 +92,77 @@ class LaneKeepingPlanner:
         p = self.params
         return self.speed_planner.target(station, set_speed=p.set_speed, max_speed=p.max_speed)
 
-    def update(self, ego: EgoState) -> Plan:
-        """The plan for this tick, made from ``ego`` (map frame, car centre)."""
+    def update(self, ego: EgoState, view: LaneView | None = None,
+               tracks: Sequence[Track] = ()) -> Plan:
+        """The plan for this tick, made from ``ego`` (map frame, car centre), the camera's
+        lane ``view`` (None before the first frame) and the confirmed ``tracks``."""
+        dt = 0.0 if self._last_t is None else max(ego.t - self._last_t, 0.0)
+        self._last_t = ego.t
+        changes = self._update_source(ego.t, view)
         station, lateral = self.localise(ego)
+        camera = self.source is LaneSource.CAMERA and view is not None
+        path = self._camera_path(view) if camera and view is not None else \
+            self.path_for(ego, station)
         target = self.speed_for(station)
+        speed, accel = target.speed, target.accel
+        lead = self._lead(view, tracks, ego)
+        if lead is not None and lead.safe_speed < speed:
+            speed, accel = lead.safe_speed, 0.0
+        speed, accel = self._degraded_cap(speed, accel, ego.speed, dt)
         return Plan(
             t=ego.t,
             ego=ego,
-            path=self.path_for(ego, station),
-            target_speed=target.speed,
-            target_accel=target.accel,
+            path=path,
+            target_speed=speed,
+            target_accel=accel,
             speed_limit=target.limit_at_front,
             station=station,
             lateral_error=lateral,
+            lane_source=self.source,
+            lead=lead,
+            changes=changes,
         )
+
+    def _update_source(self, t: float, view: LaneView | None) -> tuple[StateChange, ...]:
+        if self._since is None:
+            self._since = t
+        confidence = view.estimate.confidence if view is not None else 0.0
+        change = transition(self.source, LaneSourceInput(t, confidence, self._since),
+                            self.params.source)
+        if change is None:
+            return ()
+        old, self.source, self._since = self.source, change.to, t
+        return (StateChange(t, "lane_source", old.value, change.to.value, change.reason),)
+
+    def _camera_path(self, view: LaneView) -> ReferencePath:
+        p = self.params
+        return camera_lane_path(view.estimate, view.pose, behind=p.path_behind,
+                                ahead=p.camera_ahead, spacing=p.path_spacing)
+
+    def _lead(self, view: LaneView | None, tracks: Sequence[Track], ego: EgoState) -> Lead | None:
+        if not tracks:
+            return None
+        centre: Callable[[float], float] = _straight_ahead
+        if view is not None and self.source is LaneSource.CAMERA:
+            centre = view.estimate.centre_y
+        return select_lead(tracks, centre, ego.heading, self.params.lead)
+
+    def _degraded_cap(self, speed: float, accel: float, ego_speed: float,
+                      dt: float) -> tuple[float, float]:
+        """With the lane lost, ramp the target down at a_comf to the hold speed / to 0."""
+        wanted = {LaneSource.MAP_HOLD: self.params.source.hold_speed,
+                  LaneSource.STOP_IN_LANE: 0.0}.get(self.source, math.inf)
+        if math.isinf(wanted):
+            self._cap = math.inf
+            return speed, accel
+        a_comf = self.params.speed.a_comf
+        start = min(self._cap, max(ego_speed, speed)) if math.isfinite(self._cap) else ego_speed
+        self._cap = max(wanted, start - a_comf * dt)
+        if self._cap < speed:
+            return self._cap, -a_comf if self._cap > wanted else 0.0
+        return speed, accel
+
+
+def _straight_ahead(_x: float) -> float:
+    """The lane centre when the camera's lane is not available: straight ahead."""
+    return 0.0

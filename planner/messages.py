@@ -12,8 +12,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from perception.messages import EgoState
+from planner.lane_source import LaneSource
 
-__all__ = ["EgoState", "Plan", "ReferencePath"]
+__all__ = ["EgoState", "Lead", "Plan", "ReferencePath", "StateChange"]
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -23,6 +24,27 @@ class ReferencePath:
     xy: NDArray[np.float64]  # [m] (N, 2) map frame points, N >= 2, spaced about `spacing`
     heading: NDArray[np.float64]  # [rad] (N,) path tangent, counter-clockwise from +x
     curvature: NDArray[np.float64]  # [1/m] (N,) signed, > 0 turns left
+
+
+@dataclass(frozen=True, slots=True)
+class Lead:
+    """The vehicle ahead in the ego's lane, as the tracks show it."""
+
+    track_id: int
+    gap: float  # [m] ego front bumper to the lead's rear, along the ego's heading
+    speed: float  # [m/s] the lead's speed over ground along the ego's heading
+    safe_speed: float  # [m/s] the cap it sets on the ego's target speed
+
+
+@dataclass(frozen=True, slots=True)
+class StateChange:
+    """One change of a planner state machine, with its reason (for the log and results)."""
+
+    t: float  # [s]
+    machine: str  # e.g. "lane_source", "motion", "control", "acc"
+    source: str  # the state left
+    target: str  # the state entered
+    reason: str
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -35,3 +57,6 @@ class Plan:
     speed_limit: float  # [m/s] posted limit in force at the front bumper
     station: float  # [m] the ego's station on the route (from the map and its own estimate)
     lateral_error: float  # [m] the planner's view of the ego's offset from the path, left +
+    lane_source: LaneSource = LaneSource.ACQUIRING  # where the path comes from
+    lead: Lead | None = None  # the vehicle ahead in the lane, if a track shows one
+    changes: tuple[StateChange, ...] = ()  # state changes made in this tick

@@ -22,6 +22,13 @@ class CarGeometry:
     rear_axle: float  # [m] behind the car's centre, as a positive distance
     mass: float  # [kg] total
     max_steer: float  # [rad] road-wheel hinge limit
+    tyre_stiffness: float = 300_000.0  # [N/m] vertical contact stiffness of one tyre
+
+    @property
+    def ride_height(self) -> float:
+        """[m] the base link origin's height above the ground at rest: the wheel radius less
+        each tyre's static compression under a quarter of the weight."""
+        return self.wheel_radius - self.mass * 9.81 / (4.0 * self.tyre_stiffness)
 
     @property
     def front_overhang(self) -> float:
@@ -47,7 +54,8 @@ def read_geometry(path: Path = URDF_PATH) -> CarGeometry:
     cylinder = links["front_left_wheel"].find("visual/geometry/cylinder")
     body = links["base_link"].find("visual[@name='lower_body']/geometry/box")
     limit = joints["front_left_steer_joint"].find("limit")
-    if cylinder is None or body is None or limit is None:
+    stiffness = links["front_left_wheel"].find("contact/stiffness")
+    if cylinder is None or body is None or limit is None or stiffness is None:
         raise ValueError(f"{path}: not an avsim car URDF")
     length, width, _ = (float(v) for v in body.attrib["size"].split())
     mass = sum(float(m.attrib["value"]) for m in root.iter("mass"))
@@ -61,6 +69,7 @@ def read_geometry(path: Path = URDF_PATH) -> CarGeometry:
         rear_axle=-rl[0],
         mass=mass,
         max_steer=float(limit.attrib["upper"]),
+        tyre_stiffness=float(stiffness.attrib["value"]),
     )
 
 

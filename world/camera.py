@@ -16,6 +16,7 @@ from numpy.typing import NDArray
 from pybullet_utils.bullet_client import BulletClient
 
 from world.frames import CameraFrame, CameraInfo
+from world.quiet import quiet_c_output
 from world.rendering import Renderer
 
 
@@ -42,9 +43,10 @@ class Camera:
         view = self._c.computeViewMatrix(eye.tolist(), (eye + axes[:, 0]).tolist(),
                                          axes[:, 2].tolist())
         info = self.info
-        _, _, rgba, _, _ = self._c.getCameraImage(
-            info.width, info.height, view, self._projection, renderer=self._renderer,
-            flags=pybullet.ER_NO_SEGMENTATION_MASK, shadow=0,
-        )
+        with quiet_c_output():  # the EGL plugin reports its GL vendor on the first frame
+            _, _, rgba, _, _ = self._c.getCameraImage(
+                info.width, info.height, view, self._projection, renderer=self._renderer,
+                flags=pybullet.ER_NO_SEGMENTATION_MASK, shadow=0,
+            )
         rgb = np.asarray(rgba, dtype=np.uint8).reshape(info.height, info.width, 4)[..., :3]
         return CameraFrame(t=t, info=info, rgb=np.ascontiguousarray(rgb))

@@ -17,6 +17,8 @@ from dataclasses import dataclass, field
 import pybullet
 from pybullet_utils.bullet_client import BulletClient
 
+from world.quiet import quiet_c_output
+
 PHYSICS_RATE = 240  # [Hz] fixed physics step
 GRAVITY = 9.81  # [m/s^2]
 GROUND_EXTENT = 2000.0  # [m] half size of the visible ground
@@ -25,7 +27,8 @@ GROUND_FRICTION = 1.0  # [-] dry asphalt; Bullet multiplies it with the tyre's (
 
 def make_client() -> BulletClient:
     """A new headless physics server with gravity and the fixed 240 Hz step."""
-    client = BulletClient(connection_mode=pybullet.DIRECT)
+    with quiet_c_output():  # the connection prints its (empty) argv
+        client = BulletClient(connection_mode=pybullet.DIRECT)
     client.setGravity(0.0, 0.0, -GRAVITY)
     client.setTimeStep(1.0 / PHYSICS_RATE)
     # Pyramid friction, not the cone: Bullet picks the first friction direction along the

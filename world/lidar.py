@@ -32,7 +32,7 @@ RAY_MASK = 0xFFFF & ~EGO_RAY_GROUP
 class LidarTruth:
     """What each return of a scan really hit (ground truth, same order as the points)."""
 
-    bodies: NDArray[np.int32]  # (N,) PyBullet body id hit by each return
+    actor: NDArray[np.int16]  # (N,) index of the scenario actor hit, -1 for anything else
 
 
 def beam_directions(info: LidarInfo) -> tuple[NDArray[np.float64], NDArray[np.uint8],
@@ -51,8 +51,12 @@ def beam_directions(info: LidarInfo) -> tuple[NDArray[np.float64], NDArray[np.ui
 class Lidar:
     """Casts one `LidarInfo` in one client."""
 
-    def __init__(self, client: BulletClient, info: LidarInfo, rng: np.random.Generator) -> None:
+    def __init__(self, client: BulletClient, info: LidarInfo, rng: np.random.Generator,
+                 actor_bodies: list[int]) -> None:
+        """`actor_bodies`: the scenario actors' body ids, in scenario order (ground truth)."""
         self.info = info
+        self._actor_of = np.full(max([*actor_bodies, 0]) + 1, -1, dtype=np.int16)
+        self._actor_of[actor_bodies] = np.arange(len(actor_bodies), dtype=np.int16)
         self._c = client
         self._rng = rng
         self._dirs, self._ring, self._column = beam_directions(info)
@@ -84,4 +88,8 @@ class Lidar:
         points = (self._dirs[keep] * ranges[:, None]).astype(np.float32)
         scan = LidarScan(t=t, info=info, points=points, ring=self._ring[keep],
                          column=self._column[keep])
-        return scan, LidarTruth(bodies=body[keep])
+        hit = body[keep]
+        actor = np.full(len(hit), -1, dtype=np.int16)
+        known = hit < len(self._actor_of)
+        actor[known] = self._actor_of[hit[known]]
+        return scan, LidarTruth(actor=actor)

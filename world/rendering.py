@@ -9,16 +9,15 @@ stdout; it is silenced (the choice is reported by the caller instead).
 
 from __future__ import annotations
 
-import contextlib
 import enum
 import os
 import pkgutil
-import sys
-from collections.abc import Iterator
 
 import numpy as np
 import pybullet
 from pybullet_utils.bullet_client import BulletClient
+
+from world.quiet import quiet_c_output
 
 
 class Renderer(enum.Enum):
@@ -30,25 +29,6 @@ class Renderer(enum.Enum):
         """The `getCameraImage` renderer argument."""
         return int(pybullet.ER_BULLET_HARDWARE_OPENGL if self is Renderer.EGL
                    else pybullet.ER_TINY_RENDERER)
-
-
-@contextlib.contextmanager
-def quiet_c_output() -> Iterator[None]:
-    """Silence what native code prints on file descriptors 1 and 2 (Python's own streams
-    are flushed first and left alone)."""
-    sys.stdout.flush()
-    sys.stderr.flush()
-    saved = [os.dup(1), os.dup(2)]
-    with open(os.devnull, "w") as devnull:
-        try:
-            os.dup2(devnull.fileno(), 1)
-            os.dup2(devnull.fileno(), 2)
-            yield
-        finally:
-            os.dup2(saved[0], 1)
-            os.dup2(saved[1], 2)
-            for fd in saved:
-                os.close(fd)
 
 
 def attach_renderer(client: BulletClient) -> Renderer:

@@ -10,7 +10,8 @@ Profiles (`--profile`):
 
 Cameras have an 80 deg horizontal field of view. The LiDAR is VLP-16-like: channels from
 -15 to +15 deg every 2 deg, 360 deg, 100 m. Mounts come from the URDF's sensor links (the
-vehicle frame's origin is on the ground, the base link's origin a wheel radius above it).
+vehicle frame's origin is on the ground, the base link's origin `CarGeometry.ride_height`
+above it: the wheel radius less the tyres' static compression).
 The scenario's `sensors.lidar` block sets range noise and dropout.
 """
 
@@ -77,7 +78,7 @@ def _mount(pose: MountPose, ride_height: float) -> SensorMount:
 def sensor_setup(profile: Profile, lidar_noise: LidarNoiseSpec | None = None) -> SensorSetup:
     """The profile's sensors on the URDF's mounts, with the scenario's LiDAR noise."""
     mounts = read_sensor_mounts()
-    ride_height = read_geometry().wheel_radius  # [m] base link origin above the ground
+    ride_height = read_geometry().ride_height  # [m] base link origin above the ground
     cams_spec, columns = _PROFILES[profile]
     cameras = tuple(
         CameraInfo(name=c.name, width=c.width, height=c.height, fov_x=CAMERA_FOV,

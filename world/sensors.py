@@ -72,19 +72,36 @@ class SensorSchedule:
 
 
 class SensorRig:
-    """Cameras and LiDAR of one `SensorSetup` in one client."""
+    """Cameras (when given a renderer) and LiDAR (when given a generator) of one
+    `SensorSetup` in one client."""
 
-    def __init__(self, client: BulletClient, setup: SensorSetup, renderer: Renderer,
-                 ride_height: float, rng: np.random.Generator) -> None:
+    def __init__(self, client: BulletClient, setup: SensorSetup, ride_height: float, *,
+                 renderer: Renderer | None, lidar_rng: np.random.Generator | None,
+                 actor_bodies: list[int]) -> None:
         self.setup = setup
         self.renderer = renderer
         self._ride_height = ride_height
-        self._cameras = {c.name: Camera(client, c, renderer) for c in setup.cameras}
-        self._lidar = Lidar(client, setup.lidar, rng)
+        self._cameras = ({} if renderer is None else
+                         {c.name: Camera(client, c, renderer) for c in setup.cameras})
+        self._lidar = (None if lidar_rng is None else
+                       Lidar(client, setup.lidar, lidar_rng, actor_bodies))
+
+    @property
+    def has_cameras(self) -> bool:
+        return bool(self._cameras)
+
+    @property
+    def has_lidar(self) -> bool:
+        return self._lidar is not None
 
     def capture(self, t: float, truth: EgoTruth, cameras: Sequence[str],
                 lidar: bool) -> SensorData:
+        """Render `cameras` and (with `lidar`) cast a revolution, at time `t` [s]."""
         origin, rotation = vehicle_pose(truth, self._ride_height)
         frames = tuple(self._cameras[name].render(t, origin, rotation) for name in cameras)
-        scan, scan_truth = self._lidar.scan(t, origin, rotation) if lidar else (None, None)
+        scan, scan_truth = None, None
+        if lidar:
+            if self._lidar is None:
+                raise RuntimeError("this rig has no LiDAR")
+            scan, scan_truth = self._lidar.scan(t, origin, rotation)
         return SensorData(t, frames, scan, scan_truth)

@@ -24,6 +24,7 @@ from world.ego import EgoBody, EgoParams, EgoTruth
 from world.gnss import GnssSensor, OdometrySensor
 from world.hdmap import RoadMap
 from world.lidar import EGO_RAY_GROUP
+from world.quiet import quiet_c_output
 from world.rendering import attach_renderer
 from world.road_mesh import TexturedMesh, build_road_surface
 from world.scenery import (
@@ -69,13 +70,15 @@ class WorldSnapshot:
 class World:
     """One scenario's world in its own physics client."""
 
-    def __init__(self, spec: ScenarioSpec, sensors: SensorSetup | None = None) -> None:
-        """`sensors`: build the camera and LiDAR rig in this client too (the renderer is
-        attached before anything else, as EGL requires)."""
+    def __init__(self, spec: ScenarioSpec, sensors: SensorSetup | None = None, *,
+                 cameras: bool = True, lidar: bool = True) -> None:
+        """`sensors`: build a sensor rig in this client too, with its cameras (the renderer
+        is attached before anything else, as EGL requires) and / or its LiDAR."""
         self.spec = spec
         seeds = np.random.SeedSequence(spec.seed).spawn(4)
         self.client = make_client()
-        self.renderer = attach_renderer(self.client) if sensors is not None else None
+        cameras = cameras and sensors is not None
+        self.renderer = attach_renderer(self.client) if cameras else None
         self.clock = Clock()
         self._step_physics = self.client.stepSimulation  # bound once: called every step
         self.road = RoadMap.from_spec(spec.road)
@@ -95,9 +98,10 @@ class World:
         self.odometry = OdometrySensor(
             self.ego.geometry.wheel_radius, np.random.default_rng(seeds[2])
         )
-        self.rig = None if sensors is None or self.renderer is None else SensorRig(
-            self.client, sensors, self.renderer, self.ego.geometry.wheel_radius,
-            np.random.default_rng(seeds[3]),
+        self.rig = None if sensors is None else SensorRig(
+            self.client, sensors, self.ego.geometry.ride_height, renderer=self.renderer,
+            lidar_rng=np.random.default_rng(seeds[3]) if lidar else None,
+            actor_bodies=self.actors.bodies,
         )
         self._truth: EgoTruth | None = None
         self._route: RouteTruth | None = None
@@ -220,12 +224,14 @@ class World:
         self.ego.set_base_state(snap.ego_com, snap.ego_quat, snap.ego_joints)
         for body, (position, quat) in zip(self.actors.bodies, snap.actors, strict=True):
             self.client.resetBasePositionAndOrientation(body, position, quat)
+        self.client.performCollisionDetection()  # bring the ray-test broadphase up to date
         self._truth = None
         self._route = None
 
     def close(self) -> None:
         if self.client is not None:
-            self.client.disconnect()
+            with quiet_c_output():  # the EGL plugin says goodbye on the C stdout
+                self.client.disconnect()
         self._tmp.cleanup()
 
 

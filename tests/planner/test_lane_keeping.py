@@ -23,8 +23,11 @@ def ego_on(road: RoadMap, lane: int, s: float, r: float, speed: float, t: float 
     return EgoState(t, float(xy[0]), float(xy[1]), heading, speed, 0.0, 0.0, 0.1)
 
 
-def planner(road: RoadMap, lane: int = 1, set_kph: float = 80.0) -> LaneKeepingPlanner:
-    return LaneKeepingPlanner(road, LaneKeepingParams(set_kph * KPH, 180.0 * KPH, lane=lane))
+def planner(road: RoadMap, lane: int = 1, set_kph: float = 80.0,
+            camera: bool = False) -> LaneKeepingPlanner:
+    """The map-only planner by default (these tests are about the map path and speed)."""
+    return LaneKeepingPlanner(road, LaneKeepingParams(set_kph * KPH, 180.0 * KPH, lane=lane,
+                                                      camera=camera))
 
 
 @needs_hdmap

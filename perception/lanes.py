@@ -1,0 +1,691 @@
+"""Lane finding on the front camera: the ego lane's boundaries, offset, heading and curvature.
+
+The classic camera pipeline (ICCAS paper, Fig. 4(a)), one frame at a time (`LaneDetector`),
+then a temporal filter (`LaneFilter`).
+
+1. **Binary mask** of lane paint, computed only on the band of image rows the bird's-eye view
+   can see (rows from the far edge of the view down to ``x_min``; the ego car's hood covers
+   the ground nearer than ~4.5 m, so ``x_min = 5 m`` leaves the hood out of the band). The
+   image is converted to OpenCV's 8-bit HLS (hue 0..179 in units of 2 deg, lightness and
+   saturation 0..255). A pixel is paint if any of:
+
+   - white: lightness >= ``white_min_lightness`` (130) and saturation <= ``white_max_saturation``
+     (60). Paint renders at L ~ 230 near the car; asphalt at L ~ 55-65, the shoulder ~ 74,
+     grass ~ 68 (saturated green), the sky and building walls are above the horizon or
+     beyond the view;
+   - yellow: hue in ``yellow_hue`` (15..35, i.e. 30..70 deg), saturation >=
+     ``yellow_min_saturation`` (80) and lightness >= ``yellow_min_lightness`` (60); the centre
+     line renders at hue ~ 22, S ~ 90-170;
+   - ridge (gradient): a greyish pixel (saturation <= 60, lightness >= ``ridge_min_lightness``,
+     75) with a rising edge at most ``ridge_max_width`` (12 px) to its left and a falling
+     edge at most 12 px to its right, an edge being where ``|Sobel x| / 4`` (3 x 3 kernel:
+     the vertically smoothed L(u + 1) - L(u - 1), lightness units) >= ``ridge_min_gradient``
+     (5). This keeps distant lines, which texture filtering blurs to L ~ 80-110 on a
+     background of ~ 60-78, and marks a line's whole width (not only its two flanks, whose
+     unequal contrast would bias its position); the asphalt's texture noise stays darker
+     than the lightness gate and the shoulder's or grass's border is a single step, not a
+     rising-falling pair.
+
+2. **Bird's-eye view** (`perception.birdseye`): the mask is remapped onto a metric grid of
+   the ground plane z = 0 of the vehicle frame (default x 5..35 m ahead of the car's centre,
+   y -7..+7 m, 0.05 m per cell), with the homography computed from the camera's intrinsics
+   and mount (precomputed once). A cell is paint when the bilinear warp of the 0/255 mask
+   reaches ``mask_min_coverage`` (128).
+
+3. **Base positions**: the view is cut into windows along x of ``window_length`` (2 m). From
+   the nearest window up to ``base_reach`` (16 m) ahead of ``x_min``, a histogram of the
+   paint's y (``base_bin`` 0.1 m bins) is taken on each side of the car, |y| between
+   ``base_inner`` (0.3 m) and ``base_outer`` (3.2 m): the ego lane's boundaries are the
+   lines nearest left and right of the car (~1.75 m each side). The first window with a bin
+   of at least ``base_min_pixels`` (12) gives that side's base: the bin nearest the car
+   (its y refined to the mean of the paint within 0.3 m). With a trusted prior estimate
+   (confidence >= ``prior_min_confidence``, 0.3) the search is instead within
+   ``prior_margin`` (0.7 m) of where the prior puts the boundary, and the bin nearest that
+   is taken. Searching several windows copes with the gaps of dashed lines (3 m of paint
+   every 12 m).
+
+4. **Sliding windows**: from its base window up the view, each side keeps the paint within
+   a lateral margin of a predicted line; a window with at least ``window_min_pixels`` (20)
+   such cells is a hit and adds its centroid. The prediction is a polynomial fit of the
+   side's own hit centroids (quadratic once they span ``quadratic_min_span``, 8 m; linear
+   from ``linear_min_span``, 1 m), or, when the other side's centroids span farther, the
+   other side's fit shifted through this side's last centroid (the boundaries are
+   parallel: a dashed line follows the solid one through its gaps), or the prior's
+   boundary (else a line parallel to the car) through the base. The margin is
+   ``window_margin`` (0.35 m), growing by ``window_margin_growth`` (0.06 m per m) with the
+   distance since the last hit, up to ``window_margin_max`` (1.0 m; the next line is >= 3.3
+   m away). A side stops when its prediction leaves the view.
+
+5. **Fits** in metres in the vehicle frame: each boundary y = c0 + c1 x + c2 x^2 by weighted
+   least squares on its hit cells (quadratic when they span >= 8 m, linear when >= 1 m, else
+   constant), refitted once without the cells farther than ``outlier_distance`` (0.25 m) from
+   the first fit. A cell's weight (1 / sigma) is ``d^-weight_power`` (power 3) with d [m] its
+   depth in front of the camera: an image pixel's footprint on the ground grows as d across and
+   d^2 along the road, the renderer's texture filtering displaces far lines (beyond ~15 m) by
+   up to ~0.15 m, and a single quadratic holds less well far ahead where the curvature may
+   change; so the near lines decide the offset and heading at x = 0, the far ones mostly the
+   curvature. With both boundaries, the lane centre comes from a joint fit (same weights) of
+   the two as parallel curves (own c0 each, shared c1 and c2): the better-seen line carries the
+   shape. Centre line y = a0 + a1 x + a2 x^2 at the car's centre (x = 0): offset = -a0 (car
+   left of the centre +), heading_error = -atan(a1), curvature = 2 a2 (left turn +), width =
+   (c0_left - c0_right) cos(atan(a1)). A pair whose width is outside [``min_width``,
+   ``max_width``] (2.5..4.5 m), or that does not straddle the car (c0_left > 0 > c0_right), is
+   not trusted. When a boundary is missing or the pair is not trusted, the other boundary is
+   searched again (steps 3-4) around the one first seen nearest the car (of equals, the
+   better-seen) shifted a lane width across (the prior's width, else ``default_width``, 3.5 m):
+   on a tight curve a dashed line whose first dash is far may already have crossed the car's
+   axis, where the nearest-line rule of step 3 misses it. Failing that, the centre is that line
+   shifted by half that width across.
+
+6. **Confidence** in [0, 1]: per side ``min(1, hits / full_windows) * min(1, span /
+   full_span)`` (``full_windows`` 4 windows with paint, ``full_span`` 15 m of fitted length);
+   the mean of both sides (a missing side scores 0, so one boundary gives <= 0.5).
+
+`LaneFilter` then runs a Kalman filter on (offset, heading_error, curvature, width); see its
+docstring. Everything is in SI units (m, rad, 1/m) in the vehicle frame of the frame's time.
+
+Limits: the ground is taken as the plane z = 0 of the vehicle frame (the body's pitch and
+roll on its suspension, and the camera's height error when the car sits lower than its
+mount says, scale the lateral metres: 1 cm of height is ~0.7 %); one quadratic cannot follow
+a curvature step (straight into a 50 m arc) inside the view, so within ~15 m of such a step
+the heading at the car can be off by a few degrees (the filter's gate and smoothing damp
+it). Cost: ~3 ms per 640 x 480 frame, ~4 ms per 1280 x 960 (the view's size is fixed).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+
+import cv2
+import numpy as np
+from numpy.typing import NDArray
+from scipy.stats import chi2
+
+from perception.birdseye import BevGrid, BirdseyeView
+from perception.messages import LaneBoundary, LaneEstimate
+from world.frames import CameraFrame, CameraInfo
+
+FloatArray = NDArray[np.float64]
+IntArray = NDArray[np.intp]
+Coefficients = tuple[float, float, float]  # (c0 [m], c1 [-], c2 [1/m]) of y = c0 + c1 x + c2 x^2
+
+LEFT, RIGHT = 1, -1  # side signs: y of the side's boundary has this sign
+
+
+@dataclass(frozen=True, slots=True)
+class LaneParams:
+    """Thresholds of `LaneDetector` (see the module docstring for each step)."""
+
+    grid: BevGrid = field(default_factory=BevGrid)  # the bird's-eye view (metres)
+    # -- mask, OpenCV 8-bit HLS: hue [2 deg units] 0..179, lightness and saturation 0..255
+    white_min_lightness: int = 130  # [0..255]
+    white_max_saturation: int = 60  # [0..255] also the ridge pixels' greyness limit
+    yellow_hue: tuple[int, int] = (15, 35)  # [2 deg] inclusive band
+    yellow_min_saturation: int = 80  # [0..255]
+    yellow_min_lightness: int = 60  # [0..255]
+    ridge_min_lightness: int = 85  # [0..255]
+    ridge_min_gradient: float = 5.0  # [lightness] |Sobel x| / 4 at a ridge's two flanks
+    ridge_max_width: int = 12  # [px] rising to falling flank, in the image
+    mask_min_coverage: int = 128  # [0..255] of the warped 0/255 mask
+    # -- base search
+    base_reach: float = 16.0  # [m] searched from x_min up to x_min + base_reach
+    base_bin: float = 0.1  # [m] histogram bin
+    base_min_pixels: int = 12  # [cells] in a bin
+    base_inner: float = 0.3  # [m] nearest |y| of a base (no prior)
+    base_outer: float = 3.2  # [m] farthest |y| of a base (no prior)
+    base_refine: float = 0.3  # [m] half width around the bin the base y is averaged over
+    prior_margin: float = 0.7  # [m] half width of the search around the prior's boundary
+    prior_min_confidence: float = 0.3  # [-] a prior less confident than this is ignored
+    # -- sliding windows
+    window_length: float = 2.0  # [m] along x
+    window_margin: float = 0.35  # [m] half width around the prediction after a hit
+    window_margin_growth: float = 0.06  # [m/m] per metre since the last hit
+    window_margin_max: float = 1.0  # [m]
+    window_min_pixels: int = 20  # [cells] for a hit
+    # -- fits
+    quadratic_min_span: float = 8.0  # [m] x range for a quadratic (fits and predictions)
+    linear_min_span: float = 1.0  # [m] x range for a linear fit
+    outlier_distance: float = 0.25  # [m] cells farther from the first fit are dropped
+    weight_power: float = 3.0  # [-] a cell's lateral sigma grows as (its depth)^weight_power
+    # -- estimate and confidence
+    default_width: float = 3.5  # [m] lane width with one boundary and no prior
+    min_width: float = 2.5  # [m] plausible lane width
+    max_width: float = 4.5  # [m]
+    full_windows: int = 4  # [-] windows with paint for a side's full score
+    full_span: float = 15.0  # [m] fitted length for a side's full score
+
+
+# ---- mask -----------------------------------------------------------------------------------
+
+
+def lane_mask(rgb: NDArray[np.uint8], p: LaneParams) -> NDArray[np.uint8]:
+    """(H, W) 0/255 paint mask of an RGB image (band): white | yellow | light ridge."""
+    hls = cv2.cvtColor(rgb, cv2.COLOR_RGB2HLS)
+    white = cv2.inRange(hls, (0, p.white_min_lightness, 0), (180, 255, p.white_max_saturation))
+    yellow = cv2.inRange(hls, (p.yellow_hue[0], p.yellow_min_lightness, p.yellow_min_saturation),
+                         (p.yellow_hue[1], 255, 255))
+    grey = cv2.inRange(hls, (0, p.ridge_min_lightness, 0), (180, 255, p.white_max_saturation))
+    sobel = cv2.Sobel(hls[:, :, 1], cv2.CV_16S, 1, 0, ksize=3)  # 4 x lightness per pixel
+    step = round(4.0 * p.ridge_min_gradient)
+    rising = cv2.inRange(sobel, step, 32767)
+    falling = cv2.inRange(sobel, -32768, -step)
+    reach = np.ones((1, p.ridge_max_width + 1), np.uint8)
+    rise_left = cv2.dilate(rising, reach, anchor=(p.ridge_max_width, 0))  # rise at u-w .. u
+    fall_right = cv2.dilate(falling, reach, anchor=(0, 0))  # fall at u .. u+w
+    ridge = cv2.bitwise_and(cv2.bitwise_and(rise_left, fall_right), grey)
+    paint = cv2.bitwise_or(white, yellow)
+    return np.asarray(cv2.bitwise_or(paint, ridge), dtype=np.uint8)
+
+
+def paint_cells(bev_mask: NDArray[np.uint8], grid: BevGrid,
+                min_coverage: int) -> tuple[FloatArray, FloatArray]:
+    """(x, y) [m] of the paint cells of a warped mask, sorted by ascending x."""
+    rows, cols = np.nonzero(bev_mask >= min_coverage)  # row-major: x descending
+    return grid.row_to_x(rows[::-1]), grid.col_to_y(cols[::-1])
+
+
+# ---- polynomials ----------------------------------------------------------------------------
+
+
+def poly_y(c: Coefficients, x: FloatArray | float) -> FloatArray:
+    """[m] y = c0 + c1 x + c2 x^2 at x [m]."""
+    xa = np.asarray(x, dtype=np.float64)
+    return np.asarray(c[0] + (c[1] + c[2] * xa) * xa)
+
+
+def fit_poly(x: FloatArray, y: FloatArray, p: LaneParams,
+             w: FloatArray | None = None) -> Coefficients:
+    """Least-squares y(x) [m] with residual weights ``w`` (1 / sigma), degree by the x span:
+    2 (>= quadratic_min_span), 1 (>= linear_min_span), else 0 (the weighted mean)."""
+    span = float(x.max() - x.min()) if len(x) else 0.0
+    degree = 2 if span >= p.quadratic_min_span and len(x) >= 3 else 1 if (
+        span >= p.linear_min_span and len(x) >= 2) else 0
+    if degree == 0:
+        return float(np.average(y, weights=None if w is None else w * w)), 0.0, 0.0
+    a = np.vander(x, degree + 1, increasing=True)  # columns 1, x[, x^2]
+    if w is not None:
+        a, y = a * w[:, None], y * w
+    c = np.linalg.solve(a.T @ a, a.T @ y)  # normal equations: 2 or 3 unknowns
+    return float(c[0]), float(c[1]), float(c[2]) if degree == 2 else 0.0
+
+
+def shifted_through(c: Coefficients, x: float, y: float) -> Coefficients:
+    """``c`` moved sideways to pass through (x, y) [m]."""
+    return y - float(poly_y((0.0, c[1], c[2]), x)), c[1], c[2]
+
+
+def prior_boundary(prior: LaneEstimate, side: int) -> Coefficients:
+    """The prior's boundary on ``side`` (+1 left, -1 right), half a width from its centre."""
+    slope = -math.tan(prior.heading_error)
+    half = 0.5 * prior.width / math.cos(math.atan(slope))
+    return -prior.offset + side * half, slope, 0.5 * prior.curvature
+
+
+# ---- base search ----------------------------------------------------------------------------
+
+
+@dataclass(frozen=True, slots=True)
+class _Windows:
+    """The view's paint cells cut into windows along x."""
+
+    x: FloatArray  # [m] cell x, ascending
+    y: FloatArray  # [m] cell y
+    w: FloatArray  # [-] cell fit weight (1 / sigma): (depth in front of the camera)^-power
+    bounds: IntArray  # (n + 1,) cell index where each window starts (and the end)
+    centres: FloatArray  # (n,) [m] window centre x
+
+    @staticmethod
+    def make(x: FloatArray, y: FloatArray, grid: BevGrid, length: float,
+             camera_x: float, power: float) -> _Windows:
+        """``camera_x`` [m]: the camera's forward position on the car; ``power``: of the
+        depth in the weights."""
+        n = max(1, round((grid.x_max - grid.x_min) / length))
+        edges = grid.x_min + (grid.x_max - grid.x_min) * np.arange(n + 1) / n
+        bounds = np.searchsorted(x, edges).astype(np.intp)
+        return _Windows(x, y, (x - camera_x) ** -power, bounds, 0.5 * (edges[:-1] + edges[1:]))
+
+    def fit_boundary(self, idx: IntArray, p: LaneParams) -> LaneBoundary:
+        return fit_boundary(self.x[idx], self.y[idx], self.w[idx], p)
+
+    def cells(self, k: int) -> slice:
+        return slice(int(self.bounds[k]), int(self.bounds[k + 1]))
+
+
+def _base_in_window(y: FloatArray, lo: float, hi: float, target: float,
+                    p: LaneParams) -> float | None:
+    """[m] the paint line in y (cells of one window) within [lo, hi] nearest ``target``."""
+    inside = y[(y >= lo) & (y <= hi)]
+    if len(inside) < p.base_min_pixels:
+        return None
+    n_bins = max(1, math.ceil((hi - lo) / p.base_bin))
+    counts, edges = np.histogram(inside, bins=n_bins, range=(lo, hi))
+    strong = np.flatnonzero(counts >= p.base_min_pixels)
+    if len(strong) == 0:
+        return None
+    centres = 0.5 * (edges[strong] + edges[strong + 1])
+    best = float(centres[np.argmin(np.abs(centres - target))])
+    return float(np.mean(inside[np.abs(inside - best) <= p.base_refine]))
+
+
+def _find_base(win: _Windows, side: int, guide: Coefficients | None,
+              p: LaneParams) -> tuple[int, float] | None:
+    """(window index, y [m]) where the boundary on ``side`` is first seen, or None.
+
+    Without a guide (prior boundary) the line nearest the car within |y| in [base_inner,
+    base_outer] on that side; with one, the line nearest the guide within prior_margin."""
+    reach = win.centres[0] + p.base_reach
+    for k in range(len(win.centres)):
+        if win.centres[k] > reach:
+            break
+        if guide is None:
+            lo, hi = sorted((side * p.base_inner, side * p.base_outer))
+            target = 0.0
+        else:
+            target = float(poly_y(guide, float(win.centres[k])))
+            lo, hi = target - p.prior_margin, target + p.prior_margin
+        y = _base_in_window(win.y[win.cells(k)], lo, hi, target, p)
+        if y is not None:
+            return k, y
+    return None
+
+
+# ---- sliding windows ------------------------------------------------------------------------
+
+
+@dataclass
+class _Side:
+    """One boundary's search state (mutable while the windows run)."""
+
+    sign: int  # LEFT or RIGHT
+    start: int  # first window index
+    guide: Coefficients  # shape before own hits: the prior's boundary or a line through the base
+    anchor: tuple[float, float]  # [m] (x, y) the borrowed shapes are moved through
+    centroids_x: list[float] = field(default_factory=list)  # [m] hit window centroids
+    centroids_y: list[float] = field(default_factory=list)  # [m]
+    chunks: list[IntArray] = field(default_factory=list)  # cell indices of hit windows
+    last_x: float = 0.0  # [m] centre of the last hit window (or the base window)
+    hits: int = 0  # windows with paint
+    active: bool = True
+    fit: tuple[Coefficients, float] | None = None  # centroid fit and its x span [m]
+
+    def add_hit(self, idx: IntArray, win: _Windows, xc: float, p: LaneParams) -> None:
+        """Record window cells ``idx`` as a hit of the window centred at ``xc`` [m]."""
+        self.chunks.append(idx)
+        self.centroids_x.append(float(np.mean(win.x[idx])))
+        self.centroids_y.append(float(np.mean(win.y[idx])))
+        self.anchor = (self.centroids_x[-1], self.centroids_y[-1])
+        self.last_x = xc
+        self.hits += 1
+        span = self.centroids_x[-1] - self.centroids_x[0]
+        if span >= p.linear_min_span:
+            self.fit = fit_poly(np.array(self.centroids_x), np.array(self.centroids_y), p), span
+
+    def cell_indices(self) -> IntArray:
+        return np.concatenate(self.chunks) if self.chunks else np.zeros(0, dtype=np.intp)
+
+
+def _prediction(side: _Side, other: _Side | None, p: LaneParams) -> Coefficients:
+    """The line the next window of ``side`` searches around (see module doc, step 4)."""
+    own = side.fit
+    theirs = other.fit if other is not None else None
+    if own is not None and (theirs is None or own[1] >= min(theirs[1], p.quadratic_min_span)):
+        return own[0]
+    shape = theirs[0] if theirs is not None else own[0] if own is not None else side.guide
+    return shifted_through(shape, *side.anchor)
+
+
+def _step(side: _Side, other: _Side | None, k: int, win: _Windows, grid: BevGrid,
+          p: LaneParams) -> None:
+    """Search window k for ``side``'s boundary; record a hit."""
+    line = _prediction(side, other, p)
+    xc = float(win.centres[k])
+    yc = float(poly_y(line, xc))
+    if not grid.y_min < yc < grid.y_max:
+        side.active = False
+        return
+    cells = win.cells(k)
+    margin = min(p.window_margin_max,
+                 p.window_margin + p.window_margin_growth * max(0.0, xc - side.last_x))
+    near = np.abs(win.y[cells] - poly_y(line, win.x[cells])) < margin
+    if np.count_nonzero(near) < p.window_min_pixels:
+        return
+    side.add_hit(cells.start + np.flatnonzero(near), win, xc, p)
+
+
+def _start_side(win: _Windows, sign: int, guide: Coefficients | None,
+                p: LaneParams) -> _Side | None:
+    base = _find_base(win, sign, guide, p)
+    if base is None:
+        return None
+    k, y = base
+    x = float(win.centres[k])
+    shape = guide if guide is not None else (y, 0.0, 0.0)
+    return _Side(sign, k, shape, (x, y), last_x=x)
+
+
+def _search_sides(win: _Windows, grid: BevGrid, prior: LaneEstimate | None,
+                 p: LaneParams) -> tuple[_Side | None, _Side | None]:
+    """(left, right) boundary searches run window by window, both sides in step; ``prior``
+    guides both bases."""
+    left = _start_side(win, LEFT, None if prior is None else prior_boundary(prior, LEFT), p)
+    right = _start_side(win, RIGHT, None if prior is None else prior_boundary(prior, RIGHT), p)
+    for k in range(len(win.centres)):
+        for side, other in ((left, right), (right, left)):
+            if side is not None and side.active and k >= side.start:
+                _step(side, other, k, win, grid, p)
+    return left, right
+
+
+def _search_beside(win: _Windows, grid: BevGrid, found: _Side, boundary: LaneBoundary,
+                  width: float, p: LaneParams) -> _Side | None:
+    """The boundary on the other side of ``found`` (its fit ``boundary``), searched around
+    ``boundary`` shifted a lane ``width`` [m] across."""
+    c0, c1, c2 = boundary.coefficients
+    sign = -found.sign
+    side = _start_side(win, sign, (c0 + sign * width / math.cos(math.atan(c1)), c1, c2), p)
+    if side is None:
+        return None
+    for k in range(side.start, len(win.centres)):
+        if side.active:
+            _step(side, found, k, win, grid, p)
+    return side
+
+
+# ---- fits and the estimate ------------------------------------------------------------------
+
+
+def fit_boundary(x: FloatArray, y: FloatArray, w: FloatArray, p: LaneParams) -> LaneBoundary:
+    """The boundary's weighted fit on its cells, refitted once without outliers (module doc,
+    step 5)."""
+    c = fit_poly(x, y, p, w)
+    keep = np.abs(y - poly_y(c, x)) <= p.outlier_distance
+    if np.count_nonzero(keep) >= max(3, len(x) // 2):
+        x, y, w = x[keep], y[keep], w[keep]
+        c = fit_poly(x, y, p, w)
+    return LaneBoundary(c, float(x.min()), float(x.max()), len(x))
+
+
+def _wlstsq(a: FloatArray, y: FloatArray, w: FloatArray) -> FloatArray:
+    """Weighted linear least squares: x minimising |w (a x - y)|."""
+    return np.asarray(np.linalg.lstsq(a * w[:, None], y * w, rcond=None)[0], dtype=np.float64)
+
+
+def _fit_parallel(win: _Windows, left: IntArray, right: IntArray,
+                 p: LaneParams) -> tuple[float, float, Coefficients]:
+    """(c0_left, c0_right, (a0, a1, a2) centre) of the weighted joint fit of both
+    boundaries' cells as curves concentric with the centre line y = a0 + a1 x + a2 x^2:
+    y = c0_side + a1 x + g_side a2 x^2 with a0 = (c0_left + c0_right) / 2 and g_side = 1 /
+    (1 - 2 a2 (c0_side - a0)) (a boundary d to the left of an arc of curvature k has
+    curvature k / (1 - k d)). A first fit with g = 1 gives g and the outliers (farther than
+    outlier_distance) the second fit leaves out. Linear (a2 = 0) unless a side spans
+    quadratic_min_span."""
+    idx = np.concatenate([left, right])
+    x, y, w = win.x[idx], win.y[idx], win.w[idx]
+    is_left = np.concatenate([np.ones(len(left)), np.zeros(len(right))])
+    quadratic = max(float(np.ptp(win.x[left])), float(np.ptp(win.x[right]))) >= (
+        p.quadratic_min_span)
+    columns = [is_left, 1.0 - is_left, x] + ([x * x] if quadratic else [])
+    a = np.column_stack(columns)
+    sol = _wlstsq(a, y, w)
+    keep = np.abs(y - a @ sol) <= p.outlier_distance
+    if np.count_nonzero(keep) < len(y) // 2 or not (
+            keep[is_left > 0].any() and keep[is_left == 0].any()):
+        keep = np.ones(len(y), dtype=bool)
+    if quadratic:
+        a0, a2 = 0.5 * (sol[0] + sol[1]), sol[3]
+        g = 1.0 / (1.0 - 2.0 * a2 * np.where(is_left > 0, sol[0] - a0, sol[1] - a0))
+        a[:, 3] = x * x * g
+    sol = _wlstsq(a[keep], y[keep], w[keep])
+    c0l, c0r, a1 = float(sol[0]), float(sol[1]), float(sol[2])
+    return c0l, c0r, (0.5 * (c0l + c0r), a1, float(sol[3]) if quadratic else 0.0)
+
+
+def _side_score(side: _Side, boundary: LaneBoundary, p: LaneParams) -> float:
+    """[0, 1] how well one boundary was seen (module doc, step 6)."""
+    span = boundary.x_max - boundary.x_min
+    return min(1.0, side.hits / p.full_windows) * min(1.0, span / p.full_span)
+
+
+def _estimate(t: float, centre: Coefficients, width: float, confidence: float,
+              left: LaneBoundary | None, right: LaneBoundary | None) -> LaneEstimate:
+    a0, a1, a2 = centre
+    return LaneEstimate(t=t, offset=-a0, heading_error=-math.atan(a1), curvature=2.0 * a2,
+                        width=width, confidence=confidence, left=left, right=right)
+
+
+def _one_sided(t: float, boundary: LaneBoundary, sign: int, score: float, width: float
+              ) -> LaneEstimate:
+    """The estimate from one boundary on ``sign``'s side and a known lane ``width`` [m]."""
+    c0, c1, c2 = boundary.coefficients
+    a0 = c0 - sign * 0.5 * width / math.cos(math.atan(c1))
+    left, right = (boundary, None) if sign == LEFT else (None, boundary)
+    return _estimate(t, (a0, c1, c2), width, 0.5 * score, left, right)
+
+
+_Fits = dict[int, tuple[_Side, LaneBoundary]]  # by side sign: the search and its fit
+
+
+def _fit_sides(win: _Windows, sides: tuple[_Side | None, _Side | None], p: LaneParams
+               ) -> _Fits:
+    """The boundary fit of each side that found enough paint, by side sign."""
+    fits: _Fits = {}
+    for side in sides:
+        if side is None:
+            continue
+        idx = side.cell_indices()
+        if len(idx) >= p.window_min_pixels:
+            fits[side.sign] = (side, win.fit_boundary(idx, p))
+    return fits
+
+
+# ---- the detector ---------------------------------------------------------------------------
+
+
+class LaneDetector:
+    """One-frame lane finder for one camera (see module doc). No memory between frames."""
+
+    def __init__(self, camera: CameraInfo, params: LaneParams | None = None) -> None:
+        self.camera = camera
+        self.params = params if params is not None else LaneParams()
+        self.view = BirdseyeView(camera, self.params.grid)
+
+    def birdseye_mask(self, frame: CameraFrame) -> NDArray[np.uint8]:
+        """(rows, cols) the warped 0/255 paint mask (bilinear) of a frame, for inspection."""
+        if frame.rgb.shape != (self.camera.height, self.camera.width, 3):
+            raise ValueError(f"frame is {frame.rgb.shape}, the camera "
+                             f"{self.camera.height} x {self.camera.width} x 3")
+        band = np.ascontiguousarray(self.view.crop(frame.rgb))
+        return self.view.warp(lane_mask(band, self.params))
+
+    def detect(self, frame: CameraFrame, prior: LaneEstimate | None = None) -> LaneEstimate:
+        """The ego lane in ``frame``; ``prior`` (e.g. the filter's last output) guides the
+        base search and gives the width when one boundary is seen."""
+        p = self.params
+        if prior is not None and prior.confidence < p.prior_min_confidence:
+            prior = None
+        x, y = paint_cells(self.birdseye_mask(frame), p.grid, p.mask_min_coverage)
+        win = _Windows.make(x, y, p.grid, p.window_length, self.camera.mount.x, p.weight_power)
+        fits = _fit_sides(win, _search_sides(win, p.grid, prior, p), p)
+        width = prior.width if prior is not None else p.default_width
+        estimate = self._two_sided(frame.t, win, fits)
+        if estimate is None and fits:
+            estimate = self._with_the_other_side(frame.t, win, fits, width)
+        if estimate is not None:
+            return estimate
+        guess = (0.0, 0.0, 0.0) if prior is None else (
+            -prior.offset, -math.tan(prior.heading_error), 0.5 * prior.curvature)
+        return _estimate(frame.t, guess, width, 0.0, None, None)
+
+    def _with_the_other_side(self, t: float, win: _Windows, fits: _Fits,
+                             width: float) -> LaneEstimate:
+        """The boundary first seen nearest the car (then the better-seen one) with the other
+        one searched beside it (a dashed line in a gap on a tight curve, a wrong line taken
+        for it); else that boundary alone."""
+        p = self.params
+        sign = min(fits, key=lambda s: (fits[s][0].start, -_side_score(*fits[s], p)))
+        side, boundary = fits[sign]
+        other = _search_beside(win, p.grid, side, boundary, width, p)
+        if other is not None:
+            both = _fit_sides(win, (side, other), p)
+            estimate = self._two_sided(t, win, both)
+            if estimate is not None:
+                return estimate
+        return _one_sided(t, boundary, sign, _side_score(side, boundary, p), width)
+
+    def _two_sided(self, t: float, win: _Windows, fits: _Fits) -> LaneEstimate | None:
+        """The estimate from both boundaries, or None if one is missing, their width is
+        implausible or they do not straddle the car's centre."""
+        p = self.params
+        if LEFT not in fits or RIGHT not in fits:
+            return None
+        (left, bl), (right, br) = fits[LEFT], fits[RIGHT]
+        c0l, c0r, centre = _fit_parallel(win, left.cell_indices(), right.cell_indices(), p)
+        width = (c0l - c0r) * math.cos(math.atan(centre[1]))
+        if not (p.min_width <= width <= p.max_width and c0l > 0.0 > c0r):
+            return None
+        confidence = 0.5 * (_side_score(left, bl, p) + _side_score(right, br, p))
+        return _estimate(t, centre, width, confidence, bl, br)
+
+
+# ---- temporal filter ------------------------------------------------------------------------
+
+DIM = 4
+I_OFFSET, I_HEADING, I_CURVATURE, I_WIDTH = range(DIM)
+
+
+@dataclass(frozen=True, slots=True)
+class LaneFilterParams:
+    """Noise (1-sigma), gating and confidence dynamics of `LaneFilter`."""
+
+    offset_sigma: float = 0.05  # [m] measurement noise at confidence 1
+    heading_sigma: float = 0.01  # [rad]
+    curvature_sigma: float = 0.002  # [1/m]
+    width_sigma: float = 0.05  # [m]
+    offset_walk: float = 0.3  # [m/sqrt(s)] process random walk
+    heading_walk: float = 0.05  # [rad/sqrt(s)]
+    curvature_walk: float = 0.01  # [1/m/sqrt(s)]
+    width_walk: float = 0.05  # [m/sqrt(s)]
+    min_confidence: float = 0.2  # [-] measurements below this are not used (predict only)
+    confidence_floor: float = 0.1  # [-] measurement noise is divided by max(this, confidence)
+    gate_probability: float = 0.999  # [-] chi-square gate on the innovation
+    max_rejections: int = 3  # consecutive gated-out measurements before re-initialising
+    confidence_gain: float = 0.5  # [-] share of the measurement's confidence taken per update
+    confidence_tau: float = 0.5  # [s] decay time constant of the confidence while predicting
+    init_width_sigma: float = 0.5  # [m] width uncertainty when initialised from one boundary
+
+
+class LaneFilter:
+    """Kalman filter on x = (offset [m], heading_error [rad], curvature [1/m], width [m]).
+
+    Prediction over dt [s]: random walks (``*_walk``); with the car's ``speed`` [m/s] the
+    offset also moves by ``speed dt sin(heading_error)`` (linearised), and with its
+    ``yaw_rate`` [rad/s] the heading error by ``(yaw_rate - speed curvature) dt``.
+    Update: offset, heading and curvature always, the width only when both boundaries were
+    seen; the noise is the ``*_sigma`` divided by the measurement's confidence. Gating: an
+    innovation whose squared Mahalanobis distance exceeds the chi-square quantile
+    ``gate_probability`` is rejected (predict only); after ``max_rejections`` consecutive
+    rejections the filter re-initialises on the measurement (a lane change, a new lane).
+    Frames with confidence below ``min_confidence`` only predict. The output confidence
+    moves by ``confidence_gain`` towards each accepted measurement's and decays as
+    ``exp(-dt / confidence_tau)`` while predicting, so it goes to ~0 when lines vanish for
+    a few seconds and recovers within a few frames when they come back.
+    """
+
+    def __init__(self, params: LaneFilterParams | None = None) -> None:
+        self.params = params if params is not None else LaneFilterParams()
+        p = self.params
+        self._r_sigma = np.array([p.offset_sigma, p.heading_sigma, p.curvature_sigma,
+                                  p.width_sigma])
+        self._walk = np.array([p.offset_walk, p.heading_walk, p.curvature_walk, p.width_walk])
+        self._gate = {n: float(chi2.ppf(p.gate_probability, n)) for n in (3, 4)}
+        self.x = np.zeros(DIM)  # state, see class doc
+        self.P = np.eye(DIM)  # covariance
+        self.t = 0.0  # [s] time of the state
+        self.confidence = 0.0  # [0, 1]
+        self.initialised = False
+        self.rejections = 0  # consecutive gated-out measurements
+
+    def reset(self) -> None:
+        """Forget everything; the next confident measurement initialises again."""
+        self.x = np.zeros(DIM)
+        self.P = np.eye(DIM)
+        self.t = 0.0
+        self.confidence = 0.0
+        self.initialised = False
+        self.rejections = 0
+
+    def update(self, estimate: LaneEstimate, speed: float = 0.0,
+               yaw_rate: float | None = None) -> LaneEstimate:
+        """Filter one detection; return the filtered estimate at ``estimate.t``."""
+        p = self.params
+        usable = estimate.confidence >= p.min_confidence
+        if not self.initialised:
+            if not usable:
+                return replace(estimate, confidence=0.0, left=None, right=None)
+            self._initialise(estimate)
+            self.confidence = p.confidence_gain * estimate.confidence
+            return self._output(estimate)
+        dt = max(0.0, estimate.t - self.t)
+        self._predict(dt, speed, yaw_rate)
+        self.t = max(self.t, estimate.t)
+        if not (usable and self._correct(estimate)):
+            self.confidence *= math.exp(-dt / p.confidence_tau)
+            return self._output(replace(estimate, left=None, right=None))
+        self.confidence += p.confidence_gain * (estimate.confidence - self.confidence)
+        return self._output(estimate)
+
+    def _initialise(self, z: LaneEstimate) -> None:
+        p = self.params
+        self.x = np.array([z.offset, z.heading_error, z.curvature, z.width])
+        sigma = self._r_sigma / max(p.confidence_floor, z.confidence)
+        if z.left is None or z.right is None:
+            sigma[I_WIDTH] = p.init_width_sigma
+        self.P = np.diag(sigma**2)
+        self.t = z.t
+        self.initialised = True
+        self.rejections = 0
+
+    def _predict(self, dt: float, speed: float, yaw_rate: float | None) -> None:
+        if dt <= 0.0:
+            return
+        f = np.eye(DIM)
+        f[I_OFFSET, I_HEADING] = speed * dt
+        if yaw_rate is not None:
+            f[I_HEADING, I_CURVATURE] = -speed * dt
+        self.x = f @ self.x
+        if yaw_rate is not None:
+            self.x[I_HEADING] += yaw_rate * dt
+        self.P = f @ self.P @ f.T + np.diag(self._walk**2 * dt)
+
+    def _correct(self, z: LaneEstimate) -> bool:
+        """Kalman update with ``z`` (True), or a rejection by the gate (False); the
+        ``max_rejections``-th rejection in a row re-initialises on ``z`` instead (True)."""
+        p = self.params
+        rows = [I_OFFSET, I_HEADING, I_CURVATURE] + (
+            [I_WIDTH] if z.left is not None and z.right is not None else [])
+        h = np.eye(DIM)[rows]
+        meas = np.array([z.offset, z.heading_error, z.curvature, z.width])[rows]
+        r = np.diag((self._r_sigma[rows] / max(p.confidence_floor, z.confidence)) ** 2)
+        innovation = meas - h @ self.x
+        s = h @ self.P @ h.T + r
+        if float(innovation @ np.linalg.solve(s, innovation)) > self._gate[len(rows)]:
+            self.rejections += 1
+            if self.rejections < p.max_rejections:
+                return False
+            self._initialise(z)
+            return True
+        gain = self.P @ h.T @ np.linalg.inv(s)
+        self.x = self.x + gain @ innovation
+        i_kh = np.eye(DIM) - gain @ h
+        self.P = i_kh @ self.P @ i_kh.T + gain @ r @ gain.T  # Joseph form
+        self.rejections = 0
+        return True
+
+    def _output(self, z: LaneEstimate) -> LaneEstimate:
+        """The state as an estimate at ``z.t`` with ``z``'s boundaries."""
+        return LaneEstimate(
+            t=z.t, offset=float(self.x[I_OFFSET]), heading_error=float(self.x[I_HEADING]),
+            curvature=float(self.x[I_CURVATURE]), width=float(self.x[I_WIDTH]),
+            confidence=float(self.confidence), left=z.left, right=z.right,
+        )

@@ -1,0 +1,555 @@
+"""Object detection in one LiDAR scan: oriented, class-completed boxes in the vehicle frame.
+
+Input: a `LidarScan` (points in the sensor frame). Output: `Detection` boxes in the vehicle
+frame (x forward, y left, z up, origin on the ground below the car's centre), sorted by
+horizontal range from the sensor. Every threshold below is a field of `DetectorParams`
+(defaults in brackets); all lengths in metres, angles in radians (degrees where stated).
+
+Steps:
+
+1. **Vehicle frame and region of interest.** ``mount.to_vehicle``; keep ``|x| <= roi_x``
+   (60 m) and ``|y| <= roi_y`` (60 m).
+2. **Ground plane.** The ground is flat, but the body pitches and rolls (braking,
+   cornering), so in the vehicle frame it is a plane near ``z = 0`` that must be fitted.
+   RANSAC in numpy: ``ground_hypotheses`` (40) planes through three points drawn from
+   ``ground_sample`` (~1500, an even stride of the ROI points), with a generator seeded by
+   ``ground_seed`` at every call (a scan always gives the same plane). A hypothesis is
+   admissible only if its normal is within ``ground_max_tilt`` (6 deg) of vertical and it
+   passes within ``ground_max_offset`` (0.5 m) of the vehicle origin: walls (vertical) and
+   car roofs (1.5 m up) cannot win. The one with the most sample points within
+   ``ground_threshold`` (0.10 m) is refined twice by least squares (``z = a x + b y + c``)
+   on its inliers among all ROI points. No admissible hypothesis (no ground seen): ``z =
+   0``. A point's height is ``z - (a x + b y + c)``; points below ``ground_clearance``
+   (0.2 m) are ground; points above ``roi_height`` (8 m) are dropped. The ceiling is well
+   above ``max_height`` (4.5 m) on purpose: a wall cropped at 5 m would look like a row of
+   4-5 m posts; kept whole, its upper rings make it too tall and it is rejected.
+3. **Clustering.** Objects stand on the ground and do not stack, so clustering is done on
+   the horizontal coordinates: at 20-50 m a VLP-16's rings are 0.7-1.7 m apart vertically,
+   which would split a car in 3D. The points are averaged per ``voxel`` x ``voxel``
+   (0.15 m) grid cell (centroids, the cell of each point kept), then the centroids are
+   clustered with Open3D's ``cluster_dbscan`` (``eps = cluster_eps`` 0.6 m, ``min_points
+   = 1``: single-linkage Euclidean clustering) and the labels go back to the points.
+   0.6 m bridges the column spacing of the 0.4 deg LiDAR at 60 m (0.42 m) and still
+   separates two cars in adjacent lanes (1.5 m apart).
+4. **Cluster gate.** Clusters with fewer than ``min_points`` (4) returns, whose highest
+   point is lower than ``min_top`` (0.3 m) or higher than ``max_height`` (4.5 m:
+   buildings), or whose axis-aligned extent exceeds ``max_length * sqrt(2)`` (17 m) are
+   dropped before fitting.
+5. **Oriented rectangle (L-shape fitting).** The heading that maximises the closeness
+   criterion of Zhang et al. 2017 ("Efficient L-shape fitting for vehicle detection using
+   laser scanners"): for each candidate heading in [0, pi/2) the points are projected on
+   the two rectangle axes, each axis keeps the edge its points are closer to (norm of the
+   distance vector), and the score is ``sum 1 / max(min(d1, d2), closeness_d0)`` (d0 =
+   0.01 m). Search every ``coarse_step`` (3 deg), then every ``fine_step`` (0.25 deg)
+   within one coarse step of the best, on at most ``fit_max_points`` (400) points (an even
+   stride). The criterion chases the extreme (noisiest) points, so the heading is then
+   refitted ``refine_iterations`` (2) times by least squares: each point is given to the
+   nearer of the two kept edges, and the two perpendicular lines minimising the summed
+   squared distances have the normal ``n`` = eigenvector of the smallest eigenvalue of
+   ``S_1 - S_2`` (the scatter matrices of the two point sets; closed form). This takes the
+   yaw error of a car seen from behind at 50 m from up to ~8 deg to ~2.5 deg.
+6. **Candidate classes** from the observed extents ``a >= b`` and the highest point ``h``
+   (observed sizes are lower bounds: a LiDAR sees only the near faces and, far away, one
+   or two rings): none (not an object) if ``a > max_length`` (12 m) or ``h > max_height``
+   (4.5 m); if ``a <= small_footprint`` (1.3 m): ``PEDESTRIAN`` when ``a <=
+   pedestrian_footprint`` (0.85 m) and ``pedestrian_min_height <= h <=
+   pedestrian_max_height`` (0.9-2.2 m), else ``OTHER`` (obstacles, poles); ``TRUCK`` alone
+   if ``h > car.height + height_margin`` (1.9 m), ``a > truck_min_length`` (5.6 m) or ``b
+   > truck_min_width`` (2.2 m); otherwise ``CAR`` or ``TRUCK``.
+7. **Box completion.** A LiDAR sees the near faces only, so each candidate class's box is
+   grown to its size prior (``car`` 4.6 x 1.8 x 1.5 m, ``truck`` 9.0 x 2.5 x 3.4 m,
+   ``pedestrian`` 0.5 x 0.6 x 1.75 m; never shrunk below what was seen; ``OTHER``: a
+   square of the longer observed side), with either rectangle axis as the length. Each
+   axis is grown AWAY from the sensor, so that the faces that were seen stay where they
+   were seen: if the sensor projects onto the axis outside the observed interval, the
+   interval's end nearer to the sensor is kept; if inside (a face seen head-on, both its
+   ends visible), the interval grows symmetrically. Among these hypotheses the one of
+   least cost wins: ``cost = silhouette growth + overshoot_weight (2) x overshoot (+
+   truck_bias 0.1 m for trucks)``, where the silhouette growth is how far the box sticks
+   out sideways beyond the seen points as viewed from the sensor (azimuth growth x mean
+   range; a correctly completed box hides behind its visible faces and adds ~0) and the
+   overshoot is how much the seen extents exceed the prior's. This decides, e.g., whether
+   a lone 1.8 m face is a car's rear (grown away: no growth) or part of its side (grown
+   sideways: 2.8 m growth), and whether a 2.4 m rear is a truck's or a too-wide car's.
+   Height: the prior height (or the observed one if larger); ``z`` is half the height.
+8. **Fragments.** A surface seen at grazing incidence breaks into separate clusters, each
+   one azimuth column (e.g. a truck's side seen from just behind it: one column every
+   1-2 m). Walking the detections from the most points down, one whose points lie mostly
+   (>= 50 %) inside an already kept box grown by ``fragment_margin`` (0.2 m) is dropped
+   (two objects cannot overlap).
+
+The yaw is the length axis's heading, wrapped to (-pi/2, pi/2] (front and back are not
+told apart). Limits: a pedestrian beyond ~30 m is seen by one ring at < 0.9 m and comes
+out as ``OTHER``, and beyond ~40 m (fewer than 4 returns) not at all; far (> ~45 m)
+vehicles on the 900-column LiDAR get only 4-5 returns across their rear.
+
+Open3D is imported lazily on the first scan (~1 s), after loading a libusb-1.0 into the
+process (Open3D links against it; the same preload as `avsim.deps`, which perception may not
+import).
+"""
+
+from __future__ import annotations
+
+import ctypes
+import functools
+import importlib
+import math
+from dataclasses import dataclass, field, replace
+from types import ModuleType
+
+import numpy as np
+from numpy.typing import NDArray
+
+from perception.messages import Detection, ObjectClass
+from world.frames import LidarScan
+
+FloatArray = NDArray[np.float64]
+IntArray = NDArray[np.int64]
+DEG = math.pi / 180.0  # [rad/deg]
+
+
+@dataclass(frozen=True, slots=True)
+class SizePrior:
+    """A class's box size [m]."""
+
+    length: float  # [m] along the heading
+    width: float  # [m]
+    height: float  # [m]
+
+
+@dataclass(frozen=True, slots=True)
+class DetectorParams:
+    """Thresholds of the detector (see the module docstring for their roles)."""
+
+    roi_x: float = 60.0  # [m] keep |x| <= roi_x (vehicle frame)
+    roi_y: float = 60.0  # [m] keep |y| <= roi_y
+    roi_height: float = 8.0  # [m] drop points higher than this above the ground
+    ground_hypotheses: int = 40  # [-] RANSAC plane hypotheses
+    ground_sample: int = 1500  # [-] ROI points the hypotheses are drawn from and scored on
+    ground_threshold: float = 0.10  # [m] RANSAC / refit inlier distance
+    ground_max_tilt: float = 6.0 * DEG  # [rad] admissible ground normal tilt from vertical
+    ground_max_offset: float = 0.5  # [m] admissible ground distance from the vehicle origin
+    ground_clearance: float = 0.2  # [m] points lower than this above the plane are ground
+    ground_seed: int = 0  # [-] RANSAC generator seed (fixed: deterministic output)
+    voxel: float = 0.15  # [m] horizontal grid cell of the downsampling before clustering
+    cluster_eps: float = 0.6  # [m] DBSCAN neighbourhood radius (horizontal)
+    min_points: int = 4  # [-] fewest returns in a detected cluster
+    min_top: float = 0.3  # [m] a cluster's highest point must be at least this high
+    max_length: float = 12.0  # [m] longer clusters are structures, not objects
+    max_height: float = 4.5  # [m] taller clusters are structures, not objects
+    small_footprint: float = 1.3  # [m] longest side up to this: pedestrian or other
+    pedestrian_footprint: float = 0.85  # [m] longest side of a pedestrian, at most
+    pedestrian_min_height: float = 0.9  # [m] highest point of a pedestrian, at least
+    pedestrian_max_height: float = 2.2  # [m] and at most
+    height_margin: float = 0.4  # [m] a vehicle higher than the car prior + this is a truck
+    truck_min_length: float = 5.6  # [m] a longer one too
+    truck_min_width: float = 2.2  # [m] a wider one too
+    overshoot_weight: float = 2.0  # [-] cost per metre seen beyond a prior's size
+    truck_bias: float = 0.1  # [m] cost added to truck boxes (a car when equally likely)
+    coarse_step: float = 3.0 * DEG  # [rad] L-shape heading search, coarse
+    fine_step: float = 0.25 * DEG  # [rad] L-shape heading search, refinement
+    fit_max_points: int = 400  # [-] points used in the heading search, at most
+    closeness_d0: float = 0.01  # [m] closeness criterion distance floor
+    refine_iterations: int = 2  # [-] least-squares refits of the L-shape heading
+    fragment_margin: float = 0.2  # [m] a box absorbs smaller clusters within this of it
+    car: SizePrior = field(default_factory=lambda: SizePrior(4.6, 1.8, 1.5))
+    truck: SizePrior = field(default_factory=lambda: SizePrior(9.0, 2.5, 3.4))
+    pedestrian: SizePrior = field(default_factory=lambda: SizePrior(0.5, 0.6, 1.75))
+
+    def prior(self, cls: ObjectClass) -> SizePrior | None:
+        """The size prior of ``cls`` (None for `ObjectClass.OTHER`)."""
+        return {ObjectClass.CAR: self.car, ObjectClass.TRUCK: self.truck,
+                ObjectClass.PEDESTRIAN: self.pedestrian}.get(cls)
+
+
+# ---- Open3D ----------------------------------------------------------------------------------
+
+
+def _preload_libusb() -> None:
+    """Load a libusb-1.0 globally so that Open3D's dependency resolves (see avsim.deps)."""
+    try:
+        ctypes.CDLL("libusb-1.0.so.0", mode=ctypes.RTLD_GLOBAL)
+        return
+    except OSError:
+        pass
+    import libusb_package
+
+    path = libusb_package.get_library_path()
+    if path is None:
+        raise ImportError("no libusb-1.0 found (install libusb-1.0-0 or libusb-package)")
+    ctypes.CDLL(str(path), mode=ctypes.RTLD_GLOBAL)
+
+
+@functools.cache
+def _open3d() -> ModuleType:
+    """The open3d module, imported once, quiet."""
+    _preload_libusb()
+    o3d = importlib.import_module("open3d")
+    o3d.utility.set_verbosity_level(o3d.utility.VerbosityLevel.Error)
+    return o3d
+
+
+# ---- ground ----------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True, slots=True)
+class GroundPlane:
+    """The ground in the vehicle frame: ``z = a x + b y + c``."""
+
+    a: float  # [-] slope along x
+    b: float  # [-] slope along y
+    c: float  # [m] height at the vehicle origin
+
+    def height(self, points: FloatArray) -> FloatArray:
+        """(N,) [m] height of (N, 3) vehicle-frame points above the plane (vertical)."""
+        out: FloatArray = points[:, 2] - (self.a * points[:, 0] + self.b * points[:, 1] + self.c)
+        return out
+
+
+def _plane_hypotheses(sample: FloatArray, rng: np.random.Generator,
+                      p: DetectorParams) -> FloatArray:
+    """(K, 4) admissible planes ``n . x + d = 0`` (unit n, n_z > 0) through random triplets."""
+    idx = rng.integers(0, len(sample), size=(p.ground_hypotheses, 3))
+    p0, p1, p2 = sample[idx[:, 0]], sample[idx[:, 1]], sample[idx[:, 2]]
+    normal = np.cross(p1 - p0, p2 - p0)
+    norm = np.linalg.norm(normal, axis=1)
+    ok = norm > 1e-9
+    normal = normal[ok] / norm[ok, None]
+    normal *= np.where(normal[:, 2] < 0.0, -1.0, 1.0)[:, None]
+    d = -np.einsum("ij,ij->i", normal, p0[ok])
+    keep = (normal[:, 2] >= math.cos(p.ground_max_tilt)) & (np.abs(d) <= p.ground_max_offset)
+    return np.column_stack([normal[keep], d[keep]])
+
+
+def _refit(points: FloatArray, plane: GroundPlane, threshold: float) -> GroundPlane:
+    """Least-squares ``z = a x + b y + c`` on the points within ``threshold`` of ``plane``."""
+    inliers = points[np.abs(plane.height(points)) < threshold]
+    if len(inliers) < 3:
+        return plane
+    design = np.column_stack([inliers[:, 0], inliers[:, 1], np.ones(len(inliers))])
+    (a, b, c), *_ = np.linalg.lstsq(design, inliers[:, 2], rcond=None)
+    return GroundPlane(float(a), float(b), float(c))
+
+
+def fit_ground(points: FloatArray, p: DetectorParams) -> GroundPlane:
+    """The ground plane under (N, 3) vehicle-frame points [m] (RANSAC + least squares)."""
+    flat = GroundPlane(0.0, 0.0, 0.0)
+    if len(points) < 3:
+        return flat
+    rng = np.random.default_rng(p.ground_seed)
+    step = max(1, len(points) // p.ground_sample)
+    sample = points[::step]
+    planes = _plane_hypotheses(sample, rng, p)
+    if len(planes) == 0:
+        return flat
+    inliers = np.abs(sample @ planes[:, :3].T + planes[:, 3]) < p.ground_threshold  # (M, K)
+    nx, ny, nz, d = planes[int(np.argmax(inliers.sum(axis=0)))]
+    plane = GroundPlane(float(-nx / nz), float(-ny / nz), float(-d / nz))
+    return _refit(points, _refit(points, plane, p.ground_threshold), p.ground_threshold)
+
+
+# ---- clustering ------------------------------------------------------------------------------
+
+
+def voxel_centroids(xy: FloatArray, size: float) -> tuple[FloatArray, IntArray]:
+    """Centroids (M, 2) [m] of the occupied ``size`` grid cells of (N, 2) points, and each
+    point's cell index (N,)."""
+    cells = np.floor(xy / size).astype(np.int64)
+    keys = (cells[:, 0] << 32) + cells[:, 1]
+    _, inverse = np.unique(keys, return_inverse=True)
+    inverse = inverse.reshape(-1)
+    counts = np.bincount(inverse)
+    centroids = np.column_stack([np.bincount(inverse, weights=xy[:, 0]) / counts,
+                                 np.bincount(inverse, weights=xy[:, 1]) / counts])
+    return centroids, inverse
+
+
+def cluster_labels(xy: FloatArray, p: DetectorParams) -> IntArray:
+    """(N,) cluster label of each (N, 2) point [m] (-1: none); see module doc, step 3."""
+    if len(xy) == 0:
+        return np.zeros(0, dtype=np.int64)
+    centroids, inverse = voxel_centroids(xy, p.voxel)
+    o3d = _open3d()
+    cloud = o3d.geometry.PointCloud(
+        o3d.utility.Vector3dVector(np.column_stack([centroids, np.zeros(len(centroids))])))
+    labels = np.asarray(cloud.cluster_dbscan(eps=p.cluster_eps, min_points=1), dtype=np.int64)
+    out: IntArray = labels[inverse]
+    return out
+
+
+def gated_clusters(labels: IntArray, xy: FloatArray, heights: FloatArray,
+                   p: DetectorParams) -> list[IntArray]:
+    """Point indices of each cluster (label >= 0) that passes the gate of step 4, in label
+    order; ``xy`` (N, 2) [m] and ``heights`` (N,) [m] are the labelled points."""
+    if len(labels) == 0:
+        return []
+    order = np.argsort(labels, kind="stable")
+    sorted_labels = labels[order]
+    starts = np.flatnonzero(np.diff(sorted_labels, prepend=-2))
+    counts = np.diff(np.append(starts, len(order)))
+    top = np.maximum.reduceat(heights[order], starts)
+    sxy = xy[order]
+    extent = np.max(np.maximum.reduceat(sxy, starts) - np.minimum.reduceat(sxy, starts), axis=1)
+    ok = ((sorted_labels[starts] >= 0) & (counts >= p.min_points) & (top >= p.min_top)
+          & (top <= p.max_height) & (extent <= p.max_length * math.sqrt(2.0)))
+    return [order[i:i + n] for i, n in zip(starts[ok], counts[ok], strict=True)]
+
+
+# ---- L-shape fitting ---------------------------------------------------------------------------
+
+
+def _edge_distances(proj: FloatArray) -> FloatArray:
+    """(A, N) distance of each projection to the box edge (min or max) its axis keeps."""
+    to_max = proj.max(axis=1, keepdims=True) - proj
+    to_min = proj - proj.min(axis=1, keepdims=True)
+    use_max = np.linalg.norm(to_max, axis=1) <= np.linalg.norm(to_min, axis=1)
+    out: FloatArray = np.where(use_max[:, None], to_max, to_min)
+    return out
+
+
+def closeness(xy: FloatArray, angles: FloatArray, d0: float) -> FloatArray:
+    """(A,) Zhang et al.'s closeness score of (N, 2) points [m] for each heading [rad]."""
+    c, s = np.cos(angles)[:, None], np.sin(angles)[:, None]
+    x, y = xy[:, 0][None, :], xy[:, 1][None, :]
+    d1 = _edge_distances(c * x + s * y)
+    d2 = _edge_distances(-s * x + c * y)
+    score: FloatArray = (1.0 / np.maximum(np.minimum(d1, d2), d0)).sum(axis=1)
+    return score
+
+
+def l_shape_heading(xy: FloatArray, p: DetectorParams) -> float:
+    """[rad] heading in [0, pi/2) of the box axis best fitting (N, 2) points (module doc 5)."""
+    pts = xy[:: max(1, math.ceil(len(xy) / p.fit_max_points))]
+    coarse = np.arange(0.0, 0.5 * math.pi, p.coarse_step)
+    best = float(coarse[int(np.argmax(closeness(pts, coarse, p.closeness_d0)))])
+    fine = best + np.arange(-p.coarse_step, p.coarse_step + 0.5 * p.fine_step, p.fine_step)
+    best = float(fine[int(np.argmax(closeness(pts, fine, p.closeness_d0)))])
+    for _ in range(p.refine_iterations):
+        best = refine_heading(xy, best)
+    return best % (0.5 * math.pi)
+
+
+def _scatter(pts: FloatArray) -> FloatArray:
+    """(2, 2) scatter matrix of (N, 2) points about their mean (zeros if N = 0)."""
+    if len(pts) == 0:
+        return np.zeros((2, 2))
+    d = pts - pts.mean(axis=0)
+    out: FloatArray = d.T @ d
+    return out
+
+
+def refine_heading(xy: FloatArray, theta: float) -> float:
+    """[rad] the heading of two perpendicular lines fitted to (N, 2) points [m] by least
+    squares, starting from the L-shape heading ``theta`` [rad] (module doc, step 5)."""
+    axes = np.array([[math.cos(theta), math.sin(theta)], [-math.sin(theta), math.cos(theta)]])
+    d = _edge_distances((xy @ axes.T).T)  # (2, N): distance to each axis's kept edge
+    on_first = d[0] < d[1]  # nearer the edge line whose normal is axis 1
+    # sum_A (n.p)^2 + sum_B (n_perp.p)^2 = n^T (S_A - S_B) n + tr(S_B): n is the eigenvector
+    # of the smallest eigenvalue of S_A - S_B.
+    _, vectors = np.linalg.eigh(_scatter(xy[on_first]) - _scatter(xy[~on_first]))
+    n = vectors[:, 0]
+    return math.atan2(float(n[1]), float(n[0]))
+
+
+# ---- class and box completion ------------------------------------------------------------------
+
+
+def candidate_classes(long_side: float, short_side: float, top: float,
+                      p: DetectorParams) -> tuple[ObjectClass, ...]:
+    """The classes observed extents [m] and highest point [m] allow (module doc, step 6);
+    empty: not an object."""
+    if long_side > p.max_length or top > p.max_height:
+        return ()
+    if long_side <= p.small_footprint:
+        is_ped = (long_side <= p.pedestrian_footprint
+                  and p.pedestrian_min_height <= top <= p.pedestrian_max_height)
+        return (ObjectClass.PEDESTRIAN,) if is_ped else (ObjectClass.OTHER,)
+    if (top > p.car.height + p.height_margin or long_side > p.truck_min_length
+            or short_side > p.truck_min_width):
+        return (ObjectClass.TRUCK,)
+    return (ObjectClass.CAR, ObjectClass.TRUCK)
+
+
+def grow_interval(lo: float, hi: float, size: float, sensor: float) -> tuple[float, float]:
+    """Grow [lo, hi] [m] to ``size`` away from the sensor's projection ``sensor`` [m]."""
+    if size <= hi - lo:
+        return lo, hi
+    if sensor < lo:
+        return lo, lo + size
+    if sensor > hi:
+        return hi - size, hi
+    mid = 0.5 * (lo + hi)
+    return mid - 0.5 * size, mid + 0.5 * size
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class Footprint:
+    """A cluster's fitted rectangle and how the sensor sees it (vehicle frame)."""
+
+    axes: FloatArray  # (2, 2) rows: the rectangle's unit axes
+    lo: tuple[float, float]  # [m] observed interval of the points along each axis
+    hi: tuple[float, float]  # [m]
+    sensor: FloatArray  # (2,) [m] the sensor's position (x, y)
+    view: FloatArray  # (2, 2) rotation into a frame whose x points from the sensor to the points
+    azimuth: tuple[float, float]  # [rad] the points' azimuth interval in that frame
+    distance: float  # [m] mean horizontal range of the points
+
+    @property
+    def extents(self) -> tuple[float, float]:
+        """[m] observed extent along each axis."""
+        return self.hi[0] - self.lo[0], self.hi[1] - self.lo[1]
+
+    def azimuths(self, xy: FloatArray) -> FloatArray:
+        """(N,) [rad] azimuths of (N, 2) points as seen from the sensor, in the view frame."""
+        v = (xy - self.sensor) @ self.view.T
+        out: FloatArray = np.arctan2(v[:, 1], v[:, 0])
+        return out
+
+
+def footprint(xy: FloatArray, sensor_xy: tuple[float, float], p: DetectorParams) -> Footprint:
+    """L-shape fit of (N, 2) vehicle-frame points [m] seen from ``sensor_xy`` [m]."""
+    theta = l_shape_heading(xy, p)
+    c, s = math.cos(theta), math.sin(theta)
+    axes = np.array([[c, s], [-s, c]])
+    proj = xy @ axes.T
+    lo, hi = proj.min(axis=0), proj.max(axis=0)
+    sensor = np.asarray(sensor_xy, dtype=np.float64)
+    rel = xy - sensor
+    ref = math.atan2(float(rel[:, 1].mean()), float(rel[:, 0].mean()))
+    cr, sr = math.cos(ref), math.sin(ref)
+    fp = Footprint(axes=axes, lo=(float(lo[0]), float(lo[1])), hi=(float(hi[0]), float(hi[1])),
+                   sensor=sensor, view=np.array([[cr, sr], [-sr, cr]]), azimuth=(0.0, 0.0),
+                   distance=float(np.hypot(rel[:, 0], rel[:, 1]).mean()))
+    az = fp.azimuths(xy)
+    return replace(fp, azimuth=(float(az.min()), float(az.max())))
+
+
+@dataclass(frozen=True, slots=True)
+class Hypothesis:
+    """One completed box for a cluster: class, which fitted axis is the length, bounds."""
+
+    cost: float  # [m] silhouette growth + overshoot weight x overshoot (+ truck bias)
+    cls: ObjectClass
+    axis1_length: bool  # the first fitted axis is the box's length axis
+    bounds: tuple[tuple[float, float], tuple[float, float]]  # [m] (lo, hi) along each axis
+
+
+def silhouette_growth(fp: Footprint, bounds: tuple[tuple[float, float], ...]) -> float:
+    """[m] how far a box of ``bounds`` (along ``fp.axes``) sticks out sideways, as seen from
+    the sensor, beyond the points that were seen (angle x mean range)."""
+    (lo1, hi1), (lo2, hi2) = bounds
+    corners = np.array([[lo1, lo2], [lo1, hi2], [hi1, lo2], [hi1, hi2]]) @ fp.axes
+    az = fp.azimuths(corners)
+    out = max(0.0, fp.azimuth[0] - float(az.min())) + max(0.0, float(az.max()) - fp.azimuth[1])
+    return out * fp.distance
+
+
+def hypothesis(fp: Footprint, cls: ObjectClass, axis1_length: bool,
+               p: DetectorParams) -> Hypothesis:
+    """The box of class ``cls`` grown from ``fp`` away from the sensor, and its cost."""
+    ext = fp.extents
+    prior = p.prior(cls)
+    if prior is None:
+        dims = (max(ext), max(ext))  # unknown size: a square of the longer observed side
+    elif axis1_length:
+        dims = (prior.length, prior.width)
+    else:
+        dims = (prior.width, prior.length)
+    sensor = fp.axes @ fp.sensor  # [m] the sensor's projection on each axis
+    bounds = (grow_interval(fp.lo[0], fp.hi[0], max(dims[0], ext[0]), float(sensor[0])),
+              grow_interval(fp.lo[1], fp.hi[1], max(dims[1], ext[1]), float(sensor[1])))
+    overshoot = max(0.0, ext[0] - dims[0]) + max(0.0, ext[1] - dims[1])
+    bias = p.truck_bias if cls is ObjectClass.TRUCK else 0.0
+    cost = silhouette_growth(fp, bounds) + p.overshoot_weight * overshoot + bias
+    return Hypothesis(cost, cls, axis1_length, bounds)
+
+
+def wrap_half_pi(a: float) -> float:
+    """[rad] a box heading wrapped to (-pi/2, pi/2]."""
+    w = math.remainder(a, math.pi)
+    return math.pi / 2 if w == -math.pi / 2 else w
+
+
+def box_from_points(xy: FloatArray, top: float, sensor_xy: tuple[float, float],
+                    p: DetectorParams) -> Detection | None:
+    """The completed box of one cluster: (N, 2) vehicle-frame points [m], highest point
+    ``top`` [m] above the ground, sensor position [m]; None if it is not an object."""
+    fp = footprint(xy, sensor_xy, p)
+    ext = fp.extents
+    longer_first = ext[0] >= ext[1]
+    hyps = [hypothesis(fp, cls, axis1_length, p)
+            for cls in candidate_classes(max(ext), min(ext), top, p)
+            for axis1_length in (longer_first, not longer_first)]
+    if not hyps:
+        return None
+    best = min(hyps, key=lambda h: h.cost)  # the first of equals: deterministic
+    (lo1, hi1), (lo2, hi2) = best.bounds
+    centre = np.array([0.5 * (lo1 + hi1), 0.5 * (lo2 + hi2)]) @ fp.axes
+    prior = p.prior(best.cls)
+    height = max(top, prior.height) if prior is not None else top
+    length, width = (hi1 - lo1, hi2 - lo2) if best.axis1_length else (hi2 - lo2, hi1 - lo1)
+    axis = fp.axes[0] if best.axis1_length else fp.axes[1]
+    return Detection(x=float(centre[0]), y=float(centre[1]), z=0.5 * height, length=length,
+                     width=width, height=height,
+                     yaw=wrap_half_pi(math.atan2(float(axis[1]), float(axis[0]))),
+                     cls=best.cls, points=len(xy))
+
+
+# ---- the detector ------------------------------------------------------------------------------
+
+
+def inside_box(xy: FloatArray, det: Detection, margin: float) -> NDArray[np.bool_]:
+    """(N,) whether (N, 2) vehicle-frame points [m] lie in ``det``'s footprint grown by
+    ``margin`` [m] on every side."""
+    c, s = math.cos(det.yaw), math.sin(det.yaw)
+    dx, dy = xy[:, 0] - det.x, xy[:, 1] - det.y
+    along, across = c * dx + s * dy, -s * dx + c * dy
+    out: NDArray[np.bool_] = ((np.abs(along) <= 0.5 * det.length + margin)
+                              & (np.abs(across) <= 0.5 * det.width + margin))
+    return out
+
+
+def suppress_fragments(found: list[tuple[Detection, FloatArray]],
+                       margin: float) -> list[Detection]:
+    """Drop detections whose points lie mostly inside a box with more points (module doc,
+    step 8); ``found`` pairs each detection with its cluster's (N, 2) points [m]."""
+    order = sorted(found, key=lambda f: (-f[0].points, f[0].x, f[0].y))
+    kept: list[Detection] = []
+    for det, xy in order:
+        if not any(inside_box(xy, k, margin).mean() >= 0.5 for k in kept):
+            kept.append(det)
+    return kept
+
+
+class ObjectDetector:
+    """LiDAR object detector; see the module docstring for the method."""
+
+    def __init__(self, params: DetectorParams | None = None) -> None:
+        self.params = params if params is not None else DetectorParams()
+        self.ground = GroundPlane(0.0, 0.0, 0.0)  # the last scan's fitted ground
+
+    def obstacle_points(self, scan: LidarScan) -> tuple[FloatArray, FloatArray]:
+        """(N, 3) vehicle-frame points [m] in the ROI above the ground, and their (N,)
+        heights [m] above the fitted ground plane (steps 1-2)."""
+        p = self.params
+        pts = scan.info.mount.to_vehicle(np.asarray(scan.points, dtype=np.float64))
+        pts = pts[(np.abs(pts[:, 0]) <= p.roi_x) & (np.abs(pts[:, 1]) <= p.roi_y)]
+        self.ground = fit_ground(pts, p)
+        h = self.ground.height(pts)
+        keep = (h >= p.ground_clearance) & (h <= p.roi_height)
+        return pts[keep], h[keep]
+
+    def detect(self, scan: LidarScan) -> tuple[Detection, ...]:
+        """Boxes of the objects in ``scan``, vehicle frame, nearest first."""
+        p = self.params
+        pts, heights = self.obstacle_points(scan)
+        xy = pts[:, :2]
+        sensor = (scan.info.mount.x, scan.info.mount.y)
+        found: list[tuple[Detection, FloatArray]] = []
+        for idx in gated_clusters(cluster_labels(xy, p), xy, heights, p):
+            det = box_from_points(xy[idx], float(heights[idx].max()), sensor, p)
+            if det is not None:
+                found.append((det, xy[idx]))
+        kept = suppress_fragments(found, p.fragment_margin)
+        kept.sort(key=lambda d: (math.hypot(d.x - sensor[0], d.y - sensor[1]), d.x, d.y))
+        return tuple(kept)

@@ -1,0 +1,284 @@
+"""Multi-object tracking of LiDAR detections in the map frame.
+
+Input, every scan: the time ``t`` [s], the localiser's `EgoState` at ``t`` and the scan's
+`Detection` boxes (vehicle frame of the ego at ``t``). Output: the confirmed `Track`s.
+
+Model (one linear Kalman filter per track, filterpy's `KalmanFilter`):
+
+- state ``[x, y, vx, vy]`` [m, m, m/s, m/s] in the map frame (over ground: parked cars stand
+  still whatever the ego does), constant velocity: ``x' = x + vx dt``;
+- process noise: continuous white acceleration of spectral density ``accel_psd`` [m^2/s^3]
+  on each axis, ``Q = q [[dt^3/3, dt^2/2], [dt^2/2, dt]]`` per axis;
+- measurement: the box centre, converted to the map frame with the ego pose,
+  ``R = position_sigma^2 I`` (the box completion puts car centres within ~0.1-0.2 m; the
+  ego pose error is small next to that and is not added);
+- a new track starts at the detection with zero velocity and ``init_speed_sigma``
+  [m/s] velocity uncertainty.
+
+Steps of `MultiObjectTracker.update`:
+
+1. Predict every track to ``t``.
+2. Association: cost = Mahalanobis distance squared of each detection centre to each
+   track's predicted centre (innovation covariance ``S = H P H^T + R``); pairs beyond the
+   chi-square gate ``gate`` (9.21: 99 % for 2 degrees of freedom) are not allowed; the
+   assignment is `scipy.optimize.linear_sum_assignment` (global minimum of the summed
+   cost).
+3. Update the matched tracks: the filter; the box size (exponential smoothing with weight
+   ``size_alpha``); the box heading (the same smoothing on the doubled angle, so that the
+   front/back ambiguity of a box does not matter); the class (majority vote over the
+   track's detections, ties to the most recent class).
+4. Track management. A track is born TENTATIVE from every unmatched detection and is
+   CONFIRMED once ``confirm_hits`` (3) of its first ``confirm_window`` (5) scans matched;
+   a tentative track that can no longer reach that is deleted. A confirmed track coasts
+   (predicted only) through misses and is deleted when it has not been matched for more
+   than ``max_coast`` (0.5 s: 5 scans at 10 Hz), or when it is farther than
+   ``max_distance`` (80 m) from the ego (no track is born there either). Ids are
+   consecutive integers from 1, never reused.
+5. Output: the confirmed tracks (coasting ones included, with ``misses`` > 0), by id. The
+   yaw is the smoothed box heading (map frame); when the track moves faster than
+   ``heading_min_speed`` it is the one of the two box directions closer to the velocity.
+   ``rel_x, rel_y`` are the centre in the ego's vehicle frame; ``rel_vx, rel_vy`` the
+   object's velocity minus the ego's (``ego.speed`` along ``ego.heading``), rotated into
+   the vehicle frame (the rotation of the frame itself, ``yaw_rate x r``, is not included).
+
+Everything is deterministic: no random numbers; tracks are kept and processed by id,
+detections in the order given.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from filterpy.kalman import KalmanFilter
+from numpy.typing import NDArray
+from scipy.optimize import linear_sum_assignment
+
+from perception.messages import Detection, EgoState, ObjectClass, Track
+
+FloatArray = NDArray[np.float64]
+
+DIM_X = 4  # [x, y, vx, vy]
+_H = np.eye(2, DIM_X)  # (2, 4) the centre
+_CLASS_ORDER = tuple(ObjectClass)
+INFEASIBLE = 1e9  # [-] assignment cost of a pair outside the gate
+
+
+@dataclass(frozen=True, slots=True)
+class TrackerParams:
+    """Noise, gating and track management of the tracker (see the module docstring)."""
+
+    accel_psd: float = 1.0  # [m^2/s^3] white acceleration spectral density, per axis
+    position_sigma: float = 0.15  # [m] measurement noise of a box centre, per axis
+    init_speed_sigma: float = 10.0  # [m/s] velocity uncertainty of a new track, per axis
+    gate: float = 9.21  # [-] chi-square (2 dof, 99 %) gate on the Mahalanobis distance^2
+    confirm_hits: int = 3  # [-] M: matched scans needed for confirmation ...
+    confirm_window: int = 5  # [-] N: ... within the track's first N scans
+    max_coast: float = 0.5  # [s] a track unmatched for longer is deleted
+    max_distance: float = 80.0  # [m] a track farther from the ego is deleted
+    size_alpha: float = 0.3  # [-] smoothing weight of a new box size / heading
+    heading_min_speed: float = 1.0  # [m/s] faster tracks take the yaw closer to the velocity
+
+
+def process_noise(dt: float, q: float) -> FloatArray:
+    """(4, 4) white-acceleration process noise of ``[x, y, vx, vy]`` over ``dt`` [s] for a
+    spectral density ``q`` [m^2/s^3]."""
+    block = q * np.array([[dt**3 / 3.0, dt**2 / 2.0], [dt**2 / 2.0, dt]])
+    out = np.zeros((DIM_X, DIM_X))
+    for axis in (0, 1):
+        idx = np.ix_([axis, axis + 2], [axis, axis + 2])
+        out[idx] = block
+    return out
+
+
+def transition(dt: float) -> FloatArray:
+    """(4, 4) constant-velocity transition over ``dt`` [s]."""
+    f = np.eye(DIM_X)
+    f[0, 2] = f[1, 3] = dt
+    return f
+
+
+def wrap_angle(a: float) -> float:
+    """[rad] ``a`` wrapped to (-pi, pi]."""
+    w = math.remainder(a, 2.0 * math.pi)
+    return math.pi if w == -math.pi else w
+
+
+@dataclass(frozen=True, slots=True)
+class MapDetection:
+    """A detection moved to the map frame."""
+
+    x: float  # [m] box centre, map frame
+    y: float  # [m]
+    yaw: float  # [rad] box heading, map frame (mod pi)
+    length: float  # [m]
+    width: float  # [m]
+    height: float  # [m]
+    cls: ObjectClass
+
+
+def to_map(det: Detection, ego: EgoState) -> MapDetection:
+    """``det`` (vehicle frame of ``ego``) in the map frame."""
+    c, s = math.cos(ego.heading), math.sin(ego.heading)
+    return MapDetection(x=ego.x + c * det.x - s * det.y, y=ego.y + s * det.x + c * det.y,
+                        yaw=det.yaw + ego.heading, length=det.length, width=det.width,
+                        height=det.height, cls=det.cls)
+
+
+class _TrackState:
+    """One track's filter and bookkeeping (mutable, private to the tracker)."""
+
+    def __init__(self, track_id: int, t: float, det: MapDetection, p: TrackerParams) -> None:
+        self.id = track_id
+        self.kf = KalmanFilter(dim_x=DIM_X, dim_z=2)
+        self.kf.x = np.array([[det.x], [det.y], [0.0], [0.0]])
+        r = p.position_sigma**2
+        self.kf.P = np.diag([r, r, p.init_speed_sigma**2, p.init_speed_sigma**2])
+        self.kf.H = _H.copy()
+        self.kf.R = np.eye(2) * r
+        self.t = t  # [s] time of the filter state
+        self.last_hit = t  # [s]
+        self.scans = 1  # [-] scans since birth, this one included
+        self.hits = 1  # [-] matched scans
+        self.misses = 0  # [-] consecutive unmatched scans
+        self.confirmed = False
+        self.size = np.array([det.length, det.width, det.height])  # [m] smoothed
+        self.axis = np.array([math.cos(2.0 * det.yaw), math.sin(2.0 * det.yaw)])  # doubled
+        self.votes = dict.fromkeys(_CLASS_ORDER, 0)
+        self.votes[det.cls] = 1
+        self.last_cls = det.cls
+
+    @property
+    def state(self) -> FloatArray:
+        """(4,) ``[x, y, vx, vy]``."""
+        return np.asarray(self.kf.x, dtype=np.float64).reshape(DIM_X)
+
+    def predict(self, t: float, p: TrackerParams) -> None:
+        dt = t - self.t
+        if dt > 0.0:
+            self.kf.predict(F=transition(dt), Q=process_noise(dt, p.accel_psd))
+            self.t = t
+
+    def mahalanobis2(self, z: FloatArray) -> FloatArray:
+        """(D,) squared Mahalanobis distance of (D, 2) map-frame centres [m]."""
+        s = self.kf.P[:2, :2] + self.kf.R
+        y = z - self.state[:2]
+        out: FloatArray = np.einsum("ij,jk,ik->i", y, np.linalg.inv(s), y)
+        return out
+
+    def update(self, det: MapDetection, t: float, p: TrackerParams) -> None:
+        self.kf.update(np.array([det.x, det.y]))
+        a = p.size_alpha
+        self.size = (1.0 - a) * self.size + a * np.array([det.length, det.width, det.height])
+        self.axis = (1.0 - a) * self.axis + a * np.array([math.cos(2.0 * det.yaw),
+                                                          math.sin(2.0 * det.yaw)])
+        self.votes[det.cls] += 1
+        self.last_cls = det.cls
+        self.hits += 1
+        self.misses = 0
+        self.last_hit = t
+
+    def cls(self) -> ObjectClass:
+        """The majority class; a tie goes to the most recent detection's class, then to
+        the enum order."""
+        best = max(self.votes.values())
+        if self.votes[self.last_cls] == best:
+            return self.last_cls
+        return next(c for c in _CLASS_ORDER if self.votes[c] == best)
+
+    def yaw(self, p: TrackerParams) -> float:
+        """[rad] map-frame heading: the smoothed box axis, pointed along the velocity when
+        moving."""
+        axis = 0.5 * math.atan2(float(self.axis[1]), float(self.axis[0]))  # (-pi/2, pi/2]
+        vx, vy = self.state[2:]
+        if math.hypot(vx, vy) < p.heading_min_speed:
+            return axis
+        course = math.atan2(vy, vx)
+        flipped = wrap_angle(axis + math.pi)
+        return axis if abs(wrap_angle(axis - course)) <= abs(wrap_angle(flipped - course)) \
+            else flipped
+
+
+def relative(x: float, y: float, vx: float, vy: float,
+             ego: EgoState) -> tuple[float, float, float, float]:
+    """(rel_x, rel_y, rel_vx, rel_vy) [m, m, m/s, m/s] of a map-frame position and velocity
+    in the ego's vehicle frame; the velocity is relative to the ego's (speed along heading)."""
+    c, s = math.cos(ego.heading), math.sin(ego.heading)
+    dx, dy = x - ego.x, y - ego.y
+    dvx, dvy = vx - ego.speed * c, vy - ego.speed * s
+    return c * dx + s * dy, -s * dx + c * dy, c * dvx + s * dvy, -s * dvx + c * dvy
+
+
+def associate(tracks: list[_TrackState], dets: list[MapDetection],
+              gate: float) -> list[tuple[int, int]]:
+    """(track index, detection index) pairs of the gated minimum-cost assignment."""
+    if not tracks or not dets:
+        return []
+    z = np.array([[d.x, d.y] for d in dets])
+    cost = np.array([tr.mahalanobis2(z) for tr in tracks])  # (T, D)
+    cost = np.where(cost <= gate, cost, INFEASIBLE)
+    rows, cols = linear_sum_assignment(cost)
+    return [(int(r), int(c)) for r, c in zip(rows, cols, strict=True)
+            if cost[r, c] < INFEASIBLE]
+
+
+class MultiObjectTracker:
+    """Kalman-filter multi-object tracker in the map frame; see the module docstring."""
+
+    def __init__(self, params: TrackerParams | None = None) -> None:
+        self.params = params if params is not None else TrackerParams()
+        self._tracks: list[_TrackState] = []
+        self._next_id = 1
+
+    def update(self, t: float, ego: EgoState,
+               detections: tuple[Detection, ...]) -> tuple[Track, ...]:
+        """Advance to time ``t`` [s] with the detections of the scan at ``t`` (vehicle frame
+        of ``ego``) and return the confirmed tracks, by id."""
+        p = self.params
+        dets = [to_map(d, ego) for d in detections]
+        for tr in self._tracks:
+            tr.predict(t, p)
+        pairs = associate(self._tracks, dets, p.gate)
+        matched_tracks = {i for i, _ in pairs}
+        matched_dets = {j for _, j in pairs}
+        for i, j in pairs:
+            self._tracks[i].update(dets[j], t, p)
+        for i, tr in enumerate(self._tracks):
+            tr.scans += 1
+            if i not in matched_tracks:
+                tr.misses += 1
+        self._manage(ego)
+        for j, det in enumerate(dets):
+            if j not in matched_dets and math.hypot(det.x - ego.x, det.y - ego.y) <= p.max_distance:
+                self._tracks.append(_TrackState(self._next_id, t, det, p))
+                self._next_id += 1
+        return tuple(self._output(tr, ego) for tr in self._tracks if tr.confirmed)
+
+    def _manage(self, ego: EgoState) -> None:
+        """Confirm and delete tracks (module doc, step 4)."""
+        p = self.params
+        kept = []
+        for tr in self._tracks:
+            if not tr.confirmed and tr.hits >= p.confirm_hits:
+                tr.confirmed = True
+            misses_allowed = p.confirm_window - p.confirm_hits
+            if not tr.confirmed and tr.scans - tr.hits > misses_allowed:
+                continue
+            if tr.confirmed and tr.t - tr.last_hit > p.max_coast + 1e-9:
+                continue
+            x, y = tr.state[:2]
+            if math.hypot(x - ego.x, y - ego.y) > p.max_distance:
+                continue
+            kept.append(tr)
+        self._tracks = kept
+
+    def _output(self, tr: _TrackState, ego: EgoState) -> Track:
+        x, y, vx, vy = (float(v) for v in tr.state)
+        rel_x, rel_y, rel_vx, rel_vy = relative(x, y, vx, vy, ego)
+        p_pos = tr.kf.P[:2, :2]
+        length, width, height = (float(v) for v in tr.size)
+        return Track(id=tr.id, t=tr.t, x=x, y=y, vx=vx, vy=vy, rel_x=rel_x, rel_y=rel_y,
+                     rel_vx=rel_vx, rel_vy=rel_vy, length=length, width=width, height=height,
+                     yaw=tr.yaw(self.params), cls=tr.cls(), hits=tr.hits, misses=tr.misses,
+                     position_sigma=math.sqrt(max(float(np.linalg.eigvalsh(p_pos)[-1]), 0.0)))

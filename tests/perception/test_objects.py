@@ -1,0 +1,240 @@
+"""LiDAR object detector on synthetic scans (numpy ray caster, VLP-16-like, 2 cm range noise)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from perception.messages import Detection, ObjectClass
+from perception.objects import (
+    DetectorParams,
+    ObjectDetector,
+    fit_ground,
+    grow_interval,
+    wrap_half_pi,
+)
+from tests.perception.lidar_synth import (
+    CAR,
+    FLAT,
+    OBSTACLE,
+    PEDESTRIAN,
+    TRUCK,
+    Box,
+    Ground,
+    cast,
+    lidar_info,
+    on_ground,
+)
+from world.frames import LidarScan, SensorMount
+
+DEG = math.pi / 180.0
+POSITION_TOL = 0.3  # [m] box centre error
+YAW_TOL = 5.0 * DEG  # [rad] box heading error (mod pi)
+
+
+@pytest.fixture(scope="module")
+def detector() -> ObjectDetector:
+    return ObjectDetector(DetectorParams())
+
+
+def detect(detector: ObjectDetector, boxes: list[Box], columns: int = 1800,
+           ground: Ground | None = FLAT, seed: int = 0) -> tuple[Detection, ...]:
+    return detector.detect(cast(lidar_info(columns), boxes, ground=ground, seed=seed))
+
+
+def yaw_error(a: float, b: float) -> float:
+    """[rad] heading difference modulo pi (a box has no front)."""
+    return abs(math.remainder(a - b, math.pi))
+
+
+def assert_box(det: Detection, box: Box, cls: ObjectClass, check_yaw: bool = True) -> None:
+    assert det.cls is cls, det
+    assert math.hypot(det.x - box.x, det.y - box.y) <= POSITION_TOL, (det, box)
+    if check_yaw:
+        assert yaw_error(det.yaw, box.yaw) <= YAW_TOL, (det, box)
+    assert -math.pi / 2 < det.yaw <= math.pi / 2
+
+
+@pytest.mark.parametrize("distance", [10.0, 30.0, 50.0])
+@pytest.mark.parametrize("columns", [1800, 900])
+def test_car_ahead_is_completed_from_its_rear(detector: ObjectDetector, distance: float,
+                                              columns: int) -> None:
+    box = on_ground(distance, 0.0, CAR)
+    found = detect(detector, [box], columns)
+    assert len(found) == 1, found
+    det = found[0]
+    assert_box(det, box, ObjectClass.CAR)
+    assert (det.length, det.width, det.height) == pytest.approx(CAR, abs=0.05)
+    assert det.z == pytest.approx(0.75, abs=0.05)
+    assert det.points >= 4
+
+
+@pytest.mark.parametrize(("x", "y"), [(0.0, 5.0), (3.0, -4.5), (-12.0, 3.5), (30.0, -3.5)])
+def test_car_beside_or_in_an_adjacent_lane(detector: ObjectDetector, x: float, y: float) -> None:
+    box = on_ground(x, y, CAR)
+    found = detect(detector, [box])
+    assert len(found) == 1, found
+    assert_box(found[0], box, ObjectClass.CAR)
+
+
+@pytest.mark.parametrize(("x", "y", "yaw_deg"), [(15.0, 3.0, 30.0), (25.0, -6.0, -30.0),
+                                                 (-10.0, 8.0, 60.0), (40.0, 10.0, 60.0)])
+def test_car_at_an_angle(detector: ObjectDetector, x: float, y: float, yaw_deg: float) -> None:
+    box = on_ground(x, y, CAR, yaw_deg * DEG)
+    found = detect(detector, [box])
+    assert len(found) == 1, found
+    assert_box(found[0], box, ObjectClass.CAR)
+
+
+@pytest.mark.parametrize(("x", "y", "yaw_deg"), [(20.0, 0.0, 0.0), (40.0, -3.5, 0.0),
+                                                 (12.0, -6.0, 20.0)])
+def test_truck(detector: ObjectDetector, x: float, y: float, yaw_deg: float) -> None:
+    box = on_ground(x, y, TRUCK, yaw_deg * DEG)
+    found = detect(detector, [box])
+    assert len(found) == 1, found  # its side, seen at grazing incidence, is not a second one
+    assert_box(found[0], box, ObjectClass.TRUCK)
+    assert (found[0].length, found[0].width) == pytest.approx(TRUCK[:2], abs=0.05)
+
+
+@pytest.mark.parametrize(("x", "y"), [(12.0, 2.0), (8.0, -5.5), (-6.0, 4.0), (20.0, 6.0)])
+def test_pedestrian(detector: ObjectDetector, x: float, y: float) -> None:
+    box = on_ground(x, y, PEDESTRIAN)
+    found = detect(detector, [box])
+    assert len(found) == 1, found
+    assert_box(found[0], box, ObjectClass.PEDESTRIAN, check_yaw=False)
+
+
+def test_obstacle_is_other(detector: ObjectDetector) -> None:
+    box = on_ground(8.0, 0.0, OBSTACLE)
+    found = detect(detector, [box])
+    assert len(found) == 1, found
+    assert_box(found[0], box, ObjectClass.OTHER, check_yaw=False)
+    assert abs(math.remainder(found[0].yaw, math.pi / 2)) <= YAW_TOL  # a square: mod 90 deg
+    assert (found[0].length, found[0].width) == pytest.approx((1.0, 1.0), abs=0.1)
+
+
+@pytest.mark.parametrize("distance", [8.0, 15.0, 30.0])
+def test_two_cars_side_by_side_are_two_detections(detector: ObjectDetector,
+                                                  distance: float) -> None:
+    gap = 1.5  # [m] between the bodies (adjacent lanes)
+    boxes = [on_ground(distance, 0.0, CAR), on_ground(distance, CAR[1] + gap, CAR)]
+    found = detect(detector, boxes)
+    assert len(found) == 2, found
+    for box in boxes:
+        nearest = min(found, key=lambda d: math.hypot(d.x - box.x, d.y - box.y))
+        assert_box(nearest, box, ObjectClass.CAR)
+
+
+@pytest.mark.parametrize(("pitch_deg", "roll_deg"), [(1.0, 0.0), (-1.0, 0.0), (1.5, -1.0),
+                                                     (0.0, 2.0)])
+def test_tilted_ground_gives_no_detection(detector: ObjectDetector, pitch_deg: float,
+                                          roll_deg: float) -> None:
+    ground = Ground(pitch=pitch_deg * DEG, roll=roll_deg * DEG)
+    assert detect(detector, [], ground=ground) == ()
+    plane = detector.ground
+    assert plane.a == pytest.approx(math.tan(pitch_deg * DEG), abs=1e-3)
+    assert plane.b == pytest.approx(math.tan(roll_deg * DEG), abs=1e-3)
+
+
+def test_car_on_a_pitched_ground_is_still_found(detector: ObjectDetector) -> None:
+    pitch = 1.0 * DEG  # nose down: the ground rises ahead, the car stands on it
+    x = 25.0
+    box = Box(x, 0.0, x * math.tan(pitch) + 0.75, *CAR, yaw=0.0)
+    found = detect(detector, [box], ground=Ground(pitch=pitch))
+    assert len(found) == 1, found
+    assert_box(found[0], box, ObjectClass.CAR)
+
+
+def test_ground_fit_ignores_walls_and_roofs() -> None:
+    scan = cast(lidar_info(), [on_ground(20.0, -14.0, (40.0, 10.0, 12.0)),
+                               on_ground(6.0, 0.0, CAR), on_ground(6.0, 3.5, CAR)],
+                ground=Ground(pitch=0.5 * DEG, offset=0.02))
+    points = scan.info.mount.to_vehicle(scan.points)
+    plane = fit_ground(points, DetectorParams())
+    assert plane.a == pytest.approx(math.tan(0.5 * DEG), abs=1e-3)
+    assert plane.b == pytest.approx(0.0, abs=1e-3)
+    assert plane.c == pytest.approx(0.02, abs=0.01)
+
+
+@pytest.mark.parametrize("building", [
+    on_ground(20.0, -25.0, (30.0, 15.0, 10.0)),  # set back from the road
+    on_ground(0.0, 9.0, (40.0, 8.0, 6.0)),  # a long wall alongside
+    on_ground(30.0, 0.0, (8.0, 8.0, 6.0)),  # short but too tall
+])
+def test_building_is_not_a_detection(detector: ObjectDetector, building: Box) -> None:
+    assert detect(detector, [building]) == ()
+
+
+def test_empty_scans(detector: ObjectDetector) -> None:
+    info = lidar_info()
+    empty = LidarScan(t=0.0, info=info, points=np.zeros((0, 3), dtype=np.float32),
+                      ring=np.zeros(0, dtype=np.uint8), column=np.zeros(0, dtype=np.uint16))
+    assert detector.detect(empty) == ()
+    assert detect(detector, []) == ()  # ground only
+    box = on_ground(10.0, 0.0, CAR)
+    assert len(detect(detector, [box], ground=None)) == 1  # no ground at all
+
+
+def test_street_scene(detector: ObjectDetector) -> None:
+    """Buildings, sign poles and traffic together: every vehicle and the pedestrian found
+    once and right, nothing that is not there."""
+    vehicles = [on_ground(12.0, 0.0, CAR), on_ground(25.0, 3.5, CAR), on_ground(-15.0, 0.0, CAR),
+                on_ground(40.0, -3.5, TRUCK), on_ground(-30.0, 3.5, CAR, 3.0 * DEG)]
+    pedestrian = on_ground(8.0, -5.5, PEDESTRIAN)
+    poles = [on_ground(x, side * 7.5, (0.08, 0.08, 2.5)) for x in range(-57, 60, 20)
+             for side in (1.0, -1.0)]
+    buildings = [on_ground(x, 20.0, (18.0, 14.0, 12.0)) for x in range(-70, 80, 25)]
+    buildings += [on_ground(x + 10.0, -19.0, (16.0, 12.0, 9.0)) for x in range(-70, 80, 25)]
+    truth = [*vehicles, pedestrian, *poles]
+    found = detect(detector, [*truth, *buildings], ground=Ground(pitch=0.7 * DEG))
+    for det in found:  # no phantom: each detection is on a real object
+        assert min(math.hypot(det.x - b.x, det.y - b.y) for b in truth) < 0.5, det
+    for box, cls in [*((v, ObjectClass.CAR) for v in vehicles if v.length == CAR[0]),
+                     (vehicles[3], ObjectClass.TRUCK), (pedestrian, ObjectClass.PEDESTRIAN)]:
+        near = [d for d in found if math.hypot(d.x - box.x, d.y - box.y) < 1.0]
+        assert len(near) == 1, (box, near)
+        assert_box(near[0], box, cls, check_yaw=cls is not ObjectClass.PEDESTRIAN)
+
+
+def test_mount_offset_and_tilt_are_undone(detector: ObjectDetector) -> None:
+    mount = SensorMount(x=1.2, y=-0.3, z=1.65, roll=0.5 * DEG, pitch=1.0 * DEG, yaw=2.0 * DEG)
+    box = on_ground(20.0, 3.5, CAR, 10.0 * DEG)
+    found = detector.detect(cast(lidar_info(mount=mount), [box]))
+    assert len(found) == 1, found
+    assert_box(found[0], box, ObjectClass.CAR)
+
+
+def test_noise_and_dropout(detector: ObjectDetector) -> None:
+    info = lidar_info(range_sigma=0.03, dropout=0.1)
+    boxes = [on_ground(18.0, 0.0, CAR), on_ground(14.0, -3.5, CAR, -5.0 * DEG)]
+    for seed in range(3):
+        found = detector.detect(cast(info, boxes, seed=seed))
+        assert len(found) == 2, found
+        for box in boxes:
+            nearest = min(found, key=lambda d: math.hypot(d.x - box.x, d.y - box.y))
+            assert_box(nearest, box, ObjectClass.CAR)
+
+
+def test_deterministic_and_sorted_by_range(detector: ObjectDetector) -> None:
+    boxes = [on_ground(30.0, 3.5, CAR), on_ground(10.0, 0.0, CAR), on_ground(-20.0, 0.0, TRUCK)]
+    scan = cast(lidar_info(), boxes)
+    first = detector.detect(scan)
+    assert ObjectDetector().detect(scan) == first
+    assert detector.detect(scan) == first
+    ranges = [math.hypot(d.x, d.y) for d in first]
+    assert ranges == sorted(ranges)
+
+
+def test_grow_interval_keeps_the_faces_that_were_seen() -> None:
+    assert grow_interval(10.0, 10.1, 4.6, 0.0) == pytest.approx((10.0, 14.6))  # grow away
+    assert grow_interval(-10.1, -10.0, 4.6, 0.0) == pytest.approx((-14.6, -10.0))
+    assert grow_interval(-0.8, 0.8, 1.8, 0.0) == pytest.approx((-0.9, 0.9))  # head-on
+    assert grow_interval(1.0, 6.0, 4.6, 0.0) == (1.0, 6.0)  # never shrunk
+
+
+def test_wrap_half_pi() -> None:
+    assert wrap_half_pi(math.pi) == pytest.approx(0.0, abs=1e-12)
+    assert wrap_half_pi(-math.pi / 2) == pytest.approx(math.pi / 2)
+    assert wrap_half_pi(2.0) == pytest.approx(2.0 - math.pi)
