@@ -13,9 +13,9 @@ An enum FSM with a pure transition function (table-tested):
 
 MAP is the state of a stack built without a camera (GNSS + odometry on the HD map only):
 it never changes. ACQUIRING follows the map lane at the planned speed (the camera's first
-estimate arrives one sensor period after the start). MAP_HOLD follows the map lane with the localisation estimate
-(GNSS + odometry) and slows to `hold_speed`; STOP_IN_LANE brings the car to a stop in its
-lane. Every change carries a reason for the log.
+estimate arrives one sensor period after the start). MAP_HOLD follows the map lane with the
+localisation estimate (GNSS + odometry) and slows to `hold_speed`; STOP_IN_LANE brings the
+car to a stop in its lane. Every change carries a reason for the log.
 """
 
 from __future__ import annotations
