@@ -74,6 +74,7 @@ class TrajectoryLog:
     drive_torque: list[float] = field(default_factory=list)  # [N m] commanded, total
     brake_torque: list[float] = field(default_factory=list)  # [N m] commanded, total
     wheel_spin: list[NDArray[np.float64]] = field(default_factory=list)  # [rad/s] (4,)
+    actor_station: list[NDArray[np.float64]] = field(default_factory=list)  # [m] (N,) true
 
     def array(self, name: str) -> NDArray[np.float64]:
         return np.asarray(getattr(self, name), dtype=np.float64)
@@ -215,6 +216,7 @@ class Runner:
         log.drive_torque.append(out.command.drive_torque)
         log.brake_torque.append(out.command.brake_torque)
         log.wheel_spin.append(truth.wheel_spin.copy())
+        log.actor_station.append(np.array([m.s for m in w.actors.motions]))
         if self.recorder is not None and RECORD_RATE.fires(w.clock.step):
             self._record_tick(out)
 

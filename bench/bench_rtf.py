@@ -52,7 +52,7 @@ def stack_rtf(record: bool) -> tuple[float, RunResult]:
     spec = load_scenario(SCENARIO)
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp) / "bench.rrd" if record else None
-        runner = Runner(spec, out)
+        runner = Runner(spec, out, profile=None)  # issue A: no cameras or LiDAR
         start = time.perf_counter()
         result = runner.run()
         wall = time.perf_counter() - start

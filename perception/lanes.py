@@ -30,7 +30,10 @@ then a temporal filter (`LaneFilter`).
    the ground plane z = 0 of the vehicle frame (default x 5..35 m ahead of the car's centre,
    y -7..+7 m, 0.05 m per cell), with the homography computed from the camera's intrinsics
    and mount (precomputed once). A cell is paint when the bilinear warp of the 0/255 mask
-   reaches ``mask_min_coverage`` (128).
+   reaches ``mask_min_coverage`` (128), unless it belongs to a run across the view (along y)
+   of at least ``max_paint_width`` (1.0 m): lines are 0.15 m wide, the double centre line
+   0.45 m, but a vertical face (a truck's side, yellow ones pass the colour test) smears
+   over metres of the ground plane in this view (`narrow_only`).
 
 3. **Base positions**: the view is cut into windows along x of ``window_length`` (2 m). From
    the nearest window up to ``base_reach`` (16 m) ahead of ``x_min``, a histogram of the
@@ -128,6 +131,7 @@ class LaneParams:
     ridge_min_gradient: float = 5.0  # [lightness] |Sobel x| / 4 at a ridge's two flanks
     ridge_max_width: int = 12  # [px] rising to falling flank, in the image
     mask_min_coverage: int = 128  # [0..255] of the warped 0/255 mask
+    max_paint_width: float = 1.0  # [m] wider runs across the view are not paint (car sides)
     # -- base search
     base_reach: float = 16.0  # [m] searched from x_min up to x_min + base_reach
     base_bin: float = 0.1  # [m] histogram bin
@@ -176,6 +180,18 @@ def lane_mask(rgb: NDArray[np.uint8], p: LaneParams) -> NDArray[np.uint8]:
     ridge = cv2.bitwise_and(cv2.bitwise_and(rise_left, fall_right), grey)
     paint = cv2.bitwise_or(white, yellow)
     return np.asarray(cv2.bitwise_or(paint, ridge), dtype=np.uint8)
+
+
+def narrow_only(bev_mask: NDArray[np.uint8], min_coverage: int,
+                max_cells: int) -> NDArray[np.uint8]:
+    """The paint cells of a warped mask without the runs across the view (along y) at least
+    `max_cells` wide, and a cell either side of them: painted lines are 0.15 m wide (a double
+    centre line 0.45 m), but a vehicle's or a wall's side, a vertical face, smears across the
+    ground plane of a bird's-eye view far wider (a yellow truck passes the colour test)."""
+    paint = np.where(bev_mask >= min_coverage, 255, 0).astype(np.uint8)
+    wide = cv2.morphologyEx(paint, cv2.MORPH_OPEN, np.ones((1, max_cells), np.uint8))
+    wide = cv2.dilate(wide, np.ones((1, 3), np.uint8))
+    return np.asarray(cv2.bitwise_and(paint, cv2.bitwise_not(wide)), dtype=np.uint8)
 
 
 def paint_cells(bev_mask: NDArray[np.uint8], grid: BevGrid,
@@ -496,7 +512,10 @@ class LaneDetector:
             raise ValueError(f"frame is {frame.rgb.shape}, the camera "
                              f"{self.camera.height} x {self.camera.width} x 3")
         band = np.ascontiguousarray(self.view.crop(frame.rgb))
-        return self.view.warp(lane_mask(band, self.params))
+        p = self.params
+        warped = self.view.warp(lane_mask(band, p))
+        return narrow_only(warped, p.mask_min_coverage,
+                           max(2, round(p.max_paint_width / p.grid.resolution)))
 
     def detect(self, frame: CameraFrame, prior: LaneEstimate | None = None) -> LaneEstimate:
         """The ego lane in ``frame``; ``prior`` (e.g. the filter's last output) guides the
@@ -570,6 +589,8 @@ class LaneFilterParams:
     confidence_floor: float = 0.1  # [-] measurement noise is divided by max(this, confidence)
     gate_probability: float = 0.999  # [-] chi-square gate on the innovation
     max_rejections: int = 3  # consecutive gated-out measurements before re-initialising
+    agree_offset: float = 0.3  # [m] ... if those measurements agree this well (offsets)
+    agree_heading: float = 0.035  # [rad] ... and headings (2 deg)
     confidence_gain: float = 0.5  # [-] share of the measurement's confidence taken per update
     confidence_tau: float = 0.5  # [s] decay time constant of the confidence while predicting
     init_width_sigma: float = 0.5  # [m] width uncertainty when initialised from one boundary
@@ -585,7 +606,9 @@ class LaneFilter:
     seen; the noise is the ``*_sigma`` divided by the measurement's confidence. Gating: an
     innovation whose squared Mahalanobis distance exceeds the chi-square quantile
     ``gate_probability`` is rejected (predict only); after ``max_rejections`` consecutive
-    rejections the filter re-initialises on the measurement (a lane change, a new lane).
+    rejections that agree with each other (offsets within ``agree_offset``, headings within
+    ``agree_heading``) the filter re-initialises on the measurement (a lane change, a new
+    lane); rejections that scatter (a vehicle's side, glare) only ever predict.
     Frames with confidence below ``min_confidence`` only predict. The output confidence
     moves by ``confidence_gain`` towards each accepted measurement's and decays as
     ``exp(-dt / confidence_tau)`` while predicting, so it goes to ~0 when lines vanish for
@@ -605,6 +628,7 @@ class LaneFilter:
         self.confidence = 0.0  # [0, 1]
         self.initialised = False
         self.rejections = 0  # consecutive gated-out measurements
+        self._rejected: list[LaneEstimate] = []  # the last of them
 
     def reset(self) -> None:
         """Forget everything; the next confident measurement initialises again."""
@@ -614,6 +638,7 @@ class LaneFilter:
         self.confidence = 0.0
         self.initialised = False
         self.rejections = 0
+        self._rejected = []
 
     def update(self, estimate: LaneEstimate, speed: float = 0.0,
                yaw_rate: float | None = None) -> LaneEstimate:
@@ -645,6 +670,7 @@ class LaneFilter:
         self.t = z.t
         self.initialised = True
         self.rejections = 0
+        self._rejected = []
 
     def _predict(self, dt: float, speed: float, yaw_rate: float | None) -> None:
         if dt <= 0.0:
@@ -660,7 +686,8 @@ class LaneFilter:
 
     def _correct(self, z: LaneEstimate) -> bool:
         """Kalman update with ``z`` (True), or a rejection by the gate (False); the
-        ``max_rejections``-th rejection in a row re-initialises on ``z`` instead (True)."""
+        ``max_rejections``-th rejection in a row re-initialises on ``z`` instead (True) when
+        the rejected measurements agree with each other."""
         p = self.params
         rows = [I_OFFSET, I_HEADING, I_CURVATURE] + (
             [I_WIDTH] if z.left is not None and z.right is not None else [])
@@ -671,16 +698,25 @@ class LaneFilter:
         s = h @ self.P @ h.T + r
         if float(innovation @ np.linalg.solve(s, innovation)) > self._gate[len(rows)]:
             self.rejections += 1
-            if self.rejections < p.max_rejections:
+            self._rejected = [*self._rejected, z][-p.max_rejections:]
+            if self.rejections < p.max_rejections or not self._rejections_agree():
                 return False
             self._initialise(z)
             return True
+        self._rejected = []
         gain = self.P @ h.T @ np.linalg.inv(s)
         self.x = self.x + gain @ innovation
         i_kh = np.eye(DIM) - gain @ h
         self.P = i_kh @ self.P @ i_kh.T + gain @ r @ gain.T  # Joseph form
         self.rejections = 0
         return True
+
+    def _rejections_agree(self) -> bool:
+        p = self.params
+        offsets = [z.offset for z in self._rejected]
+        headings = [z.heading_error for z in self._rejected]
+        return (max(offsets) - min(offsets) <= p.agree_offset
+                and max(headings) - min(headings) <= p.agree_heading)
 
     def _output(self, z: LaneEstimate) -> LaneEstimate:
         """The state as an estimate at ``z.t`` with ``z``'s boundaries."""

@@ -90,17 +90,14 @@ import).
 
 from __future__ import annotations
 
-import ctypes
-import functools
-import importlib
 import math
 from dataclasses import dataclass, field, replace
-from types import ModuleType
 
 import numpy as np
 from numpy.typing import NDArray
 
 from perception.messages import Detection, ObjectClass
+from perception.open3d_loader import import_open3d
 from world.frames import LidarScan
 
 FloatArray = NDArray[np.float64]
@@ -165,28 +162,7 @@ class DetectorParams:
 # ---- Open3D ----------------------------------------------------------------------------------
 
 
-def _preload_libusb() -> None:
-    """Load a libusb-1.0 globally so that Open3D's dependency resolves (see avsim.deps)."""
-    try:
-        ctypes.CDLL("libusb-1.0.so.0", mode=ctypes.RTLD_GLOBAL)
-        return
-    except OSError:
-        pass
-    import libusb_package
-
-    path = libusb_package.get_library_path()
-    if path is None:
-        raise ImportError("no libusb-1.0 found (install libusb-1.0-0 or libusb-package)")
-    ctypes.CDLL(str(path), mode=ctypes.RTLD_GLOBAL)
-
-
-@functools.cache
-def _open3d() -> ModuleType:
-    """The open3d module, imported once, quiet."""
-    _preload_libusb()
-    o3d = importlib.import_module("open3d")
-    o3d.utility.set_verbosity_level(o3d.utility.VerbosityLevel.Error)
-    return o3d
+_open3d = import_open3d
 
 
 # ---- ground ----------------------------------------------------------------------------------

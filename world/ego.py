@@ -163,6 +163,12 @@ class EgoBody:
             targetVelocities=[spin] * 4, forces=[abs(net) / 4] * 4,
         )
 
+    @property
+    def com_offset(self) -> NDArray[np.float64]:
+        """[m] (3,) the base's centre of mass in the base link frame (Bullet's base frame
+        is there, the link origin is not)."""
+        return self._com_offset.copy()
+
     def base_state(self) -> tuple[tuple[float, ...], tuple[float, ...], list[float]]:
         """Bullet's raw base pose (centre-of-mass frame position, quaternion) and the joint
         positions in joint order: what a mirror of this body needs to look the same."""

@@ -4,8 +4,12 @@ Each revolution is cast at one instant (no motion skew) from the sensor's true p
 per (channel, column), channel elevations from `LidarInfo`, columns evenly spaced over 360
 deg from the sensor's forward axis, counter-clockwise. Rays go to `max_range` in batches of at
 most 16,383 (`rayTestBatch`'s limit; 16,384 silently drops a ray), as (N, 3) numpy arrays,
-on all cores (``numThreads=0``). The ego's own body is in a collision group the rays skip
+on all cores (``numThreads=0``; 1 when another process renders the cameras on the other
+core, see `world.sensing`). The ego's own body is in a collision group the rays skip
 (a real roof sensor's self-returns are cropped by its driver the same way).
+
+Rays that can only meet the flat ground are solved in closed form and only the others are
+cast (`world.ray_culling`): the same returns at a fraction of the cost.
 
 Returns: range = hit fraction x max range, plus Gaussian range noise (``range_sigma``), and a
 ``dropout`` fraction of returns lost, both from the world's seeded generator. Points are in
@@ -15,13 +19,17 @@ perception scoring and the recording; never given to the stack).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
+from operator import itemgetter
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 from pybullet_utils.bullet_client import BulletClient
 
 from world.frames import LidarInfo, LidarScan
+from world.ray_culling import Box, ground_distance, rays_to_cast
 
 MAX_BATCH = 16_383  # rays per rayTestBatch call
 EGO_RAY_GROUP = 0x40  # collision group of the ego's links; the rays' mask leaves it out
@@ -52,9 +60,14 @@ class Lidar:
     """Casts one `LidarInfo` in one client."""
 
     def __init__(self, client: BulletClient, info: LidarInfo, rng: np.random.Generator,
-                 actor_bodies: list[int]) -> None:
-        """`actor_bodies`: the scenario actors' body ids, in scenario order (ground truth)."""
+                 actor_bodies: list[int], ground: int, static_bodies: list[int]) -> None:
+        """`actor_bodies`: the scenario actors' body ids, in scenario order (ground truth,
+        and moving boxes for the ray culling); `ground`: the ground plane's body;
+        `static_bodies`: every other body with collision that never moves (ego excluded)."""
         self.info = info
+        self._ground = ground
+        self._actors = list(actor_bodies)
+        self._static_boxes = [_aabb(client, b) for b in static_bodies]
         self._actor_of = np.full(max([*actor_bodies, 0]) + 1, -1, dtype=np.int16)
         self._actor_of[actor_bodies] = np.arange(len(actor_bodies), dtype=np.int16)
         self._c = client
@@ -63,6 +76,7 @@ class Lidar:
         m = info.mount
         self._mount_xyz = np.array([m.x, m.y, m.z])
         self._mount_rot = m.rotation()
+        self.threads = 0  # rayTestBatch threads: 0 = Bullet's choice (all cores)
 
     def scan(self, t: float, vehicle_origin: NDArray[np.float64],
              vehicle_rotation: NDArray[np.float64]) -> tuple[LidarScan, LidarTruth]:
@@ -71,14 +85,8 @@ class Lidar:
         info = self.info
         rotation = vehicle_rotation @ self._mount_rot  # sensor -> world
         origin = vehicle_origin + vehicle_rotation @ self._mount_xyz
-        ends = origin + (self._dirs @ rotation.T) * info.max_range
-        starts = np.broadcast_to(origin, ends.shape)
-        results: list[tuple[object, ...]] = []
-        for i in range(0, len(ends), MAX_BATCH):
-            results += self._c.rayTestBatch(starts[i:i + MAX_BATCH], ends[i:i + MAX_BATCH],
-                                            numThreads=0, collisionFilterMask=RAY_MASK)
-        body = np.fromiter((r[0] for r in results), dtype=np.int32, count=len(results))
-        fraction = np.fromiter((r[2] for r in results), dtype=np.float64, count=len(results))
+        body, fraction = self._cast(origin, self._dirs @ rotation.T,
+                                    math.atan2(rotation[1, 0], rotation[0, 0]))
         keep = body >= 0
         if info.dropout > 0.0:
             keep &= self._rng.random(len(body)) >= info.dropout
@@ -93,3 +101,35 @@ class Lidar:
         known = hit < len(self._actor_of)
         actor[known] = self._actor_of[hit[known]]
         return scan, LidarTruth(actor=actor)
+
+    def _cast(self, origin: NDArray[np.float64], directions: NDArray[np.float64],
+              heading: float) -> tuple[NDArray[np.int32], NDArray[np.float64]]:
+        """(body hit or -1, hit fraction of the max range) per ray: the flat ground in
+        closed form where nothing else can be met (`world.ray_culling`), Bullet for the
+        rest."""
+        info = self.info
+        ground = ground_distance(origin, directions, info.max_range)
+        reach = np.minimum(ground, info.max_range)
+        boxes = self._static_boxes + [_aabb(self._c, b) for b in self._actors]
+        shape = (info.channels, info.azimuth_steps)
+        need = rays_to_cast(origin, directions.reshape(*shape, 3), reach.reshape(shape),
+                            boxes, heading, info.azimuth_steps).reshape(-1)
+        body = np.where(np.isfinite(ground), self._ground, -1).astype(np.int32)
+        fraction = np.where(np.isfinite(ground), ground / info.max_range, 1.0)
+        idx = np.flatnonzero(need)
+        if len(idx):
+            ends = origin + directions[idx] * info.max_range
+            starts = np.broadcast_to(origin, ends.shape)
+            results: list[tuple[Any, ...]] = []
+            for i in range(0, len(idx), MAX_BATCH):
+                results += self._c.rayTestBatch(starts[i:i + MAX_BATCH], ends[i:i + MAX_BATCH],
+                                                numThreads=self.threads,
+                                                collisionFilterMask=RAY_MASK)
+            body[idx] = np.array(list(map(itemgetter(0), results)), dtype=np.int32)
+            fraction[idx] = np.array(list(map(itemgetter(2), results)), dtype=np.float64)
+        return body, fraction
+
+
+def _aabb(client: BulletClient, body: int) -> Box:
+    lo, hi = client.getAABB(body)
+    return np.array(lo), np.array(hi)

@@ -76,6 +76,7 @@ class ProcessSensing:
             raise ValueError("ProcessSensing needs a World with a LiDAR-only rig")
         self._world = world
         self._rig = world.rig
+        self._rig.lidar_threads = 1  # the other core renders: no oversubscription
         ctx = mp.get_context("spawn")  # a fresh interpreter: no inherited physics or GL state
         self._conn, child = ctx.Pipe()
         self._proc = ctx.Process(target=sensing_worker.main, args=(child, world.spec, setup),

@@ -77,14 +77,25 @@ class SensorRig:
 
     def __init__(self, client: BulletClient, setup: SensorSetup, ride_height: float, *,
                  renderer: Renderer | None, lidar_rng: np.random.Generator | None,
-                 actor_bodies: list[int]) -> None:
+                 actor_bodies: list[int], ground: int, static_bodies: list[int]) -> None:
         self.setup = setup
         self.renderer = renderer
         self._ride_height = ride_height
         self._cameras = ({} if renderer is None else
                          {c.name: Camera(client, c, renderer) for c in setup.cameras})
         self._lidar = (None if lidar_rng is None else
-                       Lidar(client, setup.lidar, lidar_rng, actor_bodies))
+                       Lidar(client, setup.lidar, lidar_rng, actor_bodies, ground,
+                             static_bodies))
+
+    @property
+    def lidar_threads(self) -> int:
+        """Threads the LiDAR's ray casting may use (0: all cores)."""
+        return self._lidar.threads if self._lidar is not None else 0
+
+    @lidar_threads.setter
+    def lidar_threads(self, n: int) -> None:
+        if self._lidar is not None:
+            self._lidar.threads = n
 
     @property
     def has_cameras(self) -> bool:

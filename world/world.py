@@ -101,7 +101,8 @@ class World:
         self.rig = None if sensors is None else SensorRig(
             self.client, sensors, self.ego.geometry.ride_height, renderer=self.renderer,
             lidar_rng=np.random.default_rng(seeds[3]) if lidar else None,
-            actor_bodies=self.actors.bodies,
+            actor_bodies=self.actors.bodies, ground=self.scene.ground,
+            static_bodies=sorted(self.scene.obstacle_bodies),
         )
         self._truth: EgoTruth | None = None
         self._route: RouteTruth | None = None

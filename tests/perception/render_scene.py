@@ -6,8 +6,8 @@ station ``s`` [m] of a lane, ``offset`` [m] left of the lane's centre and ``head
 true offset, heading error, curvature and width of that lane at the car's actual pose.
 
 The world is never stepped: the ego is placed with `EgoBody.set_base_state` (meant for
-mirror worlds that only render), resting on its wheels (base link origin a wheel radius
-less `SETTLE` above the ground, level). Building a world takes ~1.5 s, so one world is kept
+mirror worlds that only render), resting on its wheels (base link origin at the car's
+`ride_height` above the ground, level). Building a world takes ~1.5 s, so one world is kept
 per (road, profile) for the whole test session; NPCs are left out so nothing hides the lines.
 """
 
@@ -25,7 +25,6 @@ from world.sensor_setup import Profile, sensor_setup
 from world.spec import RoadSpec
 from world.world import World
 
-SETTLE = 0.012  # [m] how far the car sinks on its tyres below a wheel radius at rest
 BASE_SCENARIO = "normal_driving"  # the scenario whose other settings the test worlds use
 
 _WORLDS: dict[tuple[RoadSpec, Profile], World] = {}
@@ -78,8 +77,8 @@ def pose_ego(world: World, lane: int, s: float, offset: float, heading_error: fl
     yaw = float(ln.heading_at(s)) + heading_error
     rot = np.array([[math.cos(yaw), -math.sin(yaw), 0.0], [math.sin(yaw), math.cos(yaw), 0.0],
                     [0.0, 0.0, 1.0]])
-    origin = np.array([xy[0], xy[1], world.ego.geometry.wheel_radius - SETTLE])
-    com = origin + rot @ world.ego._com_offset
+    origin = np.array([xy[0], xy[1], world.ego.geometry.ride_height])
+    com = origin + rot @ world.ego.com_offset
     quat = (0.0, 0.0, math.sin(0.5 * yaw), math.cos(0.5 * yaw))
     joints = [0.0] * len(world.ego.base_state()[2])
     world.ego.set_base_state(tuple(float(c) for c in com), quat, joints)

@@ -9,18 +9,23 @@ import pytest
 
 from avsim.runner import Runner, RunResult
 from avsim.scenario import load_scenario
+from avsim.sensor_loop import FrameHook
+from world.sensor_setup import Profile
 
 
 @pytest.fixture(scope="module")
 def run_scenario(tmp_path_factory: pytest.TempPathFactory) -> Callable[..., RunResult]:
-    cache: dict[tuple[str, bool], RunResult] = {}
+    """`run(name, record=True, profile=Profile.DEFAULT, frame_hook=None, **overrides)`:
+    one run per distinct argument set in this module."""
+    cache: dict[str, RunResult] = {}
 
-    def run(name: str, record: bool = True, **overrides: object) -> RunResult:
-        key = (name + repr(sorted(overrides.items())), record)
+    def run(name: str, record: bool = True, profile: Profile | None = Profile.DEFAULT,
+            frame_hook: FrameHook | None = None, **overrides: object) -> RunResult:
+        key = repr((name, record, profile, frame_hook, sorted(overrides.items())))
         if key not in cache:
             spec = load_scenario(name, overrides or None)
             out: Path | None = tmp_path_factory.mktemp("runs") / f"{name}.rrd" if record else None
-            cache[key] = Runner(spec, out).run()
+            cache[key] = Runner(spec, out, profile=profile, frame_hook=frame_hook).run()
         return cache[key]
 
     return run

@@ -1,0 +1,50 @@
+"""LiDAR tracking in the loop: eight vehicles in five lanes, one overtaking the ego; the
+scores come from the result JSON, as a user would read them."""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable
+
+import numpy as np
+import pytest
+
+from avsim.result import result_json
+from avsim.runner import RunResult
+
+pytestmark = pytest.mark.slow
+
+
+@pytest.fixture(scope="module")
+def result(run_scenario: Callable[..., RunResult]) -> RunResult:
+    return run_scenario("tracking", record=False)
+
+
+def test_the_situation_happened(result: RunResult) -> None:
+    """>= 5 cars in several lanes at several speeds; the overtaker came from behind and
+    passed the ego; the ego passed the slower cars on its right."""
+    spec = result.spec
+    cars = [a for a in spec.actors if a.type.value in ("car", "truck")]
+    assert len(cars) >= 5
+    assert len({a.lane for a in cars}) >= 4 and len({a.speed for a in cars}) >= 5
+    ids = [a.id for a in spec.actors]
+    ego = result.log.array("station")
+    actors = np.array(result.log.actor_station)
+    ahead = actors - ego[:, None]  # > 0: the actor is ahead of the ego
+    overtaker = ids.index("overtaker")
+    assert ahead[0, overtaker] < -10.0 and ahead[-1, overtaker] > 30.0
+    for slower in ("slow_right", "far_right", "truck"):
+        k = ids.index(slower)
+        assert ahead[0, k] > 0.0 and ahead[-1, k] < -10.0, slower
+
+
+def test_tracking_scores_from_the_result_json(result: RunResult) -> None:
+    payload = json.loads(json.dumps(result_json(result, "tracking", "none.rrd", "default")))
+    m = payload["metrics"]
+    assert payload["passed"], payload["criteria"]
+    assert m["track_recall"] >= 0.95  # visible cars within 50 m
+    assert m["detection_recall"] >= 0.95 and m["detection_precision"] >= 0.95
+    assert m["track_position_rmse"] <= 0.3
+    assert m["track_speed_rmse"] <= 0.5
+    assert m["max_id_switches_per_car_per_100s"] <= 1.0
+    assert m["lane_offset_rmse"] <= 0.10  # the camera's lane held with traffic alongside
