@@ -35,6 +35,7 @@ test-quick: lint
 bench: $(STAMP)
 	$(BIN)/python -m bench.bench_rtf
 	$(BIN)/python -m bench.bench_components
+	$(BIN)/python -m bench.bench_sensing
 
 clean:
 	rm -rf runs .pytest_cache .mypy_cache .ruff_cache

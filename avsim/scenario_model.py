@@ -573,7 +573,7 @@ class GnssModel(_Model):
 
 
 class LidarModel(_Model):
-    """LiDAR noise. Not supported yet (no LiDAR yet)."""
+    """LiDAR noise (the beam layout comes from `--profile`)."""
 
     range_sigma: NonNegFloat = Field(
         default=0.02, description="[m] 1-sigma range noise, >= 0. Default 0.02."

@@ -128,7 +128,6 @@ def _stripped_example() -> dict[str, Any]:
     del data["road"]["segments"][3]["exit"]
     data["road"]["features"] = data["road"]["features"][:1]
     data["actors"] = data["actors"][:2]
-    del data["sensors"]["lidar"]
     del data["events"]
     del data["criteria"]["min_gap"]
     return data
@@ -191,7 +190,7 @@ BAD: dict[str, tuple[str, str]] = {
     "wrong_format": ("format", "must be avsim/1, got 'avsim/2'"),
     "unsupported_feature": ("road.features.0.type", "not supported yet (stop signs)"),
     "unsupported_town": ("town", "not supported yet (the town map kind)"),
-    "unsupported_lidar": ("sensors.lidar", "not supported yet (no LiDAR yet)"),
+    "bad_lidar_dropout": ("sensors.lidar.dropout", "must be <= 1, got 1.5"),
 }
 
 
