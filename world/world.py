@@ -246,7 +246,9 @@ def _write_obj(path: Path, vertices: NDArray[np.float64], indices: NDArray[np.in
     with path.open("w") as f:
         f.write(f"mtllib {material.name}\nusemtl painted\n")
         np.savetxt(f, vertices, fmt="v %.6f %.6f %.6f")
-        np.savetxt(f, uvs, fmt="vt %.6f %.6f")
+        # our uvs put (0, 0) at the texture's first row (the top of the PNG); an OBJ's v runs
+        # up from the bottom row
+        np.savetxt(f, np.column_stack([uvs[:, 0], 1.0 - uvs[:, 1]]), fmt="vt %.6f %.6f")
         np.savetxt(f, normals, fmt="vn %.6f %.6f %.6f")
         np.savetxt(f, np.repeat(faces, 3, axis=1), fmt="f %d/%d/%d %d/%d/%d %d/%d/%d")
 
@@ -257,12 +259,12 @@ def _disc_mesh(
     """A two-sided triangle fan for a round plate, `offset` [m] in front of the pole."""
     n = SIGN_SEGMENTS
     normal = np.array([math.cos(sign.yaw), math.sin(sign.yaw), 0.0])
-    across = np.array([-math.sin(sign.yaw), math.cos(sign.yaw), 0.0])  # plate's left
+    across = np.array([-math.sin(sign.yaw), math.cos(sign.yaw), 0.0])  # a viewer's right
     centre = np.array([*sign.pole_xy, sign.plate_height]) + offset * normal
     angles = np.linspace(0.0, 2 * math.pi, n, endpoint=False)
     radius = sign.plate_diameter / 2
-    ring = centre + radius * (
-        np.cos(angles)[:, None] * -across + np.sin(angles)[:, None] * np.array([0, 0, 1.0])
+    ring = centre + radius * (  # u runs to the viewer's right (`across`), v down
+        np.cos(angles)[:, None] * across + np.sin(angles)[:, None] * np.array([0, 0, 1.0])
     )
     vertices = np.vstack([centre, ring])
     uvs = np.vstack([[0.5, 0.5], np.column_stack([0.5 + 0.5 * np.cos(angles),

@@ -189,7 +189,7 @@ def test_a_dashed_line_past_the_cars_axis_on_the_tight_curve(detector: LaneDetec
     the car's axis (closer than the nearest-line rule's base_inner): the nearest line left of
     the car is the yellow one, the pair is too wide, and the dashed line is found again
     beside the solid right line."""
-    scene = render(normal_driving_road(), 622.0, 0.1, 1.0 * DEG)
+    scene = render(normal_driving_road(), 625.0, 0.1, 1.0 * DEG)  # dashes at s mod 12 < 3
     est = detector.detect(scene.frame)
     assert est.left is not None and est.right is not None
     assert est.left.x_min > 10.0 and est.left.y_at(est.left.x_min) < LaneParams().base_inner
@@ -211,8 +211,10 @@ def test_a_prior_gives_the_same_lane(detector: LaneDetector) -> None:
     scene = render(normal_driving_road(), 640.0, 0.3, 2.0 * DEG)
     first = detector.detect(scene.frame)
     again = detector.detect(scene.frame, prior=first)
+    # the same lane (not a neighbour 3.5 m off), to well within the per-frame accuracy
+    # (0.1 m): the prior moves the base search windows, which moves a fit by ~2 cm
     for a, b in zip(_errors(first, scene), _errors(again, scene), strict=True):
-        assert a == pytest.approx(b, abs=0.02)
+        assert a == pytest.approx(b, abs=0.05)
 
 
 def test_a_black_frame_has_no_lane(detector: LaneDetector) -> None:
