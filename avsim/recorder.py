@@ -94,6 +94,10 @@ SERIES_STYLES: dict[str, tuple[str, Rgb]] = {  # metric -> (label with unit, col
     "steering": ("steering [rad]", (255, 127, 14)),
     "cross_track_error": ("cross-track error [m]", (148, 103, 189)),
     "gap": ("gap [m]", (140, 86, 75)),
+    "lane_offset_error": ("camera lane offset error [m]", (23, 190, 207)),
+    "lane_heading_error": ("camera lane heading error [rad]", (188, 189, 34)),
+    "lane_confidence": ("camera lane confidence [-]", (127, 127, 127)),
+    "tracks": ("confirmed tracks [-]", (227, 119, 194)),
 }
 SERIES_PALETTE: tuple[Rgb, ...] = (  # for metrics not in SERIES_STYLES, in order of appearance
     (227, 119, 194),

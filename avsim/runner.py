@@ -309,6 +309,9 @@ class Runner:
     def _record_criteria(self) -> None:
         rec = self.recorder
         assert rec is not None
+        if self.sensors is not None:
+            scores = ", ".join(f"{k} {v:.3f}" for k, v in self.sensors.metrics().items())
+            rec.log_event(self.world.t, f"perception against the truth: {scores}", "INFO")
         for r in self.criteria.results():
             level = "INFO" if r.passed else "ERROR"
             t = r.first_failure if r.first_failure is not None else self.world.t

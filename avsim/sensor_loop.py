@@ -99,7 +99,23 @@ class SensorLoop:
             self.score.objects(out.detections, out.tracks, truth, data.scan_truth)
         if self.recorder is not None:
             self._record(data, out)
+            self._record_scores(out, truth)
         return out
+
+    def _record_scores(self, out: PerceptionOutput, truth: CaptureTruth) -> None:
+        """Perception against the truth at the capture instant, as time series."""
+        assert self.recorder is not None
+        values: dict[str, float] = {}
+        if out.lane is not None:
+            values["lane_confidence"] = out.lane.confidence
+            if truth.lane_offset is not None:
+                values["lane_offset_error"] = out.lane.offset - truth.lane_offset
+                values["lane_heading_error"] = math.remainder(
+                    out.lane.heading_error - truth.lane_heading_error, 2.0 * math.pi)
+        if out.tracks is not None:
+            values["tracks"] = float(len(out.tracks))
+        if values:
+            self.recorder.log_scalars(out.t, values)
 
     def _capture_truth(self) -> CaptureTruth:
         w = self.world

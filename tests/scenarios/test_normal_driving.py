@@ -141,3 +141,14 @@ def test_the_map_only_stack_still_drives_it(run_scenario: Callable[..., RunResul
     assert r.profile is None and "lane_offset_rmse" not in r.metrics
     xte = r.log.array("cross_track")
     assert np.max(np.abs(xte)) <= 0.30
+
+
+def test_perception_scores_are_in_the_recording(result: RunResult) -> None:
+    from rerun.chunk import RrdReader
+
+    assert result.recording is not None
+    store = RrdReader(result.recording).store()
+    for name in ("lane_offset_error", "lane_heading_error", "lane_confidence", "tracks"):
+        chunks = store.stream().filter(content=f"/metrics/{name}",
+                                       components="Scalars:scalars").to_chunks()
+        assert sum(c.num_rows for c in chunks) >= 0.9 * 10.0 * result.sim_time, name
