@@ -27,6 +27,7 @@ from click.testing import CliRunner
 
 from avsim.cli import main
 from tests.avsim.test_scenario import BAD
+from tests.avsim.texts import MINIMAL
 
 HERE = Path(__file__).parent
 BAD_DIR = HERE / "bad_scenarios"
@@ -35,16 +36,6 @@ SCENARIOS = REPO / "scenarios"
 TIMEOUT = 60.0  # [s] per subprocess; a bad input that is not rejected would start a long run
 EXIT_BAD_INPUT = 2
 
-VALID = """\
-format: avsim/1
-name: minimal
-duration: 10
-road:
-  speed_limit_kph: 50
-  segments:
-    - straight: 100
-ego: {s: 10, set_speed_kph: 40}
-"""
 
 
 @dataclass(frozen=True)
@@ -95,7 +86,7 @@ def _inputs(directory: Path) -> dict[str, Case]:
     comments.write_text("# nothing here\n\n", encoding="utf-8")
     cases["only_comments"] = Case(_run_args(str(comments)), str(comments), "(file)")
     unknown = directory / "unknown_key.yaml"
-    unknown.write_text(VALID.replace("set_speed_kph: 40}", "set_speed_kph: 40, colour: red}"),
+    unknown.write_text(MINIMAL.replace("set_speed_kph: 40}", "set_speed_kph: 40, colour: red}"),
                        encoding="utf-8")
     cases["unknown_key"] = Case(_run_args(str(unknown)), str(unknown), "ego.colour")
     cases["out_is_a_directory"] = Case(

@@ -24,6 +24,7 @@ from avsim.scenario import (
     scenario_path,
 )
 from avsim.schema import scenario_json_schema
+from tests.avsim.texts import MINIMAL
 from world import spec
 
 HERE = Path(__file__).parent
@@ -31,16 +32,6 @@ BAD_DIR = HERE / "bad_scenarios"
 DOC = HERE.parents[1] / "docs" / "scenario-format.md"
 KPH = scenario_module.MPS_PER_KPH  # [m/s] per [km/h], checked against 1 / 3.6 below
 
-MINIMAL = """\
-format: avsim/1
-name: minimal
-duration: 10
-road:
-  speed_limit_kph: 50
-  segments:
-    - straight: 100
-ego: {s: 10, set_speed_kph: 40}
-"""
 
 # SCENARIO_FORMAT.md's complete example, verbatim but for the comments.
 FULL_EXAMPLE = """\

@@ -21,6 +21,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from world.frames import LidarInfo, LidarScan, SensorMount
+from world.lidar import beam_directions
 
 FloatArray = NDArray[np.float64]
 
@@ -72,17 +73,6 @@ class Ground:
 FLAT = Ground()  # level ground at z = 0
 
 
-def beams(info: LidarInfo) -> tuple[FloatArray, NDArray[np.uint8], NDArray[np.uint16]]:
-    """(rays, 3) unit directions in the sensor frame, ring-major, with ring and column."""
-    elevation = np.asarray(info.elevations)[:, None]
-    azimuth = 2.0 * np.pi * np.arange(info.azimuth_steps)[None, :] / info.azimuth_steps
-    dirs = np.stack(np.broadcast_arrays(np.cos(elevation) * np.cos(azimuth),
-                                        np.cos(elevation) * np.sin(azimuth),
-                                        np.sin(elevation)), axis=-1).reshape(-1, 3)
-    ring, column = np.indices((info.channels, info.azimuth_steps))
-    return dirs, ring.reshape(-1).astype(np.uint8), column.reshape(-1).astype(np.uint16)
-
-
 def ground_hits(origin: FloatArray, dirs: FloatArray, ground: Ground) -> FloatArray:
     """(rays,) ray parameter [m] of the ground hit, inf where the ray misses it."""
     a, b = math.tan(ground.pitch), math.tan(ground.roll)
@@ -112,7 +102,7 @@ def box_hits(origin: FloatArray, dirs: FloatArray, box: Box) -> FloatArray:
 def cast(info: LidarInfo, boxes: Sequence[Box] = (), ground: Ground | None = FLAT,
          t: float = 0.0, seed: int | None = 0) -> LidarScan:
     """One scan of the scene; ``ground=None`` for no ground; ``seed=None`` for no noise."""
-    dirs_sensor, ring, column = beams(info)
+    dirs_sensor, ring, column = beam_directions(info)
     mount = info.mount
     origin = np.array([mount.x, mount.y, mount.z])
     dirs = dirs_sensor @ mount.rotation().T

@@ -2,12 +2,11 @@
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 import pytest
 from numpy.typing import NDArray
 
+from tests.roads import SHOULDER, W, arc, seg
 from world.hdmap import CrossSection, RoadMap
 from world.road_mesh import (
     DASH_LENGTH,
@@ -21,26 +20,7 @@ from world.road_mesh import (
     make_road_texture,
     markings,
 )
-from world.spec import RoadSpec, SegmentSpec, Zone
-
-W = 3.5  # [m]
-SHOULDER = 2.5  # [m]
-
-
-def seg(length: float, radius: float = 0.0, lanes: int = 2, oncoming: int = 1) -> SegmentSpec:
-    return SegmentSpec(
-        length=length,
-        curvature=0.0 if radius == 0.0 else 1.0 / radius,
-        lanes=lanes,
-        oncoming_lanes=oncoming,
-        lane_width=W,
-        shoulder=SHOULDER,
-    )
-
-
-def arc(radius: float, angle_deg: float, lanes: int = 2, oncoming: int = 1) -> SegmentSpec:
-    r = abs(radius)
-    return seg(r * math.radians(abs(angle_deg)), math.copysign(r, angle_deg), lanes, oncoming)
+from world.spec import RoadSpec, Zone
 
 
 @pytest.fixture(scope="module")

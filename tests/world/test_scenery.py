@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 from numpy.typing import NDArray
 
+from tests.roads import KPH, arc, seg
 from world.hdmap import RoadMap
 from world.scenery import (
     DEPTH_RANGE,
@@ -19,34 +20,7 @@ from world.scenery import (
     layout_speed_limit_signs,
     speed_limit_sign_image,
 )
-from world.spec import BuildingsSpec, RoadSpec, SegmentSpec, SpeedLimitSign
-
-W = 3.5  # [m]
-SHOULDER = 2.5  # [m]
-KPH = 1.0 / 3.6  # [m/s per km/h]
-
-
-def seg(
-    length: float,
-    radius: float = 0.0,
-    lanes: int = 2,
-    oncoming: int = 1,
-    speed_kph: float | None = None,
-) -> SegmentSpec:
-    return SegmentSpec(
-        length=length,
-        curvature=0.0 if radius == 0.0 else 1.0 / radius,
-        lanes=lanes,
-        oncoming_lanes=oncoming,
-        lane_width=W,
-        shoulder=SHOULDER,
-        speed_limit=None if speed_kph is None else speed_kph * KPH,
-    )
-
-
-def arc(radius: float, angle_deg: float, lanes: int = 2, oncoming: int = 1) -> SegmentSpec:
-    r = abs(radius)
-    return seg(r * math.radians(abs(angle_deg)), math.copysign(r, angle_deg), lanes, oncoming)
+from world.spec import BuildingsSpec, RoadSpec, SpeedLimitSign
 
 
 @pytest.fixture(scope="module")

@@ -1,0 +1,47 @@
+"""Road specs and maps for tests: segments by length and radius, arcs by radius and angle."""
+
+from __future__ import annotations
+
+import math
+
+from world.hdmap import RoadMap
+from world.spec import Feature, RoadSpec, SegmentSpec, Zone
+
+W = 3.5  # [m] lane width used throughout
+SHOULDER = 2.5  # [m]
+KPH = 1.0 / 3.6  # [m/s per km/h]
+
+
+def seg(
+    length: float,
+    radius: float = 0.0,
+    *,
+    lanes: int = 2,
+    oncoming: int = 1,
+    speed_kph: float | None = None,
+    zone: Zone | None = None,
+) -> SegmentSpec:
+    """A segment; radius > 0 turns left, < 0 right, 0 is a straight."""
+    return SegmentSpec(
+        length=length,
+        curvature=0.0 if radius == 0.0 else 1.0 / radius,
+        lanes=lanes,
+        oncoming_lanes=oncoming,
+        lane_width=W,
+        shoulder=SHOULDER,
+        speed_limit=None if speed_kph is None else speed_kph * KPH,
+        zone=zone,
+    )
+
+
+def arc(radius: float, angle_deg: float, *, lanes: int = 2, oncoming: int = 1) -> SegmentSpec:
+    """Arc of |radius| turning by angle_deg (> 0 left)."""
+    r = abs(radius)
+    length = r * math.radians(abs(angle_deg))
+    return seg(length, math.copysign(r, angle_deg), lanes=lanes, oncoming=oncoming)
+
+
+def make_map(
+    *segments: SegmentSpec, speed_kph: float = 50.0, features: tuple[Feature, ...] = ()
+) -> RoadMap:
+    return RoadMap.from_spec(RoadSpec(tuple(segments), speed_kph * KPH, features))
