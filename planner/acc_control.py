@@ -1,0 +1,88 @@
+"""The controllers of the ACC / event modes: a speed reference and a feed-forward
+acceleration for the speed loop (`control.longitudinal`), one law per mode.
+
+The DECS paper names them (hard braking, speed limit, off-ramp, speed bump) but its
+equations are missing; these are designed here. Speeds in m/s, gaps in metres.
+
+- CRUISE, SPEED_LIMIT, OFF_RAMP: the map's speed plan (`planner.speed_planning`: the set
+  speed, the posted limit V_GPS at the front bumper and the curves, with braking curves at
+  a_comf towards lower limits ahead). An exit ramp's limit is a posting of the map.
+- TRAIL, constant time-gap following: ``v_ref = v_l + k_gap (d - d_des)``, clamped to
+  [0, v_plan]: the lead's speed fed forward and the gap error closed with the time constant
+  1 / k_gap (4 s at 0.25 1/s), slow enough not to chase the lead's speed noise.
+- BRAKE (gap at or below d_min), hard braking that eases in: the deceleration that matches
+  the lead's speed before the gap shrinks to d_stop, ``a_need = (v^2 - v_l^2) / (2 max(d -
+  d_stop, 0.5 m))`` (>= 0), at most a_hard; the command rises towards it at no more than the
+  jerk j_in ("the throttle is held momentarily, then gradually eased"), so a cut-in does not
+  jolt the car (or the one behind it), and drops back at once when less is needed. The
+  speed reference follows the planned deceleration (``v - a_cmd dt``) so that the speed
+  loop adds little of its own.
+- PEDESTRIAN, STOP_SIGN: stop at a point ``s_stop`` metres ahead of the front bumper:
+  ``v_ref = sqrt(2 a_comf max(s_stop - margin, 0))`` with the same ease-in as BRAKE.
+- SPEED_BUMP: cross at the bump's pass speed: ``v_ref = sqrt(v_pass^2 + 2 a_comf max(d_bump
+  - margin, 0))``, where d_bump is the front axle's distance to the bump.
+- FLAT: ease off to a stop at no more than a_flat (4 m/s^2), jerk limited.
+
+Every law ends in ``min(v_ref, v_plan)``: no mode ever plans faster than the map allows.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True, slots=True)
+class AccControlParams:
+    k_gap: float = 0.25  # [1/s] trail: gap error to speed
+    a_comf: float = 1.5  # [m/s^2] comfortable deceleration (stops, bumps)
+    a_hard: float = 5.0  # [m/s^2] the most BRAKE plans
+    a_flat: float = 4.0  # [m/s^2] the most FLAT plans
+    j_in: float = 4.0  # [m/s^3] how fast a hard deceleration eases in
+    d_stop: float = 2.0  # [m] gap BRAKE aims to keep at the lead's speed
+    margin: float = 1.0  # [m] stop / pass points are aimed this far before the point
+
+
+@dataclass(frozen=True, slots=True)
+class SpeedRef:
+    speed: float  # [m/s] target speed
+    accel: float  # [m/s^2] feed-forward, signed
+
+
+def trail(v_plan: float, d: float, d_des: float, v_l: float, p: AccControlParams) -> SpeedRef:
+    """Constant time-gap following behind a lead at gap d with speed v_l."""
+    return SpeedRef(min(max(v_l + p.k_gap * (d - d_des), 0.0), v_plan), 0.0)
+
+
+def braking_need(v: float, v_l: float, d: float, p: AccControlParams) -> float:
+    """[m/s^2] >= 0: the deceleration that matches v_l before the gap d shrinks to d_stop."""
+    room = max(d - p.d_stop, 0.5)
+    return min(max(v * v - max(v_l, 0.0) ** 2, 0.0) / (2.0 * room), p.a_hard)
+
+
+def stop_speed(distance: float, v_plan: float, p: AccControlParams) -> float:
+    """[m/s] the speed from which braking at a_comf stops `margin` before `distance` [m]."""
+    return min(math.sqrt(2.0 * p.a_comf * max(distance - p.margin, 0.0)), v_plan)
+
+
+def pass_speed(distance: float, v_pass: float, v_plan: float, p: AccControlParams) -> float:
+    """[m/s] the speed from which braking at a_comf reaches v_pass `margin` before it."""
+    return min(math.sqrt(v_pass**2 + 2.0 * p.a_comf * max(distance - p.margin, 0.0)), v_plan)
+
+
+class EasedBrake:
+    """A deceleration command that rises at most at the jerk j_in and falls at once."""
+
+    def __init__(self) -> None:
+        self.a = 0.0  # [m/s^2] >= 0, the deceleration commanded last
+
+    def reset(self) -> None:
+        self.a = 0.0
+
+    def step(self, v: float, a_need: float, dt: float, p: AccControlParams,
+             cap: float | None = None) -> SpeedRef:
+        """Move the command towards `a_need` (capped at `cap`, default a_hard) and give the
+        speed reference that follows it from the current speed v over dt [s]."""
+        target = min(a_need, p.a_hard if cap is None else cap)
+        self.a = min(target, self.a + p.j_in * dt)
+        return SpeedRef(max(v - self.a * dt, 0.0), -self.a)
