@@ -7,11 +7,17 @@ equations are missing; these are designed here. Speeds in m/s, gaps in metres.
 - CRUISE, SPEED_LIMIT, OFF_RAMP: the map's speed plan (`planner.speed_planning`: the set
   speed, the posted limit V_GPS at the front bumper and the curves, with braking curves at
   a_comf towards lower limits ahead). An exit ramp's limit is a posting of the map.
-- TRAIL, constant time-gap following: ``v_ref = v_l + k_gap (d - d_des)``, clamped to
-  [0, v_plan]: the lead's speed fed forward and the gap error closed with the time constant
-  1 / k_gap (4 s at 0.25 1/s), slow enough not to chase the lead's speed noise.
-- BRAKE (gap at or below d_min), hard braking that eases in: the deceleration that matches
-  the lead's speed before the gap shrinks to d_stop, ``a_need = (v^2 - v_l^2) / (2 max(d -
+- TRAIL, constant time-gap following: ``v_ref = min(v_l + k_gap (d - d_des), sqrt(v_l^2 +
+  2 a_comf max(d - d0, 0)))``, clamped to [0, v_plan]. The first term feeds the lead's speed
+  forward and closes the gap error with the time constant 1 / k_gap (4 s at 0.25 1/s), slow
+  enough not to chase the lead's speed noise; the second is the speed from which braking at
+  a_comf still stops d0 behind a lead that stops. Stop-and-go: behind a lead slower than
+  ``v_standstill`` (0.5 m/s) the reference is 0 once the gap is within ``stop_band`` (1.5 m)
+  of d0, so the car comes to rest (the speed loop holds it) instead of creeping up for
+  seconds, and moves off as soon as the lead does.
+- BRAKE (gap at or below d_min), hard braking that eases in: the deceleration that brings
+  the speed down to the trail law's (below the lead's while the gap is short, so the gap
+  opens again) before the gap shrinks to d_stop, ``a_need = (v^2 - v_trail^2) / (2 max(d -
   d_stop, 0.5 m))`` (>= 0), at most a_hard; the command rises towards it at no more than the
   jerk j_in ("the throttle is held momentarily, then gradually eased"), so a cut-in does not
   jolt the car (or the one behind it), and drops back at once when less is needed. The
@@ -41,6 +47,8 @@ class AccControlParams:
     j_in: float = 4.0  # [m/s^3] how fast a hard deceleration eases in
     d_stop: float = 2.0  # [m] gap BRAKE aims to keep at the lead's speed
     margin: float = 1.0  # [m] stop / pass points are aimed this far before the point
+    v_standstill: float = 0.5  # [m/s] a lead slower than this counts as stopped (trail)
+    stop_band: float = 1.5  # [m] behind a stopped lead, stop within this of d0 (trail)
 
 
 @dataclass(frozen=True, slots=True)
@@ -49,13 +57,19 @@ class SpeedRef:
     accel: float  # [m/s^2] feed-forward, signed
 
 
-def trail(v_plan: float, d: float, d_des: float, v_l: float, p: AccControlParams) -> SpeedRef:
-    """Constant time-gap following behind a lead at gap d with speed v_l."""
-    return SpeedRef(min(max(v_l + p.k_gap * (d - d_des), 0.0), v_plan), 0.0)
+def trail(v_plan: float, d: float, d_des: float, v_l: float, d0: float,
+          p: AccControlParams) -> SpeedRef:
+    """Constant time-gap following behind a lead at gap d with speed v_l (d0: the
+    standstill gap)."""
+    if v_l < p.v_standstill and d < d0 + p.stop_band:
+        return SpeedRef(0.0, 0.0)
+    gap_law = v_l + p.k_gap * (d - d_des)
+    stop_law = math.sqrt(max(v_l, 0.0) ** 2 + 2.0 * p.a_comf * max(d - d0, 0.0))
+    return SpeedRef(min(max(min(gap_law, stop_law), 0.0), v_plan), 0.0)
 
 
 def braking_need(v: float, v_l: float, d: float, p: AccControlParams) -> float:
-    """[m/s^2] >= 0: the deceleration that matches v_l before the gap d shrinks to d_stop."""
+    """[m/s^2] >= 0: the deceleration that slows to v_l before the gap d shrinks to d_stop."""
     room = max(d - p.d_stop, 0.5)
     return min(max(v * v - max(v_l, 0.0) ** 2, 0.0) / (2.0 * room), p.a_hard)
 

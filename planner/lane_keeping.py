@@ -4,9 +4,10 @@ Each tick: project the ego estimate onto the map lane (station, for the speed pl
 events; the map is the paper's HD map), choose the lateral reference with the lane-source
 FSM (`planner.lane_source`): the camera's lane (`planner.camera_lane`) when it is seen,
 the map lane (`planner.route.lane_path`, placed by the GNSS + odometry estimate) while it is
-acquired or lost. The target speed is the map's (`planner.speed_planning.SpeedPlanner`),
-capped behind a lead vehicle from the tracks (`planner.lead`) and, when the lane is lost,
-ramped down at ``a_comf`` to the hold speed, then to a stop in lane.
+acquired or lost. The target speed is the map's (`planner.speed_planning.SpeedPlanner`)
+through the ACC / event layer (`planner.acc_layer`: cruise, trail or brake behind the lead
+vehicle of the tracks, `planner.lead`) and, when the lane is lost, ramped down at ``a_comf``
+to the hold speed, then to a stop in lane.
 
 The path and the speed target are computed separately (`path_for`, `speed_for`) so that
 the motion / control FSM planners built on this can swap either one (a lane-change path, an
@@ -24,6 +25,8 @@ import numpy as np
 from perception.messages import EgoState, LaneEstimate, Track
 from planner.camera_lane import camera_lane_path
 from planner.lane_source import LaneSource, LaneSourceInput, LaneSourceParams, transition
+from planner.acc_control import SpeedRef
+from planner.acc_layer import AccLayer, AccLayerParams
 from planner.lead import LeadParams, select_lead
 from planner.messages import Lead, Plan, ReferencePath, StateChange
 from planner.route import lane_path
@@ -53,6 +56,7 @@ class LaneKeepingParams:
     speed: SpeedPlanningParams = field(default_factory=SpeedPlanningParams)
     source: LaneSourceParams = field(default_factory=LaneSourceParams)
     lead: LeadParams = field(default_factory=LeadParams)
+    acc: AccLayerParams = field(default_factory=AccLayerParams)
 
 
 class LaneKeepingPlanner:
@@ -73,6 +77,7 @@ class LaneKeepingPlanner:
         self._since: float | None = None  # [s] time of the last lane-source change
         self._cap = math.inf  # [m/s] the ramped speed cap of the degraded modes
         self._last_t: float | None = None
+        self.acc = AccLayer(self.params.acc)
 
     def localise(self, ego: EgoState) -> tuple[float, float]:
         """(station [m], lateral offset [m], left +) of the ego's centre on the lane."""
@@ -104,11 +109,11 @@ class LaneKeepingPlanner:
         path = self._camera_path(view) if camera and view is not None else \
             self.path_for(ego, station)
         target = self.speed_for(station)
-        speed, accel = target.speed, target.accel
         lead = self._lead(view, tracks, ego)
-        if lead is not None and lead.safe_speed < speed:
-            speed, accel = lead.safe_speed, 0.0
-        speed, accel = self._degraded_cap(speed, accel, ego.speed, dt)
+        ref, acc_changes = self.acc.update(ego.t, dt, ego.speed, self.params.set_speed,
+                                           target.limit_at_front,
+                                           SpeedRef(target.speed, target.accel), lead)
+        speed, accel = self._degraded_cap(ref.speed, ref.accel, ego.speed, dt)
         return Plan(
             t=ego.t,
             ego=ego,
@@ -120,7 +125,8 @@ class LaneKeepingPlanner:
             lateral_error=lateral,
             lane_source=self.source,
             lead=lead,
-            changes=changes,
+            acc_mode=self.acc.mode.value,
+            changes=changes + acc_changes,
         )
 
     def _update_source(self, t: float, view: LaneView | None) -> tuple[StateChange, ...]:

@@ -1,11 +1,9 @@
-"""The vehicle ahead in the ego's lane, from LiDAR tracks, and a safe speed behind it.
+"""The vehicle ahead in the ego's lane, from the LiDAR tracks (the ACC layer's d and V_l).
 
-Until the ACC / event layer (issue C) plans the gap, lane keeping caps its target speed so
-that braking at ``a_brake`` brings the ego to the lead's speed with the gap ``d0 + tau v_l``
-still free: ``v <= sqrt(v_l^2 + 2 a_brake max(gap - d0 - tau v_l, 0))``, with the lead's
-speed ``v_l`` over ground along the ego's heading (>= 0). The lead is the nearest confirmed
-track ahead whose centre lies within ``half_width`` of the ego lane's centre line (the
-camera's lane when it is seen, else straight ahead).
+The lead is the nearest confirmed track ahead whose centre lies within ``half_width`` of the
+ego lane's centre line (the camera's lane when it is seen, else straight ahead); its gap is
+bumper to bumper along the ego's heading, its speed the track's over ground along the ego's
+heading (>= 0), both at the track's time.
 """
 
 from __future__ import annotations
@@ -20,9 +18,6 @@ from planner.messages import Lead
 
 @dataclass(frozen=True, slots=True)
 class LeadParams:
-    d0: float = 4.0  # [m] gap kept at standstill
-    tau: float = 1.5  # [s] time gap
-    a_brake: float = 3.0  # [m/s^2] deceleration planned towards the lead's speed
     half_width: float = 1.6  # [m] a track is in the lane within this of its centre line
     front_overhang: float = 2.4  # [m] the ego's centre -> front bumper
 
@@ -41,6 +36,5 @@ def select_lead(tracks: Sequence[Track], centre_y: Callable[[float], float],
         if best is not None and gap >= best.gap:
             continue
         speed = max(0.0, tr.vx * math.cos(ego_heading) + tr.vy * math.sin(ego_heading))
-        room = max(gap - p.d0 - p.tau * speed, 0.0)
-        best = Lead(tr.id, gap, speed, math.sqrt(speed * speed + 2.0 * p.a_brake * room))
+        best = Lead(tr.id, tr.t, gap, speed)
     return best

@@ -31,9 +31,9 @@ class Lead:
     """The vehicle ahead in the ego's lane, as the tracks show it."""
 
     track_id: int
+    t: float  # [s] time of the track it comes from
     gap: float  # [m] ego front bumper to the lead's rear, along the ego's heading
     speed: float  # [m/s] the lead's speed over ground along the ego's heading
-    safe_speed: float  # [m/s] the cap it sets on the ego's target speed
 
 
 @dataclass(frozen=True, slots=True)
@@ -59,4 +59,5 @@ class Plan:
     lateral_error: float  # [m] the planner's view of the ego's offset from the path, left +
     lane_source: LaneSource = LaneSource.ACQUIRING  # where the path comes from
     lead: Lead | None = None  # the vehicle ahead in the lane, if a track shows one
+    acc_mode: str = "acc_off"  # the ACC / event layer's mode (`planner.acc.AccMode` value)
     changes: tuple[StateChange, ...] = ()  # state changes made in this tick

@@ -20,12 +20,17 @@ P = AccControlParams()
 
 
 def test_trail_closes_the_gap_error_and_never_exceeds_the_plan() -> None:
-    assert trail(30.0, 40.0, 40.0, 20.0, P).speed == pytest.approx(20.0)  # at d_des: v_l
-    assert trail(30.0, 48.0, 40.0, 20.0, P).speed == pytest.approx(22.0)  # too far: faster
-    assert trail(30.0, 32.0, 40.0, 20.0, P).speed == pytest.approx(18.0)  # too close: slower
-    assert trail(19.0, 48.0, 40.0, 20.0, P).speed == 19.0  # the map's plan caps it
-    assert trail(30.0, 5.0, 40.0, 1.0, P).speed == 0.0  # never backwards
-    assert trail(30.0, 40.0, 40.0, 20.0, P).accel == 0.0
+    d0 = 4.0
+    assert trail(30.0, 40.0, 40.0, 20.0, d0, P).speed == pytest.approx(20.0)  # at d_des: v_l
+    assert trail(30.0, 48.0, 40.0, 20.0, d0, P).speed == pytest.approx(22.0)  # far: faster
+    assert trail(30.0, 32.0, 40.0, 20.0, d0, P).speed == pytest.approx(18.0)  # close: slower
+    assert trail(19.0, 48.0, 40.0, 20.0, d0, P).speed == 19.0  # the map's plan caps it
+    assert trail(30.0, 5.0, 40.0, 1.0, d0, P).speed == 0.0  # never backwards
+    assert trail(30.0, 40.0, 40.0, 20.0, d0, P).accel == 0.0
+    # far behind a stopped lead the braking curve to d0 binds; near it, the car stops
+    assert trail(30.0, 60.0, d0, 0.0, d0, P).speed == pytest.approx(math.sqrt(3.0 * 56.0))
+    assert trail(30.0, d0 + 1.0, d0, 0.0, d0, P).speed == 0.0
+    assert trail(30.0, d0 + 1.0, d0, 1.0, d0, P).speed > 0.0  # it moves off with the lead
 
 
 def test_braking_need() -> None:

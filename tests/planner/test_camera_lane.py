@@ -61,15 +61,11 @@ def test_lead_is_the_nearest_in_lane_track_ahead() -> None:
     lead = select_lead(tracks, lambda x: 0.0, 0.0, p)
     assert lead is not None and lead.track_id == 1
     assert lead.gap == pytest.approx(40.0 - p.front_overhang - 2.3)
-    room = lead.gap - p.d0 - p.tau * 8.0
-    assert lead.safe_speed == pytest.approx(math.sqrt(64.0 + 2.0 * p.a_brake * room))
+    assert lead.speed == pytest.approx(8.0) and lead.t == 1.0
+    # its speed is along the ego's heading: a car crossing at right angles has none
+    assert select_lead(tracks, lambda x: 0.0, math.pi / 2, p).speed == pytest.approx(0.0)
     # the lane bends right: the car at (60, -5) is in it, the one at (40, 0.3) is not
     lead = select_lead(tracks, lambda x: -5.0 * (x / 60.0) ** 2, 0.0, p)
     assert lead is not None and lead.track_id == 4
     assert select_lead([track(30.0, 0.0, 5.0, cls=ObjectClass.OTHER)], lambda x: 0.0, 0.0,
                        p) is None
-
-
-def test_lead_too_close_caps_at_its_speed() -> None:
-    lead = select_lead([track(8.0, 0.0, 3.0)], lambda x: 0.0, 0.0, LeadParams())
-    assert lead is not None and lead.safe_speed == pytest.approx(3.0)

@@ -1,0 +1,87 @@
+"""The ACC layer in closed loop with a point-mass ego that follows its speed reference
+through a first-order lag (the speed loop), behind a scripted lead."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from planner.acc import r157_min_gap
+from planner.acc_control import SpeedRef
+from planner.acc_layer import AccLayer
+from planner.messages import Lead
+
+DT = 1.0 / 40.0  # [s] planner tick
+TAU = 0.5  # [s] speed-loop lag of the point mass
+
+
+def drive(lead_speed: list[float], v0: float, gap0: float, set_speed: float,
+          limit: float = 30.0) -> dict[str, np.ndarray]:
+    acc = AccLayer()
+    v, gap = v0, gap0
+    out: dict[str, list[float]] = {"t": [], "v": [], "gap": [], "vl": [], "a": []}
+    modes = []
+    for k, vl in enumerate(lead_speed):
+        t = k * DT
+        lead = Lead(track_id=1, t=t - 0.1, gap=gap - (vl - v) * 0.1, speed=vl)  # 100 ms old
+        ref, changes = acc.update(t, DT, v, set_speed, limit, SpeedRef(set_speed, 0.0), lead)
+        modes += [c.target for c in changes]
+        # the speed loop: the feed-forward, plus the lag on the reference it leaves behind
+        a = float(np.clip(ref.accel + (ref.speed - v - ref.accel * DT) / TAU, -6.0, 3.0))
+        v = max(v + a * DT, 0.0)
+        gap += (vl - v) * DT
+        for key, val in (("t", t), ("v", v), ("gap", gap), ("vl", vl), ("a", a)):
+            out[key].append(val)
+    arrays = {k: np.array(x) for k, x in out.items()}
+    arrays["modes"] = np.array(modes)
+    return arrays
+
+
+def ramp(v_from: float, v_to: float, a: float) -> list[float]:
+    n = max(1, round(abs(v_to - v_from) / (a * DT)))
+    return list(np.linspace(v_from, v_to, n))
+
+
+def test_follows_a_slower_lead_at_the_desired_gap() -> None:
+    run = drive([15.0] * 2400, v0=20.0, gap0=60.0, set_speed=22.0)
+    assert list(run["modes"][:2]) == ["cruise", "trail"]
+    end = run["t"] > 40.0
+    d_des = max(4.0 + 1.5 * 15.0, r157_min_gap(15.0))
+    assert np.allclose(run["gap"][end], d_des, atol=0.5)
+    assert np.allclose(run["v"][end], 15.0, atol=0.05)
+
+
+def test_lead_brakes_to_a_stop_waits_and_drives_off() -> None:
+    """traffic_jam in miniature: 1 m/s^2 to a stop, 10 s, off again at 1 m/s^2."""
+    lead = [12.0] * 400 + ramp(12.0, 0.0, 1.0) + [0.0] * 400 + ramp(0.0, 12.0, 1.0) + \
+        [12.0] * 800
+    run = drive(lead, v0=12.0, gap0=30.0, set_speed=14.0)
+    t, v, gap, vl = run["t"], run["v"], run["gap"], run["vl"]
+    moving = (v > 0.5) & (t > 5.0)
+    assert np.all(gap[moving] >= np.array([r157_min_gap(x) for x in v[moving]]) - 0.5)
+    stopped = (vl == 0.0) & (v < 0.01)
+    assert stopped.any() and 2.0 <= float(np.min(gap[stopped])) <= 6.0
+    assert float(np.min(gap)) > 2.0
+    # the ego moves off within 2 s of the lead
+    lead_off = t[np.argmax((vl > 0.0) & (t > 20.0))]
+    ego_off = t[np.argmax((v > 0.1) & (t > lead_off - 1.0))]
+    assert ego_off - lead_off <= 2.0
+    assert float(-run["a"].min()) <= 3.5
+    assert v[-1] == pytest.approx(12.0, abs=0.1)
+
+
+def test_cut_in_close_ahead_brakes_eased_then_recovers() -> None:
+    """A car 20 km/h slower appears 15 m ahead (inside d_min): BRAKE eases in, never
+    above the hard limit, and the gap is back above d_min."""
+    v0 = 60 / 3.6
+    run = drive([v0 - 20 / 3.6] * 800, v0=v0, gap0=15.0, set_speed=v0)
+    assert run["modes"][0] == "cruise" and "brake" in list(run["modes"])
+    decel = -run["a"]
+    assert float(decel.max()) <= 5.0 + 1e-9
+    assert float(decel[0]) < 1.0  # eased in: no step at the cut-in
+    late = run["t"] > 10.0
+    v, gap = run["v"][late], run["gap"][late]
+    assert np.all(gap >= np.array([r157_min_gap(x) for x in v]) - 0.5)
+    assert math.isclose(float(run["v"][-1]), v0 - 20 / 3.6, abs_tol=0.1)
