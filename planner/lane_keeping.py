@@ -23,10 +23,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from perception.messages import EgoState, LaneEstimate, Track
-from planner.camera_lane import camera_lane_path
-from planner.lane_source import LaneSource, LaneSourceInput, LaneSourceParams, transition
 from planner.acc_control import SpeedRef
 from planner.acc_layer import AccLayer, AccLayerParams
+from planner.camera_lane import camera_lane_path
+from planner.lane_source import LaneSource, LaneSourceInput, LaneSourceParams, transition
 from planner.lead import LeadParams, select_lead
 from planner.messages import Lead, Plan, ReferencePath, StateChange
 from planner.route import lane_path
