@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
+from world.actors import ActorPoses
 from world.hdmap import RoadMap
 
 KPH = 1 / 3.6  # [m/s] per km/h
@@ -35,6 +36,8 @@ class TruthSample:
     tyre_stations: NDArray[np.float64]  # [m] (4,) their stations
     tyre_offsets: NDArray[np.float64]  # [m] (4,) their offsets from the reference line, left +
     touching: frozenset[int]  # body ids in contact with the ego (ground excluded)
+    offset: float = 0.0  # [m] ego centre offset from the reference line, left +
+    actors: ActorPoses | None = None  # every NPC now (for gap criteria)
 
 
 @dataclass(frozen=True, slots=True)
@@ -197,6 +200,73 @@ class MaxDecel(Criterion):
 
     def result(self) -> CriterionResult:
         return CriterionResult(self.name, self.peak <= self.threshold, self.peak,
+                               self.threshold, self.unit, self.first_failure)
+
+
+def r157_min_gap(v: float) -> float:
+    """[m] UN R157's minimum following distance at speed v [m/s] (as `planner.acc`)."""
+    return max(v * (1.0 + max(v / KPH, 10.0) / 100.0), 2.0)
+
+
+class MinGap(Criterion):
+    """The bumper gap to the vehicle ahead in the ego's lane is never below the threshold
+    (UN R157's d_min(v), or a fixed number of metres) while the ego moves faster than 2 m/s,
+    except for `grace` seconds after that vehicle entered the lane ahead (a cut-in) and while
+    it brakes harder than 3 m/s^2. Value: the smallest gap [m] checked; its threshold at that
+    moment is reported with it (the least margin decides)."""
+
+    name, unit = "min_gap", "m"
+    MIN_SPEED = 2.0  # [m/s]
+    HARD_BRAKE = 3.0  # [m/s^2]
+
+    def __init__(self, threshold: float | str, road: RoadMap, ego_length: float,
+                 grace: float = 10.0) -> None:
+        super().__init__()
+        self.fixed = None if threshold == "r157" else float(threshold)
+        self.road = road
+        self.ego_length = ego_length
+        self.grace = grace
+        self.entered: dict[str, float] = {}  # actor id -> time it entered the lane ahead
+        self._started = False
+        self.margin = math.inf
+        self.gap = math.inf  # [m] at the least margin
+        self.threshold = math.nan if self.fixed is None else self.fixed
+
+    def update(self, sample: TruthSample) -> None:
+        ahead = self._ahead(sample)
+        for name in list(self.entered):
+            if name not in ahead:
+                del self.entered[name]
+        for name in ahead:  # a vehicle ahead from the start has not cut in: no grace
+            self.entered.setdefault(name, sample.t if self._started else -math.inf)
+        self._started = True
+        if not ahead or sample.speed <= self.MIN_SPEED:
+            return
+        name, gap, accel = min(ahead.values(), key=lambda a: a[1])
+        if sample.t - self.entered[name] < self.grace or accel < -self.HARD_BRAKE:
+            return
+        d_min = self.fixed if self.fixed is not None else r157_min_gap(sample.speed)
+        if gap - d_min < self.margin:
+            self.margin, self.gap, self.threshold = gap - d_min, gap, d_min
+        if gap < d_min:
+            self._fail(sample.t)
+
+    def _ahead(self, sample: TruthSample) -> dict[str, tuple[str, float, float]]:
+        """Actor id -> (id, bumper gap [m], acceleration [m/s^2]) of the vehicles whose
+        centre is in the ego's lane band ahead of the ego."""
+        a = sample.actors
+        if a is None or not len(a.ids):
+            return {}
+        width = float(self.road.lane(0).width_at(sample.station))
+        lateral = np.abs(a.offsets - sample.offset) < 0.5 * width
+        gap = a.stations - sample.station - (2.0 * a.half_sizes[:, 0] + self.ego_length) / 2
+        out = {}
+        for i in np.flatnonzero(lateral & (a.stations > sample.station)):
+            out[a.ids[i]] = (a.ids[i], float(gap[i]), float(a.accels[i]))
+        return out
+
+    def result(self) -> CriterionResult:
+        return CriterionResult(self.name, self.first_failure is None, self.gap,
                                self.threshold, self.unit, self.first_failure)
 
 

@@ -27,6 +27,7 @@ from avsim.criteria import (
     CriteriaSet,
     CriterionResult,
     MaxDecel,
+    MinGap,
     NoCollision,
     SpeedLimit,
     TruthSample,
@@ -75,6 +76,8 @@ class TrajectoryLog:
     brake_torque: list[float] = field(default_factory=list)  # [N m] commanded, total
     wheel_spin: list[NDArray[np.float64]] = field(default_factory=list)  # [rad/s] (4,)
     actor_station: list[NDArray[np.float64]] = field(default_factory=list)  # [m] (N,) true
+    actor_offset: list[NDArray[np.float64]] = field(default_factory=list)  # [m] (N,) true,
+    #   from the reference line, left +
 
     def array(self, name: str) -> NDArray[np.float64]:
         return np.asarray(getattr(self, name), dtype=np.float64)
@@ -127,6 +130,9 @@ class Runner:
                  SpeedLimit(w.road), self.completes]
         if spec.criteria.max_decel is not None:
             items.append(MaxDecel(spec.criteria.max_decel, CRITERIA_RATE.hz))
+        self._gap_criteria = spec.criteria.min_gap is not None
+        if spec.criteria.min_gap is not None:
+            items.append(MinGap(spec.criteria.min_gap, w.road, self.car.body_length))
         self.criteria = CriteriaSet(items)
         self.recorder = Recorder(recording, recording_name=spec.name) if recording else None
         self.sensors = None if self.setup is None else SensorLoop(
@@ -217,6 +223,7 @@ class Runner:
         log.brake_torque.append(out.command.brake_torque)
         log.wheel_spin.append(truth.wheel_spin.copy())
         log.actor_station.append(np.array([m.s for m in w.actors.motions]))
+        log.actor_offset.append(np.array([m.offset for m in w.actors.motions]))
         if self.recorder is not None and RECORD_RATE.fires(w.clock.step):
             self._record_tick(out)
 
@@ -243,6 +250,7 @@ class Runner:
             front_station=route.station + self.car.front_overhang,
             tyres=route.tyres, tyre_stations=route.tyre_stations,
             tyre_offsets=route.tyre_offsets, touching=self._touching,
+            offset=float(route.offsets[0]), actors=w.actors.poses if self._gap_criteria else None,
         ))
 
     # -- results -------------------------------------------------------------------------------

@@ -69,7 +69,6 @@ UNSUPPORTED: dict[str, str] = {
     "actors.*.actions.*.walk": "the walk action",
     "events.*.accelerator_override": "ego events: accelerator_override",
     "events.*.flat_tire": "ego events: flat_tire",
-    "criteria.min_gap": "the min_gap criterion",
 }
 
 KeyPath = tuple[str | int, ...]

@@ -18,7 +18,9 @@ equations are missing; these are designed here. Speeds in m/s, gaps in metres.
 - BRAKE (gap at or below d_min), hard braking that eases in: the deceleration that brings
   the speed down to the trail law's (below the lead's while the gap is short, so the gap
   opens again) before the gap shrinks to d_stop, ``a_need = (v^2 - v_trail^2) / (2 max(d -
-  d_stop, 0.5 m))`` (>= 0), at most a_hard; the command rises towards it at no more than the
+  d_stop, 0.5 m))`` (>= 0), at most a_firm (3 m/s^2: a cut-in at UN R157's distances needs
+  less), or a_hard when the time to collision at the present closing speed is under
+  ``ttc_hard`` (2.5 s: an emergency); the command rises towards it at no more than the
   jerk j_in ("the throttle is held momentarily, then gradually eased"), so a cut-in does not
   jolt the car (or the one behind it), and drops back at once when less is needed. The
   speed reference follows the planned deceleration (``v - a_cmd dt``) so that the speed
@@ -42,7 +44,9 @@ from dataclasses import dataclass
 class AccControlParams:
     k_gap: float = 0.25  # [1/s] trail: gap error to speed
     a_comf: float = 1.5  # [m/s^2] comfortable deceleration (stops, bumps)
-    a_hard: float = 5.0  # [m/s^2] the most BRAKE plans
+    a_firm: float = 3.0  # [m/s^2] the most BRAKE plans unless a collision is imminent
+    a_hard: float = 5.0  # [m/s^2] the most BRAKE plans when it is
+    ttc_hard: float = 2.5  # [s] time to collision below which a_hard is allowed
     a_flat: float = 4.0  # [m/s^2] the most FLAT plans
     j_in: float = 4.0  # [m/s^3] how fast a hard deceleration eases in
     d_stop: float = 2.0  # [m] gap BRAKE aims to keep at the lead's speed
@@ -72,6 +76,13 @@ def braking_need(v: float, v_l: float, d: float, p: AccControlParams) -> float:
     """[m/s^2] >= 0: the deceleration that slows to v_l before the gap d shrinks to d_stop."""
     room = max(d - p.d_stop, 0.5)
     return min(max(v * v - max(v_l, 0.0) ** 2, 0.0) / (2.0 * room), p.a_hard)
+
+
+def brake_cap(v: float, v_lead: float, d: float, p: AccControlParams) -> float:
+    """[m/s^2] the most BRAKE may plan: a_firm, or a_hard when the time to collision at the
+    present closing speed v - v_lead is under ttc_hard."""
+    closing = v - v_lead
+    return p.a_hard if closing > 0.0 and d / closing < p.ttc_hard else p.a_firm
 
 
 def stop_speed(distance: float, v_plan: float, p: AccControlParams) -> float:

@@ -13,7 +13,14 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from planner.acc import AccInput, AccMode, AccParams, gaps, transition
-from planner.acc_control import AccControlParams, EasedBrake, SpeedRef, braking_need, trail
+from planner.acc_control import (
+    AccControlParams,
+    EasedBrake,
+    SpeedRef,
+    brake_cap,
+    braking_need,
+    trail,
+)
 from planner.messages import Lead, StateChange
 
 
@@ -53,7 +60,7 @@ class AccLayer:
             following = trail(plan.speed, x.d, gaps(x.v, x.v_l, m).d_des, x.v_l, m.d0, c)
         if self.mode is AccMode.BRAKE:
             need = braking_need(x.v, following.speed, x.d, c)
-            ref = self._brake.step(x.v, need, dt, c)
+            ref = self._brake.step(x.v, need, dt, c, cap=brake_cap(x.v, x.v_l, x.d, c))
             return ref if ref.speed < plan.speed else plan
         self._brake.reset()
         if self.mode is AccMode.TRAIL:

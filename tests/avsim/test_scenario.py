@@ -120,7 +120,6 @@ def _stripped_example() -> dict[str, Any]:
     data["road"]["features"] = data["road"]["features"][:1]
     data["actors"] = data["actors"][:2]
     del data["events"]
-    del data["criteria"]["min_gap"]
     return data
 
 
@@ -289,7 +288,7 @@ def test_example_converts(tmp_path: Path) -> None:
         (),
     )
     assert loaded.sensors.gnss.heading_sigma == pytest.approx(math.radians(0.2))
-    assert loaded.criteria == spec.CriteriaSpec(min_gap=None, max_decel=5.0, reach_s=560.0)
+    assert loaded.criteria == spec.CriteriaSpec(min_gap="r157", max_decel=5.0, reach_s=560.0)
 
 
 def test_full_example_converts_once_everything_is_supported(
