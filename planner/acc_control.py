@@ -12,9 +12,10 @@ equations are missing; these are designed here. Speeds in m/s, gaps in metres.
   forward and closes the gap error with the time constant 1 / k_gap (4 s at 0.25 1/s), slow
   enough not to chase the lead's speed noise; the second is the speed from which braking at
   a_comf still stops d0 behind a lead that stops. Stop-and-go: behind a lead slower than
-  ``v_standstill`` (0.5 m/s) the reference is 0 once the gap is within ``stop_band`` (1.5 m)
-  of d0, so the car comes to rest (the speed loop holds it) instead of creeping up for
-  seconds, and moves off as soon as the lead does.
+  ``v_standstill`` (0.5 m/s) the gap law would creep up on it for seconds (its time
+  constant), so the reference is the braking curve ``sqrt(2 a_final (d - d0 - stop_band))``
+  alone (a_final 0.5 m/s^2): the car comes to rest ``stop_band`` (1 m) beyond d0 in finite
+  time, the speed loop holds it, and it moves off as soon as the lead does.
 - BRAKE (gap at or below d_min), hard braking that eases in: the deceleration that brings
   the speed down to the trail law's (below the lead's while the gap is short, so the gap
   opens again) before the gap shrinks to d_stop, ``a_need = (v^2 - v_trail^2) / (2 max(d -
@@ -52,7 +53,8 @@ class AccControlParams:
     d_stop: float = 2.0  # [m] gap BRAKE aims to keep at the lead's speed
     margin: float = 1.0  # [m] stop / pass points are aimed this far before the point
     v_standstill: float = 0.5  # [m/s] a lead slower than this counts as stopped (trail)
-    stop_band: float = 1.5  # [m] behind a stopped lead, stop within this of d0 (trail)
+    stop_band: float = 1.0  # [m] behind a stopped lead, stop this far beyond d0 (trail)
+    a_final: float = 0.5  # [m/s^2] the last metres' deceleration behind a stopped lead
 
 
 @dataclass(frozen=True, slots=True)
@@ -65,8 +67,9 @@ def trail(v_plan: float, d: float, d_des: float, v_l: float, d0: float,
           p: AccControlParams) -> SpeedRef:
     """Constant time-gap following behind a lead at gap d with speed v_l (d0: the
     standstill gap)."""
-    if v_l < p.v_standstill and d < d0 + p.stop_band:
-        return SpeedRef(0.0, 0.0)
+    if v_l < p.v_standstill:
+        approach = math.sqrt(2.0 * p.a_final * max(d - d0 - p.stop_band, 0.0))
+        return SpeedRef(min(approach, v_plan), 0.0)
     gap_law = v_l + p.k_gap * (d - d_des)
     stop_law = math.sqrt(max(v_l, 0.0) ** 2 + 2.0 * p.a_comf * max(d - d0, 0.0))
     return SpeedRef(min(max(min(gap_law, stop_law), 0.0), v_plan), 0.0)

@@ -27,8 +27,11 @@ def test_trail_closes_the_gap_error_and_never_exceeds_the_plan() -> None:
     assert trail(19.0, 48.0, 40.0, 20.0, d0, P).speed == 19.0  # the map's plan caps it
     assert trail(30.0, 5.0, 40.0, 1.0, d0, P).speed == 0.0  # never backwards
     assert trail(30.0, 40.0, 40.0, 20.0, d0, P).accel == 0.0
-    # far behind a stopped lead the braking curve to d0 binds; near it, the car stops
-    assert trail(30.0, 60.0, d0, 0.0, d0, P).speed == pytest.approx(math.sqrt(3.0 * 56.0))
+    # far behind a moving lead the braking curve to d0 binds
+    assert trail(30.0, 60.0, d0, 0.6, d0, P).speed == pytest.approx(
+        math.sqrt(0.36 + 3.0 * 56.0))
+    # behind a stopped lead: the final approach, to rest 1 m beyond d0
+    assert trail(30.0, d0 + 3.0, 5.0, 0.0, d0, P).speed == pytest.approx(math.sqrt(2.0))
     assert trail(30.0, d0 + 1.0, d0, 0.0, d0, P).speed == 0.0
     assert trail(30.0, d0 + 1.0, d0, 1.0, d0, P).speed > 0.0  # it moves off with the lead
 

@@ -1,0 +1,58 @@
+"""ICCAS traffic jam: the lead brakes to a stop at 1 m/s^2, waits 10 s and drives off,
+twice. The ego stops 2-6 m behind, moves off within 2 s of the lead, keeps UN R157's d_min
+while moving, and is back at its set speed when the jam clears."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+import pytest
+
+from avsim.runner import RunResult
+
+pytestmark = pytest.mark.slow
+KPH = 1 / 3.6
+
+
+@pytest.fixture(scope="module")
+def result(run_scenario: Callable[..., RunResult]) -> RunResult:
+    return run_scenario("traffic_jam", record=False)
+
+
+def _intervals(mask: np.ndarray, t: np.ndarray) -> list[tuple[float, float]]:
+    edges = np.flatnonzero(np.diff(mask.astype(int)))
+    starts = [t[i + 1] for i in edges if not mask[i]]
+    ends = [t[i] for i in edges if mask[i]]
+    return list(zip(starts, ends, strict=False))
+
+
+def test_stop_and_go_twice(result: RunResult) -> None:
+    log = result.log
+    t, v, s = log.array("t"), log.array("speed"), log.array("station")
+    k = [a.id for a in result.spec.actors].index("lead")
+    lead_s = np.array(log.actor_station)[:, k]
+    lead_v = np.gradient(lead_s, t)
+    gap = lead_s - s - (4.6 + 4.8) / 2
+    stops = [(a, b) for a, b in _intervals(lead_v < 0.05, t) if b - a >= 9.0]
+    assert len(stops) == 2, stops  # the lead stopped twice, ~10 s each
+    for a, b in stops:
+        during = (t >= a) & (t <= b)
+        standing = during & (v < 0.05)
+        assert standing.any()  # the ego came to rest behind it
+        assert 2.0 <= float(gap[standing].min()) <= float(gap[standing].max()) <= 6.0
+        lead_off = t[np.argmax((t > b) & (lead_v > 0.1))]
+        ego_off = t[np.argmax((t > b - 1.0) & (v > 0.1))]
+        assert 0.0 <= ego_off - lead_off <= 2.0
+    assert float(gap.min()) > 2.0
+
+
+def test_verdict_and_back_to_set_speed(result: RunResult) -> None:
+    assert all(c.passed for c in result.criteria), result.criteria
+    c = {r.name: r for r in result.criteria}
+    assert c["min_gap"].value >= c["min_gap"].threshold  # d_min while moving
+    assert c["max_decel"].value <= 1.5  # the jam is taken gently
+    v = result.log.array("speed")
+    assert v[-1] == pytest.approx(45 * KPH, abs=1 * KPH)  # the jam cleared: set speed
+    modes = [x.target for x in result.state_changes if x.machine == "acc"]
+    assert modes[:2] == ["cruise", "trail"] and modes[-1] == "cruise"
