@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
+from planner.acc import r157_min_gap
 from world.actors import ActorPoses
 from world.hdmap import RoadMap
 
@@ -201,11 +202,6 @@ class MaxDecel(Criterion):
     def result(self) -> CriterionResult:
         return CriterionResult(self.name, self.peak <= self.threshold, self.peak,
                                self.threshold, self.unit, self.first_failure)
-
-
-def r157_min_gap(v: float) -> float:
-    """[m] UN R157's minimum following distance at speed v [m/s] (as `planner.acc`)."""
-    return max(v * (1.0 + max(v / KPH, 10.0) / 100.0), 2.0)
 
 
 class MinGap(Criterion):

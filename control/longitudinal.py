@@ -55,13 +55,7 @@ class SpeedParams:
     @property
     def pid(self) -> PidParams:
         """The speed PID: error [m/s], output [m/s^2]."""
-        return PidParams(
-            kp=self.kp,
-            ki=self.ki,
-            kd=self.kd,
-            integral_limit=self.integral_limit,
-            derivative_tau=self.derivative_tau,
-        )
+        return PidParams.of(self)
 
 
 @dataclass(frozen=True, slots=True)

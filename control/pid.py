@@ -18,8 +18,24 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Protocol
 
-__all__ = ["Pid", "PidParams"]
+__all__ = ["Pid", "PidGains", "PidParams"]
+
+
+class PidGains(Protocol):
+    """Anything carrying the five PID fields (a loop's own parameter set)."""
+
+    @property
+    def kp(self) -> float: ...
+    @property
+    def ki(self) -> float: ...
+    @property
+    def kd(self) -> float: ...
+    @property
+    def integral_limit(self) -> float: ...
+    @property
+    def derivative_tau(self) -> float: ...
 
 
 @dataclass(frozen=True, slots=True)
@@ -31,6 +47,12 @@ class PidParams:
     kd: float = 0.0  # [U s/E] derivative gain
     integral_limit: float = math.inf  # [U] |ki * integral| is clamped to this (anti-windup)
     derivative_tau: float = 0.0  # [s] time constant of the derivative low-pass (0: unfiltered)
+
+    @classmethod
+    def of(cls, g: PidGains) -> PidParams:
+        """The PID part of a loop's parameter set."""
+        return cls(kp=g.kp, ki=g.ki, kd=g.kd, integral_limit=g.integral_limit,
+                   derivative_tau=g.derivative_tau)
 
     def __post_init__(self) -> None:
         if self.integral_limit < 0.0:

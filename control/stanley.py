@@ -201,13 +201,7 @@ class StanleyParams:
     @property
     def pid(self) -> PidParams:
         """The numerator's PID: error e_fa [m], output [m/s]."""
-        return PidParams(
-            kp=self.kp,
-            ki=self.ki,
-            kd=self.kd,
-            integral_limit=self.integral_limit,
-            derivative_tau=self.derivative_tau,
-        )
+        return PidParams.of(self)
 
 
 class StanleyPid:
