@@ -39,6 +39,10 @@ class TruthSample:
     touching: frozenset[int]  # body ids in contact with the ego (ground excluded)
     offset: float = 0.0  # [m] ego centre offset from the reference line, left +
     actors: ActorPoses | None = None  # every NPC now (for gap criteria)
+    lane: int = 0  # the lane the stack keeps, or moves into (its plan's command)
+    origin_lane: int = 0  # the lane a commanded lane change leaves (== lane otherwise)
+    lateral_accel: float = 0.0  # [m/s^2] speed * yaw rate, left +
+    road_curvature: float = 0.0  # [1/m] the route's curvature at the ego's station
 
 
 @dataclass(frozen=True, slots=True)
@@ -49,6 +53,7 @@ class CriterionResult:
     threshold: float
     unit: str
     first_failure: float | None = None  # [s] sim time it first failed, if it did
+    note: str | None = None  # why it failed when the value does not say (nothing happened)
 
     def as_json(self) -> dict[str, object]:
         out: dict[str, object] = {
@@ -57,6 +62,8 @@ class CriterionResult:
         }
         if self.first_failure is not None:
             out["first_failure"] = round(self.first_failure, 3)
+        if self.note is not None:
+            out["note"] = self.note
         return out
 
 
@@ -110,21 +117,23 @@ class NoCollision(Criterion):
 
 class TyresInLane(Criterion):
     """Every tyre stays inside the ego's lane markings: value = least margin [m] of a tyre's
-    outer edge to the inner edge of the painted line (negative: on or over the paint)."""
+    outer edge to the inner edge of the painted line (negative: on or over the paint).
+
+    The lane is the one the stack keeps. During a commanded lane change (the plan's lane
+    differs from its origin lane) the tyres may be anywhere inside the two lanes' outer
+    lines; once the change ends, inside the target lane."""
 
     name, unit = "tyres_in_lane", "m"
 
-    def __init__(self, road: RoadMap, lane: int, tyre_half_width: float) -> None:
+    def __init__(self, road: RoadMap, tyre_half_width: float) -> None:
         super().__init__()
-        self.lane = road.lane(lane)
+        self.road = road
         self.tyre_half_width = tyre_half_width
         self.margin = math.inf
 
     def update(self, sample: TruthSample) -> None:
-        s = sample.tyre_stations
-        r = sample.tyre_offsets - self.lane.offset_at(s)
-        half = np.asarray(self.lane.width_at(s)) / 2 - LINE_HALF_WIDTH
-        margin = float(np.min(half - np.abs(r) - self.tyre_half_width))
+        margin = float(np.min(lane_margins(self.road, sample, sample.lane, sample.origin_lane)))
+        margin -= self.tyre_half_width
         self.margin = min(self.margin, margin)
         if margin < 0:
             self._fail(sample.t)
@@ -132,6 +141,17 @@ class TyresInLane(Criterion):
     def result(self) -> CriterionResult:
         return CriterionResult(self.name, self.margin >= 0, self.margin, 0.0, self.unit,
                                self.first_failure)
+
+
+def lane_margins(road: RoadMap, sample: TruthSample, a: int, b: int) -> NDArray[np.float64]:
+    """[m] (4,) each tyre patch centre's distance inside the inner edges of the outer lines
+    of lanes a..b (one lane when a == b); negative outside."""
+    s = sample.tyre_stations
+    lo, hi = road.lane(min(a, b)), road.lane(max(a, b))
+    c_lo, c_hi = np.asarray(lo.offset_at(s)), np.asarray(hi.offset_at(s))
+    centre = 0.5 * (c_lo + c_hi)
+    half = 0.5 * (c_hi - c_lo) + np.asarray(lo.width_at(s)) / 2 - LINE_HALF_WIDTH
+    return np.asarray(half - np.abs(sample.tyre_offsets - centre), dtype=np.float64)
 
 
 class SpeedLimit(Criterion):
@@ -229,7 +249,7 @@ class MinGap(Criterion):
         self.threshold = math.nan if self.fixed is None else self.fixed
 
     def update(self, sample: TruthSample) -> None:
-        ahead = self._ahead(sample)
+        ahead = vehicles_ahead(sample, self.road, self.ego_length)
         for name in list(self.entered):
             if name not in ahead:
                 del self.entered[name]
@@ -247,23 +267,194 @@ class MinGap(Criterion):
         if gap < d_min:
             self._fail(sample.t)
 
-    def _ahead(self, sample: TruthSample) -> dict[str, tuple[str, float, float]]:
-        """Actor id -> (id, bumper gap [m], acceleration [m/s^2]) of the vehicles whose
-        centre is in the ego's lane band ahead of the ego."""
-        a = sample.actors
-        if a is None or not len(a.ids):
-            return {}
-        width = float(self.road.lane(0).width_at(sample.station))
-        lateral = np.abs(a.offsets - sample.offset) < 0.5 * width
-        gap = a.stations - sample.station - (2.0 * a.half_sizes[:, 0] + self.ego_length) / 2
-        out = {}
-        for i in np.flatnonzero(lateral & (a.stations > sample.station)):
-            out[a.ids[i]] = (a.ids[i], float(gap[i]), float(a.accels[i]))
-        return out
-
     def result(self) -> CriterionResult:
         return CriterionResult(self.name, self.first_failure is None, self.gap,
                                self.threshold, self.unit, self.first_failure)
+
+
+def vehicles_ahead(sample: TruthSample, road: RoadMap,
+                   ego_length: float) -> dict[str, tuple[str, float, float]]:
+    """Actor id -> (id, bumper gap [m], acceleration [m/s^2]) of the vehicles whose centre
+    is in the ego's lane band (half a lane width either side of the ego's centre) ahead."""
+    a = sample.actors
+    if a is None or not len(a.ids):
+        return {}
+    width = float(road.lane(0).width_at(sample.station))
+    lateral = np.abs(a.offsets - sample.offset) < 0.5 * width
+    gap = a.stations - sample.station - (2.0 * a.half_sizes[:, 0] + ego_length) / 2
+    out = {}
+    for i in np.flatnonzero(lateral & (a.stations > sample.station)):
+        if a.kinds[i].value in VEHICLES:
+            out[a.ids[i]] = (a.ids[i], float(gap[i]), float(a.accels[i]))
+    return out
+
+
+VEHICLES = frozenset({"car", "truck"})
+
+
+class LaneChangeDuration(Criterion):
+    """Each commanded lane change takes at most `threshold` seconds from the first tyre
+    leaving the origin lane's markings to all tyres inside the target lane's. Value: the
+    longest [s]; fails if no lane change was made (the scenario asks for one)."""
+
+    name, unit = "lane_change_duration", "s"
+
+    def __init__(self, road: RoadMap, tyre_half_width: float, threshold: float) -> None:
+        super().__init__()
+        self.road, self.tyre_half_width, self.threshold = road, tyre_half_width, threshold
+        self.durations: list[float] = []
+        self._change: tuple[int, int] | None = None  # (origin, target) being watched
+        self._left: float | None = None  # [s] a tyre left the origin lane
+
+    def update(self, sample: TruthSample) -> None:
+        if sample.lane != sample.origin_lane and self._change != (sample.origin_lane,
+                                                                  sample.lane):
+            self._change, self._left = (sample.origin_lane, sample.lane), None
+        if self._change is None:
+            return
+        origin, target = self._change
+        w = self.tyre_half_width
+        if self._left is None:
+            if np.min(lane_margins(self.road, sample, origin, origin)) < w:
+                self._left = sample.t
+            return
+        if np.min(lane_margins(self.road, sample, target, target)) >= w:
+            self.durations.append(sample.t - self._left)
+            if self.durations[-1] > self.threshold:
+                self._fail(sample.t)
+            self._change = self._left = None
+
+    def result(self) -> CriterionResult:
+        value = max(self.durations, default=0.0)
+        return CriterionResult(self.name, bool(self.durations) and value <= self.threshold,
+                               value, self.threshold, self.unit, self.first_failure,
+                               None if self.durations else "no lane change was made")
+
+
+class LaneChangeLateralAccel(Criterion):
+    """During each commanded lane change and 1 s after, the lateral acceleration the change
+    adds (speed * yaw rate less speed^2 * the road's curvature, 0.2 s moving average) stays
+    within `threshold`. Value: its peak [m/s^2]; fails if no lane change was made."""
+
+    name, unit = "lane_change_lateral_accel", "m/s^2"
+    AFTER = 1.0  # [s]
+
+    def __init__(self, threshold: float, rate: float) -> None:
+        super().__init__()
+        self.threshold = threshold
+        self.window: deque[float] = deque(maxlen=max(1, round(DECEL_WINDOW * rate)))
+        self.peak = 0.0
+        self.changes = 0
+        self._until = -math.inf
+        self._changing = False
+
+    def update(self, sample: TruthSample) -> None:
+        self.window.append(sample.lateral_accel - sample.speed**2 * sample.road_curvature)
+        changing = sample.lane != sample.origin_lane
+        if changing and not self._changing:
+            self.changes += 1
+        self._changing = changing
+        if changing:
+            self._until = sample.t + self.AFTER
+        if sample.t <= self._until and len(self.window) == self.window.maxlen:
+            a = abs(sum(self.window) / len(self.window))
+            self.peak = max(self.peak, a)
+            if a > self.threshold:
+                self._fail(sample.t)
+
+    def result(self) -> CriterionResult:
+        return CriterionResult(self.name, self.changes > 0 and self.peak <= self.threshold,
+                               self.peak, self.threshold, self.unit, self.first_failure,
+                               None if self.changes else "no lane change was made")
+
+
+class StandstillGap(Criterion):
+    """Each time the ego stands (below 0.1 m/s for 1 s) behind a vehicle in its lane within
+    `reach` metres, the bumper gap is within [low, high]. Value: the standstill gap farthest
+    from the band's middle [m], against the bound on its side; fails if it never stood."""
+
+    name, unit = "standstill_gap", "m"
+    STOPPED, HOLD, REACH = 0.1, 1.0, 15.0  # [m/s], [s], [m]
+
+    def __init__(self, low: float, high: float, road: RoadMap, ego_length: float) -> None:
+        super().__init__()
+        self.low, self.high, self.road, self.ego_length = low, high, road, ego_length
+        self.gaps: list[float] = []
+        self._since: float | None = None
+
+    def update(self, sample: TruthSample) -> None:
+        if sample.speed >= self.STOPPED:
+            self._since = None
+            return
+        self._since = sample.t if self._since is None else self._since
+        ahead = vehicles_ahead(sample, self.road, self.ego_length)
+        gap = min((g for _, g, _ in ahead.values()), default=math.inf)
+        if sample.t - self._since < self.HOLD or gap > self.REACH:
+            return
+        self.gaps.append(gap)
+        if not self.low <= gap <= self.high:
+            self._fail(sample.t)
+
+    def result(self) -> CriterionResult:
+        if not self.gaps:
+            return CriterionResult(self.name, False, 0.0, self.low, self.unit, None,
+                                   "the ego never stood behind a vehicle")
+        mid = 0.5 * (self.low + self.high)
+        worst = max(self.gaps, key=lambda g: abs(g - mid))
+        bound = self.low if worst < mid else self.high
+        return CriterionResult(self.name, self.first_failure is None, worst, bound, self.unit,
+                               self.first_failure)
+
+
+class TimeToResume(Criterion):
+    """Once the lane ahead clears (no vehicle in it within 3 s at the wanted speed + 10 m
+    that is slower than that speed) while the ego is slower than the wanted speed (the set
+    speed, or the posted limit where lower) less 1 km/h, the ego is back at it within
+    `threshold` seconds. Value: the longest such wait [s] (one still open at the end counts
+    to the end); fails if the lane never cleared with the ego slowed."""
+
+    name, unit = "time_to_resume", "s"
+
+    def __init__(self, threshold: float, set_speed: float, road: RoadMap,
+                 ego_length: float) -> None:
+        super().__init__()
+        self.threshold, self.set_speed, self.road = threshold, set_speed, road
+        self.ego_length = ego_length
+        self.waits: list[float] = []
+        self._clear_at: float | None = None
+        self._was_blocked = False
+        self._t = 0.0
+
+    def update(self, sample: TruthSample) -> None:
+        self._t = sample.t
+        want = min(self.set_speed, float(self.road.speed_limit_at(sample.front_station)))
+        slow = sample.speed < want - SPEED_TOLERANCE_KPH * KPH
+        a = sample.actors
+        reach = 3.0 * want + 10.0
+        blocking = a is not None and any(
+            g <= reach and a.speeds[a.ids.index(name)] < want - SPEED_TOLERANCE_KPH * KPH
+            for name, g, _ in vehicles_ahead(sample, self.road, self.ego_length).values())
+        if self._clear_at is not None and (not slow or blocking):
+            self._close(sample.t)
+        if self._clear_at is None and slow and not blocking and self._was_blocked:
+            self._clear_at = sample.t
+        self._was_blocked = blocking
+
+    def _close(self, t: float) -> None:
+        assert self._clear_at is not None
+        self.waits.append(t - self._clear_at)
+        if self.waits[-1] > self.threshold:
+            self._fail(t)
+        self._clear_at = None
+
+    def result(self) -> CriterionResult:
+        waits = self.waits + ([self._t - self._clear_at] if self._clear_at is not None else [])
+        if not waits:
+            return CriterionResult(self.name, False, 0.0, self.threshold, self.unit, None,
+                                   "the lane ahead never cleared with the ego slowed")
+        value = max(waits)
+        return CriterionResult(self.name, value <= self.threshold, value, self.threshold,
+                               self.unit, self.first_failure)
 
 
 @dataclass

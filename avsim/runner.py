@@ -25,11 +25,16 @@ from numpy.typing import NDArray
 from avsim.criteria import (
     Completes,
     CriteriaSet,
+    Criterion,
     CriterionResult,
+    LaneChangeDuration,
+    LaneChangeLateralAccel,
     MaxDecel,
     MinGap,
     NoCollision,
     SpeedLimit,
+    StandstillGap,
+    TimeToResume,
     TruthSample,
     TyresInLane,
 )
@@ -52,6 +57,8 @@ ACTOR_RECORD_RATE = Rate("record_actors", 10)
 # criteria samples are taken at contact checks
 assert CRITERIA_RATE.every % CONTACT_RATE.every == 0, "criteria rate must divide the contacts'"
 END_MARGIN = 30.0  # [m] default `completes` station: the route's end less this
+TYRE_HALF_WIDTH = 0.105  # [m] half the tyre's tread (the URDF's wheel width)
+NEEDS_ACTORS = (MinGap, StandstillGap, TimeToResume)  # criteria that read the NPCs
 SETTLE_AFTER_DONE = 1.0  # [s] the run goes on this long after `completes` is reached
 
 ProgressCallback = Callable[[float, float], None]  # (sim time, duration) [s]
@@ -67,7 +74,8 @@ class TrajectoryLog:
     yaw: list[float] = field(default_factory=list)  # [rad]
     speed: list[float] = field(default_factory=list)  # [m/s] true forward speed
     station: list[float] = field(default_factory=list)  # [m] true centre station
-    cross_track: list[float] = field(default_factory=list)  # [m] true centre offset, left +
+    cross_track: list[float] = field(default_factory=list)  # [m] true centre offset from
+    #   the centre of the lane kept, left +
     front_axle_error: list[float] = field(default_factory=list)  # [m] true, at front axle
     target_speed: list[float] = field(default_factory=list)  # [m/s]
     speed_limit: list[float] = field(default_factory=list)  # [m/s] at the front bumper
@@ -75,6 +83,9 @@ class TrajectoryLog:
     drive_torque: list[float] = field(default_factory=list)  # [N m] commanded, total
     brake_torque: list[float] = field(default_factory=list)  # [N m] commanded, total
     wheel_spin: list[NDArray[np.float64]] = field(default_factory=list)  # [rad/s] (4,)
+    lane: list[int] = field(default_factory=list)  # the lane the stack keeps (cross_track's)
+    changing: list[bool] = field(default_factory=list)  # a commanded lane change in hand
+    pedal: list[float] = field(default_factory=list)  # [-] the driver's accelerator pedal
     actor_station: list[NDArray[np.float64]] = field(default_factory=list)  # [m] (N,) true
     actor_offset: list[NDArray[np.float64]] = field(default_factory=list)  # [m] (N,) true,
     #   from the reference line, left +
@@ -126,14 +137,10 @@ class Runner:
         reach = spec.criteria.reach_s
         self.completes = Completes(reach if reach is not None else w.road.length - END_MARGIN)
         self.collisions = NoCollision(names)
-        items = [self.collisions, TyresInLane(w.road, spec.ego.lane, 0.105),
-                 SpeedLimit(w.road), self.completes]
-        if spec.criteria.max_decel is not None:
-            items.append(MaxDecel(spec.criteria.max_decel, CRITERIA_RATE.hz))
-        self._gap_criteria = spec.criteria.min_gap is not None
-        if spec.criteria.min_gap is not None:
-            items.append(MinGap(spec.criteria.min_gap, w.road, self.car.body_length))
-        self.criteria = CriteriaSet(items)
+        self.criteria = CriteriaSet([self.collisions, TyresInLane(w.road, TYRE_HALF_WIDTH),
+                                     SpeedLimit(w.road), self.completes,
+                                     *self._optional_criteria()])
+        self._gap_criteria = any(isinstance(c, NEEDS_ACTORS) for c in self.criteria.items)
         self.recorder = Recorder(recording, recording_name=spec.name) if recording else None
         self.sensors = None if self.setup is None else SensorLoop(
             w, self.setup, self.stack, mode, self.recorder, frame_hook)
@@ -141,7 +148,23 @@ class Runner:
         self._touching: frozenset[int] = frozenset()
         self._logged_events = 0  # collision events already sent to the recording
         self._last: StackOutput | None = None
-        self._lane_offset = w.road.lane(spec.ego.lane).offset_at
+        self._lane = self._origin_lane = spec.ego.lane  # the stack's lane command
+
+    def _optional_criteria(self) -> list[Criterion]:
+        c, road, length = self.spec.criteria, self.world.road, self.car.body_length
+        items: list[Criterion] = []
+        if c.max_decel is not None:
+            items.append(MaxDecel(c.max_decel, CRITERIA_RATE.hz))
+        if c.min_gap is not None:
+            items.append(MinGap(c.min_gap, road, length))
+        if c.lane_change is not None:
+            items += [LaneChangeDuration(road, TYRE_HALF_WIDTH, c.lane_change[0]),
+                      LaneChangeLateralAccel(c.lane_change[1], CRITERIA_RATE.hz)]
+        if c.standstill_gap is not None:
+            items.append(StandstillGap(*c.standstill_gap, road, length))
+        if c.resume_within is not None:
+            items.append(TimeToResume(c.resume_within, self.spec.ego.set_speed, road, length))
+        return items
 
     # -- the loop ------------------------------------------------------------------------------
 
@@ -197,6 +220,7 @@ class Runner:
         cmd = out.command
         w.ego.apply(cmd.steering_angle, cmd.drive_torque, cmd.brake_torque)
         self._last = out
+        self._lane, self._origin_lane = out.plan.lane, out.plan.origin_lane
         self._log_tick(out)
         for change in out.plan.changes:
             self.state_changes.append(change)
@@ -207,7 +231,8 @@ class Runner:
         w, log = self.world, self.log
         truth, route = w.ego_truth, w.ego_route
         s = route.station
-        r, r_fa = (route.offsets[:2] - self._lane_offset(route.stations[:2])).tolist()
+        lane = self.world.road.lane(out.plan.lane)
+        r, r_fa = (route.offsets[:2] - lane.offset_at(route.stations[:2])).tolist()
         log.t.append(w.t)
         log.x.append(float(truth.position[0]))
         log.y.append(float(truth.position[1]))
@@ -222,6 +247,9 @@ class Runner:
         log.drive_torque.append(out.command.drive_torque)
         log.brake_torque.append(out.command.brake_torque)
         log.wheel_spin.append(truth.wheel_spin.copy())
+        log.lane.append(out.plan.lane)
+        log.changing.append(out.plan.lane != out.plan.origin_lane)
+        log.pedal.append(w.accelerator_pedal)
         log.actor_station.append(np.array([m.s for m in w.actors.motions]))
         log.actor_offset.append(np.array([m.offset for m in w.actors.motions]))
         if self.recorder is not None and RECORD_RATE.fires(w.clock.step):
@@ -251,12 +279,16 @@ class Runner:
             tyres=route.tyres, tyre_stations=route.tyre_stations,
             tyre_offsets=route.tyre_offsets, touching=self._touching,
             offset=float(route.offsets[0]), actors=w.actors.poses if self._gap_criteria else None,
+            lane=self._lane, origin_lane=self._origin_lane,
+            lateral_accel=truth.speed * truth.yaw_rate,
+            road_curvature=float(w.road.curvature_at(route.station)),
         ))
 
     # -- results -------------------------------------------------------------------------------
 
     def _metrics(self) -> dict[str, float]:
-        xte = self.log.array("cross_track")
+        keeping = ~np.asarray(self.log.changing, dtype=bool)  # lane changes are not errors
+        xte = self.log.array("cross_track")[keeping]
         speed = self.log.array("speed")
         dt = CONTROL_RATE.every / PHYSICS_RATE
         decel = -np.diff(speed) / dt if len(speed) > 1 else np.zeros(1)
@@ -265,7 +297,8 @@ class Runner:
         return {
             "max_lateral_error": float(np.max(np.abs(xte))) if len(xte) else math.nan,
             "rms_lateral_error": float(np.sqrt(np.mean(xte**2))) if len(xte) else math.nan,
-            "max_front_axle_error": float(np.max(np.abs(self.log.array("front_axle_error"))))
+            "max_front_axle_error":
+                float(np.max(np.abs(self.log.array("front_axle_error")[keeping])))
             if len(xte) else math.nan,
             "max_decel": float(max(0.0, np.max(smooth))) if len(smooth) else 0.0,
             "max_speed": float(np.max(speed)) if len(speed) else 0.0,

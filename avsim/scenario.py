@@ -67,7 +67,6 @@ UNSUPPORTED: dict[str, str] = {
     "road.features.*.type=traffic_light": "traffic lights",
     "actors.*.type=pedestrian": "pedestrians",
     "actors.*.actions.*.walk": "the walk action",
-    "events.*.accelerator_override": "ego events: accelerator_override",
     "events.*.flat_tire": "ego events: flat_tire",
 }
 
@@ -800,12 +799,16 @@ def _build(model: ScenarioModel) -> spec.ScenarioSpec:
             speed=_kph(ego.speed_kph),
             set_speed=_kph(ego.set_speed_kph),
             max_speed=_kph(ego.max_speed_kph),
+            overtake=ego.overtake,
         ),
         actors=tuple(_actor_spec(index, actor) for index, actor in enumerate(model.actors)),
         sensors=_sensors_spec(model),
         events=tuple(_event_spec(event) for event in model.events),
         criteria=spec.CriteriaSpec(
-            min_gap=criteria.min_gap, max_decel=criteria.max_decel, reach_s=criteria.reach_s
+            min_gap=criteria.min_gap, max_decel=criteria.max_decel, reach_s=criteria.reach_s,
+            lane_change=None if criteria.lane_change is None else (
+                criteria.lane_change.max_duration, criteria.lane_change.max_lateral_accel),
+            standstill_gap=criteria.standstill_gap, resume_within=criteria.resume_within,
         ),
     )
 

@@ -440,7 +440,9 @@ class ActionModel(_Model):
 
 
 class AcceleratorOverrideModel(_Model):
-    """An external disturbance: the accelerator pedal is held. Not supported yet."""
+    """An external disturbance: the accelerator pedal is held at `pedal` for `duration`
+    seconds, then released. The car is drive-by-wire: the pedal is a sensor the driving stack
+    reads and arbitrates (its speed limiter); the world adds no torque for it."""
 
     pedal: Fraction = Field(description="[-] pedal position 0..1; required.")
     duration: PosFloat = Field(description="[s] how long, > 0; required.")
@@ -455,8 +457,9 @@ class FlatTireModel(_Model):
 
 
 class EventModel(_Model):
-    """Something that happens to the ego car: a `trigger` and exactly one event key.
-    Not supported yet."""
+    """Something that happens to the ego car: a `trigger` (not `gap`: there is no actor)
+    and exactly one event key. `accelerator_override` is simulated; `flat_tire` is not
+    supported yet."""
 
     model_config = ConfigDict(json_schema_extra=_one_of(EVENT_KINDS))
 
@@ -518,6 +521,11 @@ class EgoModel(_Model):
     max_speed_kph: PosFloat = Field(
         default=54.0,
         description="[km/h] vehicle speed limit, > 0. Default 54 (15 m/s, the ICCAS car).",
+    )
+    overtake: bool = Field(
+        default=False,
+        description="(road) the car may change lanes to pass a slower vehicle when the next "
+        "lane is free (ICCAS lane changing). Default false: it follows.",
     )
 
 
@@ -594,13 +602,44 @@ class SensorsModel(_Model):
     )
 
 
+class LaneChangeCriteriaModel(_Model):
+    """Bounds on every commanded lane change; at least one must happen."""
+
+    max_duration: PosFloat = Field(
+        default=5.0,
+        description="[s] from the first tyre leaving the origin lane to all tyres inside the "
+        "target lane, > 0. Default 5.",
+    )
+    max_lateral_accel: PosFloat = Field(
+        default=1.0,
+        description="[m/s^2] the lateral acceleration the change adds (0.2 s average), > 0. "
+        "Default 1.",
+    )
+
+
 class CriteriaModel(_Model):
     """Optional criteria; the default criteria always apply."""
 
     min_gap: Literal["r157"] | PosFloat | None = Field(
         default=None,
         description="`r157` (UN R157 d_min(v)) or a number [m] > 0: minimum bumper gap to the "
-        "vehicle ahead. Default: off. Not supported yet.",
+        "vehicle ahead. Default: off.",
+    )
+    lane_change: LaneChangeCriteriaModel | None = Field(
+        default=None,
+        description="`{max_duration, max_lateral_accel}`: bounds on each lane change; at "
+        "least one must happen. Default: off.",
+    )
+    standstill_gap: tuple[NonNegFloat, PosFloat] | None = Field(
+        default=None,
+        description="[m] `[low, high]`: the bumper gap to the vehicle ahead each time the ego "
+        "stands behind it; it must stand at least once. Default: off.",
+    )
+    resume_within: PosFloat | None = Field(
+        default=None,
+        description="[s] once the lane ahead clears, the ego is back at its wanted speed "
+        "within this, > 0; the lane must clear at least once with the ego slowed. "
+        "Default: off.",
     )
     max_decel: PosFloat | None = Field(
         default=None,
@@ -612,6 +651,13 @@ class CriteriaModel(_Model):
         description="[m] station the ego must reach, > 0, on the route. Default: the end of "
         "the route less 30 m.",
     )
+
+    @field_validator("standstill_gap")
+    @classmethod
+    def _low_below_high(cls, value: Any) -> Any:
+        if value is not None and not value[0] < value[1]:
+            raise problem(f"low must be below high, got {list(value)}")
+        return value
 
     @field_validator("min_gap", mode="before")
     @classmethod
@@ -660,7 +706,8 @@ class ScenarioModel(_Model):
     )
     events: list[EventModel] = Field(
         default_factory=list,
-        description="What happens to the ego car. Default none. Not supported yet.",
+        description="What happens to the ego car. Default none. `flat_tire` is not supported "
+        "yet.",
     )
     criteria: CriteriaModel = Field(
         default_factory=CriteriaModel,

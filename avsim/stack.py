@@ -26,6 +26,7 @@ from perception.objects import ObjectDetector
 from perception.tracking import MultiObjectTracker
 from planner.lane_keeping import LaneKeepingParams, LaneKeepingPlanner, LaneView
 from planner.messages import Plan
+from planner.motion_layer import MotionLayerParams
 from vehicle_urdf import CarGeometry
 from world.frames import CameraFrame, CameraInfo, GnssFix, LidarScan, Odometry
 from world.hdmap import RoadMap
@@ -61,7 +62,8 @@ class Stack:
         self.localizer = Localizer()
         self.planner = LaneKeepingPlanner(
             road, LaneKeepingParams(set_speed=ego.set_speed, max_speed=ego.max_speed,
-                                    lane=ego.lane, camera=front_camera is not None)
+                                    lane=ego.lane, camera=front_camera is not None,
+                                    motion=MotionLayerParams(overtake=ego.overtake))
         )
         lateral = StanleyParams(
             wheelbase=car.wheelbase, centre_to_front_axle=car.front_axle,
@@ -79,12 +81,14 @@ class Stack:
         self._poses: list[EgoState] = []
         self._view: LaneView | None = None
         self._tracks: tuple[Track, ...] = ()
+        self._pedal = 0.0  # [-] the driver's accelerator pedal, from the odometry
 
     def on_gnss(self, fix: GnssFix) -> None:
         self.localizer.on_gnss(fix)
 
     def on_odometry(self, odo: Odometry) -> None:
         self.localizer.on_odometry(odo)
+        self._pedal = odo.accelerator_pedal
 
     def on_sensors(self, t: float, frames: tuple[CameraFrame, ...],
                    scan: LidarScan | None) -> PerceptionOutput | None:
@@ -110,7 +114,7 @@ class Stack:
     def tick(self, t: float, dt: float) -> StackOutput:
         ego = self.localizer.estimate(t)
         self._remember(ego)
-        plan = self.planner.update(ego, self._view, self._tracks)
+        plan = self.planner.update(ego, self._view, self._tracks, self._pedal)
         return StackOutput(plan, self.controller.update(plan, dt))
 
     def _remember(self, ego: EgoState) -> None:

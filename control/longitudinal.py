@@ -19,6 +19,10 @@ Steps of `SpeedController.update` (all along the car's forward axis):
    an emergency stop reach the full 6 m/s^2 in 0.6 s.
 
 The first step after `reset()` ramps from 0 m/s^2.
+
+Emergency stop (the planner's control FSM in EMERGENCY_STOP): the request is
+-`emergency_decel` at once, under the wider `emergency_jerk` (the brake's own rise rate), the
+PID is reset; afterwards the jerk limit takes the request on from where it is.
 """
 
 from __future__ import annotations
@@ -51,6 +55,8 @@ class SpeedParams:
     stop_target_speed: float = 0.05  # [m/s] a target at or below this means "stop"
     standstill_speed: float = 0.3  # [m/s] below this (with a stop target) the car holds
     hold_decel: float = 3.0  # [m/s^2] positive, the request while holding (brake only)
+    emergency_decel: float = 8.0  # [m/s^2] positive, the emergency stop's request
+    emergency_jerk: float = 40.0  # [m/s^3] its rise rate (full braking in 0.2 s)
 
     @property
     def pid(self) -> PidParams:
@@ -82,11 +88,19 @@ class SpeedController:
         self._excess = 0.0
 
     def update(
-        self, target_speed: float, target_accel: float, speed: float, dt: float
+        self, target_speed: float, target_accel: float, speed: float, dt: float,
+        *, emergency: bool = False,
     ) -> SpeedCommand:
         """One step: target_speed [m/s], target_accel [m/s^2] feed-forward, speed [m/s]
-        measured forward speed, dt [s] -> the acceleration request."""
+        measured forward speed, dt [s] -> the acceleration request. `emergency`: brake at
+        `emergency_decel` now (module doc)."""
         p = self.params
+        if emergency:
+            self._pid.reset()
+            step = p.emergency_jerk * dt
+            accel = max(self._accel - step, -p.emergency_decel)
+            self._accel, self._excess = accel, 0.0
+            return SpeedCommand(accel=accel, hold=speed < p.standstill_speed)
         stop_requested = target_speed <= p.stop_target_speed
         at_standstill = speed < p.standstill_speed
         hold = stop_requested and at_standstill

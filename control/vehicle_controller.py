@@ -22,7 +22,7 @@ from control.actuation import VehicleParams, wheel_torques
 from control.command import VehicleCommand
 from control.longitudinal import SpeedController, SpeedParams
 from control.stanley import FrontAxleError, StanleyParams, StanleyPid, front_axle_error
-from planner.messages import Plan, ReferencePath
+from planner.messages import ControlState, Plan, ReferencePath
 
 __all__ = ["VehicleController", "VehicleControllerParams"]
 
@@ -81,7 +81,9 @@ class VehicleController:
         )
         self._path, self._hint, self._last_error = plan.path, error.index, error
         steer = self.lateral.update(error, ego.heading, ego.speed, ego.yaw_rate, dt)
-        speed_cmd = self.longitudinal.update(plan.target_speed, plan.target_accel, ego.speed, dt)
+        speed_cmd = self.longitudinal.update(
+            plan.target_speed, plan.target_accel, ego.speed, dt,
+            emergency=plan.control is ControlState.EMERGENCY_STOP)
         torques = wheel_torques(
             speed_cmd.accel, ego.speed, self.params.vehicle, hold=speed_cmd.hold
         )

@@ -37,27 +37,34 @@ class AccLayer:
         self.params = params if params is not None else AccLayerParams()
         self.mode = AccMode.ACC_OFF
         self._brake = EasedBrake()
+        self.lead_gap = float("inf")  # [m] the last update's lead gap, carried to its time
 
     def update(self, t: float, dt: float, v: float, set_speed: float, limit: float,
-               plan: SpeedRef, lead: Lead | None) -> tuple[SpeedRef, tuple[StateChange, ...]]:
+               plan: SpeedRef, lead: Lead | None, driver_gap: float | None = None,
+               ) -> tuple[SpeedRef, tuple[StateChange, ...]]:
         """The speed reference now [m/s, m/s^2] and the mode change made, if any.
 
         `v` ego speed, `limit` the posted limit at the front bumper (V_GPS), `plan` the map's
-        speed plan (set speed, limits, curves) [m/s]."""
+        speed plan (set speed, limits, curves) [m/s]. `driver_gap` [m]: the driver's pedal
+        overrides, and the trail law may close up to d_min + this instead of d_des."""
         d, v_l = (lead.gap + (lead.speed - v) * max(t - lead.t, 0.0), lead.speed) \
             if lead is not None else (float("inf"), float("inf"))
+        self.lead_gap = d
         x = AccInput(acc_on=set_speed > 0.0, v=v, v_s=set_speed, v_gps=limit, d=d, v_l=v_l)
         changes: tuple[StateChange, ...] = ()
         change = transition(self.mode, x, self.params.modes)
         if change is not None:
             changes = (StateChange(t, "acc", self.mode.value, change.to.value, change.reason),)
             self.mode = change.to
-        return self._control(x, dt, plan), changes
+        return self._control(x, dt, plan, driver_gap), changes
 
-    def _control(self, x: AccInput, dt: float, plan: SpeedRef) -> SpeedRef:
+    def _control(self, x: AccInput, dt: float, plan: SpeedRef,
+                 driver_gap: float | None) -> SpeedRef:
         c, m = self.params.control, self.params.modes
         if self.mode in (AccMode.BRAKE, AccMode.TRAIL):
-            following = trail(plan.speed, x.d, gaps(x.v, x.v_l, m).d_des, x.v_l, m.d0, c)
+            g = gaps(x.v, x.v_l, m)
+            d_des = g.d_des if driver_gap is None else min(g.d_des, g.d_min + driver_gap)
+            following = trail(plan.speed, x.d, d_des, x.v_l, m.d0, c)
         if self.mode is AccMode.BRAKE:
             need = braking_need(x.v, following.speed, x.d, c)
             ref = self._brake.step(x.v, need, dt, c, cap=brake_cap(x.v, x.v_l, x.d, c))

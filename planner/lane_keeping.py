@@ -26,9 +26,12 @@ from perception.messages import EgoState, LaneEstimate, Track
 from planner.acc_control import SpeedRef
 from planner.acc_layer import AccLayer, AccLayerParams
 from planner.camera_lane import camera_lane_path
+from planner.control_layer import ControlLayer
+from planner.driver_override import OverrideParams, override_reference, overriding
 from planner.lane_source import LaneSource, LaneSourceInput, LaneSourceParams, transition
-from planner.lead import LeadParams, select_lead
+from planner.lead import LeadAccel, LeadParams, select_lead
 from planner.messages import Lead, Plan, ReferencePath, StateChange
+from planner.motion_layer import Manoeuvre, MotionLayer, MotionLayerParams
 from planner.route import lane_path
 from planner.speed_planning import SpeedPlanner, SpeedPlanningParams, SpeedTarget
 from world.hdmap import RoadMap
@@ -57,6 +60,9 @@ class LaneKeepingParams:
     source: LaneSourceParams = field(default_factory=LaneSourceParams)
     lead: LeadParams = field(default_factory=LeadParams)
     acc: AccLayerParams = field(default_factory=AccLayerParams)
+    motion: MotionLayerParams = field(default_factory=MotionLayerParams)
+    override: OverrideParams = field(default_factory=OverrideParams)
+    camera_agree: float = 1.0  # [m] the camera's lane is used only within this of the map's
 
 
 class LaneKeepingPlanner:
@@ -67,17 +73,31 @@ class LaneKeepingPlanner:
             raise ValueError(f"lane keeping needs an ego-direction lane, got {params.lane}")
         self.road = road
         self.params = params
-        self.lane = road.lane(params.lane)
-        self.speed_planner = SpeedPlanner(road, self.lane, params.speed)
+        self._speed_planners: dict[int, SpeedPlanner] = {}
         self.reset()
 
     def reset(self) -> None:
-        """Back to ACQUIRING the lane (MAP without a camera), with no speed cap."""
+        """Back to ACQUIRING the lane (MAP without a camera) of `params.lane`, keeping it,
+        with no speed cap."""
         self.source = LaneSource.ACQUIRING if self.params.camera else LaneSource.MAP
         self._since: float | None = None  # [s] time of the last lane-source change
         self._cap = math.inf  # [m/s] the ramped speed cap of the degraded modes
         self._last_t: float | None = None
+        self._keep(self.params.lane)
         self.acc = AccLayer(self.params.acc)
+        self.motion = MotionLayer(self.road, self.params.lane, self.params.acc.modes,
+                                  self.params.motion)
+        self.control = ControlLayer()
+        self.lead_accel = LeadAccel()
+        self._camera_ok = False  # the camera's lane is seen and agrees with the map's
+
+    def _keep(self, lane: int) -> None:
+        """Make `lane` the lane whose stations, speed plan and map path are used."""
+        self.lane_index = lane
+        self.lane = self.road.lane(lane)
+        if lane not in self._speed_planners:
+            self._speed_planners[lane] = SpeedPlanner(self.road, self.lane, self.params.speed)
+        self.speed_planner = self._speed_planners[lane]
 
     def localise(self, ego: EgoState) -> tuple[float, float]:
         """(station [m], lateral offset [m], left +) of the ego's centre on the lane."""
@@ -98,22 +118,38 @@ class LaneKeepingPlanner:
         return self.speed_planner.target(station, set_speed=p.set_speed, max_speed=p.max_speed)
 
     def update(self, ego: EgoState, view: LaneView | None = None,
-               tracks: Sequence[Track] = ()) -> Plan:
+               tracks: Sequence[Track] = (), pedal: float = 0.0) -> Plan:
         """The plan for this tick, made from ``ego`` (map frame, car centre), the camera's
-        lane ``view`` (None before the first frame) and the confirmed ``tracks``."""
+        lane ``view`` (None before the first frame), the confirmed ``tracks`` and the
+        driver's accelerator ``pedal`` position (0..1, `planner.driver_override`)."""
         dt = 0.0 if self._last_t is None else max(ego.t - self._last_t, 0.0)
         self._last_t = ego.t
         changes = self._update_source(ego.t, view)
+        station, _ = self.localise(ego)
+        want = min(self.params.set_speed, self.speed_for(station).limit_at_front)
+        manoeuvre, motion_changes = self.motion.update(ego, want, tracks)
+        if manoeuvre.lane != self.lane_index:
+            self._keep(manoeuvre.lane)
         station, lateral = self.localise(ego)
-        camera = self.source is LaneSource.CAMERA and view is not None
-        path = self._camera_path(view) if camera and view is not None else \
-            self.path_for(ego, station)
+        path = self._path(ego, station, view, manoeuvre)
         target = self.speed_for(station)
-        lead = self._lead(view, tracks, ego)
+        lead = self._lead(view, tracks, ego, manoeuvre)
+        plan_ref = SpeedRef(target.speed, target.accel)
+        driver = overriding(pedal, self.params.override)
+        if driver:
+            cap = self.speed_planner.target(station, set_speed=self.params.max_speed,
+                                            max_speed=self.params.max_speed)
+            plan_ref = override_reference(pedal, ego.speed, cap, self.params.override)
         ref, acc_changes = self.acc.update(ego.t, dt, ego.speed, self.params.set_speed,
-                                           target.limit_at_front,
-                                           SpeedRef(target.speed, target.accel), lead)
+                                           target.limit_at_front, plan_ref, lead,
+                                           driver_gap=self.params.override.gap_margin
+                                           if driver else None)
         speed, accel = self._degraded_cap(ref.speed, ref.accel, ego.speed, dt)
+        control, control_changes = self.control.update(
+            ego.t, ego.speed, speed, accel, self.acc.lead_gap, lead,
+            self.lead_accel.update(lead))
+        if control.emergency:
+            speed, accel = 0.0, -self.control.decel
         return Plan(
             t=ego.t,
             ego=ego,
@@ -126,8 +162,30 @@ class LaneKeepingPlanner:
             lane_source=self.source,
             lead=lead,
             acc_mode=self.acc.mode.value,
-            changes=changes + acc_changes,
+            motion=manoeuvre.motion.value,
+            lane=manoeuvre.lane,
+            origin_lane=manoeuvre.origin,
+            control=control.state,
+            changes=changes + motion_changes + acc_changes + control_changes,
         )
+
+    def _path(self, ego: EgoState, station: float, view: LaneView | None,
+              manoeuvre: Manoeuvre) -> ReferencePath:
+        """The lane-change path in hand, else the camera's lane when it is seen and agrees
+        with the map's lane kept (not yet re-found after a lane change: the map's), else
+        the map's."""
+        p = self.params
+        self._camera_ok = False
+        if manoeuvre.path is not None:
+            ahead = max(p.path_ahead_min, p.path_ahead_time * max(ego.speed, 0.0))
+            return manoeuvre.path.reference_path(self.lane, station, p.path_behind, ahead,
+                                                 p.path_spacing, self.road.length)
+        if self.source is LaneSource.CAMERA and view is not None:
+            _, r = self.localise(view.pose)
+            self._camera_ok = abs(view.estimate.offset - r) <= p.camera_agree
+            if self._camera_ok:
+                return self._camera_path(view)
+        return self.path_for(ego, station)
 
     def _update_source(self, t: float, view: LaneView | None) -> tuple[StateChange, ...]:
         if self._since is None:
@@ -145,11 +203,20 @@ class LaneKeepingPlanner:
         return camera_lane_path(view.estimate, view.pose, behind=p.path_behind,
                                 ahead=p.camera_ahead, spacing=p.path_spacing)
 
-    def _lead(self, view: LaneView | None, tracks: Sequence[Track], ego: EgoState) -> Lead | None:
+    def _lead(self, view: LaneView | None, tracks: Sequence[Track], ego: EgoState,
+              manoeuvre: Manoeuvre) -> Lead | None:
+        """The vehicle ahead in the lane (camera's lane, else straight ahead); during a lane
+        change the nearest ahead in the lanes the car occupies (`MotionLayer`)."""
+        if manoeuvre.path is not None:
+            if not manoeuvre.leads:
+                return None
+            n = min(manoeuvre.leads, key=lambda n: n.gap)
+            gap = n.gap - (n.speed - ego.speed) * max(ego.t - n.t, 0.0)  # at the track's time
+            return Lead(n.track_id, n.t, gap, max(n.speed, 0.0))
         if not tracks:
             return None
         centre: Callable[[float], float] = _straight_ahead
-        if view is not None and self.source is LaneSource.CAMERA:
+        if view is not None and self._camera_ok:
             centre = view.estimate.centre_y
         return select_lead(tracks, centre, ego.heading, self.params.lead)
 

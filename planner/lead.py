@@ -38,3 +38,27 @@ def select_lead(tracks: Sequence[Track], centre_y: Callable[[float], float],
         speed = max(0.0, tr.vx * math.cos(ego_heading) + tr.vy * math.sin(ego_heading))
         best = Lead(tr.id, tr.t, gap, speed)
     return best
+
+
+class LeadAccel:
+    """The lead's acceleration [m/s^2]: the derivative of its track speed between track
+    updates, through a first-order low-pass of time constant `tau` [s]; 0 for a new lead."""
+
+    def __init__(self, tau: float = 0.3) -> None:
+        self.tau = tau
+        self._id: int | None = None
+        self._t = 0.0
+        self._v = 0.0
+        self.accel = 0.0
+
+    def update(self, lead: Lead | None) -> float:
+        if lead is None or lead.track_id != self._id:
+            self._id = None if lead is None else lead.track_id
+            self.accel = 0.0
+        elif lead.t > self._t:
+            dt = lead.t - self._t
+            raw = (lead.speed - self._v) / dt
+            self.accel += dt / (self.tau + dt) * (raw - self.accel)
+        if lead is not None:
+            self._t, self._v = lead.t, lead.speed
+        return self.accel

@@ -12,9 +12,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from perception.messages import EgoState
+from planner.control_fsm import ControlState
 from planner.lane_source import LaneSource
 
-__all__ = ["EgoState", "Lead", "Plan", "ReferencePath", "StateChange"]
+__all__ = ["ControlState", "EgoState", "Lead", "Plan", "ReferencePath", "StateChange"]
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -60,4 +61,8 @@ class Plan:
     lane_source: LaneSource = LaneSource.ACQUIRING  # where the path comes from
     lead: Lead | None = None  # the vehicle ahead in the lane, if a track shows one
     acc_mode: str = "acc_off"  # the ACC / event layer's mode (`planner.acc.AccMode` value)
+    motion: str = "lane_keep"  # the motion FSM's state (`planner.motion.Motion` value)
+    lane: int = 0  # the lane kept, or moved into by a lane change
+    origin_lane: int = 0  # the lane a lane change in hand leaves (== lane otherwise)
+    control: ControlState = ControlState.SPEED_KEEPING  # the control FSM's state
     changes: tuple[StateChange, ...] = ()  # state changes made in this tick

@@ -15,7 +15,7 @@ ended, plus a delay). Each action fires once, when its trigger first holds.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 from world.spec import (
@@ -45,6 +45,24 @@ class TriggerContext:
     gap: float  # [m] bumper-to-bumper distance between this actor and the ego along the route
 
 
+def trigger_holds(
+    trigger: Trigger, ctx: TriggerContext, ended_at: Sequence[float | None]
+) -> bool:
+    """Whether `trigger` holds now. `ended_at[i]` [s] is when item i of the same list (an
+    actor's actions, or the ego's events) ended, None while it has not; `after` reads it.
+    Shared by the NPC actions and the ego events (`world.ego_events`)."""
+    if isinstance(trigger, TimeTrigger):
+        return ctx.t >= trigger.time
+    if isinstance(trigger, EgoStationTrigger):
+        return ctx.ego_s >= trigger.s
+    if isinstance(trigger, GapTrigger):
+        return ctx.gap <= trigger.gap
+    if isinstance(trigger, AfterTrigger):
+        ended = ended_at[trigger.index]
+        return ended is not None and ctx.t >= ended + trigger.delay
+    raise TypeError(f"unknown trigger {trigger!r}")
+
+
 class NpcMotion:
     """One actor's kinematic state in route coordinates and its scripted actions."""
 
@@ -68,23 +86,11 @@ class NpcMotion:
 
     # -- triggers --------------------------------------------------------------------------
 
-    def _holds(self, trigger: Trigger, ctx: TriggerContext) -> bool:
-        if isinstance(trigger, TimeTrigger):
-            return ctx.t >= trigger.time
-        if isinstance(trigger, EgoStationTrigger):
-            return ctx.ego_s >= trigger.s
-        if isinstance(trigger, GapTrigger):
-            return ctx.gap <= trigger.gap
-        if isinstance(trigger, AfterTrigger):
-            ended = self.ended_at[trigger.index]
-            return ended is not None and ctx.t >= ended + trigger.delay
-        raise TypeError(f"unknown trigger {trigger!r}")
-
     def fire_due(self, ctx: TriggerContext, lane_offset: LaneOffset) -> list[int]:
         """Start every action whose trigger holds now; returns their indices."""
         started = []
         for i, spec in enumerate(self.actions):
-            if self.fired_at[i] is None and self._holds(spec.trigger, ctx):
+            if self.fired_at[i] is None and trigger_holds(spec.trigger, ctx, self.ended_at):
                 self.fired_at[i] = ctx.t
                 self._start(i, spec, lane_offset)
                 started.append(i)

@@ -34,13 +34,16 @@ class GnssFix:
 
 @dataclass(frozen=True, slots=True)
 class Odometry:
-    """Wheel encoders, steering encoder and yaw-rate gyro, sampled together."""
+    """The vehicle signals sampled together: wheel encoders, steering encoder, yaw-rate gyro
+    and the accelerator pedal sensor (drive-by-wire: the driver's, or an external control
+    device's, pedal is an input the stack arbitrates, not a torque on the wheels)."""
 
     t: float  # [s] sim time of the measurement
     wheel_speeds: tuple[float, float, float, float]  # [rad/s] FL, FR, RL, RR spin rates
     wheel_radius: float  # [m] nominal rolling radius the car was built with
     yaw_rate: float  # [rad/s] gyro z, counter-clockwise positive
     steering_angle: float  # [rad] measured road-wheel angle (bicycle equivalent), left +
+    accelerator_pedal: float = 0.0  # [-] 0..1, the driver's accelerator pedal position sensor
 
     @property
     def speed(self) -> float:

@@ -2,13 +2,15 @@
 
 GNSS: position of the car centre with white noise (sigma) plus a constant bias, heading with
 white noise, at 10 Hz. Odometry: wheel spin rates (encoders, 0.5 % scale noise), gyro yaw
-rate (0.002 rad/s noise) and the steering encoder, at the control rate. Noise is drawn from
-the world's seeded generator, so a run is reproducible.
+rate (0.002 rad/s noise), the steering encoder and the accelerator pedal sensor (exact: a
+position the world's ego events hold, `world.ego_events`), at the control rate. Noise is
+drawn from the world's seeded generator, so a run is reproducible.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -40,10 +42,15 @@ class GnssSensor:
         )
 
 
+def _released() -> float:
+    return 0.0
+
+
 @dataclass(frozen=True, slots=True)
 class OdometrySensor:
     wheel_radius: float  # [m]
     rng: np.random.Generator
+    pedal: Callable[[], float] = _released  # [-] 0..1, the accelerator pedal position now
 
     def measure(self, t: float, truth: EgoTruth) -> Odometry:
         noise = self.rng.normal(0.0, 1.0, 6)
@@ -54,4 +61,5 @@ class OdometrySensor:
             wheel_radius=self.wheel_radius,
             yaw_rate=truth.yaw_rate + GYRO_NOISE * float(noise[4]),
             steering_angle=truth.steering_angle + STEERING_NOISE * float(noise[5]),
+            accelerator_pedal=self.pedal(),
         )

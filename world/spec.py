@@ -221,6 +221,7 @@ class EgoSpec:
     speed: float  # [m/s] initial speed
     set_speed: float  # [m/s] the driver's desired (cruise) speed
     max_speed: float  # [m/s] vehicle limit
+    overtake: bool = False  # may change lanes to pass a slower vehicle
 
 
 @dataclass(frozen=True, slots=True)
@@ -250,6 +251,9 @@ class CriteriaSpec:
     min_gap: float | str | None = None  # [m] or "r157"; None: criterion off
     max_decel: float | None = None  # [m/s^2]; None: criterion off
     reach_s: float | None = None  # [m]; None: end of route less 30 m
+    lane_change: tuple[float, float] | None = None  # ([s] duration, [m/s^2] lateral accel)
+    standstill_gap: tuple[float, float] | None = None  # [m] (low, high)
+    resume_within: float | None = None  # [s]
 
 
 @dataclass(frozen=True, slots=True)

@@ -1,9 +1,10 @@
 """The physics world of one scenario: road, scenery, the ego car, NPCs and the GNSS/odometry.
 
 `World(spec)` builds everything from a `ScenarioSpec` into its own `BulletClient`; `step()`
-advances physics by one fixed 240 Hz step (ego forces, Bullet step, NPC behaviours).
-Ground truth for criteria and the recording is in `world.truth`; the stack only ever sees
-what `world.gnss` measures.
+advances physics by one fixed 240 Hz step (ego forces, Bullet step, NPC behaviours, the
+ego's events). Ground truth for criteria and the recording is in `world.truth`; the stack
+only ever sees what `world.gnss` measures (the accelerator pedal an ego event holds is one
+of those signals: the world applies no force for it).
 """
 
 from __future__ import annotations
@@ -21,6 +22,7 @@ from numpy.typing import NDArray
 from world.actors import ActorSet
 from world.client import Clock, Rate, add_ground, make_client
 from world.ego import EgoBody, EgoParams, EgoTruth
+from world.ego_events import EgoEvents
 from world.gnss import GnssSensor, OdometrySensor
 from world.hdmap import RoadMap
 from world.lidar import EGO_RAY_GROUP
@@ -39,7 +41,7 @@ from world.sensors import SensorRig
 from world.spec import ScenarioSpec
 from world.truth import RouteTruth, route_truth
 
-TRIGGER_RATE = Rate("npc_triggers", 40)
+TRIGGER_RATE = Rate("npc_triggers", 40)  # NPC actions' and ego events' triggers checked
 ACTOR_RATE = Rate("npc_motion", 120)  # NPC motion integrated and bodies moved
 SIGN_POLE_RADIUS = 0.04  # [m]
 SIGN_SEGMENTS = 24  # triangles in a round sign plate
@@ -95,8 +97,10 @@ class World:
             self.client.setCollisionFilterGroupMask(self.ego.body, link, EGO_RAY_GROUP, 0xFFFF)
         self.actors = ActorSet(self.client, self.road, spec.actors)
         self.gnss = GnssSensor(spec.sensors.gnss, np.random.default_rng(seeds[1]))
+        self._events = events = EgoEvents(spec.events)
         self.odometry = OdometrySensor(
-            self.ego.geometry.wheel_radius, np.random.default_rng(seeds[2])
+            self.ego.geometry.wheel_radius, np.random.default_rng(seeds[2]),
+            pedal=lambda: events.pedal,
         )
         self.rig = None if sensors is None else SensorRig(
             self.client, sensors, self.ego.geometry.ride_height, renderer=self.renderer,
@@ -194,12 +198,35 @@ class World:
             self._route = route_truth(self.ego_truth, self.ego.geometry, self.road.line)
         return self._route
 
-    def step(self) -> None:
-        """One physics step (the ego's joint motors hold the last command), then the NPCs.
+    @property
+    def accelerator_pedal(self) -> float:
+        """[-] 0..1, the accelerator pedal position an ego event holds now (0: released), as
+        of the last trigger check; what `odometry` measures. No force comes with it."""
+        return self._events.pedal
 
-        NPC triggers are checked at `TRIGGER_RATE` against the ego's true station; NPC
-        motion is integrated and the bodies are moved at `ACTOR_RATE` (kinematic bodies:
-        the contact query between moves sees the last placed pose, 1/120 s old at most).
+    @property
+    def event_fired_at(self) -> tuple[float | None, ...]:
+        """[s] per ego event (`spec.events` order): when it fired, None if not yet."""
+        return self._events.fired_at
+
+    @property
+    def event_ended_at(self) -> tuple[float | None, ...]:
+        """[s] per ego event: when it ended (an override: the pedal released), None while not."""
+        return self._events.ended_at
+
+    @property
+    def started_events(self) -> tuple[int, ...]:
+        """Indices of the ego events that fired at the last trigger check."""
+        return self._events.started
+
+    def step(self) -> None:
+        """One physics step (the ego's joint motors hold the last command), then the NPCs and
+        the ego's events.
+
+        Triggers (NPC actions and ego events) are checked at `TRIGGER_RATE` against the
+        ego's true station; NPC motion is integrated and the bodies are moved at `ACTOR_RATE`
+        (kinematic bodies: the contact query between moves sees the last placed pose, 1/120 s
+        old at most). Ego events only set the pedal the odometry reads.
         """
         self._step_physics()
         self.clock.advance()
@@ -210,11 +237,15 @@ class World:
             self.started_actions = self.actors.fire_triggers(
                 self.clock.t, self.ego_s, self.ego.geometry.body_length
             )
+            self._events.update(self.clock.t, self.ego_s)
         if self.clock.step % ACTOR_RATE.every == 0:
             self.actors.step(self.clock.t, ACTOR_RATE.every * self.clock.dt)
 
     def snapshot(self) -> WorldSnapshot:
-        """The moving bodies' poses now (for a mirror world that only renders)."""
+        """The moving bodies' poses now (for a mirror world that only renders).
+
+        The ego events' state (the accelerator pedal) is left out: it changes nothing that
+        is drawn or ray-cast, and a mirror world is never stepped, so it never needs it."""
         com, quat, joints = self.ego.base_state()
         actors = tuple(self.client.getBasePositionAndOrientation(b) for b in self.actors.bodies)
         return WorldSnapshot(self.clock.step, com, quat, joints, actors)

@@ -119,7 +119,7 @@ def _stripped_example() -> dict[str, Any]:
     del data["road"]["segments"][3]["exit"]
     data["road"]["features"] = data["road"]["features"][:1]
     data["actors"] = data["actors"][:2]
-    del data["events"]
+    data["events"] = data["events"][:1]  # the accelerator override; not the flat tyre
     return data
 
 
@@ -288,6 +288,9 @@ def test_example_converts(tmp_path: Path) -> None:
         (),
     )
     assert loaded.sensors.gnss.heading_sigma == pytest.approx(math.radians(0.2))
+    assert loaded.events == (
+        spec.EventSpec(spec.TimeTrigger(20.0), spec.AcceleratorOverride(pedal=1.0, duration=5.0)),
+    )
     assert loaded.criteria == spec.CriteriaSpec(min_gap="r157", max_decel=5.0, reach_s=560.0)
 
 

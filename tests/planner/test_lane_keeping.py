@@ -13,7 +13,7 @@ from planner.speed_planning import Binding, SpeedPlanner
 from tests.planner.maps import KPH, needs_hdmap, real_map, road_spec, segment, straight_road
 from world.hdmap import RoadMap
 
-KINDS = ["double", "real"]
+KINDS = ["real"]  # the planner now needs the whole map (lanes, projection)
 
 
 def ego_on(road: RoadMap, lane: int, s: float, r: float, speed: float, t: float = 1.0) -> EgoState:
@@ -94,6 +94,6 @@ def test_closed_loop_point_mass_through_posting(kind: str) -> None:
 
 
 def test_rejects_oncoming_lane() -> None:
-    road = straight_road("double", 100.0, 50.0)
+    road = straight_road("real", 100.0, 50.0)
     with pytest.raises(ValueError, match="ego-direction"):
         LaneKeepingPlanner(road, LaneKeepingParams(10.0, 20.0, lane=-1))

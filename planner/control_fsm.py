@@ -1,0 +1,199 @@
+"""The Control FSM (C-FSM) of the ICCAS 2020 paper: which control action holds.
+
+States (the paper's Fig. 3a): STOP, EMERGENCY_STOP, ACCELERATION, DECELERATION and
+SPEED_KEEPING. The paper names them and says the changes follow the recognised objects,
+lights and signs; it gives no conditions, so these are designed here. Inputs
+(`ControlInput`): the ego speed v, the planner's target speed v_target and feed-forward
+acceleration a_target after the ACC layer, the deceleration a_required needed to avoid the
+vehicle ahead and the time to collision ttc with it (both computed upstream, see
+`required_deceleration` and `time_to_collision`). Speeds in m/s, accelerations in m/s^2.
+
+Terms (the thresholds are `ControlParams`):
+
+- moving: v >= v_stopped; stopped otherwise. A stopped car has no emergency.
+- threat: a_required >= a_emergency_enter (the ACC's hard braking covers up to 5 m/s^2) or
+  ttc < ttc_emergency. It is over when a_required < a_emergency_exit and ttc > ttc_exit: the
+  gap between the two is the hysteresis that keeps EMERGENCY_STOP from chattering.
+- slow down (D): v - v_target > speed_band or a_target < -accel_band.
+- speed up (A): (v_target - v > speed_band or a_target > accel_band), not D and no threat.
+  Slowing down wins when the speed error and the plan's acceleration disagree (a target
+  above the speed but a braking feed-forward, or the reverse): without it ACCELERATION and
+  DECELERATION would swap every tick. A threat keeps a stopped car (below v_stopped, so no
+  emergency) from starting into it; a moving car under a threat is in EMERGENCY_STOP first.
+- on target: |v_target - v| <= keep_band and |a_target| <= accel_band (keep_band is
+  narrower than speed_band: the hysteresis of SPEED_KEEPING).
+
+Transitions. Within a state they are tried in this order, and the first that holds is
+taken: the emergency first, then the stop, then the rest (whose conditions exclude each
+other):
+
+| from                | to             | when                                               |
+|---------------------|----------------|----------------------------------------------------|
+| any but EMERGENCY_STOP | EMERGENCY_STOP | moving and a_required >= a_emergency_enter       |
+| any but EMERGENCY_STOP | EMERGENCY_STOP | moving and ttc < ttc_emergency                   |
+| EMERGENCY_STOP      | STOP           | v < v_stopped ("stopped", whatever the threat)     |
+| EMERGENCY_STOP      | DECELERATION   | moving and the threat is over                      |
+| ACCELERATION, DECELERATION, SPEED_KEEPING | STOP | v < v_stopped and v_target <= v_start     |
+| STOP                | ACCELERATION   | v_target > v_start and no threat                   |
+| SPEED_KEEPING       | ACCELERATION   | A                                                  |
+| SPEED_KEEPING       | DECELERATION   | D                                                  |
+| ACCELERATION        | DECELERATION   | D                                                  |
+| DECELERATION        | ACCELERATION   | A                                                  |
+| ACCELERATION        | SPEED_KEEPING  | on target                                          |
+| DECELERATION        | SPEED_KEEPING  | on target                                          |
+
+Anything else stays. In particular STOP holds while v_target <= v_start (v_start above
+v_stopped is the start/stop hysteresis), and also when a stopped car creeps above v_stopped
+with no target to start (the speed loop holds it). The C-FSM only says which action holds;
+the speed reference stays the planner's.
+"""
+
+from __future__ import annotations
+
+import enum
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+
+class ControlState(enum.Enum):
+    STOP = "stop"
+    EMERGENCY_STOP = "emergency_stop"
+    ACCELERATION = "acceleration"
+    DECELERATION = "deceleration"
+    SPEED_KEEPING = "speed_keeping"
+
+
+@dataclass(frozen=True, slots=True)
+class ControlParams:
+    a_emergency_enter: float = 5.0  # [m/s^2] required deceleration at/above it: an emergency
+    ttc_emergency: float = 1.2  # [s] time to collision below it: an emergency
+    a_emergency_exit: float = 2.5  # [m/s^2] the threat is over below it (and ttc > ttc_exit)
+    ttc_exit: float = 3.0  # [s] the threat is over above it (and a_required < a_emergency_exit)
+    v_stopped: float = 0.1  # [m/s] below it the car is stopped
+    v_start: float = 0.5  # [m/s] a target speed above it starts the car from STOP
+    speed_band: float = 0.5  # [m/s] speed error beyond which SPEED_KEEPING speeds up / slows
+    keep_band: float = 0.2  # [m/s] speed error within which the car settles to SPEED_KEEPING
+    accel_band: float = 0.3  # [m/s^2] |a_target| above it: the plan itself speeds up / slows
+
+
+@dataclass(frozen=True, slots=True)
+class ControlInput:
+    v: float  # [m/s] ego speed
+    v_target: float  # [m/s] the planner's target speed (after the ACC layer)
+    a_target: float = 0.0  # [m/s^2] its feed-forward acceleration, signed
+    a_required: float = 0.0  # [m/s^2] >= 0: deceleration needed to avoid the lead (0: none)
+    ttc: float = math.inf  # [s] time to collision with the lead (+inf: none or opening)
+
+
+@dataclass(frozen=True, slots=True)
+class ControlChange:
+    to: ControlState
+    reason: str
+
+
+def required_deceleration(v: float, d: float, v_l: float, a_l: float,
+                          d_stop: float = 1.0) -> float:
+    """[m/s^2] >= 0: the deceleration that keeps the ego `d_stop` [m] behind the vehicle ahead.
+
+    d: the bumper-to-bumper gap [m] (+inf: no lead); v: the ego speed, v_l the lead's speed
+    [m/s]; a_l the lead's acceleration [m/s^2], signed (< 0: braking). The larger of
+
+    - the lead brakes (a_l < -0.5): it stops within ``D_l = v_l^2 / (2 |a_l|)`` (v_l taken
+      as at least 0), and the ego must stop within ``d + D_l - d_stop``:
+      ``v^2 / (2 max(d + D_l - d_stop, 0.1 m))``;
+    - the ego is faster (v > v_l): at a constant lead speed it must shed the closing speed
+      before the gap shrinks to d_stop: ``(v - v_l)^2 / (2 max(d - d_stop, 0.1 m))``;
+
+    and 0 when neither applies (an opening gap behind a lead that does not brake).
+    """
+    need = 0.0
+    if a_l < -0.5:
+        lead_stop = max(v_l, 0.0) ** 2 / (2.0 * abs(a_l))
+        need = v * v / (2.0 * max(d + lead_stop - d_stop, 0.1))
+    if v > v_l:
+        need = max(need, (v - v_l) ** 2 / (2.0 * max(d - d_stop, 0.1)))
+    return need
+
+
+def time_to_collision(d: float, v: float, v_l: float) -> float:
+    """[s] the time until the gap d [m] closes at the present speeds (ego v, lead v_l, m/s):
+    ``d / (v - v_l)`` when the ego is faster, +inf otherwise; 0 when d <= 0 (touching)."""
+    if d <= 0.0:
+        return 0.0
+    if v > v_l:
+        return d / (v - v_l)
+    return math.inf
+
+
+Rule = tuple[ControlState, Callable[[ControlInput, ControlParams], bool], str]
+
+
+def _moving(x: ControlInput, p: ControlParams) -> bool:
+    return x.v >= p.v_stopped
+
+
+def _threat(x: ControlInput, p: ControlParams) -> bool:
+    return x.a_required >= p.a_emergency_enter or x.ttc < p.ttc_emergency
+
+
+def _threat_over(x: ControlInput, p: ControlParams) -> bool:
+    return x.a_required < p.a_emergency_exit and x.ttc > p.ttc_exit
+
+
+def _slow_down(x: ControlInput, p: ControlParams) -> bool:
+    return x.v - x.v_target > p.speed_band or x.a_target < -p.accel_band
+
+
+def _speed_up(x: ControlInput, p: ControlParams) -> bool:
+    wants = x.v_target - x.v > p.speed_band or x.a_target > p.accel_band
+    return wants and not _slow_down(x, p) and not _threat(x, p)
+
+
+def _on_target(x: ControlInput, p: ControlParams) -> bool:
+    return abs(x.v_target - x.v) <= p.keep_band and abs(x.a_target) <= p.accel_band
+
+
+def _rules() -> dict[ControlState, tuple[Rule, ...]]:
+    """The rows of the table, per state, in the order they are tried."""
+    s, e = ControlState.STOP, ControlState.EMERGENCY_STOP
+    a, d, k = (ControlState.ACCELERATION, ControlState.DECELERATION,
+               ControlState.SPEED_KEEPING)
+    emergency: tuple[Rule, ...] = (
+        (e, lambda x, p: _moving(x, p) and x.a_required >= p.a_emergency_enter,
+         "required deceleration at or above a_emergency_enter (beyond the ACC's braking)"),
+        (e, lambda x, p: _moving(x, p) and x.ttc < p.ttc_emergency,
+         "time to collision below ttc_emergency"),
+    )
+    stop: Rule = (s, lambda x, p: x.v < p.v_stopped and x.v_target <= p.v_start,
+                  "stopped with no target speed to start")
+    speed_up: Rule = (a, _speed_up, "target speed above the speed or the plan accelerates")
+    slow_down: Rule = (d, _slow_down, "target speed below the speed or the plan decelerates")
+    keep: Rule = (k, _on_target, "speed on target and the plan steady")
+    return {
+        s: (*emergency,
+            (a, lambda x, p: x.v_target > p.v_start and not _threat(x, p),
+             "target speed above v_start")),
+        e: ((s, lambda x, p: not _moving(x, p), "stopped"),
+            (d, lambda x, p: _moving(x, p) and _threat_over(x, p),
+             "threat over: required deceleration below a_emergency_exit and time to "
+             "collision above ttc_exit")),
+        a: (*emergency, stop, slow_down, keep),
+        d: (*emergency, stop, speed_up, keep),
+        k: (*emergency, stop, speed_up, slow_down),
+    }
+
+
+_RULES = _rules()
+
+# every (from, to) pair the table allows
+EDGES: frozenset[tuple[ControlState, ControlState]] = frozenset(
+    (state, rule[0]) for state, rules in _RULES.items() for rule in rules)
+
+
+def transition(state: ControlState, x: ControlInput, p: ControlParams) -> ControlChange | None:
+    """The change of state for input `x`, or None to stay (see the module doc's table)."""
+    for to, holds, reason in _RULES[state]:
+        if holds(x, p):
+            return ControlChange(to, reason)
+    return None

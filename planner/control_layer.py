@@ -1,0 +1,71 @@
+"""The control FSM in the planner (`planner.control_fsm`): the threat from the lead and the
+control action that holds.
+
+Per tick the lead's gap (carried to now), speed and acceleration (`planner.lead.LeadAccel`)
+give the deceleration needed to avoid it and the time to collision; with the speed target
+after the ACC layer, the FSM steps once. In EMERGENCY_STOP the plan asks for
+``emergency_decel`` down to a standstill, whatever the ACC's target: the speed loop brakes
+at once at the actuator's limits (`control.longitudinal`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+from planner.control_fsm import (
+    ControlInput,
+    ControlParams,
+    ControlState,
+    required_deceleration,
+    time_to_collision,
+    transition,
+)
+from planner.messages import Lead, StateChange
+
+
+@dataclass(frozen=True, slots=True)
+class ControlLayerParams:
+    fsm: ControlParams = field(default_factory=ControlParams)
+    emergency_decel: float = 8.0  # [m/s^2] the emergency stop's deceleration (mu g ~ 9.8)
+    stop_gap: float = 1.0  # [m] the gap the required deceleration keeps to the lead
+
+
+@dataclass(frozen=True, slots=True)
+class ControlOutput:
+    state: ControlState
+    a_required: float  # [m/s^2] to stop `stop_gap` short of the lead
+    ttc: float  # [s] time to collision with the lead (+inf: none)
+
+    @property
+    def emergency(self) -> bool:
+        return self.state is ControlState.EMERGENCY_STOP
+
+
+class ControlLayer:
+    """Control state of one run."""
+
+    def __init__(self, params: ControlLayerParams | None = None) -> None:
+        self.params = params if params is not None else ControlLayerParams()
+        self.state = ControlState.STOP
+
+    @property
+    def decel(self) -> float:
+        return self.params.emergency_decel
+
+    def update(self, t: float, v: float, v_target: float, a_target: float, gap: float,
+               lead: Lead | None, lead_accel: float) -> tuple[ControlOutput,
+                                                               tuple[StateChange, ...]]:
+        """`gap` [m] to the lead now, `lead_accel` [m/s^2] its acceleration (signed)."""
+        a_req, ttc = 0.0, math.inf
+        if lead is not None and math.isfinite(gap):
+            a_req = required_deceleration(v, gap, lead.speed, lead_accel, self.params.stop_gap)
+            ttc = time_to_collision(gap, v, lead.speed)
+        x = ControlInput(v=v, v_target=v_target, a_target=a_target, a_required=a_req, ttc=ttc)
+        change = transition(self.state, x, self.params.fsm)
+        changes: tuple[StateChange, ...] = ()
+        if change is not None:
+            changes = (StateChange(t, "control", self.state.value, change.to.value,
+                                   change.reason),)
+            self.state = change.to
+        return ControlOutput(self.state, a_req, ttc), changes

@@ -1,0 +1,49 @@
+"""The driver's accelerator pedal under the stack: a speed limiter (ICCAS 2020's external
+disturbance, "an external acceleration command issued by a gas pedal or a control device").
+
+The car is drive-by-wire: the pedal position p in [0, 1] is a vehicle signal the stack reads
+with the odometry, and it adds no torque by itself. It asks for an acceleration
+``a_drv = p * a_full`` (a_full 3 m/s^2, about a mid-size car's full-throttle acceleration at
+town speeds). Above ``threshold`` the driver overrides the cruise set speed, and the
+reference becomes
+
+    v_ref = min(v_cap, v + a_drv * horizon)
+    a_ff  = min(a_drv, max(v_cap - v, 0) / tau)      (a_ff = the envelope's while it brakes)
+
+where v_cap is the map's speed envelope with the set speed raised to the vehicle's maximum
+(the posted limit, the curves, the braking curves to lower limits ahead): the pedal raises
+the speed up to the limit and never past it, and the feed-forward fades over the last
+``tau * a_drv`` m/s so that the car reaches the limit without overshoot. The ACC layer keeps
+its modes and laws on top of this reference, with the driver's shorter gap: it lets the
+pedal close up on a lead to ``d_min + gap_margin``, never to d_min (`planner.acc_layer`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from planner.acc_control import SpeedRef
+from planner.speed_planning import SpeedTarget
+
+
+@dataclass(frozen=True, slots=True)
+class OverrideParams:
+    threshold: float = 0.05  # [-] pedal positions above this override the set speed
+    a_full: float = 3.0  # [m/s^2] the acceleration the full pedal asks for
+    horizon: float = 0.5  # [s] the reference leads the speed by a_drv * horizon
+    tau: float = 1.0  # [s] the feed-forward fades within a_drv * tau of the limit
+    gap_margin: float = 2.0  # [m] following, the driver may close up to d_min + this
+
+
+def overriding(pedal: float, p: OverrideParams) -> bool:
+    return pedal > p.threshold
+
+
+def override_reference(pedal: float, v: float, cap: SpeedTarget, p: OverrideParams) -> SpeedRef:
+    """The speed reference for pedal position `pedal` at speed `v` [m/s] under the envelope
+    `cap` (the speed plan at the vehicle's maximum set speed)."""
+    a_drv = min(max(pedal, 0.0), 1.0) * p.a_full
+    speed = min(cap.speed, v + a_drv * p.horizon)
+    if cap.accel < 0.0:
+        return SpeedRef(speed, cap.accel)
+    return SpeedRef(speed, min(a_drv, max(cap.speed - v, 0.0) / p.tau))

@@ -1,0 +1,136 @@
+"""Which lanes are taken, from the tracks and the HD map: the motion FSM's view of the side.
+
+Each confirmed track is placed on the map (its box centre projected onto the route's
+reference line) and counted in every lane its box overlaps by at least ``overlap`` across.
+Per lane, the nearest vehicle ahead of the ego and the nearest behind it give bumper gaps
+along the route (stations, carried from the track's time to now at the relative speed) and
+speeds along the route.
+
+A lane is *free* for the ego to move into when nothing is alongside and
+
+- ahead: gap >= d_min(v) + max(v - V_ahead, 0) * ``front_time`` (UN R157's minimum gap, plus
+  the closing during the change);
+- behind: gap >= dv * t_B + dv^2 / (2 a_rear) + v * t_G with dv = max(V_behind - v, 0): UN R157
+  (5.2.5) asks that an approaching vehicle need not brake harder than a_rear = 3 m/s^2 after
+  t_B = 0.4 s, and keeps a time gap t_G = 1 s behind the ego at the end.
+
+The ego's own lane is *blocked* when the vehicle ahead in it moves slower than the speed
+the ego wants by more than ``block_margin`` and is within the ACC's d_max (the gap inside
+which the ACC would start to trail it; `planner.acc.gaps`).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from perception.messages import Track
+from planner.acc import AccParams, gaps, r157_min_gap
+from world.hdmap import RoadMap
+
+
+@dataclass(frozen=True, slots=True)
+class OccupancyParams:
+    overlap: float = 0.3  # [m] a box overlapping a lane this much across is in it
+    front_time: float = 2.0  # [s] closing time allowed for a slower vehicle ahead
+    rear_reaction: float = 0.4  # [s] t_B, UN R157
+    rear_decel: float = 3.0  # [m/s^2] a_rear, UN R157
+    rear_time_gap: float = 1.0  # [s] t_G, UN R157
+    ego_front: float = 2.4  # [m] the ego's centre -> front bumper
+    ego_rear: float = 2.4  # [m] the ego's centre -> rear bumper
+    block_margin: float = 10.0 / 3.6  # [m/s] slower than wanted by this blocks the lane
+
+
+@dataclass(frozen=True, slots=True)
+class Neighbour:
+    """A vehicle in a lane, relative to the ego."""
+
+    track_id: int
+    t: float  # [s] the track's time
+    gap: float  # [m] bumper to bumper along the route, now
+    speed: float  # [m/s] along the route
+
+
+@dataclass(frozen=True, slots=True)
+class LaneTraffic:
+    lane: int
+    ahead: Neighbour | None = None  # nearest vehicle ahead
+    behind: Neighbour | None = None  # nearest vehicle behind
+    alongside: bool = False  # a vehicle overlapping the ego along the route
+
+
+def lane_traffic(road: RoadMap, tracks: Sequence[Track], t: float, station: float, v: float,
+                 lanes: Sequence[int], p: OccupancyParams) -> dict[int, LaneTraffic]:
+    """The traffic in each of `lanes` (ego-direction lane indices) around the ego at
+    `station` [m] with speed `v` [m/s], now at time `t` [s]."""
+    out = {k: LaneTraffic(k) for k in lanes}
+    if not tracks:
+        return out
+    xy = np.array([[tr.x, tr.y] for tr in tracks], dtype=np.float64)
+    s_all, d_all = road.local_coordinates(xy)
+    heading = np.asarray(road.heading_at(s_all))
+    for i, tr in enumerate(tracks):
+        s, d = float(s_all[i]), float(d_all[i])
+        speed = tr.vx * math.cos(heading[i]) + tr.vy * math.sin(heading[i])
+        half_len, half_wid = _half_extent(tr, float(heading[i]))
+        dt = max(t - tr.t, 0.0)
+        ahead = s - station + (speed - v) * dt
+        for k in lanes:
+            lane = road.lane(k)
+            centre, width = float(lane.offset_at(s)), float(lane.width_at(s))
+            if abs(d - centre) > 0.5 * width + half_wid - p.overlap:
+                continue
+            out[k] = _add(out[k], Neighbour(tr.id, tr.t, 0.0, speed), ahead, half_len, p)
+    return out
+
+
+def _half_extent(tr: Track, road_heading: float) -> tuple[float, float]:
+    """Half the box's extent along and across the road [m]."""
+    a = tr.yaw - road_heading
+    c, s = abs(math.cos(a)), abs(math.sin(a))
+    return (0.5 * (tr.length * c + tr.width * s), 0.5 * (tr.length * s + tr.width * c))
+
+
+def _add(lt: LaneTraffic, n: Neighbour, ahead: float, half_len: float,
+         p: OccupancyParams) -> LaneTraffic:
+    if ahead - half_len >= p.ego_front:
+        gap = ahead - half_len - p.ego_front
+        if lt.ahead is None or gap < lt.ahead.gap:
+            return LaneTraffic(lt.lane, Neighbour(n.track_id, n.t, gap, n.speed), lt.behind,
+                               lt.alongside)
+        return lt
+    if -ahead - half_len >= p.ego_rear:
+        gap = -ahead - half_len - p.ego_rear
+        if lt.behind is None or gap < lt.behind.gap:
+            return LaneTraffic(lt.lane, lt.ahead, Neighbour(n.track_id, n.t, gap, n.speed),
+                               lt.alongside)
+        return lt
+    return LaneTraffic(lt.lane, lt.ahead, lt.behind, True)
+
+
+def is_free(lt: LaneTraffic, v: float, p: OccupancyParams) -> bool:
+    """The ego at speed `v` [m/s] may move into this lane now (see the module doc)."""
+    if lt.alongside:
+        return False
+    if lt.ahead is not None:
+        need = r157_min_gap(v) + max(v - lt.ahead.speed, 0.0) * p.front_time
+        if lt.ahead.gap < need:
+            return False
+    if lt.behind is not None:
+        dv = max(lt.behind.speed - v, 0.0)
+        need = dv * p.rear_reaction + dv * dv / (2.0 * p.rear_decel) + v * p.rear_time_gap
+        if lt.behind.gap < need:
+            return False
+    return True
+
+
+def is_blocked(lt: LaneTraffic, v: float, v_want: float, p: OccupancyParams,
+               acc: AccParams) -> bool:
+    """A vehicle ahead in this lane slower than `v_want` - margin, within the ACC's d_max."""
+    lead = lt.ahead
+    if lead is None or lead.speed >= v_want - p.block_margin:
+        return False
+    return lead.gap < gaps(v, lead.speed, acc).d_max

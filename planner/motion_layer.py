@@ -1,0 +1,160 @@
+"""The motion FSM in the planner: lane occupancy in, the lane to keep and the path out.
+
+Per tick: the tracks are placed in the ego's lane and its neighbours
+(`planner.lane_occupancy`); the ego lane is *blocked* once a slower vehicle has blocked it for
+``blocked_time``; the motion FSM (`planner.motion`) steps once. Entering a lane change makes
+the target lane the lane kept (its speed plan and, once done, its camera lane) and plans the
+Hermite path into it from the car's pose (`planner.lane_change_path`); the change is done
+when the car reaches the path's end. An abort plans the same kind of path back to the origin
+lane, followed in LANE_KEEP until its end.
+
+While the car changes lanes, the vehicles ahead in the target lane and, until the car's
+centre has crossed into the target lane, in the origin lane are both leads for the ACC
+(`leads`): the car does not run into the vehicle it is leaving.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+from perception.messages import EgoState, Track
+from planner.acc import AccParams
+from planner.lane_change_path import LaneChangeParams, LaneChangePath, start_lane_change
+from planner.lane_occupancy import (
+    LaneTraffic,
+    Neighbour,
+    OccupancyParams,
+    is_blocked,
+    is_free,
+    lane_traffic,
+)
+from planner.messages import StateChange
+from planner.motion import LANE_CHANGES, Motion, MotionInput, MotionParams, transition
+from world.hdmap import RoadMap
+
+
+@dataclass(frozen=True, slots=True)
+class MotionLayerParams:
+    overtake: bool = False  # the driver allows lane changes to pass slower vehicles
+    blocked_time: float = 1.0  # [s] blocked this long before it counts
+    half_width: float = 0.9  # [m] half the ego's width, mirrors included
+    motion: MotionParams = field(default_factory=MotionParams)
+    occupancy: OccupancyParams = field(default_factory=OccupancyParams)
+    lane_change: LaneChangeParams = field(default_factory=LaneChangeParams)
+
+
+@dataclass(frozen=True, slots=True)
+class Manoeuvre:
+    """The motion layer's output for one tick."""
+
+    motion: Motion
+    lane: int  # the lane kept, or moved into
+    origin: int  # the lane left by a lane change in hand (== lane otherwise)
+    path: LaneChangePath | None  # the lane-change (or abort) path being followed
+    leads: tuple[Neighbour, ...] = ()  # during a change: the vehicles ahead in both lanes
+
+
+class MotionLayer:
+    """Motion state, lane and lane-change path of one run."""
+
+    def __init__(self, road: RoadMap, lane: int, acc: AccParams,
+                 params: MotionLayerParams | None = None) -> None:
+        self.road = road
+        self.acc = acc
+        self.params = params if params is not None else MotionLayerParams()
+        self.motion = Motion.LANE_KEEP
+        self.lane = self.origin = lane
+        self.path: LaneChangePath | None = None
+        self._since: float | None = None
+        self._blocked_since: float | None = None
+
+    def update(self, ego: EgoState, v_want: float,
+               tracks: Sequence[Track]) -> tuple[Manoeuvre, tuple[StateChange, ...]]:
+        """Step with the ego estimate, the speed it wants [m/s] and the confirmed tracks."""
+        if self._since is None:
+            self._since = ego.t
+        s, d = (float(a) for a in self.road.local_coordinates((ego.x, ego.y)))
+        lanes = self._lanes_around(s, ego.speed)
+        traffic = lane_traffic(self.road, tracks, ego.t, s, ego.speed, lanes,
+                               self.params.occupancy)
+        x = self._input(ego, s, d, v_want, traffic)
+        change = transition(self.motion, x, self.params.motion)
+        changes: tuple[StateChange, ...] = ()
+        if change is not None:
+            changes = (StateChange(ego.t, "motion", self.motion.value, change.to.value,
+                                   change.reason),)
+            self._enter(change.to, change.abort, ego)
+        elif self.path is not None and self.motion is Motion.LANE_KEEP and \
+                s >= self.path.s0 + self.path.length:
+            self.path = None  # the way back after an abort is done
+            self.origin = self.lane
+        return Manoeuvre(self.motion, self.lane, self.origin, self.path,
+                         self._leads(traffic, s, d)), changes
+
+    def _lanes_around(self, s: float, v: float) -> tuple[int, ...]:
+        """The lane kept, the origin, and the neighbours that go on for a whole change."""
+        n_now = self.road.lanes_at(s)
+        reach = min(s + max(v, 5.0) * self.params.lane_change.t_cap, self.road.length)
+        n_later = self.road.lanes_at(reach)
+        near = {self.lane, self.origin}
+        near.update(k for k in (self.lane - 1, self.lane + 1) if 0 <= k < min(n_now, n_later))
+        return tuple(sorted(near))
+
+    def _input(self, ego: EgoState, s: float, d: float, v_want: float,
+               traffic: dict[int, LaneTraffic]) -> MotionInput:
+        p, v, t = self.params, ego.speed, ego.t
+        assert self._since is not None
+        blocked_now = is_blocked(traffic[self.lane], v, v_want, p.occupancy, self.acc)
+        if not blocked_now:
+            self._blocked_since = None
+        elif self._blocked_since is None:
+            self._blocked_since = t
+        blocked = self._blocked_since is not None and t - self._blocked_since >= p.blocked_time
+        left, right = traffic.get(self.lane + 1), traffic.get(self.lane - 1)
+        x = MotionInput(
+            t=t, since=self._since, overtake=p.overtake, blocked=blocked,
+            left_free=left is not None and is_free(left, v, p.occupancy),
+            right_free=right is not None and is_free(right, v, p.occupancy),
+        )
+        if self.motion not in LANE_CHANGES or self.path is None:
+            return x
+        target = self.road.lane(self.lane)
+        centre, width = float(target.offset_at(s)), float(target.width_at(s))
+        return MotionInput(
+            t=t, since=self._since, overtake=p.overtake, blocked=blocked,
+            target_free=is_free(traffic[self.lane], v, p.occupancy),
+            committed=abs(d - centre) < 0.5 * width,
+            change_done=s >= self.path.s0 + self.path.length,
+        )
+
+    def _enter(self, to: Motion, abort: bool, ego: EgoState) -> None:
+        self._since = ego.t
+        self._blocked_since = None
+        if to in LANE_CHANGES:
+            self.origin = self.lane
+            self.lane += 1 if to is Motion.LANE_CHANGE_LEFT else -1
+            self.path = self._plan_into(self.lane, ego)
+        elif abort:  # back to the origin; both lanes are in use until the path's end
+            self.lane, self.origin = self.origin, self.lane
+            self.path = self._plan_into(self.lane, ego)
+        else:
+            self.origin = self.lane
+            self.path = None
+        self.motion = to
+
+    def _plan_into(self, lane: int, ego: EgoState) -> LaneChangePath:
+        return start_lane_change(self.road.lane(lane), lane, ego.x, ego.y, ego.heading,
+                                 ego.speed, self.params.lane_change)
+
+    def _leads(self, traffic: dict[int, LaneTraffic], s: float,
+               d: float) -> tuple[Neighbour, ...]:
+        if self.path is None:
+            return ()
+        lanes = [self.lane]
+        origin = self.road.lane(self.origin)
+        clear = 0.5 * float(origin.width_at(s)) + self.params.half_width
+        if abs(d - float(origin.offset_at(s))) < clear:
+            lanes.append(self.origin)  # the car's body still overlaps the origin lane
+        return tuple(n for k in lanes if k in traffic
+                     for n in (traffic[k].ahead,) if n is not None)

@@ -1,0 +1,83 @@
+"""Lane occupancy from tracks on the map: neighbours per lane, free and blocked lanes."""
+
+from __future__ import annotations
+
+import pytest
+
+from perception.messages import ObjectClass, Track
+from planner.acc import AccParams, gaps, r157_min_gap
+from planner.lane_occupancy import (
+    LaneTraffic,
+    Neighbour,
+    OccupancyParams,
+    is_blocked,
+    is_free,
+    lane_traffic,
+)
+from tests.roads import W, make_map, seg
+
+P = OccupancyParams()
+ROAD = make_map(seg(400.0))  # 2 lanes: lane 0 centre y = 0, lane 1 centre y = 3.5
+V = 13.9  # [m/s] ego speed
+EGO_S = 100.0  # [m] ego centre station (x on this straight road)
+
+
+def car(x: float, y: float, vx: float, ident: int = 1, t: float = 1.0) -> Track:
+    return Track(id=ident, t=t, x=x, y=y, vx=vx, vy=0.0, rel_x=x - EGO_S, rel_y=y,
+                 rel_vx=vx - V, rel_vy=0.0, length=4.6, width=1.8, height=1.5, yaw=0.0,
+                 cls=ObjectClass.CAR, hits=5, misses=0, position_sigma=0.1)
+
+
+def traffic(*tracks: Track, t: float = 1.0) -> dict[int, LaneTraffic]:
+    return lane_traffic(ROAD, tracks, t, EGO_S, V, (0, 1), P)
+
+
+def test_neighbours_ahead_behind_and_alongside() -> None:
+    lt = traffic(car(150.0, 0.1, 8.0, 1), car(130.0, 0.0, 9.0, 2), car(60.0, W, 20.0, 3),
+                 car(102.0, W + 0.2, 14.0, 4))
+    assert lt[0].ahead == Neighbour(2, 1.0, pytest.approx(30.0 - 2.3 - 2.4), 9.0)
+    assert lt[0].behind is None and not lt[0].alongside
+    assert lt[1].behind == Neighbour(3, 1.0, pytest.approx(40.0 - 2.3 - 2.4), 20.0)
+    assert lt[1].alongside and lt[1].ahead is None
+
+
+def test_a_straddling_box_counts_in_both_lanes_a_grazing_one_in_neither_other() -> None:
+    straddling = traffic(car(140.0, 0.5 * W, 10.0))
+    assert straddling[0].ahead is not None and straddling[1].ahead is not None
+    # box edge 0.2 m into lane 1 (less than the 0.3 m overlap): lane 0 only
+    grazing = traffic(car(140.0, 0.5 * W - 0.9 - 0.2, 10.0))
+    assert grazing[0].ahead is not None and grazing[1].ahead is None
+
+
+def test_gaps_are_carried_to_now() -> None:
+    lt = traffic(car(140.0, 0.0, 8.0), t=1.5)  # the track is 0.5 s old, closing at 5.9 m/s
+    assert lt[0].ahead is not None
+    assert lt[0].ahead.gap == pytest.approx(40.0 - 4.7 - 0.5 * (V - 8.0))
+
+
+def test_free_ahead_needs_d_min_plus_closing() -> None:
+    need = r157_min_gap(V) + (V - 10.0) * P.front_time
+    assert is_free(LaneTraffic(1, ahead=Neighbour(1, 1.0, need + 0.1, 10.0)), V, P)
+    assert not is_free(LaneTraffic(1, ahead=Neighbour(1, 1.0, need - 0.1, 10.0)), V, P)
+    assert is_free(LaneTraffic(1), V, P)
+    assert not is_free(LaneTraffic(1, alongside=True), V, P)
+
+
+def test_free_behind_is_r157s_approaching_vehicle_rule() -> None:
+    dv = 25.0 - V
+    need = dv * 0.4 + dv**2 / 6.0 + V * 1.0
+    assert is_free(LaneTraffic(1, behind=Neighbour(1, 1.0, need + 0.1, 25.0)), V, P)
+    assert not is_free(LaneTraffic(1, behind=Neighbour(1, 1.0, need - 0.1, 25.0)), V, P)
+    slower = LaneTraffic(1, behind=Neighbour(1, 1.0, V * 1.0 + 0.1, 10.0))  # only t_G counts
+    assert is_free(slower, V, P)
+
+
+def test_blocked_by_a_slower_lead_within_d_max() -> None:
+    acc = AccParams()
+    d_max = gaps(V, 5.5, acc).d_max
+    slow_near = LaneTraffic(0, ahead=Neighbour(1, 1.0, d_max - 1.0, 5.5))
+    assert is_blocked(slow_near, V, V, P, acc)
+    assert not is_blocked(LaneTraffic(0, ahead=Neighbour(1, 1.0, d_max + 1.0, 5.5)), V, V, P, acc)
+    nearly = LaneTraffic(0, ahead=Neighbour(1, 1.0, 20.0, V - 2.0))  # within the margin
+    assert not is_blocked(nearly, V, V, P, acc)
+    assert not is_blocked(LaneTraffic(0), V, V, P, acc)
