@@ -295,7 +295,8 @@ VEHICLES = frozenset({"car", "truck"})
 class LaneChangeDuration(Criterion):
     """Each commanded lane change takes at most `threshold` seconds from the first tyre
     leaving the origin lane's markings to all tyres inside the target lane's. Value: the
-    longest [s]; fails if no lane change was made (the scenario asks for one)."""
+    longest [s] (one still unfinished at the end counts to the end); fails if no lane change
+    was made (the scenario asks for one)."""
 
     name, unit = "lane_change_duration", "s"
 
@@ -303,13 +304,17 @@ class LaneChangeDuration(Criterion):
         super().__init__()
         self.road, self.tyre_half_width, self.threshold = road, tyre_half_width, threshold
         self.durations: list[float] = []
+        self._command: tuple[int, int] | None = None  # (origin, lane) at the last sample
         self._change: tuple[int, int] | None = None  # (origin, target) being watched
         self._left: float | None = None  # [s] a tyre left the origin lane
+        self._t = 0.0
 
     def update(self, sample: TruthSample) -> None:
-        if sample.lane != sample.origin_lane and self._change != (sample.origin_lane,
-                                                                  sample.lane):
-            self._change, self._left = (sample.origin_lane, sample.lane), None
+        self._t = sample.t
+        command = (sample.origin_lane, sample.lane)
+        if sample.lane != sample.origin_lane and command != self._command:
+            self._change, self._left = command, None  # a new command (once per change)
+        self._command = command
         if self._change is None:
             return
         origin, target = self._change
@@ -318,17 +323,18 @@ class LaneChangeDuration(Criterion):
             if np.min(lane_margins(self.road, sample, origin, origin)) < w:
                 self._left = sample.t
             return
+        if sample.t - self._left > self.threshold:
+            self._fail(sample.t)
         if np.min(lane_margins(self.road, sample, target, target)) >= w:
             self.durations.append(sample.t - self._left)
-            if self.durations[-1] > self.threshold:
-                self._fail(sample.t)
             self._change = self._left = None
 
     def result(self) -> CriterionResult:
-        value = max(self.durations, default=0.0)
-        return CriterionResult(self.name, bool(self.durations) and value <= self.threshold,
+        durations = self.durations + ([self._t - self._left] if self._left is not None else [])
+        value = max(durations, default=0.0)
+        return CriterionResult(self.name, bool(durations) and value <= self.threshold,
                                value, self.threshold, self.unit, self.first_failure,
-                               None if self.durations else "no lane change was made")
+                               None if durations else "no lane change was made")
 
 
 class LaneChangeLateralAccel(Criterion):

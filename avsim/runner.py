@@ -13,6 +13,7 @@ command is held on the joints for the next 6 physics steps.
 
 from __future__ import annotations
 
+import enum
 import math
 import time
 from collections.abc import Callable
@@ -328,6 +329,12 @@ class Runner:
         lanes = [np.column_stack([lane.position(np.linspace(0, w.road.length, 400), 0.0),
                                   np.full(400, 0.02)]) for lane in w.road.lanes]
         rec.log_static_lines("/world/map/lanes", lanes, (90, 160, 255), 0.03)
+        p = self.stack.planner  # a lane per state machine, from the state it starts in
+        initial: dict[str, enum.Enum] = {"lane_source": p.source, "motion": p.motion.motion,
+                                         "acc": p.acc.mode, "control": p.control.state}
+        for machine, state in initial.items():
+            rec.log_state_machine(machine, [x.value for x in type(state)])
+            rec.log_state(0.0, machine, state.value, "initial state")
 
     def _record_tick(self, out: StackOutput) -> None:
         rec, w = self.recorder, self.world

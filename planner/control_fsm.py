@@ -12,8 +12,11 @@ Terms (the thresholds are `ControlParams`):
 
 - moving: v >= v_stopped; stopped otherwise. A stopped car has no emergency.
 - threat: a_required >= a_emergency_enter (the ACC's hard braking covers up to 5 m/s^2) or
-  ttc < ttc_emergency. It is over when a_required < a_emergency_exit and ttc > ttc_exit: the
-  gap between the two is the hysteresis that keeps EMERGENCY_STOP from chattering.
+  ttc < ttc_emergency. It is over when a_required < a_emergency_exit and the gap no longer
+  closes (ttc infinite): once braking hard the car closes more slowly, so a finite TTC or a
+  falling a_required says the braking works, not that the threat is gone (AEB practice,
+  and ICCAS: the car "stops the same when the deceleration exceeds a threshold"). The
+  gap between the two thresholds keeps EMERGENCY_STOP from chattering.
 - slow down (D): v - v_target > speed_band or a_target < -accel_band.
 - speed up (A): (v_target - v > speed_band or a_target > accel_band), not D and no threat.
   Slowing down wins when the speed error and the plan's acceleration disagree (a target
@@ -68,8 +71,7 @@ class ControlState(enum.Enum):
 class ControlParams:
     a_emergency_enter: float = 5.0  # [m/s^2] required deceleration at/above it: an emergency
     ttc_emergency: float = 1.2  # [s] time to collision below it: an emergency
-    a_emergency_exit: float = 2.5  # [m/s^2] the threat is over below it (and ttc > ttc_exit)
-    ttc_exit: float = 3.0  # [s] the threat is over above it (and a_required < a_emergency_exit)
+    a_emergency_exit: float = 2.5  # [m/s^2] the threat is over below it (and the gap opens)
     v_stopped: float = 0.1  # [m/s] below it the car is stopped
     v_start: float = 0.5  # [m/s] a target speed above it starts the car from STOP
     speed_band: float = 0.5  # [m/s] speed error beyond which SPEED_KEEPING speeds up / slows
@@ -138,7 +140,7 @@ def _threat(x: ControlInput, p: ControlParams) -> bool:
 
 
 def _threat_over(x: ControlInput, p: ControlParams) -> bool:
-    return x.a_required < p.a_emergency_exit and x.ttc > p.ttc_exit
+    return x.a_required < p.a_emergency_exit and math.isinf(x.ttc)
 
 
 def _slow_down(x: ControlInput, p: ControlParams) -> bool:
@@ -176,8 +178,8 @@ def _rules() -> dict[ControlState, tuple[Rule, ...]]:
              "target speed above v_start")),
         e: ((s, lambda x, p: not _moving(x, p), "stopped"),
             (d, lambda x, p: _moving(x, p) and _threat_over(x, p),
-             "threat over: required deceleration below a_emergency_exit and time to "
-             "collision above ttc_exit")),
+             "threat over: required deceleration below a_emergency_exit and the gap "
+             "opening")),
         a: (*emergency, stop, slow_down, keep),
         d: (*emergency, stop, speed_up, keep),
         k: (*emergency, stop, speed_up, slow_down),

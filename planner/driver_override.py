@@ -16,10 +16,13 @@ the speed up to the limit and never past it, and the feed-forward fades over the
 ``tau * a_drv`` m/s so that the car reaches the limit without overshoot. The ACC layer keeps
 its modes and laws on top of this reference, with the driver's shorter gap: it lets the
 pedal close up on a lead to ``d_min + gap_margin``, never to d_min (`planner.acc_layer`).
+When the pedal is released above the set speed, the reference comes back down to the plan
+at ``a_release`` (1 m/s^2), not in a step.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 from planner.acc_control import SpeedRef
@@ -33,6 +36,7 @@ class OverrideParams:
     horizon: float = 0.5  # [s] the reference leads the speed by a_drv * horizon
     tau: float = 1.0  # [s] the feed-forward fades within a_drv * tau of the limit
     gap_margin: float = 2.0  # [m] following, the driver may close up to d_min + this
+    a_release: float = 1.0  # [m/s^2] after the pedal, back down to the plan at this
 
 
 def overriding(pedal: float, p: OverrideParams) -> bool:
@@ -47,3 +51,28 @@ def override_reference(pedal: float, v: float, cap: SpeedTarget, p: OverridePara
     if cap.accel < 0.0:
         return SpeedRef(speed, cap.accel)
     return SpeedRef(speed, min(a_drv, max(cap.speed - v, 0.0) / p.tau))
+
+
+class DriverOverride:
+    """The pedal's reference and the ramp back after it, for one run."""
+
+    def __init__(self, params: OverrideParams | None = None) -> None:
+        self.params = params if params is not None else OverrideParams()
+        self._release: float | None = None  # [m/s] the ramp's speed after a release
+
+    def update(self, pedal: float, v: float, plan: SpeedRef, cap: Callable[[], SpeedTarget],
+               dt: float) -> tuple[SpeedRef, bool]:
+        """The reference in place of `plan` (the map's at the set speed) and whether the
+        driver overrides now; `cap()` gives the envelope at the vehicle's maximum speed."""
+        p = self.params
+        if overriding(pedal, p):
+            ref = override_reference(pedal, v, cap(), p)
+            self._release = max(ref.speed, v)
+            return ref, True
+        if self._release is None:
+            return plan, False
+        self._release -= p.a_release * dt
+        if self._release <= plan.speed:
+            self._release = None
+            return plan, False
+        return SpeedRef(self._release, -p.a_release), False

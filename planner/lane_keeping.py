@@ -27,7 +27,7 @@ from planner.acc_control import SpeedRef
 from planner.acc_layer import AccLayer, AccLayerParams
 from planner.camera_lane import camera_lane_path
 from planner.control_layer import ControlLayer
-from planner.driver_override import OverrideParams, override_reference, overriding
+from planner.driver_override import DriverOverride, OverrideParams
 from planner.lane_source import LaneSource, LaneSourceInput, LaneSourceParams, transition
 from planner.lead import LeadAccel, LeadParams, select_lead
 from planner.messages import Lead, Plan, ReferencePath, StateChange
@@ -89,6 +89,7 @@ class LaneKeepingPlanner:
                                   self.params.motion)
         self.control = ControlLayer()
         self.lead_accel = LeadAccel()
+        self.driver = DriverOverride(self.params.override)
         self._camera_ok = False  # the camera's lane is seen and agrees with the map's
 
     def _keep(self, lane: int) -> None:
@@ -112,10 +113,13 @@ class LaneKeepingPlanner:
             self.lane, station, p.path_behind, ahead, p.path_spacing, length=self.road.length
         )
 
-    def speed_for(self, station: float) -> SpeedTarget:
-        """The speed target for the car's centre at ``station`` [m]."""
+    def speed_for(self, station: float, set_speed: float | None = None) -> SpeedTarget:
+        """The speed target for the car's centre at ``station`` [m] (at ``set_speed``
+        [m/s], by default the driver's set speed)."""
         p = self.params
-        return self.speed_planner.target(station, set_speed=p.set_speed, max_speed=p.max_speed)
+        return self.speed_planner.target(
+            station, set_speed=p.set_speed if set_speed is None else set_speed,
+            max_speed=p.max_speed)
 
     def update(self, ego: EgoState, view: LaneView | None = None,
                tracks: Sequence[Track] = (), pedal: float = 0.0) -> Plan:
@@ -134,12 +138,9 @@ class LaneKeepingPlanner:
         path = self._path(ego, station, view, manoeuvre)
         target = self.speed_for(station)
         lead = self._lead(view, tracks, ego, manoeuvre)
-        plan_ref = SpeedRef(target.speed, target.accel)
-        driver = overriding(pedal, self.params.override)
-        if driver:
-            cap = self.speed_planner.target(station, set_speed=self.params.max_speed,
-                                            max_speed=self.params.max_speed)
-            plan_ref = override_reference(pedal, ego.speed, cap, self.params.override)
+        plan_ref, driver = self.driver.update(
+            pedal, ego.speed, SpeedRef(target.speed, target.accel),
+            lambda: self.speed_for(station, self.params.max_speed), dt)
         ref, acc_changes = self.acc.update(ego.t, dt, ego.speed, self.params.set_speed,
                                            target.limit_at_front, plan_ref, lead,
                                            driver_gap=self.params.override.gap_margin

@@ -71,7 +71,7 @@ class MotionParams:
 @dataclass(frozen=True, slots=True)
 class MotionInput:
     t: float  # [s]
-    since: float  # [s] time of the last motion change (the run's start before any)
+    since: float  # [s] time of the last motion change (-inf before any)
     overtake: bool = False  # the driver allows lane changes to pass slower vehicles
     blocked: bool = False  # a slower vehicle blocks the lane ahead (debounced upstream)
     left_free: bool = False  # a lane to the left exists and is free by the tracks

@@ -15,6 +15,7 @@ centre has crossed into the target lane, in the origin lane are both leads for t
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
@@ -66,14 +67,12 @@ class MotionLayer:
         self.motion = Motion.LANE_KEEP
         self.lane = self.origin = lane
         self.path: LaneChangePath | None = None
-        self._since: float | None = None
+        self._since = -math.inf  # [s] time of the last motion change (none yet)
         self._blocked_since: float | None = None
 
     def update(self, ego: EgoState, v_want: float,
                tracks: Sequence[Track]) -> tuple[Manoeuvre, tuple[StateChange, ...]]:
         """Step with the ego estimate, the speed it wants [m/s] and the confirmed tracks."""
-        if self._since is None:
-            self._since = ego.t
         s, d = (float(a) for a in self.road.local_coordinates((ego.x, ego.y)))
         lanes = self._lanes_around(s, ego.speed)
         traffic = lane_traffic(self.road, tracks, ego.t, s, ego.speed, lanes,
@@ -104,7 +103,6 @@ class MotionLayer:
     def _input(self, ego: EgoState, s: float, d: float, v_want: float,
                traffic: dict[int, LaneTraffic]) -> MotionInput:
         p, v, t = self.params, ego.speed, ego.t
-        assert self._since is not None
         blocked_now = is_blocked(traffic[self.lane], v, v_want, p.occupancy, self.acc)
         if not blocked_now:
             self._blocked_since = None

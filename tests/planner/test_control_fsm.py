@@ -78,7 +78,6 @@ def test_time_to_collision() -> None:
 
 def test_params_have_hysteresis() -> None:
     assert P.a_emergency_exit < P.a_emergency_enter
-    assert P.ttc_emergency < P.ttc_exit
     assert P.v_stopped < P.v_start
     assert P.keep_band < P.speed_band
 
@@ -121,7 +120,8 @@ TABLE = [
     ("estop_stop", ESTOP, x(v=0.05, v_target=0.0), STOP),
     ("estop_stop_threat_holds", ESTOP, x(v=0.0, v_target=10.0, a_required=8.0, ttc=0.2),
      STOP),
-    ("estop_decel", ESTOP, x(v_target=8.0, a_required=2.0, ttc=3.5), DECEL),
+    ("estop_decel", ESTOP, x(v_target=8.0, a_required=2.0, ttc=math.inf), DECEL),
+    ("estop_stays_closing_slowly", ESTOP, x(v_target=8.0, a_required=2.0, ttc=10.0), None),
     ("estop_decel_lead_gone", ESTOP, x(), DECEL),
     ("estop_decel_from_slow", ESTOP, x(v=P.v_stopped, v_target=0.0), DECEL),
     ("estop_stays_threat", ESTOP, x(a_required=6.0, ttc=0.8), None),

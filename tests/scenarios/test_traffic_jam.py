@@ -52,6 +52,8 @@ def test_verdict_and_back_to_set_speed(result: RunResult) -> None:
     c = {r.name: r for r in result.criteria}
     assert c["min_gap"].value >= c["min_gap"].threshold  # d_min while moving
     assert c["max_decel"].value <= 1.5  # the jam is taken gently
+    assert 2.0 <= c["standstill_gap"].value <= 6.0
+    assert c["time_to_resume"].value <= 15.0
     v = result.log.array("speed")
     assert v[-1] == pytest.approx(45 * KPH, abs=1 * KPH)  # the jam cleared: set speed
     modes = [x.target for x in result.state_changes if x.machine == "acc"]

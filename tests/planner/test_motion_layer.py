@@ -1,0 +1,83 @@
+"""The motion layer on a straight two-lane road with synthetic tracks: it overtakes a
+blocking car when the left lane is free, follows the Hermite path into it, is done at its
+end, and aborts back to its lane when a fast car comes up behind in the target lane."""
+
+from __future__ import annotations
+
+import pytest
+
+from perception.messages import EgoState, ObjectClass, Track
+from planner.acc import AccParams
+from planner.motion import Motion
+from planner.motion_layer import MotionLayer, MotionLayerParams
+from tests.roads import W, make_map, seg
+
+ROAD = make_map(seg(1000.0))
+V = 13.9  # [m/s]
+
+
+def ego(t: float, x: float, y: float = 0.0) -> EgoState:
+    return EgoState(t=t, x=x, y=y, heading=0.0, speed=V, yaw_rate=0.0, steering_angle=0.0,
+                    position_sigma=0.05)
+
+
+def car(t: float, x: float, y: float, vx: float, ident: int) -> Track:
+    return Track(id=ident, t=t, x=x, y=y, vx=vx, vy=0.0, rel_x=0.0, rel_y=0.0, rel_vx=0.0,
+                 rel_vy=0.0, length=4.6, width=1.8, height=1.5, yaw=0.0, cls=ObjectClass.CAR,
+                 hits=9, misses=0, position_sigma=0.1)
+
+
+def layer(overtake: bool = True) -> MotionLayer:
+    return MotionLayer(ROAD, 0, AccParams(), MotionLayerParams(overtake=overtake))
+
+
+def drive(m: MotionLayer, t0: float, t1: float, slow_x0: float,
+          fast: tuple[float, float] | None = None) -> list[tuple[float, Motion, int]]:
+    """Step from t0 to t1 at 40 Hz with the ego on the plan's path (perfect tracking) and
+    a 20 km/h car ahead in lane 0; `fast` = (x at t0, speed) of a car in lane 1."""
+    out, t, x, y = [], t0, 100.0 + V * t0, 0.0
+    while t < t1:
+        tracks = [car(t, slow_x0 + 5.56 * t, 0.0, 5.56, 1)]
+        if fast is not None:
+            tracks.append(car(t, fast[0] + fast[1] * (t - t0), W, fast[1], 2))
+        man, _ = m.update(ego(t, x, y), V, tracks)
+        if man.path is not None:
+            y = float(ROAD.lane(man.path.target_index).offset_at(x)) + float(
+                man.path.offset_at(x))
+        out.append((t, man.motion, man.lane))
+        t += 0.025
+        x += V * 0.025
+    return out
+
+
+def test_overtakes_a_blocking_car_when_the_left_lane_is_free() -> None:
+    m = layer()
+    steps = drive(m, 0.0, 12.0, slow_x0=170.0)
+    motions = [s[1] for s in steps]
+    start = motions.index(Motion.LANE_CHANGE_LEFT)
+    assert steps[start][0] == pytest.approx(1.0, abs=0.05)  # blocked for blocked_time
+    end = start + motions[start:].index(Motion.LANE_KEEP)
+    duration = steps[end][0] - steps[start][0]
+    assert m.path is None and steps[-1][2] == 1 and m.origin == 1
+    assert 4.0 < duration < 5.5  # the path's length at this speed
+
+
+def test_follows_when_overtaking_is_not_allowed() -> None:
+    steps = drive(layer(overtake=False), 0.0, 5.0, slow_x0=170.0)
+    assert {s[1] for s in steps} == {Motion.LANE_KEEP}
+
+
+def test_waits_while_a_fast_car_comes_up_in_the_left_lane() -> None:
+    steps = drive(layer(), 0.0, 3.0, slow_x0=170.0, fast=(60.0, 25.0))
+    assert {s[1] for s in steps} == {Motion.LANE_KEEP}
+
+
+def test_aborts_when_the_target_lane_stops_being_free() -> None:
+    m = layer()
+    drive(m, 0.0, 1.2, slow_x0=170.0)
+    assert m.motion is Motion.LANE_CHANGE_LEFT and m.lane == 1
+    # a car at 30 m/s appears 40 m behind in the target lane: it would have to brake hard
+    steps = drive(m, 1.2, 1.5, slow_x0=170.0, fast=(100.0 + V * 1.2 - 45.0, 30.0))
+    assert steps[-1][1] is Motion.LANE_KEEP and steps[-1][2] == 0  # back to lane 0
+    assert m.path is not None and m.path.target_index == 0  # on the way back
+    assert m.origin == 1  # both lanes in use until the path's end

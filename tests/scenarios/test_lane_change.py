@@ -1,0 +1,58 @@
+"""ICCAS lane changing: a car 30 km/h slower ahead, the left lane free; the ego changes lanes
+left to pass it (the motion FSM's decision from the tracks), without contact, taking under
+5 s from leaving its lane to being inside the target lane, at no more than 1 m/s^2 of lateral
+acceleration, and ends with every tyre inside the target lane."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+import pytest
+
+from avsim.runner import RunResult
+
+pytestmark = pytest.mark.slow
+KPH = 1 / 3.6
+
+
+@pytest.fixture(scope="module")
+def result(run_scenario: Callable[..., RunResult]) -> RunResult:
+    return run_scenario("lane_change", record=False)
+
+
+def test_the_ego_overtook_the_slower_car(result: RunResult) -> None:
+    log = result.log
+    t, s, v = log.array("t"), log.array("station"), log.array("speed")
+    k = [a.id for a in result.spec.actors].index("slow")
+    slow_s = np.array(log.actor_station)[:, k]
+    slow_offset = np.array(log.actor_offset)[:, k]
+    assert np.abs(slow_offset).max() < 0.1  # it kept the ego's lane 0 throughout
+    rel = v - np.gradient(slow_s, t)
+    assert rel[0] == pytest.approx(30 * KPH, abs=0.5 * KPH)  # 30 km/h slower
+    change = next(c for c in result.state_changes if c.machine == "motion")
+    i = int(np.searchsorted(t, change.t))
+    assert rel[i] > 20 * KPH  # still closing fast when it pulled out (the ACC trailed 1 s)
+    assert 10.0 < slow_s[i] - s[i] < 100.0  # it was ahead when the change began
+    assert s[-1] > slow_s[-1] + 30.0  # and is behind now
+    assert log.lane[0] == 0 and log.lane[-1] == 1
+
+
+def test_the_motion_fsm_changed_left_once(result: RunResult) -> None:
+    motion = [(c.source, c.target, c.reason) for c in result.state_changes
+              if c.machine == "motion"]
+    assert [m[:2] for m in motion] == [("lane_keep", "lane_change_left"),
+                                       ("lane_change_left", "lane_keep")]
+    assert "slower vehicle" in motion[0][2]
+    acc = [c.target for c in result.state_changes if c.machine == "acc"]
+    assert acc == ["cruise", "trail", "cruise"]  # slowed behind it, then free again
+
+
+def test_verdict_and_the_lane_change_figures(result: RunResult) -> None:
+    assert all(c.passed for c in result.criteria), result.criteria
+    c = {r.name: r for r in result.criteria}
+    assert 0.5 < c["lane_change_duration"].value < 5.0
+    assert 0.2 < c["lane_change_lateral_accel"].value <= 1.0
+    assert c["tyres_in_lane"].value > 0.0  # in the target lane after, in the two during
+    # settled in the target lane: the cross-track error (from lane 1 now) is small
+    assert abs(result.log.cross_track[-1]) < 0.15

@@ -1,0 +1,65 @@
+"""ICCAS sudden stop: the car ahead brakes at 6 m/s^2 to a stop from 50 km/h, 12 m ahead
+(Euro NCAP CCRb) and 1.5 s ahead (UN R157); the ego stops behind it without contact, at
+least 0.5 m short, in its lane, and follows it off again."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+import pytest
+
+from avsim.runner import RunResult
+
+pytestmark = pytest.mark.slow
+KPH = 1 / 3.6
+CASES = {"sudden_stop": (1.0, 12.0), "sudden_stop_headway": (3.0, 50 * KPH * 1.5)}
+
+
+@pytest.fixture(scope="module", params=sorted(CASES))
+def result(request: pytest.FixtureRequest,
+           run_scenario: Callable[..., RunResult]) -> RunResult:
+    return run_scenario(request.param, record=False)
+
+
+def _lead(result: RunResult) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    log = result.log
+    t = log.array("t")
+    k = [a.id for a in result.spec.actors].index("lead")
+    lead_s = np.array(log.actor_station)[:, k]
+    gap = lead_s - log.array("station") - (4.6 + 4.8) / 2
+    return t, lead_s, np.gradient(lead_s, t), gap
+
+
+def test_the_lead_braked_hard_from_50_close_ahead(result: RunResult) -> None:
+    t, _, lead_v, gap = _lead(result)
+    t_brake, nominal_gap = CASES[result.spec.name]
+    i = int(np.searchsorted(t, t_brake))
+    assert lead_v[i - 1] == pytest.approx(50 * KPH, abs=0.1)
+    # the ego keeps its distance until then (it may start to open the gap)
+    assert nominal_gap - 0.3 <= gap[i] <= nominal_gap + 1.5
+    stopped = np.flatnonzero(lead_v < 0.05)
+    t_stop = t[stopped[stopped > i][0]]
+    assert t_stop - t_brake == pytest.approx(50 * KPH / 6.0, abs=0.15)  # 6 m/s^2
+    assert (lead_v[(t > t_stop) & (t < t_stop + 3.5)] < 0.05).all()  # it stood
+
+
+def test_no_contact_and_the_ego_stops_short(result: RunResult) -> None:
+    assert all(c.passed for c in result.criteria), result.criteria
+    t, _, lead_v, gap = _lead(result)
+    v = result.log.array("speed")
+    t_brake, _ = CASES[result.spec.name]
+    after = t > t_brake
+    assert float(gap.min()) >= 0.5
+    standing = after & (v < 0.05) & (lead_v < 0.05)
+    assert standing.any()  # it came to rest behind the standing lead
+    assert float(gap[standing].min()) >= 0.5
+    assert result.metrics["max_lateral_error"] < 0.3  # in its lane while braking
+
+
+def test_the_control_fsm_brakes_to_a_stop(result: RunResult) -> None:
+    control = [c.target for c in result.state_changes if c.machine == "control"]
+    assert "stop" in control[control.index("deceleration"):]
+    if result.spec.name == "sudden_stop":  # 12 m at 50 km/h: beyond the ACC's braking
+        assert "emergency_stop" in control
+        assert result.metrics["max_decel"] > 6.0
