@@ -630,7 +630,7 @@ class CriteriaModel(_Model):
         description="`{max_duration, max_lateral_accel}`: bounds on each lane change; at "
         "least one must happen. Default: off.",
     )
-    standstill_gap: tuple[NonNegFloat, PosFloat] | None = Field(
+    standstill_gap: Annotated[tuple[NonNegFloat, PosFloat], Field(strict=False)] | None = Field(
         default=None,
         description="[m] `[low, high]`: the bumper gap to the vehicle ahead each time the ego "
         "stands behind it; it must stand at least once. Default: off.",

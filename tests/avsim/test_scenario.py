@@ -158,6 +158,8 @@ BAD: dict[str, tuple[str, str]] = {
         "lane 1 does not exist at s = 150 m (the road has 1 lane there)",
     ),
     "lane_change_missing_lane": ("actors.0.actions.0.lane_change.to_lane", "lane 2 does not"),
+    "standstill_gap_reversed": ("criteria.standstill_gap", "low must be below high"),
+    "lane_change_bad_bound": ("criteria.lane_change.max_lateral_accel", "must be > 0"),
     "station_beyond_route": ("actors.0.s", "beyond the end of the route (100 m)"),
     "unknown_feature_type": ("road.features.0.type", "unknown feature type 'zebra'"),
     "unknown_action": (

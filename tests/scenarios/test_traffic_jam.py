@@ -57,4 +57,4 @@ def test_verdict_and_back_to_set_speed(result: RunResult) -> None:
     v = result.log.array("speed")
     assert v[-1] == pytest.approx(45 * KPH, abs=1 * KPH)  # the jam cleared: set speed
     modes = [x.target for x in result.state_changes if x.machine == "acc"]
-    assert modes[:2] == ["cruise", "trail"] and modes[-1] == "cruise"
+    assert modes == ["cruise", "trail", "cruise"]  # trailed through both stops, no brake
