@@ -594,6 +594,7 @@ class LaneFilterParams:
     confidence_gain: float = 0.5  # [-] share of the measurement's confidence taken per update
     confidence_tau: float = 0.5  # [s] decay time constant of the confidence while predicting
     init_width_sigma: float = 0.5  # [m] width uncertainty when initialised from one boundary
+    reassign_margin: float = 0.2  # [m] past half a width by this: the neighbour is the lane
 
 
 class LaneFilter:
@@ -609,7 +610,12 @@ class LaneFilter:
     rejections that agree with each other (offsets within ``agree_offset``, headings within
     ``agree_heading``) the filter re-initialises on the measurement (a lane change, a new
     lane); rejections that scatter (a vehicle's side, glare) only ever predict.
-    Frames with confidence below ``min_confidence`` only predict. The output confidence
+    Frames with confidence below ``min_confidence`` only predict. Ego-lane re-assignment:
+    once the car's centre is more than ``reassign_margin`` past a boundary of the lane
+    tracked (|offset| > width / 2 + margin: a lane change), the state moves to the lane
+    beyond that line (offset -+ width, the covariance with it); the detector's next search
+    follows, as the filtered estimate is its prior, and the lines it tracked stay in view as
+    the new lane's other boundary. The output confidence
     moves by ``confidence_gain`` towards each accepted measurement's and decays as
     ``exp(-dt / confidence_tau)`` while predicting, so it goes to ~0 when lines vanish for
     a few seconds and recovers within a few frames when they come back.
@@ -658,7 +664,22 @@ class LaneFilter:
             self.confidence *= math.exp(-dt / p.confidence_tau)
             return self._output(replace(estimate, left=None, right=None))
         self.confidence += p.confidence_gain * (estimate.confidence - self.confidence)
+        if self._reassign():  # this frame's lines belong to the lane left behind
+            return self._output(replace(estimate, left=None, right=None))
         return self._output(estimate)
+
+    def _reassign(self) -> bool:
+        """Move the state to the neighbouring lane once the car's centre is past its line
+        (see the class doc); True if it moved."""
+        offset, width = float(self.x[I_OFFSET]), float(self.x[I_WIDTH])
+        if abs(offset) <= 0.5 * width + self.params.reassign_margin:
+            return False
+        j = np.eye(DIM)
+        j[I_OFFSET, I_WIDTH] = -math.copysign(1.0, offset)
+        self.x = j @ self.x
+        self.P = j @ self.P @ j.T
+        self.rejections, self._rejected = 0, []
+        return True
 
     def _initialise(self, z: LaneEstimate) -> None:
         p = self.params

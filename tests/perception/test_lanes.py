@@ -311,6 +311,26 @@ def test_filter_follows_a_lasting_jump_after_a_few_frames() -> None:
     assert out[-1].offset == pytest.approx(-1.6, abs=0.1)
 
 
+def test_filter_moves_to_the_next_lane_when_the_car_crosses_into_it() -> None:
+    """A lane change seen by a detector that keeps tracking the old lane's lines: once the
+    car's centre is 0.2 m past the left line, the filter takes the lane to the left, and the
+    detections made from that prior (offsets from the new lane) are accepted."""
+    f = LaneFilter()
+    run_steady(f, 20)
+    outs = [f.update(measurement(2.0 + 0.1 * i, offset=0.2 + 0.1 * i, heading=0.02))
+            for i in range(1, 20)]  # the car drifts left at 1 m/s
+    offsets = [o.offset for o in outs]
+    k = next(i for i, o in enumerate(offsets) if o < 0.0)  # the first frame in the new lane
+    assert offsets[k - 1] <= 1.75 + 0.2 + 0.15  # it moved at the line + the margin ...
+    assert offsets[k] == pytest.approx(offsets[k - 1] + 0.1 - 3.5, abs=0.15)  # ... by a width
+    assert outs[k].left is None and outs[k].right is None
+    follow = [f.update(measurement(4.0 + 0.1 * i, offset=-1.3 + 0.1 * i, heading=0.02))
+              for i in range(5)]  # detections referenced to the new lane
+    assert f.rejections == 0
+    assert follow[-1].offset == pytest.approx(-0.9, abs=0.1)
+    assert follow[-1].left is BOUNDARY
+
+
 def test_filter_confidence_decays_without_lines_and_recovers() -> None:
     f = LaneFilter()
     run_steady(f, 20)

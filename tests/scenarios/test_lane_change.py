@@ -56,3 +56,8 @@ def test_verdict_and_the_lane_change_figures(result: RunResult) -> None:
     assert c["tyres_in_lane"].value > 0.0  # in the target lane after, in the two during
     # settled in the target lane: the cross-track error (from lane 1 now) is small
     assert abs(result.log.cross_track[-1]) < 0.15
+    # the camera's lane moved with the car: off by a lane width only in the frames while
+    # the car's centre is between the line and the 0.2 m re-assignment margin
+    assert result.metrics["lane_offset_rmse"] < 0.4
+    sources = [c.target for c in result.state_changes if c.machine == "lane_source"]
+    assert sources == ["camera"]
