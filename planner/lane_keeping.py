@@ -1,17 +1,23 @@
-"""Lane keeping: follow the ego lane as the camera sees it, at the planned speed.
+"""The planner: the ICCAS dual FSM with the DECS ACC / event layer, for one route road.
 
-Each tick: project the ego estimate onto the map lane (station, for the speed plan and
-events; the map is the paper's HD map), choose the lateral reference with the lane-source
-FSM (`planner.lane_source`): the camera's lane (`planner.camera_lane`) when it is seen,
-the map lane (`planner.route.lane_path`, placed by the GNSS + odometry estimate) while it is
-acquired or lost. The target speed is the map's (`planner.speed_planning.SpeedPlanner`)
-through the ACC / event layer (`planner.acc_layer`: cruise, trail or brake behind the lead
-vehicle of the tracks, `planner.lead`) and, when the lane is lost, ramped down at ``a_comf``
-to the hold speed, then to a stop in lane.
+Each tick, from the ego estimate, the camera's lane, the confirmed tracks and the driver's
+accelerator pedal:
 
-The path and the speed target are computed separately (`path_for`, `speed_for`) so that
-the motion / control FSM planners built on this can swap either one (a lane-change path, an
-ACC speed) and keep the other.
+1. the lane-source FSM (`planner.lane_source`) says where the lateral reference comes from:
+   the camera's lane (`planner.camera_lane`) when it is seen and agrees with the map's lane
+   kept, the map lane (`planner.route.lane_path`, placed by the GNSS + odometry estimate)
+   while it is acquired or lost;
+2. the motion FSM (`planner.motion_layer`) keeps the lane or changes lanes, from the lane
+   occupancy of the tracks; a lane change (or its abort) replaces the path with its Hermite
+   path (`planner.lane_change_path`) and makes the target lane the lane kept;
+3. the speed: the map's plan (`planner.speed_planning`, the lane kept's limits and curves),
+   raised by the driver's pedal up to the limit (`planner.driver_override`), through the
+   ACC / event layer (`planner.acc_layer`: cruise, trail or brake behind the lead vehicle,
+   `planner.lead`), ramped down at ``a_comf`` when the lane is lost (then a stop in lane);
+4. the control FSM (`planner.control_layer`) names the control action and, in an
+   emergency, asks for the emergency stop's deceleration instead.
+
+The path and the speed target are computed separately (`path_for`, `speed_for`).
 """
 
 from __future__ import annotations
@@ -129,14 +135,15 @@ class LaneKeepingPlanner:
         dt = 0.0 if self._last_t is None else max(ego.t - self._last_t, 0.0)
         self._last_t = ego.t
         changes = self._update_source(ego.t, view)
-        station, _ = self.localise(ego)
-        want = min(self.params.set_speed, self.speed_for(station).limit_at_front)
-        manoeuvre, motion_changes = self.motion.update(ego, want, tracks)
-        if manoeuvre.lane != self.lane_index:
-            self._keep(manoeuvre.lane)
         station, lateral = self.localise(ego)
-        path = self._path(ego, station, view, manoeuvre)
         target = self.speed_for(station)
+        want = min(self.params.set_speed, target.limit_at_front)
+        manoeuvre, motion_changes = self.motion.update(ego, want, tracks)
+        if manoeuvre.lane != self.lane_index:  # a lane change began, ended or was aborted
+            self._keep(manoeuvre.lane)
+            station, lateral = self.localise(ego)
+            target = self.speed_for(station)
+        path = self._path(ego, station, view, manoeuvre)
         lead = self._lead(view, tracks, ego, manoeuvre)
         plan_ref, driver = self.driver.update(
             pedal, ego.speed, SpeedRef(target.speed, target.accel),

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 from perception.messages import EgoState, Track
 from planner.acc import AccParams
@@ -84,8 +84,7 @@ class MotionLayer:
             changes = (StateChange(ego.t, "motion", self.motion.value, change.to.value,
                                    change.reason),)
             self._enter(change.to, change.abort, ego)
-        elif self.path is not None and self.motion is Motion.LANE_KEEP and \
-                s >= self.path.s0 + self.path.length:
+        elif self.path is not None and self.motion is Motion.LANE_KEEP and s >= self.path.end:
             self.path = None  # the way back after an abort is done
             self.origin = self.lane
         return Manoeuvre(self.motion, self.lane, self.origin, self.path,
@@ -119,12 +118,8 @@ class MotionLayer:
             return x
         target = self.road.lane(self.lane)
         centre, width = float(target.offset_at(s)), float(target.width_at(s))
-        return MotionInput(
-            t=t, since=self._since, overtake=p.overtake, blocked=blocked,
-            target_free=is_free(traffic[self.lane], v, p.occupancy),
-            committed=abs(d - centre) < 0.5 * width,
-            change_done=s >= self.path.s0 + self.path.length,
-        )
+        return replace(x, target_free=is_free(traffic[self.lane], v, p.occupancy),
+                       committed=abs(d - centre) < 0.5 * width, change_done=s >= self.path.end)
 
     def _enter(self, to: Motion, abort: bool, ego: EgoState) -> None:
         self._since = ego.t
