@@ -84,6 +84,8 @@ class TrajectoryLog:
     drive_torque: list[float] = field(default_factory=list)  # [N m] commanded, total
     brake_torque: list[float] = field(default_factory=list)  # [N m] commanded, total
     wheel_spin: list[NDArray[np.float64]] = field(default_factory=list)  # [rad/s] (4,)
+    acc_mode: list[str] = field(default_factory=list)  # the ACC / event layer's mode
+    motion: list[str] = field(default_factory=list)  # the motion FSM's state
     lane: list[int] = field(default_factory=list)  # the lane the stack keeps (cross_track's)
     changing: list[bool] = field(default_factory=list)  # a commanded lane change in hand
     pedal: list[float] = field(default_factory=list)  # [-] the driver's accelerator pedal
@@ -248,6 +250,8 @@ class Runner:
         log.drive_torque.append(out.command.drive_torque)
         log.brake_torque.append(out.command.brake_torque)
         log.wheel_spin.append(truth.wheel_spin.copy())
+        log.acc_mode.append(out.plan.acc_mode)
+        log.motion.append(out.plan.motion)
         log.lane.append(out.plan.lane)
         log.changing.append(out.plan.lane != out.plan.origin_lane)
         log.pedal.append(w.accelerator_pedal)
