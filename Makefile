@@ -20,7 +20,8 @@ $(STAMP): pyproject.toml
 setup: $(STAMP)
 
 demo: $(STAMP)
-	$(BIN)/avsim run normal_driving --out runs/normal_driving.rrd --json runs/normal_driving.json
+	$(BIN)/avsim run normal_driving --out runs/normal_driving.rrd --json runs/normal_driving.json \
+		--plot runs/normal_driving.png
 
 lint: $(STAMP)
 	$(BIN)/ruff check .

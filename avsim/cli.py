@@ -28,6 +28,7 @@ if TYPE_CHECKING:
 PROFILES = ("fast", "default", "paper", "none")
 SENSING = ("auto", "inline", "process")
 EXIT_FAILED, EXIT_BAD_INPUT = 1, 2
+PLOT_NEXT_TO_RECORDING = "\0next-to-recording"  # `--plot` given without a file name
 
 
 def _bad_input(message: str) -> NoReturn:
@@ -62,9 +63,14 @@ def main() -> None:
 @click.option("--sensing", type=click.Choice(SENSING), default="auto", show_default=True,
               help="Where cameras render: a worker process (auto on 2+ cores) or inline.")
 @click.option("--seed", type=int, default=None, help="Override the scenario's seed.")
+@click.option("--plot", "plot", is_flag=False, flag_value=PLOT_NEXT_TO_RECORDING, default=None,
+              metavar="[PNG]",
+              help="Also write the speed profile (ego, lead, limit and set speed over time, "
+                   "ACC / event mode as bands; the DECS paper's Fig. 3) as a 1600x700 PNG. "
+                   "Without a value: next to the recording, <name>.png")
 @click.option("--no-progress", is_flag=True, help="No progress bar.")
 def run(scenario: str, out: Path | None, json_path: Path | None, profile: str, sensing: str,
-        seed: int | None, no_progress: bool) -> None:
+        seed: int | None, plot: str | None, no_progress: bool) -> None:
     """Run SCENARIO (a file or a bundled name) and judge it."""
     overrides = {"seed": seed} if seed is not None else None
     try:
@@ -75,6 +81,10 @@ def run(scenario: str, out: Path | None, json_path: Path | None, profile: str, s
     json_path = json_path if json_path is not None else out.with_suffix(".json")
     _writable(out, "--out")
     _writable(json_path, "--json")
+    plot_path = None if plot is None else (
+        out.with_suffix(".png") if plot == PLOT_NEXT_TO_RECORDING else Path(plot))
+    if plot_path is not None:
+        _writable(plot_path, "--plot")
     from world.quiet import quiet_c_output
 
     with quiet_c_output():  # PyBullet's build banner
@@ -88,6 +98,10 @@ def run(scenario: str, out: Path | None, json_path: Path | None, profile: str, s
     partial.replace(out)
     payload = result_json(result, scenario, out, profile)
     _write_atomic(json_path, json.dumps(payload, indent=2) + "\n")
+    if plot_path is not None:
+        from avsim.plot import plot_speed_profile
+
+        plot_speed_profile(result, plot_path)
     _print_verdict(payload)
     sys.exit(0 if result.passed else EXIT_FAILED)
 
