@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import enum
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 
@@ -120,3 +121,48 @@ class Track:
     def speed(self) -> float:
         """[m/s] speed over ground."""
         return math.hypot(self.vx, self.vy)
+
+
+# ---- signs (camera) ------------------------------------------------------------------------
+
+
+@dataclass(frozen=True, slots=True)
+class SignDetection:
+    """A traffic sign found in one camera frame: its plate's centre in the vehicle frame at
+    time ``t`` (x forward from the car's centre, y left, z up from the ground below it)."""
+
+    t: float  # [s] sim time of the camera frame
+    kind: str  # "stop"
+    x: float  # [m] vehicle frame, plate centre ahead of the car's centre
+    y: float  # [m] vehicle frame, left of the car's centre
+    z: float  # [m] plate centre above the ground
+    range: float  # [m] horizontal distance from the car's centre, hypot(x, y)
+    box: tuple[int, int, int, int]  # [px] (u0, v0, u1, v1) of the sign's pixels, u1/v1 exclusive
+    confidence: float  # [0, 1] how sign-like the blob is (shape, colour, size)
+
+    def match(self, ego: EgoState, map_signs: Sequence[tuple[float, float, float]],
+              tolerance: float = 5.0, range_tolerance: float = 0.15) -> float | None:
+        """The station [m] of the map sign this detection is, or None.
+
+        ``map_signs``: (station [m], x [m], y [m]) of each map sign (plate or pole, map
+        frame). The detection is placed in the map frame with the ego's pose; a map sign
+        matches when its offset from there is within ``tolerance`` [m] across the line of
+        sight and ``tolerance + range_tolerance * range`` along it (the range, from the
+        plate's apparent size, is the uncertain part); of several, the nearest in those
+        normalised units."""
+        c, s = math.cos(ego.heading), math.sin(ego.heading)
+        det_x = ego.x + c * self.x - s * self.y
+        det_y = ego.y + s * self.x + c * self.y
+        bearing = ego.heading + math.atan2(self.y, self.x)
+        ux, uy = math.cos(bearing), math.sin(bearing)
+        along_tol = tolerance + range_tolerance * self.range
+        best: tuple[float, float] | None = None  # (normalised distance, station)
+        for station, x, y in map_signs:
+            dx, dy = x - det_x, y - det_y
+            along, across = dx * ux + dy * uy, -dx * uy + dy * ux
+            if abs(along) > along_tol or abs(across) > tolerance:
+                continue
+            distance = math.hypot(along / along_tol, across / tolerance)
+            if best is None or distance < best[0]:
+                best = (distance, station)
+        return None if best is None else best[1]

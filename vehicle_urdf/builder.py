@@ -37,6 +37,9 @@ class CarDimensions:
     tyre_friction: float = 1.0  # [-] Coulomb friction of tyre on dry asphalt (ground has 1.0)
     tyre_stiffness: float = 300_000.0  # [N/m] vertical contact stiffness of one tyre
     tyre_damping: float = 20_000.0  # [N s/m] vertical contact damping (about critical per corner)
+    flat_radius: float = 0.31  # [m] rolling radius of a flat tyre: the rim on the folded carcass
+    flat_stiffness: float = 150_000.0  # [N/m] vertical contact stiffness of a flat tyre
+    flat_damping: float = 20_000.0  # [N s/m] vertical contact damping of a flat tyre
     com_height: float = 0.52  # [m] ground to the sprung mass's centre of mass
     max_steer: float = 0.65  # [rad] hinge limit (road wheel), either way
     lidar_height: float = 0.12  # [m] above the roof
@@ -133,12 +136,38 @@ def _wheel_link(name: str, d: CarDimensions) -> str:
     )
 
 
+def _rim_link(name: str, d: CarDimensions) -> str:
+    """A wheel's flat-tyre contact: a sphere of the flat rolling radius inside the tyre's,
+    fixed to the wheel (it spins with it), with the flat tyre's contact. It sits
+    `wheel_radius - flat_radius` inside the tyre's sphere, clear of the road while the
+    tyre holds its air; the ego body keeps its contact inert until that tyre goes flat
+    (`world.ego`)."""
+    i = RIM_MASS * d.flat_radius**2 / 5.0
+    contact = (
+        "    <contact>\n"
+        f'      <lateral_friction value="{d.tyre_friction:.4f}"/>\n'
+        '      <rolling_friction value="0"/>\n      <spinning_friction value="0"/>\n'
+        f'      <stiffness value="{d.flat_stiffness:.1f}"/>\n'
+        f'      <damping value="{d.flat_damping:.1f}"/>\n'
+        "    </contact>\n"
+    )
+    sphere = f'      <geometry><sphere radius="{d.flat_radius:.4f}"/></geometry>\n'
+    return (
+        f'  <link name="{name}">\n'
+        + contact
+        + _inertial(RIM_MASS, i, i, i)
+        + f"    <collision>\n{sphere}    </collision>\n"
+        + "  </link>\n"
+    )
+
+
 def _knuckle_link(name: str, d: CarDimensions) -> str:
     i = d.knuckle_mass * 0.1**2 / 6.0
     return f'  <link name="{name}">\n' + _inertial(d.knuckle_mass, i, i, i) + "  </link>\n"
 
 
 SENSOR_MASS = 0.05  # [kg] a sensor link's own mass (Bullet invents 1 kg for a bare link)
+RIM_MASS = 0.05  # [kg] a flat-tyre contact link's own mass (the rim's is in the wheel's)
 
 
 def _sensor_link(name: str) -> str:
@@ -168,6 +197,14 @@ def _joint(
     return out + "  </joint>\n"
 
 
+def _rim(corner: str, d: CarDimensions) -> list[str]:
+    """The flat-tyre contact link of a corner's wheel and its fixed joint (at the wheel's
+    centre): `front_left_rim` on `front_left_wheel`, and so on."""
+    return [_rim_link(f"{corner}_rim", d),
+            _joint(f"{corner}_rim_joint", "fixed", f"{corner}_wheel", f"{corner}_rim",
+                   (0.0, 0.0, 0.0))]
+
+
 _MATERIALS = (
     '  <material name="body"><color rgba="0.10 0.30 0.75 1"/></material>\n'
     '  <material name="glass"><color rgba="0.15 0.18 0.22 1"/></material>\n'
@@ -192,6 +229,7 @@ def build_urdf(d: CarDimensions) -> str:
             _wheel_link(wheel, d),
             _joint(f"front_{side}_wheel_joint", "continuous", knuckle, wheel, (0.0, 0.0, 0.0),
                    axis="0 1 0"),
+            *_rim(f"front_{side}", d),
         ]
     for side, y in (("left", half_tr), ("right", -half_tr)):
         wheel = f"rear_{side}_wheel"
@@ -199,6 +237,7 @@ def build_urdf(d: CarDimensions) -> str:
             _wheel_link(wheel, d),
             _joint(f"rear_{side}_wheel_joint", "continuous", "base_link", wheel,
                    (-half_wb, y, 0.0), axis="0 1 0"),
+            *_rim(f"rear_{side}", d),
         ]
     r = d.wheel_radius
     sensors = (

@@ -23,6 +23,10 @@ class CarGeometry:
     mass: float  # [kg] total
     max_steer: float  # [rad] road-wheel hinge limit
     tyre_stiffness: float = 300_000.0  # [N/m] vertical contact stiffness of one tyre
+    tyre_damping: float = 20_000.0  # [N s/m] vertical contact damping of one tyre
+    flat_radius: float = 0.31  # [m] rolling radius of a flat tyre (its rim link's sphere)
+    flat_stiffness: float = 150_000.0  # [N/m] vertical contact stiffness of a flat tyre
+    flat_damping: float = 20_000.0  # [N s/m] vertical contact damping of a flat tyre
 
     @property
     def ride_height(self) -> float:
@@ -44,7 +48,8 @@ def _xyz(element: ET.Element | None) -> tuple[float, float, float]:
 
 
 def read_geometry(path: Path = URDF_PATH) -> CarGeometry:
-    """Parse wheel joint origins, the wheel cylinder, the lower body box and all masses."""
+    """Parse wheel joint origins, the wheel cylinder, the lower body box, all masses, the
+    tyres' contact and the flat-tyre (rim) links' spheres and contact."""
     root = ET.parse(path).getroot()
     joints = {j.attrib["name"]: j for j in root.iter("joint")}
     links = {link.attrib["name"]: link for link in root.iter("link")}
@@ -55,7 +60,13 @@ def read_geometry(path: Path = URDF_PATH) -> CarGeometry:
     body = links["base_link"].find("visual[@name='lower_body']/geometry/box")
     limit = joints["front_left_steer_joint"].find("limit")
     stiffness = links["front_left_wheel"].find("contact/stiffness")
-    if cylinder is None or body is None or limit is None or stiffness is None:
+    damping = links["front_left_wheel"].find("contact/damping")
+    rim = links.get("front_left_rim")
+    flat_sphere = None if rim is None else rim.find("collision/geometry/sphere")
+    flat_stiffness = None if rim is None else rim.find("contact/stiffness")
+    flat_damping = None if rim is None else rim.find("contact/damping")
+    if (cylinder is None or body is None or limit is None or stiffness is None or damping is None
+            or flat_sphere is None or flat_stiffness is None or flat_damping is None):
         raise ValueError(f"{path}: not an avsim car URDF")
     length, width, _ = (float(v) for v in body.attrib["size"].split())
     mass = sum(float(m.attrib["value"]) for m in root.iter("mass"))
@@ -70,6 +81,10 @@ def read_geometry(path: Path = URDF_PATH) -> CarGeometry:
         mass=mass,
         max_steer=float(limit.attrib["upper"]),
         tyre_stiffness=float(stiffness.attrib["value"]),
+        tyre_damping=float(damping.attrib["value"]),
+        flat_radius=float(flat_sphere.attrib["radius"]),
+        flat_stiffness=float(flat_stiffness.attrib["value"]),
+        flat_damping=float(flat_damping.attrib["value"]),
     )
 
 

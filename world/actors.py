@@ -3,6 +3,9 @@
 NPCs are kinematic: static (mass 0) boxes placed at `world.ACTOR_RATE` from their
 `NpcMotion` in route coordinates. The ego collides with them like with a wall, and contact
 queries see them. (Only the ego must drive through its joints; NPCs are scripted traffic.)
+Pedestrians are boxes too (0.5 m deep, 0.6 m wide, 1.75 m tall), placed by station and
+offset from their lane's centre like any actor; `speed_kph` is a walking speed along the
+lane, the `walk` action moves them across the road, facing where they walk.
 Bodies are placed with one scalar map lookup per moving actor; `poses` (all of them, for
 criteria, scoring and the recording) is one vectorised map call, when asked.
 """
@@ -54,8 +57,10 @@ class ActorPoses:
     half_sizes: NDArray[np.float64]  # [m] (N, 3) length, width, height halves
     stations: NDArray[np.float64]  # [m] (N,) route station of each centre
     offsets: NDArray[np.float64]  # [m] (N,) lateral offset from the reference line
-    speeds: NDArray[np.float64]  # [m/s] (N,) along each one's travel direction
-    accels: NDArray[np.float64]  # [m/s^2] (N,) longitudinal, signed
+    # [m/s] (N,) vehicles: along their lane; pedestrians: walking speed over ground (a
+    # crossing's lateral motion included)
+    speeds: NDArray[np.float64]
+    accels: NDArray[np.float64]  # [m/s^2] (N,) rate of change of `speeds`, signed
 
 
 class ActorSet:
@@ -72,7 +77,8 @@ class ActorSet:
             lane = road.lane(spec.lane)
             offset = float(lane.offset_at(spec.s)) + spec.offset
             self.motions.append(
-                NpcMotion(spec.s, offset, spec.speed, lane.direction, spec.actions)
+                NpcMotion(spec.s, offset, spec.speed, lane.direction, spec.actions,
+                          lane=spec.lane, pedestrian=spec.type is ActorType.PEDESTRIAN)
             )
             self.bodies.append(self._make_body(spec.type))
         self.lengths = np.array([SIZES[a.type].length for a in specs])
@@ -80,13 +86,19 @@ class ActorSet:
             [[SIZES[a.type].length / 2, SIZES[a.type].width / 2, SIZES[a.type].height / 2]
              for a in specs]
         ).reshape(-1, 3)
-        self._last_speed = [a.speed for a in specs]  # [m/s] before the last step
+        self._last_speed = self._speeds()  # [m/s] before the last step
         self._dt = 1.0  # [s] the last step
         self._ids = tuple(a.id for a in specs)
         self._kinds = tuple(a.type for a in specs)
         self._flip_list = [math.pi if m.direction < 0 else 0.0 for m in self.motions]
         self._flip = np.array(self._flip_list)
         self._heights = self.half_sizes[:, 2].tolist()  # [m] box centre above the ground
+        # traffic on the road before the route's first exit keeps that road (it goes on
+        # straight from the fork, `RoadMap.through_line`); the rest follows the route
+        self._fork = road.exits[0].s if road.exits else math.inf
+        self._through = np.array([a.s < self._fork for a in specs], dtype=bool)
+        self._lines = [road.through_line if through else road.line
+                       for through in self._through.tolist()]
         self._poses: ActorPoses | None = None
         self._place(force=True)
 
@@ -120,19 +132,22 @@ class ActorSet:
 
     def step(self, t: float, dt: float) -> None:
         """Advance every motion by dt [s] and move the moving bodies to their new poses."""
-        line = self._road.line
-        self._last_speed = [m.speed for m in self.motions]
+        self._last_speed = self._speeds()
         self._dt = dt
-        for motion in self.motions:
+        for motion, line in zip(self.motions, self._lines, strict=True):
             motion.step(t, dt, line.curvature_one(motion.s))
         self._poses = None
         self._place(force=False)
 
+    def _speeds(self) -> NDArray[np.float64]:
+        """[m/s] (N,) `ActorPoses.speeds` now."""
+        return np.array([m.ground_speed if m.pedestrian else m.speed for m in self.motions],
+                        dtype=np.float64)
+
     @property
     def accels(self) -> NDArray[np.float64]:
-        """[m/s^2] (N,) each actor's longitudinal acceleration over the last step."""
-        speeds = np.array([m.speed for m in self.motions], dtype=np.float64)
-        out: NDArray[np.float64] = (speeds - np.array(self._last_speed)) / self._dt
+        """[m/s^2] (N,) each actor's acceleration (of `ActorPoses.speeds`) over the last step."""
+        out: NDArray[np.float64] = (self._speeds() - self._last_speed) / self._dt
         return out
 
     @property
@@ -147,6 +162,14 @@ class ActorSet:
         s = np.array([x.s for x in m])
         offsets = np.array([x.offset for x in m])
         x, y, heading = self._road.line.pose(s, offsets)  # offsets are from the reference line
+        through = self._through & (s > self._fork)  # on the road the route left by its exit
+        if through.any():
+            x[through], y[through], heading[through] = self._road.through_line.pose(
+                s[through], offsets[through])
+            # the truth along the route, where criteria look for vehicles: projected
+            s = s.copy()
+            s[through], offsets[through] = self._road.local_coordinates(
+                np.column_stack([x[through], y[through]]))
         yaws = heading + self._flip + np.array([x.heading_offset for x in m])
         centres = np.column_stack([x, y, self.half_sizes[:, 2]]) if m else np.zeros((0, 3))
         return ActorPoses(
@@ -157,16 +180,15 @@ class ActorSet:
             half_sizes=self.half_sizes,
             stations=s,
             offsets=offsets,
-            speeds=np.array([x.speed for x in m]),
+            speeds=self._speeds(),
             accels=self.accels,
         )
 
     def _place(self, force: bool) -> None:
         """Move the bodies of the actors that move (all of them with `force`): one scalar
         map lookup each, the hot path of the NPCs."""
-        line = self._road.line
-        for body, m, flip, z in zip(self.bodies, self.motions, self._flip_list,
-                                    self._heights, strict=True):
+        for body, m, flip, z, line in zip(self.bodies, self.motions, self._flip_list,
+                                          self._heights, self._lines, strict=True):
             if force or m.speed != 0.0 or m.lateral_speed != 0.0:
                 x, y, heading = line.pose_one(m.s, m.offset)
                 half = 0.5 * (heading + flip + m.heading_offset)

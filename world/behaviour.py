@@ -7,9 +7,16 @@ acceleration, lateral moves follow a trapezoidal lateral-speed profile (bounded 
 acceleration), so positions and headings never jump.
 
 Actions (scenario format): `speed` (to a speed at an acceleration), `lane_change` (to a
-lane's centre at a lateral speed), `stop` (brake to rest). Triggers: `time`, `ego_s`,
-`gap` (bumper-to-bumper distance to the ego along the route), `after` (an earlier action
-ended, plus a delay). Each action fires once, when its trigger first holds.
+lane's centre at a lateral speed), `walk` (across the road to an offset from the actor's
+lane centre, at a walking speed: the same trapezoidal lateral move), `stop` (brake to rest).
+Triggers: `time`, `ego_s`, `gap` (bumper-to-bumper distance to the ego along the route),
+`after` (an earlier action ended, plus a delay). Each action fires once, when its trigger
+first holds.
+
+Headings: a vehicle's body points along its velocity while it moves faster than 0.1 m/s
+(along its lane at rest). A pedestrian faces where it walks, also straight across the road
+(no longitudinal speed), turning towards it at `PEDESTRIAN_TURN_RATE`, and keeps the last
+heading it walked in while it stands.
 """
 
 from __future__ import annotations
@@ -33,6 +40,8 @@ from world.spec import (
 
 LATERAL_ACCEL = 1.5  # [m/s^2] ramp of the lateral speed at the start and end of a lane change
 ARRIVED = 1e-3  # [m] lateral distance that counts as arrived
+PEDESTRIAN_TURN_RATE = math.pi  # [rad/s] a pedestrian turns to face where it walks (90 deg: 0.5 s)
+PEDESTRIAN_MOVING = 0.05  # [m/s] a pedestrian slower than this over ground keeps its heading
 
 LaneOffset = Callable[[int, float], float]
 """(lane index, station) -> lateral offset [m] of that lane's centre from the reference line."""
@@ -67,13 +76,19 @@ class NpcMotion:
     """One actor's kinematic state in route coordinates and its scripted actions."""
 
     def __init__(
-        self, s: float, offset: float, speed: float, direction: int, actions: tuple[ActionSpec, ...]
+        self, s: float, offset: float, speed: float, direction: int,
+        actions: tuple[ActionSpec, ...], *, lane: int = 0, pedestrian: bool = False,
     ) -> None:
+        """`lane`: the lane whose centre `walk` offsets are measured from (a `lane_change`
+        moves it); `pedestrian`: face the walking direction (module doc)."""
         self.s = s  # [m] station of the actor's centre
         self.offset = offset  # [m] lateral offset of its centre from the reference line, left +
-        self.speed = speed  # [m/s] along its travel direction
+        self.speed = speed  # [m/s] along its lane's direction of travel
         self.lateral_speed = 0.0  # [m/s] d(offset)/dt
         self.direction = direction  # +1 with the route, -1 against
+        self.lane = lane
+        self.pedestrian = pedestrian
+        self._facing = 0.0  # [rad] a pedestrian's heading relative to its lane's direction
         self.actions = actions
         self.fired_at: list[float | None] = [None] * len(actions)  # [s]
         self.ended_at: list[float | None] = [None] * len(actions)  # [s]
@@ -105,17 +120,15 @@ class NpcMotion:
         elif isinstance(action, LaneChangeAction):
             self._target_offset = lane_offset(action.to_lane, self.s)
             self._lateral_max, self._lateral_action = action.lateral_speed, i
+            self.lane = action.to_lane
         elif isinstance(action, WalkAction):
-            self._target_offset = self.offset + (action.to_offset - self._lane_relative_offset())
+            self._target_offset = lane_offset(self.lane, self.s) + action.to_offset
             self._lateral_max, self._lateral_action = action.speed, i
         # an action replacing a running one of the same kind ends the old one now
         for j in range(len(self.actions)):
             running = self.fired_at[j] is not None and self.ended_at[j] is None
             if j != i and running and _same_kind(self.actions[j].action, action):
                 self.ended_at[j] = self.fired_at[i]
-
-    def _lane_relative_offset(self) -> float:
-        return 0.0  # walking targets are relative to the actor's spawn lane centre (issue D)
 
     # -- motion ------------------------------------------------------------------------------
 
@@ -124,9 +137,22 @@ class NpcMotion:
         (the station rate of a body at lateral offset r is v / (1 - k r))."""
         self._step_speed(t, dt)
         self._step_lateral(t, dt)
+        if self.pedestrian:
+            self._turn(dt)
         scale = 1.0 - curvature * self.offset
         self.s += self.direction * self.speed * dt / max(scale, 1e-3)
         self.offset += self.lateral_speed * dt
+
+    def _turn(self, dt: float) -> None:
+        """A pedestrian turns towards its direction of travel, at most at the turn rate."""
+        if math.hypot(self.speed, self.lateral_speed) < PEDESTRIAN_MOVING:
+            return
+        course = math.atan2(self.lateral_speed, self.direction * self.speed)  # route frame
+        wanted = course if self.direction > 0 else course - math.pi  # from its lane's direction
+        error = math.remainder(wanted - self._facing, 2.0 * math.pi)
+        limit = PEDESTRIAN_TURN_RATE * dt
+        self._facing = math.remainder(self._facing + max(-limit, min(limit, error)),
+                                      2.0 * math.pi)
 
     def _step_speed(self, t: float, dt: float) -> None:
         error = self._target_speed - self.speed
@@ -162,10 +188,17 @@ class NpcMotion:
 
     @property
     def heading_offset(self) -> float:
-        """[rad] the body's yaw relative to its travel direction along the route."""
+        """[rad] the body's yaw relative to its lane's direction of travel (module doc)."""
+        if self.pedestrian:
+            return self._facing
         if self.speed <= 0.1:
             return 0.0
         return math.atan2(self.lateral_speed, self.speed) * self.direction
+
+    @property
+    def ground_speed(self) -> float:
+        """[m/s] speed over ground, the lateral motion included."""
+        return math.hypot(self.speed, self.lateral_speed)
 
 
 def _same_kind(a: object, b: object) -> bool:

@@ -17,6 +17,29 @@ control rate) and held by Bullet between commands, so the ego costs no Python pe
 - a top-speed governor: no drive torque at or above the vehicle's maximum speed.
 Bullet's default link damping (0.04, applied as m v (k + k |v|), about 4 kN at 8 m/s) is
 switched off: drag and rolling resistance are modelled explicitly instead.
+
+Flat tyre (`puncture`, advanced by `update_tyres` at the world's trigger checks). Each wheel
+rolls on its tyre's sphere (the rolling radius); inside it, fixed to the wheel, a smaller
+sphere of the flat rolling radius (the URDF's `<corner>_rim` link: the rim on the folded
+carcass) whose contact is made inert at spawn (stiffness ~0, no friction) so an intact car
+never feels it. A collision shape cannot change at run time, so a puncture moves the
+wheel's contact from one sphere to the other, over `EgoParams.deflation_time`:
+1. the first `DEFLATE_TYRE_SHARE` of it, the tyre's contact stiffness falls geometrically to
+   `TYRE_END_STIFFNESS` of its value: the corner sinks until the rim is ~1 mm off the road;
+2. then the tyre stops colliding and the rim's contact takes the load, its stiffness falling
+   geometrically from `RIM_START_STIFFNESS` times the flat tyre's to the flat tyre's (URDF):
+   the corner sinks on. From here the wheel rolls on the flat radius: it spins
+   `wheel_radius / flat_radius` times faster than the others at the same ground speed.
+The flat wheel also gets a rolling-resistance torque `deflated * (c_flat - c) * N * r_flat`
+(N its contact's normal force, read when its motor is set): its joint motor's torque is
+less that much, so the car needs more drive to hold its speed. That drag is also a yaw
+moment toward the flat side (~190 N m at 50 km/h), but it does not turn the car: Bullet's
+tyre contacts take no slip angle (sideways they hold rigidly up to mu N), so with the
+steering held straight the car keeps its heading. A pull would need tyre compliance, which
+the simulator does not model for any tyre.
+The body has no suspension (the tyres' compliance is all of it), so a corner cannot drop
+much before the diagonal wheel unloads: the flat corner settles ~2 cm lower (its load and
+the diagonal one's fall to ~45 %), not by the tyre's whole sidewall.
 """
 
 from __future__ import annotations
@@ -36,6 +59,15 @@ AIR_DENSITY = 1.2  # [kg/m^3]
 STEER_TORQUE = 4000.0  # [N m] steering hinge servo force limit
 STEER_RATE = 1.2  # [rad/s] steering hinge servo speed limit (actuator, not the controller's)
 MAX_WHEEL_SPIN = 200.0  # [rad/s] joint velocity cap (Bullet's default 100 rad/s is 33 m/s)
+INERT_CONTACT = 1e-3  # [N/m], [N s/m] a rim's contact stiffness and damping while its tyre is
+#   inflated: it carries nothing (~1e-5 N at 1 cm), and it has no friction
+LARGE_THRESHOLD = 1e18  # [m] Bullet's default contact processing threshold (BT_LARGE_FLOAT)
+DEFLATE_TYRE_SHARE = 0.25  # [-] share of the deflation time in which the tyre's sphere sinks
+TYRE_END_STIFFNESS = 0.35  # [-] the tyre's contact stiffness when the rim takes over, of its
+#   own: the corner has sunk until the rim (0.02 m inside the tyre) is ~1 mm off the road
+#   (measured: the corner lags the falling stiffness; at rest it would sink further)
+RIM_START_STIFFNESS = 10.0  # [-] the rim's contact stiffness when it takes over, of the flat
+#   tyre's: it takes the load within ~1 mm, then softens to the flat tyre's
 
 
 @dataclass(frozen=True, slots=True)
@@ -44,6 +76,8 @@ class EgoParams:
     max_accel: float = 5.0  # [m/s^2] the drive torque is capped to give this on the flat
     rolling_resistance: float = 0.012  # [-] coefficient, F = c m g
     drag_area: float = 0.7  # [m^2] Cd * A
+    flat_rolling_resistance: float = 0.15  # [-] coefficient of a flat tyre, F = c N (its load)
+    deflation_time: float = 1.0  # [s] a punctured tyre goes flat over this
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -107,6 +141,17 @@ class EgoBody:
             client.changeDynamics(self.body, link, linearDamping=0.0, angularDamping=0.0)
         for j in self.wheel_joints:
             client.changeDynamics(self.body, j, maxJointVelocity=MAX_WHEEL_SPIN)
+        self.rim_links = [self.links[f"{w}_rim"] for w in WHEELS]
+        self._rim_friction = [float(client.getDynamicsInfo(self.body, rim)[1])
+                              for rim in self.rim_links]
+        for rim in self.rim_links:  # inert until its tyre goes flat, and the contacts Bullet
+            # finds before it touches (2 cm off the road) not solved: ~15 % of a step
+            client.changeDynamics(self.body, rim, contactStiffness=INERT_CONTACT,
+                                  contactDamping=INERT_CONTACT, lateralFriction=0.0,
+                                  contactProcessingThreshold=0.0)
+        self._punctured: dict[int, float] = {}  # wheel index -> [s] sim time of the puncture
+        self._on_rim: set[int] = set()  # punctured wheels whose rim carries them
+        self._deflated: dict[int, float] = {}  # wheel index -> [-] 0..1, how flat
         self._com_offset = np.array(client.getDynamicsInfo(self.body, -1)[3])
         self._all_joints = list(range(client.getNumJoints(self.body)))
         # bound once: these run at the control rate
@@ -122,6 +167,7 @@ class EgoBody:
         self.drive_torque = 0.0  # [N m] last applied, total
         self.brake_torque = 0.0  # [N m] last applied, total
         self.steer_command = 0.0  # [rad] last commanded bicycle angle
+        self._net_torque = 0.0  # [N m] total wheel torque of the last command, + forward
         self._spawn_speed(yaw, speed)
         self.apply(0.0, 0.0, 0.0)
 
@@ -156,12 +202,82 @@ class EgoBody:
         if speed >= self.params.max_speed:
             self.drive_torque = 0.0
         drag = 0.5 * AIR_DENSITY * self.params.drag_area * speed**2 * g.wheel_radius
-        net = self.drive_torque - self.brake_torque - self._roll_torque - drag  # [N m]
-        spin = MAX_WHEEL_SPIN if net > 0.0 else 0.0
+        self._net_torque = self.drive_torque - self.brake_torque - self._roll_torque - drag
+        self._set_wheel_motors()
+
+    def _set_wheel_motors(self) -> None:
+        """Each wheel's motor: a quarter of the net torque, less a flat tyre's extra rolling
+        resistance (`flat_drag`); forward torque spins it up, the rest is a Coulomb torque."""
+        quarter = self._net_torque / 4  # [N m]
+        torques = [quarter - self.flat_drag(i) if self._punctured else quarter
+                   for i in range(4)]
         self._motors(
             self.body, self.wheel_joints, pybullet.VELOCITY_CONTROL,
-            targetVelocities=[spin] * 4, forces=[abs(net) / 4] * 4,
+            targetVelocities=[MAX_WHEEL_SPIN if tq > 0.0 else 0.0 for tq in torques],
+            forces=[abs(tq) for tq in torques],
         )
+
+    # -- flat tyres ---------------------------------------------------------------------------
+
+    def puncture(self, wheel: str, t: float) -> None:
+        """The tyre of `wheel` (a `vehicle_urdf.WHEELS` name) is punctured at sim time `t`
+        [s]: it goes flat over `EgoParams.deflation_time` as `update_tyres` is called.
+        A tyre already punctured stays as it is."""
+        i = WHEELS.index(wheel)
+        if i not in self._punctured:
+            self._punctured[i] = t
+            self.update_tyres(t)
+
+    def update_tyres(self, t: float) -> None:
+        """Deflate the punctured tyres to their state at sim time `t` [s] (contact
+        stiffness, which sphere rolls) and set the wheel motors again (a flat tyre's drag
+        follows its load). Nothing while every tyre holds its air."""
+        if not self._punctured:
+            return
+        for i, t0 in self._punctured.items():
+            if self._deflated.get(i) != 1.0:
+                self._deflate(i, t - t0)
+        self._set_wheel_motors()
+
+    def _deflate(self, i: int, age: float) -> None:
+        """Wheel `i`'s tyre `age` [s] after its puncture (the module docstring's steps)."""
+        g, c = self.geometry, self._c
+        span = self.params.deflation_time
+        x = 1.0 if span <= 0.0 else min(max(age / span, 0.0), 1.0)  # [-] how flat
+        self._deflated[i] = x
+        tyre, rim = self.wheel_joints[i], self.rim_links[i]
+        if x < DEFLATE_TYRE_SHARE:
+            k = g.tyre_stiffness * TYRE_END_STIFFNESS ** (x / DEFLATE_TYRE_SHARE)
+            c.changeDynamics(self.body, tyre, contactStiffness=k, contactDamping=g.tyre_damping)
+            return
+        if i not in self._on_rim:
+            self._on_rim.add(i)
+            c.setCollisionFilterGroupMask(self.body, tyre, 0, 0)  # the tyre's sphere: gone
+            c.changeDynamics(self.body, rim, lateralFriction=self._rim_friction[i],
+                             contactProcessingThreshold=LARGE_THRESHOLD)
+        y = (x - DEFLATE_TYRE_SHARE) / (1.0 - DEFLATE_TYRE_SHARE)
+        k = g.flat_stiffness * RIM_START_STIFFNESS ** (1.0 - y)
+        c.changeDynamics(self.body, rim, contactStiffness=k, contactDamping=g.flat_damping)
+
+    def flat_drag(self, i: int) -> float:
+        """[N m] wheel `i`'s extra rolling-resistance torque from its flat tyre (0 while it
+        holds air): deflated share * (c_flat - c) * N * r, N [N] its contact's normal force
+        after the last step, r the radius it rolls on."""
+        x = self._deflated.get(i, 0.0)
+        if x == 0.0:
+            return 0.0
+        on_rim = i in self._on_rim
+        link = self.rim_links[i] if on_rim else self.wheel_joints[i]
+        load = sum(float(p[9]) for p in self._c.getContactPoints(bodyA=self.body,
+                                                                   linkIndexA=link))
+        radius = self.geometry.flat_radius if on_rim else self.geometry.wheel_radius
+        extra = self.params.flat_rolling_resistance - self.params.rolling_resistance
+        return x * extra * load * radius
+
+    @property
+    def flat_wheels(self) -> tuple[str, ...]:
+        """The wheels (`vehicle_urdf.WHEELS` names) whose tyre is punctured, in wheel order."""
+        return tuple(w for i, w in enumerate(WHEELS) if i in self._punctured)
 
     @property
     def com_offset(self) -> NDArray[np.float64]:

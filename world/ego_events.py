@@ -7,6 +7,12 @@ pedal being pressed, and the pedal is a SENSOR that the stack reads
 no torque for it: it holds the pedal position from the trigger for `duration` seconds, then
 releases it to 0. What the car does about it is the stack's decision.
 
+A `flat_tire` punctures one tyre: the world hands the wheel to the ego body
+(`world.ego.EgoBody.puncture`), which deflates it physically (a smaller rolling radius, more
+rolling resistance, the corner sinks). Nothing tells the stack: it must notice from the
+car's own signals (the wheel speeds). A puncture is an instant: the event ends when it fires
+(so `after: i` counts from it). A later override does not replace it, nor it an override.
+
 Triggers mean what they mean for the NPC actions and are evaluated by the same code
 (`world.behaviour.trigger_holds`), at the same checks (`world.world.TRIGGER_RATE`): `time`
 [s], `ego_s` (the ego's centre station on the route) and `after: i, delay: t` (event i ended
@@ -22,7 +28,7 @@ from __future__ import annotations
 import math
 
 from world.behaviour import TriggerContext, trigger_holds
-from world.spec import AcceleratorOverride, AfterTrigger, EventSpec, GapTrigger
+from world.spec import AcceleratorOverride, AfterTrigger, EventSpec, FlatTire, GapTrigger, Wheel
 
 RELEASE_TOLERANCE = 1e-9  # [s] so that fired + duration summed in floats lands on its check
 
@@ -37,20 +43,22 @@ class EgoEvents:
                 raise ValueError(f"{key}.trigger.gap: only for actors (the gap to the ego)")
             if isinstance(event.trigger, AfterTrigger) and not 0 <= event.trigger.index < i:
                 raise ValueError(f"{key}.trigger.after: must refer to an earlier event")
-            if not isinstance(event.event, AcceleratorOverride):
+            if not isinstance(event.event, AcceleratorOverride | FlatTire):
                 raise ValueError(f"{key}: {type(event.event).__name__} is not simulated yet")
         self.events = events
         self._fired_at: list[float | None] = [None] * len(events)  # [s]
         self._ended_at: list[float | None] = [None] * len(events)  # [s]
         self._override: int | None = None  # the override holding the pedal now
         self._started: tuple[int, ...] = ()
+        self._flats: list[Wheel] = []  # punctured tyres, in the order they fired
 
     def update(self, t: float, ego_s: float) -> tuple[int, ...]:
         """One check at sim time `t` [s], the ego's centre at station `ego_s` [m].
 
         First the running override whose duration is over ends (the pedal is released),
         then every event whose trigger holds fires, in list order (so `after: i, delay: 0`
-        fires at the check where event i ended). Returns the indices fired now."""
+        fires at the check where event i ended; a flat tyre ends as it fires). Returns the
+        indices fired now."""
         running = self._override
         if running is not None:
             override = self._accelerator(running)
@@ -64,10 +72,14 @@ class EgoEvents:
         for i, event in enumerate(self.events):
             if self._fired_at[i] is None and trigger_holds(event.trigger, ctx, self._ended_at):
                 self._fired_at[i] = t
+                started.append(i)
+                if isinstance(event.event, FlatTire):  # an instant: it ends as it fires
+                    self._ended_at[i] = t
+                    self._flats.append(event.event.wheel)
+                    continue
                 if self._override is not None:  # replaced, as a running NPC action is
                     self._ended_at[self._override] = t
                 self._override = i
-                started.append(i)
         self._started = tuple(started)
         return self._started
 
@@ -88,10 +100,22 @@ class EgoEvents:
 
     @property
     def ended_at(self) -> tuple[float | None, ...]:
-        """[s] per event: when it ended (the pedal released), None while not."""
+        """[s] per event: when it ended (an override: the pedal released; a flat tyre: as it
+        fired), None while not."""
         return tuple(self._ended_at)
 
     @property
     def started(self) -> tuple[int, ...]:
         """Indices of the events that fired at the last check."""
         return self._started
+
+    @property
+    def flat_tires(self) -> tuple[Wheel, ...]:
+        """The punctured tyres so far, in the order they fired (a wheel may repeat)."""
+        return tuple(self._flats)
+
+    @property
+    def started_flats(self) -> tuple[Wheel, ...]:
+        """The tyres punctured at the last check (the world passes them to the ego body)."""
+        events = (self.events[i].event for i in self._started)
+        return tuple(event.wheel for event in events if isinstance(event, FlatTire))

@@ -35,10 +35,43 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from world.spec import Feature, RoadSpec, SpeedLimitSign, Zone
+from world.spec import (
+    Crosswalk,
+    Feature,
+    RoadSpec,
+    Side,
+    SpeedBump,
+    SpeedLimitSign,
+    StopSign,
+    TrafficLight,
+    Zone,
+)
+
+__all__ = [  # the map's own types, and the spec types of what it holds (features, zones)
+    "SHOULDER",
+    "CrossSection",
+    "Crosswalk",
+    "Exit",
+    "Feature",
+    "FloatArray",
+    "IntArray",
+    "Lane",
+    "MapError",
+    "Piece",
+    "ReferenceLine",
+    "RoadMap",
+    "Side",
+    "SpeedBump",
+    "SpeedLimitPosting",
+    "SpeedLimitSign",
+    "StopSign",
+    "TrafficLight",
+    "Zone",
+]
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.intp]
+SHOULDER = -1000  # the lane index of the paved right shoulder (`RoadMap.lane`)
 
 HALF_PI = 0.5 * np.pi  # [rad]
 TWO_PI = 2.0 * np.pi  # [rad]
@@ -90,6 +123,22 @@ class CrossSection:
     def paved_width(self) -> float:
         """[m] width of the paved road, shoulder included."""
         return self.left_edge - self.right_edge
+
+
+@dataclass(frozen=True, slots=True)
+class Exit:
+    """Where the route leaves the road it was on by an exit on the right: the route goes on
+    into the exit segment (a ramp: its own lanes and limit), the road goes on straight from
+    the fork as scenery, with its lanes and its traffic (`RoadMap.through_line`).
+
+    The ramp's lane 0 starts as the continuation of the road's lane 0 (the rightmost): the
+    lanes left of it end at the fork, and a car on the route must be in lane 0 by then."""
+
+    s: float  # [m] station of the fork (the exit segment's start)
+    section: CrossSection  # the through road's layout (the route's before the fork)
+    x: float  # [m] the fork on the reference line (lane 0's centre)
+    y: float  # [m]
+    heading: float  # [rad] the through road's heading
 
 
 @dataclass(frozen=True, slots=True)
@@ -267,7 +316,7 @@ class Lane:
     ) -> None:
         """`offsets`, `exists`, `widths`: per segment, shape (P,) ([m], -, [m])."""
         self.index = index
-        self.direction = 1 if index >= 0 else -1
+        self.direction = 1 if index >= 0 or index == SHOULDER else -1
         self._line = line
         self._offsets = offsets
         self._exists = exists
@@ -324,10 +373,12 @@ class RoadMap:
     pieces: tuple[Piece, ...]
     length: float  # [m] route length (end station)
     lanes: tuple[Lane, ...]  # ego-direction lanes by index, as many as the widest segment
+    shoulder: Lane  # the paved right shoulder, as a lane (`SHOULDER`)
     oncoming: tuple[Lane, ...]  # oncoming lanes, [0] next to the centre line
     features: tuple[Feature, ...]  # sorted by station
     speed_limits: tuple[SpeedLimitPosting, ...]  # sorted by station, first at s = 0
     sections: tuple[CrossSection, ...]  # per segment (= piece)
+    exits: tuple[Exit, ...]  # sorted by station
 
     def __init__(
         self,
@@ -335,13 +386,20 @@ class RoadMap:
         sections: tuple[CrossSection, ...],
         features: tuple[Feature, ...],
         speed_limits: tuple[SpeedLimitPosting, ...],
+        exit_pieces: tuple[int, ...] = (),
     ) -> None:
-        """Use `from_spec`; this takes the already laid pieces, one section per piece."""
+        """Use `from_spec`; this takes the already laid pieces, one section per piece, and
+        the indices of the pieces that leave the road before them by an exit (right)."""
         self.pieces = pieces
         self.sections = sections
         self.features = features
         self.speed_limits = speed_limits
         self.line = ReferenceLine(pieces)
+        self.exits = tuple(
+            Exit(pieces[i].s0, sections[i - 1], pieces[i].x0, pieces[i].y0, pieces[i].heading0)
+            for i in exit_pieces)
+        # the road the traffic keeps: the route up to the first fork, then straight on
+        self.through_line = ReferenceLine(pieces[:exit_pieces[0]]) if exit_pieces else self.line
         self.length = self.line.length
         w = np.array([c.lane_width for c in sections])
         n_ego = np.array([c.lanes for c in sections])
@@ -353,6 +411,9 @@ class RoadMap:
             Lane(-j, self.line, (n_ego + j - 1) * w, n_onc >= j, w)
             for j in range(1, int(n_onc.max()) + 1)
         )
+        shoulder = np.array([c.shoulder for c in sections])
+        self.shoulder = Lane(SHOULDER, self.line, -0.5 * (w + shoulder), shoulder > 0.0,
+                             shoulder)
         self._limit_s: FloatArray = np.array([p.s for p in speed_limits])
         self._limit_v: FloatArray = np.array([p.limit for p in speed_limits])
 
@@ -362,6 +423,7 @@ class RoadMap:
             raise MapError("road: no segments")
         pieces: list[Piece] = []
         sections: list[CrossSection] = []
+        exits: list[int] = []
         s, xy, heading = 0.0, np.zeros(2), 0.0
         zone = Zone.HIGHWAY
         for i, seg in enumerate(spec.segments):
@@ -370,6 +432,9 @@ class RoadMap:
                 seg.lanes, seg.oncoming_lanes, seg.lane_width, seg.shoulder, zone
             )
             _check_segment(i, seg.length, seg.curvature, section)
+            if seg.exit is not None:
+                _check_exit(i, seg.exit, sections)
+                exits.append(i)
             piece = Piece(
                 s, float(seg.length), float(seg.curvature), float(xy[0]), float(xy[1]), heading
             )
@@ -382,10 +447,21 @@ class RoadMap:
             tuple(sections),
             tuple(sorted(spec.features, key=lambda f: f.s)),
             _speed_limit_postings(spec, [p.s0 for p in pieces]),
+            tuple(exits),
         )
 
+    def through_road(self, exit_: Exit, length: float) -> RoadMap:
+        """The road `exit_` leaves, from its fork straight on for `length` [m] (scenery),
+        as a map of its own."""
+        piece = Piece(0.0, length, 0.0, exit_.x, exit_.y, exit_.heading)
+        limit = float(self.speed_limit_at(exit_.s - 1e-6))
+        return RoadMap((piece,), (exit_.section,), (), (SpeedLimitPosting(0.0, limit),))
+
     def lane(self, index: int) -> Lane:
-        """Ego-direction lane `index` >= 0, or oncoming lane for index < 0 (-1 is nearest)."""
+        """Ego-direction lane `index` >= 0, or oncoming lane for index < 0 (-1 is nearest),
+        or the paved right shoulder for `SHOULDER` (a lane the car only pulls over into)."""
+        if index == SHOULDER:
+            return self.shoulder
         if 0 <= index < len(self.lanes):
             return self.lanes[index]
         if -len(self.oncoming) <= index < 0:
@@ -452,6 +528,14 @@ class RoadMap:
         if c.lanes <= band < c.lanes + c.oncoming_lanes:
             return c.lanes - 1 - band, s, d - band * w
         return None, s, d
+
+
+def _check_exit(i: int, side: Side, before: list[CrossSection]) -> None:
+    """Raise MapError unless segment i can leave the road before it by an exit."""
+    if i == 0:
+        raise MapError("road.segments.0.exit: the first segment has no road to leave")
+    if side is not Side.RIGHT:
+        raise MapError(f"road.segments.{i}.exit: only exits on the right are simulated")
 
 
 def _check_segment(i: int, length: float, curvature: float, c: CrossSection) -> None:

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import itertools
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from numpy.typing import NDArray
@@ -249,4 +249,18 @@ def build_road_surface(road_map: RoadMap) -> list[TexturedMesh]:
     for buf in buffers.values():
         buf.flush()
         meshes += buf.meshes
+    return meshes
+
+
+THROUGH_LENGTH = 400.0  # [m] how far a road left by an exit is drawn on from its fork
+THROUGH_DROP = 0.003  # [m] it lies this much below the route's surface (no z-fighting)
+
+
+def build_through_roads(road_map: RoadMap, length: float = THROUGH_LENGTH) -> list[TexturedMesh]:
+    """The roads the route leaves by its exits, straight on from each fork (scenery)."""
+    meshes: list[TexturedMesh] = []
+    for k, exit_ in enumerate(road_map.exits):
+        for mesh in build_road_surface(road_map.through_road(exit_, length)):
+            lowered = mesh.vertices - np.array([0.0, 0.0, THROUGH_DROP])
+            meshes.append(replace(mesh, name=f"through{k}_{mesh.name}", vertices=lowered))
     return meshes

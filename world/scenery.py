@@ -1,8 +1,11 @@
-"""Roadside scenery as pure layout data: building boxes and speed-limit signs (no PyBullet).
+"""Roadside scenery as pure layout data: building boxes, speed-limit and stop signs (no PyBullet).
 
-The world builder turns `BuildingBox` into box bodies and `SignPlacement` into a pole with a
-textured plate (`speed_limit_sign_image`). Every placement is checked against the HD map,
-so it holds on arcs and where the cross-section changes too.
+The world builder turns `BuildingBox` into box bodies, `SignPlacement` into a pole with a
+round textured plate (`speed_limit_sign_image`) and `StopSignPlacement` into a pole with an
+octagonal one (`stop_sign_image`). Signs stand `SIGN_CLEARANCE` beyond the right paved edge
+at their station, their plate facing the approaching ego traffic (`roadside_pose`). Every
+placement is checked against the HD map, so it holds on arcs and where the cross-section
+changes too.
 """
 
 from __future__ import annotations
@@ -15,7 +18,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from world.hdmap import RoadMap
-from world.spec import BuildingsSpec
+from world.spec import BuildingsSpec, StopSign
 
 FloatArray = NDArray[np.float64]
 
@@ -47,6 +50,12 @@ SIGN_RING_FRACTION = 0.12  # [-] red ring width / plate diameter (Vienna convent
 SIGN_TEXT_WIDTH = 0.70  # [-] of the white disc's diameter, for the widest (3-digit) number
 SIGN_TEXT_HEIGHT = 0.48  # [-] of the white disc's diameter
 SIGN_SUPERSAMPLE = 4  # drawn this much larger, then area-averaged down (anti-aliasing)
+# -- stop signs (Vienna convention octagon: red, white border, white STOP) ------------------
+STOP_PLATE_WIDTH = 0.75  # [m] across the flats (same size class as the round signs)
+STOP_BORDER_FRACTION = 0.04  # [-] white border width / width across the flats
+STOP_TEXT_WIDTH = 0.72  # [-] of the red octagon's width across the flats
+STOP_TEXT_HEIGHT = 0.30  # [-] of the red octagon's width across the flats
+OCTAGON_PHASE = math.pi / 8  # [rad] first corner's angle from the plate's right: flat on top
 RED_RGB = (200, 16, 30)  # [0..255]
 BLACK_RGB = (10, 10, 10)  # [0..255]
 WHITE_RGB = (250, 250, 250)  # [0..255]
@@ -80,6 +89,22 @@ class SignPlacement:
     yaw: float  # [rad] direction the plate's front (its normal) faces: route heading + pi
     plate_height: float = SIGN_PLATE_HEIGHT  # [m] plate centre above the ground
     plate_diameter: float = SIGN_PLATE_DIAMETER  # [m]
+
+
+@dataclass(frozen=True, slots=True)
+class StopSignPlacement:
+    """A stop sign on the right of the route at a stop line, its plate facing ego traffic."""
+
+    s: float  # [m] station of the stop line
+    pole_xy: tuple[float, float]  # [m] map frame, foot of the pole
+    yaw: float  # [rad] direction the plate's front (its normal) faces: route heading + pi
+    plate_height: float = SIGN_PLATE_HEIGHT  # [m] plate centre above the ground
+    plate_width: float = STOP_PLATE_WIDTH  # [m] across the octagon's flats
+
+    @property
+    def corner_radius(self) -> float:
+        """[m] the octagon's circumradius (centre to a corner)."""
+        return 0.5 * self.plate_width / math.cos(math.pi / 8)
 
 
 def _rotation(yaw: float) -> FloatArray:
@@ -216,24 +241,42 @@ def layout_buildings(
 # -- speed-limit signs --------------------------------------------------------------------
 
 
+def roadside_pose(road_map: RoadMap, s: float) -> tuple[tuple[float, float], float]:
+    """([m] pole foot (x, y), [rad] plate yaw) of a sign at station s: the pole
+    SIGN_CLEARANCE beyond the right paved edge, the plate's front facing the approaching ego
+    traffic (yaw = route heading + pi, wrapped to (-pi, pi])."""
+    right, _ = road_map.paved_edges(s)
+    x, y = road_map.position(s, float(right) - SIGN_CLEARANCE)
+    heading = float(road_map.heading_at(s))
+    return (float(x), float(y)), _wrap(heading + math.pi)
+
+
 def layout_speed_limit_signs(road_map: RoadMap) -> list[SignPlacement]:
-    """A sign for every speed-limit posting (s = 0 included), in station order: the pole
-    SIGN_CLEARANCE beyond the right paved edge at the posting's station, the plate's front
-    facing the approaching ego traffic (yaw = route heading + pi)."""
+    """A sign for every speed-limit posting (s = 0 included), in station order, at the
+    posting's station (`roadside_pose`)."""
     signs = []
     for posting in road_map.speed_limits:
-        right, _ = road_map.paved_edges(posting.s)
-        x, y = road_map.position(posting.s, float(right) - SIGN_CLEARANCE)
-        heading = float(road_map.heading_at(posting.s))
+        pole_xy, yaw = roadside_pose(road_map, posting.s)
         signs.append(
             SignPlacement(
                 s=posting.s,
                 kph=round(posting.limit * MPS_TO_KPH),
                 limit=posting.limit,
-                pole_xy=(float(x), float(y)),
-                yaw=_wrap(heading + math.pi),
+                pole_xy=pole_xy,
+                yaw=yaw,
             )
         )
+    return signs
+
+
+def layout_stop_signs(road_map: RoadMap) -> list[StopSignPlacement]:
+    """A stop sign for every `StopSign` feature, in station order, at the stop line's
+    station (`roadside_pose`)."""
+    signs = []
+    for feature in road_map.features:
+        if isinstance(feature, StopSign):
+            pole_xy, yaw = roadside_pose(road_map, feature.s)
+            signs.append(StopSignPlacement(s=feature.s, pole_xy=pole_xy, yaw=yaw))
     return signs
 
 
@@ -266,3 +309,57 @@ def _draw_number(rgb: NDArray[np.uint8], text: str, centre: tuple[int, int], dis
     (w, h), _ = cv2.getTextSize(text, font, scale, thickness)
     origin = (centre[0] - w // 2, centre[1] + h // 2)
     cv2.putText(rgb, text, origin, font, scale, BLACK_RGB, thickness, cv2.LINE_AA)
+
+
+# -- stop signs ---------------------------------------------------------------------------
+
+
+def octagon_corners(centre: tuple[float, float], radius: float) -> FloatArray:
+    """(8, 2) corners of the stop-sign octagon in image coordinates (x right, y down),
+    counter-clockwise on the plate: at angles OCTAGON_PHASE + k pi / 4 from the plate's
+    right, `radius` from `centre` (so the top and bottom edges are flat)."""
+    angles = OCTAGON_PHASE + np.arange(8) * (math.pi / 4)
+    return np.column_stack([centre[0] + radius * np.cos(angles),
+                            centre[1] - radius * np.sin(angles)])
+
+
+def stop_sign_image(size: int = 128) -> NDArray[np.uint8]:
+    """(size, size, 4) uint8 RGBA picture of a stop sign: a red octagon with a white border
+    and "STOP" in white, transparent outside the octagon (white there in RGB, so a plate's
+    edge samples no other colour).
+
+    The octagon's corners are those of `octagon_corners` with the circumradius size / 2:
+    the texture coordinates (0.5 + 0.5 cos a, 0.5 - 0.5 sin a) of a plate corner at angle
+    a land on the picture's corner. The border is STOP_BORDER_FRACTION of the width across
+    the flats; the text fits STOP_TEXT_WIDTH x STOP_TEXT_HEIGHT of the red octagon's width.
+    Drawn SIGN_SUPERSAMPLE times larger, then area-averaged down for smooth edges."""
+    big = size * SIGN_SUPERSAMPLE
+    centre = (0.5 * big, 0.5 * big)
+    radius = 0.5 * big
+    flats = 2.0 * radius * math.cos(math.pi / 8)
+    inner = radius - STOP_BORDER_FRACTION * flats / math.cos(math.pi / 8)
+    shift = 4  # fractional bits of the polygon vertices
+    outer_pts = np.rint(octagon_corners(centre, radius) * (1 << shift)).astype(np.int32)
+    inner_pts = np.rint(octagon_corners(centre, inner) * (1 << shift)).astype(np.int32)
+    rgb = np.full((big, big, 3), WHITE_RGB, dtype=np.uint8)
+    alpha = np.zeros((big, big), dtype=np.uint8)
+    cv2.fillPoly(alpha, [outer_pts], 255, lineType=cv2.LINE_AA, shift=shift)
+    cv2.fillPoly(rgb, [inner_pts], RED_RGB, lineType=cv2.LINE_AA, shift=shift)
+    red_flats = 2.0 * inner * math.cos(math.pi / 8)
+    _draw_fitted(rgb, "STOP", (big // 2, big // 2), STOP_TEXT_WIDTH * red_flats,
+                 STOP_TEXT_HEIGHT * red_flats, WHITE_RGB)
+    rgba = np.dstack([rgb, alpha])
+    small = cv2.resize(rgba, (size, size), interpolation=cv2.INTER_AREA)
+    return np.asarray(small, dtype=np.uint8)
+
+
+def _draw_fitted(rgb: NDArray[np.uint8], text: str, centre: tuple[int, int], width: float,
+                 height: float, colour: tuple[int, int, int]) -> None:
+    """`text` centred on `centre`, as large as fits `width` x `height` pixels."""
+    font = cv2.FONT_HERSHEY_DUPLEX
+    (w1, h1), _ = cv2.getTextSize(text, font, 1.0, 1)
+    scale = min(width / w1, height / h1)
+    thickness = max(1, round(scale * 2.2))
+    (w, h), _ = cv2.getTextSize(text, font, scale, thickness)
+    origin = (centre[0] - w // 2, centre[1] + h // 2)
+    cv2.putText(rgb, text, origin, font, scale, colour, thickness, cv2.LINE_AA)

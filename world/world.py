@@ -4,7 +4,8 @@
 advances physics by one fixed 240 Hz step (ego forces, Bullet step, NPC behaviours, the
 ego's events). Ground truth for criteria and the recording is in `world.truth`; the stack
 only ever sees what `world.gnss` measures (the accelerator pedal an ego event holds is one
-of those signals: the world applies no force for it).
+of those signals: the world applies no force for it; a flat tyre an ego event makes is
+physical, and no signal says it).
 """
 
 from __future__ import annotations
@@ -20,7 +21,8 @@ import pybullet
 from numpy.typing import NDArray
 
 from world.actors import ActorSet
-from world.client import Clock, Rate, add_ground, make_client
+from world.bump import BumpPlacement, build_speed_bumps, hull_vertices
+from world.client import GROUND_FRICTION, Clock, Rate, add_ground, make_client
 from world.ego import EgoBody, EgoParams, EgoTruth
 from world.ego_events import EgoEvents
 from world.gnss import GnssSensor, OdometrySensor
@@ -28,13 +30,24 @@ from world.hdmap import RoadMap
 from world.lidar import EGO_RAY_GROUP
 from world.quiet import quiet_c_output
 from world.rendering import attach_renderer
-from world.road_mesh import TexturedMesh, build_road_surface
+from world.road_marks import build_road_marks
+from world.road_mesh import (
+    THROUGH_LENGTH,
+    TexturedMesh,
+    build_road_surface,
+    build_through_roads,
+)
 from world.scenery import (
+    OCTAGON_PHASE,
     BuildingBox,
     SignPlacement,
+    StopSignPlacement,
     layout_buildings,
     layout_speed_limit_signs,
+    layout_stop_signs,
+    road_intrusion,
     speed_limit_sign_image,
+    stop_sign_image,
 )
 from world.sensor_setup import SensorSetup
 from world.sensors import SensorRig
@@ -45,17 +58,27 @@ TRIGGER_RATE = Rate("npc_triggers", 40)  # NPC actions' and ego events' triggers
 ACTOR_RATE = Rate("npc_motion", 120)  # NPC motion integrated and bodies moved
 SIGN_POLE_RADIUS = 0.04  # [m]
 SIGN_SEGMENTS = 24  # triangles in a round sign plate
+POLE_RGBA = (0.6, 0.6, 0.62, 1.0)  # [-] galvanised steel
 
 
 @dataclass(frozen=True, slots=True)
 class StaticScene:
     """What was built once: for the recording and the collision criterion."""
 
-    road_meshes: tuple[TexturedMesh, ...]
+    road_meshes: tuple[TexturedMesh, ...]  # the road surfaces, then the painted marks (stop
+    #   lines, crosswalks) and the speed bumps' visible surfaces
     buildings: tuple[BuildingBox, ...]
-    signs: tuple[SignPlacement, ...]
+    signs: tuple[SignPlacement, ...]  # speed-limit signs
     ground: int  # body id
     obstacle_bodies: frozenset[int]  # buildings and sign poles: touching one is a collision
+    stop_signs: tuple[StopSignPlacement, ...] = ()
+    bumps: tuple[BumpPlacement, ...] = ()
+    bump_bodies: frozenset[int] = frozenset()  # speed bumps: driven over, not collisions
+
+    @property
+    def static_bodies(self) -> frozenset[int]:
+        """Every static body with collision but the ground (what the LiDAR can hit)."""
+        return self.obstacle_bodies | self.bump_bodies
 
 
 @dataclass(frozen=True, slots=True)
@@ -106,7 +129,7 @@ class World:
             self.client, sensors, self.ego.geometry.ride_height, renderer=self.renderer,
             lidar_rng=np.random.default_rng(seeds[3]) if lidar else None,
             actor_bodies=self.actors.bodies, ground=self.scene.ground,
-            static_bodies=sorted(self.scene.obstacle_bodies),
+            static_bodies=sorted(self.scene.static_bodies),
         )
         self._truth: EgoTruth | None = None
         self._route: RouteTruth | None = None
@@ -117,17 +140,32 @@ class World:
 
     def _build_scene(self, rng: np.random.Generator) -> StaticScene:
         ground = add_ground(self.client)
-        meshes = tuple(build_road_surface(self.road))
-        for mesh in meshes:
+        painted = (*build_road_surface(self.road), *build_through_roads(self.road),
+                   *build_road_marks(self.road))
+        for mesh in painted:
             self._add_textured_mesh(mesh.name, mesh.vertices, mesh.indices, mesh.uvs,
                                     mesh.normals, mesh.texture)
+        bumps = build_speed_bumps(self.road)
+        bump_bodies = frozenset(self._add_bump(bump, mesh) for bump, mesh in bumps)
+        meshes = (*painted, *(mesh for _, mesh in bumps))
         buildings: tuple[BuildingBox, ...] = ()
         if self.spec.road.buildings is not None:
-            buildings = tuple(layout_buildings(self.road, self.spec.road.buildings, rng))
+            spec = self.spec.road.buildings
+            buildings = tuple(b for b in layout_buildings(self.road, spec, rng)
+                              if not self._on_through_road(b, spec.setback))
         obstacles = {self._add_building(b) for b in buildings}
         signs = tuple(layout_speed_limit_signs(self.road))
         obstacles |= {self._add_sign(sign) for sign in signs}
-        return StaticScene(meshes, buildings, signs, ground, frozenset(obstacles))
+        stop_signs = tuple(layout_stop_signs(self.road))
+        obstacles |= {self._add_stop_sign(i, sign) for i, sign in enumerate(stop_signs)}
+        return StaticScene(meshes, buildings, signs, ground, frozenset(obstacles),
+                           stop_signs, tuple(bump for bump, _ in bumps), bump_bodies)
+
+    def _on_through_road(self, box: BuildingBox, setback: float) -> bool:
+        """Whether a building stands on (or within `setback` of) a road left by an exit."""
+        points = np.vstack([box.footprint(), box.centre[:2]])
+        return any(road_intrusion(self.road.through_road(e, THROUGH_LENGTH), points, setback, 1)
+                   > 0.0 for e in self.road.exits)
 
     def _add_textured_mesh(
         self,
@@ -138,17 +176,29 @@ class World:
         normals: NDArray[np.float64],
         texture: NDArray[np.uint8],
     ) -> int:
-        """A visual-only body (no collision: the ground plane carries the car).
+        """A visual-only body (no collision: the ground plane carries the car)."""
+        visual = self._mesh_visual(name, vertices, indices, uvs, normals, texture)
+        return int(self.client.createMultiBody(0.0, -1, visual, useMaximalCoordinates=True))
+
+    def _mesh_visual(
+        self,
+        name: str,
+        vertices: NDArray[np.float64],
+        indices: NDArray[np.int32],
+        uvs: NDArray[np.float64],
+        normals: NDArray[np.float64],
+        texture: NDArray[np.uint8],
+    ) -> int:
+        """A textured mesh visual shape (vertices in the frame of the body it will be on).
 
         The mesh goes through a Wavefront OBJ file whose material names the texture PNG:
         both renderers load that (the EGL plugin drops meshes given as vertex arrays, and
         ignores textures attached afterwards with `changeVisualShape`)."""
-        c = self.client
         folder = Path(self._tmp.name)
         cv2.imwrite(str(folder / f"{name}.png"), cv2.cvtColor(texture, cv2.COLOR_RGB2BGR))
         _write_obj(folder / f"{name}.obj", vertices, indices, uvs, normals, f"{name}.png")
-        visual = c.createVisualShape(pybullet.GEOM_MESH, fileName=str(folder / f"{name}.obj"))
-        return int(c.createMultiBody(0.0, -1, visual, useMaximalCoordinates=True))
+        return int(self.client.createVisualShape(pybullet.GEOM_MESH,
+                                                 fileName=str(folder / f"{name}.obj")))
 
     def _add_building(self, b: BuildingBox) -> int:
         c = self.client
@@ -160,21 +210,57 @@ class World:
         return int(c.createMultiBody(0.0, shape, visual, list(b.centre), quat,
                                      useMaximalCoordinates=True))
 
-    def _add_sign(self, sign: SignPlacement) -> int:
-        """A pole (with collision) and a round textured plate facing the traffic."""
+    def _add_pole(self, xy: tuple[float, float], top: float) -> int:
+        """A sign pole standing on the ground up to `top` [m], with collision."""
         c = self.client
-        top = sign.plate_height + sign.plate_diameter / 2
         shape = c.createCollisionShape(pybullet.GEOM_CYLINDER, radius=SIGN_POLE_RADIUS,
                                        height=top)
         visual = c.createVisualShape(pybullet.GEOM_CYLINDER, radius=SIGN_POLE_RADIUS,
-                                     length=top, rgbaColor=[0.6, 0.6, 0.62, 1.0])
-        pole = int(c.createMultiBody(0.0, shape, visual, [*sign.pole_xy, top / 2],
+                                     length=top, rgbaColor=list(POLE_RGBA))
+        return int(c.createMultiBody(0.0, shape, visual, [*xy, top / 2],
                                      useMaximalCoordinates=True))
-        vertices, indices, uvs, normals = _disc_mesh(sign, offset=2 * SIGN_POLE_RADIUS)
+
+    def _add_sign(self, sign: SignPlacement) -> int:
+        """A pole (with collision) and a round textured plate facing the traffic."""
+        pole = self._add_pole(sign.pole_xy, sign.plate_height + sign.plate_diameter / 2)
+        vertices, indices, uvs, normals = _plate_mesh(
+            sign.pole_xy, sign.yaw, sign.plate_height, sign.plate_diameter / 2,
+            offset=2 * SIGN_POLE_RADIUS, sides=SIGN_SEGMENTS)
         rgba = speed_limit_sign_image(sign.kph)
         self._add_textured_mesh(f"sign_{sign.kph}_{sign.s:.0f}", vertices, indices, uvs,
                                 normals, np.ascontiguousarray(rgba[..., :3]))
         return pole
+
+    def _add_stop_sign(self, index: int, sign: StopSignPlacement) -> int:
+        """A pole (with collision) and an octagonal stop plate facing the traffic."""
+        pole = self._add_pole(sign.pole_xy, sign.plate_height + sign.corner_radius)
+        vertices, indices, uvs, normals = _plate_mesh(
+            sign.pole_xy, sign.yaw, sign.plate_height, sign.corner_radius,
+            offset=2 * SIGN_POLE_RADIUS, sides=8, phase=OCTAGON_PHASE)
+        rgba = stop_sign_image()
+        self._add_textured_mesh(f"stop_sign_{index}", vertices, indices, uvs, normals,
+                                np.ascontiguousarray(rgba[..., :3]))
+        return pole
+
+    def _add_bump(self, bump: BumpPlacement, mesh: TexturedMesh) -> int:
+        """A speed bump's static body, placed at its centre with the ground's friction: the
+        convex hull of its prism for collision (`createCollisionShape` with vertices and no
+        indices makes a convex hull) and its surface `mesh` (map frame) as the visual, in
+        the body's frame (a body without a visual shape makes the EGL plugin try to draw
+        the collision mesh from a file, and warn)."""
+        c = self.client
+        shape = c.createCollisionShape(pybullet.GEOM_MESH,
+                                       vertices=hull_vertices(bump).tolist())
+        cos, sin = math.cos(bump.yaw), math.sin(bump.yaw)
+        rotation = np.array([[cos, -sin, 0.0], [sin, cos, 0.0], [0.0, 0.0, 1.0]])
+        local = (mesh.vertices - np.array([*bump.centre, 0.0])) @ rotation
+        visual = self._mesh_visual(mesh.name, local, mesh.indices, mesh.uvs,
+                                   mesh.normals @ rotation, mesh.texture)
+        quat = c.getQuaternionFromEuler([0.0, 0.0, bump.yaw])
+        body = int(c.createMultiBody(0.0, shape, visual, [*bump.centre, 0.0], quat,
+                                     useMaximalCoordinates=True))
+        c.changeDynamics(body, -1, lateralFriction=GROUND_FRICTION)
+        return body
 
     # -- stepping ----------------------------------------------------------------------------
 
@@ -226,7 +312,8 @@ class World:
         Triggers (NPC actions and ego events) are checked at `TRIGGER_RATE` against the
         ego's true station; NPC motion is integrated and the bodies are moved at `ACTOR_RATE`
         (kinematic bodies: the contact query between moves sees the last placed pose, 1/120 s
-        old at most). Ego events only set the pedal the odometry reads.
+        old at most). Ego events set the pedal the odometry reads, and puncture tyres: the
+        ego body deflates those, advanced at each check (`EgoBody.update_tyres`).
         """
         self._step_physics()
         self.clock.advance()
@@ -238,6 +325,9 @@ class World:
                 self.clock.t, self.ego_s, self.ego.geometry.body_length
             )
             self._events.update(self.clock.t, self.ego_s)
+            for wheel in self._events.started_flats:
+                self.ego.puncture(wheel.value, self.clock.t)
+            self.ego.update_tyres(self.clock.t)
         if self.clock.step % ACTOR_RATE.every == 0:
             self.actors.step(self.clock.t, ACTOR_RATE.every * self.clock.dt)
 
@@ -284,16 +374,20 @@ def _write_obj(path: Path, vertices: NDArray[np.float64], indices: NDArray[np.in
         np.savetxt(f, np.repeat(faces, 3, axis=1), fmt="f %d/%d/%d %d/%d/%d %d/%d/%d")
 
 
-def _disc_mesh(
-    sign: SignPlacement, offset: float
+def _plate_mesh(
+    pole_xy: tuple[float, float], yaw: float, height: float, radius: float, offset: float,
+    sides: int, phase: float = 0.0,
 ) -> tuple[NDArray[np.float64], NDArray[np.int32], NDArray[np.float64], NDArray[np.float64]]:
-    """A two-sided triangle fan for a round plate, `offset` [m] in front of the pole."""
-    n = SIGN_SEGMENTS
-    normal = np.array([math.cos(sign.yaw), math.sin(sign.yaw), 0.0])
-    across = np.array([-math.sin(sign.yaw), math.cos(sign.yaw), 0.0])  # a viewer's right
-    centre = np.array([*sign.pole_xy, sign.plate_height]) + offset * normal
-    angles = np.linspace(0.0, 2 * math.pi, n, endpoint=False)
-    radius = sign.plate_diameter / 2
+    """A two-sided triangle fan for a sign plate, `offset` [m] in front of the pole, its
+    centre `height` [m] above the ground, facing `yaw`: a regular polygon of `sides` corners
+    `radius` [m] from the centre, the first at `phase` [rad] counter-clockwise from the
+    viewer's right (many sides: a round plate). A corner at angle a has the texture
+    coordinates (0.5 + 0.5 cos a, 0.5 - 0.5 sin a)."""
+    n = sides
+    normal = np.array([math.cos(yaw), math.sin(yaw), 0.0])
+    across = np.array([-math.sin(yaw), math.cos(yaw), 0.0])  # a viewer's right
+    centre = np.array([*pole_xy, height]) + offset * normal
+    angles = phase + np.linspace(0.0, 2 * math.pi, n, endpoint=False)
     ring = centre + radius * (  # u runs to the viewer's right (`across`), v down
         np.cos(angles)[:, None] * across + np.sin(angles)[:, None] * np.array([0, 0, 1.0])
     )

@@ -22,7 +22,7 @@ import numpy as np
 from avsim.scenario import load_scenario
 from world.frames import CameraFrame, CameraInfo
 from world.sensor_setup import Profile, sensor_setup
-from world.spec import RoadSpec
+from world.spec import ActorSpec, RoadSpec
 from world.world import World
 
 BASE_SCENARIO = "normal_driving"  # the scenario whose other settings the test worlds use
@@ -112,3 +112,28 @@ def close_all() -> None:
 
 
 atexit.register(close_all)
+
+
+_ACTOR_WORLDS: dict[tuple[RoadSpec, tuple[ActorSpec, ...], Profile], World] = {}
+
+
+def render_with_actors(road: RoadSpec, actors: tuple[ActorSpec, ...], s: float, lane: int = 0,
+                       profile: Profile = Profile.DEFAULT) -> CameraFrame:
+    """The front camera's frame with the ego posed at station ``s`` on the centre of ``lane``
+    of ``road``, among ``actors`` standing at their initial poses (the world, cached per
+    (road, actors, profile) and closed at exit, is never stepped)."""
+    key = (road, actors, profile)
+    if key not in _ACTOR_WORLDS:
+        spec = replace(load_scenario(BASE_SCENARIO), road=road, actors=actors, events=())
+        _ACTOR_WORLDS[key] = World(spec, sensor_setup(profile))
+    world = _ACTOR_WORLDS[key]
+    pose_ego(world, lane, s, 0.0, 0.0)
+    assert world.rig is not None
+    return world.rig.capture(world.t, world.ego.truth(), ["front"], False).frames[0]
+
+
+@atexit.register
+def _close_actor_worlds() -> None:
+    while _ACTOR_WORLDS:
+        _, world = _ACTOR_WORLDS.popitem()
+        world.close()

@@ -24,12 +24,10 @@ from world.spec import (
     AfterTrigger,
     EgoStationTrigger,
     EventSpec,
-    FlatTire,
     GapTrigger,
     ScenarioSpec,
     TimeTrigger,
     Trigger,
-    Wheel,
 )
 from world.world import TRIGGER_RATE, World
 
@@ -143,7 +141,6 @@ def test_a_later_override_replaces_a_running_one_which_ends() -> None:
     ("event", "message"),
     [
         (override(GapTrigger(10.0), 1.0, 1.0), "events.0.trigger.gap: only for actors"),
-        (EventSpec(TimeTrigger(1.0), FlatTire(Wheel.REAR_LEFT)), "events.0: FlatTire is not"),
         (override(AfterTrigger(0, 0.0), 1.0, 1.0), "events.0.trigger.after: must refer"),
     ],
 )
@@ -199,15 +196,6 @@ def test_a_gap_trigger_on_an_event_is_a_load_error_naming_the_key(tmp_path: Path
         load_scenario(path)
     assert info.value.key == "events.1.trigger.gap"
     assert str(info.value) == f"{path}: events.1.trigger.gap: only for actors (the gap to the ego)"
-
-
-def test_a_flat_tire_is_still_not_supported(tmp_path: Path) -> None:
-    text = SCENARIO + "  - trigger: {time: 3}\n    flat_tire: {wheel: rear_left}\n"
-    with pytest.raises(ScenarioError) as info:
-        load_scenario(_write(tmp_path, text))
-    assert (info.value.key, info.value.problem) == (
-        "events.3.flat_tire", "not supported yet (ego events: flat_tire)"
-    )
 
 
 # ---------------------------------------------------------------------------------------
