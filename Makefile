@@ -22,6 +22,8 @@ setup: $(STAMP)
 demo: $(STAMP)
 	$(BIN)/avsim run normal_driving --out runs/normal_driving.rrd --json runs/normal_driving.json \
 		--plot runs/normal_driving.png
+	$(BIN)/avsim run decs_route --out runs/decs_route.rrd --json runs/decs_route.json \
+		--plot runs/decs_route.png
 
 lint: $(STAMP)
 	$(BIN)/ruff check .

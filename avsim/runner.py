@@ -28,13 +28,16 @@ from avsim.criteria import (
     CriteriaSet,
     Criterion,
     CriterionResult,
+    Crosswalks,
     LaneChangeDuration,
     LaneChangeLateralAccel,
     MaxDecel,
     MinGap,
     NoCollision,
+    SpeedBumps,
     SpeedLimit,
     StandstillGap,
+    StopSigns,
     TimeToResume,
     TruthSample,
     TyresInLane,
@@ -45,7 +48,7 @@ from avsim.stack import Stack, StackOutput
 from planner.messages import StateChange
 from world.client import PHYSICS_RATE, Rate
 from world.sensor_setup import Profile, sensor_setup
-from world.spec import ScenarioSpec
+from world.spec import FlatTire, ScenarioSpec
 from world.truth import touching
 from world.world import World
 
@@ -86,12 +89,15 @@ class TrajectoryLog:
     wheel_spin: list[NDArray[np.float64]] = field(default_factory=list)  # [rad/s] (4,)
     acc_mode: list[str] = field(default_factory=list)  # the ACC / event layer's mode
     motion: list[str] = field(default_factory=list)  # the motion FSM's state
+    hazard: list[bool] = field(default_factory=list)  # the stack's hazard lights
     lane: list[int] = field(default_factory=list)  # the lane the stack keeps (cross_track's)
     changing: list[bool] = field(default_factory=list)  # a commanded lane change in hand
     pedal: list[float] = field(default_factory=list)  # [-] the driver's accelerator pedal
-    actor_station: list[NDArray[np.float64]] = field(default_factory=list)  # [m] (N,) true
+    actor_station: list[NDArray[np.float64]] = field(default_factory=list)  # [m] (N,) true,
+    #   along the road each drives on (the route; past an exit's fork, the road the route
+    #   left for traffic that kept it: `RoadMap.through_line`)
     actor_offset: list[NDArray[np.float64]] = field(default_factory=list)  # [m] (N,) true,
-    #   from the reference line, left +
+    #   from that road's reference line, left +
 
     def array(self, name: str) -> NDArray[np.float64]:
         return np.asarray(getattr(self, name), dtype=np.float64)
@@ -140,10 +146,13 @@ class Runner:
         reach = spec.criteria.reach_s
         self.completes = Completes(reach if reach is not None else w.road.length - END_MARGIN)
         self.collisions = NoCollision(names)
+        crosswalks = Crosswalks(w.road)
         self.criteria = CriteriaSet([self.collisions, TyresInLane(w.road, TYRE_HALF_WIDTH),
-                                     SpeedLimit(w.road), self.completes,
-                                     *self._optional_criteria()])
-        self._gap_criteria = any(isinstance(c, NEEDS_ACTORS) for c in self.criteria.items)
+                                     SpeedLimit(w.road), StopSigns(w.road), crosswalks,
+                                     SpeedBumps(w.road, self.car.front_axle, self.car.rear_axle),
+                                     self.completes, *self._optional_criteria()])
+        self._gap_criteria = crosswalks.needs_actors or any(
+            isinstance(c, NEEDS_ACTORS) for c in self.criteria.items)
         self.recorder = Recorder(recording, recording_name=spec.name) if recording else None
         self.sensors = None if self.setup is None else SensorLoop(
             w, self.setup, self.stack, mode, self.recorder, frame_hook)
@@ -251,6 +260,7 @@ class Runner:
         log.brake_torque.append(out.command.brake_torque)
         log.wheel_spin.append(truth.wheel_spin.copy())
         log.acc_mode.append(out.plan.acc_mode)
+        log.hazard.append(out.plan.hazard)
         log.motion.append(out.plan.motion)
         log.lane.append(out.plan.lane)
         log.changing.append(out.plan.lane != out.plan.origin_lane)
@@ -263,7 +273,7 @@ class Runner:
     def _watch(self, step: int) -> None:
         """Criteria: contact onsets at the contact rate, the rest at the criteria rate."""
         w = self.world
-        now = frozenset(touching(w.client, w.ego.body, w.scene.ground))
+        now = frozenset(touching(w.client, w.ego.body, w.scene.ground)) - w.scene.bump_bodies
         if now != self._touching:
             self._touching = now
             self._sample()
@@ -287,7 +297,16 @@ class Runner:
             lane=self._lane, origin_lane=self._origin_lane,
             lateral_accel=truth.speed * truth.yaw_rate,
             road_curvature=float(w.road.curvature_at(route.station)),
+            rear_station=route.station - self.car.body_length / 2,
+            axle_stations=(float(route.stations[1]),
+                           float(np.mean(route.stations[4:6]))),
+            flat=self._flat_fired(),
         ))
+
+    def _flat_fired(self) -> bool:
+        """A flat tyre event has happened to the ego (truth, for `completes`)."""
+        return any(t is not None and isinstance(e.event, FlatTire)
+                   for t, e in zip(self.world.event_fired_at, self.spec.events, strict=True))
 
     # -- results -------------------------------------------------------------------------------
 

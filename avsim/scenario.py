@@ -60,14 +60,8 @@ FILE_KEY = "(file)"
 # `<file>: <key.path>: not supported yet (<what>)`. Delete a line once it is simulated.
 UNSUPPORTED: dict[str, str] = {
     "town": "the town map kind",
-    "road.segments.*.exit": "exits",
-    "road.features.*.type=stop_sign": "stop signs",
-    "road.features.*.type=crosswalk": "crosswalks",
-    "road.features.*.type=speed_bump": "speed bumps",
+    "road.segments.*.exit=left": "exits on the left",
     "road.features.*.type=traffic_light": "traffic lights",
-    "actors.*.type=pedestrian": "pedestrians",
-    "actors.*.actions.*.walk": "the walk action",
-    "events.*.flat_tire": "ego events: flat_tire",
 }
 
 KeyPath = tuple[str | int, ...]
@@ -516,6 +510,13 @@ def _check_arcs(road: RoadModel) -> None:
             )
 
 
+def _check_exits(road: RoadModel) -> None:
+    """An exit leaves the road of the segment before it: not on the first segment."""
+    if road.segments and road.segments[0].exit is not None:
+        raise _LocatedError("road.segments.0.exit",
+                            "the first segment has no road before it to leave")
+
+
 def _check_ego(model: ScenarioModel, segments: Sequence[spec.SegmentSpec]) -> None:
     ego = model.ego
     for town_key in ("start", "route"):
@@ -781,6 +782,7 @@ def _build(model: ScenarioModel) -> spec.ScenarioSpec:
         raise _LocatedError("town", f"not supported yet ({UNSUPPORTED.get('town', 'town maps')})")
     road_spec = _road_spec(model.road)
     _check_arcs(model.road)
+    _check_exits(model.road)
     _check_ego(model, road_spec.segments)
     _check_actors(model, road_spec.segments)
     _check_rest(model, model.road, road_spec.segments)

@@ -176,8 +176,8 @@ class SegmentModel(_Model):
     exit: SideName | None = Field(
         default=None,
         description="right | left: this segment leaves the road before it by an exit from its "
-        "right / left edge; that road goes on straight as scenery. Default: none. "
-        "Not supported yet.",
+        "right / left edge; that road goes on straight as scenery (left: not supported "
+        "yet). Default: none.",
     )
 
     @model_validator(mode="after")
@@ -195,14 +195,14 @@ class SpeedLimitFeature(_Model):
 
 
 class StopSignFeature(_Model):
-    """A stop line across the route with a stop sign on the right. Not supported yet."""
+    """A stop line across the route with a stop sign on the right."""
 
     type: Literal["stop_sign"] = Field(description="Feature type `stop_sign`.")
     s: NonNegFloat = Field(description="[m] station of the stop line; required, on the route.")
 
 
 class CrosswalkFeature(_Model):
-    """A zebra crossing from `s` to `s + width`. Not supported yet."""
+    """A zebra crossing from `s` to `s + width`."""
 
     type: Literal["crosswalk"] = Field(description="Feature type `crosswalk`.")
     s: NonNegFloat = Field(description="[m] station of the near edge; required, on the route.")
@@ -210,7 +210,7 @@ class CrosswalkFeature(_Model):
 
 
 class SpeedBumpFeature(_Model):
-    """A speed bump across the road. Not supported yet."""
+    """A speed bump across the road."""
 
     type: Literal["speed_bump"] = Field(description="Feature type `speed_bump`.")
     s: NonNegFloat = Field(description="[m] station of the bump's centre; required, on the route.")
@@ -386,7 +386,8 @@ class LaneChangeActionModel(_Model):
 
 
 class WalkActionModel(_Model):
-    """A pedestrian walks across to a lateral offset. Not supported yet."""
+    """Walk across the road to a lateral offset from the actor's lane centre, at a walking
+    speed (reached and left at 1.5 m/s^2), facing the walking direction; then stand."""
 
     to_offset: float = Field(
         description="[m] lateral offset from the actor's lane centre to walk to, left "
@@ -416,7 +417,7 @@ class ActionModel(_Model):
         default=None, description="Change lane: `{to_lane, lateral_speed}`."
     )
     walk: WalkActionModel | None = Field(
-        default=None, description="Walk across: `{to_offset, speed_kph}`. Not supported yet."
+        default=None, description="Walk across: `{to_offset, speed_kph}`."
     )
     stop: StopActionModel | None = Field(
         default=None, description="Brake to a stop: `{}` (optional `decel`)."
@@ -449,7 +450,7 @@ class AcceleratorOverrideModel(_Model):
 
 
 class FlatTireModel(_Model):
-    """A tyre goes flat. Not supported yet."""
+    """A tyre goes flat."""
 
     wheel: WheelName = Field(
         description="front_left | front_right | rear_left | rear_right; required."
@@ -535,7 +536,7 @@ class ActorModel(_Model):
     id: Identifier = Field(description="Unique name, [a-z0-9_]+; required.")
     type: ActorTypeName = Field(
         description="car | truck | pedestrian | obstacle (a static box); required. "
-        "`pedestrian` is not supported yet."
+        "A pedestrian is a 0.5 x 0.6 x 1.75 m body; its speed_kph is a walking speed."
     )
     lane: int | None = Field(
         default=None,
@@ -598,7 +599,7 @@ class SensorsModel(_Model):
         default=None, description="GNSS noise `{sigma, heading_sigma_deg, bias}`."
     )
     lidar: LidarModel | None = Field(
-        default=None, description="LiDAR noise `{range_sigma, dropout}`. Not supported yet."
+        default=None, description="LiDAR noise `{range_sigma, dropout}`."
     )
 
 

@@ -19,11 +19,14 @@ from control.actuation import VehicleParams
 from control.command import VehicleCommand
 from control.stanley import StanleyParams
 from control.vehicle_controller import VehicleController, VehicleControllerParams
+from perception.flat_tyre import FlatTyreDetector, FlatTyreParams
 from perception.lanes import LaneDetector, LaneFilter
 from perception.localization import Localizer
 from perception.messages import Detection, EgoState, LaneEstimate, Track
 from perception.objects import ObjectDetector
+from perception.signs import StopSignDetector
 from perception.tracking import MultiObjectTracker
+from planner.events import EventParams
 from planner.lane_keeping import LaneKeepingParams, LaneKeepingPlanner, LaneView
 from planner.messages import Plan
 from planner.motion_layer import MotionLayerParams
@@ -63,7 +66,10 @@ class Stack:
         self.planner = LaneKeepingPlanner(
             road, LaneKeepingParams(set_speed=ego.set_speed, max_speed=ego.max_speed,
                                     lane=ego.lane, camera=front_camera is not None,
-                                    motion=MotionLayerParams(overtake=ego.overtake))
+                                    motion=MotionLayerParams(overtake=ego.overtake),
+                                    events=EventParams(front_overhang=car.front_overhang,
+                                                       front_axle=car.front_axle,
+                                                       rear_axle=car.rear_axle))
         )
         lateral = StanleyParams(
             wheelbase=car.wheelbase, centre_to_front_axle=car.front_axle,
@@ -74,8 +80,12 @@ class Stack:
             VehicleControllerParams(lateral=lateral, vehicle=vehicle)
         )
         self.lane_detector = LaneDetector(front_camera) if front_camera is not None else None
+        self.sign_detector = StopSignDetector(front_camera) if front_camera is not None \
+            else None
         self.lane_filter = LaneFilter()
         self.object_detector = ObjectDetector()
+        self.flat_detector = FlatTyreDetector(FlatTyreParams(track=car.track,
+                                                             wheelbase=car.wheelbase))
         self.tracker = MultiObjectTracker()
         self._times: list[float] = []  # [s] of the poses below, increasing
         self._poses: list[EgoState] = []
@@ -89,6 +99,7 @@ class Stack:
     def on_odometry(self, odo: Odometry) -> None:
         self.localizer.on_odometry(odo)
         self._pedal = odo.accelerator_pedal
+        self.flat_detector.update(odo)
 
     def on_sensors(self, t: float, frames: tuple[CameraFrame, ...],
                    scan: LidarScan | None) -> PerceptionOutput | None:
@@ -104,6 +115,9 @@ class Stack:
             lane_raw = self.lane_detector.detect(front, prior)
             lane = self.lane_filter.update(lane_raw, pose.speed, pose.yaw_rate)
             self._view = LaneView(lane, pose)
+        if front is not None and self.sign_detector is not None:
+            signs = self.sign_detector.detect(front)
+            self.planner.events.see_signs(signs, pose)
         detections = tracks = None
         if scan is not None:
             detections = self.object_detector.detect(scan)
@@ -114,7 +128,8 @@ class Stack:
     def tick(self, t: float, dt: float) -> StackOutput:
         ego = self.localizer.estimate(t)
         self._remember(ego)
-        plan = self.planner.update(ego, self._view, self._tracks, self._pedal)
+        plan = self.planner.update(ego, self._view, self._tracks, self._pedal,
+                                   flat=self.flat_detector.state is not None)
         return StackOutput(plan, self.controller.update(plan, dt))
 
     def _remember(self, ego: EgoState) -> None:

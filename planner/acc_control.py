@@ -30,7 +30,10 @@ equations are missing; these are designed here. Speeds in m/s, gaps in metres.
   ``v_ref = sqrt(2 a_comf max(s_stop - margin, 0))`` with the same ease-in as BRAKE.
 - SPEED_BUMP: cross at the bump's pass speed: ``v_ref = sqrt(v_pass^2 + 2 a_comf max(d_bump
   - margin, 0))``, where d_bump is the front axle's distance to the bump.
-- FLAT: ease off to a stop at no more than a_flat (4 m/s^2), jerk limited.
+- FLAT: ease off at a_flat_plan (2 m/s^2; the DECS limit a_flat is 4 m/s^2) to a crawl,
+  v_pull_over (3 m/s), while the motion FSM pulls the car onto the shoulder, then to a stop
+  there: the reference falls from the speed at that rate, and the speed loop's jerk limit
+  eases it in.
 
 Every law ends in ``min(v_ref, v_plan)``: no mode ever plans faster than the map allows.
 """
@@ -48,7 +51,9 @@ class AccControlParams:
     a_firm: float = 3.0  # [m/s^2] the most BRAKE plans unless a collision is imminent
     a_hard: float = 5.0  # [m/s^2] the most BRAKE plans when it is
     ttc_hard: float = 2.5  # [s] time to collision below which a_hard is allowed
-    a_flat: float = 4.0  # [m/s^2] the most FLAT plans
+    a_flat: float = 4.0  # [m/s^2] the most FLAT may plan (DECS acceptance)
+    a_flat_plan: float = 2.0  # [m/s^2] the deceleration FLAT plans: a gentle stop
+    v_pull_over: float = 3.0  # [m/s] FLAT's crawl while the car pulls onto the shoulder
     j_in: float = 4.0  # [m/s^3] how fast a hard deceleration eases in
     d_stop: float = 2.0  # [m] gap BRAKE aims to keep at the lead's speed
     margin: float = 1.0  # [m] stop / pass points are aimed this far before the point

@@ -4,12 +4,17 @@ the lead track, and the mode's controller (`planner.acc_control`) giving the tar
 Per tick: the lead's gap is carried from its track's time to now with the relative speed
 (``d_now = d + (V_l - v) (t - t_track)``: tracks are one sensor period old); V_GPS is the
 posted limit at the front bumper; V_s the set speed. The FSM steps once; the mode's law gives
-the speed reference, never above the map's plan. Events (ramp, pedestrian, bump, stop sign,
-flat) are not detected yet: their modes keep the map's plan (the DECS route, issue D).
+the speed reference, never above the map's plan. The events (`planner.events`) enter the
+event modes; their laws (`planner.acc_control`): OFF_RAMP the map's plan (the ramp's limit
+is a posting), STOP_SIGN and PEDESTRIAN a stop at the event's stop point, SPEED_BUMP the
+pass speed at the bump, FLAT down at ``a_flat_plan`` to ``v_pull_over`` while the car pulls
+over, then to a stop on the shoulder. A vehicle ahead still counts in an
+event mode: the reference is the lower of the event's law and the trail law behind it.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 from planner.acc import AccInput, AccMode, AccParams, gaps, transition
@@ -19,9 +24,16 @@ from planner.acc_control import (
     SpeedRef,
     brake_cap,
     braking_need,
+    pass_speed,
+    stop_speed,
     trail,
 )
+from planner.events import Events
 from planner.messages import Lead, StateChange
+
+NO_EVENTS = Events()
+EVENT_LAWS = frozenset({AccMode.OFF_RAMP, AccMode.PEDESTRIAN, AccMode.SPEED_BUMP,
+                        AccMode.STOP_SIGN, AccMode.FLAT})
 
 
 @dataclass(frozen=True, slots=True)
@@ -38,10 +50,11 @@ class AccLayer:
         self.mode = AccMode.ACC_OFF
         self._brake = EasedBrake()
         self.lead_gap = float("inf")  # [m] the last update's lead gap, carried to its time
+        self._flat: float | None = None  # [m/s] FLAT's ramped reference
 
     def update(self, t: float, dt: float, v: float, set_speed: float, limit: float,
                plan: SpeedRef, lead: Lead | None, driver_gap: float | None = None,
-               ) -> tuple[SpeedRef, tuple[StateChange, ...]]:
+               events: Events = NO_EVENTS) -> tuple[SpeedRef, tuple[StateChange, ...]]:
         """The speed reference now [m/s, m/s^2] and the mode change made, if any.
 
         `v` ego speed, `limit` the posted limit at the front bumper (V_GPS), `plan` the map's
@@ -50,13 +63,42 @@ class AccLayer:
         d, v_l = (lead.gap + (lead.speed - v) * max(t - lead.t, 0.0), lead.speed) \
             if lead is not None else (float("inf"), float("inf"))
         self.lead_gap = d
-        x = AccInput(acc_on=set_speed > 0.0, v=v, v_s=set_speed, v_gps=limit, d=d, v_l=v_l)
+        x = AccInput(acc_on=set_speed > 0.0, v=v, v_s=set_speed, v_gps=limit, d=d, v_l=v_l,
+                     off_ramp=events.off_ramp, pedestrian=events.pedestrian,
+                     speed_bump=events.speed_bump, stop_sign=events.stop_sign,
+                     flat=events.flat)
         changes: tuple[StateChange, ...] = ()
         change = transition(self.mode, x, self.params.modes)
         if change is not None:
             changes = (StateChange(t, "acc", self.mode.value, change.to.value, change.reason),)
             self.mode = change.to
+        if self.mode in EVENT_LAWS:
+            return self._event(x, dt, plan, events), changes
         return self._control(x, dt, plan, driver_gap), changes
+
+    def _event(self, x: AccInput, dt: float, plan: SpeedRef, events: Events) -> SpeedRef:
+        """The event mode's law, never above the trail law behind a vehicle ahead."""
+        c, m = self.params.control, self.params.modes
+        self._brake.reset()
+        if self.mode is AccMode.FLAT:  # down to a crawl until on the shoulder, then a stop
+            floor = 0.0 if events.pulled_over else min(c.v_pull_over, plan.speed)
+            self._flat = plan.speed if self._flat is None else self._flat
+            self._flat = max(min(self._flat, x.v) - c.a_flat_plan * dt, floor)
+            ref = SpeedRef(self._flat, -c.a_flat_plan if self._flat > floor else 0.0)
+        elif self.mode is AccMode.SPEED_BUMP:
+            v = pass_speed(events.bump_distance, events.bump_speed, plan.speed, c)
+            braking = events.bump_speed < v < plan.speed  # on the braking curve
+            ref = SpeedRef(v, -c.a_comf if braking else 0.0 if v < plan.speed else plan.accel)
+        elif self.mode in (AccMode.STOP_SIGN, AccMode.PEDESTRIAN):
+            v = stop_speed(events.stop_distance, plan.speed, c)
+            ref = SpeedRef(v, -c.a_comf if 0.0 < v < plan.speed else 0.0)
+        else:
+            ref = plan
+        if math.isfinite(x.d):
+            following = trail(plan.speed, x.d, gaps(x.v, x.v_l, m).d_des, x.v_l, m.d0, c)
+            if following.speed < ref.speed:
+                return following
+        return ref
 
     def _control(self, x: AccInput, dt: float, plan: SpeedRef,
                  driver_gap: float | None) -> SpeedRef:

@@ -34,13 +34,14 @@ from planner.acc_layer import AccLayer, AccLayerParams
 from planner.camera_lane import camera_lane_path
 from planner.control_layer import ControlLayer
 from planner.driver_override import DriverOverride, OverrideParams
+from planner.events import EventMonitor, EventParams
 from planner.lane_source import LaneSource, LaneSourceInput, LaneSourceParams, transition
 from planner.lead import LeadAccel, LeadParams, select_lead
 from planner.messages import Lead, Plan, ReferencePath, StateChange
 from planner.motion_layer import Manoeuvre, MotionLayer, MotionLayerParams
 from planner.route import lane_path
 from planner.speed_planning import SpeedPlanner, SpeedPlanningParams, SpeedTarget
-from world.hdmap import RoadMap
+from world.hdmap import SHOULDER, RoadMap
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -68,6 +69,7 @@ class LaneKeepingParams:
     acc: AccLayerParams = field(default_factory=AccLayerParams)
     motion: MotionLayerParams = field(default_factory=MotionLayerParams)
     override: OverrideParams = field(default_factory=OverrideParams)
+    events: EventParams = field(default_factory=EventParams)
     camera_agree: float = 1.0  # [m] the camera's lane is used only within this of the map's
 
 
@@ -96,7 +98,9 @@ class LaneKeepingPlanner:
         self.control = ControlLayer()
         self.lead_accel = LeadAccel()
         self.driver = DriverOverride(self.params.override)
+        self.events = EventMonitor(self.road, self.params.events)
         self._camera_ok = False  # the camera's lane is seen and agrees with the map's
+        self._hazard = False  # the hazard lights (on from a flat tyre)
 
     def _keep(self, lane: int) -> None:
         """Make `lane` the lane whose stations, speed plan and map path are used."""
@@ -128,17 +132,18 @@ class LaneKeepingPlanner:
             max_speed=p.max_speed)
 
     def update(self, ego: EgoState, view: LaneView | None = None,
-               tracks: Sequence[Track] = (), pedal: float = 0.0) -> Plan:
+               tracks: Sequence[Track] = (), pedal: float = 0.0, flat: bool = False) -> Plan:
         """The plan for this tick, made from ``ego`` (map frame, car centre), the camera's
-        lane ``view`` (None before the first frame), the confirmed ``tracks`` and the
-        driver's accelerator ``pedal`` position (0..1, `planner.driver_override`)."""
+        lane ``view`` (None before the first frame), the confirmed ``tracks``, the driver's
+        accelerator ``pedal`` position (0..1, `planner.driver_override`) and whether a flat
+        tyre has been detected."""
         dt = 0.0 if self._last_t is None else max(ego.t - self._last_t, 0.0)
         self._last_t = ego.t
         changes = self._update_source(ego.t, view)
         station, lateral = self.localise(ego)
         target = self.speed_for(station)
         want = min(self.params.set_speed, target.limit_at_front)
-        manoeuvre, motion_changes = self.motion.update(ego, want, tracks)
+        manoeuvre, motion_changes = self.motion.update(ego, want, tracks, pull_over=flat)
         if manoeuvre.lane != self.lane_index:  # a lane change began, ended or was aborted
             self._keep(manoeuvre.lane)
             station, lateral = self.localise(ego)
@@ -148,16 +153,24 @@ class LaneKeepingPlanner:
         plan_ref, driver = self.driver.update(
             pedal, ego.speed, SpeedRef(target.speed, target.accel),
             lambda: self.speed_for(station, self.params.max_speed), dt)
+        events = self.events.update(ego.t, station, ego.speed,
+                                    float(self.lane.offset_at(station)),
+                                    float(self.lane.width_at(station)), tracks, flat,
+                                    pulled_over=manoeuvre.lane == SHOULDER
+                                    and manoeuvre.path is None)
         ref, acc_changes = self.acc.update(ego.t, dt, ego.speed, self.params.set_speed,
                                            target.limit_at_front, plan_ref, lead,
                                            driver_gap=self.params.override.gap_margin
-                                           if driver else None)
+                                           if driver else None, events=events)
         speed, accel = self._degraded_cap(ref.speed, ref.accel, ego.speed, dt)
         control, control_changes = self.control.update(
             ego.t, ego.speed, speed, accel, self.acc.lead_gap, lead,
             self.lead_accel.update(lead))
         if control.emergency:
             speed, accel = 0.0, -self.control.decel
+        if flat and not self._hazard:  # the hazard lights go on, and stay on
+            self._hazard = True
+            control_changes += (StateChange(ego.t, "hazard", "off", "on", "flat tyre"),)
         return Plan(
             t=ego.t,
             ego=ego,
@@ -174,6 +187,7 @@ class LaneKeepingPlanner:
             lane=manoeuvre.lane,
             origin_lane=manoeuvre.origin,
             control=control.state,
+            hazard=self._hazard,
             changes=changes + motion_changes + acc_changes + control_changes,
         )
 

@@ -65,4 +65,5 @@ class Plan:
     lane: int = 0  # the lane kept, or moved into by a lane change
     origin_lane: int = 0  # the lane a lane change in hand leaves (== lane otherwise)
     control: ControlState = ControlState.SPEED_KEEPING  # the control FSM's state
+    hazard: bool = False  # the hazard lights: on from a flat tyre's detection
     changes: tuple[StateChange, ...] = ()  # state changes made in this tick

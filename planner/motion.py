@@ -15,6 +15,7 @@ lane, `MotionChange.abort`); after it, finishing is the safer way out.
 
 | from              | to                | when                                                  |
 |-------------------|-------------------|-------------------------------------------------------|
+| LANE_KEEP         | LANE_CHANGE_RIGHT | a flat tyre: pull over (right lane, then shoulder)    |
 | LANE_KEEP         | TURN_RIGHT        | the route turns right at the junction being entered   |
 | LANE_KEEP         | TURN_LEFT         | the route turns left there                            |
 | LANE_KEEP         | U_TURN            | the route turns back there                            |
@@ -28,7 +29,9 @@ lane, `MotionChange.abort`); after it, finishing is the safer way out.
 | LANE_CHANGE_RIGHT | LANE_KEEP (abort) | the target lane is no longer free, not yet committed  |
 | TURN_RIGHT, TURN_LEFT, U_TURN | LANE_KEEP | the turn is done (in the exit lane)           |
 
-Rows are tried top to bottom. Out of LANE_KEEP, route needs come before overtaking, and
+Rows are tried top to bottom. A flat tyre comes first and stops everything else: the car
+moves right lane by lane (`right_free` then means the next lane, or the paved shoulder from
+lane 0) and stays on the shoulder. Out of LANE_KEEP, route needs come before overtaking, and
 overtaking waits `keep_time` after the last change (no weaving); a route lane change waits
 `route_keep_time` only.
 """
@@ -82,6 +85,7 @@ class MotionInput:
     change_done: bool = False  # the lane change's path is finished
     turn: Turn | None = None  # the route's command at the junction being entered
     turn_done: bool = False  # the turn's path is finished
+    pull_over: bool = False  # a flat tyre: get onto the shoulder
 
 
 @dataclass(frozen=True, slots=True)
@@ -108,6 +112,10 @@ def transition(state: Motion, x: MotionInput, p: MotionParams) -> MotionChange |
 
 
 def _from_lane_keep(x: MotionInput, p: MotionParams) -> MotionChange | None:
+    if x.pull_over:
+        if x.right_free and x.t - x.since >= p.route_keep_time:
+            return MotionChange(Motion.LANE_CHANGE_RIGHT, "a flat tyre: pull over")
+        return None
     if x.turn is not None:
         return MotionChange(_TURN_STATE[x.turn], f"the route turns {x.turn.value} here")
     waited = x.t - x.since

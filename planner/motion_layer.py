@@ -19,6 +19,8 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 
+import numpy as np
+
 from perception.messages import EgoState, Track
 from planner.acc import AccParams
 from planner.lane_change_path import LaneChangeParams, LaneChangePath, start_lane_change
@@ -32,7 +34,7 @@ from planner.lane_occupancy import (
 )
 from planner.messages import StateChange
 from planner.motion import LANE_CHANGES, Motion, MotionInput, MotionParams, transition
-from world.hdmap import RoadMap
+from world.hdmap import SHOULDER, RoadMap
 
 
 @dataclass(frozen=True, slots=True)
@@ -40,6 +42,8 @@ class MotionLayerParams:
     overtake: bool = False  # the driver allows lane changes to pass slower vehicles
     blocked_time: float = 1.0  # [s] blocked this long before it counts
     half_width: float = 0.9  # [m] half the ego's width, mirrors included
+    prepare_distance: float = 150.0  # [m] a lane ending this near ahead is left ...
+    prepare_time: float = 12.0  # [s] ... or this many seconds ahead at the present speed
     motion: MotionParams = field(default_factory=MotionParams)
     occupancy: OccupancyParams = field(default_factory=OccupancyParams)
     lane_change: LaneChangeParams = field(default_factory=LaneChangeParams)
@@ -68,11 +72,14 @@ class MotionLayer:
         self.lane = self.origin = lane
         self.path: LaneChangePath | None = None
         self._since = -math.inf  # [s] time of the last motion change (none yet)
+        self._pull_over = False
         self._blocked_since: float | None = None
 
-    def update(self, ego: EgoState, v_want: float,
-               tracks: Sequence[Track]) -> tuple[Manoeuvre, tuple[StateChange, ...]]:
-        """Step with the ego estimate, the speed it wants [m/s] and the confirmed tracks."""
+    def update(self, ego: EgoState, v_want: float, tracks: Sequence[Track],
+               pull_over: bool = False) -> tuple[Manoeuvre, tuple[StateChange, ...]]:
+        """Step with the ego estimate, the speed it wants [m/s], the confirmed tracks and
+        whether to pull over onto the shoulder (a flat tyre)."""
+        self._pull_over = pull_over
         s, d = (float(a) for a in self.road.local_coordinates((ego.x, ego.y)))
         lanes = self._lanes_around(s, ego.speed)
         traffic = lane_traffic(self.road, tracks, ego.t, s, ego.speed, lanes,
@@ -96,8 +103,24 @@ class MotionLayer:
         reach = min(s + max(v, 5.0) * self.params.lane_change.t_cap, self.road.length)
         n_later = self.road.lanes_at(reach)
         near = {self.lane, self.origin}
-        near.update(k for k in (self.lane - 1, self.lane + 1) if 0 <= k < min(n_now, n_later))
+        if self.lane != SHOULDER:
+            near.update(k for k in (self.lane - 1, self.lane + 1)
+                        if 0 <= k < min(n_now, n_later))
+        if self.lane == 0 and self._pull_over and self.road.shoulder.exists_at(s):
+            near.add(SHOULDER)
         return tuple(sorted(near))
+
+    def _right_of(self, lane: int) -> int:
+        """The lane to the right of `lane`; from lane 0, the shoulder when pulling over."""
+        return SHOULDER if lane == 0 and self._pull_over else lane - 1
+
+    def _lanes_ahead(self, s: float, v: float) -> int:
+        """The fewest ego-direction lanes from `s` to `prepare` ahead (a lane that ends
+        there, at an exit or a lane drop, must be left in time)."""
+        end = s + max(self.params.prepare_distance, self.params.prepare_time * v)
+        line = self.road.line
+        first, last = (int(i) for i in line.segment_index(np.array([s, min(end, line.length)])))
+        return min(self.road.sections[i].lanes for i in range(first, last + 1))
 
     def _input(self, ego: EgoState, s: float, d: float, v_want: float,
                traffic: dict[int, LaneTraffic]) -> MotionInput:
@@ -108,11 +131,14 @@ class MotionLayer:
         elif self._blocked_since is None:
             self._blocked_since = t
         blocked = self._blocked_since is not None and t - self._blocked_since >= p.blocked_time
-        left, right = traffic.get(self.lane + 1), traffic.get(self.lane - 1)
+        left = traffic.get(self.lane + 1) if self.lane != SHOULDER else None
+        right = traffic.get(self._right_of(self.lane)) if self.lane != SHOULDER else None
         x = MotionInput(
             t=t, since=self._since, overtake=p.overtake, blocked=blocked,
             left_free=left is not None and is_free(left, v, p.occupancy),
             right_free=right is not None and is_free(right, v, p.occupancy),
+            route_lane=min(self._lanes_ahead(s, v) - 1 - self.lane, 0),
+            pull_over=self._pull_over and self.lane != SHOULDER,
         )
         if self.motion not in LANE_CHANGES or self.path is None:
             return x
@@ -126,7 +152,8 @@ class MotionLayer:
         self._blocked_since = None
         if to in LANE_CHANGES:
             self.origin = self.lane
-            self.lane += 1 if to is Motion.LANE_CHANGE_LEFT else -1
+            self.lane = self.lane + 1 if to is Motion.LANE_CHANGE_LEFT else \
+                self._right_of(self.lane)
             self.path = self._plan_into(self.lane, ego)
         elif abort:  # back to the origin; both lanes are in use until the path's end
             self.lane, self.origin = self.origin, self.lane

@@ -119,7 +119,6 @@ def _stripped_example() -> dict[str, Any]:
     del data["road"]["segments"][3]["exit"]
     data["road"]["features"] = data["road"]["features"][:1]
     data["actors"] = data["actors"][:2]
-    data["events"] = data["events"][:1]  # the accelerator override; not the flat tyre
     return data
 
 
@@ -180,7 +179,7 @@ BAD: dict[str, tuple[str, str]] = {
     "no_map": ("road", "a map is required"),
     "bad_name": ("name", "must match [a-z0-9_]+"),
     "wrong_format": ("format", "must be avsim/1, got 'avsim/2'"),
-    "unsupported_feature": ("road.features.0.type", "not supported yet (stop signs)"),
+    "unsupported_feature": ("road.features.0.type", "not supported yet (traffic lights)"),
     "unsupported_town": ("town", "not supported yet (the town map kind)"),
     "bad_lidar_dropout": ("sensors.lidar.dropout", "must be <= 1, got 1.5"),
 }
@@ -292,6 +291,7 @@ def test_example_converts(tmp_path: Path) -> None:
     assert loaded.sensors.gnss.heading_sigma == pytest.approx(math.radians(0.2))
     assert loaded.events == (
         spec.EventSpec(spec.TimeTrigger(20.0), spec.AcceleratorOverride(pedal=1.0, duration=5.0)),
+        spec.EventSpec(spec.TimeTrigger(38.0), spec.FlatTire(spec.Wheel.REAR_LEFT)),
     )
     assert loaded.criteria == spec.CriteriaSpec(min_gap="r157", max_decel=5.0, reach_s=560.0)
 
@@ -322,6 +322,8 @@ def test_each_unsupported_entry_is_refused(
 ) -> None:
     monkeypatch.setattr(scenario_module, "UNSUPPORTED", {pattern: UNSUPPORTED[pattern]})
     text = TOWN_EXAMPLE if pattern == "town" else FULL_EXAMPLE
+    if pattern == "road.segments.*.exit=left":  # the example's exit is on the right
+        text = text.replace("exit: right", "exit: left")
     error = _error(_write(tmp_path, text))
     regex = re.escape(pattern.split("=", maxsplit=1)[0]).replace(r"\*", r"\d+")
     assert re.fullmatch(regex, error.key), error

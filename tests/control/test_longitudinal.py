@@ -114,3 +114,21 @@ def test_gains_are_time_constants() -> None:
     p = SpeedParams()
     assert p.kp == pytest.approx(1 / 0.8)
     assert p.ki == pytest.approx(p.kp / 4.0)
+
+
+def _against_a_bump(params: SpeedParams, target: float, duration: float) -> float:
+    """Start at rest against an obstacle that lets the car go only under a request above
+    2.2 m/s^2 (a speed bump's face, measured: ~900 N m); returns the time it moved [s]."""
+    c, speed = SpeedController(params), 0.0
+    for k in range(round(duration / CONTROL_DT)):
+        command = c.update(target, 0.0, speed, CONTROL_DT)
+        if command.accel > 2.2:
+            return k * CONTROL_DT
+    return float("inf")
+
+
+def test_a_stalled_car_presses_on_until_it_moves() -> None:
+    target = 4.5 / 3.6  # [m/s] a speed bump's pass speed
+    assert _against_a_bump(SpeedParams(), target, 10.0) < 3.0
+    # without the stall rule the speed error is beyond the integration band: it stays put
+    assert _against_a_bump(replace(SpeedParams(), stall_speed=0.0), target, 10.0) == float("inf")

@@ -20,6 +20,14 @@ def x(**kw: object) -> MotionInput:
 
 # (name, from, input, expected next state or None to stay, abort)
 TABLE = [
+    # LANE_KEEP -> pull over (a flat tyre), before anything else
+    ("keep_pull_over", M.LANE_KEEP, x(pull_over=True, right_free=True), M.LANE_CHANGE_RIGHT,
+     False),
+    ("keep_pull_over_first", M.LANE_KEEP,
+     x(pull_over=True, right_free=True, turn=Turn.LEFT, blocked=True, left_free=True),
+     M.LANE_CHANGE_RIGHT, False),
+    ("keep_pull_over_waits_for_the_gap", M.LANE_KEEP,
+     x(pull_over=True, blocked=True, left_free=True, turn=Turn.LEFT), None, False),
     # LANE_KEEP -> turns (the route's command at the junction)
     ("keep_turn_right", M.LANE_KEEP, x(turn=Turn.RIGHT), M.TURN_RIGHT, False),
     ("keep_turn_left", M.LANE_KEEP, x(turn=Turn.LEFT), M.TURN_LEFT, False),

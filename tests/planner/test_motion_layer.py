@@ -4,6 +4,8 @@ end, and aborts back to its lane when a fast car comes up behind in the target l
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import pytest
 
 from perception.messages import EgoState, ObjectClass, Track
@@ -11,6 +13,8 @@ from planner.acc import AccParams
 from planner.motion import Motion
 from planner.motion_layer import MotionLayer, MotionLayerParams
 from tests.roads import W, make_map, seg
+from world.hdmap import SHOULDER
+from world.spec import Side
 
 ROAD = make_map(seg(1000.0))
 V = 13.9  # [m/s]
@@ -81,3 +85,30 @@ def test_aborts_when_the_target_lane_stops_being_free() -> None:
     assert steps[-1][1] is Motion.LANE_KEEP and steps[-1][2] == 0  # back to lane 0
     assert m.path is not None and m.path.target_index == 0  # on the way back
     assert m.origin == 1  # both lanes in use until the path's end
+
+
+def test_moves_to_the_lane_that_goes_on_before_an_exit() -> None:
+    ramp = replace(seg(100.0, lanes=1, oncoming=0), exit=Side.RIGHT)
+    road = make_map(seg(600.0), ramp)
+    m = MotionLayer(road, 1, AccParams(), MotionLayerParams())  # no overtaking: a route need
+    far = m.update(ego(0.0, 100.0 + V * 0.0, W), V, [])[0]  # 500 m before the fork
+    assert far.motion is Motion.LANE_KEEP
+    man, changes = m.update(ego(1.0, 450.0, W), V, [])  # 150 m before it
+    assert man.motion is Motion.LANE_CHANGE_RIGHT and man.lane == 0 and man.origin == 1
+    assert "route" in changes[0].reason
+
+
+def test_a_flat_tyre_pulls_over_lane_by_lane_onto_the_shoulder() -> None:
+    m = MotionLayer(ROAD, 1, AccParams(), MotionLayerParams())
+    t, x, y, lanes = 0.0, 100.0, W, []
+    while t < 20.0:
+        man, _ = m.update(ego(t, x, y), V, [], pull_over=True)
+        if man.path is not None:
+            y = float(ROAD.lane(man.path.target_index).offset_at(x)) + float(
+                man.path.offset_at(x))
+        lanes.append(man.lane)
+        t, x = t + 0.025, x + V * 0.025
+    assert lanes[0] == 0 and lanes[-1] == SHOULDER  # lane 1 -> 0 -> the shoulder
+    assert sorted(set(lanes), key=lanes.index) == [0, SHOULDER]
+    assert m.motion is Motion.LANE_KEEP and m.path is None
+    assert y == pytest.approx(float(ROAD.shoulder.offset_at(x)))

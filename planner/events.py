@@ -1,0 +1,178 @@
+"""The DECS events for the ACC layer, from the HD map and what perception found: the exit
+ramp, a stop sign, a pedestrian at a crosswalk, a speed bump, a flat tyre.
+
+Each tick (stations along the route; the car's front bumper f, front axle a_f, rear axle a_r):
+
+- off_ramp: the car's centre is on a segment of zone `ramp` (the paper's [Off_Ramp]).
+- stop_sign: the next stop line of the map ahead, at L, once perception has confirmed its
+  sign (`see_signs`: the camera's stop sign, placed on the map, near the line), from
+  ``approach(v)`` before it until the car has stood (below ``stopped_speed``) for
+  ``stop_hold`` with its front bumper 0 to 4 m before the line; then the line is done
+  until the car has passed it. The car aims to stand ``stop_margin`` +
+  the controller's margin before the line (`stop_distance` = L - f - stop_margin).
+- pedestrian: a crosswalk ahead (from ``approach(v)`` before it, while the front bumper has
+  not reached it) with a pedestrian track on it or within ``crossing_margin`` of it along
+  the route, whose centre is, or will be within ``look_ahead`` at its velocity, inside the
+  lane kept widened by ``lane_margin`` on each side; the car stops ``crossing_stop`` before
+  the zebra and waits until it is clear.
+- speed_bump: from ``approach(v)`` before a bump's near edge until the rear axle is
+  ``bump_margin`` past its far edge; the speed at the bump is its pass speed less
+  ``bump_undershoot``, reached ``bump_margin`` before the near edge by the front axle.
+- flat: a flat tyre detected from the car's own signals; pulled_over once the motion layer
+  has brought the car onto the shoulder.
+
+``approach(v) = v^2 / (2 a_comf) + approach_extra``: the distance braking at a_comf needs,
+plus room to settle.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from perception.messages import EgoState, ObjectClass, SignDetection, Track
+from world.hdmap import Crosswalk, RoadMap, SpeedBump, StopSign, Zone
+
+
+@dataclass(frozen=True, slots=True)
+class EventParams:
+    front_overhang: float = 2.4  # [m] centre -> front bumper
+    front_axle: float = 1.35  # [m] centre -> front axle
+    rear_axle: float = 1.35  # [m] centre -> rear axle
+    a_comf: float = 1.5  # [m/s^2] approach braking
+    approach_extra: float = 30.0  # [m]
+    stop_margin: float = 0.5  # [m] stop this much (+ the controller's margin) before a line
+    stopped_speed: float = 0.1  # [m/s]
+    stop_hold: float = 1.5  # [s] standing this long at the line completes the stop
+    stop_zone: float = 4.0  # [m] the front bumper within this before the line counts
+    crossing_margin: float = 1.0  # [m] along the route, a pedestrian this near counts
+    lane_margin: float = 1.5  # [m] across, beyond the lane's edges
+    look_ahead: float = 2.0  # [s] a pedestrian walking into the lane within this counts
+    crossing_stop: float = 1.0  # [m] stop this much (+ the controller's margin) before it
+    bump_margin: float = 1.0  # [m] the criterion's reach around a bump
+    bump_undershoot: float = 0.5 / 3.6  # [m/s] aim this far below the pass speed
+    sign_match: float = 5.0  # [m] a seen sign this near a stop line (along) is its sign
+
+
+@dataclass(frozen=True, slots=True)
+class Events:
+    off_ramp: bool = False
+    stop_sign: bool = False
+    pedestrian: bool = False
+    speed_bump: bool = False
+    flat: bool = False
+    pulled_over: bool = False  # on the shoulder, the pull-over done (a flat tyre's stop)
+    stop_distance: float = math.inf  # [m] front bumper to where the car must stand
+    bump_distance: float = math.inf  # [m] front axle to where it must be at bump_speed
+    bump_speed: float = math.inf  # [m/s]
+
+
+class EventMonitor:
+    """The events of one run (it remembers the stop lines done and the signs seen)."""
+
+    def __init__(self, road: RoadMap, params: EventParams | None = None) -> None:
+        self.road = road
+        self.params = params if params is not None else EventParams()
+        f = road.features
+        self.stop_lines = sorted(x.s for x in f if isinstance(x, StopSign))
+        self.crosswalks = sorted((x for x in f if isinstance(x, Crosswalk)), key=lambda c: c.s)
+        self.bumps = sorted((x for x in f if isinstance(x, SpeedBump)), key=lambda b: b.s)
+        self.confirmed: set[float] = set()  # stop lines whose sign perception saw
+        self.done: set[float] = set()  # stop lines stopped at, not yet passed
+        self._standing_since: float | None = None
+
+    def confirm_sign(self, line_s: float) -> None:
+        """Perception found the sign of the stop line at `line_s` [m]."""
+        self.confirmed.add(line_s)
+
+    def see_signs(self, signs: Sequence[SignDetection], pose: EgoState) -> None:
+        """Match the camera's stop signs (vehicle frame at `pose`, the pose the frame was
+        taken in) with the map's: a sign whose station is within ``sign_match`` (or 20 % of
+        its range) of a stop line, right of the route, confirms that line."""
+        p = self.params
+        c, s = math.cos(pose.heading), math.sin(pose.heading)
+        for d in signs:
+            if d.kind != "stop":
+                continue
+            xy = (pose.x + c * d.x - s * d.y, pose.y + s * d.x + c * d.y)
+            station, offset = (float(a) for a in self.road.local_coordinates(xy))
+            tolerance = max(p.sign_match, 0.2 * d.range)
+            for line in self.stop_lines:
+                if abs(station - line) <= tolerance and offset < 0.0:
+                    self.confirmed.add(line)
+
+    def update(self, t: float, station: float, v: float, lane_offset: float, lane_width: float,
+               tracks: Sequence[Track] = (), flat: bool = False,
+               pulled_over: bool = False) -> Events:
+        """`station` [m] of the car's centre, `lane_offset` [m] of the lane kept's centre from
+        the reference line there, `tracks` the confirmed tracks."""
+        p = self.params
+        front = station + p.front_overhang
+        approach = v * v / (2.0 * p.a_comf) + p.approach_extra
+        stop = self._stop_sign(t, front, v, approach)
+        crossing = self._crossing(front, approach, lane_offset, lane_width, tracks)
+        bump = self._bump(station, approach)
+        zone = self.road.cross_section_at(station).zone
+        return Events(
+            off_ramp=zone is Zone.RAMP,
+            stop_sign=stop is not None,
+            pedestrian=crossing is not None,
+            speed_bump=bump is not None,
+            flat=flat,
+            pulled_over=pulled_over,
+            stop_distance=min(x for x in (stop, crossing, math.inf) if x is not None),
+            bump_distance=bump[0] if bump is not None else math.inf,
+            bump_speed=bump[1] if bump is not None else math.inf,
+        )
+
+    def _stop_sign(self, t: float, front: float, v: float, approach: float) -> float | None:
+        p = self.params
+        self.done = {s for s in self.done if s > front - 1.0}  # passed: forget
+        line = next((s for s in self.stop_lines if s > front - 1.0 and s not in self.done), None)
+        if line is None or line - front > approach or line not in self.confirmed:
+            self._standing_since = None
+            return None
+        at_line = 0.0 <= line - front <= p.stop_zone
+        if v < p.stopped_speed and at_line:
+            self._standing_since = t if self._standing_since is None else self._standing_since
+            if t - self._standing_since >= p.stop_hold:
+                self.done.add(line)
+                self._standing_since = None
+                return None
+        else:
+            self._standing_since = None
+        return line - front - p.stop_margin
+
+    def _crossing(self, front: float, approach: float, lane_offset: float, lane_width: float,
+                  tracks: Sequence[Track]) -> float | None:
+        p = self.params
+        cw = next((c for c in self.crosswalks if front < c.s and c.s - front <= approach), None)
+        walkers = [tr for tr in tracks if tr.cls is ObjectClass.PEDESTRIAN]
+        if cw is None or not walkers:
+            return None
+        xy = np.array([[tr.x, tr.y] for tr in walkers])
+        ahead = xy + p.look_ahead * np.array([[tr.vx, tr.vy] for tr in walkers])
+        s_now, d_now = self.road.local_coordinates(xy)
+        _, d_next = self.road.local_coordinates(ahead)
+        on = (s_now >= cw.s - p.crossing_margin) & (s_now <= cw.s + cw.width + p.crossing_margin)
+        half = 0.5 * lane_width + p.lane_margin
+        lateral = np.minimum(np.abs(d_now - lane_offset), np.abs(d_next - lane_offset)) <= half
+        crossing_between = np.sign(d_now - lane_offset) != np.sign(d_next - lane_offset)
+        if not np.any(on & (lateral | crossing_between)):
+            return None
+        return cw.s - front - p.crossing_stop
+
+    def _bump(self, station: float, approach: float) -> tuple[float, float] | None:
+        p = self.params
+        front_axle, rear_axle = station + p.front_axle, station - p.rear_axle
+        for b in self.bumps:
+            near, far = b.s - 0.5 * b.length, b.s + 0.5 * b.length
+            if rear_axle > far + p.bump_margin:
+                continue
+            if near - front_axle > approach:
+                return None
+            return near - p.bump_margin - front_axle, max(b.pass_speed - p.bump_undershoot, 0.5)
+        return None
