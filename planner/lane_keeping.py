@@ -202,7 +202,9 @@ class LaneKeepingPlanner:
             ahead = max(p.path_ahead_min, p.path_ahead_time * max(ego.speed, 0.0))
             return manoeuvre.path.reference_path(self.lane, station, p.path_behind, ahead,
                                                  p.path_spacing, self.road.length)
-        if self.source is LaneSource.CAMERA and view is not None:
+        # the camera's lane lies between painted lines: not the shoulder (no outer line)
+        if self.source is LaneSource.CAMERA and view is not None and \
+                self.lane_index != SHOULDER:
             _, r = self.localise(view.pose)
             self._camera_ok = abs(view.estimate.offset - r) <= p.camera_agree
             if self._camera_ok:

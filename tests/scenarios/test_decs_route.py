@@ -69,7 +69,12 @@ def test_the_exit_ramp_and_the_city_limits(result: RunResult) -> None:
     assert ramp.sum() > 100 and v[ramp].max() <= 26 * KPH
     city = front > RAMP_END
     assert v[city].max() <= 41 * KPH
-    assert log.lane[int(np.argmax(s > FORK))] == 0  # in the lane that goes on into the ramp
+    # it came in the left lane and moved right in time, into the lane that goes on
+    assert log.lane[0] == 1 and log.lane[int(np.argmax(s > FORK))] == 0
+    right = next(c for c in result.state_changes if c.target == "lane_change_right")
+    assert "route" in right.reason
+    t = log.array("t")
+    assert FORK - 160.0 < s[int(np.searchsorted(t, right.t))] < FORK - 60.0
     # the lead kept the highway (the log has its station and offset along the road it is on)
     k = [a.id for a in result.spec.actors].index("lead")
     road = RoadMap.from_spec(result.spec.road)
