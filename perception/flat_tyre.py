@@ -39,8 +39,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from world.frames import Odometry
-from world.spec import Wheel
+from world.frames import Odometry, Wheel
 
 WHEELS = (Wheel.FRONT_LEFT, Wheel.FRONT_RIGHT, Wheel.REAR_LEFT, Wheel.REAR_RIGHT)  # odometry order
 PARTNER = (1, 0, 3, 2)  # the same axle's other wheel, by index

@@ -19,6 +19,11 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from world.spec import Wheel  # the wheels, named as the odometry orders them
+
+__all__ = ["CameraFrame", "CameraInfo", "GnssFix", "LidarInfo", "LidarScan", "Odometry",
+           "SensorMount", "Wheel"]
+
 
 @dataclass(frozen=True, slots=True)
 class GnssFix:
