@@ -18,7 +18,7 @@ from numpy.typing import NDArray
 from planner.acc import r157_min_gap
 from world.actors import ActorPoses
 from world.hdmap import RoadMap
-from world.spec import ActorType, Crosswalk, SpeedBump, StopSign
+from world.spec import ActorType, Crosswalk, SpeedBump, StopSign, TrafficLight
 
 KPH = 1 / 3.6  # [m/s] per km/h
 SPEED_TOLERANCE_KPH = 1.0  # [km/h] the speed_limit rule's tolerance
@@ -42,6 +42,7 @@ class TruthSample:
     actors: ActorPoses | None = None  # every NPC now (for gap criteria)
     lane: int = 0  # the lane the stack keeps, or moves into (its plan's command)
     origin_lane: int = 0  # the lane a commanded lane change leaves (== lane otherwise)
+    turning: bool = False  # the stack's motion FSM is in a commanded turn (a town junction)
     lateral_accel: float = 0.0  # [m/s^2] speed * yaw rate, left +
     road_curvature: float = 0.0  # [1/m] the route's curvature at the ego's station
     flat: bool = False  # a flat tyre event has happened to the ego
@@ -117,8 +118,9 @@ class NoCollision(Criterion):
         self._touching = sample.touching
 
     def result(self) -> CriterionResult:
+        note = "; ".join(f"{what} at {t:.2f} s" for t, what in self.events[:5])
         return CriterionResult(self.name, self.count == 0, self.count, 0, self.unit,
-                               self.first_failure)
+                               self.first_failure, note=note)
 
 
 class TyresInLane(Criterion):
@@ -127,7 +129,9 @@ class TyresInLane(Criterion):
 
     The lane is the one the stack keeps. During a commanded lane change (the plan's lane
     differs from its origin lane) the tyres may be anywhere inside the two lanes' outer
-    lines; once the change ends, inside the target lane."""
+    lines; once the change ends, inside the target lane. During a commanded turn through a
+    town junction (no lines there) they are not judged; once it ends, inside the lane the
+    turn leads into."""
 
     name, unit = "tyres_in_lane", "m"
 
@@ -138,6 +142,8 @@ class TyresInLane(Criterion):
         self.margin = math.inf
 
     def update(self, sample: TruthSample) -> None:
+        if sample.turning:
+            return
         margin = float(np.min(lane_margins(self.road, sample, sample.lane, sample.origin_lane)))
         margin -= self.tyre_half_width
         self.margin = min(self.margin, margin)
@@ -529,6 +535,46 @@ class StopSigns(Criterion):
         judged = [d for d, j in zip(self.longest, self.judged, strict=True) if j]
         return CriterionResult(self.name, self.first_failure is None, min(judged, default=0.0),
                                self.HOLD, self.unit, self.first_failure)
+
+
+class RedLights(Criterion):
+    """The ego does not enter a junction on red: when its front bumper goes over a traffic
+    light's stop line (a `traffic_light` feature's station s), the light is not red.
+
+    Value: the least margin [s] to red over the lines crossed: at each crossing, the time
+    left until the light turns red, or minus the time it has been red (fails). No line
+    crossed: value +inf, passed."""
+
+    name, unit = "red_lights", "s"
+
+    def __init__(self, road: RoadMap) -> None:
+        super().__init__()
+        self.lights = [f for f in road.features if isinstance(f, TrafficLight)]
+        self.margin = math.inf
+        self._front: float | None = None  # [m] the front bumper's station at the last sample
+
+    def update(self, sample: TruthSample) -> None:
+        front, before = sample.front_station, self._front
+        self._front = front
+        if before is None:
+            return
+        for light in self.lights:
+            if before <= light.s < front:
+                margin = _margin_to_red(light, sample.t)
+                self.margin = min(self.margin, margin)
+                if margin < 0.0:
+                    self._fail(sample.t)
+
+    def result(self) -> CriterionResult:
+        return CriterionResult(self.name, self.first_failure is None, self.margin, 0.0,
+                               self.unit, self.first_failure)
+
+
+def _margin_to_red(light: TrafficLight, t: float) -> float:
+    """[s] until `light` turns red at time t, or minus how long it has been red."""
+    into = (t + light.phase) % light.cycle
+    red_at = light.green + light.yellow
+    return red_at - into
 
 
 class Crosswalks(Criterion):

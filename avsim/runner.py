@@ -34,6 +34,7 @@ from avsim.criteria import (
     MaxDecel,
     MinGap,
     NoCollision,
+    RedLights,
     SpeedBumps,
     SpeedLimit,
     StandstillGap,
@@ -46,6 +47,7 @@ from avsim.recorder import Recorder
 from avsim.sensor_loop import FrameHook, SensorLoop, sensing_mode
 from avsim.stack import Stack, StackOutput
 from planner.messages import StateChange
+from planner.motion import TURNS
 from world.client import PHYSICS_RATE, Rate
 from world.sensor_setup import Profile, sensor_setup
 from world.spec import FlatTire, ScenarioSpec
@@ -63,6 +65,7 @@ assert CRITERIA_RATE.every % CONTACT_RATE.every == 0, "criteria rate must divide
 END_MARGIN = 30.0  # [m] default `completes` station: the route's end less this
 TYRE_HALF_WIDTH = 0.105  # [m] half the tyre's tread (the URDF's wheel width)
 NEEDS_ACTORS = (MinGap, StandstillGap, TimeToResume)  # criteria that read the NPCs
+TURN_MOTIONS = frozenset(m.value for m in TURNS)  # the plan's `motion` in a turn
 SETTLE_AFTER_DONE = 1.0  # [s] the run goes on this long after `completes` is reached
 
 ProgressCallback = Callable[[float, float], None]  # (sim time, duration) [s]
@@ -141,6 +144,7 @@ class Runner:
         self.stack = Stack(w.road, spec.ego, self.car, front)
         self.log = TrajectoryLog()
         names = {b: "building or sign" for b in w.scene.obstacle_bodies}
+        names.update({b: "kerb" for b in w.scene.kerb_bodies})
         names.update({b: f"actor {a.id}" for b, a in zip(w.actors.bodies, spec.actors,
                                                           strict=True)})
         reach = spec.criteria.reach_s
@@ -148,7 +152,8 @@ class Runner:
         self.collisions = NoCollision(names)
         crosswalks = Crosswalks(w.road)
         self.criteria = CriteriaSet([self.collisions, TyresInLane(w.road, TYRE_HALF_WIDTH),
-                                     SpeedLimit(w.road), StopSigns(w.road), crosswalks,
+                                     SpeedLimit(w.road), StopSigns(w.road), RedLights(w.road),
+                                     crosswalks,
                                      SpeedBumps(w.road, self.car.front_axle, self.car.rear_axle),
                                      self.completes, *self._optional_criteria()])
         self._gap_criteria = crosswalks.needs_actors or any(
@@ -161,6 +166,7 @@ class Runner:
         self._logged_events = 0  # collision events already sent to the recording
         self._last: StackOutput | None = None
         self._lane = self._origin_lane = spec.ego.lane  # the stack's lane command
+        self._turning = False  # the stack's motion FSM is in a turn
 
     def _optional_criteria(self) -> list[Criterion]:
         c, road, length = self.spec.criteria, self.world.road, self.car.body_length
@@ -233,6 +239,7 @@ class Runner:
         w.ego.apply(cmd.steering_angle, cmd.drive_torque, cmd.brake_torque)
         self._last = out
         self._lane, self._origin_lane = out.plan.lane, out.plan.origin_lane
+        self._turning = out.plan.motion in TURN_MOTIONS
         self._log_tick(out)
         for change in out.plan.changes:
             self.state_changes.append(change)
@@ -294,7 +301,7 @@ class Runner:
             tyres=route.tyres, tyre_stations=route.tyre_stations,
             tyre_offsets=route.tyre_offsets, touching=self._touching,
             offset=float(route.offsets[0]), actors=w.actors.poses if self._gap_criteria else None,
-            lane=self._lane, origin_lane=self._origin_lane,
+            lane=self._lane, origin_lane=self._origin_lane, turning=self._turning,
             lateral_accel=truth.speed * truth.yaw_rate,
             road_curvature=float(w.road.curvature_at(route.station)),
             rear_station=route.station - self.car.body_length / 2,

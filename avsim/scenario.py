@@ -22,6 +22,7 @@ import math
 import os
 import re
 from collections.abc import Hashable, Iterator, Mapping, Sequence
+from dataclasses import replace
 from pathlib import Path
 from typing import Any, TypeVar, get_args
 
@@ -45,6 +46,7 @@ from avsim.scenario_model import (
     TriggerModel,
 )
 from world import spec
+from world.town import TownError, TownLayout, compile_route
 
 REPO_ROOT = Path(__file__).resolve().parent.parent
 SCENARIO_DIR = REPO_ROOT / "scenarios"
@@ -59,7 +61,6 @@ FILE_KEY = "(file)"
 # (the reported key path ends at `key`). Loading a file that uses one of these raises
 # `<file>: <key.path>: not supported yet (<what>)`. Delete a line once it is simulated.
 UNSUPPORTED: dict[str, str] = {
-    "town": "the town map kind",
     "road.segments.*.exit=left": "exits on the left",
     "road.features.*.type=traffic_light": "traffic lights",
 }
@@ -779,13 +780,20 @@ def _sensors_spec(model: ScenarioModel) -> spec.SensorsSpec:
 def _build(model: ScenarioModel) -> spec.ScenarioSpec:
     """Check what spans several keys and convert the validated model into the world spec."""
     if model.road is None:
-        raise _LocatedError("town", f"not supported yet ({UNSUPPORTED.get('town', 'town maps')})")
+        return _build_town(model)
     road_spec = _road_spec(model.road)
     _check_arcs(model.road)
     _check_exits(model.road)
     _check_ego(model, road_spec.segments)
     _check_actors(model, road_spec.segments)
     _check_rest(model, model.road, road_spec.segments)
+    return _scenario_spec(model, road_spec,
+                          tuple(_actor_spec(i, actor) for i, actor in enumerate(model.actors)))
+
+
+def _scenario_spec(model: ScenarioModel, road_spec: spec.RoadSpec,
+                   actors: tuple[spec.ActorSpec, ...],
+                   town: spec.TownSpec | None = None) -> spec.ScenarioSpec:
     ego = model.ego
     criteria = model.criteria
     return spec.ScenarioSpec(
@@ -803,7 +811,7 @@ def _build(model: ScenarioModel) -> spec.ScenarioSpec:
             max_speed=_kph(ego.max_speed_kph),
             overtake=ego.overtake,
         ),
-        actors=tuple(_actor_spec(index, actor) for index, actor in enumerate(model.actors)),
+        actors=actors,
         sensors=_sensors_spec(model),
         events=tuple(_event_spec(event) for event in model.events),
         criteria=spec.CriteriaSpec(
@@ -812,7 +820,75 @@ def _build(model: ScenarioModel) -> spec.ScenarioSpec:
                 criteria.lane_change.max_duration, criteria.lane_change.max_lateral_accel),
             standstill_gap=criteria.standstill_gap, resume_within=criteria.resume_within,
         ),
+        town=town,
     )
+
+
+# ---------------------------------------------------------------------------------------
+# Towns
+# ---------------------------------------------------------------------------------------
+
+TOWN_START_S = 5.0  # [m] default station of a car on its town route (past the start mouth)
+
+
+def _build_town(model: ScenarioModel) -> spec.ScenarioSpec:
+    """A town: each car's `start` and `route` compile into its own route road
+    (`world.town`); the ego's is the scenario's `road`."""
+    assert model.town is not None  # the model has exactly one map
+    t = model.town
+    town = spec.TownSpec(t.blocks_x, t.blocks_y, float(t.block), t.lanes, float(t.lane_width),
+                         _kph(t.speed_limit_kph), t.junctions)
+    layout = TownLayout(town)
+    try:
+        layout.check("town")
+        ego_road = _town_route(layout, "ego", model.ego.start, model.ego.route)
+        roads = [_town_route(layout, f"actors.{i}", a.start, a.route)
+                 for i, a in enumerate(model.actors)]
+    except TownError as error:
+        raise _LocatedError(error.key, error.problem) from None
+    _check_town_car("ego", model.ego.lane, model.ego.s, ego_road)
+    actors = []
+    for index, (actor, road) in enumerate(zip(model.actors, roads, strict=True)):
+        _check_town_car(f"actors.{index}", actor.lane, actor.s, road)
+        actors.append(replace(_actor_spec(index, actor), s=_or(actor.s, TOWN_START_S), road=road))
+    _check_town_ids(model)
+    length = _route_length(ego_road.segments)
+    for index, event in enumerate(model.events):
+        _check_trigger(f"events.{index}.trigger", event.trigger, index, length, "event")
+    if model.criteria.reach_s is not None:
+        _check_station("criteria.reach_s", model.criteria.reach_s, length)
+    for key in ("speed_kph", "set_speed_kph"):
+        if getattr(model.ego, key) > model.ego.max_speed_kph:
+            raise _LocatedError(f"ego.{key}", f"must be <= max_speed_kph "
+                                f"({_fmt(model.ego.max_speed_kph)}), got "
+                                f"{_fmt(getattr(model.ego, key))}")
+    scenario = _scenario_spec(model, ego_road, tuple(actors), town)
+    return replace(scenario, ego=replace(scenario.ego, s=_or(model.ego.s, TOWN_START_S)))
+
+
+def _town_route(layout: TownLayout, key: str, start: tuple[int, int, str] | None,
+                route: Sequence[str] | None) -> spec.RoadSpec:
+    if start is None:
+        raise _LocatedError(f"{key}.start", "required key missing in a town ([ix, iy, heading])")
+    turns = tuple(spec.Manoeuvre(turn) for turn in (route or ()))
+    return compile_route(layout, (start[0], start[1], start[2]), turns, key)
+
+
+def _check_town_car(key: str, lane: int | None, s: float | None, road: spec.RoadSpec) -> None:
+    """In a town a car starts in lane 0 of its route, `s` metres past its start junction."""
+    if lane not in (None, 0):
+        raise _LocatedError(f"{key}.lane", "in a town a car starts in lane 0 of its route")
+    if s is not None:
+        _check_station(f"{key}.s", s, _route_length(road.segments))
+
+
+def _check_town_ids(model: ScenarioModel) -> None:
+    first_seen: dict[str, int] = {}
+    for index, actor in enumerate(model.actors):
+        if actor.id in first_seen:
+            raise _LocatedError(f"actors.{index}.id", f"duplicate id {actor.id!r} "
+                                f"(also actors.{first_seen[actor.id]})")
+        first_seen[actor.id] = index
 
 
 # ---------------------------------------------------------------------------------------

@@ -24,6 +24,7 @@ from avsim.scoring import CaptureTruth, PerceptionScore
 from avsim.stack import PerceptionOutput, Stack
 from perception.messages import Detection
 from world.frames import CameraFrame
+from world.hdmap import Zone
 from world.sensing import InlineSensing, ProcessSensing, Sensing
 from world.sensor_setup import SensorSetup
 from world.sensors import SensorData, SensorSchedule
@@ -122,6 +123,8 @@ class SensorLoop:
         truth = w.ego_truth
         xy = truth.position[:2]
         lane, s, r = w.road.lane_at(xy)
+        if lane is not None and w.road.cross_section_at(s).zone is Zone.JUNCTION:
+            lane = None  # inside a town junction: no painted lane to score against
         heading_error = 0.0
         if lane is not None:
             heading = float(w.road.lane(lane).heading_at(s))

@@ -21,12 +21,14 @@ from control.stanley import StanleyParams
 from control.vehicle_controller import VehicleController, VehicleControllerParams
 from perception.flat_tyre import FlatTyreDetector, FlatTyreParams
 from perception.lanes import LaneDetector, LaneFilter
+from perception.lights import TrafficLightDetector
 from perception.localization import Localizer
 from perception.messages import Detection, EgoState, LaneEstimate, Track
 from perception.objects import ObjectDetector
 from perception.signs import StopSignDetector
 from perception.tracking import MultiObjectTracker
 from planner.events import EventParams
+from planner.junctions import JunctionParams
 from planner.lane_keeping import LaneKeepingParams, LaneKeepingPlanner, LaneView
 from planner.messages import Plan
 from planner.motion_layer import MotionLayerParams
@@ -69,7 +71,9 @@ class Stack:
                                     motion=MotionLayerParams(overtake=ego.overtake),
                                     events=EventParams(front_overhang=car.front_overhang,
                                                        front_axle=car.front_axle,
-                                                       rear_axle=car.rear_axle))
+                                                       rear_axle=car.rear_axle),
+                                    junctions=JunctionParams(
+                                        front_overhang=car.front_overhang))
         )
         lateral = StanleyParams(
             wheelbase=car.wheelbase, centre_to_front_axle=car.front_axle,
@@ -82,6 +86,8 @@ class Stack:
         self.lane_detector = LaneDetector(front_camera) if front_camera is not None else None
         self.sign_detector = StopSignDetector(front_camera) if front_camera is not None \
             else None
+        self.light_detector = TrafficLightDetector(front_camera) \
+            if front_camera is not None and self.planner.junctions.lights else None
         self.lane_filter = LaneFilter()
         self.object_detector = ObjectDetector()
         self.flat_detector = FlatTyreDetector(FlatTyreParams(track=car.track,
@@ -118,6 +124,11 @@ class Stack:
         if front is not None and self.sign_detector is not None:
             signs = self.sign_detector.detect(front)
             self.planner.events.see_signs(signs, pose)
+        if front is not None and self.light_detector is not None:
+            station, _ = self.planner.localise(pose)
+            heads = self.planner.junctions.heads_ahead(station)
+            if heads:
+                self.planner.junctions.see_lights(self.light_detector.detect(front, pose, heads))
         detections = tracks = None
         if scan is not None:
             detections = self.object_detector.detect(scan)

@@ -7,6 +7,8 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+from world.hdmap import LightColour
+
 
 @dataclass(frozen=True, slots=True)
 class EgoState:
@@ -166,3 +168,18 @@ class SignDetection:
             if best is None or distance < best[0]:
                 best = (distance, station)
         return None if best is None else best[1]
+
+
+# ---- traffic lights (camera) ---------------------------------------------------------------
+
+
+@dataclass(frozen=True, slots=True)
+class LightDetection:
+    """The lit lamp of one map traffic light, as seen in one camera frame."""
+
+    t: float  # [s] sim time of the camera frame
+    light: int  # the caller's id of the light's head (`TrafficLightDetector.detect`'s heads)
+    colour: LightColour
+    range: float  # [m] horizontal distance from the car's centre to the head (map and pose)
+    confidence: float  # [0, 1] how clearly the lamp was seen (size, uniqueness, position)
+    box: tuple[int, int, int, int]  # [px] (u0, v0, u1, v1) of the lamp's pixels, u1/v1 exclusive

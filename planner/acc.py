@@ -2,8 +2,10 @@
 
 States (the paper's Stateflow chart, Fig. 2): ACC_OFF, and inside ACC_ON either ACC_ACTIVE
 {CRUISE, TRAIL, BRAKE, SPEED_LIMIT} or EDACC {OFF_RAMP, PEDESTRIAN, SPEED_BUMP, STOP_SIGN,
-FLAT}. Inputs (`AccInput`): the gap d to the vehicle ahead in the lane and its speed V_l
-(+inf when there is none), the set speed V_s, the posted limit where the car is V_GPS (the
+FLAT}, plus two of our own for town junctions, RED_LIGHT and YIELD (their rows are marked *
+in the table, as are the rows the paper's chart has no counterpart for). Inputs
+(`AccInput`): the gap d to the vehicle ahead in the lane and its speed V_l (+inf when there
+is none), the set speed V_s, the posted limit where the car is V_GPS (the
 paper reads it from the map by GPS), the ego speed v and the discrete events.
 
 Gaps (the paper gives none; designed here, all in metres, speeds in m/s):
@@ -26,8 +28,10 @@ beyond d_max, Trail's row also holds, so Cruise and SpeedLimit are tried first):
 | ACC_OFF            | CRUISE      | ACC switched on (the chart's default state)            |
 | any but FLAT*      | ACC_OFF     | ACC switched off                                       |
 | any ACC_ON*        | FLAT        | flat tyre (Table 2: SpeedBump -> Flat)                 |
-| ACC_ACTIVE, OFF_RAMP, SPEED_BUMP, STOP_SIGN* | PEDESTRIAN | [Pedestrian] (Trail, SpeedBump) |
+| ACC_ACTIVE, OFF_RAMP, SPEED_BUMP, STOP_SIGN*, RED_LIGHT*, YIELD* | PEDESTRIAN | [Pedestrian] |
 | ACC_ACTIVE*, OFF_RAMP | STOP_SIGN | [StopS] (Table 2: OffRamp -> StopSign)                  |
+| ACC_ACTIVE*, OFF_RAMP*, YIELD* | RED_LIGHT | a light ahead to stop for (`planner.junctions`) |
+| ACC_ACTIVE*, OFF_RAMP*, RED_LIGHT*, STOP_SIGN* | YIELD | a gap to wait for at a junction (town) |
 | ACC_ACTIVE         | SPEED_BUMP  | [SpeedBump] (Table 2: Trail, Brake)                    |
 | ACC_ACTIVE*        | OFF_RAMP    | [Off_Ramp]                                             |
 | CRUISE, TRAIL*, SPEED_LIMIT* | BRAKE | d <= d_min (Table 2: Cruise -> Brake)           |
@@ -43,6 +47,7 @@ beyond d_max, Trail's row also holds, so Cruise and SpeedLimit are tried first):
 | PEDESTRIAN         | CRUISE      | [!Pedestrian]                                          |
 | SPEED_BUMP         | CRUISE      | [!SpeedBump]                                           |
 | STOP_SIGN*         | CRUISE      | [!StopS] (the stop is done)                            |
+| RED_LIGHT*, YIELD* | CRUISE      | the light lets the car go / the gap has come           |
 | FLAT               | -           | none: the car stops on the shoulder ("Simulation Stops") |
 
 The ACC_ACTIVE mode after an event is CRUISE (the chart's default); the next tick's
@@ -70,12 +75,14 @@ class AccMode(enum.Enum):
     PEDESTRIAN = "pedestrian"
     SPEED_BUMP = "speed_bump"
     STOP_SIGN = "stop_sign"
+    RED_LIGHT = "red_light"
+    YIELD = "yield"
     FLAT = "flat"
 
 
 ACC_ACTIVE = frozenset({AccMode.CRUISE, AccMode.TRAIL, AccMode.BRAKE, AccMode.SPEED_LIMIT})
 EDACC = frozenset({AccMode.OFF_RAMP, AccMode.PEDESTRIAN, AccMode.SPEED_BUMP, AccMode.STOP_SIGN,
-                   AccMode.FLAT})
+                   AccMode.RED_LIGHT, AccMode.YIELD, AccMode.FLAT})
 
 
 @dataclass(frozen=True, slots=True)
@@ -98,6 +105,8 @@ class AccInput:
     pedestrian: bool = False  # a pedestrian on or at the crossing ahead
     speed_bump: bool = False  # a speed bump ahead within its approach
     stop_sign: bool = False  # a stop line ahead not yet stopped at
+    red_light: bool = False  # a light ahead to stop for (red, yellow, unread)
+    give_way: bool = False  # a junction ahead to wait at for a gap
     flat: bool = False  # a flat tyre detected
 
 
@@ -175,15 +184,21 @@ _FOLLOWING = _following_rules()
 _EVENTS: tuple[tuple[str, AccMode, str], ...] = (
     ("pedestrian", AccMode.PEDESTRIAN, "a pedestrian at the crossing ahead"),
     ("stop_sign", AccMode.STOP_SIGN, "a stop line ahead"),
+    ("red_light", AccMode.RED_LIGHT, "a traffic light ahead to stop for"),
+    ("give_way", AccMode.YIELD, "giving way at the junction ahead"),
     ("speed_bump", AccMode.SPEED_BUMP, "a speed bump ahead"),
     ("off_ramp", AccMode.OFF_RAMP, "on the exit ramp"),
 )
 _ENTERED_FROM_EVENTS = {
-    AccMode.PEDESTRIAN: frozenset({AccMode.OFF_RAMP, AccMode.SPEED_BUMP, AccMode.STOP_SIGN}),
+    AccMode.PEDESTRIAN: frozenset({AccMode.OFF_RAMP, AccMode.SPEED_BUMP, AccMode.STOP_SIGN,
+                                   AccMode.RED_LIGHT, AccMode.YIELD}),
     AccMode.STOP_SIGN: frozenset({AccMode.OFF_RAMP}),
+    AccMode.RED_LIGHT: frozenset({AccMode.OFF_RAMP, AccMode.YIELD}),
+    AccMode.YIELD: frozenset({AccMode.OFF_RAMP, AccMode.RED_LIGHT, AccMode.STOP_SIGN}),
 }
 _CLEARS = {AccMode.OFF_RAMP: "off_ramp", AccMode.PEDESTRIAN: "pedestrian",
-           AccMode.SPEED_BUMP: "speed_bump", AccMode.STOP_SIGN: "stop_sign"}
+           AccMode.SPEED_BUMP: "speed_bump", AccMode.STOP_SIGN: "stop_sign",
+           AccMode.RED_LIGHT: "red_light", AccMode.YIELD: "give_way"}
 
 
 def transition(mode: AccMode, x: AccInput, p: AccParams) -> AccChange | None:
@@ -212,8 +227,10 @@ def transition(mode: AccMode, x: AccInput, p: AccParams) -> AccChange | None:
 
 def _event_change(mode: AccMode, x: AccInput) -> AccChange | None:
     for flag, to, reason in _EVENTS:
-        if not getattr(x, flag) or to is mode:
+        if not getattr(x, flag):
             continue
+        if to is mode:
+            return None  # the mode's own event holds: only a higher one may take over
         if mode in ACC_ACTIVE or mode in _ENTERED_FROM_EVENTS.get(to, frozenset()):
             return AccChange(to, reason)
     return None

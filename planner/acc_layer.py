@@ -32,8 +32,9 @@ from planner.events import Events
 from planner.messages import Lead, StateChange
 
 NO_EVENTS = Events()
-EVENT_LAWS = frozenset({AccMode.OFF_RAMP, AccMode.PEDESTRIAN, AccMode.SPEED_BUMP,
-                        AccMode.STOP_SIGN, AccMode.FLAT})
+STOP_LAWS = frozenset({AccMode.STOP_SIGN, AccMode.PEDESTRIAN, AccMode.RED_LIGHT,
+                       AccMode.YIELD})  # a stop at `Events.stop_distance`
+EVENT_LAWS = frozenset({AccMode.OFF_RAMP, AccMode.SPEED_BUMP, AccMode.FLAT}) | STOP_LAWS
 
 
 @dataclass(frozen=True, slots=True)
@@ -66,6 +67,7 @@ class AccLayer:
         x = AccInput(acc_on=set_speed > 0.0, v=v, v_s=set_speed, v_gps=limit, d=d, v_l=v_l,
                      off_ramp=events.off_ramp, pedestrian=events.pedestrian,
                      speed_bump=events.speed_bump, stop_sign=events.stop_sign,
+                     red_light=events.red_light, give_way=events.give_way,
                      flat=events.flat)
         changes: tuple[StateChange, ...] = ()
         change = transition(self.mode, x, self.params.modes)
@@ -89,7 +91,7 @@ class AccLayer:
             v = pass_speed(events.bump_distance, events.bump_speed, plan.speed, c)
             braking = events.bump_speed < v < plan.speed  # on the braking curve
             ref = SpeedRef(v, -c.a_comf if braking else 0.0 if v < plan.speed else plan.accel)
-        elif self.mode in (AccMode.STOP_SIGN, AccMode.PEDESTRIAN):
+        elif self.mode in STOP_LAWS:
             v = stop_speed(events.stop_distance, plan.speed, c)
             ref = SpeedRef(v, -c.a_comf if 0.0 < v < plan.speed else 0.0)
         else:

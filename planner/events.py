@@ -64,6 +64,8 @@ class Events:
     pedestrian: bool = False
     speed_bump: bool = False
     flat: bool = False
+    red_light: bool = False  # a traffic light ahead to stop for (`planner.junctions`)
+    give_way: bool = False  # a junction ahead to wait at for a gap (`planner.junctions`)
     pulled_over: bool = False  # on the shoulder, the pull-over done (a flat tyre's stop)
     stop_distance: float = math.inf  # [m] front bumper to where the car must stand
     bump_distance: float = math.inf  # [m] front axle to where it must be at bump_speed

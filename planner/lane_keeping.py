@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -35,8 +35,9 @@ from planner.camera_lane import camera_lane_path
 from planner.control_layer import ControlLayer
 from planner.driver_override import DriverOverride, OverrideParams
 from planner.events import EventMonitor, EventParams
+from planner.junctions import JunctionMonitor, JunctionParams
 from planner.lane_source import LaneSource, LaneSourceInput, LaneSourceParams, transition
-from planner.lead import LeadAccel, LeadParams, select_lead
+from planner.lead import LeadAccel, LeadParams, route_lead, select_lead
 from planner.messages import Lead, Plan, ReferencePath, StateChange
 from planner.motion_layer import Manoeuvre, MotionLayer, MotionLayerParams
 from planner.route import lane_path
@@ -70,7 +71,10 @@ class LaneKeepingParams:
     motion: MotionLayerParams = field(default_factory=MotionLayerParams)
     override: OverrideParams = field(default_factory=OverrideParams)
     events: EventParams = field(default_factory=EventParams)
+    junctions: JunctionParams = field(default_factory=JunctionParams)
     camera_agree: float = 1.0  # [m] the camera's lane is used only within this of the map's
+    junction_before: float = 10.0  # [m] before a town junction's stop line ...
+    junction_after: float = 15.0  # [m] ... to after its exit, the map's path is followed
 
 
 class LaneKeepingPlanner:
@@ -99,6 +103,7 @@ class LaneKeepingPlanner:
         self.lead_accel = LeadAccel()
         self.driver = DriverOverride(self.params.override)
         self.events = EventMonitor(self.road, self.params.events)
+        self.junctions = JunctionMonitor(self.road, self.params.junctions)
         self._camera_ok = False  # the camera's lane is seen and agrees with the map's
         self._hazard = False  # the hazard lights (on from a flat tyre)
 
@@ -139,8 +144,8 @@ class LaneKeepingPlanner:
         tyre has been detected."""
         dt = 0.0 if self._last_t is None else max(ego.t - self._last_t, 0.0)
         self._last_t = ego.t
-        changes = self._update_source(ego.t, view)
         station, lateral = self.localise(ego)
+        changes = self._update_source(ego.t, view, self.near_junction(station))
         target = self.speed_for(station)
         want = min(self.params.set_speed, target.limit_at_front)
         manoeuvre, motion_changes = self.motion.update(ego, want, tracks, pull_over=flat)
@@ -158,6 +163,9 @@ class LaneKeepingPlanner:
                                     float(self.lane.width_at(station)), tracks, flat,
                                     pulled_over=manoeuvre.lane == SHOULDER
                                     and manoeuvre.path is None)
+        junction = self.junctions.update(ego.t, station, ego.speed, tracks)
+        events = replace(events, red_light=junction.red_light, give_way=junction.give_way,
+                         stop_distance=min(events.stop_distance, junction.stop_distance))
         ref, acc_changes = self.acc.update(ego.t, dt, ego.speed, self.params.set_speed,
                                            target.limit_at_front, plan_ref, lead,
                                            driver_gap=self.params.override.gap_margin
@@ -211,11 +219,12 @@ class LaneKeepingPlanner:
                 return self._camera_path(view)
         return self.path_for(ego, station)
 
-    def _update_source(self, t: float, view: LaneView | None) -> tuple[StateChange, ...]:
+    def _update_source(self, t: float, view: LaneView | None,
+                       junction: bool) -> tuple[StateChange, ...]:
         if self._since is None:
             self._since = t
         confidence = view.estimate.confidence if view is not None else 0.0
-        change = transition(self.source, LaneSourceInput(t, confidence, self._since),
+        change = transition(self.source, LaneSourceInput(t, confidence, self._since, junction),
                             self.params.source)
         if change is None:
             return ()
@@ -239,10 +248,19 @@ class LaneKeepingPlanner:
             return Lead(n.track_id, n.t, gap, max(n.speed, 0.0))
         if not tracks:
             return None
+        if self.source is LaneSource.JUNCTION:  # on the map's path through the junction
+            return route_lead(tracks, self.lane, self.localise(ego)[0], self.params.lead)
         centre: Callable[[float], float] = _straight_ahead
         if view is not None and self._camera_ok:
             centre = view.estimate.centre_y
         return select_lead(tracks, centre, ego.heading, self.params.lead)
+
+    def near_junction(self, station: float) -> bool:
+        """Whether the car's centre is near or in a town junction, where the map's path is
+        followed and an unseen painted lane is no fault."""
+        p = self.params
+        return any(j.s_stop - p.junction_before <= station <= j.s_exit + p.junction_after
+                   for j in self.road.junctions)
 
     def _degraded_cap(self, speed: float, accel: float, ego_speed: float,
                       dt: float) -> tuple[float, float]:

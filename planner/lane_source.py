@@ -10,12 +10,17 @@ An enum FSM with a pure transition function (table-tested):
 | MAP_HOLD     | CAMERA       | confidence >= `acquire` again                            |
 | MAP_HOLD     | STOP_IN_LANE | lost for `stop_after` seconds                            |
 | STOP_IN_LANE | CAMERA       | confidence >= `acquire` again                            |
+| any but MAP  | JUNCTION     | near a town junction (no lines inside; the map's turn path) |
+| JUNCTION     | CAMERA       | past the junction, confidence >= `acquire`               |
+| JUNCTION     | ACQUIRING    | past the junction, no good estimate yet                  |
 
 MAP is the state of a stack built without a camera (GNSS + odometry on the HD map only):
 it never changes. ACQUIRING follows the map lane at the planned speed (the camera's first
 estimate arrives one sensor period after the start). MAP_HOLD follows the map lane with the
 localisation estimate (GNSS + odometry) and slows to `hold_speed`; STOP_IN_LANE brings the
-car to a stop in its lane. Every change carries a reason for the log.
+car to a stop in its lane. JUNCTION follows the map's path through a town junction at the
+planned speed: its lines end at the junction's mouth, and the path turns where none are
+painted. Every change carries a reason for the log.
 """
 
 from __future__ import annotations
@@ -30,6 +35,7 @@ class LaneSource(enum.Enum):
     CAMERA = "camera"
     MAP_HOLD = "map_hold"
     STOP_IN_LANE = "stop_in_lane"
+    JUNCTION = "junction"
 
 
 @dataclass(frozen=True, slots=True)
@@ -46,6 +52,7 @@ class LaneSourceInput:
     t: float  # [s] now
     confidence: float  # [-] of the latest lane estimate (0 when there is none)
     since: float  # [s] time of the last change of state (the start, for ACQUIRING)
+    junction: bool = False  # the car is near a town junction (`LaneKeepingPlanner`)
 
 
 @dataclass(frozen=True, slots=True)
@@ -59,6 +66,10 @@ def transition(state: LaneSource, x: LaneSourceInput, p: LaneSourceParams) -> Ch
     good = x.confidence >= p.acquire
     if state is LaneSource.MAP:
         return None
+    if state is LaneSource.JUNCTION:
+        return None if x.junction else _past_junction(good, x.confidence)
+    if x.junction:
+        return Change(LaneSource.JUNCTION, "at a junction: the map's path")
     if state is LaneSource.CAMERA:
         if x.confidence < p.lose:
             return Change(LaneSource.MAP_HOLD,
@@ -72,3 +83,10 @@ def transition(state: LaneSource, x: LaneSourceInput, p: LaneSourceParams) -> Ch
         return Change(LaneSource.STOP_IN_LANE,
                       f"lane lost for {p.stop_after:.1f} s: stopping in lane")
     return None
+
+
+def _past_junction(good: bool, confidence: float) -> Change:
+    if good:
+        return Change(LaneSource.CAMERA, f"past the junction, lane found "
+                                         f"(confidence {confidence:.2f})")
+    return Change(LaneSource.ACQUIRING, "past the junction: looking for the lane")

@@ -4,6 +4,10 @@ The lead is the nearest confirmed track ahead whose centre lies within ``half_wi
 ego lane's centre line (the camera's lane when it is seen, else straight ahead); its gap is
 bumper to bumper along the ego's heading, its speed the track's over ground along the ego's
 heading (>= 0), both at the track's time.
+
+Through a town junction the lane is the map's turn path (`route_lead`): the lead is the
+nearest track ahead along the map lane kept whose centre is within ``half_width`` of it;
+its gap is along the lane, its speed along the lane's heading where it is.
 """
 
 from __future__ import annotations
@@ -12,14 +16,18 @@ import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
+import numpy as np
+
 from perception.messages import ObjectClass, Track
 from planner.messages import Lead
+from world.hdmap import Lane
 
 
 @dataclass(frozen=True, slots=True)
 class LeadParams:
     half_width: float = 1.6  # [m] a track is in the lane within this of its centre line
     front_overhang: float = 2.4  # [m] the ego's centre -> front bumper
+    path_reach: float = 60.0  # [m] along a map path, tracks farther ahead are not looked at
 
 
 def select_lead(tracks: Sequence[Track], centre_y: Callable[[float], float],
@@ -36,6 +44,28 @@ def select_lead(tracks: Sequence[Track], centre_y: Callable[[float], float],
         if best is not None and gap >= best.gap:
             continue
         speed = max(0.0, tr.vx * math.cos(ego_heading) + tr.vy * math.sin(ego_heading))
+        best = Lead(tr.id, tr.t, gap, speed)
+    return best
+
+
+def route_lead(tracks: Sequence[Track], lane: Lane, station: float,
+               p: LeadParams) -> Lead | None:
+    """The nearest vehicle ahead on the map lane `lane` from the car's centre at `station`
+    (the turn path through a town junction; map frame)."""
+    vehicles = [tr for tr in tracks if tr.cls is not ObjectClass.OTHER]
+    if not vehicles:
+        return None
+    s, r = lane.local_coordinates(np.array([[tr.x, tr.y] for tr in vehicles]))
+    best: Lead | None = None
+    for tr, s_tr, r_tr in zip(vehicles, np.atleast_1d(s), np.atleast_1d(r), strict=True):
+        ahead = float(s_tr) - station
+        if not 0.0 < ahead <= p.path_reach or abs(float(r_tr)) > p.half_width:
+            continue
+        gap = ahead - p.front_overhang - 0.5 * tr.length
+        if best is not None and gap >= best.gap:
+            continue
+        heading = float(lane.heading_at(float(s_tr)))
+        speed = max(0.0, tr.vx * math.cos(heading) + tr.vy * math.sin(heading))
         best = Lead(tr.id, tr.t, gap, speed)
     return best
 

@@ -1,8 +1,7 @@
 """The motion FSM (ICCAS 2020's M-FSM): which manoeuvre the car is in.
 
 States: LANE_KEEP, LANE_CHANGE_LEFT, LANE_CHANGE_RIGHT, TURN_RIGHT, TURN_LEFT, U_TURN. The
-turns are entered from the route's command at a junction (the town map, issue E); here they
-are defined with their transitions.
+turns are entered from the route's command at a town junction (`planner.motion_layer`).
 
 Inputs (`MotionInput`) are decided upstream from the tracks and the map
 (`planner.lane_occupancy`): whether a slower vehicle blocks the lane ahead, whether the lanes

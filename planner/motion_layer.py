@@ -11,6 +11,12 @@ lane, followed in LANE_KEEP until its end.
 While the car changes lanes, the vehicles ahead in the target lane and, until the car's
 centre has crossed into the target lane, in the origin lane are both leads for the ACC
 (`leads`): the car does not run into the vehicle it is leaving.
+
+At a town junction where the route turns, the turn is entered when the car's centre passes
+the stop line and done at the junction's exit (`RoadMap.junctions`); its path is the map's
+lane 0, which turns along the junction's arc (`world.town`), so the path needs nothing
+planned here. Lane 0 is the only lane through a turn: the route lane change has already
+brought the car into it ("a lane ends ahead").
 """
 
 from __future__ import annotations
@@ -33,8 +39,17 @@ from planner.lane_occupancy import (
     lane_traffic,
 )
 from planner.messages import StateChange
-from planner.motion import LANE_CHANGES, Motion, MotionInput, MotionParams, transition
+from planner.motion import (
+    LANE_CHANGES,
+    TURNS,
+    Motion,
+    MotionInput,
+    MotionParams,
+    Turn,
+    transition,
+)
 from world.hdmap import SHOULDER, RoadMap
+from world.hdmap import Manoeuvre as JunctionManoeuvre
 
 
 @dataclass(frozen=True, slots=True)
@@ -74,6 +89,7 @@ class MotionLayer:
         self._since = -math.inf  # [s] time of the last motion change (none yet)
         self._pull_over = False
         self._blocked_since: float | None = None
+        self._turn_end = math.inf  # [m] where the turn in hand ends (its junction's exit)
 
     def update(self, ego: EgoState, v_want: float, tracks: Sequence[Track],
                pull_over: bool = False) -> tuple[Manoeuvre, tuple[StateChange, ...]]:
@@ -139,6 +155,7 @@ class MotionLayer:
             right_free=right is not None and is_free(right, v, p.occupancy),
             route_lane=min(self._lanes_ahead(s, v) - 1 - self.lane, 0),
             pull_over=self._pull_over and self.lane != SHOULDER,
+            turn=self._turn_at(s), turn_done=self.motion in TURNS and s >= self._turn_end,
         )
         if self.motion not in LANE_CHANGES or self.path is None:
             return x
@@ -146,6 +163,15 @@ class MotionLayer:
         centre, width = float(target.offset_at(s)), float(target.width_at(s))
         return replace(x, target_free=is_free(traffic[self.lane], v, p.occupancy),
                        committed=abs(d - centre) < 0.5 * width, change_done=s >= self.path.end)
+
+    def _turn_at(self, s: float) -> Turn | None:
+        """The route's turn at the town junction whose stop line the car's centre has
+        passed and whose exit it has not reached (None going straight, or elsewhere)."""
+        for j in self.road.junctions:
+            if j.s_stop <= s < j.s_exit and j.manoeuvre is not JunctionManoeuvre.STRAIGHT:
+                self._turn_end = j.s_exit
+                return Turn(j.manoeuvre.value)
+        return None
 
     def _enter(self, to: Motion, abort: bool, ego: EgoState) -> None:
         self._since = ego.t

@@ -23,6 +23,7 @@ from pybullet_utils.bullet_client import BulletClient
 from world.behaviour import NpcMotion, TriggerContext
 from world.hdmap import RoadMap
 from world.spec import ActorSpec, ActorType
+from world.town_traffic import TownDriver
 
 
 @dataclass(frozen=True, slots=True)
@@ -71,10 +72,13 @@ class ActorSet:
         self._reset_pose = client.resetBasePositionAndOrientation  # bound once: hot path
         self._road = road
         self.specs = specs
+        # in a town each actor drives its own route road; on a road, the route
+        self._maps = [road if a.road is None else RoadMap.from_spec(a.road) for a in specs]
+        self._own = np.array([a.road is not None for a in specs], dtype=bool)
         self.motions: list[NpcMotion] = []
         self.bodies: list[int] = []
-        for spec in specs:
-            lane = road.lane(spec.lane)
+        for spec, own_map in zip(specs, self._maps, strict=True):
+            lane = own_map.lane(spec.lane)
             offset = float(lane.offset_at(spec.s)) + spec.offset
             self.motions.append(
                 NpcMotion(spec.s, offset, spec.speed, lane.direction, spec.actions,
@@ -86,6 +90,11 @@ class ActorSet:
             [[SIZES[a.type].length / 2, SIZES[a.type].width / 2, SIZES[a.type].height / 2]
              for a in specs]
         ).reshape(-1, 3)
+        self._drivers = [
+            TownDriver(own_map, SIZES[a.type].length / 2)
+            if a.road is not None and a.type in (ActorType.CAR, ActorType.TRUCK) else None
+            for a, own_map in zip(specs, self._maps, strict=True)
+        ]
         self._last_speed = self._speeds()  # [m/s] before the last step
         self._dt = 1.0  # [s] the last step
         self._ids = tuple(a.id for a in specs)
@@ -96,9 +105,13 @@ class ActorSet:
         # traffic on the road before the route's first exit keeps that road (it goes on
         # straight from the fork, `RoadMap.through_line`); the rest follows the route
         self._fork = road.exits[0].s if road.exits else math.inf
-        self._through = np.array([a.s < self._fork for a in specs], dtype=bool)
-        self._lines = [road.through_line if through else road.line
-                       for through in self._through.tolist()]
+        self._through = np.array([a.s < self._fork and a.road is None for a in specs],
+                                 dtype=bool)
+        self._lines = [road.through_line if through else own_map.line
+                       for through, own_map in zip(self._through.tolist(), self._maps,
+                                                   strict=True)]
+        self.town_drivers = any(d is not None for d in self._drivers)
+        self._xy = np.zeros((len(specs), 2))  # [m] each body's centre as last placed
         self._poses: ActorPoses | None = None
         self._place(force=True)
 
@@ -113,31 +126,65 @@ class ActorSet:
                                          useMaximalCoordinates=True))
 
     def lane_offset(self, lane: int, s: float) -> float:
+        """[m] offset of a route lane's centre at s (the actors on the route's road)."""
         return float(self._road.lane(lane).offset_at(s))
 
-    def gaps(self, ego_s: float, ego_length: float) -> NDArray[np.float64]:
-        """[m] (N,) bumper-to-bumper distance of each actor to the ego along the route."""
+    def gaps(self, ego_s: float, ego_length: float,
+             ego_xy: tuple[float, float] | None = None) -> NDArray[np.float64]:
+        """[m] (N,) bumper-to-bumper distance of each actor to the ego: along the route, or
+        for an actor on its own town route (given `ego_xy`), centre to centre less both
+        half lengths."""
         s = np.array([m.s for m in self.motions])
-        return np.maximum(0.0, np.abs(s - ego_s) - (self.lengths + ego_length) / 2)
+        gaps = np.maximum(0.0, np.abs(s - ego_s) - (self.lengths + ego_length) / 2)
+        if ego_xy is not None and self._own.any():
+            apart = np.hypot(self._xy[:, 0] - ego_xy[0], self._xy[:, 1] - ego_xy[1])
+            direct = np.maximum(0.0, apart - (self.lengths + ego_length) / 2)
+            gaps = np.where(self._own, direct, gaps)
+        return gaps
 
-    def fire_triggers(self, t: float, ego_s: float, ego_length: float) -> list[tuple[str, int]]:
+    def fire_triggers(self, t: float, ego_s: float, ego_length: float,
+                      ego_xy: tuple[float, float] | None = None) -> list[tuple[str, int]]:
         """Start the actions whose triggers hold; returns (actor id, action index) started."""
         started = []
-        for spec, motion, gap in zip(
-            self.specs, self.motions, self.gaps(ego_s, ego_length), strict=True
+        for spec, motion, gap, own_map in zip(
+            self.specs, self.motions, self.gaps(ego_s, ego_length, ego_xy), self._maps,
+            strict=True,
         ):
             ctx = TriggerContext(t=t, ego_s=ego_s, gap=float(gap))
-            started += [(spec.id, i) for i in motion.fire_due(ctx, self.lane_offset)]
+
+            def lane_offset(lane: int, s: float, m: RoadMap = own_map) -> float:
+                return float(m.lane(lane).offset_at(s))
+
+            started += [(spec.id, i) for i in motion.fire_due(ctx, lane_offset)]
         return started
 
-    def step(self, t: float, dt: float) -> None:
-        """Advance every motion by dt [s] and move the moving bodies to their new poses."""
+    def step(self, t: float, dt: float, ego: tuple[float, float, float] | None = None) -> None:
+        """Advance every motion by dt [s] and move the moving bodies to their new poses.
+        `ego`: (x, y, half length) of the ego, for town drivers to keep their distance."""
         self._last_speed = self._speeds()
         self._dt = dt
+        self._cap_town_drivers(t, ego)
         for motion, line in zip(self.motions, self._lines, strict=True):
             motion.step(t, dt, line.curvature_one(motion.s))
         self._poses = None
         self._place(force=False)
+
+    def _cap_town_drivers(self, t: float, ego: tuple[float, float, float] | None) -> None:
+        """Each town driver's speed cap from its rules and the other vehicles' centres."""
+        if not self._own.any():
+            return
+        vehicles = np.array([k in (ActorType.CAR, ActorType.TRUCK) for k in self._kinds])
+        xy, half = self._xy[vehicles], self.half_sizes[vehicles, 0]
+        if ego is not None:
+            xy = np.vstack([xy, [ego[:2]]])
+            half = np.append(half, ego[2])
+        index = np.cumsum(vehicles) - 1  # row of each vehicle actor in xy
+        for i, (driver, motion) in enumerate(zip(self._drivers, self.motions, strict=True)):
+            if driver is None:
+                continue
+            others = np.ones(len(xy), dtype=bool)
+            others[index[i]] = False
+            motion.cap = driver.speed_cap(t, motion.s, motion.speed, xy[others], half[others])
 
     def _speeds(self) -> NDArray[np.float64]:
         """[m/s] (N,) `ActorPoses.speeds` now."""
@@ -166,6 +213,10 @@ class ActorSet:
         if through.any():
             x[through], y[through], heading[through] = self._road.through_line.pose(
                 s[through], offsets[through])
+        for i in np.flatnonzero(self._own):  # on its own town route
+            x[i], y[i], heading[i] = self._lines[i].pose_one(float(s[i]), float(offsets[i]))
+        through = through | self._own
+        if through.any():
             # the truth along the route, where criteria look for vehicles: projected
             s = s.copy()
             s[through], offsets[through] = self._road.local_coordinates(
@@ -187,9 +238,11 @@ class ActorSet:
     def _place(self, force: bool) -> None:
         """Move the bodies of the actors that move (all of them with `force`): one scalar
         map lookup each, the hot path of the NPCs."""
-        for body, m, flip, z, line in zip(self.bodies, self.motions, self._flip_list,
-                                          self._heights, self._lines, strict=True):
+        for i, (body, m, flip, z, line) in enumerate(zip(
+                self.bodies, self.motions, self._flip_list, self._heights, self._lines,
+                strict=True)):
             if force or m.speed != 0.0 or m.lateral_speed != 0.0:
                 x, y, heading = line.pose_one(m.s, m.offset)
+                self._xy[i] = (x, y)
                 half = 0.5 * (heading + flip + m.heading_offset)
                 self._reset_pose(body, (x, y, z), (0.0, 0.0, math.sin(half), math.cos(half)))

@@ -42,6 +42,7 @@ LATERAL_ACCEL = 1.5  # [m/s^2] ramp of the lateral speed at the start and end of
 ARRIVED = 1e-3  # [m] lateral distance that counts as arrived
 PEDESTRIAN_TURN_RATE = math.pi  # [rad/s] a pedestrian turns to face where it walks (90 deg: 0.5 s)
 PEDESTRIAN_MOVING = 0.05  # [m/s] a pedestrian slower than this over ground keeps its heading
+CAP_ACCEL = 1.5  # [m/s^2] a capped NPC (a town driver) speeds up again at this
 
 LaneOffset = Callable[[int, float], float]
 """(lane index, station) -> lateral offset [m] of that lane's centre from the reference line."""
@@ -93,6 +94,8 @@ class NpcMotion:
         self.fired_at: list[float | None] = [None] * len(actions)  # [s]
         self.ended_at: list[float | None] = [None] * len(actions)  # [s]
         self._target_speed = speed  # [m/s]
+        self._planned = speed  # [m/s] the scripted speed (actions alone)
+        self.cap: float | None = None  # [m/s] a town driver's limit (`world.town_traffic`)
         self._accel = 0.0  # [m/s^2] magnitude towards the target speed
         self._speed_action: int | None = None
         self._target_offset = offset  # [m]
@@ -155,15 +158,19 @@ class NpcMotion:
                                       2.0 * math.pi)
 
     def _step_speed(self, t: float, dt: float) -> None:
-        error = self._target_speed - self.speed
+        error = self._target_speed - self._planned
         change = self._accel * dt
         if abs(error) <= change:
-            self.speed = self._target_speed
+            self._planned = self._target_speed
             if self._speed_action is not None:
                 self.ended_at[self._speed_action] = t
                 self._speed_action = None
         else:
-            self.speed += math.copysign(change, error)
+            self._planned += math.copysign(change, error)
+        if self.cap is None:
+            self.speed = self._planned
+        else:  # a town driver's rules: never above the cap, back up at CAP_ACCEL
+            self.speed = max(0.0, min(self._planned, self.cap, self.speed + CAP_ACCEL * dt))
 
     def _step_lateral(self, t: float, dt: float) -> None:
         if self._lateral_action is None:

@@ -5,7 +5,8 @@ builder, actors, criteria) code against them.
 
 Geometry: the route's reference line is the centre line of lane 0 (the rightmost lane of the
 ego's direction), a chain of straight and constant-curvature arc pieces laid end to end from
-the origin, heading +x. Every lane shares the route's station `s` (metres along the
+the spec's `origin` pose (a road's: the origin, heading +x; a town route starts where its
+start junction is). Every lane shares the route's station `s` (metres along the
 reference line); a lane is the reference line shifted sideways by the lane's `offset_at(s)`.
 Lateral `r` is metres from the lane's centre, left of the route direction positive (for
 oncoming lanes too: their travel `direction` is -1 but s and r stay in route coordinates).
@@ -36,8 +37,13 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from world.spec import (
+    Control,
     Crosswalk,
     Feature,
+    JunctionSpec,
+    LightColour,
+    LightHead,
+    Manoeuvre,
     RoadSpec,
     Side,
     SpeedBump,
@@ -49,13 +55,18 @@ from world.spec import (
 
 __all__ = [  # the map's own types, and the spec types of what it holds (features, zones)
     "SHOULDER",
+    "Control",
     "CrossSection",
     "Crosswalk",
     "Exit",
     "Feature",
     "FloatArray",
     "IntArray",
+    "JunctionSpec",
     "Lane",
+    "LightColour",
+    "LightHead",
+    "Manoeuvre",
     "MapError",
     "Piece",
     "ReferenceLine",
@@ -73,6 +84,9 @@ FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.intp]
 SHOULDER = -1000  # the lane index of the paved right shoulder (`RoadMap.lane`)
 
+LIGHT_AHEAD = 12.0  # [m] a road light's head stands this far past its stop line ...
+LIGHT_SIDE = 1.0  # [m] ... this far right of the paved edge ...
+LIGHT_HEIGHT = 3.5  # [m] ... with its housing's centre this high (a town places its own)
 HALF_PI = 0.5 * np.pi  # [rad]
 TWO_PI = 2.0 * np.pi  # [rad]
 
@@ -379,6 +393,7 @@ class RoadMap:
     speed_limits: tuple[SpeedLimitPosting, ...]  # sorted by station, first at s = 0
     sections: tuple[CrossSection, ...]  # per segment (= piece)
     exits: tuple[Exit, ...]  # sorted by station
+    junctions: tuple[JunctionSpec, ...]  # a town route's junctions, sorted by station
 
     def __init__(
         self,
@@ -387,10 +402,12 @@ class RoadMap:
         features: tuple[Feature, ...],
         speed_limits: tuple[SpeedLimitPosting, ...],
         exit_pieces: tuple[int, ...] = (),
+        junctions: tuple[JunctionSpec, ...] = (),
     ) -> None:
         """Use `from_spec`; this takes the already laid pieces, one section per piece, and
         the indices of the pieces that leave the road before them by an exit (right)."""
         self.pieces = pieces
+        self.junctions = tuple(sorted(junctions, key=lambda j: j.s_stop))
         self.sections = sections
         self.features = features
         self.speed_limits = speed_limits
@@ -424,7 +441,7 @@ class RoadMap:
         pieces: list[Piece] = []
         sections: list[CrossSection] = []
         exits: list[int] = []
-        s, xy, heading = 0.0, np.zeros(2), 0.0
+        s, xy, heading = 0.0, np.array(spec.origin[:2], dtype=float), float(spec.origin[2])
         zone = Zone.HIGHWAY
         for i, seg in enumerate(spec.segments):
             zone = seg.zone if seg.zone is not None else zone
@@ -448,6 +465,7 @@ class RoadMap:
             tuple(sorted(spec.features, key=lambda f: f.s)),
             _speed_limit_postings(spec, [p.s0 for p in pieces]),
             tuple(exits),
+            spec.junctions,
         )
 
     def through_road(self, exit_: Exit, length: float) -> RoadMap:
@@ -467,6 +485,17 @@ class RoadMap:
         if -len(self.oncoming) <= index < 0:
             return self.oncoming[-index - 1]
         raise IndexError(f"no lane {index} on this road")
+
+    def light_head(self, light: TrafficLight) -> LightHead:
+        """Where `light`'s head stands: its own `head` (a town places them on the far
+        corner of the junction), else on a pole `LIGHT_AHEAD` past the stop line, right of
+        the paved edge, facing the route's traffic."""
+        if light.head is not None:
+            return light.head
+        s = light.s + LIGHT_AHEAD
+        right, _ = self.paved_edges(s)
+        x, y, heading = self.line.pose_one(s, float(right) - LIGHT_SIDE)
+        return LightHead(x, y, LIGHT_HEIGHT, heading + np.pi)
 
     def cross_section_at(self, s: float) -> CrossSection:
         return self.sections[int(self.line.segment_index(_as_float(s)))]

@@ -25,6 +25,7 @@ class Zone(enum.Enum):
     HIGHWAY = "highway"
     RAMP = "ramp"
     CITY = "city"
+    JUNCTION = "junction"  # inside a town junction: no markings, the route's turn path
 
 
 class Side(enum.Enum):
@@ -77,16 +78,79 @@ class SpeedBump:
     pass_speed: float  # [m/s] the speed to take it at
 
 
+class LightColour(enum.Enum):
+    """The lit lamp of a traffic light."""
+
+    GREEN = "green"
+    YELLOW = "yellow"
+    RED = "red"
+
+
+@dataclass(frozen=True, slots=True)
+class LightHead:
+    """Where a traffic light's head stands: the centre of its housing (the yellow lamp) in
+    the map frame, and the way its lamps face (towards the traffic it controls)."""
+
+    x: float  # [m]
+    y: float  # [m]
+    z: float  # [m] above the ground
+    facing: float  # [rad] yaw of the lamps' outward normal
+
+
 @dataclass(frozen=True, slots=True)
 class TrafficLight:
+    """A signal for the traffic on the route at stop line `s`. The cycle starts green:
+    green, then yellow, then red; `phase` is the time into the cycle at t = 0."""
+
     s: float  # [m] station of the stop line
     green: float  # [s]
     yellow: float  # [s]
     red: float  # [s]
     phase: float  # [s] time into the cycle at t = 0
+    head: LightHead | None = None  # None: the map places it (`RoadMap.light_head`)
+
+    @property
+    def cycle(self) -> float:
+        return self.green + self.yellow + self.red
 
 
 Feature = SpeedLimitSign | StopSign | Crosswalk | SpeedBump | TrafficLight
+
+
+class Manoeuvre(enum.Enum):
+    """What a route does at a town junction."""
+
+    STRAIGHT = "straight"
+    LEFT = "left"
+    RIGHT = "right"
+    U_TURN = "u_turn"
+
+
+class Control(enum.Enum):
+    """How a town junction is controlled (every approach alike)."""
+
+    NONE = "none"  # a bend at the town's corner: nothing to give way to
+    STOP_SIGNS = "stop_signs"  # all-way stop
+    TRAFFIC_LIGHTS = "traffic_lights"
+
+
+@dataclass(frozen=True, slots=True)
+class JunctionSpec:
+    """A town junction met along a route, in the route's stations (`world.town`).
+
+    The approach street runs along `heading` into the junction whose centre is (x, y); the
+    box is the square where the streets cross, `half_width` each side of the centre."""
+
+    index: tuple[int, int]  # (ix, iy) in the town grid
+    manoeuvre: Manoeuvre
+    control: Control
+    s_stop: float  # [m] station of the approach's stop line
+    s_enter: float  # [m] where the route's path starts to turn / enters the box
+    s_exit: float  # [m] where it has turned and left the box, in its new lane
+    x: float  # [m] the junction's centre
+    y: float  # [m]
+    heading: float  # [rad] the approach's direction of travel
+    half_width: float  # [m] half the street's width (kerb to kerb)
 
 
 @dataclass(frozen=True, slots=True)
@@ -101,6 +165,37 @@ class RoadSpec:
     speed_limit: float  # [m/s] posted at s = 0
     features: tuple[Feature, ...] = ()
     buildings: BuildingsSpec | None = None
+    origin: tuple[float, float, float] = (0.0, 0.0, 0.0)  # [m, m, rad] the line's start pose
+    junctions: tuple[JunctionSpec, ...] = ()  # a town route's junctions, by station
+
+
+@dataclass(frozen=True, slots=True)
+class LightTiming:
+    """A town junction's signal plan: the east-west approaches get `green`, `yellow`, then
+    red while the north-south ones get theirs; `all_red` [s] between the two."""
+
+    green: float = 15.0  # [s]
+    yellow: float = 3.0  # [s]
+    all_red: float = 2.0  # [s]
+
+    @property
+    def cycle(self) -> float:
+        return 2.0 * (self.green + self.yellow + self.all_red)
+
+
+@dataclass(frozen=True, slots=True)
+class TownSpec:
+    """A grid town (map kind 2): streets along x = ix * block and y = iy * block, junction
+    (ix, iy) at their crossing, ix in 0..blocks_x, iy in 0..blocks_y (`world.town`)."""
+
+    blocks_x: int
+    blocks_y: int
+    block: float  # [m] junction spacing
+    lanes: int  # per direction
+    lane_width: float  # [m]
+    speed_limit: float  # [m/s]
+    junctions: str  # "stop_signs" | "traffic_lights" | "mixed" (lights where ix + iy is even)
+    lights: LightTiming = field(default_factory=LightTiming)
 
 
 # ---------------------------------------------------------------------------------------
@@ -180,6 +275,7 @@ class ActorSpec:
     offset: float  # [m] lateral, left positive, from the lane centre
     speed: float  # [m/s] initial speed
     actions: tuple[ActionSpec, ...] = ()
+    road: RoadSpec | None = None  # in a town: the actor's own route (lane, s, offset on it)
 
 
 @dataclass(frozen=True, slots=True)
@@ -269,3 +365,4 @@ class ScenarioSpec:
     sensors: SensorsSpec = field(default_factory=SensorsSpec)
     events: tuple[EventSpec, ...] = ()
     criteria: CriteriaSpec = field(default_factory=CriteriaSpec)
+    town: TownSpec | None = None  # map kind 2: `road` is then the ego's route through it

@@ -63,7 +63,7 @@ def _run_args(scenario: str) -> tuple[str, ...]:
 # (YAML, file shape, model validation, cross-key checks, unsupported features)
 SUBPROCESS_FIXTURES = (
     "bad_yaml_syntax", "duplicate_key", "not_a_mapping", "unknown_nested_key", "wrong_type",
-    "actor_lane_out_of_range", "after_forward", "unsupported_town",
+    "actor_lane_out_of_range", "after_forward", "town_route_leaves_town",
 )
 
 

@@ -180,7 +180,13 @@ BAD: dict[str, tuple[str, str]] = {
     "bad_name": ("name", "must match [a-z0-9_]+"),
     "wrong_format": ("format", "must be avsim/1, got 'avsim/2'"),
     "unsupported_feature": ("road.features.0.type", "not supported yet (traffic lights)"),
-    "unsupported_town": ("town", "not supported yet (the town map kind)"),
+    "town_route_leaves_town": (
+        "ego.route.1",
+        "right at junction (2, 0) (heading east): no street leaves it heading south",
+    ),
+    "town_narrow_u_turn": ("ego.route.0", "u_turn at junction (1, 1): the street is too narrow"),
+    "town_block_too_short": ("town.block", "must be at least 29 m with 1 lane(s) of 3.5 m"),
+    "town_actor_without_start": ("actors.0.start", "required key missing in a town"),
     "bad_lidar_dropout": ("sensors.lidar.dropout", "must be <= 1, got 1.5"),
 }
 

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from dataclasses import replace
 
+import numpy as np
 import pytest
 
 from perception.messages import EgoState, ObjectClass, Track
@@ -13,8 +14,9 @@ from planner.acc import AccParams
 from planner.motion import Motion
 from planner.motion_layer import MotionLayer, MotionLayerParams
 from tests.roads import W, make_map, seg
-from world.hdmap import SHOULDER
-from world.spec import Side
+from world.hdmap import SHOULDER, RoadMap
+from world.spec import Manoeuvre, Side, TownSpec
+from world.town import TownLayout, compile_route
 
 ROAD = make_map(seg(1000.0))
 V = 13.9  # [m/s]
@@ -112,3 +114,27 @@ def test_a_flat_tyre_pulls_over_lane_by_lane_onto_the_shoulder() -> None:
     assert sorted(set(lanes), key=lanes.index) == [0, SHOULDER]
     assert m.motion is Motion.LANE_KEEP and m.path is None
     assert y == pytest.approx(float(ROAD.shoulder.offset_at(x)))
+
+
+@pytest.mark.parametrize(
+    ("manoeuvre", "state"),
+    [("left", Motion.TURN_LEFT), ("right", Motion.TURN_RIGHT), ("u_turn", Motion.U_TURN)],
+)
+def test_a_town_turn_from_the_stop_line_to_the_junction_exit(manoeuvre: str,
+                                                             state: Motion) -> None:
+    layout = TownLayout(TownSpec(3, 2, 90.0, 2, 3.5, 11.0, "stop_signs"))
+    road = RoadMap.from_spec(compile_route(layout, (0, 1, "east"), (Manoeuvre(manoeuvre),), "e"))
+    j = road.junctions[0]
+    m = MotionLayer(road, 0, AccParams(), MotionLayerParams())
+    seen = []
+    for k, s in enumerate(np.arange(j.s_stop - 10.0, j.s_exit + 10.0, 0.5)):
+        x, y = road.position(s, 0.0)
+        pose = EgoState(t=0.1 * k, x=float(x), y=float(y), heading=float(road.heading_at(s)),
+                        speed=4.0, yaw_rate=0.0, steering_angle=0.0, position_sigma=0.1)
+        manoeuvre_now, _ = m.update(pose, 4.0, ())
+        seen.append((float(s), manoeuvre_now.motion))
+    turning = [s for s, motion in seen if motion is state]
+    assert turning[0] == pytest.approx(j.s_stop, abs=0.5)
+    assert turning[-1] == pytest.approx(j.s_exit, abs=0.6)
+    assert seen[-1][1] is Motion.LANE_KEEP
+    assert all(motion in (state, Motion.LANE_KEEP) for _, motion in seen)

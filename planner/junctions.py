@@ -1,0 +1,202 @@
+"""Town junctions for the ACC layer: traffic lights seen by the camera, and giving way.
+
+The HD map lists the route's junctions (`RoadMap.junctions`: stop line, where the turn
+starts and ends, the manoeuvre, the control) and the route's traffic lights (their stop
+lines and where their heads stand). Each tick, for the car's front bumper f (stations
+along the route):
+
+**Traffic lights.** The next light whose stop line L the front has not crossed, once
+within ``approach(v)`` (as `planner.events`). Its colour is the camera's
+(`see_lights`, `perception.lights`), if seen within ``light_memory``:
+
+- green: go;
+- yellow: decided once, when first seen: stop if the car can stop before the line at
+  ``yellow_decel`` (3 m/s^2: v^2 / (2 (L - f - stop_margin)) <= yellow_decel), else go
+  on (it then crosses the line well within the yellow phase: from the braking distance
+  at 3 m/s^2 at 11 m/s, 20 m, it needs 1.8 s of a 3 s yellow);
+- red: stop, unless the front is already over the line;
+- not seen (or not lately): stop as for red, from the distance the car needs to stop at
+  ``a_comf`` plus ``unseen_margin`` on (and from then on, while it stays unread): a light
+  the camera cannot read is not driven through, and one it reads in time costs nothing.
+
+The stop is the ACC layer's stop law at ``L - f - stop_margin`` (event ``red_light``).
+
+**Giving way** (event ``give_way``, a stop at the same line). Before a left turn or a
+U-turn, at a junction of any control: an oncoming vehicle track (on the far arm of the
+street, in the lanes heading towards the car, ``oncoming_reach`` out) that will reach the
+box within ``gap_time`` (6 s, a common critical gap for a left turn from a standstill plus
+margin) at its speed towards it, or stands within ``near_box`` of it (at its stop line: it
+goes when the light turns green, as the car's does), or any vehicle track inside the box
+that is not moving the car's way. At a stop-sign junction, also for going straight or turning right: a
+vehicle track inside the box, not moving the car's way. The car waits at the line; once
+its front is over the line it is committed and goes on (the control FSM's emergency stop
+still covers a vehicle in its path).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from perception.messages import LightDetection, ObjectClass, Track
+from world.hdmap import (
+    Control,
+    JunctionSpec,
+    LightColour,
+    LightHead,
+    Manoeuvre,
+    RoadMap,
+    TrafficLight,
+)
+
+
+@dataclass(frozen=True, slots=True)
+class JunctionParams:
+    front_overhang: float = 2.4  # [m] centre -> front bumper
+    a_comf: float = 1.5  # [m/s^2] approach braking
+    approach_extra: float = 30.0  # [m]
+    stop_margin: float = 0.5  # [m] stop this much (+ the controller's margin) before a line
+    light_range: float = 60.0  # [m] lights farther than this are not looked for
+    light_memory: float = 1.0  # [s] a light's colour is trusted this long after it was seen
+    yellow_decel: float = 3.0  # [m/s^2] the yellow rule's "can stop" deceleration
+    unseen_margin: float = 5.0  # [m] an unread light is stopped for from this + braking
+    gap_time: float = 6.0  # [s] an oncoming vehicle nearer than this in time is waited for
+    oncoming_reach: float = 100.0  # [m] how far out along the far arm oncoming traffic counts
+    moving: float = 0.5  # [m/s] slower than this towards the box: not coming ...
+    near_box: float = 12.0  # [m] ... unless this near it (about to go: a light turning green)
+    same_way: float = 0.7  # [-] cos of the angle within which a track moves the car's way
+
+
+@dataclass(frozen=True, slots=True)
+class JunctionEvents:
+    red_light: bool = False  # stopping for a light (red, yellow it can stop for, unread)
+    give_way: bool = False  # waiting for a gap before turning / entering
+    stop_distance: float = math.inf  # [m] front bumper to where the car must stand
+    light: LightColour | None = None  # the next light's colour as last seen (None: unread)
+
+
+@dataclass(slots=True)
+class _Seen:
+    colour: LightColour
+    t: float  # [s] frame time
+
+
+class JunctionMonitor:
+    """The junction rules of one run (it remembers the lights seen and yellow decisions)."""
+
+    def __init__(self, road: RoadMap, params: JunctionParams | None = None) -> None:
+        self.road = road
+        self.params = params if params is not None else JunctionParams()
+        self.lights = sorted((f for f in road.features if isinstance(f, TrafficLight)),
+                             key=lambda f: f.s)
+        self.heads = tuple(road.light_head(f) for f in self.lights)
+        self._seen: dict[int, _Seen] = {}
+        self._yellow_go: set[int] = set()  # lights whose yellow the car decided to go on
+        self._unseen: set[int] = set()  # lights the car began to stop for unread
+
+    def heads_ahead(self, station: float) -> list[tuple[int, LightHead]]:
+        """(id, `LightHead`) of the lights whose stop line is ahead within ``light_range``
+        (what the light detector is asked to look at)."""
+        p = self.params
+        front = station + p.front_overhang
+        return [(i, self.heads[i]) for i, f in enumerate(self.lights)
+                if -1.0 < f.s - front <= p.light_range]
+
+    def see_lights(self, detections: Sequence[LightDetection]) -> None:
+        for d in detections:
+            seen = self._seen.get(d.light)
+            if seen is None or d.t >= seen.t:
+                self._seen[d.light] = _Seen(d.colour, d.t)
+
+    def update(self, t: float, station: float, v: float,
+               tracks: Sequence[Track] = ()) -> JunctionEvents:
+        p = self.params
+        front = station + p.front_overhang
+        approach = v * v / (2.0 * p.a_comf) + p.approach_extra
+        light_stop, colour = self._light(t, front, v, approach)
+        way_stop = self._give_way(front, approach, tracks)
+        stops = [d for d in (light_stop, way_stop) if d is not None]
+        return JunctionEvents(
+            red_light=light_stop is not None,
+            give_way=way_stop is not None,
+            stop_distance=min(stops) if stops else math.inf,
+            light=colour,
+        )
+
+    # -- lights ----------------------------------------------------------------------------
+
+    def _light(self, t: float, front: float, v: float,
+               approach: float) -> tuple[float | None, LightColour | None]:
+        p = self.params
+        i = next((i for i, f in enumerate(self.lights) if f.s > front), None)
+        if i is None:
+            return None, None
+        room = self.lights[i].s - front - p.stop_margin  # [m] to where the car would stand
+        if room + p.stop_margin > approach:
+            return None, None
+        seen = self._seen.get(i)
+        colour = seen.colour if seen is not None and t - seen.t <= p.light_memory else None
+        if colour is LightColour.GREEN:
+            self._yellow_go.discard(i)
+            return None, colour
+        if colour is LightColour.YELLOW:
+            if i not in self._yellow_go and v * v > 2.0 * p.yellow_decel * max(room, 0.0):
+                self._yellow_go.add(i)  # cannot stop comfortably: go on through
+            return (None if i in self._yellow_go else room), colour
+        if colour is LightColour.RED:
+            return (None if i in self._yellow_go else room), colour
+        if i not in self._unseen and room <= v * v / (2.0 * p.a_comf) + p.unseen_margin:
+            self._unseen.add(i)  # from here on, stop for it until it is read
+        return (room if i in self._unseen else None), None
+
+    # -- giving way ------------------------------------------------------------------------
+
+    def _give_way(self, front: float, approach: float, tracks: Sequence[Track]) -> float | None:
+        p = self.params
+        j = next((j for j in self.road.junctions if j.s_stop > front - 0.5), None)
+        if j is None or j.s_stop - front > approach:
+            return None
+        vehicles = [tr for tr in tracks if tr.cls in (ObjectClass.CAR, ObjectClass.TRUCK)]
+        if not vehicles:
+            return None
+        turning_across = j.manoeuvre in (Manoeuvre.LEFT, Manoeuvre.U_TURN)
+        if not (turning_across or j.control is Control.STOP_SIGNS):
+            return None
+        xy = np.array([[tr.x, tr.y] for tr in vehicles])
+        vel = np.array([[tr.vx, tr.vy] for tr in vehicles])
+        wait = bool(np.any(self._in_box(j, xy, vel)))
+        if turning_across:
+            wait = wait or bool(np.any(self._oncoming_soon(j, xy, vel)))
+        return j.s_stop - front - p.stop_margin if wait else None
+
+    def _frame(self, j: JunctionSpec, xy: np.ndarray,
+               vel: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Along / left of the approach's direction, from the junction's centre, for the
+        positions, and the velocities' components the same way."""
+        f = np.array([math.cos(j.heading), math.sin(j.heading)])
+        left = np.array([-f[1], f[0]])
+        rel = xy - np.array([j.x, j.y])
+        return rel @ f, rel @ left, vel @ f, vel @ left
+
+    def _in_box(self, j: JunctionSpec, xy: np.ndarray, vel: np.ndarray) -> np.ndarray:
+        along, left, v_along, v_left = self._frame(j, xy, vel)
+        inside = (np.abs(along) <= j.half_width) & (np.abs(left) <= j.half_width)
+        speed = np.hypot(v_along, v_left)
+        my_way = v_along > self.params.same_way * np.maximum(speed, 1e-9)
+        out: np.ndarray = inside & ~(my_way & (speed > self.params.moving))
+        return out
+
+    def _oncoming_soon(self, j: JunctionSpec, xy: np.ndarray, vel: np.ndarray) -> np.ndarray:
+        p = self.params
+        along, left, v_along, _ = self._frame(j, xy, vel)
+        towards = -v_along
+        on_far_arm = (along > j.half_width) & (along < j.half_width + p.oncoming_reach) & \
+            (left > 0.0) & (left < j.half_width + 1.0)
+        arrive = (along - j.half_width) / np.maximum(towards, 1e-9)
+        coming = (towards > p.moving) & (arrive < p.gap_time)
+        about_to = along - j.half_width < p.near_box
+        out: np.ndarray = on_far_arm & (coming | about_to)
+        return out

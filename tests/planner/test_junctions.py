@@ -1,0 +1,144 @@
+"""Town junction rules: lights as the camera saw them (the yellow rule, an unread light) and
+giving way before a left turn or U-turn, on routes compiled from a grid town."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from perception.messages import LightDetection, ObjectClass, Track
+from planner.junctions import JunctionMonitor, JunctionParams
+from world.hdmap import LightColour, RoadMap
+from world.spec import Manoeuvre, TownSpec
+from world.town import TownLayout, compile_route
+
+P = JunctionParams()
+LIGHTS = TownLayout(TownSpec(3, 2, 90.0, 2, 3.5, 40 / 3.6, "traffic_lights"))
+STOPS = TownLayout(TownSpec(3, 2, 90.0, 2, 3.5, 40 / 3.6, "stop_signs"))
+
+
+def route(layout: TownLayout, manoeuvre: Manoeuvre) -> RoadMap:
+    return RoadMap.from_spec(compile_route(layout, (0, 1, "east"), (manoeuvre,), "ego"))
+
+
+def car(x: float, y: float, vx: float = 0.0, vy: float = 0.0) -> Track:
+    return Track(id=3, t=0.0, x=x, y=y, vx=vx, vy=vy, rel_x=0.0, rel_y=0.0, rel_vx=0.0,
+                 rel_vy=0.0, length=4.6, width=1.8, height=1.5, yaw=0.0,
+                 cls=ObjectClass.CAR, hits=9, misses=0, position_sigma=0.1)
+
+
+def seen(colour: LightColour, t: float = 0.0) -> LightDetection:
+    return LightDetection(t=t, light=0, colour=colour, range=30.0, confidence=0.9,
+                          box=(0, 0, 1, 1))
+
+
+def front_at(m: JunctionMonitor, before_line: float) -> float:
+    """The car's centre station with its front bumper `before_line` [m] before the first
+    junction's stop line."""
+    return m.road.junctions[0].s_stop - before_line - P.front_overhang
+
+
+@pytest.mark.parametrize(
+    ("colour", "before_line", "v", "stops"),
+    [
+        (LightColour.GREEN, 20.0, 11.0, False),
+        (LightColour.RED, 20.0, 11.0, True),
+        (LightColour.RED, 0.2, 0.0, True),  # standing at the line
+        (LightColour.YELLOW, 40.0, 11.0, True),  # 11^2 / (2 x 39.5) = 1.5 m/s^2: stop
+        (LightColour.YELLOW, 15.0, 11.0, False),  # 4.2 m/s^2 needed: go on
+        (LightColour.YELLOW, 15.0, 8.0, True),  # 2.2 m/s^2: stop
+        (None, 50.0, 11.0, False),  # unread, but far: no need to brake yet
+        (None, 40.0, 11.0, True),  # unread within braking distance + 5 m: stop for it
+    ],
+)
+def test_the_light_rules(colour: LightColour | None, before_line: float, v: float,
+                         stops: bool) -> None:
+    m = JunctionMonitor(route(LIGHTS, Manoeuvre.STRAIGHT), P)
+    if colour is not None:
+        m.see_lights([seen(colour)])
+    e = m.update(0.5, front_at(m, before_line), v)
+    assert e.red_light is stops
+    assert e.light is colour
+    if stops:
+        assert e.stop_distance == pytest.approx(before_line - P.stop_margin)
+
+
+def test_a_yellow_decision_to_go_holds_when_it_turns_red() -> None:
+    m = JunctionMonitor(route(LIGHTS, Manoeuvre.STRAIGHT), P)
+    m.see_lights([seen(LightColour.YELLOW, 0.0)])
+    assert not m.update(0.0, front_at(m, 12.0), 11.0).red_light
+    m.see_lights([seen(LightColour.RED, 1.0)])
+    assert not m.update(1.0, front_at(m, 2.0), 11.0).red_light
+
+
+def test_a_colour_seen_too_long_ago_is_not_trusted() -> None:
+    m = JunctionMonitor(route(LIGHTS, Manoeuvre.STRAIGHT), P)
+    m.see_lights([seen(LightColour.GREEN, 0.0)])
+    assert m.update(P.light_memory + 0.5, front_at(m, 10.0), 5.0).red_light
+
+
+def test_the_light_over_the_line_is_no_longer_looked_at() -> None:
+    m = JunctionMonitor(route(LIGHTS, Manoeuvre.STRAIGHT), P)
+    m.see_lights([seen(LightColour.RED)])
+    assert not m.update(0.0, front_at(m, -0.5), 5.0).red_light
+    assert m.heads_ahead(front_at(m, 30.0)) == [(0, m.heads[0])]
+    assert m.heads_ahead(front_at(m, -2.0)) == []
+
+
+def oncoming(m: JunctionMonitor, distance: float, speed: float) -> Track:
+    """An oncoming car in the far arm's inner lane, `distance` past the junction's box."""
+    j = m.road.junctions[0]
+    hw = j.half_width
+    return car(j.x + hw + distance, j.y + 1.75, vx=-speed)
+
+
+@pytest.mark.parametrize(
+    ("manoeuvre", "distance", "speed", "waits"),
+    [
+        (Manoeuvre.LEFT, 30.0, 10.0, True),  # 3 s away: wait
+        (Manoeuvre.LEFT, 80.0, 10.0, False),  # 8 s away: go
+        (Manoeuvre.LEFT, 30.0, 0.0, False),  # standing 30 m out: not coming
+        (Manoeuvre.LEFT, 8.0, 0.0, True),  # standing at its own line: about to go
+        (Manoeuvre.U_TURN, 30.0, 10.0, True),
+        (Manoeuvre.RIGHT, 30.0, 10.0, False),  # turning right does not cross it
+        (Manoeuvre.STRAIGHT, 30.0, 10.0, False),
+    ],
+)
+def test_a_left_turn_waits_for_a_close_oncoming_car(manoeuvre: Manoeuvre, distance: float,
+                                                    speed: float, waits: bool) -> None:
+    m = JunctionMonitor(route(LIGHTS, manoeuvre), P)
+    m.see_lights([seen(LightColour.GREEN)])
+    e = m.update(0.0, front_at(m, 10.0), 6.0, [oncoming(m, distance, speed)])
+    assert e.give_way is waits
+    assert not e.red_light
+    if waits:
+        assert e.stop_distance == pytest.approx(10.0 - P.stop_margin)
+
+
+def test_once_over_the_line_the_turn_is_committed() -> None:
+    m = JunctionMonitor(route(LIGHTS, Manoeuvre.LEFT), P)
+    m.see_lights([seen(LightColour.GREEN)])
+    assert not m.update(0.0, front_at(m, -1.0), 3.0, [oncoming(m, 20.0, 10.0)]).give_way
+
+
+@pytest.mark.parametrize(
+    ("vx", "vy", "waits"),
+    [(0.0, 5.0, True), (0.0, 0.0, True), (5.0, 0.0, False)],  # across, standing, my way
+)
+def test_at_a_stop_sign_the_car_waits_for_the_box_to_clear(vx: float, vy: float,
+                                                           waits: bool) -> None:
+    m = JunctionMonitor(route(STOPS, Manoeuvre.STRAIGHT), P)
+    j = m.road.junctions[0]
+    e = m.update(0.0, front_at(m, 1.0), 0.0, [car(j.x + 1.0, j.y - 2.0, vx, vy)])
+    assert e.give_way is waits
+    assert not m.update(0.0, front_at(m, 1.0), 0.0, []).give_way
+    assert math.isinf(m.update(0.0, front_at(m, 1.0), 0.0, []).stop_distance)
+
+
+def test_an_unread_light_once_stopped_for_stays_so_until_read() -> None:
+    m = JunctionMonitor(route(LIGHTS, Manoeuvre.STRAIGHT), P)
+    assert m.update(0.0, front_at(m, 40.0), 11.0).red_light
+    assert m.update(0.1, front_at(m, 39.0), 8.0).red_light  # slower: still stopping for it
+    m.see_lights([seen(LightColour.GREEN, 0.2)])
+    assert not m.update(0.2, front_at(m, 38.0), 8.0).red_light
