@@ -27,10 +27,10 @@ street, in the lanes heading towards the car, ``oncoming_reach`` out) that will 
 box within ``gap_time`` (6 s, a common critical gap for a left turn from a standstill plus
 margin) at its speed towards it, or stands within ``near_box`` of it (at its stop line: it
 goes when the light turns green, as the car's does), or any vehicle track inside the box
-that is not moving the car's way. At a stop-sign junction, also for going straight or turning right: a
-vehicle track inside the box, not moving the car's way. The car waits at the line; once
-its front is over the line it is committed and goes on (the control FSM's emergency stop
-still covers a vehicle in its path).
+that is not moving the car's way. At a stop-sign junction, also for going straight or
+turning right: a vehicle track inside the box, not moving the car's way. The car waits at
+the line; once its front is over the line it is committed and goes on (the control FSM's
+emergency stop still covers a vehicle in its path).
 """
 
 from __future__ import annotations

@@ -20,7 +20,7 @@ from world.scenery import MIN_BUILDING_GAP
 from world.sensor_setup import Profile, sensor_setup
 from world.sensors import vehicle_pose
 from world.spec import EgoSpec, Manoeuvre, ScenarioSpec, TownSpec
-from world.town import HEADINGS, RIGHT_TURN_RADIUS, STOP_SETBACK, TownLayout, compile_route
+from world.town import HEADINGS, STOP_SETBACK, TownLayout, compile_route
 from world.town_scene import (
     KERB_HEIGHT,
     SIDEWALK_WIDTH,
