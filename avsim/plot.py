@@ -52,6 +52,8 @@ MODE_COLOURS: dict[str, str] = {
     AccMode.SPEED_BUMP.value: "#ff5722",
     AccMode.STOP_SIGN.value: "#880e4f",
     AccMode.FLAT.value: "#795548",
+    AccMode.RED_LIGHT.value: "#b71c1c",
+    AccMode.YIELD.value: "#ff9800",
 }
 OTHER_MODE_COLOUR = "#9e9e9e"  # a mode this table does not know yet
 LINES = {  # series -> (label, colour, style, width)

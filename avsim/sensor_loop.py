@@ -24,7 +24,6 @@ from avsim.scoring import CaptureTruth, PerceptionScore
 from avsim.stack import PerceptionOutput, Stack
 from perception.messages import Detection
 from world.frames import CameraFrame
-from world.hdmap import Zone
 from world.sensing import InlineSensing, ProcessSensing, Sensing
 from world.sensor_setup import SensorSetup
 from world.sensors import SensorData, SensorSchedule
@@ -36,6 +35,8 @@ RECORD_FRONT_EVERY = 5  # record every 5th front frame (2 Hz at 10 Hz)
 RECORD_SIDE_EVERY = 4  # every 4th side frame (0.5 Hz at 2 Hz)
 RECORD_LIDAR_EVERY = 10  # every 10th scan (1 Hz at 10 Hz)
 RECORD_LIDAR_POINTS = 6000  # [-] at most this many points per recorded scan (even stride)
+JUNCTION_UNSCORED = (10.0, 15.0)  # [m] before a town stop line, after the junction exit:
+#   the lane is not scored there (the stack follows the map's path, `LaneSource.JUNCTION`)
 
 
 def sensing_mode(requested: str) -> str:
@@ -123,8 +124,9 @@ class SensorLoop:
         truth = w.ego_truth
         xy = truth.position[:2]
         lane, s, r = w.road.lane_at(xy)
-        if lane is not None and w.road.cross_section_at(s).zone is Zone.JUNCTION:
-            lane = None  # inside a town junction: no painted lane to score against
+        if lane is not None and any(j.s_stop - JUNCTION_UNSCORED[0] <= s
+                                    <= j.s_exit + JUNCTION_UNSCORED[1] for j in w.road.junctions):
+            lane = None  # at a town junction: no painted lane (its lines end at the mouth)
         heading_error = 0.0
         if lane is not None:
             heading = float(w.road.lane(lane).heading_at(s))

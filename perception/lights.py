@@ -311,6 +311,9 @@ class TrafficLightDetector:
             return None
         blobs, hsv = self.lamp_blobs(frame.rgb, view)
         total = sum(b.area for b in blobs)
+        # the blob nearest where its colour's lamp projects comes first: a lamp of another
+        # head seen side-on through the ROI lies off it (the ROI is padded for pose error)
+        blobs.sort(key=lambda b: (_off_lamp(b, view), -b.area))
         for blob in blobs:
             place = self.slot(blob, hsv, view)
             if place is not None and abs(place - SLOT[blob.colour]) > self.params.slot_tolerance:
@@ -322,3 +325,10 @@ class TrafficLightDetector:
             return LightDetection(t=frame.t, light=light, colour=blob.colour,
                                   range=view.range, confidence=confidence, box=blob.box)
         return None
+
+
+def _off_lamp(blob: LampBlob, view: HeadView) -> float:
+    """[px] from the blob's centroid to where its colour's lamp projects in ``view``."""
+    top, bottom = view.housing[1], view.housing[3]
+    v = top + SLOT[blob.colour] * (bottom - top)
+    return math.hypot(blob.centroid[0] - view.centre[0], blob.centroid[1] - v)

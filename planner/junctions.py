@@ -7,7 +7,8 @@ along the route):
 
 **Traffic lights.** The next light whose stop line L the front has not crossed, once
 within ``approach(v)`` (as `planner.events`). Its colour is the camera's
-(`see_lights`, `perception.lights`), if seen within ``light_memory``:
+(`see_lights`, `perception.lights`), if seen within ``light_memory``; red and yellow count
+from one frame, green (it lets the car go) from two in a row:
 
 - green: go;
 - yellow: decided once, when first seen: stop if the car can stop before the line at
@@ -61,6 +62,7 @@ class JunctionParams:
     stop_margin: float = 0.5  # [m] stop this much (+ the controller's margin) before a line
     light_range: float = 60.0  # [m] lights farther than this are not looked for
     light_memory: float = 1.0  # [s] a light's colour is trusted this long after it was seen
+    green_frames_gap: float = 0.25  # [s] two green frames this close confirm green
     yellow_decel: float = 3.0  # [m/s^2] the yellow rule's "can stop" deceleration
     unseen_margin: float = 5.0  # [m] an unread light is stopped for from this + braking
     gap_time: float = 6.0  # [s] an oncoming vehicle nearer than this in time is waited for
@@ -93,9 +95,10 @@ class JunctionMonitor:
         self.lights = sorted((f for f in road.features if isinstance(f, TrafficLight)),
                              key=lambda f: f.s)
         self.heads = tuple(road.light_head(f) for f in self.lights)
-        self._seen: dict[int, _Seen] = {}
+        self._seen: dict[int, _Seen] = {}  # the colour believed, per light
+        self._last: dict[int, _Seen] = {}  # the last frame's colour, per light
         self._yellow_go: set[int] = set()  # lights whose yellow the car decided to go on
-        self._unseen: set[int] = set()  # lights the car began to stop for unread
+        self._stopping: set[int] = set()  # lights the car stops for until seen green
 
     def heads_ahead(self, station: float) -> list[tuple[int, LightHead]]:
         """(id, `LightHead`) of the lights whose stop line is ahead within ``light_range``
@@ -106,9 +109,17 @@ class JunctionMonitor:
                 if -1.0 < f.s - front <= p.light_range]
 
     def see_lights(self, detections: Sequence[LightDetection]) -> None:
+        """Take the camera's colours: red or yellow at once; green, which lets the car go,
+        only when two frames in a row (within ``green_frames_gap``) agree."""
         for d in detections:
             seen = self._seen.get(d.light)
-            if seen is None or d.t >= seen.t:
+            if seen is not None and d.t < seen.t:
+                continue
+            last = self._last.get(d.light)
+            self._last[d.light] = _Seen(d.colour, d.t)
+            confirmed = last is not None and last.colour is d.colour and \
+                d.t - last.t <= self.params.green_frames_gap
+            if d.colour is not LightColour.GREEN or confirmed:
                 self._seen[d.light] = _Seen(d.colour, d.t)
 
     def update(self, t: float, station: float, v: float,
@@ -141,16 +152,19 @@ class JunctionMonitor:
         colour = seen.colour if seen is not None and t - seen.t <= p.light_memory else None
         if colour is LightColour.GREEN:
             self._yellow_go.discard(i)
+            self._stopping.discard(i)
             return None, colour
         if colour is LightColour.YELLOW:
             if i not in self._yellow_go and v * v > 2.0 * p.yellow_decel * max(room, 0.0):
                 self._yellow_go.add(i)  # cannot stop comfortably: go on through
-            return (None if i in self._yellow_go else room), colour
-        if colour is LightColour.RED:
-            return (None if i in self._yellow_go else room), colour
-        if i not in self._unseen and room <= v * v / (2.0 * p.a_comf) + p.unseen_margin:
-            self._unseen.add(i)  # from here on, stop for it until it is read
-        return (room if i in self._unseen else None), None
+                self._stopping.discard(i)
+        elif colour is None and room <= v * v / (2.0 * p.a_comf) + p.unseen_margin:
+            self._stopping.add(i)  # unread this near: stop for it
+        if colour is not None and i not in self._yellow_go:
+            self._stopping.add(i)  # red, or a yellow it can stop for
+        # once stopping for it, on until the camera sees it green (a frame it misses, or
+        # the colour's memory running out, does not let the car go)
+        return (room if i in self._stopping else None), colour
 
     # -- giving way ------------------------------------------------------------------------
 

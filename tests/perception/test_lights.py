@@ -47,7 +47,10 @@ MAIN = RoadMap.from_spec(ROAD).light_head(TrafficLight(100.0, 20.0, 3.0, 20.0, 0
 AWAY = replace(MAIN, x=MAIN.x + 150.0, facing=0.0)  # lamps point along the route
 LOW = replace(MAIN, x=MAIN.x + 300.0, z=2.8)  # a low post-mounted head, a red car under it
 LEFT = LightHead(MAIN.x + 30.0, 8.0, 3.5, math.pi)  # left of the road, facing the traffic
-HEADS = (MAIN, AWAY, LOW, LEFT)
+# a town junction's near corner: the head for the cross street, 10.9 m before MAIN (two
+# corners of a one-lane junction apart), lamps facing across the road
+SIDE = replace(MAIN, x=MAIN.x - 10.9, facing=0.5 * math.pi)
+HEADS = (MAIN, AWAY, LOW, LEFT, SIDE)
 CAR = ActorSpec("parked", ActorType.CAR, 0, LOW.x - 3.0, LOW.y, 0.0)  # right under LOW
 DISTANCES = (10.0, 20.0, 30.0, 40.0, 50.0)  # [m] car centre behind the head
 POSE_ERRORS = (  # (forward [m], left [m], heading [deg]) of the estimate's error
@@ -200,6 +203,20 @@ def test_a_red_car_under_a_green_light_does_not_turn_it_red(
     assert {b.colour for b in blobs} == {LightColour.GREEN}
     (found,) = detector.detect(frame, ego, [(2, LOW)])
     assert found.colour is LightColour.GREEN
+
+
+@pytest.mark.parametrize("distance", (25.0, 35.0, 45.0, 50.0))
+def test_a_cross_street_head_seen_side_on_does_not_lend_its_colour(
+    detector: TrafficLightDetector, scene: LightScene, distance: float,
+) -> None:
+    """Beyond ~20 m the side-on head's green lamp falls in the main head's padded region;
+    the lamp nearest where the main head's lamps project is the one read."""
+    frame, ego = scene.render(MAIN.x - distance, {0: LightColour.RED, 4: LightColour.GREEN})
+    view = head_view(detector.camera, ego, MAIN, detector.params)
+    assert view is not None
+    blobs, _ = detector.lamp_blobs(frame.rgb, view)
+    (found,) = detector.detect(frame, ego, [(0, MAIN)])
+    assert found.colour is LightColour.RED, [b.colour for b in blobs]
 
 
 def test_two_lights_come_nearest_first(detector: TrafficLightDetector, render: Render) -> None:

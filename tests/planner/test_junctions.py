@@ -28,6 +28,12 @@ def car(x: float, y: float, vx: float = 0.0, vy: float = 0.0) -> Track:
                  cls=ObjectClass.CAR, hits=9, misses=0, position_sigma=0.1)
 
 
+def green(m: JunctionMonitor, t: float = 0.0) -> None:
+    """Two green frames in a row: green confirmed."""
+    m.see_lights([seen(LightColour.GREEN, t - 0.1)])
+    m.see_lights([seen(LightColour.GREEN, t)])
+
+
 def seen(colour: LightColour, t: float = 0.0) -> LightDetection:
     return LightDetection(t=t, light=0, colour=colour, range=30.0, confidence=0.9,
                           box=(0, 0, 1, 1))
@@ -56,6 +62,7 @@ def test_the_light_rules(colour: LightColour | None, before_line: float, v: floa
                          stops: bool) -> None:
     m = JunctionMonitor(route(LIGHTS, Manoeuvre.STRAIGHT), P)
     if colour is not None:
+        m.see_lights([seen(colour, -0.1)])
         m.see_lights([seen(colour)])
     e = m.update(0.5, front_at(m, before_line), v)
     assert e.red_light is stops
@@ -74,7 +81,7 @@ def test_a_yellow_decision_to_go_holds_when_it_turns_red() -> None:
 
 def test_a_colour_seen_too_long_ago_is_not_trusted() -> None:
     m = JunctionMonitor(route(LIGHTS, Manoeuvre.STRAIGHT), P)
-    m.see_lights([seen(LightColour.GREEN, 0.0)])
+    green(m, 0.0)
     assert m.update(P.light_memory + 0.5, front_at(m, 10.0), 5.0).red_light
 
 
@@ -108,7 +115,7 @@ def oncoming(m: JunctionMonitor, distance: float, speed: float) -> Track:
 def test_a_left_turn_waits_for_a_close_oncoming_car(manoeuvre: Manoeuvre, distance: float,
                                                     speed: float, waits: bool) -> None:
     m = JunctionMonitor(route(LIGHTS, manoeuvre), P)
-    m.see_lights([seen(LightColour.GREEN)])
+    green(m)
     e = m.update(0.0, front_at(m, 10.0), 6.0, [oncoming(m, distance, speed)])
     assert e.give_way is waits
     assert not e.red_light
@@ -118,7 +125,7 @@ def test_a_left_turn_waits_for_a_close_oncoming_car(manoeuvre: Manoeuvre, distan
 
 def test_once_over_the_line_the_turn_is_committed() -> None:
     m = JunctionMonitor(route(LIGHTS, Manoeuvre.LEFT), P)
-    m.see_lights([seen(LightColour.GREEN)])
+    green(m)
     assert not m.update(0.0, front_at(m, -1.0), 3.0, [oncoming(m, 20.0, 10.0)]).give_way
 
 
@@ -140,5 +147,23 @@ def test_an_unread_light_once_stopped_for_stays_so_until_read() -> None:
     m = JunctionMonitor(route(LIGHTS, Manoeuvre.STRAIGHT), P)
     assert m.update(0.0, front_at(m, 40.0), 11.0).red_light
     assert m.update(0.1, front_at(m, 39.0), 8.0).red_light  # slower: still stopping for it
-    m.see_lights([seen(LightColour.GREEN, 0.2)])
+    green(m, 0.2)
     assert not m.update(0.2, front_at(m, 38.0), 8.0).red_light
+
+
+def test_a_red_light_missed_for_a_while_is_still_stopped_for() -> None:
+    m = JunctionMonitor(route(LIGHTS, Manoeuvre.STRAIGHT), P)
+    m.see_lights([seen(LightColour.RED, 0.0)])
+    assert m.update(0.0, front_at(m, 55.0), 11.0).red_light
+    assert m.update(3.0, front_at(m, 50.0), 10.0).red_light  # not seen for 3 s, far away
+
+
+def test_one_green_frame_does_not_let_the_car_go_through_a_red() -> None:
+    m = JunctionMonitor(route(LIGHTS, Manoeuvre.STRAIGHT), P)
+    m.see_lights([seen(LightColour.RED, 0.0)])
+    m.see_lights([seen(LightColour.GREEN, 0.1)])  # a false green in one frame
+    assert m.update(0.15, front_at(m, 30.0), 8.0).red_light
+    m.see_lights([seen(LightColour.RED, 0.2)])
+    m.see_lights([seen(LightColour.GREEN, 0.3)])
+    m.see_lights([seen(LightColour.GREEN, 0.4)])  # it did turn green
+    assert not m.update(0.45, front_at(m, 30.0), 8.0).red_light
