@@ -30,8 +30,12 @@ margin) at its speed towards it, or stands within ``near_box`` of it (at its sto
 goes when the light turns green, as the car's does), or any vehicle track inside the box
 that is not moving the car's way. At a stop-sign junction, also for going straight or
 turning right: a vehicle track inside the box, not moving the car's way. The car waits at
-the line; once its front is over the line it is committed and goes on (the control FSM's
-emergency stop still covers a vehicle in its path).
+the line. Like the yellow rule, the decision to give way is taken while the car can still
+stop before the line at ``commit_decel``: once it is moving (faster than ``moving``) and
+cannot (v^2 > 2 commit_decel (L - f - stop_margin)) without having been waiting, or once
+its front is over the line, it is committed to the junction and goes on (the control FSM's
+emergency stop still covers a vehicle in its path). A gap that closes after that point is
+not chased with a stop the car cannot make.
 """
 
 from __future__ import annotations
@@ -66,6 +70,7 @@ class JunctionParams:
     yellow_decel: float = 3.0  # [m/s^2] the yellow rule's "can stop" deceleration
     unseen_margin: float = 5.0  # [m] an unread light is stopped for from this + braking
     gap_time: float = 6.0  # [s] an oncoming vehicle nearer than this in time is waited for
+    commit_decel: float = 3.0  # [m/s^2] past where it could stop at this, the car goes on
     oncoming_reach: float = 100.0  # [m] how far out along the far arm oncoming traffic counts
     moving: float = 0.5  # [m/s] slower than this towards the box: not coming ...
     near_box: float = 12.0  # [m] ... unless this near it (about to go: a light turning green)
@@ -99,6 +104,8 @@ class JunctionMonitor:
         self._last: dict[int, _Seen] = {}  # the last frame's colour, per light
         self._yellow_go: set[int] = set()  # lights whose yellow the car decided to go on
         self._stopping: set[int] = set()  # lights the car stops for until seen green
+        self._waiting: set[int] = set()  # junctions (route order) the car gives way at
+        self._committed: set[int] = set()  # junctions the car goes on through, come what may
 
     def heads_ahead(self, station: float) -> list[tuple[int, LightHead]]:
         """(id, `LightHead`) of the lights whose stop line is ahead within ``light_range``
@@ -128,7 +135,7 @@ class JunctionMonitor:
         front = station + p.front_overhang
         approach = v * v / (2.0 * p.a_comf) + p.approach_extra
         light_stop, colour = self._light(t, front, v, approach)
-        way_stop = self._give_way(front, approach, tracks)
+        way_stop = self._give_way(front, v, approach, tracks)
         stops = [d for d in (light_stop, way_stop) if d is not None]
         return JunctionEvents(
             red_light=light_stop is not None,
@@ -168,23 +175,38 @@ class JunctionMonitor:
 
     # -- giving way ------------------------------------------------------------------------
 
-    def _give_way(self, front: float, approach: float, tracks: Sequence[Track]) -> float | None:
+    def _give_way(self, front: float, v: float, approach: float,
+                  tracks: Sequence[Track]) -> float | None:
         p = self.params
-        j = next((j for j in self.road.junctions if j.s_stop > front - 0.5), None)
-        if j is None or j.s_stop - front > approach:
+        k = next((k for k, j in enumerate(self.road.junctions) if j.s_stop > front - 0.5), None)
+        if k is None or k in self._committed:
             return None
+        j = self.road.junctions[k]
+        if j.s_stop - front > approach:
+            return None
+        room = j.s_stop - front - p.stop_margin
+        wait = self._must_wait(j, tracks)
+        if k not in self._waiting and v > p.moving and \
+                v * v > 2.0 * p.commit_decel * max(room, 0.0):
+            self._committed.add(k)  # past the last point it could stop comfortably: go on
+            return None
+        if wait:
+            self._waiting.add(k)
+            return room
+        self._waiting.discard(k)
+        return None
+
+    def _must_wait(self, j: JunctionSpec, tracks: Sequence[Track]) -> bool:
         vehicles = [tr for tr in tracks if tr.cls in (ObjectClass.CAR, ObjectClass.TRUCK)]
-        if not vehicles:
-            return None
         turning_across = j.manoeuvre in (Manoeuvre.LEFT, Manoeuvre.U_TURN)
-        if not (turning_across or j.control is Control.STOP_SIGNS):
-            return None
+        if not vehicles or not (turning_across or j.control is Control.STOP_SIGNS):
+            return False
         xy = np.array([[tr.x, tr.y] for tr in vehicles])
         vel = np.array([[tr.vx, tr.vy] for tr in vehicles])
         wait = bool(np.any(self._in_box(j, xy, vel)))
         if turning_across:
             wait = wait or bool(np.any(self._oncoming_soon(j, xy, vel)))
-        return j.s_stop - front - p.stop_margin if wait else None
+        return wait
 
     def _frame(self, j: JunctionSpec, xy: np.ndarray,
                vel: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:

@@ -130,6 +130,42 @@ def test_once_over_the_line_the_turn_is_committed() -> None:
 
 
 @pytest.mark.parametrize(
+    ("before_line", "v", "gives_way"),
+    [
+        (10.0, 6.0, True),  # 6^2 / (2 x 9.5) = 1.9 m/s^2 <= 3: it can stop, so it waits
+        (4.0, 6.0, False),  # 6^2 / (2 x 3.5) = 5.1 m/s^2 > 3: committed, it goes on
+        (1.0, 3.5, False),  # rolling over the line (the far-car case): committed
+        (0.5, 0.0, True),  # standing at the line: it waits
+        (0.5, 0.4, True),  # creeping off the line, slower than `moving`: still waits
+    ],
+)
+def test_giving_way_is_decided_while_the_car_can_still_stop(
+    before_line: float, v: float, gives_way: bool,
+) -> None:
+    m = JunctionMonitor(route(LIGHTS, Manoeuvre.LEFT), P)
+    green(m)
+    e = m.update(0.0, front_at(m, before_line), v, [oncoming(m, 30.0, 10.0)])
+    assert e.give_way is gives_way
+
+
+def test_once_committed_a_closing_gap_does_not_stop_the_car() -> None:
+    m = JunctionMonitor(route(LIGHTS, Manoeuvre.LEFT), P)
+    green(m)
+    assert not m.update(0.0, front_at(m, 2.0), 5.0).give_way  # no one coming; past its point
+    assert not m.update(0.1, front_at(m, 1.5), 5.0, [oncoming(m, 30.0, 10.0)]).give_way
+
+
+def test_a_car_already_waiting_goes_on_waiting_however_close_to_the_line() -> None:
+    """Hysteresis: braking for the gap, it reaches its stop point still moving; the
+    commitment rule must not release it there."""
+    m = JunctionMonitor(route(LIGHTS, Manoeuvre.LEFT), P)
+    green(m)
+    car_coming = [oncoming(m, 30.0, 10.0)]
+    assert m.update(0.0, front_at(m, 12.0), 6.0, car_coming).give_way
+    assert m.update(0.1, front_at(m, 1.0), 2.0, car_coming).give_way
+
+
+@pytest.mark.parametrize(
     ("vx", "vy", "waits"),
     [(0.0, 5.0, True), (0.0, 0.0, True), (5.0, 0.0, False)],  # across, standing, my way
 )
