@@ -62,7 +62,6 @@ FILE_KEY = "(file)"
 # `<file>: <key.path>: not supported yet (<what>)`. Delete a line once it is simulated.
 UNSUPPORTED: dict[str, str] = {
     "road.segments.*.exit=left": "exits on the left",
-    "road.features.*.type=traffic_light": "traffic lights",
 }
 
 KeyPath = tuple[str | int, ...]

@@ -26,8 +26,13 @@ equations are missing; these are designed here. Speeds in m/s, gaps in metres.
   jolt the car (or the one behind it), and drops back at once when less is needed. The
   speed reference follows the planned deceleration (``v - a_cmd dt``) so that the speed
   loop adds little of its own.
-- PEDESTRIAN, STOP_SIGN: stop at a point ``s_stop`` metres ahead of the front bumper:
-  ``v_ref = sqrt(2 a_comf max(s_stop - margin, 0))`` with the same ease-in as BRAKE.
+- PEDESTRIAN, STOP_SIGN, RED_LIGHT, YIELD: stop at a point ``s_stop`` metres ahead of the
+  front bumper: ``v_ref = sqrt(2 a_comf max(s_stop - margin, 0))``, and 0 once within
+  ``arrived`` (0.3 m) of the stop point. The speed loop cannot follow the curve's vertical
+  end: the car comes to rest a few centimetres short, where the curve still asks for
+  ~0.5 m/s that the drive cannot break away at, and the speed loop's integrator would
+  charge for as long as the car waits (0.94 m/s^2 over a red light's 6 s, which then
+  overshot 50 km/h by 0.6 m/s on green).
 - SPEED_BUMP: cross at the bump's pass speed: ``v_ref = sqrt(v_pass^2 + 2 a_comf max(d_bump
   - margin, 0))``, where d_bump is the front axle's distance to the bump.
 - FLAT: ease off at a_flat_plan (2 m/s^2; the DECS limit a_flat is 4 m/s^2) to a crawl,
@@ -57,6 +62,7 @@ class AccControlParams:
     j_in: float = 4.0  # [m/s^3] how fast a hard deceleration eases in
     d_stop: float = 2.0  # [m] gap BRAKE aims to keep at the lead's speed
     margin: float = 1.0  # [m] stop / pass points are aimed this far before the point
+    arrived: float = 0.3  # [m] this near its stop point, a car stopping has arrived
     v_standstill: float = 0.5  # [m/s] a lead slower than this counts as stopped (trail)
     stop_band: float = 1.0  # [m] behind a stopped lead, stop this far beyond d0 (trail)
     a_final: float = 0.5  # [m/s^2] the last metres' deceleration behind a stopped lead
@@ -94,8 +100,10 @@ def brake_cap(v: float, v_lead: float, d: float, p: AccControlParams) -> float:
 
 
 def stop_speed(distance: float, v_plan: float, p: AccControlParams) -> float:
-    """[m/s] the speed from which braking at a_comf stops `margin` before `distance` [m]."""
-    return min(math.sqrt(2.0 * p.a_comf * max(distance - p.margin, 0.0)), v_plan)
+    """[m/s] the speed from which braking at a_comf stops `margin` before `distance` [m];
+    0 within `arrived` of that point."""
+    left = distance - p.margin
+    return min(math.sqrt(2.0 * p.a_comf * left), v_plan) if left > p.arrived else 0.0
 
 
 def pass_speed(distance: float, v_pass: float, v_plan: float, p: AccControlParams) -> float:

@@ -17,8 +17,12 @@ from one frame, green (it lets the car go) from two in a row:
   at 3 m/s^2 at 11 m/s, 20 m, it needs 1.8 s of a 3 s yellow);
 - red: stop, unless the front is already over the line;
 - not seen (or not lately): stop as for red, from the distance the car needs to stop at
-  ``a_comf`` plus ``unseen_margin`` on (and from then on, while it stays unread): a light
-  the camera cannot read is not driven through, and one it reads in time costs nothing.
+  ``yellow_decel`` plus ``unseen_margin`` on (and from then on, while it stays unread): a
+  light the camera cannot read is not driven through, and one it reads in time costs
+  nothing. The yellow rule's deceleration, not ``a_comf``, because the camera reads a
+  light from ``light_range`` (60 m) on: at ``a_comf`` a car at 50 km/h would begin to
+  brake 69 m out, before it could see any light; at 3 m/s^2 it is 37 m, and the car reads
+  a light before it must brake for it up to 65 km/h.
 
 The stop is the ACC layer's stop law at ``L - f - stop_margin`` (event ``red_light``).
 
@@ -165,7 +169,7 @@ class JunctionMonitor:
             if i not in self._yellow_go and v * v > 2.0 * p.yellow_decel * max(room, 0.0):
                 self._yellow_go.add(i)  # cannot stop comfortably: go on through
                 self._stopping.discard(i)
-        elif colour is None and room <= v * v / (2.0 * p.a_comf) + p.unseen_margin:
+        elif colour is None and room <= v * v / (2.0 * p.yellow_decel) + p.unseen_margin:
             self._stopping.add(i)  # unread this near: stop for it
         if colour is not None and i not in self._yellow_go:
             self._stopping.add(i)  # red, or a yellow it can stop for

@@ -179,7 +179,7 @@ BAD: dict[str, tuple[str, str]] = {
     "no_map": ("road", "a map is required"),
     "bad_name": ("name", "must match [a-z0-9_]+"),
     "wrong_format": ("format", "must be avsim/1, got 'avsim/2'"),
-    "unsupported_feature": ("road.features.0.type", "not supported yet (traffic lights)"),
+    "unsupported_left_exit": ("road.segments.1.exit", "not supported yet (exits on the left)"),
     "town_route_leaves_town": (
         "ego.route.1",
         "right at junction (2, 0) (heading east): no street leaves it heading south",

@@ -59,6 +59,8 @@ def test_hard_braking_eases_in_and_releases_at_once() -> None:
 
 def test_stop_and_pass_speeds() -> None:
     assert stop_speed(0.5, 20.0, P) == 0.0  # within the margin: stopped
+    assert stop_speed(P.margin + 0.25, 20.0, P) == 0.0  # within `arrived`: it has arrived
+    assert stop_speed(P.margin + 0.35, 20.0, P) == pytest.approx(math.sqrt(2 * 1.5 * 0.35))
     assert stop_speed(P.margin + 30.0, 50.0, P) == pytest.approx(math.sqrt(2 * 1.5 * 30.0))
     assert stop_speed(500.0, 12.0, P) == 12.0  # far away: the plan
     v_pass = 5.0 / 3.6

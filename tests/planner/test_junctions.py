@@ -55,7 +55,9 @@ def front_at(m: JunctionMonitor, before_line: float) -> float:
         (LightColour.YELLOW, 15.0, 11.0, False),  # 4.2 m/s^2 needed: go on
         (LightColour.YELLOW, 15.0, 8.0, True),  # 2.2 m/s^2: stop
         (None, 50.0, 11.0, False),  # unread, but far: no need to brake yet
-        (None, 40.0, 11.0, True),  # unread within braking distance + 5 m: stop for it
+        (None, 30.0, 11.0, False),  # 11^2 / 6 + 5 = 25.2 m: not yet
+        (None, 25.0, 11.0, True),  # unread within braking distance at 3 m/s^2 + 5 m: stop
+        (None, 45.0, 13.9, False),  # 50 km/h, 60 m is in the camera's range: read it first
     ],
 )
 def test_the_light_rules(colour: LightColour | None, before_line: float, v: float,
@@ -82,7 +84,8 @@ def test_a_yellow_decision_to_go_holds_when_it_turns_red() -> None:
 def test_a_colour_seen_too_long_ago_is_not_trusted() -> None:
     m = JunctionMonitor(route(LIGHTS, Manoeuvre.STRAIGHT), P)
     green(m, 0.0)
-    assert m.update(P.light_memory + 0.5, front_at(m, 10.0), 5.0).red_light
+    # unread again: 8 m is within 5^2 / 6 + 5 = 9.2 m, where an unread light is stopped for
+    assert m.update(P.light_memory + 0.5, front_at(m, 8.0), 5.0).red_light
 
 
 def test_the_light_over_the_line_is_no_longer_looked_at() -> None:
@@ -181,10 +184,10 @@ def test_at_a_stop_sign_the_car_waits_for_the_box_to_clear(vx: float, vy: float,
 
 def test_an_unread_light_once_stopped_for_stays_so_until_read() -> None:
     m = JunctionMonitor(route(LIGHTS, Manoeuvre.STRAIGHT), P)
-    assert m.update(0.0, front_at(m, 40.0), 11.0).red_light
-    assert m.update(0.1, front_at(m, 39.0), 8.0).red_light  # slower: still stopping for it
+    assert m.update(0.0, front_at(m, 25.0), 11.0).red_light
+    assert m.update(0.1, front_at(m, 24.0), 8.0).red_light  # slower: still stopping for it
     green(m, 0.2)
-    assert not m.update(0.2, front_at(m, 38.0), 8.0).red_light
+    assert not m.update(0.2, front_at(m, 23.0), 8.0).red_light
 
 
 def test_a_red_light_missed_for_a_while_is_still_stopped_for() -> None:
