@@ -12,8 +12,13 @@ PYTEST_ARGS ?=
 $(STAMP): pyproject.toml
 	@command -v $(PY) >/dev/null || { echo "need $(PY) (>= 3.11)"; exit 1; }
 	test -d $(VENV) || $(PY) -m venv $(VENV)
+	@dpkg -s mesa-vulkan-drivers >/dev/null 2>&1 || { \
+		if command -v apt-get >/dev/null && [ "$$(id -u)" = 0 ]; then \
+			apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq \
+				mesa-vulkan-drivers >/dev/null || echo "note: installing mesa-vulkan-drivers failed"; \
+		else echo "note: no mesa-vulkan-drivers (needs root + apt-get): avsim snapshot unavailable"; fi; }
 	$(BIN)/pip install --quiet --upgrade pip
-	$(BIN)/pip install --quiet -e '.[dev]'
+	$(BIN)/pip install --quiet -e '.[dev,ray]'
 	$(BIN)/python -c "import avsim.deps as d; d.check()"
 	touch $(STAMP)
 
@@ -39,6 +44,7 @@ bench: $(STAMP)
 	$(BIN)/python -m bench.bench_rtf
 	$(BIN)/python -m bench.bench_components
 	$(BIN)/python -m bench.bench_sensing
+	$(BIN)/python -m bench.bench_batch
 
 clean:
 	rm -rf runs .pytest_cache .mypy_cache .ruff_cache

@@ -10,6 +10,7 @@ import json
 import os
 import sys
 import tempfile
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, NoReturn
 
@@ -23,6 +24,8 @@ from avsim.scenario import ScenarioError, bundled_scenarios, load_scenario
 from avsim.schema import scenario_json_schema
 
 if TYPE_CHECKING:
+    from avsim.batch import Planned
+    from avsim.jobs import RunOutcome
     from avsim.runner import Runner, RunResult
 
 PROFILES = ("fast", "default", "paper", "none")
@@ -159,29 +162,149 @@ def schema() -> None:
     click.echo(json.dumps(scenario_json_schema(), indent=2))
 
 
-def _not_yet(what: str, issue: str) -> NoReturn:
-    _bad_input(f"{what}: not supported yet (comes with issue {issue})")
+# ---- batches: suite and sweep ---------------------------------------------------------------
+
+EXECUTORS = ("local", "ray")
+_batch_options = [
+    click.option("--jobs", "-j", type=click.IntRange(min=1), default=None,
+                 help="Runs at a time. Default: this machine's cores."),
+    click.option("--executor", type=click.Choice(EXECUTORS), default="local",
+                 show_default=True, help="Worker processes here, or Ray tasks."),
+    click.option("--address", default=None,
+                 help="Ray cluster address (default: RAY_ADDRESS, else a local Ray)."),
+    click.option("--profile", type=click.Choice(PROFILES), default="default",
+                 show_default=True, help="Sensor profile of every run."),
+    click.option("--snapshots/--no-snapshots", default=True, show_default=True,
+                 help="A picture of each failed run at its first failing moment."),
+]
 
 
-@main.command(context_settings={"ignore_unknown_options": True})
-@click.argument("args", nargs=-1, type=click.UNPROCESSED)
-def suite(args: tuple[str, ...]) -> None:
-    """Run many scenarios in parallel (issue F)."""
-    _not_yet("avsim suite", "F")
+def batch_options(f: Callable[..., None]) -> Callable[..., None]:
+    for option in reversed(_batch_options):
+        f = option(f)
+    return f
 
 
-@main.command(context_settings={"ignore_unknown_options": True})
-@click.argument("args", nargs=-1, type=click.UNPROCESSED)
-def sweep(args: tuple[str, ...]) -> None:
-    """Run a parameter grid (issue F)."""
-    _not_yet("avsim sweep", "F")
+@main.command()
+@click.argument("paths", nargs=-1)
+@click.option("--out", "out", type=click.Path(path_type=Path), default=Path("runs/suite"),
+              show_default=True, help="Folder for the runs' files and the reports.")
+@batch_options
+def suite(paths: tuple[str, ...], out: Path, jobs: int | None, executor: str,
+          address: str | None, profile: str, snapshots: bool) -> None:
+    """Run scenarios in parallel: files, folders or bundled names (default: every bundled
+    scenario). Writes each run's .rrd, .json and .png, junit.xml, summary.md."""
+    from avsim import batch
+
+    try:
+        batch.validate_out_dir(out)
+        entries: list[tuple[str | None, str, dict[str, object]]] = [
+            (None, s, {}) for s in batch.collect_scenarios(paths)]
+        planned = batch.plan(entries, out, profile)
+    except (ScenarioError, batch.BatchError) as exc:
+        _bad_input(str(exc))
+    outcomes = _execute(planned, executor, jobs, address)
+    _report(outcomes, out, f"avsim suite ({len(outcomes)} runs)", snapshots)
+    sys.exit(batch.exit_status(outcomes))
 
 
-@main.command(context_settings={"ignore_unknown_options": True})
-@click.argument("args", nargs=-1, type=click.UNPROCESSED)
-def snapshot(args: tuple[str, ...]) -> None:
-    """Render a recording at a time to PNG (issue F)."""
-    _not_yet("avsim snapshot", "F")
+@main.command()
+@click.argument("scenario")
+@click.option("--set", "sets", multiple=True, required=True, metavar="PATH=V1,V2,...",
+              help="A key path and its values; several --set make a grid.")
+@click.option("--out", "out", type=click.Path(path_type=Path), default=None,
+              help="Folder for the runs and the reports. Default: runs/sweep_<name>")
+@click.option("--metric", default="min_gap", show_default=True,
+              help="The heat map's metric (a metric or a criterion of the result).")
+@batch_options
+def sweep(scenario: str, sets: tuple[str, ...], out: Path | None, metric: str,
+          jobs: int | None, executor: str, address: str | None, profile: str,
+          snapshots: bool) -> None:
+    """Run SCENARIO over the grid of --set values, like a suite; write sweep.csv,
+    sweep.md and, over two swept keys, heatmap.png of --metric."""
+    from avsim import batch
+    from avsim.sweep import SweepError, grid, parse_set
+
+    try:
+        axes = [parse_set(s) for s in sets]
+        runs = grid(axes)
+        name = load_scenario(scenario).name
+        out = out if out is not None else Path("runs") / f"sweep_{name}"
+        batch.validate_out_dir(out)
+        entries = [(f"{name}_{k:03d}", scenario, overrides) for k, overrides in enumerate(runs)]
+        planned = batch.plan(entries, out, profile)
+    except (ScenarioError, SweepError, batch.BatchError) as exc:
+        _bad_input(str(exc))
+    outcomes = _execute(planned, executor, jobs, address)
+    _report(outcomes, out, f"avsim sweep {name} ({len(outcomes)} runs)", snapshots)
+    _sweep_report(outcomes, out, [a.path for a in axes if len(a.values) > 1],
+                  [a.path for a in axes], metric, name)
+    sys.exit(batch.exit_status(outcomes))
+
+
+def _execute(planned: Sequence[Planned], executor: str, jobs: int | None,
+             address: str | None) -> list[RunOutcome]:
+    from avsim import batch
+    from avsim.executors import ExecutorError, LocalExecutor, RayExecutor
+
+    workers = jobs if jobs is not None else (os.cpu_count() or 1)
+    runner: LocalExecutor | RayExecutor = (
+        LocalExecutor(workers) if executor == "local" else RayExecutor(address, jobs))
+    try:
+        return batch.execute(planned, runner)
+    except ExecutorError as exc:
+        _bad_input(str(exc))
+
+
+def _report(outcomes: Sequence[RunOutcome], out: Path, title: str, snapshots: bool) -> None:
+    from avsim import batch
+    from avsim.report import summary_table
+
+    console = Console()
+    pictures = batch.snapshots_of_failures(outcomes, out, console) if snapshots else {}
+    batch.write_reports(outcomes, out, title, pictures)
+    console.print(summary_table(outcomes))
+    console.print(f"reports: {out / 'summary.md'}, {out / 'junit.xml'}", highlight=False)
+
+
+def _sweep_report(outcomes: Sequence[RunOutcome], out: Path, swept: list[str],
+                  params: list[str], metric: str, name: str) -> None:
+    from avsim.jobs import write_atomic
+    from avsim.sweep_report import heat_map, sweep_csv, sweep_markdown, sweep_rows
+
+    metrics = sorted({metric, "min_gap", "max_decel", "collisions"})
+    rows = sweep_rows(outcomes, params, metrics)
+    write_atomic(out / "sweep.csv", sweep_csv(rows))
+    write_atomic(out / "sweep.md", sweep_markdown(rows))
+    console = Console()
+    if len(swept) == 2:
+        heat_map(outcomes, swept[0], swept[1], metric, out / "heatmap.png",
+                 title=f"{name}: {metric}")
+        console.print(f"heat map: {out / 'heatmap.png'}", highlight=False)
+    else:
+        console.print(f"no heat map: it needs two swept keys, {len(swept)} were swept",
+                      highlight=False)
+
+
+@main.command()
+@click.argument("recording", type=click.Path(path_type=Path))
+@click.option("--at", "at", type=float, required=True, help="[s] simulated time.")
+@click.option("--out", "out", type=click.Path(path_type=Path), default=None,
+              help="PNG. Default: next to the recording, <name>_<T>s.png")
+@click.option("--size", type=(click.IntRange(min=64), click.IntRange(min=64)),
+              default=(1600, 900), show_default=True, help="[px] width and height.")
+def snapshot(recording: Path, at: float, out: Path | None, size: tuple[int, int]) -> None:
+    """A picture of RECORDING (.rrd) at simulated time --at, as its default blueprint shows
+    it (Rerun's own viewer, headless)."""
+    from avsim.snapshot import SnapshotError, render_snapshot
+
+    out = out if out is not None else recording.with_name(f"{recording.stem}_{at:g}s.png")
+    _writable(out, "--out")
+    try:
+        render_snapshot(recording, at, out, width=size[0], height=size[1])
+    except SnapshotError as exc:
+        _bad_input(f"{recording}: {exc.key}: {exc}")
+    click.echo(str(out))
 
 
 if __name__ == "__main__":

@@ -287,7 +287,7 @@ class RoadModel(_Model):
 
 
 class TownModel(_Model):
-    """Map kind 2: a grid town of two-way streets. Not supported yet."""
+    """Map kind 2: a grid town of two-way streets, junctions, stop signs and lights."""
 
     blocks_x: PosInt = Field(description="Blocks along x, >= 1; required.")
     blocks_y: PosInt = Field(description="Blocks along y, >= 1; required.")

@@ -111,9 +111,16 @@ def _launch(case: Case, cwd: Path) -> Outcome:
 OTHER: dict[str, Case] = {
     "list": Case(("list",)),
     "schema": Case(("schema",)),
-    "suite": Case(("suite", str(SCENARIOS), "--jobs", "2")),
-    "sweep": Case(("sweep", "normal_driving", "--set", "seed=1,2")),
-    "snapshot": Case(("snapshot", "runs/x.rrd", "--at", "3")),
+    # batches validate every run before any starts: one bad file or value, nothing runs
+    "suite_bad_file": Case(("suite", str(SCENARIOS / "normal_driving.yaml"),
+                            str(BAD_DIR / "unknown_top_key.yaml"), "--out", "tmp/suite")),
+    "suite_empty_dir": Case(("suite", str(HERE), "--out", "tmp/suite")),
+    "sweep_bad_value": Case(("sweep", "normal_driving", "--set", "actors.0.speed_kph=20,fast",
+                             "--out", "tmp/sweep")),
+    "sweep_bad_path": Case(("sweep", "normal_driving", "--set", "actors.7.speed_kph=20,30",
+                            "--out", "tmp/sweep")),
+    "sweep_no_equals": Case(("sweep", "normal_driving", "--set", "seed", "--out", "tmp/sweep")),
+    "snapshot_missing": Case(("snapshot", "tmp/none.rrd", "--at", "3")),
     "bogus_profile": Case(("run", "--profile", "bogus", "normal_driving")),
 }
 
@@ -219,15 +226,26 @@ def test_schema_is_a_json_schema_that_accepts_the_bundled_scenario(
     assert not validator.is_valid({**scenario, "colour": "red"})
 
 
-@pytest.mark.parametrize("command", ["suite", "sweep", "snapshot"])
-def test_later_commands_say_not_supported_yet(
-    command: str, outcomes: dict[str, Outcome]
-) -> None:
+@pytest.mark.parametrize(
+    ("command", "names"),
+    [
+        ("suite_bad_file", ("unknown_top_key.yaml", "colour")),
+        ("suite_empty_dir", ("no scenario files",)),
+        ("sweep_bad_value", ("normal_driving", "actors.0.speed_kph", "fast")),
+        ("sweep_bad_path", ("normal_driving", "actors.7")),
+        ("sweep_no_equals", ("--set seed", "PATH=V1,V2")),
+        ("snapshot_missing", ("none.rrd",)),
+    ],
+)
+def test_batch_and_snapshot_bad_input(command: str, names: tuple[str, ...],
+                                      outcomes: dict[str, Outcome]) -> None:
     out = outcomes[command]
     assert out.returncode == EXIT_BAD_INPUT, (out.returncode, out.stderr)
     line = _assert_one_line_error(out)
-    assert "not supported yet" in line
+    for name in names:
+        assert name in line, line
     assert out.stdout == ""
+    assert list((out.cwd / "tmp").iterdir()) == []  # nothing written
 
 
 def test_unknown_profile_is_a_usage_error(outcomes: dict[str, Outcome]) -> None:
