@@ -196,15 +196,23 @@ def comparable(outcome: RunOutcome) -> dict[str, object]:
     """What must not depend on the executor or the number of workers: the verdicts, the
     criteria and the metrics (not the wall time)."""
     result = outcome.result or {}
-    metrics = result.get("metrics", {})
-    assert isinstance(metrics, dict)
-    return {
+    same = {
         "name": outcome.job.name, "status": outcome.status.value, "error": outcome.error,
-        "criteria": result.get("criteria"),
-        "metrics": {k: v for k, v in metrics.items()
-                    if not (isinstance(v, float) and math.isnan(v))},
+        "criteria": result.get("criteria"), "metrics": result.get("metrics"),
         "sim_time": result.get("sim_time"), "state_changes": result.get("state_changes"),
     }
+    return {k: _canonical(v) for k, v in same.items()}
+
+
+def _canonical(value: object) -> object:
+    """`value` with non-finite numbers as their names (NaN is never equal to itself)."""
+    if isinstance(value, float) and not math.isfinite(value):
+        return repr(value)
+    if isinstance(value, dict):
+        return {k: _canonical(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [_canonical(v) for v in value]
+    return value
 
 
 def exit_status(outcomes: Sequence[RunOutcome]) -> int:

@@ -38,7 +38,8 @@ def avsim(*args: str, cwd: Path) -> subprocess.CompletedProcess[str]:
 def results(out: Path) -> list[dict[str, object]]:
     """The batch's results.json, without what differs between executors and folders (the
     wall time, the recording's path in the batch's folder)."""
-    runs: list[dict[str, object]] = json.loads((out / "results.json").read_text())
+    runs: list[dict[str, object]] = json.loads(  # NaN and Infinity as tokens: NaN != NaN
+        (out / "results.json").read_text(), parse_constant=str)
     for run in runs:
         result = run["result"]
         assert isinstance(result, dict)

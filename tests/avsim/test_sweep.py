@@ -2,6 +2,10 @@
 
 from __future__ import annotations
 
+import json
+import math
+from pathlib import Path
+
 import pytest
 
 from avsim.sweep import Axis, SweepError, format_value, grid, parse_set, split_values
@@ -65,3 +69,18 @@ def test_a_key_swept_twice_is_refused() -> None:
 def test_a_value_prints_as_it_is_written_and_reads_back(value: object) -> None:
     axis = parse_set(f"k={format_value(value)}")
     assert axis.values == (value,)
+
+
+def test_results_compare_equal_with_non_finite_numbers() -> None:
+    """A criterion's NaN threshold (no lead: no d_min) must not make two equal runs differ."""
+    from avsim.batch import comparable
+    from avsim.jobs import RunJob, RunOutcome, Status
+
+    job = RunJob("a", "a.yaml", Path("out"))
+    result = {"criteria": [{"name": "min_gap", "value": math.inf, "threshold": math.nan}],
+              "metrics": {"min_gap": math.nan}, "sim_time": 5.0, "state_changes": []}
+    one = RunOutcome(job, Status.PASSED, result)
+    two = RunOutcome(job, Status.PASSED, json.loads(json.dumps(result)))
+    assert comparable(one) == comparable(two)
+    other = RunOutcome(job, Status.PASSED, {**result, "sim_time": 5.1})
+    assert comparable(one) != comparable(other)
