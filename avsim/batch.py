@@ -22,7 +22,8 @@ from rich.progress import BarColumn, TaskID, TextColumn, TimeElapsedColumn
 from rich.progress import Progress as RichProgress
 
 from avsim.executors import Executor, Progress
-from avsim.jobs import RunJob, RunOutcome, Status, write_atomic
+from avsim.files import write_atomic
+from avsim.jobs import RunJob, RunOutcome, Status
 from avsim.scenario import ScenarioError, bundled_scenarios, load_scenario
 
 SNAPSHOT_DIR = "snapshots"

@@ -9,7 +9,6 @@ from __future__ import annotations
 import json
 import os
 import sys
-import tempfile
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, NoReturn
@@ -19,6 +18,7 @@ from rich.console import Console
 from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.table import Table
 
+from avsim.files import write_atomic
 from avsim.result import result_json
 from avsim.scenario import ScenarioError, bundled_scenarios, load_scenario
 from avsim.schema import scenario_json_schema
@@ -100,7 +100,7 @@ def run(scenario: str, out: Path | None, json_path: Path | None, profile: str, s
     result = _run_with_progress(runner, spec.duration, not no_progress)
     partial.replace(out)
     payload = result_json(result, scenario, out, profile)
-    _write_atomic(json_path, json.dumps(payload, indent=2) + "\n")
+    write_atomic(json_path, json.dumps(payload, indent=2) + "\n")
     if plot_path is not None:
         from avsim.plot import plot_speed_profile
 
@@ -118,14 +118,6 @@ def _run_with_progress(runner: Runner, duration: float, show: bool) -> RunResult
     with Progress(*columns, console=console, transient=True) as bar:
         task = bar.add_task(runner.spec.name, total=duration)
         return runner.run(lambda t, _d: bar.update(task, completed=t))
-
-
-def _write_atomic(path: Path, text: str) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.")
-    with os.fdopen(fd, "w") as f:
-        f.write(text)
-    Path(tmp).replace(path)
 
 
 def _print_verdict(payload: dict[str, object]) -> None:
@@ -269,7 +261,6 @@ def _report(outcomes: Sequence[RunOutcome], out: Path, title: str, snapshots: bo
 
 def _sweep_report(outcomes: Sequence[RunOutcome], out: Path, swept: list[str],
                   params: list[str], metric: str, name: str) -> None:
-    from avsim.jobs import write_atomic
     from avsim.sweep_report import heat_map, sweep_csv, sweep_markdown, sweep_rows
 
     metrics = sorted({metric, "min_gap", "max_decel", "collisions"})

@@ -31,6 +31,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Protocol
 
+from avsim.files import write_atomic
 from avsim.jobs import RunJob, RunOutcome, run_job
 
 POLL = 0.2  # [s] how often the display is refreshed while runs are under way
@@ -221,9 +222,5 @@ def _ray_init(ray: Any, address: str | None, cpus: int | None) -> None:
 
 
 def _write_files(out_dir: Path, files: dict[str, bytes]) -> None:
-    out_dir.mkdir(parents=True, exist_ok=True)
     for name, data in files.items():
-        fd, tmp = tempfile.mkstemp(dir=out_dir, prefix=f".{name}.")
-        with os.fdopen(fd, "wb") as f:
-            f.write(data)
-        Path(tmp).replace(out_dir / name)
+        write_atomic(out_dir / name, data)

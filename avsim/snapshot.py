@@ -42,6 +42,7 @@ from rerun.chunk import RrdReader
 from rerun.experimental import ViewerClient
 
 from avsim.blueprint import TIMELINE
+from avsim.files import write_atomic
 
 NS_PER_S = 1_000_000_000  # [ns/s]
 POLL_PERIOD = 0.1  # [s] between two polls of the viewer while it starts or loads
@@ -51,7 +52,6 @@ STABLE_SHOTS = 3  # consecutive identical screenshots that count as "everything 
 # consecutive frames are identical.
 TOAST_TIME = 3.0
 QUIT_TIMEOUT = 5.0  # [s] the viewer gets to exit after SIGTERM, before SIGKILL
-PNG_MODE = 0o644  # the written PNG's permissions (mkstemp makes 0o600)
 HOST = "127.0.0.1"  # the viewer listens on loopback only
 # the panels a fresh viewer opens with (sources and blueprint, selection, time), closed so
 # that the blueprint's views get the whole picture
@@ -120,7 +120,7 @@ def render_snapshot(
         except Exception as err:  # the client's errors: transport, timeouts, viewer replies
             raise viewer.failure(err) from err
     _check_size(png, width, height)
-    _write_atomically(out, png)
+    write_atomic(out, png)
 
 
 # -- the recording ---------------------------------------------------------------------------
@@ -311,23 +311,6 @@ def _check_size(png: bytes, width: int, height: int) -> None:
     got = (int.from_bytes(png[16:20], "big"), int.from_bytes(png[20:24], "big"))
     if got != (width, height):
         raise SnapshotError(f"the screenshot is {got[0]}x{got[1]} px, not {width}x{height} px")
-
-
-def _write_atomically(out: Path, data: bytes) -> None:
-    """Write `data` to a temporary file beside `out`, then rename it over `out`."""
-    out.parent.mkdir(parents=True, exist_ok=True)
-    fd, name = tempfile.mkstemp(dir=out.parent, prefix=f".{out.name}.", suffix=".tmp")
-    tmp = Path(name)
-    try:
-        with os.fdopen(fd, "wb") as file:
-            file.write(data)
-            file.flush()
-            os.fsync(file.fileno())
-        tmp.chmod(PNG_MODE)
-        tmp.replace(out)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
 
 
 def _first_line(err: BaseException | None) -> str:

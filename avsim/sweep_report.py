@@ -15,8 +15,6 @@ from __future__ import annotations
 import csv
 import io
 import math
-import os
-import tempfile
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -30,6 +28,7 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Patch, Rectangle
 from numpy.typing import NDArray
 
+from avsim.files import write_atomic
 from avsim.jobs import RunOutcome, Status
 from avsim.report import format_value
 
@@ -260,12 +259,6 @@ def heat_map(outcomes: Sequence[RunOutcome], x_param: str, y_param: str, metric:
     or another key takes more than one value over the runs (a grid of more than 2 keys).
     """
     fig = heat_map_figure(outcomes, x_param, y_param, metric, title=title)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=out.parent, prefix=f".{out.name}.", suffix=".partial")
-    os.close(fd)
-    partial = Path(tmp)
-    try:
-        fig.savefig(partial, format="png", dpi=DPI)
-        partial.replace(out)
-    finally:
-        partial.unlink(missing_ok=True)
+    png = io.BytesIO()
+    fig.savefig(png, format="png", dpi=DPI)
+    write_atomic(out, png.getvalue())
