@@ -332,7 +332,8 @@ def summary_table(outcomes: Sequence[RunOutcome]) -> Table:
     passed, failed, errors = _counts(outcomes)
     table = Table(title=f"{passed} passed, {failed} failed, {errors} errors",
                   title_justify="left")
-    table.add_column("run", style="bold")
+    table.add_column("run", style="bold", no_wrap=True,  # whole names: they are ids
+                     min_width=max((len(o.job.name) for o in outcomes), default=3))
     table.add_column("verdict")
     table.add_column("failed criteria / error", overflow="fold")
     # headers as `Text`: in a markup string "[s]" would be read as a style tag
