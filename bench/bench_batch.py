@@ -9,6 +9,10 @@ same machine:
 - scaling efficiency of 2 workers, ``T(1) / (2 T(2))`` (1.0: perfect);
 - each run's own overhead: its worker's time less the simulation's (interpreter start,
   imports, world building, writing its files), median;
+- cores busy: the worker processes' CPU time over the batch's wall time (local executors;
+  Ray's workers are not this process's children). One run already keeps more than one core
+  busy (Bullet's threaded ray casts for the LiDAR, llvmpipe's render threads), which bounds
+  what a second worker can add on two cores;
 - that the outcomes are equal (verdicts, criteria, metrics), as the batch promises.
 
 `make bench` runs it; `--json FILE` also writes the figures; `--no-ray` skips Ray.
@@ -18,6 +22,8 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
+import resource
 import statistics
 import tempfile
 import time
@@ -40,20 +46,29 @@ def batch(out: Path, seconds: float, profile: str) -> list[Planned]:
     return plan(entries, out, profile)
 
 
-def measure(executor: Executor, planned: list[Planned]) -> tuple[float, list[RunOutcome]]:
-    """[s] the batch's wall time, and its outcomes."""
+def measure(executor: Executor, planned: list[Planned]) -> tuple[float, float,
+                                                                 list[RunOutcome]]:
+    """[s] the batch's wall time, [s] its child processes' CPU time, and its outcomes."""
     if isinstance(executor, (LocalExecutor, RayExecutor)):
         executor.durations.update({p.job.name: p.duration for p in planned})
+    cpu = _children_cpu()
     start = time.perf_counter()
     outcomes = executor.run([p.job for p in planned])
-    return time.perf_counter() - start, outcomes
+    return time.perf_counter() - start, _children_cpu() - cpu, outcomes
 
 
-def figures(wall: float, outcomes: list[RunOutcome]) -> dict[str, float]:
+def _children_cpu() -> float:
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return usage.ru_utime + usage.ru_stime
+
+
+def figures(wall: float, cpu: float, outcomes: list[RunOutcome],
+            local: bool) -> dict[str, float]:
     sim = sum(o.sim_time for o in outcomes)
     overhead = [o.wall_time - o.run_time for o in outcomes if o.result is not None]
     return {"wall_s": wall, "runs_per_min": 60.0 * len(outcomes) / wall,
-            "sim_per_wall": sim / wall, "overhead_s": statistics.median(overhead)}
+            "sim_per_wall": sim / wall, "overhead_s": statistics.median(overhead),
+            "cores_busy": cpu / wall if local else math.nan}
 
 
 def main() -> None:
@@ -70,18 +85,21 @@ def main() -> None:
     reference: list[dict[str, object]] | None = None
     for name, executor in executors.items():
         with tempfile.TemporaryDirectory() as tmp:
-            wall, outcomes = measure(executor, batch(Path(tmp), args.seconds, args.profile))
-        results[name] = figures(wall, outcomes)
+            wall, cpu, outcomes = measure(executor, batch(Path(tmp), args.seconds,
+                                                          args.profile))
+        results[name] = figures(wall, cpu, outcomes, isinstance(executor, LocalExecutor))
         same = [comparable(o) for o in outcomes]
         results[name]["equal_outcomes"] = float(reference is None or same == reference)
         reference = reference or same
     one, two = results["local x1"]["wall_s"], results["local x2"]["wall_s"]
     print(f"{SCENARIO} sweep: {len(GAPS) * len(CUTTER_KPH)} runs of {args.seconds:.0f} s "
           f"simulated, profile {args.profile}")
-    header = ("executor", "wall s", "runs/min", "sim/wall", "overhead s", "equal")
+    header = ("executor", "wall s", "runs/min", "sim/wall", "overhead s", "cores busy",
+              "equal")
     print("  ".join(f"{h:>11}" for h in header))
     for name, f in results.items():
-        cells = [f["wall_s"], f["runs_per_min"], f["sim_per_wall"], f["overhead_s"]]
+        cells = [f["wall_s"], f["runs_per_min"], f["sim_per_wall"], f["overhead_s"],
+                 f["cores_busy"]]
         print(f"{name:>11}  " + "  ".join(f"{c:11.2f}" for c in cells)
               + f"  {'yes' if f['equal_outcomes'] else 'NO':>11}")
     print(f"scaling efficiency of 2 local workers: {one / (2.0 * two):.2f}")
