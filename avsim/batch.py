@@ -51,20 +51,12 @@ def collect_scenarios(args: Sequence[str]) -> list[str]:
     return found
 
 
-@dataclass(frozen=True, slots=True)
-class Planned:
-    """A validated job and its scenario's simulated duration."""
-
-    job: RunJob
-    duration: float  # [s]
-
-
 def plan(entries: Sequence[tuple[str | None, str, Mapping[str, object]]], out_dir: Path,
-         profile: str) -> list[Planned]:
+         profile: str) -> list[RunJob]:
     """Validate each (job name or None for the scenario's own, scenario, overrides) and make
     its job. Raises `ScenarioError` for the first bad one, `BatchError` for two runs that
     would write the same files."""
-    planned: list[Planned] = []
+    planned: list[RunJob] = []
     names: dict[str, str] = {}
     for name, scenario, overrides in entries:
         spec = load_scenario(scenario, dict(overrides))
@@ -73,8 +65,8 @@ def plan(entries: Sequence[tuple[str | None, str, Mapping[str, object]]], out_di
             raise BatchError(f"{scenario}: name: {job_name!r} is also the name of "
                              f"{names[job_name]} (their files would collide in {out_dir})")
         names[job_name] = scenario
-        job = RunJob(job_name, scenario, out_dir, dict(overrides), profile)
-        planned.append(Planned(job, spec.duration))
+        planned.append(RunJob(job_name, scenario, out_dir, dict(overrides), profile,
+                              duration=spec.duration))
     return planned
 
 
@@ -142,13 +134,10 @@ class LiveDisplay:
         self._bar.update(self._batch, advance=1, detail=f"{self._failed} not passed")
 
 
-def execute(planned: Sequence[Planned], executor: Executor) -> list[RunOutcome]:
-    """Run the planned jobs (longest first) with the live display; outcomes in job order."""
-    durations = {p.job.name: p.duration for p in planned}
-    if hasattr(executor, "durations"):
-        executor.durations.update(durations)
-    with LiveDisplay(len(planned)) as display:
-        return executor.run([p.job for p in planned], display)
+def execute(jobs: Sequence[RunJob], executor: Executor) -> list[RunOutcome]:
+    """Run the jobs (longest first) with the live display; outcomes in job order."""
+    with LiveDisplay(len(jobs)) as display:
+        return executor.run(jobs, display)
 
 
 # ---- reports -------------------------------------------------------------------------------
@@ -223,4 +212,4 @@ def exit_status(outcomes: Sequence[RunOutcome]) -> int:
     return 0 if all(o.passed for o in outcomes) else 1
 
 
-__all__ = ["BatchError", "Planned", "ScenarioError", "collect_scenarios", "execute", "plan"]
+__all__ = ["BatchError", "ScenarioError", "collect_scenarios", "execute", "plan"]

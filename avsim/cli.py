@@ -24,8 +24,7 @@ from avsim.scenario import ScenarioError, bundled_scenarios, load_scenario
 from avsim.schema import scenario_json_schema
 
 if TYPE_CHECKING:
-    from avsim.batch import Planned
-    from avsim.jobs import RunOutcome
+    from avsim.jobs import RunJob, RunOutcome
     from avsim.runner import Runner, RunResult
 
 PROFILES = ("fast", "default", "paper", "none")
@@ -234,7 +233,7 @@ def sweep(scenario: str, sets: tuple[str, ...], out: Path | None, metric: str,
     sys.exit(batch.exit_status(outcomes))
 
 
-def _execute(planned: Sequence[Planned], executor: str, jobs: int | None,
+def _execute(planned: Sequence[RunJob], executor: str, jobs: int | None,
              address: str | None) -> list[RunOutcome]:
     from avsim import batch
     from avsim.executors import ExecutorError, LocalExecutor, RayExecutor

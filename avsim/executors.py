@@ -27,7 +27,7 @@ import queue
 import tempfile
 from collections.abc import Sequence
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Protocol
 
@@ -68,10 +68,9 @@ class Executor(Protocol):
         ...
 
 
-def longest_first(jobs: Sequence[RunJob], durations: Sequence[float]) -> list[RunJob]:
+def longest_first(jobs: Sequence[RunJob]) -> list[RunJob]:
     """The jobs ordered by falling duration (stable: ties keep their order)."""
-    order = sorted(range(len(jobs)), key=lambda k: -durations[k])
-    return [jobs[k] for k in order]
+    return sorted(jobs, key=lambda job: -job.duration)
 
 
 def _in_job_order(jobs: Sequence[RunJob], outcomes: Sequence[RunOutcome]) -> list[RunOutcome]:
@@ -104,14 +103,13 @@ class LocalExecutor:
     """Worker processes on this machine (module doc)."""
 
     jobs: int = 1  # worker processes
-    durations: dict[str, float] = field(default_factory=dict)  # [s] by job name: order
     name: str = "local"
 
     def run(self, jobs: Sequence[RunJob], sink: ProgressSink | None = None) -> list[RunOutcome]:
         if not jobs:
             return []
         ctx = mp.get_context("spawn")
-        order = longest_first(jobs, [self.durations.get(j.name, 0.0) for j in jobs])
+        order = longest_first(jobs)
         outcomes: list[RunOutcome] = []
         with ctx.Manager() as manager, ProcessPoolExecutor(
             max_workers=min(self.jobs, len(jobs)), mp_context=ctx, max_tasks_per_child=1,
@@ -164,7 +162,6 @@ class RayExecutor:
     address: str | None = None  # a cluster ("ray://host:10001", "auto"); None: RAY_ADDRESS
     #   or else a local instance started for this batch
     jobs: int | None = None  # CPUs of the local instance (None: all of this machine's)
-    durations: dict[str, float] = field(default_factory=dict)  # [s] by job name: order
     name: str = "ray"
 
     def run(self, jobs: Sequence[RunJob], sink: ProgressSink | None = None) -> list[RunOutcome]:
@@ -182,7 +179,7 @@ class RayExecutor:
     def _run(self, ray: Any, jobs: Sequence[RunJob],
              sink: ProgressSink | None) -> list[RunOutcome]:
         task = ray.remote(num_cpus=1, max_retries=0)(_ray_task)
-        order = longest_first(jobs, [self.durations.get(j.name, 0.0) for j in jobs])
+        order = longest_first(jobs)
         refs = {task.remote(job): job for job in order}
         if sink is not None:
             for job in order:

@@ -42,6 +42,7 @@ class RunJob:
     profile: str = "default"  # sensor profile: fast | default | paper | none
     sensing: str = "inline"  # cameras render in this process (workers run in parallel)
     plot: bool = True  # also write the speed-profile PNG
+    duration: float = 0.0  # [s] the scenario's simulated time: its cost, longest run first
 
     @property
     def recording(self) -> Path:

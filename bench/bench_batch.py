@@ -29,16 +29,16 @@ import tempfile
 import time
 from pathlib import Path
 
-from avsim.batch import Planned, comparable, plan
+from avsim.batch import comparable, plan
 from avsim.executors import Executor, LocalExecutor, RayExecutor
-from avsim.jobs import RunOutcome
+from avsim.jobs import RunJob, RunOutcome
 
 SCENARIO = "cut_in_out"
 GAPS = (20, 40)  # [m] the cut-in trigger gap
 CUTTER_KPH = (30, 45)  # [km/h] the cutter's speed (the ego drives at 60)
 
 
-def batch(out: Path, seconds: float, profile: str) -> list[Planned]:
+def batch(out: Path, seconds: float, profile: str) -> list[RunJob]:
     entries = [(f"{SCENARIO}_{k:03d}", SCENARIO,
                 {"duration": seconds, "actors.0.actions.0.trigger.gap": gap,
                  "actors.0.speed_kph": kph})
@@ -46,14 +46,11 @@ def batch(out: Path, seconds: float, profile: str) -> list[Planned]:
     return plan(entries, out, profile)
 
 
-def measure(executor: Executor, planned: list[Planned]) -> tuple[float, float,
-                                                                 list[RunOutcome]]:
+def measure(executor: Executor, jobs: list[RunJob]) -> tuple[float, float, list[RunOutcome]]:
     """[s] the batch's wall time, [s] its child processes' CPU time, and its outcomes."""
-    if isinstance(executor, (LocalExecutor, RayExecutor)):
-        executor.durations.update({p.job.name: p.duration for p in planned})
     cpu = _children_cpu()
     start = time.perf_counter()
-    outcomes = executor.run([p.job for p in planned])
+    outcomes = executor.run(jobs)
     return time.perf_counter() - start, _children_cpu() - cpu, outcomes
 
 
