@@ -70,7 +70,7 @@ def sweep(work: Path, out: str, *extra: str) -> subprocess.CompletedProcess[str]
     return avsim("sweep", str(SCENARIOS / "follow.yaml"),
                  "--set", f"actors.0.s={','.join(map(str, GAPS))}",
                  "--set", f"actors.0.speed_kph={','.join(map(str, LEAD_SPEEDS))}",
-                 "--set", "duration=5", "--metric", "min_gap", "--profile", "fast",
+                 "--set", "duration=3", "--metric", "min_gap", "--profile", "fast",
                  "--no-snapshots", "--out", out, *extra, cwd=work)
 
 
@@ -160,7 +160,7 @@ def test_a_three_by_three_sweep_writes_its_table_and_heat_map(
     assert len(rows) == 9
     grid = {(int(r["actors.0.s"]), int(r["actors.0.speed_kph"])) for r in rows}
     assert grid == {(g, v) for g in GAPS for v in LEAD_SPEEDS}
-    assert all(r["duration"] == "5" for r in rows)
+    assert all(r["duration"] == "3" for r in rows)
     gaps = [float(r["min_gap"]) for r in rows]
     assert max(gaps) - min(gaps) > 5.0  # the swept keys did change the runs
     heat = cv2.imread(str(out / "heatmap.png"))
