@@ -25,14 +25,14 @@ import multiprocessing as mp
 import os
 import queue
 import tempfile
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Protocol
 
 from avsim.files import write_atomic
-from avsim.jobs import RunJob, RunOutcome, run_job
+from avsim.jobs import RunJob, RunOutcome, Status, run_job
 
 POLL = 0.2  # [s] how often the display is refreshed while runs are under way
 PROGRESS_EVERY = 1.0  # [s] of simulated time between a worker's progress messages
@@ -98,43 +98,90 @@ def _local_task(job: RunJob, messages: Any) -> RunOutcome:
     return run_job(job, progress=_QueueProgress(job.name, messages))
 
 
+def died(job: RunJob, exc: BaseException) -> RunOutcome:
+    """The outcome of a job whose worker process died (a crash in native code, killed):
+    `run_job` catches what Python raises, not that."""
+    what = type(exc).__name__ + (f": {exc}" if str(exc) else "")
+    return RunOutcome(job, Status.ERROR, error=f"{job.name}: the worker died ({what})")
+
+
 @dataclass
 class LocalExecutor:
-    """Worker processes on this machine (module doc)."""
+    """Worker processes on this machine (module doc).
+
+    A worker that dies (a crash in native code, the OOM killer) breaks the whole pool: every
+    run under way or waiting fails with it. The runs that were under way (all that were
+    lost, if none had reported starting) are suspects: each runs again alone, and one that
+    dies again is reported as died (runs are deterministic: that is the one that crashed);
+    the others go to a fresh pool. Every round removes its suspects, so it ends."""
 
     jobs: int = 1  # worker processes
     name: str = "local"
+    task: Callable[[RunJob, Any], RunOutcome] = _local_task  # what a worker runs (tests)
 
     def run(self, jobs: Sequence[RunJob], sink: ProgressSink | None = None) -> list[RunOutcome]:
-        if not jobs:
-            return []
         ctx = mp.get_context("spawn")
-        order = longest_first(jobs)
         outcomes: list[RunOutcome] = []
-        with ctx.Manager() as manager, ProcessPoolExecutor(
-            max_workers=min(self.jobs, len(jobs)), mp_context=ctx, max_tasks_per_child=1,
-        ) as pool:
+        todo = longest_first(jobs)
+        with ctx.Manager() as manager:
             messages = manager.Queue()
-            pending: set[Future[RunOutcome]] = {
-                pool.submit(_local_task, job, messages) for job in order}
-            by_name = {j.name: j for j in jobs}
-            while pending:
-                done, pending = wait(pending, timeout=POLL, return_when=FIRST_COMPLETED)
-                _drain(messages, by_name, sink)
-                for future in done:
-                    outcome = future.result()
-                    outcomes.append(outcome)
-                    if sink is not None:
-                        sink.finished(outcome)
+            while todo:
+                started: set[str] = set()
+                done, lost = self._pool(ctx, todo, self.jobs, messages, started, sink)
+                outcomes += done
+                suspects = [j for j, _ in lost if j.name in started] or [j for j, _ in lost]
+                todo = [j for j, _ in lost if j not in suspects]
+                for job in suspects:
+                    outcomes.append(self._alone(ctx, job, messages, sink))
         return _in_job_order(jobs, outcomes)
 
+    def _alone(self, ctx: Any, job: RunJob, messages: Any,
+               sink: ProgressSink | None) -> RunOutcome:
+        """Run `job` in a pool of its own: its outcome, or `died` if it breaks this one too."""
+        done, lost = self._pool(ctx, [job], 1, messages, set(), sink)
+        if done:
+            return done[0]
+        outcome = died(job, lost[0][1])
+        if sink is not None:
+            sink.finished(outcome)
+        return outcome
 
-def _drain(messages: Any, jobs: dict[str, RunJob], sink: ProgressSink | None) -> None:
+    def _pool(self, ctx: Any, jobs: Sequence[RunJob], workers: int, messages: Any,
+              started: set[str], sink: ProgressSink | None,
+              ) -> tuple[list[RunOutcome], list[tuple[RunJob, BaseException]]]:
+        """Run `jobs` in one pool: the outcomes, and the jobs lost when a worker died (with
+        the error). `started` collects the names of the runs that began."""
+        outcomes: list[RunOutcome] = []
+        lost: list[tuple[RunJob, BaseException]] = []
+        by_name = {j.name: j for j in jobs}
+        with ProcessPoolExecutor(max_workers=min(workers, len(jobs)), mp_context=ctx,
+                                 max_tasks_per_child=1) as pool:
+            futures = {pool.submit(self.task, job, messages): job for job in jobs}
+            pending: set[Future[RunOutcome]] = set(futures)
+            while pending:
+                done, pending = wait(pending, timeout=POLL, return_when=FIRST_COMPLETED)
+                _drain(messages, by_name, sink, started)
+                for future in done:
+                    exc = future.exception()
+                    if exc is not None:
+                        lost.append((futures[future], exc))
+                        continue
+                    outcomes.append(future.result())
+                    if sink is not None:
+                        sink.finished(outcomes[-1])
+        _drain(messages, by_name, sink, started)
+        return outcomes, lost
+
+
+def _drain(messages: Any, jobs: dict[str, RunJob], sink: ProgressSink | None,
+           started: set[str]) -> None:
     while True:
         try:
             message = messages.get_nowait()
         except queue.Empty:
             return
+        if not isinstance(message, Progress):
+            started.add(message)
         if sink is None:
             continue
         if isinstance(message, Progress):
@@ -188,8 +235,12 @@ class RayExecutor:
         pending = list(refs)
         while pending:
             done, pending = ray.wait(pending, num_returns=1)
-            outcome, files = ray.get(done[0])
-            _write_files(refs[done[0]].out_dir, files)
+            job = refs[done[0]]
+            try:
+                outcome, files = ray.get(done[0])
+            except ray.exceptions.RayError as exc:  # the task's worker or node died
+                outcome, files = died(job, exc), {}
+            _write_files(job.out_dir, files)
             outcomes.append(outcome)
             if sink is not None:
                 sink.finished(outcome)

@@ -2,13 +2,16 @@
 
 from __future__ import annotations
 
+import os
 import sys
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import pytest
 
-from avsim.executors import ExecutorError, RayExecutor, longest_first
-from avsim.jobs import RunJob
+from avsim.executors import ExecutorError, LocalExecutor, RayExecutor, longest_first
+from avsim.jobs import RunJob, RunOutcome, Status
 
 
 def job(name: str, duration: float) -> RunJob:
@@ -28,3 +31,37 @@ def test_without_ray_the_ray_executor_says_how_to_get_it(
         RayExecutor().run([job("a", 1.0)])
     assert str(err.value) == ("--executor ray: Ray is not installed "
                               "(pip install 'avsim[ray]')")
+
+
+def _dies(job: RunJob, messages: Any) -> RunOutcome:
+    """A worker task that says it started (as the real one does), then, for the job named
+    `crashes`, ends its process as a crash in native code would."""
+    messages.put(job.name)
+    if job.name == "crashes":
+        os._exit(3)
+    return RunOutcome(job, Status.PASSED, {"criteria": [], "metrics": {}, "sim_time": 1.0})
+
+
+def _dies_at_once(job: RunJob, messages: Any) -> RunOutcome:
+    """As `_dies`, but the crash comes before the worker could say it started."""
+    if job.name == "crashes":
+        os._exit(3)
+    return _dies(job, messages)
+
+
+@pytest.mark.parametrize("task", [_dies, _dies_at_once])
+@pytest.mark.parametrize("workers", [1, 2])
+def test_a_worker_that_dies_is_that_runs_error_not_the_batchs(
+    task: Callable[[RunJob, Any], RunOutcome], workers: int,
+) -> None:
+    """The crashing run is the longest: it starts first and breaks the pool while the others
+    wait or run; they finish all the same."""
+    jobs = [job("fine", 1.0), job("crashes", 2.0), job("later", 0.5), job("last", 0.1)]
+    outcomes = LocalExecutor(workers, task=task).run(jobs)
+    assert [o.job.name for o in outcomes] == ["fine", "crashes", "later", "last"]
+    assert [o.status for o in outcomes] == [Status.PASSED, Status.ERROR, Status.PASSED,
+                                            Status.PASSED]
+    crashed = outcomes[1]
+    assert crashed.result is None and crashed.error is not None
+    assert crashed.error.startswith("crashes: the worker died")
+    assert "\n" not in crashed.error
