@@ -24,7 +24,7 @@ from rich.progress import Progress as RichProgress
 from avsim.executors import Executor, Progress
 from avsim.files import write_atomic
 from avsim.jobs import RunJob, RunOutcome, Status
-from avsim.scenario import ScenarioError, bundled_scenarios, load_scenario
+from avsim.scenario import bundled_scenarios, load_scenario
 
 SNAPSHOT_DIR = "snapshots"
 
@@ -211,5 +211,3 @@ def exit_status(outcomes: Sequence[RunOutcome]) -> int:
         return 2
     return 0 if all(o.passed for o in outcomes) else 1
 
-
-__all__ = ["BatchError", "ScenarioError", "collect_scenarios", "execute", "plan"]

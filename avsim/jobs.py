@@ -17,9 +17,13 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from enum import Enum
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from avsim.files import write_atomic
 from avsim.scenario import ScenarioError, load_scenario
+
+if TYPE_CHECKING:
+    from world.spec import ScenarioSpec
 
 
 class Status(Enum):
@@ -116,8 +120,7 @@ class RunOutcome:
         if self.status is not Status.FAILED or self.result is None:
             return None
         first = self.first_failure()
-        end = self.result.get("sim_time")
-        return first if first is not None else float(end) if isinstance(end, float) else None
+        return first if first is not None else self.sim_time
 
 
 ProgressCallback = Callable[[float, float], None]  # (sim time, duration) [s]
@@ -146,7 +149,7 @@ def run_job(job: RunJob, into: Path | None = None,
     return RunOutcome(job, status, result, wall_time=time.perf_counter() - start)
 
 
-def _simulate(job: RunJob, spec: object, into: Path,
+def _simulate(job: RunJob, spec: ScenarioSpec, into: Path,
               progress: ProgressCallback | None) -> dict[str, object]:
     from world.quiet import quiet_c_output
 
@@ -155,9 +158,7 @@ def _simulate(job: RunJob, spec: object, into: Path,
         from avsim.result import result_json
         from avsim.runner import Runner
         from world.sensor_setup import Profile
-        from world.spec import ScenarioSpec
 
-    assert isinstance(spec, ScenarioSpec)
     into.mkdir(parents=True, exist_ok=True)
     recording = into / job.recording.name
     partial = into / f".{recording.name}.partial"
