@@ -24,7 +24,12 @@ import pytest
 import rerun as rr
 import rerun.blueprint as rrb
 
-from avsim.snapshot import SnapshotError, recording_time_range, render_snapshot
+from avsim.snapshot import (
+    SnapshotError,
+    _rerun_executable,
+    recording_time_range,
+    render_snapshot,
+)
 
 END = 5.0  # [s] last sim_time of the tiny recording
 RATE = 10.0  # [Hz]
@@ -90,7 +95,11 @@ def _colour_pixels(rgb: npt.NDArray[np.int16], colour: tuple[int, int, int]) -> 
 
 
 def _viewer_processes() -> list[psutil.Process]:
-    return psutil.Process().children(recursive=True)
+    """Rerun viewers below this process (not any child: a `spawn` pool that ran earlier in
+    this worker leaves multiprocessing's resource tracker for the process's lifetime)."""
+    viewer = str(_rerun_executable())
+    return [p for p in psutil.Process().children(recursive=True)
+            if p.cmdline()[:1] == [viewer]]
 
 
 def test_time_range(tiny_rrd: Path) -> None:
