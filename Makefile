@@ -6,7 +6,7 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 PYTEST_ARGS ?=
 
-.PHONY: setup demo test test-quick lint bench clean
+.PHONY: setup demo test test-quick lint golden bench clean
 
 # The virtual environment with the pinned dependencies (pyproject.toml), installed once.
 $(STAMP): pyproject.toml
@@ -39,6 +39,11 @@ test: lint
 
 test-quick: lint
 	$(BIN)/pytest -n 2 --dist loadfile -m "not slow" $(PYTEST_ARGS)
+
+# Rewrite the golden results (tests/scenarios/golden/) from the scenario tests' own runs: only
+# for a change meant to alter behaviour, whose commit says which and why.
+golden: $(STAMP)
+	AVSIM_GOLDEN=write $(BIN)/pytest -n 2 --dist loadfile tests/scenarios -k golden -q
 
 bench: $(STAMP)
 	$(BIN)/python -m bench.bench_rtf

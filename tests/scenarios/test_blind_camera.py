@@ -14,6 +14,7 @@ import pytest
 
 from avsim.runner import RunResult
 from planner.lane_source import LaneSourceParams
+from tests.scenarios import golden
 from world.frames import CameraFrame
 
 pytestmark = pytest.mark.slow
@@ -53,3 +54,9 @@ def test_black_camera_slows_then_stops_in_lane(run_scenario: Callable[..., RunRe
     tyres = next(c for c in blind.criteria if c.name == "tyres_in_lane")
     assert tyres.passed, tyres
     assert blind.metrics["max_decel"] <= 2.5
+
+
+def test_results_match_golden(run_scenario: Callable[..., RunResult]) -> None:
+    golden.check(run_scenario("normal_driving", record=False, duration=30), "normal_driving.30s")
+    golden.check(run_scenario("normal_driving", record=False, duration=30,
+                              frame_hook=black_front), "normal_driving.30s_blind_front")

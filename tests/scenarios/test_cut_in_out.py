@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from avsim.runner import RunResult
+from tests.scenarios import golden
 
 pytestmark = pytest.mark.slow
 KPH = 1 / 3.6
@@ -52,3 +53,7 @@ def test_verdict_and_the_r157_figures(result: RunResult) -> None:
                     if x.machine == "acc" and x.target == "cruise" and x.t > 1.0)
     back = t[(t > t_cruise) & (v >= 60 * KPH - 1 * KPH)]
     assert len(back) and back[0] - t_cruise <= 15.0
+
+
+def test_result_matches_golden(result: RunResult) -> None:
+    golden.check(result, "cut_in_out")

@@ -13,6 +13,7 @@ import pytest
 
 from avsim.plot import plot_speed_profile
 from avsim.runner import RunResult
+from tests.scenarios import golden
 from world.hdmap import SHOULDER, RoadMap
 
 pytestmark = pytest.mark.slow
@@ -128,3 +129,7 @@ def test_the_mode_sequence_is_the_papers(result: RunResult) -> None:
 def test_the_plot(result: RunResult, tmp_path: Path) -> None:
     png = plot_speed_profile(result, tmp_path / "decs_route.png")
     assert 30_000 < png.stat().st_size < 1_000_000
+
+
+def test_result_matches_golden(result: RunResult) -> None:
+    golden.check(result, "decs_route")

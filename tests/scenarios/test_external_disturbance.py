@@ -11,6 +11,7 @@ import pytest
 
 from avsim.runner import RunResult
 from planner.acc import AccParams, gaps
+from tests.scenarios import golden
 
 pytestmark = pytest.mark.slow
 KPH = 1 / 3.6
@@ -65,3 +66,8 @@ def test_following_the_pedal_closes_up_but_never_below_d_min(following: RunResul
     assert c["min_gap"].value >= c["min_gap"].threshold  # ... never below d_min
     assert v.max() <= 50 * KPH + 1 * KPH
     assert gap[-1] == pytest.approx(gaps(v[-1], v[-1], AccParams()).d_des, abs=2.0)  # after
+
+
+def test_results_match_golden(alone: RunResult, following: RunResult) -> None:
+    golden.check(alone, "external_disturbance")
+    golden.check(following, "external_disturbance_following")

@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 from avsim.runner import RunResult
+from tests.scenarios import golden
 
 pytestmark = pytest.mark.slow
 KPH = 1 / 3.6
@@ -61,3 +62,7 @@ def test_verdict_and_the_lane_change_figures(result: RunResult) -> None:
     assert result.metrics["lane_offset_rmse"] < 0.4
     sources = [c.target for c in result.state_changes if c.machine == "lane_source"]
     assert sources == ["camera"]
+
+
+def test_result_matches_golden(result: RunResult) -> None:
+    golden.check(result, "lane_change")

@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 from avsim.runner import RunResult
+from tests.scenarios import golden
 from world.hdmap import RoadMap
 
 pytestmark = pytest.mark.slow
@@ -157,3 +158,12 @@ def test_perception_scores_are_in_the_recording(result: RunResult) -> None:
         chunks = store.stream().filter(content=f"/metrics/{name}",
                                        components="Scalars:scalars").to_chunks()
         assert sum(c.num_rows for c in chunks) >= 0.9 * 10.0 * result.sim_time, name
+
+
+def test_results_match_golden(result: RunResult,
+                              run_scenario: Callable[..., RunResult]) -> None:
+    golden.check(result, "normal_driving")
+    golden.check(run_scenario("normal_driving", record=False, duration=25),
+                 "normal_driving.25s")
+    golden.check(run_scenario("normal_driving", record=False, profile=None),
+                 "normal_driving.profile_none")

@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from avsim.runner import RunResult
+from tests.scenarios import golden
 
 pytestmark = pytest.mark.slow
 KPH = 1 / 3.6
@@ -63,3 +64,7 @@ def test_the_control_fsm_brakes_to_a_stop(result: RunResult) -> None:
     if result.spec.name == "sudden_stop":  # 12 m at 50 km/h: beyond the ACC's braking
         assert "emergency_stop" in control
         assert result.metrics["max_decel"] > 6.0
+
+
+def test_result_matches_golden(result: RunResult) -> None:
+    golden.check(result, result.spec.name)

@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 from avsim.runner import RunResult
+from tests.scenarios import golden
 from world.hdmap import JunctionSpec, RoadMap
 from world.signals import light_colour
 from world.spec import LightColour, StopSign, TrafficLight
@@ -170,3 +171,10 @@ def test_with_the_oncoming_car_far_the_left_turn_goes_at_once(far_car: RunResult
     assert "yield" not in _states(far_car, "acc")
     assert entered < _entered(close_car, j) - 2.0  # sooner than with the close car
     assert "turn_left" in _states(far_car, "motion")
+
+
+def test_results_match_golden(route: RunResult, close_car: RunResult,
+                              far_car: RunResult) -> None:
+    golden.check(route, "town_route")
+    golden.check(close_car, "town_left_turn")
+    golden.check(far_car, "town_left_turn.far_car")

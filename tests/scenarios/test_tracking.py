@@ -11,6 +11,7 @@ import pytest
 
 from avsim.result import result_json
 from avsim.runner import RunResult
+from tests.scenarios import golden
 
 pytestmark = pytest.mark.slow
 
@@ -48,3 +49,7 @@ def test_tracking_scores_from_the_result_json(result: RunResult) -> None:
     assert m["track_speed_rmse"] <= 0.5
     assert m["max_id_switches_per_car_per_100s"] <= 1.0
     assert m["lane_offset_rmse"] <= 0.10  # the camera's lane held with traffic alongside
+
+
+def test_result_matches_golden(result: RunResult) -> None:
+    golden.check(result, "tracking")

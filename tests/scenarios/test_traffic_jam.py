@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from avsim.runner import RunResult
+from tests.scenarios import golden
 
 pytestmark = pytest.mark.slow
 KPH = 1 / 3.6
@@ -58,3 +59,7 @@ def test_verdict_and_back_to_set_speed(result: RunResult) -> None:
     assert v[-1] == pytest.approx(45 * KPH, abs=1 * KPH)  # the jam cleared: set speed
     modes = [x.target for x in result.state_changes if x.machine == "acc"]
     assert modes == ["cruise", "trail", "cruise"]  # trailed through both stops, no brake
+
+
+def test_result_matches_golden(result: RunResult) -> None:
+    golden.check(result, "traffic_jam")

@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from avsim.runner import RunResult
+from tests.scenarios import golden
 from world.signals import light_colour
 from world.spec import LightColour, TrafficLight
 
@@ -47,3 +48,7 @@ def light_colour_change(light: TrafficLight, t: np.ndarray, colour: LightColour)
     shown = np.array([light_colour(light, x) is colour for x in t])
     k = int(np.argmax(~shown))
     return float(t[k + int(np.argmax(shown[k:]))])
+
+
+def test_result_matches_golden(run: RunResult) -> None:
+    golden.check(run, "traffic_light")
