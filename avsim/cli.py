@@ -19,13 +19,13 @@ from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.table import Table
 
 from avsim.files import write_atomic
-from avsim.result import result_json
-from avsim.scenario import ScenarioError, bundled_scenarios, load_scenario
-from avsim.schema import scenario_json_schema
+from avsim.run.result import result_json
+from avsim.scenario.load import ScenarioError, bundled_scenarios, load_scenario
+from avsim.scenario.schema import scenario_json_schema
 
 if TYPE_CHECKING:
-    from avsim.jobs import RunJob, RunOutcome
-    from avsim.runner import Runner, RunResult
+    from avsim.batch.jobs import RunJob, RunOutcome
+    from avsim.run.runner import Runner, RunResult
 
 PROFILES = ("fast", "default", "paper", "none")
 SENSING = ("auto", "inline", "process")
@@ -87,11 +87,11 @@ def run(scenario: str, out: Path | None, json_path: Path | None, profile: str, s
         out.with_suffix(".png") if plot == PLOT_NEXT_TO_RECORDING else Path(plot))
     if plot_path is not None:
         _writable(plot_path, "--plot")
-    from world.quiet import quiet_c_output
+    from world.core.quiet import quiet_c_output
 
     with quiet_c_output():  # PyBullet's build banner
-        from avsim.runner import Runner  # heavy: only once the input is known good
-        from world.sensor_setup import Profile
+        from avsim.run.runner import Runner  # heavy: only once the input is known good
+        from world.sensors.setup import Profile
 
     out.parent.mkdir(parents=True, exist_ok=True)
     partial = out.with_name(f".{out.name}.partial")
@@ -101,7 +101,7 @@ def run(scenario: str, out: Path | None, json_path: Path | None, profile: str, s
     payload = result_json(result, scenario, out, profile)
     write_atomic(json_path, json.dumps(payload, indent=2) + "\n")
     if plot_path is not None:
-        from avsim.plot import plot_speed_profile
+        from avsim.report.speed_plot import plot_speed_profile
 
         plot_speed_profile(result, plot_path)
     _print_verdict(payload)
@@ -185,7 +185,7 @@ def suite(paths: tuple[str, ...], out: Path, jobs: int | None, executor: str,
           address: str | None, profile: str, snapshots: bool) -> None:
     """Run scenarios in parallel: files, folders or bundled names (default: every bundled
     scenario). Writes each run's .rrd, .json and .png, junit.xml, summary.md."""
-    from avsim import batch
+    from avsim.batch import suite as batch
 
     try:
         batch.validate_out_dir(out)
@@ -213,8 +213,8 @@ def sweep(scenario: str, sets: tuple[str, ...], out: Path | None, metric: str,
           snapshots: bool) -> None:
     """Run SCENARIO over the grid of --set values, like a suite; write sweep.csv,
     sweep.md and, over two swept keys, heatmap.png of --metric."""
-    from avsim import batch
-    from avsim.sweep import SweepError, grid, parse_set
+    from avsim.batch import suite as batch
+    from avsim.batch.sweep import SweepError, grid, parse_set
 
     try:
         axes = [parse_set(s) for s in sets]
@@ -235,8 +235,8 @@ def sweep(scenario: str, sets: tuple[str, ...], out: Path | None, metric: str,
 
 def _execute(planned: Sequence[RunJob], executor: str, jobs: int | None,
              address: str | None) -> list[RunOutcome]:
-    from avsim import batch
-    from avsim.executors import ExecutorError, LocalExecutor, RayExecutor
+    from avsim.batch import suite as batch
+    from avsim.batch.executors import ExecutorError, LocalExecutor, RayExecutor
 
     workers = jobs if jobs is not None else (os.cpu_count() or 1)
     runner: LocalExecutor | RayExecutor = (
@@ -248,8 +248,8 @@ def _execute(planned: Sequence[RunJob], executor: str, jobs: int | None,
 
 
 def _report(outcomes: Sequence[RunOutcome], out: Path, title: str, snapshots: bool) -> None:
-    from avsim import batch
-    from avsim.report import summary_table
+    from avsim.batch import suite as batch
+    from avsim.report.suite import summary_table
 
     console = Console()
     pictures = batch.snapshots_of_failures(outcomes, out, console) if snapshots else {}
@@ -260,7 +260,7 @@ def _report(outcomes: Sequence[RunOutcome], out: Path, title: str, snapshots: bo
 
 def _sweep_report(outcomes: Sequence[RunOutcome], out: Path, swept: list[str],
                   params: list[str], metric: str, name: str) -> None:
-    from avsim.sweep_report import heat_map, sweep_csv, sweep_markdown, sweep_rows
+    from avsim.report.sweep import heat_map, sweep_csv, sweep_markdown, sweep_rows
 
     metrics = sorted({metric, "min_gap", "max_decel", "collisions"})
     rows = sweep_rows(outcomes, params, metrics)
@@ -286,7 +286,7 @@ def _sweep_report(outcomes: Sequence[RunOutcome], out: Path, swept: list[str],
 def snapshot(recording: Path, at: float, out: Path | None, size: tuple[int, int]) -> None:
     """A picture of RECORDING (.rrd) at simulated time --at, as its default blueprint shows
     it (Rerun's own viewer, headless)."""
-    from avsim.snapshot import SnapshotError, render_snapshot
+    from avsim.record.snapshot import SnapshotError, render_snapshot
 
     out = out if out is not None else recording.with_name(f"{recording.stem}_{at:g}s.png")
     _writable(out, "--out")

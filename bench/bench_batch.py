@@ -29,9 +29,9 @@ import tempfile
 import time
 from pathlib import Path
 
-from avsim.batch import comparable, plan
-from avsim.executors import Executor, LocalExecutor, RayExecutor
-from avsim.jobs import RunJob, RunOutcome
+from avsim.batch.executors import Executor, LocalExecutor, RayExecutor
+from avsim.batch.jobs import RunJob, RunOutcome
+from avsim.batch.suite import comparable, plan
 
 SCENARIO = "cut_in_out"
 GAPS = (20, 40)  # [m] the cut-in trigger gap

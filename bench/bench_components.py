@@ -21,8 +21,8 @@ from pathlib import Path
 
 import numpy as np
 
-from avsim.recorder import Recorder
-from avsim.scenario import load_scenario
+from avsim.record.recorder import Recorder
+from avsim.scenario.load import load_scenario
 from planner.speed_planning import SpeedPlanner, SpeedPlanningParams
 from world.hdmap import RoadMap
 from world.spec import RoadSpec, SegmentSpec

@@ -29,12 +29,12 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from avsim.runner import CONTROL_RATE, Runner, RunResult
-from avsim.scenario import load_scenario
-from world.client import PHYSICS_RATE
-from world.sensing import InlineSensing, ProcessSensing, Sensing
-from world.sensor_setup import Profile, sensor_setup
-from world.sensors import SensorSchedule
+from avsim.run.runner import CONTROL_RATE, Runner, RunResult
+from avsim.scenario.load import load_scenario
+from world.core.client import PHYSICS_RATE
+from world.sensors.pipeline import InlineSensing, ProcessSensing, Sensing
+from world.sensors.rig import SensorSchedule
+from world.sensors.setup import Profile, sensor_setup
 from world.world import World
 
 SCENARIO = "normal_driving"

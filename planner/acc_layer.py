@@ -1,4 +1,4 @@
-"""The ACC / event layer in the planner: the mode FSM (`planner.acc`) fed from the map and
+"""The ACC / event layer in the planner: the mode FSM (`planner.fsm.acc`) fed from the map and
 the lead track, and the mode's controller (`planner.acc_control`) giving the target speed.
 
 Per tick: the lead's gap is carried from its track's time to now with the relative speed
@@ -17,7 +17,6 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-from planner.acc import AccInput, AccMode, AccParams, gaps, transition
 from planner.acc_control import (
     AccControlParams,
     EasedBrake,
@@ -29,6 +28,7 @@ from planner.acc_control import (
     trail,
 )
 from planner.events import Events
+from planner.fsm.acc import AccInput, AccMode, AccParams, gaps, transition
 from planner.messages import Lead, StateChange
 
 NO_EVENTS = Events()

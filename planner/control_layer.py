@@ -1,4 +1,4 @@
-"""The control FSM in the planner (`planner.control_fsm`): the threat from the lead and the
+"""The control FSM in the planner (`planner.fsm.control`): the threat from the lead and the
 control action that holds.
 
 Per tick the lead's gap (carried to now), speed and acceleration (`planner.lead.LeadAccel`)
@@ -13,7 +13,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-from planner.control_fsm import (
+from planner.fsm.control import (
     ControlInput,
     ControlParams,
     ControlState,

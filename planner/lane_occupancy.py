@@ -16,7 +16,7 @@ A lane is *free* for the ego to move into when nothing is alongside and
 
 The ego's own lane is *blocked* when the vehicle ahead in it moves slower than the speed
 the ego wants by more than ``block_margin`` and is within the ACC's d_max (the gap inside
-which the ACC would start to trail it; `planner.acc.gaps`).
+which the ACC would start to trail it; `planner.fsm.acc.gaps`).
 """
 
 from __future__ import annotations
@@ -28,7 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from perception.messages import Track
-from planner.acc import AccParams, gaps, r157_min_gap
+from planner.fsm.acc import AccParams, gaps, r157_min_gap
 from world.hdmap import RoadMap
 
 

@@ -12,8 +12,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from perception.messages import EgoState
-from planner.control_fsm import ControlState
-from planner.lane_source import LaneSource
+from planner.fsm.control import ControlState
+from planner.fsm.lane_source import LaneSource
 
 __all__ = ["ControlState", "EgoState", "Lead", "Plan", "ReferencePath", "StateChange"]
 
@@ -60,8 +60,8 @@ class Plan:
     lateral_error: float  # [m] the planner's view of the ego's offset from the path, left +
     lane_source: LaneSource = LaneSource.ACQUIRING  # where the path comes from
     lead: Lead | None = None  # the vehicle ahead in the lane, if a track shows one
-    acc_mode: str = "acc_off"  # the ACC / event layer's mode (`planner.acc.AccMode` value)
-    motion: str = "lane_keep"  # the motion FSM's state (`planner.motion.Motion` value)
+    acc_mode: str = "acc_off"  # the ACC / event layer's mode (`planner.fsm.acc.AccMode` value)
+    motion: str = "lane_keep"  # the motion FSM's state (`planner.fsm.motion.Motion` value)
     lane: int = 0  # the lane kept, or moved into by a lane change
     origin_lane: int = 0  # the lane a lane change in hand leaves (== lane otherwise)
     control: ControlState = ControlState.SPEED_KEEPING  # the control FSM's state

@@ -2,7 +2,7 @@
 
 Per tick: the tracks are placed in the ego's lane and its neighbours
 (`planner.lane_occupancy`); the ego lane is *blocked* once a slower vehicle has blocked it for
-``blocked_time``; the motion FSM (`planner.motion`) steps once. Entering a lane change makes
+``blocked_time``; the motion FSM (`planner.fsm.motion`) steps once. Entering a lane change makes
 the target lane the lane kept (its speed plan and, once done, its camera lane) and plans the
 Hermite path into it from the car's pose (`planner.lane_change_path`); the change is done
 when the car reaches the path's end. An abort plans the same kind of path back to the origin
@@ -14,7 +14,7 @@ centre has crossed into the target lane, in the origin lane are both leads for t
 
 At a town junction where the route turns, the turn is entered when the car's centre passes
 the stop line and done at the junction's exit (`RoadMap.junctions`); its path is the map's
-lane 0, which turns along the junction's arc (`world.town`), so the path needs nothing
+lane 0, which turns along the junction's arc (`world.map.town`), so the path needs nothing
 planned here. Lane 0 is the only lane through a turn: the route lane change has already
 brought the car into it ("a lane ends ahead").
 """
@@ -28,7 +28,16 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from perception.messages import EgoState, Track
-from planner.acc import AccParams
+from planner.fsm.acc import AccParams
+from planner.fsm.motion import (
+    LANE_CHANGES,
+    TURNS,
+    Motion,
+    MotionInput,
+    MotionParams,
+    Turn,
+    transition,
+)
 from planner.lane_change_path import LaneChangeParams, LaneChangePath, start_lane_change
 from planner.lane_occupancy import (
     LaneTraffic,
@@ -39,15 +48,6 @@ from planner.lane_occupancy import (
     lane_traffic,
 )
 from planner.messages import StateChange
-from planner.motion import (
-    LANE_CHANGES,
-    TURNS,
-    Motion,
-    MotionInput,
-    MotionParams,
-    Turn,
-    transition,
-)
 from world.hdmap import SHOULDER, RoadMap
 from world.hdmap import Manoeuvre as JunctionManoeuvre
 

@@ -216,7 +216,7 @@ def test_checker_reports_file_and_line(source: str, rule: Rule, module: str,
         ("from planner.messages import Plan\nfrom control.pid import Pid\n", CONTROL, "control.x"),
         ("from .pid import Pid\nfrom . import stanley\nfrom ..pid import P\n", CONTROL,
          "control.sub.x"),
-        ("import pybullet\nfrom vehicle_urdf import URDF_PATH\n", WORLD, "world.ego"),
+        ("import pybullet\nfrom vehicle_urdf import URDF_PATH\n", WORLD, "world.ego.body"),
     ],
 )
 def test_checker_allows_the_permitted_imports(source: str, rule: Rule, module: str) -> None:

@@ -141,7 +141,7 @@ def _rim_link(name: str, d: CarDimensions) -> str:
     fixed to the wheel (it spins with it), with the flat tyre's contact. It sits
     `wheel_radius - flat_radius` inside the tyre's sphere, clear of the road while the
     tyre holds its air; the ego body keeps its contact inert until that tyre goes flat
-    (`world.ego`)."""
+    (`world.ego.body`)."""
     i = RIM_MASS * d.flat_radius**2 / 5.0
     contact = (
         "    <contact>\n"

@@ -1,6 +1,6 @@
 """The world's description of a scenario: validated, resolved, in SI units.
 
-`avsim.scenario` parses and validates the user's YAML (the public format, with `*_kph` and
+`avsim.scenario.load` parses and validates the user's YAML (the public format, with `*_kph` and
 `*_deg` keys and defaults) and converts it into these frozen dataclasses. Everything in
 `world/` builds from them; nothing here knows about files or YAML.
 
@@ -136,7 +136,7 @@ class Control(enum.Enum):
 
 @dataclass(frozen=True, slots=True)
 class JunctionSpec:
-    """A town junction met along a route, in the route's stations (`world.town`).
+    """A town junction met along a route, in the route's stations (`world.map.town`).
 
     The approach street runs along `heading` into the junction whose centre is (x, y); the
     box is the square where the streets cross, `half_width` each side of the centre."""
@@ -186,7 +186,7 @@ class LightTiming:
 @dataclass(frozen=True, slots=True)
 class TownSpec:
     """A grid town (map kind 2): streets along x = ix * block and y = iy * block, junction
-    (ix, iy) at their crossing, ix in 0..blocks_x, iy in 0..blocks_y (`world.town`)."""
+    (ix, iy) at their crossing, ix in 0..blocks_x, iy in 0..blocks_y (`world.map.town`)."""
 
     blocks_x: int
     blocks_y: int

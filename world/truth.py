@@ -9,7 +9,7 @@ from numpy.typing import NDArray
 from pybullet_utils.bullet_client import BulletClient
 
 from vehicle_urdf import CarGeometry
-from world.ego import EgoTruth
+from world.ego.body import EgoTruth
 from world.hdmap import ReferenceLine
 
 

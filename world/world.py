@@ -3,7 +3,7 @@
 `World(spec)` builds everything from a `ScenarioSpec` into its own `BulletClient`; `step()`
 advances physics by one fixed 240 Hz step (ego forces, Bullet step, NPC behaviours, the
 ego's events). Ground truth for criteria and the recording is in `world.truth`; the stack
-only ever sees what `world.gnss` measures (the accelerator pedal an ego event holds is one
+only ever sees what `world.sensors.gnss` measures (the accelerator pedal an ego event holds is one
 of those signals: the world applies no force for it; a flat tyre an ego event makes is
 physical, and no signal says it).
 """
@@ -20,24 +20,24 @@ import numpy as np
 import pybullet
 from numpy.typing import NDArray
 
-from world.actors import ActorSet
-from world.bump import BumpPlacement, build_speed_bumps, hull_vertices
-from world.client import GROUND_FRICTION, Clock, Rate, add_ground, make_client
-from world.ego import EgoBody, EgoParams, EgoTruth
-from world.ego_events import EgoEvents
-from world.gnss import GnssSensor, OdometrySensor
+from world.actors.actor_set import ActorSet
+from world.core.client import GROUND_FRICTION, Clock, Rate, add_ground, make_client
+from world.core.quiet import quiet_c_output
+from world.core.rendering import attach_renderer
+from world.ego.body import EgoBody, EgoParams, EgoTruth
+from world.ego.events import EgoEvents
 from world.hdmap import RoadMap
-from world.lidar import EGO_RAY_GROUP
-from world.quiet import quiet_c_output
-from world.rendering import attach_renderer
-from world.road_marks import build_road_marks
-from world.road_mesh import (
+from world.map.signals import light_colour
+from world.map.town import TownLayout
+from world.scene.bump import BumpPlacement, build_speed_bumps, hull_vertices
+from world.scene.road_marks import build_road_marks
+from world.scene.road_mesh import (
     THROUGH_LENGTH,
     TexturedMesh,
     build_road_surface,
     build_through_roads,
 )
-from world.scenery import (
+from world.scene.scenery import (
     OCTAGON_PHASE,
     BuildingBox,
     SignPlacement,
@@ -49,13 +49,13 @@ from world.scenery import (
     speed_limit_sign_image,
     stop_sign_image,
 )
-from world.sensor_setup import SensorSetup
-from world.sensors import SensorRig
-from world.signals import light_colour
+from world.scene.town_scene import Pavement, build_town_scene
+from world.scene.traffic_light import TrafficLightBody, add_traffic_light
+from world.sensors.gnss import GnssSensor, OdometrySensor
+from world.sensors.lidar import EGO_RAY_GROUP
+from world.sensors.rig import SensorRig
+from world.sensors.setup import SensorSetup
 from world.spec import ScenarioSpec, TownSpec, TrafficLight
-from world.town import TownLayout
-from world.town_scene import Pavement, build_town_scene
-from world.traffic_light import TrafficLightBody, add_traffic_light
 from world.truth import RouteTruth, route_truth
 
 TRIGGER_RATE = Rate("npc_triggers", 40)  # NPC actions' and ego events' triggers checked
@@ -178,7 +178,7 @@ class World:
 
     def _build_town(self, town: TownSpec, rng: np.random.Generator) -> StaticScene:
         """The town's streets, junctions, stop lines, sidewalks, buildings and stop signs
-        (`world.town_scene`) in place of the route's own road: the route (`self.road`) runs
+        (`world.scene.town_scene`) in place of the route's own road: the route (`self.road`) runs
         on the town's streets."""
         ground = add_ground(self.client)
         scene = build_town_scene(TownLayout(town), rng)

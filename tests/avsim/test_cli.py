@@ -26,7 +26,7 @@ import yaml
 from click.testing import CliRunner
 
 from avsim.cli import main
-from tests.avsim.test_scenario import BAD
+from tests.avsim.scenario.test_load import BAD
 from tests.avsim.texts import MINIMAL
 
 HERE = Path(__file__).parent

@@ -4,7 +4,7 @@ The scene, in the VEHICLE frame (x forward, y left, z up, origin on the ground b
 centre): a ground plane ``z = tan(pitch) x + tan(roll) y + offset`` (flat ground seen from a
 pitched/rolled body; ``pitch > 0`` = nose down, the ground rises ahead) and a list of
 oriented boxes (yaw about z). Rays are the `LidarInfo` beams (same layout as
-`world.lidar.beam_directions`), cast from the sensor mount; the nearest hit within
+`world.sensors.lidar.beam_directions`), cast from the sensor mount; the nearest hit within
 ``max_range`` is returned, with optional Gaussian range noise and dropout from a seeded
 generator. Points are in the SENSOR frame, like a real `LidarScan`.
 
@@ -21,7 +21,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from world.frames import LidarInfo, LidarScan, SensorMount
-from world.lidar import beam_directions
+from world.sensors.lidar import beam_directions
 
 FloatArray = NDArray[np.float64]
 

@@ -2,7 +2,7 @@
 
 `LightScene(road, heads, actors)` builds a sensor world of ``road`` with ``actors`` standing
 at their initial poses (the world is never stepped) and a traffic light body
-(`world.traffic_light`) at each of ``heads``; `render(s, colours)` lights the lamps, poses
+(`world.scene.traffic_light`) at each of ``heads``; `render(s, colours)` lights the lamps, poses
 the ego on the centre of lane 0 at station ``s`` [m] (as `render_scene.render` does) and
 returns the front camera's frame with the ego's true pose as an `EgoState`. Build one scene
 per test module (~1.5 s) and `close` it at the end.
@@ -13,14 +13,14 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from dataclasses import replace
 
-from avsim.scenario import load_scenario
+from avsim.scenario.load import load_scenario
 from perception.messages import EgoState
 from tests.perception.render_scene import BASE_SCENARIO, pose_ego
 from world.frames import CameraFrame
 from world.hdmap import LightColour, LightHead
-from world.sensor_setup import Profile, sensor_setup
+from world.scene.traffic_light import TrafficLightBody, add_traffic_light
+from world.sensors.setup import Profile, sensor_setup
 from world.spec import ActorSpec, RoadSpec
-from world.traffic_light import TrafficLightBody, add_traffic_light
 from world.world import World
 
 

@@ -19,9 +19,9 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from avsim.scenario import load_scenario
+from avsim.scenario.load import load_scenario
 from world.frames import CameraFrame, CameraInfo
-from world.sensor_setup import Profile, sensor_setup
+from world.sensors.setup import Profile, sensor_setup
 from world.spec import ActorSpec, RoadSpec
 from world.world import World
 

@@ -2,7 +2,7 @@
 
 Two kinds of input: odometry synthesised from the kinematics of a car rolling without slip
 (each wheel's speed from the body's speed, yaw rate and the Ackermann geometry, with the
-encoders', gyro's and steering encoder's noise of `world.gnss`), and the simulated car in a
+encoders', gyro's and steering encoder's noise of `world.sensors.gnss`), and the simulated car in a
 `World` (a puncture by `EgoBody.puncture`, read by the world's `OdometrySensor`).
 """
 
@@ -21,10 +21,10 @@ from perception.flat_tyre import (
     ackermann_split,
     corrected_speeds,
 )
-from world.client import PHYSICS_RATE
-from world.ego import ackermann
+from world.core.client import PHYSICS_RATE
+from world.ego.body import ackermann
 from world.frames import Odometry
-from world.gnss import GYRO_NOISE, STEERING_NOISE, WHEEL_SPEED_NOISE
+from world.sensors.gnss import GYRO_NOISE, STEERING_NOISE, WHEEL_SPEED_NOISE
 from world.spec import (
     EgoSpec,
     EventSpec,

@@ -23,7 +23,7 @@ from perception.lanes import LaneDetector, LaneFilter, LaneParams, lane_mask
 from perception.messages import LaneBoundary, LaneEstimate
 from tests.perception.render_scene import Scene, front_camera, normal_driving_road, render
 from world.frames import CameraFrame, CameraInfo, SensorMount
-from world.sensor_setup import Profile
+from world.sensors.setup import Profile
 
 DEG = math.pi / 180.0
 ASPHALT = (58, 58, 61)  # [0..255] RGB of the road texture's asphalt
@@ -402,9 +402,9 @@ def test_narrow_only_drops_wide_runs_and_keeps_lines() -> None:
 def test_a_yellow_truck_beside_is_not_a_line(detector: LaneDetector) -> None:
     """The regression of the tracking scenario: a yellow truck passing in the next lane
     smeared over the bird's-eye view and was taken for the lane's boundary."""
-    from avsim.scenario import load_scenario
+    from avsim.scenario.load import load_scenario
     from tests.perception.render_scene import lane_truth, pose_ego
-    from world.sensor_setup import sensor_setup
+    from world.sensors.setup import sensor_setup
     from world.spec import ActorSpec, ActorType
     from world.world import World
 

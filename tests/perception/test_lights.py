@@ -37,9 +37,9 @@ from perception.lights import (
 from perception.messages import EgoState
 from tests.perception.light_scene import LightScene
 from tests.perception.render_scene import front_camera
-from world import traffic_light
 from world.frames import CameraFrame
 from world.hdmap import LightColour, LightHead, RoadMap, TrafficLight
+from world.scene import traffic_light
 from world.spec import ActorSpec, ActorType, RoadSpec, SegmentSpec
 
 ROAD = RoadSpec(segments=(SegmentSpec(700.0, 0.0, 2, 1, 3.5, 2.5),), speed_limit=50.0 / 3.6)

@@ -18,12 +18,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from avsim.scenario import load_scenario
+from avsim.scenario.load import load_scenario
 from perception.messages import Detection, EgoState, ObjectClass, Track
 from perception.objects import ObjectDetector
 from perception.tracking import MultiObjectTracker
-from world.behaviour import LATERAL_ACCEL
-from world.sensor_setup import Profile, sensor_setup
+from world.actors.behaviour import LATERAL_ACCEL
+from world.sensors.setup import Profile, sensor_setup
 from world.world import World
 
 KPH = 1000.0 / 3600.0  # [m/s] per km/h

@@ -24,8 +24,8 @@ from perception.signs import (
     match_sign,
 )
 from tests.perception.render_scene import front_camera, render, render_with_actors, world_for
-from world import scenery
 from world.frames import CameraFrame
+from world.scene import scenery
 from world.spec import (
     ActorSpec,
     ActorType,

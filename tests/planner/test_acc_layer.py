@@ -8,9 +8,9 @@ import math
 import numpy as np
 import pytest
 
-from planner.acc import r157_min_gap
 from planner.acc_control import SpeedRef
 from planner.acc_layer import AccLayer
+from planner.fsm.acc import r157_min_gap
 from planner.messages import Lead
 
 DT = 1.0 / 40.0  # [s] planner tick

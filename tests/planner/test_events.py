@@ -8,10 +8,10 @@ from dataclasses import replace
 import pytest
 
 from perception.messages import ObjectClass, Track
-from planner.acc import AccMode
 from planner.acc_control import AccControlParams, SpeedRef, pass_speed, stop_speed
 from planner.acc_layer import AccLayer
 from planner.events import EventMonitor, EventParams, Events
+from planner.fsm.acc import AccMode
 from tests.roads import KPH, W, make_map, seg
 from world.spec import Crosswalk, SpeedBump, StopSign, Zone
 

@@ -10,8 +10,8 @@ import pytest
 from perception.messages import LightDetection, ObjectClass, Track
 from planner.junctions import JunctionMonitor, JunctionParams
 from world.hdmap import LightColour, RoadMap
+from world.map.town import TownLayout, compile_route
 from world.spec import Manoeuvre, TownSpec
-from world.town import TownLayout, compile_route
 
 P = JunctionParams()
 LIGHTS = TownLayout(TownSpec(3, 2, 90.0, 2, 3.5, 40 / 3.6, "traffic_lights"))

@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from perception.messages import ObjectClass, Track
-from planner.acc import AccParams, gaps, r157_min_gap
+from planner.fsm.acc import AccParams, gaps, r157_min_gap
 from planner.lane_occupancy import (
     LaneTraffic,
     Neighbour,

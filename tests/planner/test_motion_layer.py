@@ -10,13 +10,13 @@ import numpy as np
 import pytest
 
 from perception.messages import EgoState, ObjectClass, Track
-from planner.acc import AccParams
-from planner.motion import Motion
+from planner.fsm.acc import AccParams
+from planner.fsm.motion import Motion
 from planner.motion_layer import MotionLayer, MotionLayerParams
 from tests.roads import W, make_map, seg
 from world.hdmap import SHOULDER, RoadMap
+from world.map.town import TownLayout, compile_route
 from world.spec import Manoeuvre, Side, TownSpec
-from world.town import TownLayout, compile_route
 
 ROAD = make_map(seg(1000.0))
 V = 13.9  # [m/s]

@@ -7,10 +7,10 @@ from pathlib import Path
 
 import pytest
 
-from avsim.runner import Runner, RunResult
-from avsim.scenario import load_scenario
-from avsim.sensor_loop import FrameHook
-from world.sensor_setup import Profile
+from avsim.run.runner import Runner, RunResult
+from avsim.run.sensor_loop import FrameHook
+from avsim.scenario.load import load_scenario
+from world.sensors.setup import Profile
 
 
 @pytest.fixture(scope="module")

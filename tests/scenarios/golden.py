@@ -23,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from avsim.runner import RunResult
+from avsim.run.runner import RunResult
 
 GOLDEN_DIR = Path(__file__).resolve().parent / "golden"
 WRITE = os.environ.get("AVSIM_GOLDEN") == "write"

@@ -12,8 +12,8 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from avsim.runner import RunResult
-from planner.lane_source import LaneSourceParams
+from avsim.run.runner import RunResult
+from planner.fsm.lane_source import LaneSourceParams
 from tests.scenarios import golden
 from world.frames import CameraFrame
 

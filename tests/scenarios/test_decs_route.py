@@ -11,8 +11,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from avsim.plot import plot_speed_profile
-from avsim.runner import RunResult
+from avsim.report.speed_plot import plot_speed_profile
+from avsim.run.runner import RunResult
 from tests.scenarios import golden
 from world.hdmap import SHOULDER, RoadMap
 

@@ -9,8 +9,8 @@ from collections.abc import Callable
 import numpy as np
 import pytest
 
-from avsim.runner import RunResult
-from planner.acc import AccParams, gaps
+from avsim.run.runner import RunResult
+from planner.fsm.acc import AccParams, gaps
 from tests.scenarios import golden
 
 pytestmark = pytest.mark.slow

@@ -10,7 +10,7 @@ from collections.abc import Callable
 import numpy as np
 import pytest
 
-from avsim.runner import RunResult
+from avsim.run.runner import RunResult
 from tests.scenarios import golden
 
 pytestmark = pytest.mark.slow

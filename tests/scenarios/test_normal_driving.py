@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from avsim.runner import RunResult
+from avsim.run.runner import RunResult
 from tests.scenarios import golden
 from world.hdmap import RoadMap
 

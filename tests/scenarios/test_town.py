@@ -11,10 +11,10 @@ from collections.abc import Callable
 import numpy as np
 import pytest
 
-from avsim.runner import RunResult
+from avsim.run.runner import RunResult
 from tests.scenarios import golden
 from world.hdmap import JunctionSpec, RoadMap
-from world.signals import light_colour
+from world.map.signals import light_colour
 from world.spec import LightColour, StopSign, TrafficLight
 
 pytestmark = pytest.mark.slow

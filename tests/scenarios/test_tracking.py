@@ -9,8 +9,8 @@ from collections.abc import Callable
 import numpy as np
 import pytest
 
-from avsim.result import result_json
-from avsim.runner import RunResult
+from avsim.run.result import result_json
+from avsim.run.runner import RunResult
 from tests.scenarios import golden
 
 pytestmark = pytest.mark.slow

@@ -10,10 +10,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from avsim.scenario import ScenarioError, load_scenario
+from avsim.scenario.load import ScenarioError, load_scenario
 from tests.roads import KPH, SHOULDER, W, arc, seg
 from world.hdmap import RoadMap
-from world.road_mesh import THROUGH_DROP, build_road_surface, build_through_roads
+from world.scene.road_mesh import THROUGH_DROP, build_road_surface, build_through_roads
 from world.spec import RoadSpec, Side, Zone
 
 RAMP_RADIUS = 80.0

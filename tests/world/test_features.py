@@ -12,12 +12,12 @@ import pytest
 from numpy.typing import NDArray
 
 from tests.perception.render_scene import pose_ego
-from world.bump import bump_height_at
-from world.client import PHYSICS_RATE
+from world.core.client import PHYSICS_RATE
 from world.frames import CameraFrame
-from world.scenery import octagon_corners
-from world.sensor_setup import Profile, sensor_setup
-from world.sensors import vehicle_pose
+from world.scene.bump import bump_height_at
+from world.scene.scenery import octagon_corners
+from world.sensors.rig import vehicle_pose
+from world.sensors.setup import Profile, sensor_setup
 from world.spec import (
     Crosswalk,
     EgoSpec,

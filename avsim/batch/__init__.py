@@ -1,0 +1,1 @@
+"""Batches of runs: jobs, executors (local processes, Ray), suite, sweep."""

@@ -1,0 +1,274 @@
+"""Where the runs of a suite or a sweep execute: worker processes here, or Ray tasks.
+
+Each run is independent, seeded and deterministic (`avsim.batch.jobs.run_job`), so neither the
+executor nor the number of workers changes a result; only the order in which outcomes
+arrive does, and the batch sorts them back into job order.
+
+- `LocalExecutor`: a pool of ``jobs`` worker processes started with ``spawn`` (a fresh
+  interpreter: no PyBullet or GL state inherited), one run per worker process
+  (``max_tasks_per_child=1``: nothing carries over from one run to the next, and each
+  run's memory is given back). The workers send their simulated time through a queue for
+  the live progress display.
+- `RayExecutor`: one Ray task per run (``num_cpus=1``) on the cluster at ``address`` (or
+  ``RAY_ADDRESS``), or on a local Ray instance started for the batch. A task runs in a
+  scratch folder on its node and returns its files' bytes, which are written here: the
+  cluster's nodes need not share a file system with this machine. Ray is an optional extra
+  (``pip install 'avsim[ray]'``).
+
+Both submit the longest runs first (their scenario duration), which keeps the last worker
+from starting a long run while the others idle.
+"""
+
+from __future__ import annotations
+
+import multiprocessing as mp
+import os
+import queue
+import tempfile
+from collections.abc import Callable, Sequence
+from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Protocol
+
+from avsim.batch.jobs import RunJob, RunOutcome, Status, run_job
+from avsim.files import write_atomic
+
+POLL = 0.2  # [s] how often the display is refreshed while runs are under way
+PROGRESS_EVERY = 1.0  # [s] of simulated time between a worker's progress messages
+RAY_EXTRA = "pip install 'avsim[ray]'"
+
+
+class ExecutorError(Exception):
+    """The executor cannot start (bad input: exit status 2)."""
+
+
+@dataclass(frozen=True, slots=True)
+class Progress:
+    """A running job's simulated time, as a worker reports it."""
+
+    name: str  # the job's name
+    sim_time: float  # [s]
+    duration: float  # [s]
+
+
+class ProgressSink(Protocol):
+    """Receives what the executor knows while runs are under way (the live display)."""
+
+    def started(self, job: RunJob) -> None: ...
+    def advanced(self, progress: Progress) -> None: ...
+    def finished(self, outcome: RunOutcome) -> None: ...
+
+
+class Executor(Protocol):
+    name: str
+
+    def run(self, jobs: Sequence[RunJob], sink: ProgressSink | None = None) -> list[RunOutcome]:
+        """Run every job; the outcomes in job order."""
+        ...
+
+
+def longest_first(jobs: Sequence[RunJob]) -> list[RunJob]:
+    """The jobs ordered by falling duration (stable: ties keep their order)."""
+    return sorted(jobs, key=lambda job: -job.duration)
+
+
+def _in_job_order(jobs: Sequence[RunJob], outcomes: Sequence[RunOutcome]) -> list[RunOutcome]:
+    by_name = {o.job.name: o for o in outcomes}
+    return [by_name[j.name] for j in jobs]
+
+
+# ---- local worker processes ----------------------------------------------------------------
+
+
+class _QueueProgress:
+    """A worker's progress callback: a message per `PROGRESS_EVERY` of simulated time."""
+
+    def __init__(self, name: str, sink: Any) -> None:
+        self.name, self.sink, self.next = name, sink, 0.0
+
+    def __call__(self, t: float, duration: float) -> None:
+        if t >= self.next:
+            self.next = t + PROGRESS_EVERY
+            self.sink.put(Progress(self.name, t, duration))
+
+
+def _local_task(job: RunJob, messages: Any) -> RunOutcome:
+    messages.put(job.name)  # started
+    return run_job(job, progress=_QueueProgress(job.name, messages))
+
+
+def died(job: RunJob, exc: BaseException) -> RunOutcome:
+    """The outcome of a job whose worker process died (a crash in native code, killed):
+    `run_job` catches what Python raises, not that."""
+    what = type(exc).__name__ + (f": {exc}" if str(exc) else "")
+    return RunOutcome(job, Status.ERROR, error=f"{job.name}: the worker died ({what})")
+
+
+@dataclass
+class LocalExecutor:
+    """Worker processes on this machine (module doc).
+
+    A worker that dies (a crash in native code, the OOM killer) breaks the whole pool: every
+    run under way or waiting fails with it. The runs that were under way (all that were
+    lost, if none had reported starting) are suspects: each runs again alone, and one that
+    dies again is reported as died (runs are deterministic: that is the one that crashed);
+    the others go to a fresh pool. Every round removes its suspects, so it ends."""
+
+    jobs: int = 1  # worker processes
+    name: str = "local"
+    task: Callable[[RunJob, Any], RunOutcome] = _local_task  # what a worker runs (tests)
+
+    def run(self, jobs: Sequence[RunJob], sink: ProgressSink | None = None) -> list[RunOutcome]:
+        ctx = mp.get_context("spawn")
+        outcomes: list[RunOutcome] = []
+        todo = longest_first(jobs)
+        with ctx.Manager() as manager:
+            messages = manager.Queue()
+            while todo:
+                started: set[str] = set()
+                done, lost = self._pool(ctx, todo, self.jobs, messages, started, sink)
+                outcomes += done
+                suspects = [j for j, _ in lost if j.name in started] or [j for j, _ in lost]
+                todo = [j for j, _ in lost if j not in suspects]
+                for job in suspects:
+                    outcomes.append(self._alone(ctx, job, messages, sink))
+        return _in_job_order(jobs, outcomes)
+
+    def _alone(self, ctx: Any, job: RunJob, messages: Any,
+               sink: ProgressSink | None) -> RunOutcome:
+        """Run `job` in a pool of its own: its outcome, or `died` if it breaks this one too."""
+        done, lost = self._pool(ctx, [job], 1, messages, set(), sink)
+        if done:
+            return done[0]
+        outcome = died(job, lost[0][1])
+        if sink is not None:
+            sink.finished(outcome)
+        return outcome
+
+    def _pool(self, ctx: Any, jobs: Sequence[RunJob], workers: int, messages: Any,
+              started: set[str], sink: ProgressSink | None,
+              ) -> tuple[list[RunOutcome], list[tuple[RunJob, BaseException]]]:
+        """Run `jobs` in one pool: the outcomes, and the jobs lost when a worker died (with
+        the error). `started` collects the names of the runs that began."""
+        outcomes: list[RunOutcome] = []
+        lost: list[tuple[RunJob, BaseException]] = []
+        by_name = {j.name: j for j in jobs}
+        with ProcessPoolExecutor(max_workers=min(workers, len(jobs)), mp_context=ctx,
+                                 max_tasks_per_child=1) as pool:
+            futures = {pool.submit(self.task, job, messages): job for job in jobs}
+            pending: set[Future[RunOutcome]] = set(futures)
+            while pending:
+                done, pending = wait(pending, timeout=POLL, return_when=FIRST_COMPLETED)
+                _drain(messages, by_name, sink, started)
+                for future in done:
+                    exc = future.exception()
+                    if exc is not None:
+                        lost.append((futures[future], exc))
+                        continue
+                    outcomes.append(future.result())
+                    if sink is not None:
+                        sink.finished(outcomes[-1])
+        _drain(messages, by_name, sink, started)
+        return outcomes, lost
+
+
+def _drain(messages: Any, jobs: dict[str, RunJob], sink: ProgressSink | None,
+           started: set[str]) -> None:
+    while True:
+        try:
+            message = messages.get_nowait()
+        except queue.Empty:
+            return
+        if not isinstance(message, Progress):
+            started.add(message)
+        if sink is None:
+            continue
+        if isinstance(message, Progress):
+            sink.advanced(message)
+        else:
+            sink.started(jobs[message])
+
+
+# ---- Ray -----------------------------------------------------------------------------------
+
+
+def _ray_task(job: RunJob) -> tuple[RunOutcome, dict[str, bytes]]:
+    """A Ray task: run the job in a scratch folder, return the outcome and its files."""
+    with tempfile.TemporaryDirectory(prefix="avsim-") as scratch:
+        outcome = run_job(job, into=Path(scratch))
+        files = {p.name: p.read_bytes() for p in Path(scratch).iterdir()
+                 if p.is_file() and not p.name.startswith(".")}
+    return outcome, files
+
+
+@dataclass
+class RayExecutor:
+    """Ray tasks on a cluster, or on a local Ray instance (module doc)."""
+
+    address: str | None = None  # a cluster ("ray://host:10001", "auto"); None: RAY_ADDRESS
+    #   or else a local instance started for this batch
+    jobs: int | None = None  # CPUs of the local instance (None: all of this machine's)
+    name: str = "ray"
+
+    def run(self, jobs: Sequence[RunJob], sink: ProgressSink | None = None) -> list[RunOutcome]:
+        ray = _import_ray()
+        address = self.address or os.environ.get("RAY_ADDRESS") or None
+        started_here = not ray.is_initialized()
+        if started_here:
+            _ray_init(ray, address, self.jobs)
+        try:
+            return self._run(ray, jobs, sink)
+        finally:
+            if started_here:
+                ray.shutdown()
+
+    def _run(self, ray: Any, jobs: Sequence[RunJob],
+             sink: ProgressSink | None) -> list[RunOutcome]:
+        task = ray.remote(num_cpus=1, max_retries=0)(_ray_task)
+        order = longest_first(jobs)
+        refs = {task.remote(job): job for job in order}
+        if sink is not None:
+            for job in order:
+                sink.started(job)
+        outcomes: list[RunOutcome] = []
+        pending = list(refs)
+        while pending:
+            done, pending = ray.wait(pending, num_returns=1)
+            job = refs[done[0]]
+            try:
+                outcome, files = ray.get(done[0])
+            except ray.exceptions.RayError as exc:  # the task's worker or node died
+                outcome, files = died(job, exc), {}
+            _write_files(job.out_dir, files)
+            outcomes.append(outcome)
+            if sink is not None:
+                sink.finished(outcome)
+        return _in_job_order(jobs, outcomes)
+
+
+def _import_ray() -> Any:
+    try:
+        import ray
+    except ImportError:
+        raise ExecutorError(f"--executor ray: Ray is not installed ({RAY_EXTRA})") from None
+    return ray
+
+
+def _ray_init(ray: Any, address: str | None, cpus: int | None) -> None:
+    # the workers import avsim from wherever this process does (an editable install or a
+    # checkout on the cluster's nodes); they do not need the driver's working directory
+    options: dict[str, Any] = {"include_dashboard": False, "log_to_driver": False,
+                               "configure_logging": False}
+    if address is None and cpus is not None:
+        options["num_cpus"] = cpus
+    try:
+        ray.init(address=address, **options)
+    except (ConnectionError, RuntimeError, ValueError) as exc:
+        where = address or "a local instance"
+        raise ExecutorError(f"--executor ray: cannot connect to {where}: {exc}") from None
+
+
+def _write_files(out_dir: Path, files: dict[str, bytes]) -> None:
+    for name, data in files.items():
+        write_atomic(out_dir / name, data)

@@ -1,0 +1,172 @@
+"""One run of a suite or a sweep: what to run (`RunJob`) and what came of it (`RunOutcome`).
+
+A job is plain data, so that it pickles to a worker process or a Ray task; `run_job` is the
+worker's whole work: load the scenario with the job's overrides, run it headless, write its
+recording, result JSON and speed-profile plot into the job's folder, and return the
+outcome. A job never raises: bad input and crashes come back as outcomes with a one-line
+`error`, so that one bad run cannot take a suite down.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import time
+import traceback
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from enum import Enum
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from avsim.files import write_atomic
+from avsim.scenario.load import ScenarioError, load_scenario
+
+if TYPE_CHECKING:
+    from world.spec import ScenarioSpec
+
+
+class Status(Enum):
+    """How a run ended, as the CLI's exit status says it."""
+
+    PASSED = "passed"  # every criterion passed (exit 0)
+    FAILED = "failed"  # a criterion failed (exit 1)
+    BAD_INPUT = "bad_input"  # the scenario or an override is invalid (exit 2)
+    ERROR = "error"  # the run crashed (a bug): the message is the exception's last line
+
+
+@dataclass(frozen=True, slots=True)
+class RunJob:
+    """A scenario to run, with its key overrides, into its own folder."""
+
+    name: str  # unique within the batch: [a-z0-9_]+ (the scenario's name, + sweep values)
+    scenario: str  # a file path or a bundled scenario's name, as the user gave it
+    out_dir: Path  # the run writes <out_dir>/<name>.rrd, .json, .png here
+    overrides: Mapping[str, object] = field(default_factory=dict)  # dotted key -> value
+    profile: str = "default"  # sensor profile: fast | default | paper | none
+    sensing: str = "inline"  # cameras render in this process (workers run in parallel)
+    plot: bool = True  # also write the speed-profile PNG
+    duration: float = 0.0  # [s] the scenario's simulated time: its cost, longest run first
+
+    @property
+    def recording(self) -> Path:
+        return self.out_dir / f"{self.name}.rrd"
+
+    @property
+    def result_file(self) -> Path:
+        return self.out_dir / f"{self.name}.json"
+
+    @property
+    def plot_file(self) -> Path:
+        return self.out_dir / f"{self.name}.png"
+
+
+@dataclass(frozen=True, slots=True)
+class RunOutcome:
+    """What one job gave. `result` is the run's result JSON (`avsim.run.result.result_json`)."""
+
+    job: RunJob
+    status: Status
+    result: dict[str, object] | None = None  # None when the run did not finish
+    error: str | None = None  # one line, for BAD_INPUT and ERROR
+    wall_time: float = 0.0  # [s] the job's whole time in its worker, loading included
+
+    @property
+    def passed(self) -> bool:
+        return self.status is Status.PASSED
+
+    @property
+    def sim_time(self) -> float:
+        """[s] simulated (0 when the run did not finish)."""
+        return self._number("sim_time")
+
+    @property
+    def run_time(self) -> float:
+        """[s] the simulation's own wall time (the result's; `wall_time` adds loading)."""
+        return self._number("wall_time")
+
+    def _number(self, key: str) -> float:
+        value = None if self.result is None else self.result.get(key)
+        return float(value) if isinstance(value, (int, float)) else 0.0
+
+    def criteria(self) -> list[dict[str, object]]:
+        """The result's criteria (name, passed, value, threshold, unit, first_failure?)."""
+        if self.result is None:
+            return []
+        criteria = self.result["criteria"]
+        assert isinstance(criteria, list)
+        return criteria
+
+    def metric(self, name: str) -> float:
+        """A metric of the result, or a criterion's value by its name; NaN if absent."""
+        if self.result is None:
+            return math.nan
+        metrics = self.result["metrics"]
+        assert isinstance(metrics, dict)
+        value = metrics.get(name)
+        if value is None:
+            value = next((c["value"] for c in self.criteria() if c["name"] == name), None)
+        return float(value) if isinstance(value, (int, float)) else math.nan
+
+    def first_failure(self) -> float | None:
+        """[s] the earliest time a criterion failed, if one did and said when."""
+        times = [float(t) for c in self.criteria()
+                 if not c["passed"] and isinstance(t := c.get("first_failure"), (int, float))]
+        return min(times) if times else None
+
+    def failure_time(self) -> float | None:
+        """[s] the moment to look at a failed run: its first failure, or its end when the
+        failed criteria are judged at the end (`completes`); None if it did not fail."""
+        if self.status is not Status.FAILED or self.result is None:
+            return None
+        first = self.first_failure()
+        return first if first is not None else self.sim_time
+
+
+ProgressCallback = Callable[[float, float], None]  # (sim time, duration) [s]
+
+
+def run_job(job: RunJob, into: Path | None = None,
+            progress: ProgressCallback | None = None) -> RunOutcome:
+    """Run one job in this process (the worker's entry point); never raises.
+
+    The files go to `into` when given (a worker's scratch folder on a cluster node, whose
+    files the caller moves to ``job.out_dir``), else to ``job.out_dir``; the result names
+    the job's own paths either way. `progress` is called as the simulation advances."""
+    start = time.perf_counter()
+    try:
+        spec = load_scenario(job.scenario, dict(job.overrides))
+    except ScenarioError as exc:
+        return RunOutcome(job, Status.BAD_INPUT, error=str(exc),
+                          wall_time=time.perf_counter() - start)
+    try:
+        result = _simulate(job, spec, into or job.out_dir, progress)
+    except Exception as exc:  # a crash is this run's outcome, not the batch's
+        last = traceback.format_exception_only(exc)[-1].strip()
+        return RunOutcome(job, Status.ERROR, error=f"{job.name}: {last}",
+                          wall_time=time.perf_counter() - start)
+    status = Status.PASSED if result["passed"] else Status.FAILED
+    return RunOutcome(job, status, result, wall_time=time.perf_counter() - start)
+
+
+def _simulate(job: RunJob, spec: ScenarioSpec, into: Path,
+              progress: ProgressCallback | None) -> dict[str, object]:
+    from world.core.quiet import quiet_c_output
+
+    with quiet_c_output():  # PyBullet's build banner
+        from avsim.report.speed_plot import plot_speed_profile
+        from avsim.run.result import result_json
+        from avsim.run.runner import Runner
+        from world.sensors.setup import Profile
+
+    into.mkdir(parents=True, exist_ok=True)
+    recording = into / job.recording.name
+    partial = into / f".{recording.name}.partial"
+    profile = None if job.profile == "none" else Profile(job.profile)
+    result = Runner(spec, partial, profile, job.sensing).run(progress)
+    partial.replace(recording)
+    payload = result_json(result, job.scenario, job.recording, job.profile)
+    write_atomic(into / job.result_file.name, json.dumps(payload, indent=2) + "\n")
+    if job.plot:
+        plot_speed_profile(result, into / job.plot_file.name)
+    return payload

@@ -1,0 +1,1 @@
+"""Criteria: one module per family, and the registry that builds a scenario's set."""

@@ -1,0 +1,175 @@
+"""Following criteria, against the vehicle ahead in the ego's lane: the gap while moving, the
+gap at a standstill, and the time to resume once the lane clears."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from avsim.criteria.base import (
+    KPH,
+    SPEED_TOLERANCE_KPH,
+    Criterion,
+    CriterionResult,
+    TruthSample,
+)
+from planner.fsm.acc import r157_min_gap
+from world.hdmap import RoadMap
+
+
+class MinGap(Criterion):
+    """The bumper gap to the vehicle ahead in the ego's lane is never below the threshold
+    (UN R157's d_min(v), or a fixed number of metres) while the ego moves faster than 2 m/s,
+    except for `grace` seconds after that vehicle entered the lane ahead (a cut-in) and while
+    it brakes harder than 3 m/s^2. Value: the smallest gap [m] checked; its threshold at that
+    moment is reported with it (the least margin decides)."""
+
+    name, unit = "min_gap", "m"
+    MIN_SPEED = 2.0  # [m/s]
+    HARD_BRAKE = 3.0  # [m/s^2]
+
+    def __init__(self, threshold: float | str, road: RoadMap, ego_length: float,
+                 grace: float = 10.0) -> None:
+        super().__init__()
+        self.fixed = None if threshold == "r157" else float(threshold)
+        self.road = road
+        self.ego_length = ego_length
+        self.grace = grace
+        self.entered: dict[str, float] = {}  # actor id -> time it entered the lane ahead
+        self._started = False
+        self.margin = math.inf
+        self.gap = math.inf  # [m] at the least margin
+        self.threshold = math.nan if self.fixed is None else self.fixed
+
+    def update(self, sample: TruthSample) -> None:
+        ahead = vehicles_ahead(sample, self.road, self.ego_length)
+        for name in list(self.entered):
+            if name not in ahead:
+                del self.entered[name]
+        for name in ahead:  # a vehicle ahead from the start has not cut in: no grace
+            self.entered.setdefault(name, sample.t if self._started else -math.inf)
+        self._started = True
+        if not ahead or sample.speed <= self.MIN_SPEED:
+            return
+        name, gap, accel = min(ahead.values(), key=lambda a: a[1])
+        if sample.t - self.entered[name] < self.grace or accel < -self.HARD_BRAKE:
+            return
+        d_min = self.fixed if self.fixed is not None else r157_min_gap(sample.speed)
+        if gap - d_min < self.margin:
+            self.margin, self.gap, self.threshold = gap - d_min, gap, d_min
+        if gap < d_min:
+            self._fail(sample.t)
+
+    def result(self) -> CriterionResult:
+        return CriterionResult(self.name, self.first_failure is None, self.gap,
+                               self.threshold, self.unit, self.first_failure)
+
+
+def vehicles_ahead(sample: TruthSample, road: RoadMap,
+                   ego_length: float) -> dict[str, tuple[str, float, float]]:
+    """Actor id -> (id, bumper gap [m], acceleration [m/s^2]) of the vehicles whose centre
+    is in the ego's lane band (half a lane width either side of the ego's centre) ahead."""
+    a = sample.actors
+    if a is None or not len(a.ids):
+        return {}
+    width = float(road.lane(0).width_at(sample.station))
+    lateral = np.abs(a.offsets - sample.offset) < 0.5 * width
+    gap = a.stations - sample.station - (2.0 * a.half_sizes[:, 0] + ego_length) / 2
+    out = {}
+    for i in np.flatnonzero(lateral & (a.stations > sample.station)):
+        if a.kinds[i].value in VEHICLES:
+            out[a.ids[i]] = (a.ids[i], float(gap[i]), float(a.accels[i]))
+    return out
+
+
+VEHICLES = frozenset({"car", "truck"})
+
+
+class StandstillGap(Criterion):
+    """Each time the ego stands (below 0.1 m/s for 1 s) behind a vehicle in its lane within
+    `reach` metres, the bumper gap is within [low, high]. Value: the standstill gap farthest
+    from the band's middle [m], against the bound on its side; fails if it never stood."""
+
+    name, unit = "standstill_gap", "m"
+    STOPPED, HOLD, REACH = 0.1, 1.0, 15.0  # [m/s], [s], [m]
+
+    def __init__(self, low: float, high: float, road: RoadMap, ego_length: float) -> None:
+        super().__init__()
+        self.low, self.high, self.road, self.ego_length = low, high, road, ego_length
+        self.gaps: list[float] = []
+        self._since: float | None = None
+
+    def update(self, sample: TruthSample) -> None:
+        if sample.speed >= self.STOPPED:
+            self._since = None
+            return
+        self._since = sample.t if self._since is None else self._since
+        ahead = vehicles_ahead(sample, self.road, self.ego_length)
+        gap = min((g for _, g, _ in ahead.values()), default=math.inf)
+        if sample.t - self._since < self.HOLD or gap > self.REACH:
+            return
+        self.gaps.append(gap)
+        if not self.low <= gap <= self.high:
+            self._fail(sample.t)
+
+    def result(self) -> CriterionResult:
+        if not self.gaps:
+            return CriterionResult(self.name, False, 0.0, self.low, self.unit, None,
+                                   "the ego never stood behind a vehicle")
+        mid = 0.5 * (self.low + self.high)
+        worst = max(self.gaps, key=lambda g: abs(g - mid))
+        bound = self.low if worst < mid else self.high
+        return CriterionResult(self.name, self.first_failure is None, worst, bound, self.unit,
+                               self.first_failure)
+
+
+class TimeToResume(Criterion):
+    """Once the lane ahead clears (no vehicle in it within 3 s at the wanted speed + 10 m
+    that is slower than that speed) while the ego is slower than the wanted speed (the set
+    speed, or the posted limit where lower) less 1 km/h, the ego is back at it within
+    `threshold` seconds. Value: the longest such wait [s] (one still open at the end counts
+    to the end); fails if the lane never cleared with the ego slowed."""
+
+    name, unit = "time_to_resume", "s"
+
+    def __init__(self, threshold: float, set_speed: float, road: RoadMap,
+                 ego_length: float) -> None:
+        super().__init__()
+        self.threshold, self.set_speed, self.road = threshold, set_speed, road
+        self.ego_length = ego_length
+        self.waits: list[float] = []
+        self._clear_at: float | None = None
+        self._was_blocked = False
+        self._t = 0.0
+
+    def update(self, sample: TruthSample) -> None:
+        self._t = sample.t
+        want = min(self.set_speed, float(self.road.speed_limit_at(sample.front_station)))
+        slow = sample.speed < want - SPEED_TOLERANCE_KPH * KPH
+        a = sample.actors
+        reach = 3.0 * want + 10.0
+        blocking = a is not None and any(
+            g <= reach and a.speeds[a.ids.index(name)] < want - SPEED_TOLERANCE_KPH * KPH
+            for name, g, _ in vehicles_ahead(sample, self.road, self.ego_length).values())
+        if self._clear_at is not None and (not slow or blocking):
+            self._close(sample.t)
+        if self._clear_at is None and slow and not blocking and self._was_blocked:
+            self._clear_at = sample.t
+        self._was_blocked = blocking
+
+    def _close(self, t: float) -> None:
+        assert self._clear_at is not None
+        self.waits.append(t - self._clear_at)
+        if self.waits[-1] > self.threshold:
+            self._fail(t)
+        self._clear_at = None
+
+    def result(self) -> CriterionResult:
+        waits = self.waits + ([self._t - self._clear_at] if self._clear_at is not None else [])
+        if not waits:
+            return CriterionResult(self.name, False, 0.0, self.threshold, self.unit, None,
+                                   "the lane ahead never cleared with the ego slowed")
+        value = max(waits)
+        return CriterionResult(self.name, value <= self.threshold, value, self.threshold,
+                               self.unit, self.first_failure)

@@ -1,0 +1,212 @@
+"""Road rules at the map's features: stop lines, traffic lights, crosswalks, speed bumps."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from avsim.criteria.base import (
+    KPH,
+    SPEED_TOLERANCE_KPH,
+    Criterion,
+    CriterionResult,
+    TruthSample,
+)
+from world.hdmap import RoadMap
+from world.spec import ActorType, Crosswalk, SpeedBump, StopSign, TrafficLight
+
+
+class StopSigns(Criterion):
+    """At each stop line (a `stop_sign` feature's station s) the ego stands, speed below
+    0.1 m/s, for at least 1 s with its front bumper 0 to 4 m before the line (s - 4 <= front
+    bumper station <= s) before the front bumper is ever over it (> s).
+
+    Value: the shortest standstill [s] over the lines judged, each line's being its longest
+    unbroken standstill in that zone before the bumper went over (0 if none). A line is
+    judged once the bumper has gone over it or stood for 1 s; a line the run ends before
+    (neither) is not, nor one the bumper was already over at the first sample. Fails at the
+    first line the bumper goes over without the 1 s stop. No line judged (none on the map):
+    value 0, passed."""
+
+    name, unit = "stop_signs", "s"
+    STOPPED, HOLD, ZONE = 0.1, 1.0, 4.0  # [m/s], [s], [m]
+
+    def __init__(self, road: RoadMap) -> None:
+        super().__init__()
+        self.lines = [f.s for f in road.features if isinstance(f, StopSign)]
+        self.longest = [0.0] * len(self.lines)  # [s] per line
+        self.judged = [False] * len(self.lines)
+        self._watched: list[bool] | None = None  # per line: before it at the first sample
+        self._since: list[float | None] = [None] * len(self.lines)
+        self._over = [False] * len(self.lines)  # the bumper has gone over the line
+
+    def update(self, sample: TruthSample) -> None:
+        front = sample.front_station
+        if self._watched is None:
+            self._watched = [front <= s for s in self.lines]
+        for i, s in enumerate(self.lines):
+            if not self._watched[i] or self._over[i]:
+                continue
+            if front > s:
+                self._over[i] = self.judged[i] = True
+                if self.longest[i] < self.HOLD:  # over it without the stop
+                    self._fail(sample.t)
+            elif sample.speed < self.STOPPED and front >= s - self.ZONE:
+                since = self._since[i]
+                if since is None:
+                    since = self._since[i] = sample.t
+                self.longest[i] = max(self.longest[i], sample.t - since)
+                self.judged[i] = self.judged[i] or self.longest[i] >= self.HOLD
+            else:
+                self._since[i] = None
+
+    def result(self) -> CriterionResult:
+        judged = [d for d, j in zip(self.longest, self.judged, strict=True) if j]
+        return CriterionResult(self.name, self.first_failure is None, min(judged, default=0.0),
+                               self.HOLD, self.unit, self.first_failure)
+
+
+class RedLights(Criterion):
+    """The ego does not enter a junction on red: when its front bumper goes over a traffic
+    light's stop line (a `traffic_light` feature's station s), the light is not red.
+
+    Value: the least margin [s] to red over the lines crossed: at each crossing, the time
+    left until the light turns red, or minus the time it has been red (fails). No line
+    crossed: value +inf, passed."""
+
+    name, unit = "red_lights", "s"
+
+    def __init__(self, road: RoadMap) -> None:
+        super().__init__()
+        self.lights = [f for f in road.features if isinstance(f, TrafficLight)]
+        self.margin = math.inf
+        self._front: float | None = None  # [m] the front bumper's station at the last sample
+
+    def update(self, sample: TruthSample) -> None:
+        front, before = sample.front_station, self._front
+        self._front = front
+        if before is None:
+            return
+        for light in self.lights:
+            if before <= light.s < front:
+                margin = _margin_to_red(light, sample.t)
+                self.margin = min(self.margin, margin)
+                if margin < 0.0:
+                    self._fail(sample.t)
+
+    def result(self) -> CriterionResult:
+        return CriterionResult(self.name, self.first_failure is None, self.margin, 0.0,
+                               self.unit, self.first_failure)
+
+
+def _margin_to_red(light: TrafficLight, t: float) -> float:
+    """[s] until `light` turns red at time t, or minus how long it has been red."""
+    into = (t + light.phase) % light.cycle
+    red_at = light.green + light.yellow
+    return red_at - into
+
+
+class Crosswalks(Criterion):
+    """No part of the ego is on a crosswalk while a pedestrian is on it within the ego's
+    lane or within 1 m of that lane.
+
+    A crosswalk (a `crosswalk` feature) covers stations [s, s + width] across the paved road.
+    The ego covers stations [rear bumper, front bumper]. A pedestrian (an actor of type
+    pedestrian) is on it when its footprint (its centre +- the larger of its half length and
+    half width, along and across) overlaps the crosswalk, and in the ego's lane when that
+    footprint also overlaps, across, the ego's lane widened by 1 m on each side: the lanes
+    (of the ego's direction) its tyres are in, at the crosswalk's station. Value: the
+    deepest overlap [m] of the ego's stations with a crosswalk while a pedestrian was on it
+    in the ego's lane (negative: the ego stayed that far off it); 0 if that never happened
+    (or the map has no crosswalk)."""
+
+    name, unit = "crosswalks", "m"
+    LANE_MARGIN = 1.0  # [m]
+
+    def __init__(self, road: RoadMap) -> None:
+        super().__init__()
+        self.road = road
+        self.crosswalks = [(f.s, f.s + f.width) for f in road.features
+                           if isinstance(f, Crosswalk)]
+        self.worst: float | None = None
+
+    @property
+    def needs_actors(self) -> bool:
+        """Whether it reads the actors (only when the map has a crosswalk)."""
+        return bool(self.crosswalks)
+
+    def update(self, sample: TruthSample) -> None:
+        a = sample.actors
+        if not self.crosswalks or a is None or not len(a.ids):
+            return
+        walkers = np.array([k is ActorType.PEDESTRIAN for k in a.kinds])
+        if not walkers.any():
+            return
+        reach = np.max(a.half_sizes[:, :2], axis=1)
+        rear = (sample.rear_station if sample.rear_station is not None
+                else 2.0 * sample.station - sample.front_station)
+        for c0, c1 in self.crosswalks:
+            right, left = (float(x) for x in self.road.paved_edges(c0))
+            lo, hi = self._ego_lanes(sample, c0)
+            lo, hi = max(lo - self.LANE_MARGIN, right), min(hi + self.LANE_MARGIN, left)
+            on = (walkers & (a.stations + reach >= c0) & (a.stations - reach <= c1)
+                  & (a.offsets + reach >= lo) & (a.offsets - reach <= hi))
+            if not on.any():
+                continue
+            overlap = min(sample.front_station, c1) - max(rear, c0)
+            self.worst = overlap if self.worst is None else max(self.worst, overlap)
+            if overlap > 0.0:
+                self._fail(sample.t)
+
+    def _ego_lanes(self, sample: TruthSample, s: float) -> tuple[float, float]:
+        """([m] right, [m] left) offsets of the band of ego-direction lanes the tyres are
+        in, at station s (a tyre off the lanes counts in the nearest lane)."""
+        c = self.road.cross_section_at(s)
+        w = c.lane_width
+        index = np.clip(np.floor((sample.tyre_offsets + 0.5 * w) / w), 0, c.lanes - 1)
+        lo = self.road.lane(int(index.min())).offset_at(s)
+        hi = self.road.lane(int(index.max())).offset_at(s)
+        return float(lo) - 0.5 * w, float(hi) + 0.5 * w
+
+    def result(self) -> CriterionResult:
+        value = 0.0 if self.worst is None else self.worst
+        return CriterionResult(self.name, self.first_failure is None, value, 0.0, self.unit,
+                               self.first_failure)
+
+
+class SpeedBumps(Criterion):
+    """The ego's speed is at most the bump's pass speed + 1 km/h while either axle is within
+    1 m of a speed bump (a `speed_bump` feature centred on station s: axle station in
+    [s - length / 2 - 1, s + length / 2 + 1]).
+
+    Value: the largest excess [km/h] of the speed over the bump's pass speed at those
+    moments (negative: slower); 0 if an axle never came near a bump (or the map has none)."""
+
+    name, unit = "speed_bumps", "km/h"
+    NEAR = 1.0  # [m]
+
+    def __init__(self, road: RoadMap, front_axle: float, rear_axle: float) -> None:
+        """`front_axle`, `rear_axle`: [m] from the car's centre, both positive (used when
+        a sample does not give the axle stations)."""
+        super().__init__()
+        self.front_axle, self.rear_axle = front_axle, rear_axle
+        self.bumps = [(f.s - 0.5 * f.length - self.NEAR, f.s + 0.5 * f.length + self.NEAR,
+                       f.pass_speed) for f in road.features if isinstance(f, SpeedBump)]
+        self.worst: float | None = None
+
+    def update(self, sample: TruthSample) -> None:
+        axles = sample.axle_stations or (sample.station + self.front_axle,
+                                         sample.station - self.rear_axle)
+        for lo, hi, pass_speed in self.bumps:
+            if not any(lo <= x <= hi for x in axles):
+                continue
+            excess = (sample.speed - pass_speed) / KPH
+            self.worst = excess if self.worst is None else max(self.worst, excess)
+            if excess > SPEED_TOLERANCE_KPH:
+                self._fail(sample.t)
+
+    def result(self) -> CriterionResult:
+        value = 0.0 if self.worst is None else self.worst
+        return CriterionResult(self.name, self.first_failure is None, value,
+                               SPEED_TOLERANCE_KPH, self.unit, self.first_failure)

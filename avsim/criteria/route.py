@@ -1,0 +1,44 @@
+"""`completes`: the ego gets where the route goes (or stops as a flat tyre demands)."""
+
+from __future__ import annotations
+
+import math
+
+from avsim.criteria.base import (
+    Criterion,
+    CriterionResult,
+    TruthSample,
+)
+
+
+class Completes(Criterion):
+    """The ego's centre reaches `reach_s` before the end, or it stops (below 0.1 m/s for
+    `STOPPED_FOR`) after a flat tyre, a stop the scenario expects: value = farthest
+    station [m] (the note says when the flat tyre's stop completed it)."""
+
+    name, unit = "completes", "m"
+    STOPPED, STOPPED_FOR = 0.1, 2.0  # [m/s], [s]
+
+    def __init__(self, reach_s: float) -> None:
+        super().__init__()
+        self.reach_s = reach_s
+        self.farthest = -math.inf
+        self.stopped_flat = False
+        self._since: float | None = None
+
+    def update(self, sample: TruthSample) -> None:
+        self.farthest = max(self.farthest, sample.station)
+        if not sample.flat or sample.speed >= self.STOPPED:
+            self._since = None
+            return
+        self._since = sample.t if self._since is None else self._since
+        self.stopped_flat |= sample.t - self._since >= self.STOPPED_FOR
+
+    @property
+    def done(self) -> bool:
+        return self.farthest >= self.reach_s or self.stopped_flat
+
+    def result(self) -> CriterionResult:
+        note = "stopped after a flat tyre" if self.stopped_flat else None
+        return CriterionResult(self.name, self.done, self.farthest, self.reach_s, self.unit,
+                               note=note)

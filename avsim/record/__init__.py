@@ -1,0 +1,1 @@
+"""The Rerun recording: recorder, blueprint, headless snapshots."""

@@ -1,0 +1,1 @@
+"""Reports: speed plots, JUnit, summary.md, sweep tables and heat maps."""

@@ -1,0 +1,186 @@
+"""The speed profile of a run as a PNG, like the DECS paper's Fig. 3 (`avsim run --plot`).
+
+Speeds over time in km/h: the ego's (true), the lead vehicle's, the posted limit at the
+ego's front bumper and the driver's set speed, with the ACC / event layer's mode
+(`planner.fsm.acc.AccMode`) as coloured bands behind them, one colour per mode.
+
+The lead vehicle at a tick is the nearest car or truck ahead of the ego in its lane, from the
+ground truth in the run's log, by the `min_gap` criterion's rule: its centre station is ahead
+of the ego's and its centre is within half a lane width of the ego's centre, sideways. The
+ego's offset from the reference line is rebuilt from the log as the kept lane's centre
+(`lane * lane_width`, the HD map's layout) plus the cross-track error; so during a lane change
+the band moves with the car. The lead's speed is its station's rate of change (a central
+difference over the control ticks), scaled by (1 - curvature * offset) to the speed along its
+own path on arcs; NaN (a gap in the line) where there is no lead.
+
+Pure: no PyBullet, no pyplot (a bare `Figure` on the Agg canvas, so no display is needed).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.collections import PolyCollection
+from matplotlib.figure import Figure
+from numpy.typing import NDArray
+
+from planner.fsm.acc import AccMode
+from world.hdmap import RoadMap
+
+if TYPE_CHECKING:
+    from avsim.run.runner import RunResult
+
+KPH = 3.6  # [km/h per m/s]
+SIZE = (16.0, 7.0)  # [in] at DPI: 1600 x 700 px
+DPI = 100
+BAND_ALPHA = 0.3
+VEHICLES = frozenset({"car", "truck"})  # actor types that can be a lead
+# one colour per ACC / event mode, by `AccMode` value (legend order: AccMode's)
+MODE_COLOURS: dict[str, str] = {
+    AccMode.ACC_OFF.value: "#b0bec5",
+    AccMode.CRUISE.value: "#4caf50",
+    AccMode.TRAIL.value: "#2196f3",
+    AccMode.BRAKE.value: "#e53935",
+    AccMode.SPEED_LIMIT.value: "#ffc107",
+    AccMode.OFF_RAMP.value: "#9c27b0",
+    AccMode.PEDESTRIAN.value: "#00bcd4",
+    AccMode.SPEED_BUMP.value: "#ff5722",
+    AccMode.STOP_SIGN.value: "#880e4f",
+    AccMode.FLAT.value: "#795548",
+    AccMode.RED_LIGHT.value: "#b71c1c",
+    AccMode.YIELD.value: "#ff9800",
+}
+OTHER_MODE_COLOUR = "#9e9e9e"  # a mode this table does not know yet
+LINES = {  # series -> (label, colour, style, width)
+    "ego": ("ego speed", "#000000", "-", 2.0),
+    "lead": ("lead speed", "#1a237e", "-", 1.5),
+    "limit": ("posted limit", "#d50000", "--", 1.5),
+    "set": ("set speed", "#1b5e20", ":", 1.8),
+}
+
+FloatArray = NDArray[np.float64]
+
+
+def mode_runs(t: Sequence[float], modes: Sequence[str]) -> list[tuple[str, float, float]]:
+    """(mode, start [s], end [s]) of each run of equal modes; a run ends where the next one
+    starts, the last one a tick after the last sample."""
+    if not len(t):
+        return []
+    times = np.asarray(t, dtype=np.float64)
+    dt = float(times[-1] - times[-2]) if len(times) > 1 else 0.0
+    ends = np.append(times[1:], times[-1] + dt)
+    runs: list[tuple[str, float, float]] = []
+    start = 0
+    for i in range(1, len(modes) + 1):
+        if i == len(modes) or modes[i] != modes[start]:
+            runs.append((modes[start], float(times[start]), float(ends[i - 1])))
+            start = i
+    return runs
+
+
+def lead_speed(result: RunResult) -> FloatArray:
+    """[m/s] per tick: the speed of the nearest car or truck ahead in the ego's lane (truth),
+    NaN where there is none (see the module's doc for the rule)."""
+    log, spec = result.log, result.spec
+    n = len(log.t)
+    vehicles = np.array([a.type.value in VEHICLES for a in spec.actors], dtype=bool)
+    if n < 2 or not vehicles.any() or len(log.actor_station) != n:
+        return np.full(n, math.nan)
+    t = log.array("t")
+    stations = np.vstack(log.actor_station).astype(np.float64)  # (T, N)
+    offsets = np.vstack(log.actor_offset).astype(np.float64)
+    road = RoadMap.from_spec(spec.road)
+    ego_s = log.array("station")
+    width = np.asarray(road.lane(0).width_at(ego_s), dtype=np.float64)
+    ego_offset = np.asarray(log.lane, dtype=np.float64) * width + log.array("cross_track")
+    speeds = np.gradient(stations, t, axis=0)
+    curvature = np.asarray(road.curvature_at(stations.ravel()), dtype=np.float64)
+    speeds *= 1.0 - curvature.reshape(stations.shape) * offsets
+    candidate = (
+        vehicles[None, :]
+        & (stations > ego_s[:, None])
+        & (np.abs(offsets - ego_offset[:, None]) < 0.5 * width[:, None])
+    )
+    nearest = np.argmin(np.where(candidate, stations, np.inf), axis=1)
+    lead = speeds[np.arange(n), nearest]
+    return np.where(candidate.any(axis=1), lead, math.nan)
+
+
+def _title(result: RunResult) -> str:
+    failed = [c.name for c in result.criteria if not c.passed]
+    verdict = "PASS" if not failed else "FAIL (" + ", ".join(failed) + ")"
+    return f"{result.spec.name} ({result.spec.situation}): {verdict}"
+
+
+def _draw_bands(fig: Figure, runs: list[tuple[str, float, float]]) -> None:
+    """One collection per mode over the axes' full height, and their legend."""
+    ax = fig.axes[0]
+    by_mode: dict[str, list[tuple[float, float]]] = {}
+    for mode, start, end in runs:
+        by_mode.setdefault(mode, []).append((start, end))
+    known = [m.value for m in AccMode]
+    order = sorted(by_mode, key=lambda m: (known.index(m) if m in known else len(known), m))
+    handles = []
+    for mode in order:
+        verts = [[(a, 0.0), (b, 0.0), (b, 1.0), (a, 1.0)] for a, b in by_mode[mode]]
+        band = PolyCollection(verts, transform=ax.get_xaxis_transform(), linewidths=0,
+                              facecolors=MODE_COLOURS.get(mode, OTHER_MODE_COLOUR),
+                              alpha=BAND_ALPHA, zorder=0, label=mode.replace("_", " "))
+        ax.add_collection(band, autolim=False)
+        handles.append(band)
+    if handles:
+        fig.legend(handles=handles, loc="outside right lower", title="ACC / event mode",
+                   fontsize="small")
+
+
+def speed_profile_figure(result: RunResult) -> Figure:
+    """The figure of `plot_speed_profile`, not yet written."""
+    log = result.log
+    fig = Figure(figsize=SIZE, dpi=DPI, layout="constrained")
+    FigureCanvasAgg(fig)
+    ax = fig.add_subplot()
+    t = log.array("t")
+    limit = log.array("speed_limit")
+    series = {
+        "ego": log.array("speed") * KPH,
+        "lead": lead_speed(result) * KPH,
+        "limit": np.where(np.isfinite(limit), limit, math.nan) * KPH,
+        "set": np.full(len(t), result.spec.ego.set_speed * KPH),
+    }
+    for key, values in series.items():
+        label, colour, style, width = LINES[key]
+        ax.plot(t, values, style, color=colour, linewidth=width, label=label,
+                drawstyle="steps-post" if key == "limit" else "default", zorder=2)
+    runs = mode_runs(log.t, log.acc_mode)
+    _draw_bands(fig, runs)
+    top = max([float(np.nanmax(v)) for v in series.values() if np.isfinite(v).any()],
+              default=50.0)
+    ax.set_ylim(min(0.0, float(np.nanmin(series["ego"]))) if len(t) else 0.0,
+                top * 1.08 + 2.0)
+    if runs:
+        ax.set_xlim(runs[0][1], runs[-1][2])
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("speed [km/h]")
+    ax.set_title(_title(result))
+    ax.grid(True, alpha=0.3, zorder=1)
+    fig.legend(handles=ax.get_lines(), loc="outside right upper", fontsize="small")
+    return fig
+
+
+def plot_speed_profile(result: RunResult, path: Path) -> Path:
+    """Write the run's speed profile as a PNG of 1600 x 700 px to `path` (its directory is
+    made; the file appears whole, through a temporary file beside it). Returns `path`."""
+    fig = speed_profile_figure(result)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    partial = path.with_name(f".{path.name}.partial")
+    try:
+        fig.savefig(partial, format="png", dpi=DPI)
+        partial.replace(path)
+    finally:
+        partial.unlink(missing_ok=True)
+    return path

@@ -1,0 +1,352 @@
+"""The reports of `avsim suite`: JUnit XML, `summary.md` and the terminal table.
+
+Pure functions over the `RunOutcome`s of a batch (`avsim.batch.jobs`): nothing here runs a
+scenario or writes a file; the caller writes the text they return.
+
+- `junit_xml`: one `<testsuite>` per run, one `<testcase>` per criterion (a failed
+  criterion has a `<failure>`); a run that did not finish is one `<testcase name="run">`
+  with an `<error>`. Attributes follow the common (Jenkins / Surefire) JUnit schema.
+- `summary_markdown`: the counts, a table of runs with links to their files, a table of
+  criteria per run, and the snapshot of each failed run at its first failure.
+- `summary_table`: the same verdicts as a `rich` table for the terminal.
+
+Times: "sim time" is the run's simulated time (the result's `sim_time`); "wall time" is
+the job's whole time in its worker (`RunOutcome.wall_time`, loading included), so that runs
+that did not finish have one too.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import re
+import xml.etree.ElementTree as ET
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from types import MappingProxyType
+from urllib.parse import quote
+
+from rich.table import Table
+from rich.text import Text
+
+from avsim.batch.jobs import RunOutcome, Status
+
+DASH = "—"  # a value that is absent (None) or not a number
+DECIMALS = 3  # numbers are shown to 3 decimals, trailing zeros dropped
+VERDICTS: dict[Status, tuple[str, str]] = {  # status -> (word, rich style)
+    Status.PASSED: ("PASS", "bold green"),
+    Status.FAILED: ("FAIL", "bold red"),
+    Status.BAD_INPUT: ("BAD INPUT", "bold yellow"),
+    Status.ERROR: ("ERROR", "bold magenta"),
+}
+_NO_SNAPSHOTS: Mapping[str, Path] = MappingProxyType({})
+_MD_SPECIAL = re.compile(r"([\\`*_{}\[\]<>|])")  # escaped in free text of a table cell
+# characters XML 1.0 cannot hold, even escaped (control codes in a crash's message, say)
+_NOT_XML = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\ud800-\udfff\ufffe\uffff]")
+
+
+# --- numbers -----------------------------------------------------------------------------
+
+
+def format_value(x: object) -> str:
+    """A number to 3 decimals without trailing zeros (`18.2`, `0.333`, `0`); `inf`, `-inf`;
+    `—` for None and NaN; booleans and text as they are."""
+    if x is None:
+        return DASH
+    if isinstance(x, bool) or not isinstance(x, (int, float)):
+        return str(x)
+    if math.isnan(x):
+        return DASH
+    if math.isinf(x):
+        return "inf" if x > 0 else "-inf"
+    text = f"{x:.{DECIMALS}f}"
+    if "." in text:
+        text = text.rstrip("0").rstrip(".")
+    return "0" if text == "-0" else text
+
+
+def _seconds(x: float) -> str:
+    """[s] a time attribute of the JUnit XML: a plain decimal, never `inf` or `nan`."""
+    return f"{x:.3f}" if math.isfinite(x) else "0.000"
+
+
+def _sim_time(outcome: RunOutcome) -> float:
+    """[s] the run's simulated time; 0 if it did not finish."""
+    if outcome.result is None:
+        return 0.0
+    value = outcome.result.get("sim_time")
+    return float(value) if isinstance(value, (int, float)) else 0.0
+
+
+def _failed_names(outcome: RunOutcome) -> list[str]:
+    return [str(c["name"]) for c in outcome.criteria() if not c["passed"]]
+
+
+def _counts(outcomes: Sequence[RunOutcome]) -> tuple[int, int, int]:
+    """(passed, failed, errors): errors are the runs that did not finish."""
+    passed = sum(o.status is Status.PASSED for o in outcomes)
+    failed = sum(o.status is Status.FAILED for o in outcomes)
+    return passed, failed, len(outcomes) - passed - failed
+
+
+# --- JUnit XML ---------------------------------------------------------------------------
+
+
+def _failure_message(criterion: Mapping[str, object]) -> str:
+    unit = str(criterion.get("unit", "")).strip()
+    value = format_value(criterion.get("value"))
+    value = f"{value} {unit}" if unit else value
+    return f"value {value} (threshold {format_value(criterion.get('threshold'))})"
+
+
+def _failure_text(criterion: Mapping[str, object]) -> str:
+    lines = [f"{criterion['name']}: {_failure_message(criterion)}"]
+    if isinstance(t := criterion.get("first_failure"), (int, float)):
+        lines.append(f"first failure at {format_value(t)} s")
+    if criterion.get("note"):
+        lines.append(f"note: {criterion['note']}")
+    return "\n".join(lines)
+
+
+def _xml_safe(text: str) -> str:
+    """`text` with the characters XML cannot hold shown as `\\xNN` (ElementTree escapes the
+    rest: `<`, `&`, quotes, newlines in attributes)."""
+    return _NOT_XML.sub(lambda m: f"\\x{ord(m.group()):02x}", text)
+
+
+def _sanitize(root: ET.Element) -> None:
+    for element in root.iter():
+        if element.text is not None:
+            element.text = _xml_safe(element.text)
+        for key, value in element.attrib.items():
+            element.attrib[key] = _xml_safe(value)
+
+
+def _properties(outcome: RunOutcome) -> dict[str, str]:
+    """The run's facts: scenario, file, seed (if known), profile, status, overrides."""
+    result = outcome.result or {}
+    props = {
+        "scenario": str(result.get("scenario", outcome.job.scenario)),
+        "file": str(result.get("file", outcome.job.scenario)),
+        "seed": format_value(result.get("seed")),
+        "profile": str(result.get("profile", outcome.job.profile)),
+        "status": outcome.status.value,
+    }
+    if "seed" not in result:  # a run that did not finish: its seed is not known here
+        del props["seed"]
+    for key, value in outcome.job.overrides.items():
+        props[f"override.{key}"] = str(value)
+    return props
+
+
+def _criterion_case(suite: ET.Element, outcome: RunOutcome,
+                    criterion: Mapping[str, object], time: float) -> None:
+    case = ET.SubElement(suite, "testcase", classname=f"avsim.{outcome.job.name}",
+                         name=str(criterion["name"]), time=_seconds(time))
+    if not criterion["passed"]:
+        failure = ET.SubElement(case, "failure", message=_failure_message(criterion),
+                                type="criterion")
+        failure.text = _failure_text(criterion)
+
+
+def _error_case(suite: ET.Element, outcome: RunOutcome) -> None:
+    case = ET.SubElement(suite, "testcase", classname=f"avsim.{outcome.job.name}",
+                         name="run", time=_seconds(outcome.wall_time))
+    message = outcome.error or f"the run did not finish ({outcome.status.value})"
+    error = ET.SubElement(case, "error", message=message, type=outcome.status.value)
+    error.text = message
+
+
+def _testsuite(parent: ET.Element, outcome: RunOutcome) -> tuple[int, int, int]:
+    """Append the run's `<testsuite>`; returns its (tests, failures, errors)."""
+    suite = ET.SubElement(parent, "testsuite", name=outcome.job.name)
+    properties = ET.SubElement(suite, "properties")
+    for name, value in _properties(outcome).items():
+        ET.SubElement(properties, "property", name=name, value=value)
+    criteria = outcome.criteria()
+    if outcome.result is None:
+        _error_case(suite, outcome)
+    elif not criteria:  # a finished run with nothing to check still shows, as passed
+        ET.SubElement(suite, "testcase", classname=f"avsim.{outcome.job.name}", name="run",
+                      time=_seconds(outcome.wall_time))
+    for criterion in criteria:
+        # the run's time split evenly, so that a suite's time is the sum of its cases'
+        _criterion_case(suite, outcome, criterion, outcome.wall_time / len(criteria))
+    tests = max(len(criteria), 1)
+    failures = len(_failed_names(outcome))
+    errors = int(outcome.result is None)
+    suite.attrib.update(tests=str(tests), failures=str(failures), errors=str(errors),
+                        skipped="0", time=_seconds(outcome.wall_time))
+    return tests, failures, errors
+
+
+def junit_xml(outcomes: Sequence[RunOutcome], suite_name: str) -> str:
+    """The batch as a JUnit XML document (UTF-8 text with its declaration).
+
+    `<testsuites name=suite_name>` holds one `<testsuite name=job name>` per run, with
+    `<properties>` (scenario, file, seed, profile, status, `override.<key>` per swept key)
+    and one `<testcase classname="avsim.<job name>" name=<criterion>>` per criterion; a
+    failed criterion's `<failure message="value V unit (threshold T)">` text adds its first
+    failure time [s] and note. A run that did not finish is one `<testcase name="run">` with
+    `<error message=<its error line> type=bad_input|error>`. `time` attributes are wall
+    times [s]. ElementTree escapes `<`, `&` and quotes in attributes and text.
+    """
+    root = ET.Element("testsuites", name=suite_name)
+    totals = [0, 0, 0]
+    for outcome in outcomes:
+        for i, n in enumerate(_testsuite(root, outcome)):
+            totals[i] += n
+    root.attrib.update(tests=str(totals[0]), failures=str(totals[1]), errors=str(totals[2]),
+                       time=_seconds(sum(o.wall_time for o in outcomes)))
+    _sanitize(root)
+    ET.indent(root)
+    body = ET.tostring(root, encoding="unicode")
+    return f'<?xml version="1.0" encoding="UTF-8"?>\n{body}\n'
+
+
+# --- summary.md --------------------------------------------------------------------------
+
+
+def _md_text(text: object) -> str:
+    """Free text for a Markdown table cell: one line, Markdown's specials escaped."""
+    one_line = " ".join(str(text).split())
+    return _MD_SPECIAL.sub(r"\\\1", one_line)
+
+
+def _md_code(text: object) -> str:
+    """A name as a code span in a table cell (only the pipe needs escaping there)."""
+    return "`" + str(text).replace("`", "'").replace("|", "\\|") + "`"
+
+
+def _inline_code(text: object) -> str:
+    """A code span outside a table (a backtick in it would end the span early)."""
+    return "`" + str(text).replace("`", "'") + "`"
+
+
+def _link(label: str, path: Path, out_dir: Path) -> str:
+    """A Markdown link to `path`, relative to `out_dir` (POSIX separators, URL-quoted)."""
+    rel = Path(os.path.relpath(path, out_dir)).as_posix()
+    return f"[{label}]({quote(rel)})"
+
+
+def _verdict(outcome: RunOutcome) -> str:
+    return VERDICTS[outcome.status][0]
+
+
+def _header(outcomes: Sequence[RunOutcome], title: str) -> list[str]:
+    passed, failed, errors = _counts(outcomes)
+    sim = sum(_sim_time(o) for o in outcomes)
+    wall = sum(o.wall_time for o in outcomes)
+    return [
+        f"# {title}", "",
+        f"**{len(outcomes)} runs**: {passed} passed, {failed} failed, {errors} errors "
+        f"(did not finish) · sim time {format_value(sim)} s · wall time {format_value(wall)} s",
+        "",
+    ]
+
+
+def _run_row(outcome: RunOutcome, out_dir: Path) -> str:
+    job = outcome.job
+    if outcome.result is None:
+        files = [DASH, DASH]
+    else:
+        files = [_link(job.recording.name, job.recording, out_dir),
+                 _link(job.result_file.name, job.result_file, out_dir)]
+    plot = _link(job.plot_file.name, job.plot_file, out_dir) if job.plot_file.is_file() else DASH
+    sim = format_value(_sim_time(outcome)) if outcome.result is not None else DASH
+    cells = [_md_code(job.name), f"**{_verdict(outcome)}**", sim,
+             format_value(outcome.wall_time), *files, plot]
+    return "| " + " | ".join(cells) + " |"
+
+
+def _runs_table(outcomes: Sequence[RunOutcome], out_dir: Path) -> list[str]:
+    lines = ["| run | verdict | sim time [s] | wall time [s] | recording | result | "
+             "speed profile |",
+             "|---|---|--:|--:|---|---|---|"]
+    lines += [_run_row(o, out_dir) for o in outcomes]
+    return [*lines, ""]
+
+
+def _criterion_row(c: Mapping[str, object]) -> str:
+    cells = [_md_code(c["name"]), "pass" if c["passed"] else "**FAIL**",
+             format_value(c.get("value")), format_value(c.get("threshold")),
+             _md_text(c.get("unit", "")), format_value(c.get("first_failure")),
+             _md_text(c["note"]) if c.get("note") else ""]
+    return "| " + " | ".join(cells) + " |"
+
+
+def _run_section(outcome: RunOutcome) -> list[str]:
+    job = outcome.job
+    lines = [f"## {job.name}: {_verdict(outcome)}", ""]
+    props = _properties(outcome)
+    lines += [f"Scenario `{props['file']}`, seed {props.get('seed', DASH)}, profile "
+              f"{props['profile']}" + "".join(f", {_inline_code(k)} = {_inline_code(v)}"
+                                              for k, v in job.overrides.items()) + ".", ""]
+    if outcome.result is None:
+        return [*lines, f"> {_md_text(outcome.error or outcome.status.value)}", ""]
+    lines += ["| criterion | verdict | value | threshold | unit | first failure [s] | note |",
+              "|---|---|--:|--:|---|--:|---|"]
+    lines += [_criterion_row(c) for c in outcome.criteria()]
+    return [*lines, ""]
+
+
+def _snapshots(outcomes: Sequence[RunOutcome], out_dir: Path,
+               snapshots: Mapping[str, Path]) -> list[str]:
+    shown = [o for o in outcomes if o.status is Status.FAILED and o.job.name in snapshots]
+    if not shown:
+        return []
+    lines = ["## Snapshots at the first failure", ""]
+    for outcome in shown:
+        t = outcome.first_failure()
+        when = f"first failure at {format_value(t)} s" if t is not None else "failed"
+        failed = ", ".join(_failed_names(outcome))
+        lines += [f"### {outcome.job.name}: {when} ({failed})", "",
+                  "!" + _link(f"{outcome.job.name}, {when}", snapshots[outcome.job.name],
+                              out_dir), ""]
+    return lines
+
+
+def summary_markdown(outcomes: Sequence[RunOutcome], *, title: str, out_dir: Path,
+                     snapshots: Mapping[str, Path] = _NO_SNAPSHOTS) -> str:
+    """The text of `summary.md`, written into `out_dir` (links are relative to it).
+
+    A header with the counts and total sim and wall times [s]; a table with a row per run
+    (verdict, times, links to its .rrd and .json, and its speed-profile .png if that file
+    exists); a section per run with its scenario, seed, profile, overrides and a row per
+    criterion (or its error line); then, for each failed run with a snapshot in `snapshots`
+    (job name -> PNG), the image, titled with its first failure's time.
+    """
+    lines = _header(outcomes, title) + _runs_table(outcomes, out_dir)
+    for outcome in outcomes:
+        lines += _run_section(outcome)
+    lines += _snapshots(outcomes, out_dir, snapshots)
+    return "\n".join(lines).rstrip("\n") + "\n"
+
+
+# --- terminal ----------------------------------------------------------------------------
+
+
+def summary_table(outcomes: Sequence[RunOutcome]) -> Table:
+    """The terminal summary: a row per run (name, coloured verdict, failed criteria or the
+    error line, sim time [s], wall time [s]). Messages are `Text`, never parsed as markup."""
+    passed, failed, errors = _counts(outcomes)
+    table = Table(title=f"{passed} passed, {failed} failed, {errors} errors",
+                  title_justify="left")
+    table.add_column("run", style="bold", no_wrap=True,  # whole names: they are ids
+                     min_width=max((len(o.job.name) for o in outcomes), default=3))
+    table.add_column("verdict")
+    table.add_column("failed criteria / error", overflow="fold")
+    # headers as `Text`: in a markup string "[s]" would be read as a style tag
+    table.add_column(Text("sim time [s]"), justify="right")
+    table.add_column(Text("wall time [s]"), justify="right")
+    for outcome in outcomes:
+        word, style = VERDICTS[outcome.status]
+        if outcome.result is None:
+            detail = Text(outcome.error or "", style="yellow")
+            sim = DASH
+        else:
+            detail = Text(", ".join(_failed_names(outcome)), style="red")
+            sim = format_value(_sim_time(outcome))
+        table.add_row(Text(outcome.job.name), Text(word, style=style), detail, sim,
+                      format_value(outcome.wall_time))
+    return table

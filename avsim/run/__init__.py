@@ -1,0 +1,1 @@
+"""One run: the runner loop, the stack's wiring, the sensor loop, scoring, results."""

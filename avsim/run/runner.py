@@ -1,0 +1,385 @@
+"""The closed loop: world -> sensors -> stack -> joints, criteria on ground truth, recording.
+
+Rates (all divide the 240 Hz physics rate; checked by `Rate`):
+- GNSS 10 Hz, odometry and the stack (decide-then-apply) 40 Hz;
+- criteria sample ground truth at 40 Hz (the control ticks' snapshots, so the log, the
+  criteria and the NPC triggers share one projection of the ego onto the route), collisions
+  (contact onsets) at 120 Hz;
+- the recording logs the ego pose, scalars and the plan at 20 Hz, NPC boxes at 10 Hz.
+
+Each control tick decides on one snapshot (the sensor frames of this tick), then the
+command is held on the joints for the next 6 physics steps.
+"""
+
+from __future__ import annotations
+
+import enum
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+from avsim.criteria.base import CriteriaSet, Criterion, CriterionResult, TruthSample
+from avsim.criteria.collision import NoCollision
+from avsim.criteria.following import MinGap, StandstillGap, TimeToResume
+from avsim.criteria.lane import LaneChangeDuration, LaneChangeLateralAccel, TyresInLane
+from avsim.criteria.road_rules import Crosswalks, RedLights, SpeedBumps, StopSigns
+from avsim.criteria.route import Completes
+from avsim.criteria.speed import MaxDecel, SpeedLimit
+from avsim.record.recorder import Recorder
+from avsim.run.sensor_loop import FrameHook, SensorLoop, sensing_mode
+from avsim.run.stack import Stack, StackOutput
+from planner.fsm.motion import TURNS
+from planner.messages import StateChange
+from world.core.client import PHYSICS_RATE, Rate
+from world.sensors.setup import Profile, sensor_setup
+from world.spec import FlatTire, ScenarioSpec
+from world.truth import touching
+from world.world import World
+
+GNSS_RATE = Rate("gnss", 10)
+CONTROL_RATE = Rate("control", 40)
+CRITERIA_RATE = Rate("criteria", 40)
+CONTACT_RATE = Rate("contacts", 120)
+RECORD_RATE = Rate("record", 20)
+ACTOR_RECORD_RATE = Rate("record_actors", 10)
+# criteria samples are taken at contact checks
+assert CRITERIA_RATE.every % CONTACT_RATE.every == 0, "criteria rate must divide the contacts'"
+END_MARGIN = 30.0  # [m] default `completes` station: the route's end less this
+TYRE_HALF_WIDTH = 0.105  # [m] half the tyre's tread (the URDF's wheel width)
+NEEDS_ACTORS = (MinGap, StandstillGap, TimeToResume)  # criteria that read the NPCs
+TURN_MOTIONS = frozenset(m.value for m in TURNS)  # the plan's `motion` in a turn
+SETTLE_AFTER_DONE = 1.0  # [s] the run goes on this long after `completes` is reached
+
+ProgressCallback = Callable[[float, float], None]  # (sim time, duration) [s]
+
+
+@dataclass
+class TrajectoryLog:
+    """Per control tick: the ego's true and estimated state and what the stack did."""
+
+    t: list[float] = field(default_factory=list)  # [s]
+    x: list[float] = field(default_factory=list)  # [m] true, car centre
+    y: list[float] = field(default_factory=list)  # [m]
+    yaw: list[float] = field(default_factory=list)  # [rad]
+    speed: list[float] = field(default_factory=list)  # [m/s] true forward speed
+    station: list[float] = field(default_factory=list)  # [m] true centre station
+    cross_track: list[float] = field(default_factory=list)  # [m] true centre offset from
+    #   the centre of the lane kept, left +
+    front_axle_error: list[float] = field(default_factory=list)  # [m] true, at front axle
+    target_speed: list[float] = field(default_factory=list)  # [m/s]
+    speed_limit: list[float] = field(default_factory=list)  # [m/s] at the front bumper
+    steering: list[float] = field(default_factory=list)  # [rad] commanded
+    drive_torque: list[float] = field(default_factory=list)  # [N m] commanded, total
+    brake_torque: list[float] = field(default_factory=list)  # [N m] commanded, total
+    wheel_spin: list[NDArray[np.float64]] = field(default_factory=list)  # [rad/s] (4,)
+    acc_mode: list[str] = field(default_factory=list)  # the ACC / event layer's mode
+    motion: list[str] = field(default_factory=list)  # the motion FSM's state
+    hazard: list[bool] = field(default_factory=list)  # the stack's hazard lights
+    lane: list[int] = field(default_factory=list)  # the lane the stack keeps (cross_track's)
+    changing: list[bool] = field(default_factory=list)  # a commanded lane change in hand
+    pedal: list[float] = field(default_factory=list)  # [-] the driver's accelerator pedal
+    actor_station: list[NDArray[np.float64]] = field(default_factory=list)  # [m] (N,) true,
+    #   along the road each drives on (the route; past an exit's fork, the road the route
+    #   left for traffic that kept it: `RoadMap.through_line`)
+    actor_offset: list[NDArray[np.float64]] = field(default_factory=list)  # [m] (N,) true,
+    #   from that road's reference line, left +
+
+    def array(self, name: str) -> NDArray[np.float64]:
+        return np.asarray(getattr(self, name), dtype=np.float64)
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class RunResult:
+    spec: ScenarioSpec
+    criteria: list[CriterionResult]
+    metrics: dict[str, float]
+    sim_time: float  # [s]
+    wall_time: float  # [s]
+    log: TrajectoryLog
+    recording: Path | None
+    state_changes: tuple[StateChange, ...] = ()  # every FSM change, in time order
+    profile: str | None = None  # the sensor profile (None: map + GNSS only)
+    renderer: str | None = None  # "egl" or "tiny" when cameras rendered
+
+    @property
+    def passed(self) -> bool:
+        return all(c.passed for c in self.criteria)
+
+
+class Runner:
+    """Runs one scenario to its end (duration, or `completes` reached) and judges it."""
+
+    def __init__(self, spec: ScenarioSpec, recording: Path | None = None,
+                 profile: Profile | None = Profile.DEFAULT, sensing: str = "auto",
+                 frame_hook: FrameHook | None = None) -> None:
+        """`profile`: the sensor set-up (None: no cameras or LiDAR, the stack drives on
+        GNSS + odometry and the map); `sensing`: where cameras render ('auto', 'inline' or
+        'process', see `world.sensors.pipeline`); `frame_hook`: alters the camera frames the stack
+        gets (fault injection in tests)."""
+        self.spec = spec
+        self.setup = sensor_setup(profile, spec.sensors.lidar) if profile is not None else None
+        mode = sensing_mode(sensing)
+        self.world = World(spec, self.setup, cameras=mode == "inline")
+        w = self.world
+        self.car = w.ego.geometry
+        front = self.setup.camera("front") if self.setup is not None else None
+        self.stack = Stack(w.road, spec.ego, self.car, front)
+        self.log = TrajectoryLog()
+        names = {b: "building or sign" for b in w.scene.obstacle_bodies}
+        names.update({b: "kerb" for b in w.scene.kerb_bodies})
+        names.update({b: f"actor {a.id}" for b, a in zip(w.actors.bodies, spec.actors,
+                                                          strict=True)})
+        reach = spec.criteria.reach_s
+        self.completes = Completes(reach if reach is not None else w.road.length - END_MARGIN)
+        self.collisions = NoCollision(names)
+        crosswalks = Crosswalks(w.road)
+        self.criteria = CriteriaSet([self.collisions, TyresInLane(w.road, TYRE_HALF_WIDTH),
+                                     SpeedLimit(w.road), StopSigns(w.road), RedLights(w.road),
+                                     crosswalks,
+                                     SpeedBumps(w.road, self.car.front_axle, self.car.rear_axle),
+                                     self.completes, *self._optional_criteria()])
+        self._gap_criteria = crosswalks.needs_actors or any(
+            isinstance(c, NEEDS_ACTORS) for c in self.criteria.items)
+        self.recorder = Recorder(recording, recording_name=spec.name) if recording else None
+        self.sensors = None if self.setup is None else SensorLoop(
+            w, self.setup, self.stack, mode, self.recorder, frame_hook)
+        self.state_changes: list[StateChange] = []
+        self._touching: frozenset[int] = frozenset()
+        self._logged_events = 0  # collision events already sent to the recording
+        self._last: StackOutput | None = None
+        self._lane = self._origin_lane = spec.ego.lane  # the stack's lane command
+        self._turning = False  # the stack's motion FSM is in a turn
+
+    def _optional_criteria(self) -> list[Criterion]:
+        c, road, length = self.spec.criteria, self.world.road, self.car.body_length
+        items: list[Criterion] = []
+        if c.max_decel is not None:
+            items.append(MaxDecel(c.max_decel, CRITERIA_RATE.hz))
+        if c.min_gap is not None:
+            items.append(MinGap(c.min_gap, road, length))
+        if c.lane_change is not None:
+            items += [LaneChangeDuration(road, TYRE_HALF_WIDTH, c.lane_change[0]),
+                      LaneChangeLateralAccel(c.lane_change[1], CRITERIA_RATE.hz)]
+        if c.standstill_gap is not None:
+            items.append(StandstillGap(*c.standstill_gap, road, length))
+        if c.resume_within is not None:
+            items.append(TimeToResume(c.resume_within, self.spec.ego.set_speed, road, length))
+        return items
+
+    # -- the loop ------------------------------------------------------------------------------
+
+    def run(self, progress: ProgressCallback | None = None) -> RunResult:
+        start = time.perf_counter()
+        w = self.world
+        if self.recorder is not None:
+            self._record_static()
+        steps = round(self.spec.duration * PHYSICS_RATE)
+        done_at: float | None = None
+        try:
+            # one control period per pass: decide on this snapshot, then hold the command
+            # on the joints for the period's physics steps (contacts watched at their rate)
+            while w.clock.step < steps:
+                self._tick()
+                for _ in range(min(CONTROL_RATE.every, steps - w.clock.step)):
+                    w.step()
+                    if w.clock.step % CONTACT_RATE.every == 0:
+                        self._watch(w.clock.step)
+                if done_at is None and self.completes.done:
+                    done_at = w.t
+                if done_at is not None and w.t >= done_at + SETTLE_AFTER_DONE:
+                    break
+                if progress is not None and w.clock.step % PHYSICS_RATE == 0:
+                    progress(w.t, self.spec.duration)
+        finally:
+            if self.sensors is not None:
+                self.sensors.close()
+            if self.recorder is not None:
+                self._record_criteria()
+                self.recorder.close()
+            sim_time = w.t
+            w.close()
+        return RunResult(
+            spec=self.spec, criteria=self.criteria.results(), metrics=self._metrics(),
+            sim_time=sim_time, wall_time=time.perf_counter() - start, log=self.log,
+            recording=self.recorder.path if self.recorder else None,
+            state_changes=tuple(self.state_changes),
+            profile=self.setup.profile.value if self.setup is not None else None,
+            renderer=self.sensors.sensing.renderer.value if self.sensors is not None else None,
+        )
+
+    def _tick(self) -> None:
+        """A control tick: sensors at their rates, then decide and apply."""
+        w = self.world
+        if self.sensors is not None:
+            self.sensors.tick()
+        truth = w.ego_truth
+        if GNSS_RATE.fires(w.clock.step):
+            self.stack.on_gnss(w.gnss.measure(w.t, truth))
+        self.stack.on_odometry(w.odometry.measure(w.t, truth))
+        out = self.stack.tick(w.t, CONTROL_RATE.every / PHYSICS_RATE)
+        cmd = out.command
+        w.ego.apply(cmd.steering_angle, cmd.drive_torque, cmd.brake_torque)
+        self._last = out
+        self._lane, self._origin_lane = out.plan.lane, out.plan.origin_lane
+        self._turning = out.plan.motion in TURN_MOTIONS
+        self._log_tick(out)
+        for change in out.plan.changes:
+            self.state_changes.append(change)
+            if self.recorder is not None:
+                self.recorder.log_state(change.t, change.machine, change.target, change.reason)
+
+    def _log_tick(self, out: StackOutput) -> None:
+        w, log = self.world, self.log
+        truth, route = w.ego_truth, w.ego_route
+        s = route.station
+        lane = self.world.road.lane(out.plan.lane)
+        r, r_fa = (route.offsets[:2] - lane.offset_at(route.stations[:2])).tolist()
+        log.t.append(w.t)
+        log.x.append(float(truth.position[0]))
+        log.y.append(float(truth.position[1]))
+        log.yaw.append(truth.yaw)
+        log.speed.append(truth.speed)
+        log.station.append(s)
+        log.cross_track.append(r)
+        log.front_axle_error.append(r_fa)
+        log.target_speed.append(out.plan.target_speed)
+        log.speed_limit.append(out.plan.speed_limit)
+        log.steering.append(out.command.steering_angle)
+        log.drive_torque.append(out.command.drive_torque)
+        log.brake_torque.append(out.command.brake_torque)
+        log.wheel_spin.append(truth.wheel_spin.copy())
+        log.acc_mode.append(out.plan.acc_mode)
+        log.hazard.append(out.plan.hazard)
+        log.motion.append(out.plan.motion)
+        log.lane.append(out.plan.lane)
+        log.changing.append(out.plan.lane != out.plan.origin_lane)
+        log.pedal.append(w.accelerator_pedal)
+        log.actor_station.append(np.array([m.s for m in w.actors.motions]))
+        log.actor_offset.append(np.array([m.offset for m in w.actors.motions]))
+        if self.recorder is not None and RECORD_RATE.fires(w.clock.step):
+            self._record_tick(out)
+
+    def _watch(self, step: int) -> None:
+        """Criteria: contact onsets at the contact rate, the rest at the criteria rate."""
+        w = self.world
+        now = frozenset(touching(w.client, w.ego.body, w.scene.ground)) - w.scene.bump_bodies
+        if now != self._touching:
+            self._touching = now
+            self._sample()
+            new = self.collisions.events[self._logged_events:]
+            self._logged_events = len(self.collisions.events)
+            for t, what in new:
+                if self.recorder is not None:
+                    self.recorder.log_event(t, f"collision with {what}", "ERROR")
+        elif CRITERIA_RATE.fires(step):
+            self._sample()
+
+    def _sample(self) -> None:
+        w = self.world
+        truth, route = w.ego_truth, w.ego_route
+        self.criteria.update(TruthSample(
+            t=w.t, speed=truth.speed, station=route.station,
+            front_station=route.station + self.car.front_overhang,
+            tyres=route.tyres, tyre_stations=route.tyre_stations,
+            tyre_offsets=route.tyre_offsets, touching=self._touching,
+            offset=float(route.offsets[0]), actors=w.actors.poses if self._gap_criteria else None,
+            lane=self._lane, origin_lane=self._origin_lane, turning=self._turning,
+            lateral_accel=truth.speed * truth.yaw_rate,
+            road_curvature=float(w.road.curvature_at(route.station)),
+            rear_station=route.station - self.car.body_length / 2,
+            axle_stations=(float(route.stations[1]),
+                           float(np.mean(route.stations[4:6]))),
+            flat=self._flat_fired(),
+        ))
+
+    def _flat_fired(self) -> bool:
+        """A flat tyre event has happened to the ego (truth, for `completes`)."""
+        return any(t is not None and isinstance(e.event, FlatTire)
+                   for t, e in zip(self.world.event_fired_at, self.spec.events, strict=True))
+
+    # -- results -------------------------------------------------------------------------------
+
+    def _metrics(self) -> dict[str, float]:
+        keeping = ~np.asarray(self.log.changing, dtype=bool)  # lane changes are not errors
+        xte = self.log.array("cross_track")[keeping]
+        speed = self.log.array("speed")
+        dt = CONTROL_RATE.every / PHYSICS_RATE
+        decel = -np.diff(speed) / dt if len(speed) > 1 else np.zeros(1)
+        window = max(1, round(0.2 / dt))
+        smooth = np.convolve(decel, np.ones(window) / window, mode="valid") if len(decel) else decel
+        return {
+            "max_lateral_error": float(np.max(np.abs(xte))) if len(xte) else math.nan,
+            "rms_lateral_error": float(np.sqrt(np.mean(xte**2))) if len(xte) else math.nan,
+            "max_front_axle_error":
+                float(np.max(np.abs(self.log.array("front_axle_error")[keeping])))
+            if len(xte) else math.nan,
+            "max_decel": float(max(0.0, np.max(smooth))) if len(smooth) else 0.0,
+            "max_speed": float(np.max(speed)) if len(speed) else 0.0,
+            "distance": float(self.log.station[-1] - self.log.station[0]) if xte.size else 0.0,
+            "collisions": float(self.collisions.count),
+        } | (self.sensors.metrics() if self.sensors is not None else {})
+
+    # -- recording -----------------------------------------------------------------------------
+
+    def _record_static(self) -> None:
+        rec, w = self.recorder, self.world
+        assert rec is not None
+        rec.log_road_meshes(w.scene.road_meshes)
+        if w.scene.buildings:
+            b = w.scene.buildings
+            quats = [[0.0, 0.0, math.sin(x.yaw / 2), math.cos(x.yaw / 2)] for x in b]
+            rec.log_static_boxes("/world/buildings", [x.centre for x in b],
+                                 [x.half_extents for x in b], quats,
+                                 (np.array([x.rgb for x in b]) * 255).astype(np.uint8))
+        g = self.car
+        r = g.wheel_radius
+        wheels = [[g.front_axle, g.track / 2, 0.0], [g.front_axle, -g.track / 2, 0.0],
+                  [-g.rear_axle, g.track / 2, 0.0], [-g.rear_axle, -g.track / 2, 0.0]]
+        rec.log_ego_body(body_half_size=(g.body_length / 2, g.body_width / 2, 0.55),
+                         body_center=(0.0, 0.0, 0.55 + 0.16 - r), wheel_centers=wheels,
+                         wheel_radius=r, wheel_half_width=0.105)
+        lanes = [np.column_stack([lane.position(np.linspace(0, w.road.length, 400), 0.0),
+                                  np.full(400, 0.02)]) for lane in w.road.lanes]
+        rec.log_static_lines("/world/map/lanes", lanes, (90, 160, 255), 0.03)
+        p = self.stack.planner  # a lane per state machine, from the state it starts in
+        initial: dict[str, enum.Enum] = {"lane_source": p.source, "motion": p.motion.motion,
+                                         "acc": p.acc.mode, "control": p.control.state}
+        for machine, state in initial.items():
+            rec.log_state_machine(machine, [x.value for x in type(state)])
+            rec.log_state(0.0, machine, state.value, "initial state")
+
+    def _record_tick(self, out: StackOutput) -> None:
+        rec, w = self.recorder, self.world
+        assert rec is not None
+        truth, log = w.ego_truth, self.log
+        rec.log_ego_pose(w.t, truth.position, truth.quaternion)
+        rec.log_scalars(w.t, {
+            "speed": truth.speed, "target_speed": out.plan.target_speed,
+            "speed_limit": out.plan.speed_limit, "steering": out.command.steering_angle,
+            "cross_track_error": log.cross_track[-1],
+        })
+        rec.log_path(w.t, out.plan.path.xy)
+        if ACTOR_RECORD_RATE.fires(w.clock.step):
+            p = w.actors.poses
+            quats = np.column_stack([np.zeros((len(p.yaws), 2)), np.sin(p.yaws / 2),
+                                     np.cos(p.yaws / 2)])
+            rec.log_actors(w.t, p.ids, p.centres, p.half_sizes, quats,
+                           [k.value for k in p.kinds])
+
+    def _record_criteria(self) -> None:
+        rec = self.recorder
+        assert rec is not None
+        if self.sensors is not None:
+            scores = ", ".join(f"{k} {v:.3f}" for k, v in self.sensors.metrics().items())
+            rec.log_event(self.world.t, f"perception against the truth: {scores}", "INFO")
+        for r in self.criteria.results():
+            level = "INFO" if r.passed else "ERROR"
+            t = r.first_failure if r.first_failure is not None else self.world.t
+            rec.log_event(t, f"criterion {r.name}: {'pass' if r.passed else 'FAIL'} "
+                             f"(value {r.value:.3f} {r.unit}, threshold {r.threshold} {r.unit})",
+                          level)

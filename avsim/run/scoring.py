@@ -1,0 +1,191 @@
+"""Perception scored against ground truth, every run (the stack never sees any of this).
+
+Lane (per front-camera frame): the estimate's offset of the car's centre from the lane
+centre and its heading error against the truth at the frame's time (the lane the car's centre
+is in, `RoadMap.lane_at`); RMS and max over frames, for the filtered estimate (what the planner
+uses) and the raw detection. Frames taken while the car is outside every lane are skipped.
+
+Objects (per LiDAR scan): ground-truth vehicles (cars and trucks) within `detection_range`
+(50 m) of the car's centre that the scan actually saw (at least `min_returns` returns on
+them, from the scan's ray truth: occluded cars cannot be detected and are not counted) are
+matched one-to-one (Hungarian, scipy) to the vehicle-class detections placed in the map
+frame with the TRUE pose (detection quality alone), and to the confirmed vehicle tracks (in
+the map frame, as the stack placed them: localisation error included), within
+`match_distance` (2 m). Recall = matched / visible truth; precision = matched detections /
+vehicle detections within range that match a true vehicle in range (seen or not); track
+position error = track centre - true centre; track
+speed error = track speed - true speed; an id switch is a car matched to a different track id
+than at its previous match.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import defaultdict
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.optimize import linear_sum_assignment
+
+from perception.messages import Detection, LaneEstimate, ObjectClass, Track
+from world.actors.actor_set import ActorPoses
+from world.sensors.lidar import LidarTruth
+from world.spec import ActorType
+
+VEHICLES = (ActorType.CAR, ActorType.TRUCK)
+VEHICLE_CLASSES = (ObjectClass.CAR, ObjectClass.TRUCK)
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class CaptureTruth:
+    """Ground truth at a capture instant."""
+
+    t: float  # [s]
+    ego_xy: NDArray[np.float64]  # [m] (2,) car centre, map frame
+    ego_yaw: float  # [rad]
+    lane_offset: float | None  # [m] car centre from its lane's centre, left +; None: no lane
+    lane_heading_error: float  # [rad] car heading minus the lane's, wrapped
+    actors: ActorPoses
+
+
+@dataclass(frozen=True, slots=True)
+class ScoringParams:
+    detection_range: float = 50.0  # [m]
+    match_distance: float = 2.0  # [m]
+    min_returns: int = 10  # [-] LiDAR returns on a car for it to count as seen
+
+
+def _wrap(a: float) -> float:
+    return math.remainder(a, 2.0 * math.pi)
+
+
+def _rms(x: list[float]) -> float:
+    return math.sqrt(float(np.mean(np.square(x)))) if x else math.nan
+
+
+def _max_abs(x: list[float]) -> float:
+    return float(np.max(np.abs(x))) if x else math.nan
+
+
+def _match(a: NDArray[np.float64], b: NDArray[np.float64],
+           gate: float) -> list[tuple[int, int]]:
+    """One-to-one pairs (i, j) of points a (N, 2) and b (M, 2) closer than `gate` [m]."""
+    if len(a) == 0 or len(b) == 0:
+        return []
+    cost = np.linalg.norm(a[:, None, :] - b[None, :, :], axis=-1)
+    rows, cols = linear_sum_assignment(np.where(cost <= gate, cost, 1e6))
+    return [(int(i), int(j)) for i, j in zip(rows, cols, strict=True) if cost[i, j] <= gate]
+
+
+@dataclass
+class PerceptionScore:
+    """Accumulates the scores of one run; `metrics()` gives the result JSON's entries."""
+
+    params: ScoringParams = field(default_factory=ScoringParams)
+    offset_err: list[float] = field(default_factory=list)  # [m] filtered lane
+    heading_err: list[float] = field(default_factory=list)  # [rad]
+    raw_offset_err: list[float] = field(default_factory=list)  # [m] raw detection
+    visible: int = 0  # visible true vehicles in range, summed over scans
+    detected: int = 0  # of those, matched to a detection
+    detections: int = 0  # vehicle detections in range
+    true_detections: int = 0  # of those, matched to a true vehicle in range (seen or not)
+    tracked: int = 0  # visible true vehicles matched to a confirmed track
+    track_pos_err: list[float] = field(default_factory=list)  # [m]
+    track_speed_err: list[float] = field(default_factory=list)  # [m/s]
+    switches: dict[str, int] = field(default_factory=lambda: defaultdict(int))
+    _last_id: dict[str, int] = field(default_factory=dict)
+    _first_t: float = math.inf
+    _last_t: float = -math.inf
+
+    def lane(self, raw: LaneEstimate | None, filtered: LaneEstimate | None,
+             truth: CaptureTruth) -> None:
+        if truth.lane_offset is None:
+            return
+        if filtered is not None:
+            self.offset_err.append(filtered.offset - truth.lane_offset)
+            self.heading_err.append(_wrap(filtered.heading_error - truth.lane_heading_error))
+        if raw is not None and raw.confidence > 0.0:
+            self.raw_offset_err.append(raw.offset - truth.lane_offset)
+
+    def objects(self, detections: tuple[Detection, ...], tracks: tuple[Track, ...],
+                truth: CaptureTruth, scan: LidarTruth) -> None:
+        p = self.params
+        self._first_t, self._last_t = min(self._first_t, truth.t), max(self._last_t, truth.t)
+        idx = self._visible_vehicles(truth, scan)
+        true_xy = truth.actors.centres[idx, :2]
+        self.visible += len(idx)
+        det_xy = self._detections_in_map(detections, truth)
+        near = np.linalg.norm(det_xy - truth.ego_xy, axis=1) <= p.detection_range \
+            if len(det_xy) else np.zeros(0, bool)
+        self.detections += int(near.sum())
+        self.detected += len(_match(true_xy, det_xy[near], p.match_distance))
+        all_xy = truth.actors.centres[self._vehicles_in_range(truth), :2]
+        self.true_detections += len(_match(all_xy, det_xy[near], p.match_distance))
+        vehicle_tracks = [tr for tr in tracks if tr.cls in VEHICLE_CLASSES]
+        trk_xy = np.array([[tr.x, tr.y] for tr in vehicle_tracks]).reshape(-1, 2)
+        for i, j in _match(true_xy, trk_xy, p.match_distance):
+            self._score_track(int(idx[i]), vehicle_tracks[j], truth)
+
+    def _in_range(self, truth: CaptureTruth) -> NDArray[np.bool_]:
+        a = truth.actors
+        vehicle = np.array([k in VEHICLES for k in a.kinds], dtype=bool)
+        if not len(a.ids):
+            return vehicle
+        dist = np.linalg.norm(a.centres[:, :2] - truth.ego_xy, axis=1)
+        out: NDArray[np.bool_] = vehicle & (dist <= self.params.detection_range)
+        return out
+
+    def _vehicles_in_range(self, truth: CaptureTruth) -> NDArray[np.intp]:
+        return np.flatnonzero(self._in_range(truth))
+
+    def _visible_vehicles(self, truth: CaptureTruth, scan: LidarTruth) -> NDArray[np.intp]:
+        n = len(truth.actors.ids)
+        hits = np.bincount(scan.actor[scan.actor >= 0], minlength=n)[:n]
+        return np.flatnonzero(self._in_range(truth) & (hits >= self.params.min_returns))
+
+    @staticmethod
+    def _detections_in_map(detections: tuple[Detection, ...],
+                           truth: CaptureTruth) -> NDArray[np.float64]:
+        vehicle = [d for d in detections if d.cls in VEHICLE_CLASSES]
+        if not vehicle:
+            return np.zeros((0, 2))
+        xy = np.array([[d.x, d.y] for d in vehicle])
+        c, s = math.cos(truth.ego_yaw), math.sin(truth.ego_yaw)
+        out: NDArray[np.float64] = truth.ego_xy + xy @ np.array([[c, s], [-s, c]])
+        return out
+
+    def _score_track(self, actor: int, track: Track, truth: CaptureTruth) -> None:
+        a = truth.actors
+        self.tracked += 1
+        self.track_pos_err.append(math.hypot(track.x - a.centres[actor, 0],
+                                             track.y - a.centres[actor, 1]))
+        self.track_speed_err.append(track.speed - abs(float(a.speeds[actor])))
+        name = a.ids[actor]
+        if name in self._last_id and self._last_id[name] != track.id:
+            self.switches[name] += 1
+        self._last_id[name] = track.id
+
+    def metrics(self) -> dict[str, float]:
+        span = max(self._last_t - self._first_t, 1e-9)
+        per_100s = max(self.switches.values(), default=0) * 100.0 / max(span, 100.0)
+        out = {
+            "lane_offset_rmse": _rms(self.offset_err),
+            "lane_offset_max": _max_abs(self.offset_err),
+            "lane_heading_rmse_deg": math.degrees(_rms(self.heading_err)),
+            "lane_heading_max_deg": math.degrees(_max_abs(self.heading_err)),
+            "lane_raw_offset_rmse": _rms(self.raw_offset_err),
+            "lane_frames": float(len(self.offset_err)),
+        }
+        if self.visible or self.detections:
+            out |= {
+                "detection_recall": self.detected / self.visible if self.visible else math.nan,
+                "detection_precision": (self.true_detections / self.detections
+                                        if self.detections else math.nan),
+                "track_recall": self.tracked / self.visible if self.visible else math.nan,
+                "track_position_rmse": _rms(self.track_pos_err),
+                "track_speed_rmse": _rms(self.track_speed_err),
+                "id_switches": float(sum(self.switches.values())),
+                "max_id_switches_per_car_per_100s": per_100s,
+            }
+        return out

@@ -1,0 +1,724 @@
+"""Pydantic models of the scenario file format `avsim/1` (the public contract, see
+`SCENARIO_FORMAT.md` and `docs/scenario-format.md`).
+
+The models mirror the YAML exactly, key for key, in the file's units (`*_kph` km/h, `*_deg`
+degrees, everything else SI). They are strict: unknown keys are rejected, text is never
+coerced into a number (an integer is accepted where a float is expected), and every field
+carries a description with its unit and default, which the JSON Schema (`avsim schema`)
+shows. `avsim.scenario.load` validates a file with `ScenarioModel`, applies the cross-field
+checks (lanes at a station, stations on the route, ...) and converts it into
+`world.spec.ScenarioSpec` (SI units, radians, resolved defaults).
+
+One-key mappings of the format (a segment `straight:` / `arc:`, a trigger `time:` / ...,
+an action `speed:` / ..., an event) are models whose alternatives are optional fields; a
+`before` validator names an unknown alternative and an `after` validator demands exactly
+one. Such problems are raised as `PydanticCustomError` of type `avsim` whose context holds
+the message (`problem`) and optionally the offending key (`key`) below the model's location.
+"""
+
+from __future__ import annotations
+
+from typing import Annotated, Any, Literal
+
+from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+from pydantic_core import PydanticCustomError
+
+FORMAT = "avsim/1"
+NAME_PATTERN = r"^[a-z0-9_]+$"
+
+Situation = Literal[
+    "normal_driving",
+    "lane_change",
+    "cut_in_out",
+    "traffic_jam",
+    "sudden_stop",
+    "external_disturbance",
+    "decs_route",
+    "town",
+    "other",
+]
+ZoneName = Literal["highway", "ramp", "city"]
+SideName = Literal["right", "left"]
+ActorTypeName = Literal["car", "truck", "pedestrian", "obstacle"]
+Junctions = Literal["stop_signs", "traffic_lights", "mixed"]
+Heading = Literal["east", "north", "west", "south"]
+Turn = Literal["straight", "left", "right", "u_turn"]
+WheelName = Literal["front_left", "front_right", "rear_left", "rear_right"]
+
+TRIGGER_KINDS = ("time", "ego_s", "gap", "after")
+ACTION_KINDS = ("speed", "lane_change", "walk", "stop")
+EVENT_KINDS = ("accelerator_override", "flat_tire")
+
+# Constrained scalars. Strict mode (model config) refuses text for numbers and floats for
+# ints; a float field accepts an int.
+PosFloat = Annotated[float, Field(gt=0)]
+NonNegFloat = Annotated[float, Field(ge=0)]
+NonNegInt = Annotated[int, Field(ge=0)]
+PosInt = Annotated[int, Field(ge=1)]
+Fraction = Annotated[float, Field(ge=0, le=1)]
+Identifier = Annotated[str, Field(pattern=NAME_PATTERN)]
+
+
+def problem(message: str, key: str | None = None) -> PydanticCustomError:
+    """A validation error with a ready-made message; `key` (if given) is the offending key
+    below the location of the model that raises it. `avsim.scenario.load` formats it."""
+    context: dict[str, Any] = {"problem": message}
+    if key is not None:
+        context["key"] = key
+    return PydanticCustomError("avsim", "{problem}", context)
+
+
+def _one_of(names: tuple[str, ...]) -> dict[str, Any]:
+    """JSON Schema fragment: exactly one of `names` is present."""
+    return {"oneOf": [{"required": [name]} for name in names]}
+
+
+class _Model(BaseModel):
+    """Base of every scenario model: strict, no unknown keys, no NaN/inf, immutable."""
+
+    model_config = ConfigDict(strict=True, extra="forbid", allow_inf_nan=False, frozen=True)
+
+
+def _present(model: BaseModel, names: tuple[str, ...]) -> list[str]:
+    """Names among `names` whose field is set (not None) on `model`."""
+    return [name for name in names if getattr(model, name) is not None]
+
+
+def _reject_unknown_kind(data: Any, allowed: set[str], kinds: tuple[str, ...], what: str) -> Any:
+    """`before` validator body: name a key of a one-key mapping that is not a known kind."""
+    if isinstance(data, dict):
+        for key in data:
+            if key not in allowed:
+                expected = ", ".join(kinds)
+                raise problem(f"unknown {what} {key!r} (expected one of {expected})")
+    return data
+
+
+def _empty_for_null(data: Any, kinds: tuple[str, ...]) -> Any:
+    """`before` validator body: an action or event written without a value (`stop:`) is
+    the same as an empty mapping (`stop: {}`)."""
+    if isinstance(data, dict):
+        return {key: {} if key in kinds and value is None else value for key, value in data.items()}
+    return data
+
+
+def _exactly_one(model: BaseModel, kinds: tuple[str, ...], what: str) -> str:
+    """`after` validator body: the one kind set on `model`, else a clear error."""
+    present = _present(model, kinds)
+    if len(present) != 1:
+        listed = ", ".join(kinds)
+        if not present:
+            raise problem(f"needs one {what} (one of {listed})")
+        raise problem(f"has {len(present)} {what}s ({', '.join(present)}); give exactly one")
+    return present[0]
+
+
+# ---------------------------------------------------------------------------------------
+# Road
+# ---------------------------------------------------------------------------------------
+
+
+class ArcModel(_Model):
+    """A constant-curvature arc of the route's reference line (lane 0's centre line)."""
+
+    radius: PosFloat = Field(
+        description="[m] radius of the reference line (lane 0's centre line); required, > 0, "
+        "and larger than the road's paved width (lanes x lane_width + shoulder)."
+    )
+    angle_deg: Annotated[float, Field(ge=-360, le=360)] = Field(
+        description="[deg] turn angle; > 0 turns left, < 0 turns right; required, != 0, -360..360.",
+        json_schema_extra={"not": {"const": 0}},
+    )
+
+    @field_validator("angle_deg")
+    @classmethod
+    def _nonzero(cls, value: float) -> float:
+        if value == 0:
+            raise problem("must not be 0 (use a straight)")
+        return value
+
+
+class SegmentModel(_Model):
+    """One piece of the route, `- straight: 300` or `- {arc: {radius, angle_deg}, ...}`."""
+
+    model_config = ConfigDict(json_schema_extra=_one_of(("straight", "arc")))
+
+    straight: PosFloat | None = Field(
+        default=None, description="[m] length of a straight piece, > 0; give this or `arc`."
+    )
+    arc: ArcModel | None = Field(
+        default=None, description="An arc piece `{radius, angle_deg}`; give this or `straight`."
+    )
+    lanes: PosInt | None = Field(
+        default=None,
+        description="Driving lanes in the ego's direction on this segment, >= 1. "
+        "Default: the road's `lanes`.",
+    )
+    oncoming_lanes: NonNegInt | None = Field(
+        default=None,
+        description="Oncoming lanes on this segment, >= 0. Default: the road's `oncoming_lanes`.",
+    )
+    shoulder: NonNegFloat | None = Field(
+        default=None,
+        description="[m] paved right shoulder on this segment, >= 0. Default: the road's "
+        "`shoulder`.",
+    )
+    speed_limit_kph: PosFloat | None = Field(
+        default=None,
+        description="[km/h] limit posted at the segment's start, > 0. Default: unchanged "
+        "(the limit in force goes on).",
+    )
+    zone: ZoneName | None = Field(
+        default=None,
+        description="Scenery style: highway | ramp | city. Default: as the segment before "
+        "(highway at the start).",
+    )
+    exit: SideName | None = Field(
+        default=None,
+        description="right | left: this segment leaves the road before it by an exit from its "
+        "right / left edge; that road goes on straight as scenery (left: not supported "
+        "yet). Default: none.",
+    )
+
+    @model_validator(mode="after")
+    def _one_shape(self) -> SegmentModel:
+        _exactly_one(self, ("straight", "arc"), "shape")
+        return self
+
+
+class SpeedLimitFeature(_Model):
+    """A speed limit sign: the limit applies from its station on."""
+
+    type: Literal["speed_limit"] = Field(description="Feature type `speed_limit`.")
+    s: NonNegFloat = Field(description="[m] station of the sign; required, on the route.")
+    kph: PosFloat = Field(description="[km/h] the posted limit; required, > 0.")
+
+
+class StopSignFeature(_Model):
+    """A stop line across the route with a stop sign on the right."""
+
+    type: Literal["stop_sign"] = Field(description="Feature type `stop_sign`.")
+    s: NonNegFloat = Field(description="[m] station of the stop line; required, on the route.")
+
+
+class CrosswalkFeature(_Model):
+    """A zebra crossing from `s` to `s + width`."""
+
+    type: Literal["crosswalk"] = Field(description="Feature type `crosswalk`.")
+    s: NonNegFloat = Field(description="[m] station of the near edge; required, on the route.")
+    width: PosFloat = Field(default=4.0, description="[m] extent along the route, > 0. Default 4.")
+
+
+class SpeedBumpFeature(_Model):
+    """A speed bump across the road."""
+
+    type: Literal["speed_bump"] = Field(description="Feature type `speed_bump`.")
+    s: NonNegFloat = Field(description="[m] station of the bump's centre; required, on the route.")
+    height: PosFloat = Field(default=0.1, description="[m] height, > 0. Default 0.1.")
+    length: PosFloat = Field(
+        default=0.9, description="[m] extent along the route, > 0. Default 0.9."
+    )
+    pass_kph: PosFloat = Field(
+        default=5.0, description="[km/h] the speed to take it at, > 0. Default 5."
+    )
+
+
+class TrafficLightFeature(_Model):
+    """A traffic light with a stop line; a fixed green-yellow-red cycle. Not supported yet."""
+
+    type: Literal["traffic_light"] = Field(description="Feature type `traffic_light`.")
+    s: NonNegFloat = Field(description="[m] station of the stop line; required, on the route.")
+    green: PosFloat = Field(default=20.0, description="[s] green time, > 0. Default 20.")
+    yellow: PosFloat = Field(default=3.0, description="[s] yellow time, > 0. Default 3.")
+    red: PosFloat = Field(default=15.0, description="[s] red time, > 0. Default 15.")
+    phase: NonNegFloat = Field(
+        default=0.0, description="[s] time into the cycle (from green) at t = 0, >= 0. Default 0."
+    )
+
+
+FEATURE_TYPES = ("speed_limit", "stop_sign", "crosswalk", "speed_bump", "traffic_light")
+FeatureModel = Annotated[
+    SpeedLimitFeature | StopSignFeature | CrosswalkFeature | SpeedBumpFeature | TrafficLightFeature,
+    Field(discriminator="type"),
+]
+
+
+class BuildingsModel(_Model):
+    """Scenery buildings along both sides of the road."""
+
+    density: Fraction = Field(
+        default=0.5,
+        description="[-] built-up fraction of the roadside frontage, 0..1. Default 0.5.",
+    )
+    setback: NonNegFloat = Field(
+        default=6.0,
+        description="[m] from the road's outer paved edge to the building fronts, >= 0. Default 6.",
+    )
+
+
+class RoadModel(_Model):
+    """Map kind 1: one route road of straight and arc segments laid end to end from the
+    origin, heading +x."""
+
+    lanes: PosInt = Field(
+        default=1,
+        description="Driving lanes in the ego's direction, >= 1; lane 0 is the rightmost. "
+        "Default 1.",
+    )
+    oncoming_lanes: NonNegInt = Field(
+        default=0,
+        description="Lanes in the other direction, left of a yellow centre line, >= 0. Default 0.",
+    )
+    lane_width: PosFloat = Field(default=3.5, description="[m] lane width, > 0. Default 3.5.")
+    shoulder: NonNegFloat = Field(
+        default=2.5, description="[m] paved right shoulder, >= 0. Default 2.5."
+    )
+    speed_limit_kph: PosFloat = Field(description="[km/h] limit posted at s = 0; required, > 0.")
+    segments: list[SegmentModel] = Field(
+        min_length=1, description="The ego's route, at least one segment; required."
+    )
+    features: list[FeatureModel] = Field(
+        default_factory=list,
+        description="Features at stations along the route, each with a `type`. Default none.",
+    )
+    buildings: BuildingsModel | None = Field(
+        default=None, description="Optional scenery buildings `{density, setback}`. Default none."
+    )
+
+
+class TownModel(_Model):
+    """Map kind 2: a grid town of two-way streets, junctions, stop signs and lights."""
+
+    blocks_x: PosInt = Field(description="Blocks along x, >= 1; required.")
+    blocks_y: PosInt = Field(description="Blocks along y, >= 1; required.")
+    block: PosFloat = Field(description="[m] block size (junction spacing), > 0; required.")
+    lanes: PosInt = Field(default=1, description="Lanes per direction, >= 1. Default 1.")
+    lane_width: PosFloat = Field(default=3.5, description="[m] lane width, > 0. Default 3.5.")
+    speed_limit_kph: PosFloat = Field(description="[km/h] limit on every street; required, > 0.")
+    junctions: Junctions = Field(
+        default="stop_signs",
+        description="Junction control: stop_signs | traffic_lights | mixed. Default stop_signs.",
+    )
+
+
+TownStart = Annotated[
+    tuple[
+        Annotated[int, Field(strict=True, ge=0)], Annotated[int, Field(strict=True, ge=0)], Heading
+    ],
+    Field(strict=False),  # a YAML list is accepted for the tuple; its items stay strict
+]
+
+
+# ---------------------------------------------------------------------------------------
+# Triggers, actions, events
+# ---------------------------------------------------------------------------------------
+
+
+class TriggerModel(_Model):
+    """When an action or event fires: `{time: t}`, `{ego_s: s}`, `{gap: d}` or
+    `{after: i, delay: t}`. It fires once, when it first holds."""
+
+    model_config = ConfigDict(json_schema_extra=_one_of(TRIGGER_KINDS))
+
+    time: NonNegFloat | None = Field(default=None, description="[s] simulated time, >= 0.")
+    ego_s: NonNegFloat | None = Field(
+        default=None, description="[m] the ego's station reached, >= 0, on the route."
+    )
+    gap: NonNegFloat | None = Field(
+        default=None,
+        description="[m] bumper-to-bumper distance from this actor to the ego along the route "
+        "falls to this or below, >= 0.",
+    )
+    after: NonNegInt | None = Field(
+        default=None,
+        description="Index of an EARLIER action of the same actor (or event of the list); "
+        "fires `delay` seconds after it ended.",
+    )
+    delay: NonNegFloat | None = Field(
+        default=None, description="[s] with `after` only: wait after that action ended. Default 0."
+    )
+
+    @model_validator(mode="before")
+    @classmethod
+    def _known_kind(cls, data: Any) -> Any:
+        allowed = {*TRIGGER_KINDS, "delay"}
+        return _reject_unknown_kind(data, allowed, TRIGGER_KINDS, "trigger")
+
+    @model_validator(mode="after")
+    def _one_kind(self) -> TriggerModel:
+        kind = _exactly_one(self, TRIGGER_KINDS, "trigger")
+        if self.delay is not None and kind != "after":
+            raise problem("only goes with `after`", key="delay")
+        return self
+
+    @property
+    def kind(self) -> str:
+        """The trigger's kind: one of `TRIGGER_KINDS`."""
+        return _present(self, TRIGGER_KINDS)[0]
+
+
+class SpeedActionModel(_Model):
+    """Change speed to `kph` at a signed acceleration."""
+
+    kph: NonNegFloat = Field(description="[km/h] target speed, >= 0; required.")
+    accel: float | None = Field(
+        default=None,
+        description="[m/s^2] signed acceleration, != 0: > 0 to speed up, < 0 to slow down. "
+        "Default 2 when speeding up, -3 when slowing.",
+        json_schema_extra={"not": {"const": 0}},
+    )
+
+    @field_validator("accel")
+    @classmethod
+    def _nonzero(cls, value: float | None) -> float | None:
+        if value == 0:
+            raise problem("must not be 0 (signed: > 0 speeds up, < 0 slows down)")
+        return value
+
+
+class LaneChangeActionModel(_Model):
+    """Move to another lane at a constant lateral speed."""
+
+    to_lane: int = Field(description="Target lane index; required, must exist.")
+    lateral_speed: PosFloat = Field(
+        default=2.0, description="[m/s] lateral speed, > 0. Default 2.0 (UN R157-like)."
+    )
+
+
+class WalkActionModel(_Model):
+    """Walk across the road to a lateral offset from the actor's lane centre, at a walking
+    speed (reached and left at 1.5 m/s^2), facing the walking direction; then stand."""
+
+    to_offset: float = Field(
+        description="[m] lateral offset from the actor's lane centre to walk to, left "
+        "positive; required."
+    )
+    speed_kph: PosFloat = Field(default=5.0, description="[km/h] walking speed, > 0. Default 5.")
+
+
+class StopActionModel(_Model):
+    """Brake to a standstill, written `stop: {}`."""
+
+    decel: PosFloat = Field(
+        default=6.0, description="[m/s^2] braking deceleration, > 0. Default 6."
+    )
+
+
+class ActionModel(_Model):
+    """One scripted action of an actor: a `trigger` and exactly one action key."""
+
+    model_config = ConfigDict(json_schema_extra=_one_of(ACTION_KINDS))
+
+    trigger: TriggerModel = Field(description="When the action fires (once); required.")
+    speed: SpeedActionModel | None = Field(
+        default=None, description="Change speed: `{kph, accel}`."
+    )
+    lane_change: LaneChangeActionModel | None = Field(
+        default=None, description="Change lane: `{to_lane, lateral_speed}`."
+    )
+    walk: WalkActionModel | None = Field(
+        default=None, description="Walk across: `{to_offset, speed_kph}`."
+    )
+    stop: StopActionModel | None = Field(
+        default=None, description="Brake to a stop: `{}` (optional `decel`)."
+    )
+
+    @model_validator(mode="before")
+    @classmethod
+    def _known_kind(cls, data: Any) -> Any:
+        data = _reject_unknown_kind(data, {"trigger", *ACTION_KINDS}, ACTION_KINDS, "action")
+        return _empty_for_null(data, ACTION_KINDS)
+
+    @model_validator(mode="after")
+    def _one_kind(self) -> ActionModel:
+        _exactly_one(self, ACTION_KINDS, "action")
+        return self
+
+    @property
+    def kind(self) -> str:
+        """The action's name: one of `ACTION_KINDS`."""
+        return _present(self, ACTION_KINDS)[0]
+
+
+class AcceleratorOverrideModel(_Model):
+    """An external disturbance: the accelerator pedal is held at `pedal` for `duration`
+    seconds, then released. The car is drive-by-wire: the pedal is a sensor the driving stack
+    reads and arbitrates (its speed limiter); the world adds no torque for it."""
+
+    pedal: Fraction = Field(description="[-] pedal position 0..1; required.")
+    duration: PosFloat = Field(description="[s] how long, > 0; required.")
+
+
+class FlatTireModel(_Model):
+    """A tyre goes flat."""
+
+    wheel: WheelName = Field(
+        description="front_left | front_right | rear_left | rear_right; required."
+    )
+
+
+class EventModel(_Model):
+    """Something that happens to the ego car: a `trigger` (not `gap`: there is no actor)
+    and exactly one event key. `accelerator_override` is simulated; `flat_tire` is not
+    supported yet."""
+
+    model_config = ConfigDict(json_schema_extra=_one_of(EVENT_KINDS))
+
+    trigger: TriggerModel = Field(description="When the event fires (once); required.")
+    accelerator_override: AcceleratorOverrideModel | None = Field(
+        default=None, description="Hold the accelerator: `{pedal, duration}`."
+    )
+    flat_tire: FlatTireModel | None = Field(default=None, description="A flat tyre: `{wheel}`.")
+
+    @model_validator(mode="before")
+    @classmethod
+    def _known_kind(cls, data: Any) -> Any:
+        data = _reject_unknown_kind(data, {"trigger", *EVENT_KINDS}, EVENT_KINDS, "event")
+        return _empty_for_null(data, EVENT_KINDS)
+
+    @model_validator(mode="after")
+    def _one_kind(self) -> EventModel:
+        _exactly_one(self, EVENT_KINDS, "event")
+        return self
+
+    @property
+    def kind(self) -> str:
+        """The event's name: one of `EVENT_KINDS`."""
+        return _present(self, EVENT_KINDS)[0]
+
+
+# ---------------------------------------------------------------------------------------
+# Ego, actors, sensors, criteria
+# ---------------------------------------------------------------------------------------
+
+
+class EgoModel(_Model):
+    """The car under test. On a road: `lane` and `s`; in a town: `start` and `route`."""
+
+    lane: NonNegInt | None = Field(
+        default=None,
+        description="(road) starting lane, 0 = rightmost; must exist at `s`. Default 0.",
+    )
+    s: NonNegFloat | None = Field(
+        default=None,
+        description="[m] (road) station of the car's centre, on the route; required on a road.",
+    )
+    start: TownStart | None = Field(
+        default=None,
+        description="(town) `[ix, iy, heading]`: junction indices and east | north | west | "
+        "south; required in a town.",
+    )
+    route: list[Turn] | None = Field(
+        default=None,
+        description="(town) what to do at each junction met: straight | left | right | u_turn; "
+        "required in a town.",
+    )
+    speed_kph: NonNegFloat = Field(
+        default=0.0, description="[km/h] initial speed, >= 0, <= max_speed_kph. Default 0."
+    )
+    set_speed_kph: NonNegFloat = Field(
+        description="[km/h] the driver's desired (cruise) speed, >= 0, <= max_speed_kph; required."
+    )
+    max_speed_kph: PosFloat = Field(
+        default=54.0,
+        description="[km/h] vehicle speed limit, > 0. Default 54 (15 m/s, the ICCAS car).",
+    )
+    overtake: bool = Field(
+        default=False,
+        description="(road) the car may change lanes to pass a slower vehicle when the next "
+        "lane is free (ICCAS lane changing). Default false: it follows.",
+    )
+
+
+class ActorModel(_Model):
+    """Another road user or a static obstacle."""
+
+    id: Identifier = Field(description="Unique name, [a-z0-9_]+; required.")
+    type: ActorTypeName = Field(
+        description="car | truck | pedestrian | obstacle (a static box); required. "
+        "A pedestrian is a 0.5 x 0.6 x 1.75 m body; its speed_kph is a walking speed."
+    )
+    lane: int | None = Field(
+        default=None,
+        description="(road) lane index: 0 = rightmost of the ego's direction; -1, -2, ... "
+        "oncoming lanes from the centre line out. Must exist at `s`. Default 0.",
+    )
+    s: NonNegFloat | None = Field(
+        default=None,
+        description="[m] (road) station of the actor's centre, on the route; required on a road.",
+    )
+    offset: float = Field(
+        default=0.0,
+        description="[m] lateral offset from the lane centre, left positive. Default 0.",
+    )
+    start: TownStart | None = Field(
+        default=None, description="(town) `[ix, iy, heading]` as for the ego."
+    )
+    route: list[Turn] | None = Field(default=None, description="(town) turns as for the ego.")
+    speed_kph: NonNegFloat = Field(
+        default=0.0,
+        description="[km/h] initial speed, >= 0; an obstacle must not move. Default 0.",
+    )
+    actions: list[ActionModel] = Field(
+        default_factory=list,
+        description="Scripted actions, each fires once when its trigger first holds. "
+        "Default none: the actor keeps its lane and speed.",
+    )
+
+
+class GnssModel(_Model):
+    """GNSS / odometry noise."""
+
+    sigma: NonNegFloat = Field(
+        default=0.05, description="[m] 1-sigma horizontal position noise, >= 0. Default 0.05."
+    )
+    heading_sigma_deg: NonNegFloat = Field(
+        default=0.2, description="[deg] 1-sigma heading noise, >= 0. Default 0.2."
+    )
+    bias: Annotated[
+        tuple[Annotated[float, Field(strict=True)], Annotated[float, Field(strict=True)]],
+        Field(strict=False),
+    ] = Field(default=(0.0, 0.0), description="[m] constant (x, y) offset. Default [0, 0].")
+
+
+class LidarModel(_Model):
+    """LiDAR noise (the beam layout comes from `--profile`)."""
+
+    range_sigma: NonNegFloat = Field(
+        default=0.02, description="[m] 1-sigma range noise, >= 0. Default 0.02."
+    )
+    dropout: Fraction = Field(
+        default=0.0, description="[-] fraction of rays lost, 0..1. Default 0."
+    )
+
+
+class SensorsModel(_Model):
+    """Sensor noise; keys left out come from the run's `--profile`."""
+
+    gnss: GnssModel | None = Field(
+        default=None, description="GNSS noise `{sigma, heading_sigma_deg, bias}`."
+    )
+    lidar: LidarModel | None = Field(
+        default=None, description="LiDAR noise `{range_sigma, dropout}`."
+    )
+
+
+class LaneChangeCriteriaModel(_Model):
+    """Bounds on every commanded lane change; at least one must happen."""
+
+    max_duration: PosFloat = Field(
+        default=5.0,
+        description="[s] from the first tyre leaving the origin lane to all tyres inside the "
+        "target lane, > 0. Default 5.",
+    )
+    max_lateral_accel: PosFloat = Field(
+        default=1.0,
+        description="[m/s^2] the lateral acceleration the change adds (0.2 s average), > 0. "
+        "Default 1.",
+    )
+
+
+class CriteriaModel(_Model):
+    """Optional criteria; the default criteria always apply."""
+
+    min_gap: Literal["r157"] | PosFloat | None = Field(
+        default=None,
+        description="`r157` (UN R157 d_min(v)) or a number [m] > 0: minimum bumper gap to the "
+        "vehicle ahead. Default: off.",
+    )
+    lane_change: LaneChangeCriteriaModel | None = Field(
+        default=None,
+        description="`{max_duration, max_lateral_accel}`: bounds on each lane change; at "
+        "least one must happen. Default: off.",
+    )
+    standstill_gap: Annotated[tuple[NonNegFloat, PosFloat], Field(strict=False)] | None = Field(
+        default=None,
+        description="[m] `[low, high]`: the bumper gap to the vehicle ahead each time the ego "
+        "stands behind it; it must stand at least once. Default: off.",
+    )
+    resume_within: PosFloat | None = Field(
+        default=None,
+        description="[s] once the lane ahead clears, the ego is back at its wanted speed "
+        "within this, > 0; the lane must clear at least once with the ego slowed. "
+        "Default: off.",
+    )
+    max_decel: PosFloat | None = Field(
+        default=None,
+        description="[m/s^2] the ego's deceleration (0.2 s average) never exceeds it, > 0. "
+        "Default: off.",
+    )
+    reach_s: PosFloat | None = Field(
+        default=None,
+        description="[m] station the ego must reach, > 0, on the route. Default: the end of "
+        "the route less 30 m.",
+    )
+
+    @field_validator("standstill_gap")
+    @classmethod
+    def _low_below_high(cls, value: Any) -> Any:
+        if value is not None and not value[0] < value[1]:
+            raise problem(f"low must be below high, got {list(value)}")
+        return value
+
+    @field_validator("min_gap", mode="before")
+    @classmethod
+    def _r157_or_metres(cls, value: Any) -> Any:
+        is_number = isinstance(value, int | float) and not isinstance(value, bool)
+        if value is None or value == "r157" or (is_number and value > 0):
+            return value
+        raise problem(f"must be r157 or a number of metres > 0, got {value!r}")
+
+
+# ---------------------------------------------------------------------------------------
+# The whole file
+# ---------------------------------------------------------------------------------------
+
+
+class ScenarioModel(_Model):
+    """A scenario file, format `avsim/1`: exactly one map (`road` or `town`), the ego, and
+    optionally actors, sensors, events and criteria."""
+
+    model_config = ConfigDict(json_schema_extra=_one_of(("road", "town")))
+
+    format: Literal["avsim/1"] = Field(description="The format version, `avsim/1`; required.")
+    name: Identifier = Field(description="Scenario name, [a-z0-9_]+; required.")
+    description: str = Field(default="", description="One line for humans. Default empty.")
+    situation: Situation = Field(
+        default="other",
+        description="normal_driving | lane_change | cut_in_out | traffic_jam | sudden_stop | "
+        "external_disturbance | decs_route | town | other. Default other.",
+    )
+    duration: PosFloat = Field(description="[s] simulated time limit, > 0; required.")
+    seed: NonNegInt = Field(default=0, description="Random seed, >= 0. Default 0.")
+    road: RoadModel | None = Field(
+        default=None, description="Map kind 1, a route road; give this or `town`."
+    )
+    town: TownModel | None = Field(
+        default=None,
+        description="Map kind 2, a grid town; give this or `road`. Not supported yet.",
+    )
+    ego: EgoModel = Field(description="The car under test; required.")
+    actors: list[ActorModel] = Field(
+        default_factory=list, description="Other road users. Default none."
+    )
+    sensors: SensorsModel = Field(
+        default_factory=SensorsModel,
+        description="Sensor noise; keys left out come from `--profile`. Default: the profile's.",
+    )
+    events: list[EventModel] = Field(
+        default_factory=list,
+        description="What happens to the ego car. Default none. `flat_tire` is not supported "
+        "yet.",
+    )
+    criteria: CriteriaModel = Field(
+        default_factory=CriteriaModel,
+        description="Optional criteria `{min_gap, max_decel, reach_s}`. Default: none added.",
+    )
+
+    @model_validator(mode="after")
+    def _one_map(self) -> ScenarioModel:
+        if self.road is None and self.town is None:
+            raise problem("a map is required: give `road` or `town`", key="road")
+        if self.road is not None and self.town is not None:
+            raise problem("give either `road` or `town`, not both", key="town")
+        return self

@@ -1,0 +1,1 @@
+"""The state machines: enum + pure transition + the table as data."""

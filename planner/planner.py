@@ -1,0 +1,283 @@
+"""The planner: the ICCAS dual FSM with the DECS ACC / event layer, for one route road.
+
+Each tick, from the ego estimate, the camera's lane, the confirmed tracks and the driver's
+accelerator pedal:
+
+1. the lane-source FSM (`planner.fsm.lane_source`) says where the lateral reference comes from:
+   the camera's lane (`planner.camera_lane`) when it is seen and agrees with the map's lane
+   kept, the map lane (`planner.route.lane_path`, placed by the GNSS + odometry estimate)
+   while it is acquired or lost;
+2. the motion FSM (`planner.motion_layer`) keeps the lane or changes lanes, from the lane
+   occupancy of the tracks; a lane change (or its abort) replaces the path with its Hermite
+   path (`planner.lane_change_path`) and makes the target lane the lane kept;
+3. the speed: the map's plan (`planner.speed_planning`, the lane kept's limits and curves),
+   raised by the driver's pedal up to the limit (`planner.driver_override`), through the
+   ACC / event layer (`planner.acc_layer`: cruise, trail or brake behind the lead vehicle,
+   `planner.lead`), ramped down at ``a_comf`` when the lane is lost (then a stop in lane);
+4. the control FSM (`planner.control_layer`) names the control action and, in an
+   emergency, asks for the emergency stop's deceleration instead.
+
+The path and the speed target are computed separately (`path_for`, `speed_for`).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from perception.messages import EgoState, LaneEstimate, Track
+from planner.acc_control import SpeedRef
+from planner.acc_layer import AccLayer, AccLayerParams
+from planner.camera_lane import camera_lane_path
+from planner.control_layer import ControlLayer
+from planner.driver_override import DriverOverride, OverrideParams
+from planner.events import EventMonitor, EventParams
+from planner.fsm.lane_source import LaneSource, LaneSourceInput, LaneSourceParams, transition
+from planner.junctions import JunctionMonitor, JunctionParams
+from planner.lead import LeadAccel, LeadParams, route_lead, select_lead
+from planner.messages import Lead, Plan, ReferencePath, StateChange
+from planner.motion_layer import Manoeuvre, MotionLayer, MotionLayerParams
+from planner.route import lane_path
+from planner.speed_planning import SpeedPlanner, SpeedPlanningParams, SpeedTarget
+from world.hdmap import SHOULDER, RoadMap
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class LaneView:
+    """The camera's latest lane estimate and the ego estimate at its frame's time."""
+
+    estimate: LaneEstimate
+    pose: EgoState
+
+
+@dataclass(frozen=True, slots=True)
+class LaneKeepingParams:
+    set_speed: float  # [m/s] the driver's desired (cruise) speed
+    max_speed: float  # [m/s] the vehicle's maximum speed
+    lane: int = 0  # ego-direction lane index to keep (0 rightmost)
+    path_behind: float = 5.0  # [m] path sampled behind the car's centre
+    path_ahead_min: float = 25.0  # [m] shortest path ahead of the car's centre
+    path_ahead_time: float = 2.5  # [s] path ahead = max(path_ahead_min, this * speed)
+    path_spacing: float = 0.5  # [m] station step of the path samples
+    camera: bool = True  # False: no camera in this stack, the map lane only (state MAP)
+    camera_ahead: float = 30.0  # [m] the camera's lane is used this far ahead of its frame
+    speed: SpeedPlanningParams = field(default_factory=SpeedPlanningParams)
+    source: LaneSourceParams = field(default_factory=LaneSourceParams)
+    lead: LeadParams = field(default_factory=LeadParams)
+    acc: AccLayerParams = field(default_factory=AccLayerParams)
+    motion: MotionLayerParams = field(default_factory=MotionLayerParams)
+    override: OverrideParams = field(default_factory=OverrideParams)
+    events: EventParams = field(default_factory=EventParams)
+    junctions: JunctionParams = field(default_factory=JunctionParams)
+    camera_agree: float = 1.0  # [m] the camera's lane is used only within this of the map's
+    junction_before: float = 10.0  # [m] before a town junction's stop line ...
+    junction_after: float = 15.0  # [m] ... to after its exit, the map's path is followed
+
+
+class LaneKeepingPlanner:
+    """Follows lane ``params.lane`` of ``road``; stateless between ticks (see `reset`)."""
+
+    def __init__(self, road: RoadMap, params: LaneKeepingParams) -> None:
+        if params.lane < 0:
+            raise ValueError(f"lane keeping needs an ego-direction lane, got {params.lane}")
+        self.road = road
+        self.params = params
+        self._speed_planners: dict[int, SpeedPlanner] = {}
+        self.reset()
+
+    def reset(self) -> None:
+        """Back to ACQUIRING the lane (MAP without a camera) of `params.lane`, keeping it,
+        with no speed cap."""
+        self.source = LaneSource.ACQUIRING if self.params.camera else LaneSource.MAP
+        self._since: float | None = None  # [s] time of the last lane-source change
+        self._cap = math.inf  # [m/s] the ramped speed cap of the degraded modes
+        self._last_t: float | None = None
+        self._keep(self.params.lane)
+        self.acc = AccLayer(self.params.acc)
+        self.motion = MotionLayer(self.road, self.params.lane, self.params.acc.modes,
+                                  self.params.motion)
+        self.control = ControlLayer()
+        self.lead_accel = LeadAccel()
+        self.driver = DriverOverride(self.params.override)
+        self.events = EventMonitor(self.road, self.params.events)
+        self.junctions = JunctionMonitor(self.road, self.params.junctions)
+        self._camera_ok = False  # the camera's lane is seen and agrees with the map's
+        self._hazard = False  # the hazard lights (on from a flat tyre)
+
+    def _keep(self, lane: int) -> None:
+        """Make `lane` the lane whose stations, speed plan and map path are used."""
+        self.lane_index = lane
+        self.lane = self.road.lane(lane)
+        if lane not in self._speed_planners:
+            self._speed_planners[lane] = SpeedPlanner(self.road, self.lane, self.params.speed)
+        self.speed_planner = self._speed_planners[lane]
+
+    def localise(self, ego: EgoState) -> tuple[float, float]:
+        """(station [m], lateral offset [m], left +) of the ego's centre on the lane."""
+        s, r = self.lane.local_coordinates(np.array([ego.x, ego.y]))
+        return float(np.asarray(s)), float(np.asarray(r))
+
+    def path_for(self, ego: EgoState, station: float) -> ReferencePath:
+        """The lane centre from ``path_behind`` behind to max(25 m, 2.5 s * speed) ahead."""
+        p = self.params
+        ahead = max(p.path_ahead_min, p.path_ahead_time * max(ego.speed, 0.0))
+        return lane_path(
+            self.lane, station, p.path_behind, ahead, p.path_spacing, length=self.road.length
+        )
+
+    def speed_for(self, station: float, set_speed: float | None = None) -> SpeedTarget:
+        """The speed target for the car's centre at ``station`` [m] (at ``set_speed``
+        [m/s], by default the driver's set speed)."""
+        p = self.params
+        return self.speed_planner.target(
+            station, set_speed=p.set_speed if set_speed is None else set_speed,
+            max_speed=p.max_speed)
+
+    def update(self, ego: EgoState, view: LaneView | None = None,
+               tracks: Sequence[Track] = (), pedal: float = 0.0, flat: bool = False) -> Plan:
+        """The plan for this tick, made from ``ego`` (map frame, car centre), the camera's
+        lane ``view`` (None before the first frame), the confirmed ``tracks``, the driver's
+        accelerator ``pedal`` position (0..1, `planner.driver_override`) and whether a flat
+        tyre has been detected."""
+        dt = 0.0 if self._last_t is None else max(ego.t - self._last_t, 0.0)
+        self._last_t = ego.t
+        station, lateral = self.localise(ego)
+        changes = self._update_source(ego.t, view, self.near_junction(station))
+        target = self.speed_for(station)
+        want = min(self.params.set_speed, target.limit_at_front)
+        manoeuvre, motion_changes = self.motion.update(ego, want, tracks, pull_over=flat)
+        if manoeuvre.lane != self.lane_index:  # a lane change began, ended or was aborted
+            self._keep(manoeuvre.lane)
+            station, lateral = self.localise(ego)
+            target = self.speed_for(station)
+        path = self._path(ego, station, view, manoeuvre)
+        lead = self._lead(view, tracks, ego, manoeuvre)
+        plan_ref, driver = self.driver.update(
+            pedal, ego.speed, SpeedRef(target.speed, target.accel),
+            lambda: self.speed_for(station, self.params.max_speed), dt)
+        events = self.events.update(ego.t, station, ego.speed,
+                                    float(self.lane.offset_at(station)),
+                                    float(self.lane.width_at(station)), tracks, flat,
+                                    pulled_over=manoeuvre.lane == SHOULDER
+                                    and manoeuvre.path is None)
+        junction = self.junctions.update(ego.t, station, ego.speed, tracks)
+        events = replace(events, red_light=junction.red_light, give_way=junction.give_way,
+                         stop_distance=min(events.stop_distance, junction.stop_distance))
+        ref, acc_changes = self.acc.update(ego.t, dt, ego.speed, self.params.set_speed,
+                                           target.limit_at_front, plan_ref, lead,
+                                           driver_gap=self.params.override.gap_margin
+                                           if driver else None, events=events)
+        speed, accel = self._degraded_cap(ref.speed, ref.accel, ego.speed, dt)
+        control, control_changes = self.control.update(
+            ego.t, ego.speed, speed, accel, self.acc.lead_gap, lead,
+            self.lead_accel.update(lead))
+        if control.emergency:
+            speed, accel = 0.0, -self.control.decel
+        if flat and not self._hazard:  # the hazard lights go on, and stay on
+            self._hazard = True
+            control_changes += (StateChange(ego.t, "hazard", "off", "on", "flat tyre"),)
+        return Plan(
+            t=ego.t,
+            ego=ego,
+            path=path,
+            target_speed=speed,
+            target_accel=accel,
+            speed_limit=target.limit_at_front,
+            station=station,
+            lateral_error=lateral,
+            lane_source=self.source,
+            lead=lead,
+            acc_mode=self.acc.mode.value,
+            motion=manoeuvre.motion.value,
+            lane=manoeuvre.lane,
+            origin_lane=manoeuvre.origin,
+            control=control.state,
+            hazard=self._hazard,
+            changes=changes + motion_changes + acc_changes + control_changes,
+        )
+
+    def _path(self, ego: EgoState, station: float, view: LaneView | None,
+              manoeuvre: Manoeuvre) -> ReferencePath:
+        """The lane-change path in hand, else the camera's lane when it is seen and agrees
+        with the map's lane kept (not yet re-found after a lane change: the map's), else
+        the map's."""
+        p = self.params
+        self._camera_ok = False
+        if manoeuvre.path is not None:
+            ahead = max(p.path_ahead_min, p.path_ahead_time * max(ego.speed, 0.0))
+            return manoeuvre.path.reference_path(self.lane, station, p.path_behind, ahead,
+                                                 p.path_spacing, self.road.length)
+        # the camera's lane lies between painted lines: not the shoulder (no outer line)
+        if self.source is LaneSource.CAMERA and view is not None and \
+                self.lane_index != SHOULDER:
+            _, r = self.localise(view.pose)
+            self._camera_ok = abs(view.estimate.offset - r) <= p.camera_agree
+            if self._camera_ok:
+                return self._camera_path(view)
+        return self.path_for(ego, station)
+
+    def _update_source(self, t: float, view: LaneView | None,
+                       junction: bool) -> tuple[StateChange, ...]:
+        if self._since is None:
+            self._since = t
+        confidence = view.estimate.confidence if view is not None else 0.0
+        change = transition(self.source, LaneSourceInput(t, confidence, self._since, junction),
+                            self.params.source)
+        if change is None:
+            return ()
+        old, self.source, self._since = self.source, change.to, t
+        return (StateChange(t, "lane_source", old.value, change.to.value, change.reason),)
+
+    def _camera_path(self, view: LaneView) -> ReferencePath:
+        p = self.params
+        return camera_lane_path(view.estimate, view.pose, behind=p.path_behind,
+                                ahead=p.camera_ahead, spacing=p.path_spacing)
+
+    def _lead(self, view: LaneView | None, tracks: Sequence[Track], ego: EgoState,
+              manoeuvre: Manoeuvre) -> Lead | None:
+        """The vehicle ahead in the lane (camera's lane, else straight ahead); during a lane
+        change the nearest ahead in the lanes the car occupies (`MotionLayer`)."""
+        if manoeuvre.path is not None:
+            if not manoeuvre.leads:
+                return None
+            n = min(manoeuvre.leads, key=lambda n: n.gap)
+            gap = n.gap - (n.speed - ego.speed) * max(ego.t - n.t, 0.0)  # at the track's time
+            return Lead(n.track_id, n.t, gap, max(n.speed, 0.0))
+        if not tracks:
+            return None
+        if self.source is LaneSource.JUNCTION:  # on the map's path through the junction
+            return route_lead(tracks, self.lane, self.localise(ego)[0], self.params.lead)
+        centre: Callable[[float], float] = _straight_ahead
+        if view is not None and self._camera_ok:
+            centre = view.estimate.centre_y
+        return select_lead(tracks, centre, ego.heading, self.params.lead)
+
+    def near_junction(self, station: float) -> bool:
+        """Whether the car's centre is near or in a town junction, where the map's path is
+        followed and an unseen painted lane is no fault."""
+        p = self.params
+        return any(j.s_stop - p.junction_before <= station <= j.s_exit + p.junction_after
+                   for j in self.road.junctions)
+
+    def _degraded_cap(self, speed: float, accel: float, ego_speed: float,
+                      dt: float) -> tuple[float, float]:
+        """With the lane lost, ramp the target down at a_comf to the hold speed / to 0."""
+        wanted = {LaneSource.MAP_HOLD: self.params.source.hold_speed,
+                  LaneSource.STOP_IN_LANE: 0.0}.get(self.source, math.inf)
+        if math.isinf(wanted):
+            self._cap = math.inf
+            return speed, accel
+        a_comf = self.params.speed.a_comf
+        start = min(self._cap, max(ego_speed, speed)) if math.isfinite(self._cap) else ego_speed
+        self._cap = max(wanted, start - a_comf * dt)
+        if self._cap < speed:
+            return self._cap, -a_comf if self._cap > wanted else 0.0
+        return speed, accel
+
+
+def _straight_ahead(_x: float) -> float:
+    """The lane centre when the camera's lane is not available: straight ahead."""
+    return 0.0

@@ -1,0 +1,256 @@
+"""The situation criteria on synthetic truth (no World): tyres_in_lane following the commanded
+lane, lane_change_duration, lane_change_lateral_accel, standstill_gap, time_to_resume, and the
+`note` a criterion whose situation never happened carries into the result file."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from avsim.criteria.base import KPH, CriterionResult, TruthSample
+from avsim.criteria.following import StandstillGap, TimeToResume
+from avsim.criteria.lane import (
+    LINE_HALF_WIDTH,
+    LaneChangeDuration,
+    LaneChangeLateralAccel,
+    TyresInLane,
+)
+from tests.roads import W, make_map, seg
+from world.actors.actor_set import ActorPoses
+from world.hdmap import RoadMap
+from world.spec import ActorType
+
+ROAD = make_map(seg(1000.0))  # lane 0 centred on offset 0, lane 1 on W; 50 km/h
+TYRE = 0.105  # [m] tyre half width (the runner's)
+TRACK = 0.8  # [m] half the track: tyres at offset +-TRACK from the ego's centre
+EGO_LENGTH = 4.8
+CAR_HALF = np.array([2.3, 0.9, 0.75])
+RATE = 40.0  # [Hz]
+DT = 1 / RATE
+IN_LANE = W / 2 - LINE_HALF_WIDTH - TRACK - TYRE  # [m] margin of a centred ego
+STAGGER = np.array([1.4, 1.4, -1.4, -1.4])  # [m] tyre stations from the ego's centre
+
+
+def cars(stations: list[float], offsets: list[float], speeds: list[float]) -> ActorPoses:
+    n = len(stations)
+    return ActorPoses(ids=tuple(f"car{i}" for i in range(n)), kinds=(ActorType.CAR,) * n,
+                      centres=np.zeros((n, 3)), yaws=np.zeros(n),
+                      half_sizes=np.tile(CAR_HALF, (n, 1)), stations=np.array(stations),
+                      offsets=np.array(offsets), speeds=np.array(speeds), accels=np.zeros(n))
+
+
+def truth(t: float, d: float = 0.0, *, lane: int = 0, origin: int | None = None,
+          speed: float = 10.0, station: float = 100.0, actors: ActorPoses | None = None,
+          lat: float = 0.0, curv: float = 0.0) -> TruthSample:
+    """The ego with its centre at offset d, tyres at d +- TRACK, 1.4 m before/after it."""
+    return TruthSample(t=t, speed=speed, station=station, front_station=station + 2.4,
+                       tyres=np.zeros((4, 2)), tyre_stations=station + STAGGER,
+                       tyre_offsets=d + np.array([TRACK, -TRACK, TRACK, -TRACK]),
+                       touching=frozenset(), offset=d, actors=actors, lane=lane,
+                       origin_lane=lane if origin is None else origin, lateral_accel=lat,
+                       road_curvature=curv)
+
+
+def gap_ahead(gap: float, station: float = 100.0) -> float:
+    """The station of a car `gap` metres (bumper to bumper) ahead of the ego at `station`."""
+    return station + gap + float(CAR_HALF[0]) + EGO_LENGTH / 2
+
+
+def test_keeping_lane_0_a_tyre_on_the_line_to_lane_1_fails() -> None:
+    c = TyresInLane(ROAD, TYRE)
+    c.update(truth(0.0, 0.0))
+    assert c.result().passed and c.result().value == pytest.approx(IN_LANE)
+    c.update(truth(1.0, 1.0))  # left tyres at 1.8: over the line at 1.75
+    r = c.result()
+    assert not r.passed and r.first_failure == 1.0
+    assert r.value == pytest.approx(W / 2 - LINE_HALF_WIDTH - 1.8 - TYRE)
+
+
+@pytest.mark.parametrize(("lane", "origin"), [(1, 0), (0, 1)])  # left and right changes
+def test_during_a_change_the_tyres_may_be_anywhere_in_both_lanes(lane: int, origin: int) -> None:
+    c = TyresInLane(ROAD, TYRE)
+    for k, d in enumerate([0.0, 1.0, W / 2, 2.5, W]):
+        c.update(truth(k, d, lane=lane, origin=origin))
+    assert c.result().passed and c.result().value == pytest.approx(IN_LANE)
+
+
+def test_after_the_change_the_tyres_belong_in_the_target_lane() -> None:
+    c = TyresInLane(ROAD, TYRE)
+    c.update(truth(0.0, W, lane=1))
+    assert c.result().passed
+    c.update(truth(1.0, 0.0, lane=1))  # back in lane 0 with lane 1 kept
+    assert not c.result().passed and c.result().first_failure == 1.0
+
+
+@pytest.mark.parametrize("d", [W + 1.0, -1.0])  # over lane 1's left line, lane 0's right
+def test_during_a_change_beyond_the_two_lanes_outer_lines_fails(d: float) -> None:
+    c = TyresInLane(ROAD, TYRE)
+    c.update(truth(2.0, d, lane=1, origin=0))
+    r = c.result()
+    assert not r.passed and r.first_failure == 2.0
+    assert r.value == pytest.approx(W / 2 - LINE_HALF_WIDTH - 1.0 - TRACK - TYRE)
+
+
+def change(v_lat: float, end: float = 20.0, start: float = 1.0) -> LaneChangeDuration:
+    """Lane keeping in lane 0, then from `start` the centre moves left at v_lat [m/s] to
+    lane 1's centre, commanded (lane 1 from lane 0) until it gets there, then lane 1 kept."""
+    c = LaneChangeDuration(ROAD, TYRE, 5.0)
+    for k in range(round(end * RATE)):
+        t = k * DT
+        d = float(np.clip(v_lat * (t - start), 0.0, W))
+        c.update(truth(t, d, lane=int(t >= start), origin=0 if d < W else None))
+    return c
+
+
+def crossing(v_lat: float) -> float:
+    """[s] from the left tyre's outer edge reaching the line to the right one's leaving it."""
+    return (2 * TRACK + 2 * TYRE + 2 * LINE_HALF_WIDTH) / v_lat
+
+
+def test_a_lane_change_is_timed_from_the_first_tyre_out_to_all_tyres_in() -> None:
+    c = change(0.75)
+    r = c.result()
+    assert r.passed and r.first_failure is None and r.note is None
+    assert r.value == pytest.approx(crossing(0.75), abs=DT) and r.unit == "s"
+    assert c.durations == [r.value]  # one change, timed once
+
+
+def test_a_too_slow_lane_change_fails_when_it_runs_over() -> None:
+    r = change(0.32).result()
+    assert not r.passed and r.value == pytest.approx(crossing(0.32), abs=DT)
+    out = 1.0 + IN_LANE / 0.32  # the left tyre leaves lane 0
+    assert r.first_failure == pytest.approx(out + 5.0, abs=2 * DT)
+
+
+def test_a_lane_change_left_unfinished_counts_to_the_end() -> None:
+    c = change(0.75, end=30.0)
+    for k in range(round(10 * RATE)):  # a second change stops astride the line for 10 s
+        c.update(truth(30.0 + k * DT, W / 2, lane=0, origin=1))
+    r = c.result()
+    assert not r.passed and r.value == pytest.approx(10.0, abs=DT) and r.note is None
+    assert r.first_failure == pytest.approx(35.0, abs=2 * DT)
+
+
+def accel_run(lat: float, when: tuple[float, float] = (2.0, 6.0), speed: float = 20.0,
+              curv: float = 0.0) -> CriterionResult:
+    """10 s at 40 Hz, a change commanded from 2 to 6 s, `lat` lateral accel within `when`."""
+    c = LaneChangeLateralAccel(1.0, RATE)
+    for k in range(round(10 * RATE)):
+        t = k * DT
+        c.update(truth(t, lane=int(2.0 <= t < 6.0), origin=0, speed=speed, curv=curv,
+                       lat=lat if when[0] <= t < when[1] else 0.0))
+    return c.result()
+
+
+def test_lateral_accel_within_the_bound_passes() -> None:
+    r = accel_run(0.8)
+    assert r.passed and r.value == pytest.approx(0.8) and r.first_failure is None
+
+
+def test_lateral_accel_over_the_bound_fails_once_the_average_exceeds_it() -> None:
+    r = accel_run(1.2)
+    assert not r.passed and r.value == pytest.approx(1.2)
+    assert r.first_failure == pytest.approx(2.0 + 6 * DT)  # 7 of the 8 samples at 1.2
+
+
+def test_the_roads_curvature_is_not_the_changes() -> None:
+    r = accel_run(1.2, when=(0.0, 10.0), curv=1.2 / 20.0**2)  # at 20 m/s
+    assert r.passed and r.value == pytest.approx(0.0, abs=1e-9)
+
+
+def test_lateral_accel_counts_up_to_1_s_after_the_change_only() -> None:
+    assert accel_run(2.0, when=(7.2, 9.0)).passed
+    r = accel_run(2.0, when=(6.5, 6.8))
+    assert not r.passed and r.first_failure is not None and 6.5 < r.first_failure < 7.0
+
+
+def test_no_lane_change_fails_both_with_a_note() -> None:
+    items = (LaneChangeDuration(ROAD, TYRE, 5.0), LaneChangeLateralAccel(1.0, RATE))
+    for k in range(100):  # lane 0 kept, a little off centre and swerving
+        for c in items:
+            c.update(truth(k * DT, 0.2, lat=0.3))
+    for r in (c.result() for c in items):
+        assert not r.passed and r.value == 0.0 and r.note == "no lane change was made"
+        assert r.as_json()["note"] == "no lane change was made"
+
+
+def stood(*stops: tuple[float, float]) -> CriterionResult:
+    """Per stop (hold [s], gap [m]): roll at 2 m/s for 1 s, then stand `hold` s behind a car
+    `gap` ahead; band [2, 6] m."""
+    c, t = StandstillGap(2.0, 6.0, ROAD, EGO_LENGTH), 0.0
+    for hold, gap in stops:
+        lead = cars([gap_ahead(gap)], [0.1], [0.0])
+        for k in range(round((1.0 + hold) * RATE)):
+            c.update(truth(t + k * DT, speed=2.0 if k < RATE else 0.0, actors=lead))
+        t += (1.0 + hold) * RATE * DT
+    return c.result()
+
+
+def test_standing_4_m_behind_a_car_passes() -> None:
+    r = stood((2.0, 4.0))
+    assert r.passed and r.value == pytest.approx(4.0) and r.note is None
+    assert "note" not in r.as_json()
+
+
+def test_standing_too_close_fails_once_it_has_stood_1_s() -> None:
+    r = stood((2.0, 4.0), (2.0, 1.5))  # the second stop from t = 3 s
+    assert not r.passed and r.value == pytest.approx(1.5) and r.threshold == 2.0
+    assert r.first_failure == pytest.approx(3.0 + 2.0, abs=DT)
+
+
+@pytest.mark.parametrize("stop", [(0.9, 1.5), (3.0, 16.0)])  # short, nothing within 15 m
+def test_a_short_stop_or_one_with_nothing_near_is_no_standstill(stop: tuple[float, float]) -> None:
+    r = stood(stop)
+    assert not r.passed and r.first_failure is None
+    assert r.note == "the ego never stood behind a vehicle"
+
+
+def test_never_standing_fails_with_a_note_in_the_json() -> None:
+    c = StandstillGap(2.0, 6.0, ROAD, EGO_LENGTH)
+    for k in range(100):
+        c.update(truth(k * DT, speed=5.0, actors=cars([gap_ahead(4.0)], [0.0], [5.0])))
+    assert c.result().as_json() == {
+        "name": "standstill_gap", "passed": False, "value": 0.0, "threshold": 2.0,
+        "unit": "m", "note": "the ego never stood behind a vehicle"}
+
+
+def resume(back_at: float, *, leaves: bool = True, fast: float = 12.0, station: float = 100.0,
+           road: RoadMap = ROAD) -> CriterionResult:
+    """30 s at 10 Hz, set speed 12 m/s, 15 s allowed: the ego at 5 m/s behind a car at 5 m/s
+    20 m ahead, which moves out to the left (offset 0 to W from 4 to 6 s: out of the lane at
+    5 s); the ego at `fast` from `back_at`."""
+    c = TimeToResume(15.0, 12.0, road, EGO_LENGTH)
+    for k in range(300):
+        t = k * 0.1
+        d = float(np.clip((t - 4.0) * W / 2, 0.0, W)) if leaves else 0.0
+        lead = cars([gap_ahead(20.0, station)], [d], [5.0])
+        c.update(truth(t, speed=fast if t >= back_at - 1e-9 else 5.0, station=station,
+                       actors=lead))
+    return c.result()
+
+
+def test_back_at_the_set_speed_6_s_after_the_lane_clears() -> None:
+    r = resume(11.0)  # 12 m/s set, under the 50 km/h limit
+    assert r.passed and r.value == pytest.approx(6.0, abs=0.11) and r.unit == "s"
+
+
+@pytest.mark.parametrize(("back_at", "wait", "first_failure"),
+                         [(25.0, 20.0, 25.0), (99.0, 25.0, None)])  # late; never (to the end)
+def test_a_late_resume_fails(back_at: float, wait: float, first_failure: float | None) -> None:
+    r = resume(back_at)
+    assert not r.passed and r.value == pytest.approx(wait, abs=0.11) and r.note is None
+    assert r.first_failure == (None if first_failure is None else pytest.approx(first_failure))
+
+
+def test_a_lane_that_never_clears_fails_with_a_note() -> None:
+    r = resume(11.0, leaves=False)
+    assert not r.passed and r.note == "the lane ahead never cleared with the ego slowed"
+
+
+def test_the_wanted_speed_is_the_posted_limit_at_the_front_bumper_where_lower() -> None:
+    road = make_map(seg(200.0), seg(800.0, speed_kph=30.0))  # 30 km/h from s = 200
+    # the centre at 198 (under 50 km/h), the front bumper at 200.4 (under 30 km/h)
+    r = resume(8.0, fast=30 * KPH, station=198.0, road=road)
+    assert r.passed and r.value == pytest.approx(3.0, abs=0.11)
+    r = resume(8.0, fast=30 * KPH, station=198.0)  # 50 km/h: 12 m/s wanted, 8.3 is slow
+    assert not r.passed and r.value == pytest.approx(25.0, abs=0.11)

@@ -1,0 +1,77 @@
+"""The lane-source FSM: every transition of its table, and the ones that must not happen."""
+
+from __future__ import annotations
+
+import pytest
+
+from planner.fsm.lane_source import LaneSource, LaneSourceInput, LaneSourceParams, transition
+
+P = LaneSourceParams()
+S = LaneSource
+
+# (state, t, confidence, since) -> next state (None: stay); near a junction: JUNCTION_TABLE
+TABLE = [
+    # ACQUIRING
+    (S.ACQUIRING, 0.2, P.acquire, 0.0, S.CAMERA),
+    (S.ACQUIRING, 0.2, P.acquire - 0.01, 0.0, None),
+    (S.ACQUIRING, P.acquire_time, 0.0, 0.0, S.MAP_HOLD),
+    (S.ACQUIRING, P.acquire_time - 0.01, 0.0, 0.0, None),
+    # CAMERA: hysteresis between lose and acquire
+    (S.CAMERA, 5.0, P.lose - 0.01, 1.0, S.MAP_HOLD),
+    (S.CAMERA, 5.0, P.lose, 1.0, None),
+    (S.CAMERA, 5.0, 0.9, 1.0, None),
+    (S.CAMERA, 500.0, 0.9, 1.0, None),
+    # MAP_HOLD
+    (S.MAP_HOLD, 3.0, P.acquire, 2.0, S.CAMERA),
+    (S.MAP_HOLD, 3.0, 0.4, 2.0, None),  # between lose and acquire: not yet back
+    (S.MAP_HOLD, 2.0 + P.stop_after, 0.0, 2.0, S.STOP_IN_LANE),
+    (S.MAP_HOLD, 2.0 + P.stop_after - 0.01, 0.0, 2.0, None),
+    # STOP_IN_LANE
+    (S.STOP_IN_LANE, 20.0, P.acquire, 9.0, S.CAMERA),
+    (S.STOP_IN_LANE, 200.0, 0.1, 9.0, None),
+    # MAP (no camera in this stack): never changes
+    (S.MAP, 100.0, 1.0, 0.0, None),
+    (S.MAP, 100.0, 0.0, 0.0, None),
+]
+
+
+# (state, confidence, near a junction) -> next state
+JUNCTION_TABLE = [
+    (S.CAMERA, 0.9, True, S.JUNCTION),
+    (S.MAP_HOLD, 0.0, True, S.JUNCTION),
+    (S.STOP_IN_LANE, 0.0, True, S.JUNCTION),
+    (S.ACQUIRING, 0.9, True, S.JUNCTION),
+    (S.MAP, 0.0, True, None),  # no camera: the map anyway
+    (S.JUNCTION, 0.0, True, None),
+    (S.JUNCTION, 0.9, True, None),  # lines seen inside: still the map's turn path
+    (S.JUNCTION, P.acquire, False, S.CAMERA),
+    (S.JUNCTION, P.acquire - 0.01, False, S.ACQUIRING),
+]
+
+
+@pytest.mark.parametrize(("state", "t", "confidence", "since", "expected"), TABLE)
+def test_transition_table(state: LaneSource, t: float, confidence: float, since: float,
+                          expected: LaneSource | None) -> None:
+    change = transition(state, LaneSourceInput(t, confidence, since), P)
+    assert (change.to if change else None) is expected
+    if change is not None:
+        assert change.reason
+
+
+@pytest.mark.parametrize(("state", "confidence", "junction", "expected"), JUNCTION_TABLE)
+def test_junction_table(state: LaneSource, confidence: float, junction: bool,
+                        expected: LaneSource | None) -> None:
+    change = transition(state, LaneSourceInput(100.0, confidence, 99.0, junction), P)
+    assert (change.to if change else None) is expected
+
+
+def test_every_state_and_edge_of_the_table_is_covered() -> None:
+    edges = {(row[0], row[4]) for row in TABLE if row[4] is not None}
+    edges |= {(row[0], row[3]) for row in JUNCTION_TABLE if row[3] is not None}
+    assert edges == {(S.ACQUIRING, S.CAMERA), (S.ACQUIRING, S.MAP_HOLD),
+                     (S.CAMERA, S.MAP_HOLD), (S.MAP_HOLD, S.CAMERA),
+                     (S.MAP_HOLD, S.STOP_IN_LANE), (S.STOP_IN_LANE, S.CAMERA),
+                     *((s, S.JUNCTION) for s in (S.CAMERA, S.MAP_HOLD, S.STOP_IN_LANE,
+                                                 S.ACQUIRING)),
+                     (S.JUNCTION, S.CAMERA), (S.JUNCTION, S.ACQUIRING)}
+    assert {row[0] for row in TABLE} | {row[0] for row in JUNCTION_TABLE} == set(LaneSource)

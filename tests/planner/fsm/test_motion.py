@@ -1,0 +1,100 @@
+"""The motion FSM: every transition of its table as a row, with rows that must not fire."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import pytest
+
+from planner.fsm.motion import Motion, MotionInput, MotionParams, Turn, transition
+
+P = MotionParams()
+M = Motion
+T = 10.0  # [s] now; the last change was long ago unless a row says otherwise
+
+
+def x(**kw: object) -> MotionInput:
+    """Defaults: overtaking allowed, nothing blocked, no lane free, no route need."""
+    return replace(MotionInput(t=T, since=0.0, overtake=True), **kw)  # type: ignore[arg-type]
+
+
+# (name, from, input, expected next state or None to stay, abort)
+TABLE = [
+    # LANE_KEEP -> pull over (a flat tyre), before anything else
+    ("keep_pull_over", M.LANE_KEEP, x(pull_over=True, right_free=True), M.LANE_CHANGE_RIGHT,
+     False),
+    ("keep_pull_over_first", M.LANE_KEEP,
+     x(pull_over=True, right_free=True, turn=Turn.LEFT, blocked=True, left_free=True),
+     M.LANE_CHANGE_RIGHT, False),
+    ("keep_pull_over_waits_for_the_gap", M.LANE_KEEP,
+     x(pull_over=True, blocked=True, left_free=True, turn=Turn.LEFT), None, False),
+    # LANE_KEEP -> turns (the route's command at the junction)
+    ("keep_turn_right", M.LANE_KEEP, x(turn=Turn.RIGHT), M.TURN_RIGHT, False),
+    ("keep_turn_left", M.LANE_KEEP, x(turn=Turn.LEFT), M.TURN_LEFT, False),
+    ("keep_u_turn", M.LANE_KEEP, x(turn=Turn.U_TURN), M.U_TURN, False),
+    ("keep_turn_before_overtake", M.LANE_KEEP, x(turn=Turn.LEFT, blocked=True, left_free=True),
+     M.TURN_LEFT, False),
+    # LANE_KEEP -> route lane changes
+    ("keep_route_right", M.LANE_KEEP, x(route_lane=-1, right_free=True), M.LANE_CHANGE_RIGHT,
+     False),
+    ("keep_route_left", M.LANE_KEEP, x(route_lane=1, left_free=True), M.LANE_CHANGE_LEFT, False),
+    ("keep_route_waits_for_gap", M.LANE_KEEP, x(route_lane=-1, left_free=True), None, False),
+    ("keep_route_no_overtake_away", M.LANE_KEEP,
+     x(route_lane=-1, blocked=True, left_free=True), None, False),
+    ("keep_route_needs_no_overtake_setting", M.LANE_KEEP,
+     x(overtake=False, route_lane=-1, right_free=True), M.LANE_CHANGE_RIGHT, False),
+    ("keep_route_waits_route_keep_time", M.LANE_KEEP,
+     x(since=T - 0.5, route_lane=-1, right_free=True), None, False),
+    # LANE_KEEP -> overtaking lane changes
+    ("keep_overtake_left", M.LANE_KEEP, x(blocked=True, left_free=True), M.LANE_CHANGE_LEFT,
+     False),
+    ("keep_overtake_left_first", M.LANE_KEEP, x(blocked=True, left_free=True, right_free=True),
+     M.LANE_CHANGE_LEFT, False),
+    ("keep_overtake_right", M.LANE_KEEP, x(blocked=True, right_free=True), M.LANE_CHANGE_RIGHT,
+     False),
+    ("keep_blocked_nothing_free", M.LANE_KEEP, x(blocked=True), None, False),
+    ("keep_free_not_blocked", M.LANE_KEEP, x(left_free=True, right_free=True), None, False),
+    ("keep_overtake_not_allowed", M.LANE_KEEP, x(overtake=False, blocked=True, left_free=True),
+     None, False),
+    ("keep_overtake_waits_keep_time", M.LANE_KEEP,
+     x(since=T - 2.0, blocked=True, left_free=True), None, False),
+    # LANE_CHANGE_* -> LANE_KEEP
+    ("left_done", M.LANE_CHANGE_LEFT, x(change_done=True), M.LANE_KEEP, False),
+    ("left_abort", M.LANE_CHANGE_LEFT, x(target_free=False), M.LANE_KEEP, True),
+    ("left_committed_no_abort", M.LANE_CHANGE_LEFT, x(target_free=False, committed=True), None,
+     False),
+    ("left_stays", M.LANE_CHANGE_LEFT, x(blocked=True, left_free=True), None, False),
+    ("right_done", M.LANE_CHANGE_RIGHT, x(change_done=True), M.LANE_KEEP, False),
+    ("right_abort", M.LANE_CHANGE_RIGHT, x(target_free=False), M.LANE_KEEP, True),
+    ("right_committed_no_abort", M.LANE_CHANGE_RIGHT, x(target_free=False, committed=True),
+     None, False),
+    ("right_stays", M.LANE_CHANGE_RIGHT, x(), None, False),
+    ("change_ignores_turns", M.LANE_CHANGE_RIGHT, x(turn=Turn.LEFT), None, False),
+    # turns -> LANE_KEEP
+    ("turn_right_done", M.TURN_RIGHT, x(turn_done=True), M.LANE_KEEP, False),
+    ("turn_left_done", M.TURN_LEFT, x(turn_done=True), M.LANE_KEEP, False),
+    ("u_turn_done", M.U_TURN, x(turn_done=True), M.LANE_KEEP, False),
+    ("turn_stays", M.TURN_LEFT, x(blocked=True, left_free=True, turn=Turn.LEFT), None, False),
+    ("u_turn_stays", M.U_TURN, x(), None, False),
+]
+
+
+@pytest.mark.parametrize(("name", "state", "inp", "expected", "abort"), TABLE,
+                         ids=[r[0] for r in TABLE])
+def test_transition_table(name: str, state: Motion, inp: MotionInput, expected: Motion | None,
+                          abort: bool) -> None:
+    change = transition(state, inp, P)
+    assert (change.to if change else None) is expected, name
+    if change is not None:
+        assert change.reason and change.abort is abort
+
+
+def test_every_transition_of_the_table_has_a_row() -> None:
+    pairs = {(row[1], row[3]) for row in TABLE if row[3] is not None}
+    assert pairs == {
+        (M.LANE_KEEP, M.TURN_RIGHT), (M.LANE_KEEP, M.TURN_LEFT), (M.LANE_KEEP, M.U_TURN),
+        (M.LANE_KEEP, M.LANE_CHANGE_LEFT), (M.LANE_KEEP, M.LANE_CHANGE_RIGHT),
+        (M.LANE_CHANGE_LEFT, M.LANE_KEEP), (M.LANE_CHANGE_RIGHT, M.LANE_KEEP),
+        (M.TURN_RIGHT, M.LANE_KEEP), (M.TURN_LEFT, M.LANE_KEEP), (M.U_TURN, M.LANE_KEEP),
+    }
+    assert {row[1] for row in TABLE} == set(Motion)

@@ -1,0 +1,99 @@
+"""The lane-keeping planner: station, lateral error, path window and speed target."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from perception.messages import EgoState
+from planner.planner import LaneKeepingParams, LaneKeepingPlanner
+from planner.speed_planning import Binding, SpeedPlanner
+from tests.planner.maps import KPH, needs_hdmap, real_map, road_spec, segment, straight_road
+from world.hdmap import RoadMap
+
+KINDS = ["real"]  # the planner now needs the whole map (lanes, projection)
+
+
+def ego_on(road: RoadMap, lane: int, s: float, r: float, speed: float, t: float = 1.0) -> EgoState:
+    xy = road.lane(lane).position(s, r)
+    heading = float(road.lane(lane).heading_at(s))
+    heading = math.remainder(heading, 2.0 * math.pi)
+    return EgoState(t, float(xy[0]), float(xy[1]), heading, speed, 0.0, 0.0, 0.1)
+
+
+def planner(road: RoadMap, lane: int = 1, set_kph: float = 80.0,
+            camera: bool = False) -> LaneKeepingPlanner:
+    """The map-only planner by default (these tests are about the map path and speed)."""
+    return LaneKeepingPlanner(road, LaneKeepingParams(set_kph * KPH, 180.0 * KPH, lane=lane,
+                                                      camera=camera))
+
+
+@needs_hdmap
+def test_plan_on_an_arc() -> None:
+    road = real_map(road_spec([segment(100.0), segment(200.0, 60.0), segment(100.0)], 100.0))
+    p = planner(road)
+    ego = ego_on(road, 1, 150.0, 0.4, 20.0, t=3.5)
+    plan = p.update(ego)
+    assert plan.t == 3.5
+    assert plan.ego is ego
+    assert plan.station == pytest.approx(150.0)
+    assert plan.lateral_error == pytest.approx(0.4)
+    lane = road.lane(1)
+    s, r = lane.local_coordinates(plan.path.xy)
+    np.testing.assert_allclose(r, 0.0, atol=1e-9)
+    assert s[0] == pytest.approx(145.0)
+    assert s[-1] == pytest.approx(150.0 + 2.5 * 20.0)  # 2.5 s at 20 m/s > 25 m
+    # the speed target is the speed planner's, for the same station
+    expected = SpeedPlanner(road, lane, p.params.speed).target(
+        150.0, set_speed=80.0 * KPH, max_speed=180.0 * KPH
+    )
+    assert plan.target_speed == pytest.approx(expected.speed)
+    assert plan.target_speed == pytest.approx(math.sqrt(3.0 * 56.5))
+    assert plan.target_accel == 0.0
+    assert plan.speed_limit == pytest.approx(100.0 * KPH)
+    assert p.speed_for(150.0).binding is Binding.CURVE
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_plan_on_a_straight(kind: str) -> None:
+    road = straight_road(kind, 1000.0, 50.0, ((400.0, 30.0),))
+    p = planner(road, lane=0)
+    plan = p.update(ego_on(road, 0, 200.0, -0.25, 3.0))
+    assert plan.station == pytest.approx(200.0)
+    assert plan.lateral_error == pytest.approx(-0.25)
+    assert plan.path.xy[0, 0] == pytest.approx(195.0)
+    assert plan.path.xy[-1, 0] == pytest.approx(225.0)  # at least 25 m ahead
+    assert plan.target_speed == pytest.approx(49.7 * KPH)
+    assert plan.speed_limit == pytest.approx(50.0 * KPH)
+    ahead = p.update(ego_on(road, 0, 400.0 - 2.4 - 20.0, 0.0, 13.8))
+    assert ahead.target_accel == -1.5
+    assert ahead.speed_limit == pytest.approx(50.0 * KPH)
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_closed_loop_point_mass_through_posting(kind: str) -> None:
+    """A perfect follower driving the planner's targets on lane 1 respects the new limit
+    from the moment its front bumper passes the sign."""
+    sign = 300.0
+    road = straight_road(kind, 600.0, 50.0, ((sign, 30.0),))
+    p = planner(road, lane=1, set_kph=60.0)
+    p.reset()
+    dt = 1.0 / 40.0
+    s, v, t = 100.0, 49.7 * KPH, 0.0
+    while s < 420.0:
+        plan = p.update(ego_on(road, 1, s, 0.0, v, t))
+        assert v - plan.target_speed <= (1.5 + 0.02) * dt  # decel <= a_comf + small
+        if plan.station + 2.4 >= sign:
+            assert plan.target_speed <= 30.0 * KPH
+        s += 0.5 * (v + plan.target_speed) * dt
+        v = plan.target_speed
+        t += dt
+    assert v == pytest.approx(29.7 * KPH)
+
+
+def test_rejects_oncoming_lane() -> None:
+    road = straight_road("real", 100.0, 50.0)
+    with pytest.raises(ValueError, match="ego-direction"):
+        LaneKeepingPlanner(road, LaneKeepingParams(10.0, 20.0, lane=-1))

@@ -1,0 +1,192 @@
+"""The sensor profiles: cameras, LiDAR and mounts as `world.sensors.setup` documents them, and
+the sensor schedule that fires them at their rates on the 240 Hz physics steps."""
+
+from __future__ import annotations
+
+import math
+import xml.etree.ElementTree as ET
+from collections import Counter
+from dataclasses import dataclass, replace
+
+import numpy as np
+import pytest
+
+from vehicle_urdf import URDF_PATH, read_geometry
+from world.core.client import PHYSICS_RATE
+from world.frames import SensorMount
+from world.sensors.rig import Due, SensorSchedule
+from world.sensors.setup import Profile, SensorSetup, sensor_setup
+from world.spec import LidarNoiseSpec
+
+
+@dataclass(frozen=True, slots=True)
+class Row:
+    """One row of the profile table in `world.sensors.setup`'s docstring."""
+
+    front: tuple[int, int, float]  # width, height [px], rate [Hz]
+    sides: tuple[int, int, float] | None
+    columns: int
+
+
+TABLE = {
+    Profile.FAST: Row((640, 480, 10.0), None, 900),
+    Profile.DEFAULT: Row((640, 480, 10.0), (320, 240, 2.0), 1800),
+    Profile.PAPER: Row((1280, 960, 10.0), (1280, 960, 10.0), 1800),
+}
+
+
+def urdf_sensor_joints() -> dict[str, tuple[list[float], list[float]]]:
+    """(xyz, rpy) of each fixed joint whose child is a sensor link, read from the URDF."""
+    out = {}
+    for joint in ET.parse(URDF_PATH).getroot().iter("joint"):
+        child = joint.find("child")
+        origin = joint.find("origin")
+        assert child is not None
+        link = child.attrib["link"]
+        if link == "lidar_link" or link.startswith("camera_"):
+            assert joint.attrib["type"] == "fixed" and origin is not None
+            xyz = [float(v) for v in origin.attrib["xyz"].split()]
+            rpy = [float(v) for v in origin.attrib.get("rpy", "0 0 0").split()]
+            out[link] = (xyz, rpy)
+    return out
+
+
+def assert_mount(mount: SensorMount, xyz: list[float], rpy: list[float],
+                 ride_height: float) -> None:
+    np.testing.assert_allclose([mount.x, mount.y, mount.z],
+                               [xyz[0], xyz[1], xyz[2] + ride_height], atol=1e-12)
+    np.testing.assert_allclose([mount.roll, mount.pitch, mount.yaw], rpy, atol=1e-12)
+
+
+@pytest.mark.parametrize("profile", list(Profile))
+def test_profile_cameras_match_the_table(profile: Profile) -> None:
+    setup = sensor_setup(profile)
+    row = TABLE[profile]
+    assert setup.profile is profile
+    expected = {"front": row.front}
+    if row.sides is not None:
+        expected |= {"left": row.sides, "right": row.sides}
+    assert setup.cameras[0].name == "front"  # front first
+    assert {c.name: (c.width, c.height, c.rate) for c in setup.cameras} == expected
+    assert len(setup.cameras) == len(expected)
+    for cam in setup.cameras:
+        assert cam.fov_x == pytest.approx(math.radians(80.0))
+        # the pinhole model agrees: the image's half width seen at the focal length is 40 deg
+        assert math.degrees(math.atan(cam.cx / cam.fx)) == pytest.approx(40.0)
+        assert math.tan(cam.fov_y / 2) == pytest.approx(
+            math.tan(math.radians(40.0)) * cam.height / cam.width)
+
+
+@pytest.mark.parametrize("profile", list(Profile))
+def test_profile_lidar_is_vlp16_like(profile: Profile) -> None:
+    lidar = sensor_setup(profile).lidar
+    assert lidar.azimuth_steps == TABLE[profile].columns
+    assert lidar.channels == 16
+    np.testing.assert_allclose(np.degrees(lidar.elevations), np.arange(-15.0, 16.0, 2.0),
+                               atol=1e-12)
+    assert list(lidar.elevations) == sorted(lidar.elevations)  # ascending
+    assert lidar.max_range == 100.0
+    assert lidar.rate == 10.0
+    assert lidar.rays == 16 * TABLE[profile].columns
+    assert 360.0 / lidar.azimuth_steps == pytest.approx(0.4 if profile is Profile.FAST else 0.2)
+
+
+@pytest.mark.parametrize("profile", list(Profile))
+def test_mounts_are_the_urdf_sensor_joints_raised_by_the_ride_height(profile: Profile) -> None:
+    joints = urdf_sensor_joints()
+    ride_height = read_geometry().ride_height
+    assert 0.0 < ride_height < read_geometry().wheel_radius
+    setup = sensor_setup(profile)
+    for cam in setup.cameras:
+        assert_mount(cam.mount, *joints[f"camera_{cam.name}_link"], ride_height)
+    assert_mount(setup.lidar.mount, *joints["lidar_link"], ride_height)
+    # the side cameras look sideways: their optical axes are the car's left and right
+    if profile is not Profile.FAST:
+        np.testing.assert_allclose(setup.camera("left").mount.rotation()[:, 0], [0, 1, 0],
+                                   atol=1e-4)
+        np.testing.assert_allclose(setup.camera("right").mount.rotation()[:, 0], [0, -1, 0],
+                                   atol=1e-4)
+    np.testing.assert_allclose(setup.camera("front").mount.rotation(), np.eye(3), atol=1e-9)
+
+
+def test_lidar_noise_block_is_applied() -> None:
+    quiet = sensor_setup(Profile.DEFAULT)
+    noise = LidarNoiseSpec(range_sigma=0.07, dropout=0.3)
+    noisy = sensor_setup(Profile.DEFAULT, noise)
+    assert (noisy.lidar.range_sigma, noisy.lidar.dropout) == (0.07, 0.3)
+    assert (quiet.lidar.range_sigma, quiet.lidar.dropout) != (0.07, 0.3)
+    # nothing else changes
+    assert replace(noisy.lidar, range_sigma=quiet.lidar.range_sigma,
+                   dropout=quiet.lidar.dropout) == quiet.lidar
+    assert noisy.cameras == quiet.cameras
+    # the scenario's default block is the LiDAR's default
+    default = sensor_setup(Profile.FAST, LidarNoiseSpec())
+    assert default.lidar == sensor_setup(Profile.FAST).lidar
+
+
+@pytest.mark.parametrize("profile", list(Profile))
+def test_schedule_fires_each_sensor_at_its_rate(profile: Profile) -> None:
+    setup = sensor_setup(profile)
+    schedule = SensorSchedule(setup)
+    assert PHYSICS_RATE == 240
+    seconds = 10
+    fired: dict[str, list[int]] = {name: [] for name in [c.name for c in setup.cameras]
+                                   + ["lidar"]}
+    for step in range(seconds * PHYSICS_RATE):
+        due = schedule.due(step)
+        assert isinstance(due, Due)
+        assert bool(due) == (bool(due.cameras) or due.lidar)
+        assert len(set(due.cameras)) == len(due.cameras)
+        for name in due.cameras:
+            fired[name].append(step)
+        if due.lidar:
+            fired["lidar"].append(step)
+        if due:  # the loop may only look at the fastest sensor's instants
+            assert step % schedule.every == 0
+    rates = {c.name: c.rate for c in setup.cameras} | {"lidar": setup.lidar.rate}
+    for name, steps in fired.items():
+        assert len(steps) == seconds * rates[name], name
+        assert steps[0] == 0
+        assert set(np.diff(steps).tolist()) == {round(PHYSICS_RATE / rates[name])}, name
+    assert schedule.every == 24  # 10 Hz is the fastest in every profile
+
+
+def test_schedule_of_the_default_profile_step_by_step() -> None:
+    schedule = SensorSchedule(sensor_setup(Profile.DEFAULT))
+    assert schedule.due(0) == Due(("front", "left", "right"), True)
+    assert schedule.due(24) == Due(("front",), True)
+    assert schedule.due(120) == Due(("front", "left", "right"), True)
+    assert not schedule.due(1) and not schedule.due(23) and not schedule.due(121)
+    counts = Counter(schedule.due(step) for step in range(240) if schedule.due(step))
+    assert counts == {Due(("front", "left", "right"), True): 2, Due(("front",), True): 8}
+
+
+def test_schedule_rejects_rates_that_do_not_fit() -> None:
+    setup = sensor_setup(Profile.FAST)
+    front = setup.cameras[0]
+    for rate in (7.0, 0.0):  # does not divide 240 Hz; no rate
+        bad = replace(setup, cameras=(replace(front, rate=rate),))
+        with pytest.raises(ValueError, match="must divide"):
+            SensorSchedule(bad)
+    # 16 Hz divides 240 Hz (15 steps) but the LiDAR's 24 steps are no multiple of it
+    odd = replace(setup, cameras=(replace(front, rate=16.0),))
+    with pytest.raises(ValueError, match="multiple"):
+        SensorSchedule(odd)
+    # 20 Hz (12 steps) with the LiDAR's 24: fine, the fastest period is 12
+    assert SensorSchedule(replace(setup, cameras=(replace(front, rate=20.0),))).every == 12
+
+
+def test_camera_lookup() -> None:
+    default = sensor_setup(Profile.DEFAULT)
+    assert isinstance(default, SensorSetup)
+    for name in ("front", "left", "right"):
+        assert default.camera(name).name == name
+    assert default.camera("left").width == 320
+    assert sensor_setup(Profile.PAPER).camera("right").height == 960
+    fast = sensor_setup(Profile.FAST)
+    assert fast.camera("front").width == 640
+    for name in ("left", "right", "rear", ""):
+        with pytest.raises(KeyError, match="fast"):
+            fast.camera(name)
+    with pytest.raises(KeyError):
+        default.camera("Front")  # names are exact

@@ -1,0 +1,1 @@
+"""NPC vehicles and pedestrians, their behaviours, town traffic."""

@@ -1,0 +1,248 @@
+"""NPC bodies in the physics world, moved along the route by their scripted behaviour.
+
+NPCs are kinematic: static (mass 0) boxes placed at `world.ACTOR_RATE` from their
+`NpcMotion` in route coordinates. The ego collides with them like with a wall, and contact
+queries see them. (Only the ego must drive through its joints; NPCs are scripted traffic.)
+Pedestrians are boxes too (0.5 m deep, 0.6 m wide, 1.75 m tall), placed by station and
+offset from their lane's centre like any actor; `speed_kph` is a walking speed along the
+lane, the `walk` action moves them across the road, facing where they walk.
+Bodies are placed with one scalar map lookup per moving actor; `poses` (all of them, for
+criteria, scoring and the recording) is one vectorised map call, when asked.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import pybullet
+from numpy.typing import NDArray
+from pybullet_utils.bullet_client import BulletClient
+
+from world.actors.behaviour import NpcMotion, TriggerContext
+from world.actors.town_traffic import TownDriver
+from world.hdmap import RoadMap
+from world.spec import ActorSpec, ActorType
+
+
+@dataclass(frozen=True, slots=True)
+class BoxSize:
+    length: float  # [m]
+    width: float  # [m]
+    height: float  # [m]
+
+
+SIZES = {
+    ActorType.CAR: BoxSize(4.6, 1.8, 1.5),
+    ActorType.TRUCK: BoxSize(9.0, 2.5, 3.4),
+    ActorType.OBSTACLE: BoxSize(1.0, 1.0, 1.0),  # a crate / barrier block
+    ActorType.PEDESTRIAN: BoxSize(0.5, 0.6, 1.75),
+}
+COLOURS = {
+    ActorType.CAR: (0.85, 0.20, 0.15, 1.0),
+    ActorType.TRUCK: (0.90, 0.65, 0.10, 1.0),
+    ActorType.OBSTACLE: (0.95, 0.45, 0.05, 1.0),
+    ActorType.PEDESTRIAN: (0.20, 0.70, 0.30, 1.0),
+}
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class ActorPoses:
+    """Ground truth of all NPCs at one instant (for criteria and the recording)."""
+
+    ids: tuple[str, ...]
+    kinds: tuple[ActorType, ...]
+    centres: NDArray[np.float64]  # [m] (N, 3) map frame
+    yaws: NDArray[np.float64]  # [rad] (N,)
+    half_sizes: NDArray[np.float64]  # [m] (N, 3) length, width, height halves
+    stations: NDArray[np.float64]  # [m] (N,) route station of each centre
+    offsets: NDArray[np.float64]  # [m] (N,) lateral offset from the reference line
+    # [m/s] (N,) vehicles: along their lane; pedestrians: walking speed over ground (a
+    # crossing's lateral motion included)
+    speeds: NDArray[np.float64]
+    accels: NDArray[np.float64]  # [m/s^2] (N,) rate of change of `speeds`, signed
+
+
+class ActorSet:
+    """All scripted actors of a world."""
+
+    def __init__(self, client: BulletClient, road: RoadMap, specs: tuple[ActorSpec, ...]) -> None:
+        self._c = client
+        self._reset_pose = client.resetBasePositionAndOrientation  # bound once: hot path
+        self._road = road
+        self.specs = specs
+        # in a town each actor drives its own route road; on a road, the route
+        self._maps = [road if a.road is None else RoadMap.from_spec(a.road) for a in specs]
+        self._own = np.array([a.road is not None for a in specs], dtype=bool)
+        self.motions: list[NpcMotion] = []
+        self.bodies: list[int] = []
+        for spec, own_map in zip(specs, self._maps, strict=True):
+            lane = own_map.lane(spec.lane)
+            offset = float(lane.offset_at(spec.s)) + spec.offset
+            self.motions.append(
+                NpcMotion(spec.s, offset, spec.speed, lane.direction, spec.actions,
+                          lane=spec.lane, pedestrian=spec.type is ActorType.PEDESTRIAN)
+            )
+            self.bodies.append(self._make_body(spec.type))
+        self.lengths = np.array([SIZES[a.type].length for a in specs])
+        self.half_sizes = np.array(
+            [[SIZES[a.type].length / 2, SIZES[a.type].width / 2, SIZES[a.type].height / 2]
+             for a in specs]
+        ).reshape(-1, 3)
+        self._drivers = [
+            TownDriver(own_map, SIZES[a.type].length / 2)
+            if a.road is not None and a.type in (ActorType.CAR, ActorType.TRUCK) else None
+            for a, own_map in zip(specs, self._maps, strict=True)
+        ]
+        self._last_speed = self._speeds()  # [m/s] before the last step
+        self._dt = 1.0  # [s] the last step
+        self._ids = tuple(a.id for a in specs)
+        self._kinds = tuple(a.type for a in specs)
+        self._flip_list = [math.pi if m.direction < 0 else 0.0 for m in self.motions]
+        self._flip = np.array(self._flip_list)
+        self._heights = self.half_sizes[:, 2].tolist()  # [m] box centre above the ground
+        # traffic on the road before the route's first exit keeps that road (it goes on
+        # straight from the fork, `RoadMap.through_line`); the rest follows the route
+        self._fork = road.exits[0].s if road.exits else math.inf
+        self._through = np.array([a.s < self._fork and a.road is None for a in specs],
+                                 dtype=bool)
+        self._lines = [road.through_line if through else own_map.line
+                       for through, own_map in zip(self._through.tolist(), self._maps,
+                                                   strict=True)]
+        self.town_drivers = any(d is not None for d in self._drivers)
+        self._xy = np.zeros((len(specs), 2))  # [m] each body's centre as last placed
+        self._poses: ActorPoses | None = None
+        self._place(force=True)
+
+    def _make_body(self, kind: ActorType) -> int:
+        size = SIZES[kind]
+        half = [size.length / 2, size.width / 2, size.height / 2]
+        shape = self._c.createCollisionShape(pybullet.GEOM_BOX, halfExtents=half)
+        visual = self._c.createVisualShape(
+            pybullet.GEOM_BOX, halfExtents=half, rgbaColor=list(COLOURS[kind])
+        )
+        return int(self._c.createMultiBody(0.0, shape, visual, [0.0, 0.0, -10.0],
+                                         useMaximalCoordinates=True))
+
+    def lane_offset(self, lane: int, s: float) -> float:
+        """[m] offset of a route lane's centre at s (the actors on the route's road)."""
+        return float(self._road.lane(lane).offset_at(s))
+
+    def gaps(self, ego_s: float, ego_length: float,
+             ego_xy: tuple[float, float] | None = None) -> NDArray[np.float64]:
+        """[m] (N,) bumper-to-bumper distance of each actor to the ego: along the route, or
+        for an actor on its own town route (given `ego_xy`), centre to centre less both
+        half lengths."""
+        s = np.array([m.s for m in self.motions])
+        gaps = np.maximum(0.0, np.abs(s - ego_s) - (self.lengths + ego_length) / 2)
+        if ego_xy is not None and self._own.any():
+            apart = np.hypot(self._xy[:, 0] - ego_xy[0], self._xy[:, 1] - ego_xy[1])
+            direct = np.maximum(0.0, apart - (self.lengths + ego_length) / 2)
+            gaps = np.where(self._own, direct, gaps)
+        return gaps
+
+    def fire_triggers(self, t: float, ego_s: float, ego_length: float,
+                      ego_xy: tuple[float, float] | None = None) -> list[tuple[str, int]]:
+        """Start the actions whose triggers hold; returns (actor id, action index) started."""
+        started = []
+        for spec, motion, gap, own_map in zip(
+            self.specs, self.motions, self.gaps(ego_s, ego_length, ego_xy), self._maps,
+            strict=True,
+        ):
+            ctx = TriggerContext(t=t, ego_s=ego_s, gap=float(gap))
+
+            def lane_offset(lane: int, s: float, m: RoadMap = own_map) -> float:
+                return float(m.lane(lane).offset_at(s))
+
+            started += [(spec.id, i) for i in motion.fire_due(ctx, lane_offset)]
+        return started
+
+    def step(self, t: float, dt: float, ego: tuple[float, float, float] | None = None) -> None:
+        """Advance every motion by dt [s] and move the moving bodies to their new poses.
+        `ego`: (x, y, half length) of the ego, for town drivers to keep their distance."""
+        self._last_speed = self._speeds()
+        self._dt = dt
+        self._cap_town_drivers(t, ego)
+        for motion, line in zip(self.motions, self._lines, strict=True):
+            motion.step(t, dt, line.curvature_one(motion.s))
+        self._poses = None
+        self._place(force=False)
+
+    def _cap_town_drivers(self, t: float, ego: tuple[float, float, float] | None) -> None:
+        """Each town driver's speed cap from its rules and the other vehicles' centres."""
+        if not self._own.any():
+            return
+        vehicles = np.array([k in (ActorType.CAR, ActorType.TRUCK) for k in self._kinds])
+        xy, half = self._xy[vehicles], self.half_sizes[vehicles, 0]
+        if ego is not None:
+            xy = np.vstack([xy, [ego[:2]]])
+            half = np.append(half, ego[2])
+        index = np.cumsum(vehicles) - 1  # row of each vehicle actor in xy
+        for i, (driver, motion) in enumerate(zip(self._drivers, self.motions, strict=True)):
+            if driver is None:
+                continue
+            others = np.ones(len(xy), dtype=bool)
+            others[index[i]] = False
+            motion.cap = driver.speed_cap(t, motion.s, motion.speed, xy[others], half[others])
+
+    def _speeds(self) -> NDArray[np.float64]:
+        """[m/s] (N,) `ActorPoses.speeds` now."""
+        return np.array([m.ground_speed if m.pedestrian else m.speed for m in self.motions],
+                        dtype=np.float64)
+
+    @property
+    def accels(self) -> NDArray[np.float64]:
+        """[m/s^2] (N,) each actor's acceleration (of `ActorPoses.speeds`) over the last step."""
+        out: NDArray[np.float64] = (self._speeds() - self._last_speed) / self._dt
+        return out
+
+    @property
+    def poses(self) -> ActorPoses:
+        """Ground truth of every actor now (computed when asked, once per step)."""
+        if self._poses is None:
+            self._poses = self._compute_poses()
+        return self._poses
+
+    def _compute_poses(self) -> ActorPoses:
+        m = self.motions
+        s = np.array([x.s for x in m])
+        offsets = np.array([x.offset for x in m])
+        x, y, heading = self._road.line.pose(s, offsets)  # offsets are from the reference line
+        through = self._through & (s > self._fork)  # on the road the route left by its exit
+        if through.any():
+            x[through], y[through], heading[through] = self._road.through_line.pose(
+                s[through], offsets[through])
+        for i in np.flatnonzero(self._own):  # on its own town route
+            x[i], y[i], heading[i] = self._lines[i].pose_one(float(s[i]), float(offsets[i]))
+        through = through | self._own
+        if through.any():
+            # the truth along the route, where criteria look for vehicles: projected
+            s = s.copy()
+            s[through], offsets[through] = self._road.local_coordinates(
+                np.column_stack([x[through], y[through]]))
+        yaws = heading + self._flip + np.array([x.heading_offset for x in m])
+        centres = np.column_stack([x, y, self.half_sizes[:, 2]]) if m else np.zeros((0, 3))
+        return ActorPoses(
+            ids=self._ids,
+            kinds=self._kinds,
+            centres=centres,
+            yaws=yaws,
+            half_sizes=self.half_sizes,
+            stations=s,
+            offsets=offsets,
+            speeds=self._speeds(),
+            accels=self.accels,
+        )
+
+    def _place(self, force: bool) -> None:
+        """Move the bodies of the actors that move (all of them with `force`): one scalar
+        map lookup each, the hot path of the NPCs."""
+        for i, (body, m, flip, z, line) in enumerate(zip(
+                self.bodies, self.motions, self._flip_list, self._heights, self._lines,
+                strict=True)):
+            if force or m.speed != 0.0 or m.lateral_speed != 0.0:
+                x, y, heading = line.pose_one(m.s, m.offset)
+                self._xy[i] = (x, y)
+                half = 0.5 * (heading + flip + m.heading_offset)
+                self._reset_pose(body, (x, y, z), (0.0, 0.0, math.sin(half), math.cos(half)))

@@ -1,0 +1,216 @@
+"""Scripted NPC behaviour in route coordinates: triggers fire actions, motion is integrated.
+
+Pure (no PyBullet): `NpcMotion` holds one actor's state along the route (station, lateral
+offset from the reference line, speed, lateral speed) and its pending actions; `step()`
+advances it by dt. Motion is smooth by construction: speed changes at a bounded
+acceleration, lateral moves follow a trapezoidal lateral-speed profile (bounded lateral
+acceleration), so positions and headings never jump.
+
+Actions (scenario format): `speed` (to a speed at an acceleration), `lane_change` (to a
+lane's centre at a lateral speed), `walk` (across the road to an offset from the actor's
+lane centre, at a walking speed: the same trapezoidal lateral move), `stop` (brake to rest).
+Triggers: `time`, `ego_s`, `gap` (bumper-to-bumper distance to the ego along the route),
+`after` (an earlier action ended, plus a delay). Each action fires once, when its trigger
+first holds.
+
+Headings: a vehicle's body points along its velocity while it moves faster than 0.1 m/s
+(along its lane at rest). A pedestrian faces where it walks, also straight across the road
+(no longitudinal speed), turning towards it at `PEDESTRIAN_TURN_RATE`, and keeps the last
+heading it walked in while it stands.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+from world.spec import (
+    ActionSpec,
+    AfterTrigger,
+    EgoStationTrigger,
+    GapTrigger,
+    LaneChangeAction,
+    SpeedAction,
+    StopAction,
+    TimeTrigger,
+    Trigger,
+    WalkAction,
+)
+
+LATERAL_ACCEL = 1.5  # [m/s^2] ramp of the lateral speed at the start and end of a lane change
+ARRIVED = 1e-3  # [m] lateral distance that counts as arrived
+PEDESTRIAN_TURN_RATE = math.pi  # [rad/s] a pedestrian turns to face where it walks (90 deg: 0.5 s)
+PEDESTRIAN_MOVING = 0.05  # [m/s] a pedestrian slower than this over ground keeps its heading
+CAP_ACCEL = 1.5  # [m/s^2] a capped NPC (a town driver) speeds up again at this
+
+LaneOffset = Callable[[int, float], float]
+"""(lane index, station) -> lateral offset [m] of that lane's centre from the reference line."""
+
+
+@dataclass(frozen=True, slots=True)
+class TriggerContext:
+    t: float  # [s] sim time
+    ego_s: float  # [m] the ego's centre station
+    gap: float  # [m] bumper-to-bumper distance between this actor and the ego along the route
+
+
+def trigger_holds(
+    trigger: Trigger, ctx: TriggerContext, ended_at: Sequence[float | None]
+) -> bool:
+    """Whether `trigger` holds now. `ended_at[i]` [s] is when item i of the same list (an
+    actor's actions, or the ego's events) ended, None while it has not; `after` reads it.
+    Shared by the NPC actions and the ego events (`world.ego.events`)."""
+    if isinstance(trigger, TimeTrigger):
+        return ctx.t >= trigger.time
+    if isinstance(trigger, EgoStationTrigger):
+        return ctx.ego_s >= trigger.s
+    if isinstance(trigger, GapTrigger):
+        return ctx.gap <= trigger.gap
+    if isinstance(trigger, AfterTrigger):
+        ended = ended_at[trigger.index]
+        return ended is not None and ctx.t >= ended + trigger.delay
+    raise TypeError(f"unknown trigger {trigger!r}")
+
+
+class NpcMotion:
+    """One actor's kinematic state in route coordinates and its scripted actions."""
+
+    def __init__(
+        self, s: float, offset: float, speed: float, direction: int,
+        actions: tuple[ActionSpec, ...], *, lane: int = 0, pedestrian: bool = False,
+    ) -> None:
+        """`lane`: the lane whose centre `walk` offsets are measured from (a `lane_change`
+        moves it); `pedestrian`: face the walking direction (module doc)."""
+        self.s = s  # [m] station of the actor's centre
+        self.offset = offset  # [m] lateral offset of its centre from the reference line, left +
+        self.speed = speed  # [m/s] along its lane's direction of travel
+        self.lateral_speed = 0.0  # [m/s] d(offset)/dt
+        self.direction = direction  # +1 with the route, -1 against
+        self.lane = lane
+        self.pedestrian = pedestrian
+        self._facing = 0.0  # [rad] a pedestrian's heading relative to its lane's direction
+        self.actions = actions
+        self.fired_at: list[float | None] = [None] * len(actions)  # [s]
+        self.ended_at: list[float | None] = [None] * len(actions)  # [s]
+        self._target_speed = speed  # [m/s]
+        self._planned = speed  # [m/s] the scripted speed (actions alone)
+        self.cap: float | None = None  # [m/s] a town driver's limit (`world.actors.town_traffic`)
+        self._accel = 0.0  # [m/s^2] magnitude towards the target speed
+        self._speed_action: int | None = None
+        self._target_offset = offset  # [m]
+        self._lateral_max = 0.0  # [m/s] cruise lateral speed of the running lateral move
+        self._lateral_action: int | None = None
+
+    # -- triggers --------------------------------------------------------------------------
+
+    def fire_due(self, ctx: TriggerContext, lane_offset: LaneOffset) -> list[int]:
+        """Start every action whose trigger holds now; returns their indices."""
+        started = []
+        for i, spec in enumerate(self.actions):
+            if self.fired_at[i] is None and trigger_holds(spec.trigger, ctx, self.ended_at):
+                self.fired_at[i] = ctx.t
+                self._start(i, spec, lane_offset)
+                started.append(i)
+        return started
+
+    def _start(self, i: int, spec: ActionSpec, lane_offset: LaneOffset) -> None:
+        action = spec.action
+        if isinstance(action, SpeedAction):
+            self._target_speed, self._accel, self._speed_action = action.speed, action.accel, i
+        elif isinstance(action, StopAction):
+            self._target_speed, self._accel, self._speed_action = 0.0, action.decel, i
+        elif isinstance(action, LaneChangeAction):
+            self._target_offset = lane_offset(action.to_lane, self.s)
+            self._lateral_max, self._lateral_action = action.lateral_speed, i
+            self.lane = action.to_lane
+        elif isinstance(action, WalkAction):
+            self._target_offset = lane_offset(self.lane, self.s) + action.to_offset
+            self._lateral_max, self._lateral_action = action.speed, i
+        # an action replacing a running one of the same kind ends the old one now
+        for j in range(len(self.actions)):
+            running = self.fired_at[j] is not None and self.ended_at[j] is None
+            if j != i and running and _same_kind(self.actions[j].action, action):
+                self.ended_at[j] = self.fired_at[i]
+
+    # -- motion ------------------------------------------------------------------------------
+
+    def step(self, t: float, dt: float, curvature: float) -> None:
+        """Advance by dt [s]. `curvature` [1/m] is the reference line's at the actor's station
+        (the station rate of a body at lateral offset r is v / (1 - k r))."""
+        self._step_speed(t, dt)
+        self._step_lateral(t, dt)
+        if self.pedestrian:
+            self._turn(dt)
+        scale = 1.0 - curvature * self.offset
+        self.s += self.direction * self.speed * dt / max(scale, 1e-3)
+        self.offset += self.lateral_speed * dt
+
+    def _turn(self, dt: float) -> None:
+        """A pedestrian turns towards its direction of travel, at most at the turn rate."""
+        if math.hypot(self.speed, self.lateral_speed) < PEDESTRIAN_MOVING:
+            return
+        course = math.atan2(self.lateral_speed, self.direction * self.speed)  # route frame
+        wanted = course if self.direction > 0 else course - math.pi  # from its lane's direction
+        error = math.remainder(wanted - self._facing, 2.0 * math.pi)
+        limit = PEDESTRIAN_TURN_RATE * dt
+        self._facing = math.remainder(self._facing + max(-limit, min(limit, error)),
+                                      2.0 * math.pi)
+
+    def _step_speed(self, t: float, dt: float) -> None:
+        error = self._target_speed - self._planned
+        change = self._accel * dt
+        if abs(error) <= change:
+            self._planned = self._target_speed
+            if self._speed_action is not None:
+                self.ended_at[self._speed_action] = t
+                self._speed_action = None
+        else:
+            self._planned += math.copysign(change, error)
+        if self.cap is None:
+            self.speed = self._planned
+        else:  # a town driver's rules: never above the cap, back up at CAP_ACCEL
+            self.speed = max(0.0, min(self._planned, self.cap, self.speed + CAP_ACCEL * dt))
+
+    def _step_lateral(self, t: float, dt: float) -> None:
+        if self._lateral_action is None:
+            self.lateral_speed = 0.0
+            return
+        remaining = self._target_offset - self.offset
+        if abs(remaining) < ARRIVED and abs(self.lateral_speed) <= LATERAL_ACCEL * dt:
+            self.lateral_speed = 0.0
+            self.ended_at[self._lateral_action] = t
+            self._lateral_action = None
+            return
+        # trapezoidal profile in discrete time: the fastest lateral speed k * a dt from which
+        # slowing by a dt per step (k + (k-1) + ... + 1 steps of a dt^2) still stops on the
+        # target, capped at the action's lateral speed
+        step = LATERAL_ACCEL * dt  # [m/s] speed change per step
+        k = math.floor((math.sqrt(1.0 + 8.0 * abs(remaining) / (step * dt)) - 1.0) / 2.0)
+        if k == 0:  # closer than one step at the slowest speed: land on the target
+            self.lateral_speed = remaining / dt
+            return
+        wanted = math.copysign(min(self._lateral_max, k * step), remaining)
+        self.lateral_speed += max(-step, min(step, wanted - self.lateral_speed))
+
+    @property
+    def heading_offset(self) -> float:
+        """[rad] the body's yaw relative to its lane's direction of travel (module doc)."""
+        if self.pedestrian:
+            return self._facing
+        if self.speed <= 0.1:
+            return 0.0
+        return math.atan2(self.lateral_speed, self.speed) * self.direction
+
+    @property
+    def ground_speed(self) -> float:
+        """[m/s] speed over ground, the lateral motion included."""
+        return math.hypot(self.speed, self.lateral_speed)
+
+
+def _same_kind(a: object, b: object) -> bool:
+    longitudinal = (SpeedAction, StopAction)
+    lateral = (LaneChangeAction, WalkAction)
+    return (isinstance(a, longitudinal) and isinstance(b, longitudinal)) or (
+        isinstance(a, lateral) and isinstance(b, lateral)
+    )

@@ -1,0 +1,145 @@
+"""Town traffic: NPC cars that keep to the rules along their own routes.
+
+An NPC in a town drives its route road (`world.map.town.compile_route`) at its scripted speed
+(`NpcMotion`), capped each step by `TownDriver.speed_cap`, the least of:
+
+- **signals**: a red light ahead, or a yellow one it can stop for at ``STOP_DECEL``
+  (2.5 m/s^2), makes it stop with its front bumper ``STOP_MARGIN`` before the line, along
+  the braking curve ``v = sqrt(2 b d)``;
+- **stop signs**: it stops at the line, stands ``STOP_DWELL`` (1.5 s), then goes on once no
+  other vehicle is inside the junction's box;
+- **turns**: ``v = sqrt(TURN_LATERAL_ACCEL / curvature)`` (2.0 m/s^2) on a turn's arc,
+  braked for ahead of it;
+- **the vehicle ahead**: any vehicle (other NPCs, the ego) whose centre is on its route
+  ahead, within its lane (``FOLLOW_LANE_HALF`` of the lane centre), is kept at a standstill
+  gap of ``FOLLOW_GAP`` plus ``FOLLOW_HEADWAY`` seconds of speed, again by the braking
+  curve.
+
+At its route's end (the next junction's stop line) it stops and stays.
+
+The cap only lowers the speed; `NpcMotion` speeds up again at its ``CAP_ACCEL`` when it
+lifts.
+These are scripted drivers on ground truth (the world's own NPCs), not a stack: they read
+the light's lamp from its timing and other cars' true poses.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from world.hdmap import RoadMap
+from world.map.signals import light_colour
+from world.spec import LightColour, StopSign, TrafficLight
+
+STOP_DECEL = 2.5  # [m/s^2] the braking curve to a stop line or a car ahead
+STOP_MARGIN = 0.5  # [m] front bumper short of the stop line
+STOP_DWELL = 1.5  # [s] standing at a stop sign
+STOP_SPEED = 0.3  # [m/s] below this at the line counts as stopped
+TURN_LATERAL_ACCEL = 2.0  # [m/s^2]
+FOLLOW_GAP = 4.0  # [m] bumper to bumper at a standstill
+FOLLOW_HEADWAY = 1.2  # [s]
+FOLLOW_LANE_HALF = 1.5  # [m] how far off its lane's centre a vehicle counts as ahead
+LOOK_AHEAD = 60.0  # [m]
+
+
+FloatArray = NDArray[np.float64]
+
+
+@dataclass(slots=True)
+class _StopLine:
+    s: float  # [m] station of the line on the NPC's route
+    light: TrafficLight | None  # None: a stop sign
+    box: tuple[float, float, float]  # (x, y, half width) of the junction's box
+    stood_since: float | None = None  # [s] when it came to a stop at a stop sign
+    passed: bool = False
+
+
+class TownDriver:
+    """The rules one NPC keeps on its route `road` (module doc)."""
+
+    def __init__(self, road: RoadMap, half_length: float) -> None:
+        self.road = road
+        self.half_length = half_length
+        boxes = {j.s_stop: (j.x, j.y, j.half_width) for j in road.junctions}
+        self._lines = [
+            _StopLine(f.s, f if isinstance(f, TrafficLight) else None, boxes.get(f.s, (0, 0, 0)))
+            for f in road.features if isinstance(f, StopSign | TrafficLight)
+        ]
+        # the turn arcs: (start station, end station, curvature)
+        self._arcs = [(p.s0, p.s0 + p.length, abs(p.curvature))
+                      for p in road.pieces if p.curvature != 0.0]
+
+    def speed_cap(self, t: float, s: float, speed: float, others: FloatArray,
+                  other_half_lengths: FloatArray) -> float:
+        """[m/s] the most this NPC may drive now at station s and `speed`; `others` (N, 2)
+        are the other vehicles' centres, with their half lengths."""
+        front = s + self.half_length
+        cap = min(self._line_cap(t, front, speed, others), self._turn_cap(s),
+                  _braking_speed(max(self.road.length - front, 0.0)))
+        return min(cap, self._follow_cap(s, speed, others, other_half_lengths))
+
+    def _line_cap(self, t: float, front: float, speed: float, others: FloatArray) -> float:
+        cap = math.inf
+        for line in self._lines:
+            if line.passed:
+                continue
+            distance = line.s - STOP_MARGIN - front
+            if distance < -STOP_MARGIN:  # the front is over the line: it has gone
+                line.passed = True
+                continue
+            if distance > LOOK_AHEAD:
+                break
+            if self._must_stop(line, t, distance, speed, others):
+                cap = min(cap, _braking_speed(max(distance, 0.0)))
+        return cap
+
+    def _must_stop(self, line: _StopLine, t: float, distance: float, speed: float,
+                   others: FloatArray) -> bool:
+        if line.light is not None:
+            colour = light_colour(line.light, t)
+            if colour is LightColour.YELLOW:  # stop if it can at STOP_DECEL, else go
+                return speed * speed <= 2.0 * STOP_DECEL * max(distance, 0.0) + 1.0
+            return colour is LightColour.RED
+        if line.stood_since is None:
+            if distance < 1.0 and speed < STOP_SPEED:
+                line.stood_since = t
+            return True
+        return t - line.stood_since < STOP_DWELL or _box_occupied(line.box, others)
+
+    def _turn_cap(self, s: float) -> float:
+        cap = math.inf
+        for s0, s1, curvature in self._arcs:
+            if s > s1 or s0 - s > LOOK_AHEAD:
+                continue
+            v_turn = math.sqrt(TURN_LATERAL_ACCEL / curvature)
+            cap = min(cap, math.sqrt(v_turn * v_turn + 2.0 * STOP_DECEL * max(s0 - s, 0.0)))
+        return cap
+
+    def _follow_cap(self, s: float, speed: float, others: FloatArray,
+                    other_half_lengths: FloatArray) -> float:
+        if len(others) == 0:
+            return math.inf
+        stations, offsets = self.road.local_coordinates(others)
+        ahead = (stations > s) & (stations - s < LOOK_AHEAD) & (np.abs(offsets) < FOLLOW_LANE_HALF)
+        if not ahead.any():
+            return math.inf
+        gaps = stations[ahead] - s - self.half_length - other_half_lengths[ahead]
+        room = float(gaps.min()) - FOLLOW_GAP - FOLLOW_HEADWAY * speed
+        return _braking_speed(max(room, 0.0))
+
+
+def _braking_speed(distance: float) -> float:
+    """[m/s] the speed from which STOP_DECEL stops in `distance` [m]."""
+    return math.sqrt(2.0 * STOP_DECEL * distance)
+
+
+def _box_occupied(box: tuple[float, float, float], others: FloatArray) -> bool:
+    x, y, half = box
+    if len(others) == 0 or half == 0.0:
+        return False
+    inside = (np.abs(others[:, 0] - x) < half) & (np.abs(others[:, 1] - y) < half)
+    return bool(inside.any())

@@ -1,0 +1,1 @@
+"""The physics client and clock, rates, rendering, quiet native output."""

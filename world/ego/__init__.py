@@ -1,0 +1,1 @@
+"""The ego body: joints, drive, brake, flat tyre, pedal."""

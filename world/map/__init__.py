@@ -1,0 +1,1 @@
+"""Map builders: route roads, the town; signal timing."""

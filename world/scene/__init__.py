@@ -1,0 +1,1 @@
+"""Bodies and meshes: road surface and paint, scenery, bumps, signs, lights."""

@@ -1,0 +1,135 @@
+"""A VLP-16-like spinning LiDAR, ray-cast against the physics world in numpy batches.
+
+Each revolution is cast at one instant (no motion skew) from the sensor's true pose: one ray
+per (channel, column), channel elevations from `LidarInfo`, columns evenly spaced over 360
+deg from the sensor's forward axis, counter-clockwise. Rays go to `max_range` in batches of at
+most 16,383 (`rayTestBatch`'s limit; 16,384 silently drops a ray), as (N, 3) numpy arrays,
+on all cores (``numThreads=0``; 1 when another process renders the cameras on the other
+core, see `world.sensors.pipeline`). The ego's own body is in a collision group the rays skip
+(a real roof sensor's self-returns are cropped by its driver the same way).
+
+Rays that can only meet the flat ground are solved in closed form and only the others are
+cast (`world.sensors.ray_culling`): the same returns at a fraction of the cost.
+
+Returns: range = hit fraction x max range, plus Gaussian range noise (``range_sigma``), and a
+``dropout`` fraction of returns lost, both from the world's seeded generator. Points are in
+the sensor frame. The body each return hit is kept beside the scan as ground truth (for
+perception scoring and the recording; never given to the stack).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from operator import itemgetter
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+from pybullet_utils.bullet_client import BulletClient
+
+from world.frames import LidarInfo, LidarScan
+from world.sensors.ray_culling import Box, ground_distance, rays_to_cast
+
+MAX_BATCH = 16_383  # rays per rayTestBatch call
+EGO_RAY_GROUP = 0x40  # collision group of the ego's links; the rays' mask leaves it out
+RAY_MASK = 0xFFFF & ~EGO_RAY_GROUP
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class LidarTruth:
+    """What each return of a scan really hit (ground truth, same order as the points)."""
+
+    actor: NDArray[np.int16]  # (N,) index of the scenario actor hit, -1 for anything else
+
+
+def beam_directions(info: LidarInfo) -> tuple[NDArray[np.float64], NDArray[np.uint8],
+                                              NDArray[np.uint16]]:
+    """Unit ray directions (channels x columns, 3) in the sensor frame, ring-major, with
+    each ray's ring and column."""
+    elevation = np.asarray(info.elevations)[:, None]
+    azimuth = 2.0 * np.pi * np.arange(info.azimuth_steps)[None, :] / info.azimuth_steps
+    directions = np.stack(np.broadcast_arrays(np.cos(elevation) * np.cos(azimuth),
+                                              np.cos(elevation) * np.sin(azimuth),
+                                              np.sin(elevation)), axis=-1).reshape(-1, 3)
+    ring, column = np.indices((info.channels, info.azimuth_steps))
+    return directions, ring.reshape(-1).astype(np.uint8), column.reshape(-1).astype(np.uint16)
+
+
+class Lidar:
+    """Casts one `LidarInfo` in one client."""
+
+    def __init__(self, client: BulletClient, info: LidarInfo, rng: np.random.Generator,
+                 actor_bodies: list[int], ground: int, static_bodies: list[int]) -> None:
+        """`actor_bodies`: the scenario actors' body ids, in scenario order (ground truth,
+        and moving boxes for the ray culling); `ground`: the ground plane's body;
+        `static_bodies`: every other body with collision that never moves (ego excluded)."""
+        self.info = info
+        self._ground = ground
+        self._actors = list(actor_bodies)
+        self._static_boxes = [_aabb(client, b) for b in static_bodies]
+        self._actor_of = np.full(max([*actor_bodies, 0]) + 1, -1, dtype=np.int16)
+        self._actor_of[actor_bodies] = np.arange(len(actor_bodies), dtype=np.int16)
+        self._c = client
+        self._rng = rng
+        self._dirs, self._ring, self._column = beam_directions(info)
+        m = info.mount
+        self._mount_xyz = np.array([m.x, m.y, m.z])
+        self._mount_rot = m.rotation()
+        self.threads = 0  # rayTestBatch threads: 0 = Bullet's choice (all cores)
+
+    def scan(self, t: float, vehicle_origin: NDArray[np.float64],
+             vehicle_rotation: NDArray[np.float64]) -> tuple[LidarScan, LidarTruth]:
+        """One revolution at time `t` for the vehicle frame's world pose (origin (3,) [m],
+        rotation (3, 3) vehicle -> world)."""
+        info = self.info
+        rotation = vehicle_rotation @ self._mount_rot  # sensor -> world
+        origin = vehicle_origin + vehicle_rotation @ self._mount_xyz
+        body, fraction = self._cast(origin, self._dirs @ rotation.T,
+                                    math.atan2(rotation[1, 0], rotation[0, 0]))
+        keep = body >= 0
+        if info.dropout > 0.0:
+            keep &= self._rng.random(len(body)) >= info.dropout
+        ranges = fraction[keep] * info.max_range
+        if info.range_sigma > 0.0:
+            ranges = ranges + self._rng.normal(0.0, info.range_sigma, len(ranges))
+        points = (self._dirs[keep] * ranges[:, None]).astype(np.float32)
+        scan = LidarScan(t=t, info=info, points=points, ring=self._ring[keep],
+                         column=self._column[keep])
+        hit = body[keep]
+        actor = np.full(len(hit), -1, dtype=np.int16)
+        known = hit < len(self._actor_of)
+        actor[known] = self._actor_of[hit[known]]
+        return scan, LidarTruth(actor=actor)
+
+    def _cast(self, origin: NDArray[np.float64], directions: NDArray[np.float64],
+              heading: float) -> tuple[NDArray[np.int32], NDArray[np.float64]]:
+        """(body hit or -1, hit fraction of the max range) per ray: the flat ground in
+        closed form where nothing else can be met (`world.sensors.ray_culling`), Bullet for the
+        rest."""
+        info = self.info
+        ground = ground_distance(origin, directions, info.max_range)
+        reach = np.minimum(ground, info.max_range)
+        boxes = self._static_boxes + [_aabb(self._c, b) for b in self._actors]
+        shape = (info.channels, info.azimuth_steps)
+        need = rays_to_cast(origin, directions.reshape(*shape, 3), reach.reshape(shape),
+                            boxes, heading, info.azimuth_steps).reshape(-1)
+        body = np.where(np.isfinite(ground), self._ground, -1).astype(np.int32)
+        fraction = np.where(np.isfinite(ground), ground / info.max_range, 1.0)
+        idx = np.flatnonzero(need)
+        if len(idx):
+            ends = origin + directions[idx] * info.max_range
+            starts = np.broadcast_to(origin, ends.shape)
+            results: list[tuple[Any, ...]] = []
+            for i in range(0, len(idx), MAX_BATCH):
+                results += self._c.rayTestBatch(starts[i:i + MAX_BATCH], ends[i:i + MAX_BATCH],
+                                                numThreads=self.threads,
+                                                collisionFilterMask=RAY_MASK)
+            body[idx] = np.array(list(map(itemgetter(0), results)), dtype=np.int32)
+            fraction[idx] = np.array(list(map(itemgetter(2), results)), dtype=np.float64)
+        return body, fraction
+
+
+def _aabb(client: BulletClient, body: int) -> Box:
+    lo, hi = client.getAABB(body)
+    return np.array(lo), np.array(hi)
