@@ -24,7 +24,7 @@ import numpy as np
 from avsim.record.recorder import Recorder
 from avsim.scenario.load import load_scenario
 from planner.speed_planning import SpeedPlanner, SpeedPlanningParams
-from world.hdmap import RoadMap
+from world.map.road import build_road_map
 from world.spec import RoadSpec, SegmentSpec
 from world.world import World
 
@@ -44,7 +44,7 @@ def projection() -> float:
     def seg(length: float, curvature: float = 0.0) -> SegmentSpec:
         return SegmentSpec(length=length, curvature=curvature, lanes=2, oncoming_lanes=1,
                            lane_width=3.5, shoulder=2.5)
-    road = RoadMap.from_spec(RoadSpec(
+    road = build_road_map(RoadSpec(
         segments=tuple([seg(100.0), seg(70.0, 1 / 200), seg(50.0), seg(52.0, -1 / 150)] * 3),
         speed_limit=50 / 3.6))
     lane = road.lane(0)
@@ -54,7 +54,7 @@ def projection() -> float:
 
 def speed_planner() -> float:
     spec = load_scenario("normal_driving")
-    road = RoadMap.from_spec(spec.road)
+    road = build_road_map(spec.road)
     planner = SpeedPlanner(road, road.lane(0), SpeedPlanningParams())
     stations = iter(np.tile(np.linspace(0.0, road.length, 1000), 20).tolist())
     return best_per_call(lambda: planner.target(next(stations), set_speed=13.9,

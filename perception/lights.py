@@ -2,8 +2,8 @@
 light is.
 
 `TrafficLightDetector.detect(frame, ego, heads)` takes one `world.frames.CameraFrame`, the
-stack's pose estimate and the map's light heads near the route (`RoadMap.light_head`), and
-returns a `perception.messages.LightDetection` (the lit colour) for each head it sees,
+stack's pose estimate and the map's light heads near the route (`world.hdmap.TrafficLight`),
+and returns a `perception.messages.LightDetection` (the lit colour) for each head it sees,
 nearest first. Classical and stateless, one frame at a time: colour blobs in the light's
 expected image region. Only OpenCV and numpy; the housing's size is the standard one
 (`HOUSING_WIDTH` ...), not read from the world model.

@@ -53,7 +53,7 @@ import numpy as np
 from perception.messages import LightDetection, ObjectClass, Track
 from world.hdmap import (
     Control,
-    JunctionSpec,
+    Junction,
     LightColour,
     LightHead,
     Manoeuvre,
@@ -103,7 +103,7 @@ class JunctionMonitor:
         self.params = params if params is not None else JunctionParams()
         self.lights = sorted((f for f in road.features if isinstance(f, TrafficLight)),
                              key=lambda f: f.s)
-        self.heads = tuple(road.light_head(f) for f in self.lights)
+        self.heads = tuple(f.head for f in self.lights)
         self._seen: dict[int, _Seen] = {}  # the colour believed, per light
         self._last: dict[int, _Seen] = {}  # the last frame's colour, per light
         self._yellow_go: set[int] = set()  # lights whose yellow the car decided to go on
@@ -200,7 +200,7 @@ class JunctionMonitor:
         self._waiting.discard(k)
         return None
 
-    def _must_wait(self, j: JunctionSpec, tracks: Sequence[Track]) -> bool:
+    def _must_wait(self, j: Junction, tracks: Sequence[Track]) -> bool:
         vehicles = [tr for tr in tracks if tr.cls in (ObjectClass.CAR, ObjectClass.TRUCK)]
         turning_across = j.manoeuvre in (Manoeuvre.LEFT, Manoeuvre.U_TURN)
         if not vehicles or not (turning_across or j.control is Control.STOP_SIGNS):
@@ -212,7 +212,7 @@ class JunctionMonitor:
             wait = wait or bool(np.any(self._oncoming_soon(j, xy, vel)))
         return wait
 
-    def _frame(self, j: JunctionSpec, xy: np.ndarray,
+    def _frame(self, j: Junction, xy: np.ndarray,
                vel: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Along / left of the approach's direction, from the junction's centre, for the
         positions, and the velocities' components the same way."""
@@ -221,7 +221,7 @@ class JunctionMonitor:
         rel = xy - np.array([j.x, j.y])
         return rel @ f, rel @ left, vel @ f, vel @ left
 
-    def _in_box(self, j: JunctionSpec, xy: np.ndarray, vel: np.ndarray) -> np.ndarray:
+    def _in_box(self, j: Junction, xy: np.ndarray, vel: np.ndarray) -> np.ndarray:
         along, left, v_along, v_left = self._frame(j, xy, vel)
         inside = (np.abs(along) <= j.half_width) & (np.abs(left) <= j.half_width)
         speed = np.hypot(v_along, v_left)
@@ -229,7 +229,7 @@ class JunctionMonitor:
         out: np.ndarray = inside & ~(my_way & (speed > self.params.moving))
         return out
 
-    def _oncoming_soon(self, j: JunctionSpec, xy: np.ndarray, vel: np.ndarray) -> np.ndarray:
+    def _oncoming_soon(self, j: Junction, xy: np.ndarray, vel: np.ndarray) -> np.ndarray:
         p = self.params
         along, left, v_along, _ = self._frame(j, xy, vel)
         towards = -v_along

@@ -4,8 +4,9 @@ from __future__ import annotations
 
 import math
 
-from world.hdmap import RoadMap
-from world.spec import Feature, RoadSpec, SegmentSpec, Zone
+from world.hdmap import RoadMap, Zone
+from world.map.road import build_road_map
+from world.spec import FeatureSpec, RoadSpec, SegmentSpec
 
 W = 3.5  # [m] lane width used throughout
 SHOULDER = 2.5  # [m]
@@ -42,6 +43,6 @@ def arc(radius: float, angle_deg: float, *, lanes: int = 2, oncoming: int = 1) -
 
 
 def make_map(
-    *segments: SegmentSpec, speed_kph: float = 50.0, features: tuple[Feature, ...] = ()
+    *segments: SegmentSpec, speed_kph: float = 50.0, features: tuple[FeatureSpec, ...] = ()
 ) -> RoadMap:
-    return RoadMap.from_spec(RoadSpec(tuple(segments), speed_kph * KPH, features))
+    return build_road_map(RoadSpec(tuple(segments), speed_kph * KPH, features))

@@ -19,7 +19,7 @@ import pytest
 REPO = Path(__file__).resolve().parent.parent
 OURS = ("vehicle_urdf", "world", "perception", "planner", "control", "avsim", "bench", "tests")
 PYBULLET = ("pybullet", "pybullet_utils", "pybullet_data")
-STATIC_WORLD = ("world.frames", "world.hdmap", "world.spec")  # PyBullet-free data and types
+STATIC_WORLD = ("world.frames", "world.hdmap")  # the sensor data types and the static map
 DYNAMIC_IMPORTS = ("importlib.import_module", "import_module", "__import__")
 
 
@@ -141,8 +141,8 @@ def test_package_imports_follow_the_arrows(rule: Rule) -> None:
 
 def test_the_static_world_modules_reach_no_simulator() -> None:
     """The world modules the stack may import (and `world/__init__.py`, which runs first)
-    import no PyBullet and no other world module, so the stack cannot reach the simulator
-    through them."""
+    import no PyBullet and no other world module (not even `world.spec`, which holds the
+    scenario's truth), so the stack cannot reach the simulator or the truth through them."""
     static = Rule("world (static part)", STATIC_WORLD, no_pybullet=True)
     found = []
     for module in ("world", *STATIC_WORLD):
@@ -197,6 +197,10 @@ PERCEPTION, PLANNER, CONTROL, WORLD, URDF = RULES
          ["x.py:1: imports pybullet", "x.py:2: imports pybullet"]),
         ("from world.spec import RoadSpec\n", URDF, "vehicle_urdf.builder",
          ["x.py:1: vehicle_urdf/ imports world.spec"]),
+        ("from world.spec import TrafficLightSpec\n", PLANNER, "planner.junctions",
+         ["x.py:1: planner/ imports world.spec"]),
+        ("from world import spec\n", PERCEPTION, "perception.lights",
+         ["x.py:1: perception/ imports world.spec"]),
     ],
 )
 def test_checker_reports_file_and_line(source: str, rule: Rule, module: str,
@@ -211,7 +215,7 @@ def test_checker_reports_file_and_line(source: str, rule: Rule, module: str,
     ("source", "rule", "module"),
     [
         ("import numpy as np\nfrom world.frames import GnssFix\n", PERCEPTION, "perception.x"),
-        ("from world import hdmap, spec\nfrom world.hdmap import Lane\n", PLANNER, "planner.x"),
+        ("from world import hdmap\nfrom world.hdmap import Lane\n", PLANNER, "planner.x"),
         ("from perception.messages import EgoState\n", PLANNER, "planner.x"),
         ("from planner.messages import Plan\nfrom control.pid import Pid\n", CONTROL, "control.x"),
         ("from .pid import Pid\nfrom . import stanley\nfrom ..pid import P\n", CONTROL,

@@ -13,16 +13,24 @@ Frames:
 
 from __future__ import annotations
 
+import enum
 import math
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
 
-from world.spec import Wheel  # the wheels, named as the odometry orders them
-
 __all__ = ["CameraFrame", "CameraInfo", "GnssFix", "LidarInfo", "LidarScan", "Odometry",
            "SensorMount", "Wheel"]
+
+
+class Wheel(enum.Enum):
+    """The wheels, named as the odometry orders them."""
+
+    FRONT_LEFT = "front_left"
+    FRONT_RIGHT = "front_right"
+    REAR_LEFT = "rear_left"
+    REAR_RIGHT = "rear_right"
 
 
 @dataclass(frozen=True, slots=True)

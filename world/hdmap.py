@@ -1,12 +1,15 @@
 """The static HD map: the route's reference line, its lanes, limits and features.
 
-API CONTRACT: signatures and semantics below are fixed; other modules (planner, road mesh
-builder, actors, criteria) code against them.
+What the stack may know of the road, and nothing more: lane geometry, speed limits, stop
+lines, crosswalks, speed bumps, junctions and where the traffic lights' heads stand; no
+signal timing and no actor (those stay in the world: `world.spec`, `world.map.signals`).
+A map kind builds it: a route road (`world.map.road`), a town route (`world.map.town`).
+Other modules (planner, road mesh builder, actors, criteria) code against this API.
 
 Geometry: the route's reference line is the centre line of lane 0 (the rightmost lane of the
 ego's direction), a chain of straight and constant-curvature arc pieces laid end to end from
-the spec's `origin` pose (a road's: the origin, heading +x; a town route starts where its
-start junction is). Every lane shares the route's station `s` (metres along the
+an origin pose (a road's: the origin, heading +x; a town route starts where its start
+junction is). Every lane shares the route's station `s` (metres along the
 reference line); a lane is the reference line shifted sideways by the lane's `offset_at(s)`.
 Lateral `r` is metres from the lane's centre, left of the route direction positive (for
 oncoming lanes too: their travel `direction` is -1 but s and r stay in route coordinates).
@@ -30,69 +33,131 @@ No PyBullet here: the planner reads this module.
 from __future__ import annotations
 
 import bisect
+import enum
 import math
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from world.spec import (
-    Control,
-    Crosswalk,
-    Feature,
-    JunctionSpec,
-    LightColour,
-    LightHead,
-    Manoeuvre,
-    RoadSpec,
-    Side,
-    SpeedBump,
-    SpeedLimitSign,
-    StopSign,
-    TrafficLight,
-    Zone,
-)
-
-__all__ = [  # the map's own types, and the spec types of what it holds (features, zones)
-    "SHOULDER",
-    "Control",
-    "CrossSection",
-    "Crosswalk",
-    "Exit",
-    "Feature",
-    "FloatArray",
-    "IntArray",
-    "JunctionSpec",
-    "Lane",
-    "LightColour",
-    "LightHead",
-    "Manoeuvre",
-    "MapError",
-    "Piece",
-    "ReferenceLine",
-    "RoadMap",
-    "Side",
-    "SpeedBump",
-    "SpeedLimitPosting",
-    "SpeedLimitSign",
-    "StopSign",
-    "TrafficLight",
-    "Zone",
-]
-
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.intp]
 SHOULDER = -1000  # the lane index of the paved right shoulder (`RoadMap.lane`)
 
-LIGHT_AHEAD = 12.0  # [m] a road light's head stands this far past its stop line ...
-LIGHT_SIDE = 1.0  # [m] ... this far right of the paved edge ...
-LIGHT_HEIGHT = 3.5  # [m] ... with its housing's centre this high (a town places its own)
 HALF_PI = 0.5 * np.pi  # [rad]
 TWO_PI = 2.0 * np.pi  # [rad]
 
 
-class MapError(ValueError):
-    """The spec cannot be built into a map (e.g. a lane offset beyond an arc's radius)."""
+# ---------------------------------------------------------------------------------------
+# What the map holds: zones, features, lights, junctions
+# ---------------------------------------------------------------------------------------
+
+
+class Zone(enum.Enum):
+    """Scenery style of a segment; it changes what is built beside the road, not the rules."""
+
+    HIGHWAY = "highway"
+    RAMP = "ramp"
+    CITY = "city"
+    JUNCTION = "junction"  # inside a town junction: no markings, the route's turn path
+
+
+class Side(enum.Enum):
+    RIGHT = "right"
+    LEFT = "left"
+
+
+@dataclass(frozen=True, slots=True)
+class SpeedLimitSign:
+    s: float  # [m] station of the sign; the limit applies from here on
+    limit: float  # [m/s]
+
+
+@dataclass(frozen=True, slots=True)
+class StopSign:
+    s: float  # [m] station of the stop line; the sign stands on the right
+
+
+@dataclass(frozen=True, slots=True)
+class Crosswalk:
+    s: float  # [m] station of the near edge of the zebra
+    width: float  # [m] along the route
+
+
+@dataclass(frozen=True, slots=True)
+class SpeedBump:
+    s: float  # [m] station of the bump's centre
+    height: float  # [m]
+    length: float  # [m] along the route
+    pass_speed: float  # [m/s] the speed to take it at
+
+
+class LightColour(enum.Enum):
+    """The lit lamp of a traffic light."""
+
+    GREEN = "green"
+    YELLOW = "yellow"
+    RED = "red"
+
+
+@dataclass(frozen=True, slots=True)
+class LightHead:
+    """Where a traffic light's head stands: the centre of its housing (the yellow lamp) in
+    the map frame, and the way its lamps face (towards the traffic it controls)."""
+
+    x: float  # [m]
+    y: float  # [m]
+    z: float  # [m] above the ground
+    facing: float  # [rad] yaw of the lamps' outward normal
+
+
+@dataclass(frozen=True, slots=True)
+class TrafficLight:
+    """A traffic light for the traffic on the route at stop line `s`: where its head stands.
+    Its signal plan is not on the map (the world keeps it: `world.spec.TrafficLightSpec`);
+    the stack learns the colour from the camera."""
+
+    s: float  # [m] station of the stop line
+    head: LightHead  # where the camera looks for it
+
+
+Feature = SpeedLimitSign | StopSign | Crosswalk | SpeedBump | TrafficLight
+
+
+class Manoeuvre(enum.Enum):
+    """What a route does at a town junction."""
+
+    STRAIGHT = "straight"
+    LEFT = "left"
+    RIGHT = "right"
+    U_TURN = "u_turn"
+
+
+class Control(enum.Enum):
+    """How a town junction is controlled (every approach alike)."""
+
+    NONE = "none"  # a bend at the town's corner: nothing to give way to
+    STOP_SIGNS = "stop_signs"  # all-way stop
+    TRAFFIC_LIGHTS = "traffic_lights"
+
+
+@dataclass(frozen=True, slots=True)
+class Junction:
+    """A town junction met along a route, in the route's stations (`world.map.town`).
+
+    The approach street runs along `heading` into the junction whose centre is (x, y); the
+    box is the square where the streets cross, `half_width` each side of the centre."""
+
+    index: tuple[int, int]  # (ix, iy) in the town grid
+    manoeuvre: Manoeuvre
+    control: Control
+    s_stop: float  # [m] station of the approach's stop line
+    s_enter: float  # [m] where the route's path starts to turn / enters the box
+    s_exit: float  # [m] where it has turned and left the box, in its new lane
+    x: float  # [m] the junction's centre
+    y: float  # [m]
+    heading: float  # [rad] the approach's direction of travel
+    half_width: float  # [m] half the street's width (kerb to kerb)
 
 
 @dataclass(frozen=True, slots=True)
@@ -168,7 +233,7 @@ class ReferenceLine:
 
     def __init__(self, pieces: tuple[Piece, ...]) -> None:
         first, last = pieces[0], pieces[-1]
-        end_xy, end_heading = _piece_end(last)
+        end_xy, end_heading = piece_end(last)
         length = last.s0 + last.length
         before = Piece(0.0, 0.0, 0.0, first.x0, first.y0, first.heading0)
         after = Piece(length, 0.0, 0.0, float(end_xy[0]), float(end_xy[1]), end_heading)
@@ -298,7 +363,7 @@ class ReferenceLine:
         return s, d[rows, best]
 
 
-def _piece_end(piece: Piece) -> tuple[FloatArray, float]:
+def piece_end(piece: Piece) -> tuple[FloatArray, float]:
     """([m] end point (2,), [rad] end heading) of a piece."""
     k, t, h0 = piece.curvature, piece.length, piece.heading0
     theta = k * t
@@ -393,7 +458,7 @@ class RoadMap:
     speed_limits: tuple[SpeedLimitPosting, ...]  # sorted by station, first at s = 0
     sections: tuple[CrossSection, ...]  # per segment (= piece)
     exits: tuple[Exit, ...]  # sorted by station
-    junctions: tuple[JunctionSpec, ...]  # a town route's junctions, sorted by station
+    junctions: tuple[Junction, ...]  # a town route's junctions, sorted by station
 
     def __init__(
         self,
@@ -402,10 +467,11 @@ class RoadMap:
         features: tuple[Feature, ...],
         speed_limits: tuple[SpeedLimitPosting, ...],
         exit_pieces: tuple[int, ...] = (),
-        junctions: tuple[JunctionSpec, ...] = (),
+        junctions: tuple[Junction, ...] = (),
     ) -> None:
-        """Use `from_spec`; this takes the already laid pieces, one section per piece, and
-        the indices of the pieces that leave the road before them by an exit (right)."""
+        """A map kind's builder makes it (`world.map.road.build_road_map`): this takes the
+        already laid pieces, one section per piece, and the indices of the pieces that leave
+        the road before them by an exit (right)."""
         self.pieces = pieces
         self.junctions = tuple(sorted(junctions, key=lambda j: j.s_stop))
         self.sections = sections
@@ -434,40 +500,6 @@ class RoadMap:
         self._limit_s: FloatArray = np.array([p.s for p in speed_limits])
         self._limit_v: FloatArray = np.array([p.limit for p in speed_limits])
 
-    @classmethod
-    def from_spec(cls, spec: RoadSpec) -> RoadMap:
-        if not spec.segments:
-            raise MapError("road: no segments")
-        pieces: list[Piece] = []
-        sections: list[CrossSection] = []
-        exits: list[int] = []
-        s, xy, heading = 0.0, np.array(spec.origin[:2], dtype=float), float(spec.origin[2])
-        zone = Zone.HIGHWAY
-        for i, seg in enumerate(spec.segments):
-            zone = seg.zone if seg.zone is not None else zone
-            section = CrossSection(
-                seg.lanes, seg.oncoming_lanes, seg.lane_width, seg.shoulder, zone
-            )
-            _check_segment(i, seg.length, seg.curvature, section)
-            if seg.exit is not None:
-                _check_exit(i, seg.exit, sections)
-                exits.append(i)
-            piece = Piece(
-                s, float(seg.length), float(seg.curvature), float(xy[0]), float(xy[1]), heading
-            )
-            pieces.append(piece)
-            sections.append(section)
-            xy, heading = _piece_end(piece)
-            s += float(seg.length)
-        return cls(
-            tuple(pieces),
-            tuple(sections),
-            tuple(sorted(spec.features, key=lambda f: f.s)),
-            _speed_limit_postings(spec, [p.s0 for p in pieces]),
-            tuple(exits),
-            spec.junctions,
-        )
-
     def through_road(self, exit_: Exit, length: float) -> RoadMap:
         """The road `exit_` leaves, from its fork straight on for `length` [m] (scenery),
         as a map of its own."""
@@ -485,17 +517,6 @@ class RoadMap:
         if -len(self.oncoming) <= index < 0:
             return self.oncoming[-index - 1]
         raise IndexError(f"no lane {index} on this road")
-
-    def light_head(self, light: TrafficLight) -> LightHead:
-        """Where `light`'s head stands: its own `head` (a town places them on the far
-        corner of the junction), else on a pole `LIGHT_AHEAD` past the stop line, right of
-        the paved edge, facing the route's traffic."""
-        if light.head is not None:
-            return light.head
-        s = light.s + LIGHT_AHEAD
-        right, _ = self.paved_edges(s)
-        x, y, heading = self.line.pose_one(s, float(right) - LIGHT_SIDE)
-        return LightHead(x, y, LIGHT_HEIGHT, heading + np.pi)
 
     def cross_section_at(self, s: float) -> CrossSection:
         return self.sections[int(self.line.segment_index(_as_float(s)))]
@@ -557,51 +578,3 @@ class RoadMap:
         if c.lanes <= band < c.lanes + c.oncoming_lanes:
             return c.lanes - 1 - band, s, d - band * w
         return None, s, d
-
-
-def _check_exit(i: int, side: Side, before: list[CrossSection]) -> None:
-    """Raise MapError unless segment i can leave the road before it by an exit."""
-    if i == 0:
-        raise MapError("road.segments.0.exit: the first segment has no road to leave")
-    if side is not Side.RIGHT:
-        raise MapError(f"road.segments.{i}.exit: only exits on the right are simulated")
-
-
-def _check_segment(i: int, length: float, curvature: float, c: CrossSection) -> None:
-    """Raise MapError if the segment is empty, its arc turns more than a full circle, or
-    the arc is tighter than the road's inner half (the inner paved edge would cross the
-    arc's centre)."""
-    if not length > 0.0:
-        raise MapError(f"road.segments[{i}]: length {length} m must be > 0")
-    if curvature == 0.0:
-        return
-    if abs(curvature) * length > TWO_PI + 1e-9:
-        raise MapError(
-            f"road.segments[{i}]: an arc may turn at most 360 degrees (it would lie on itself)"
-        )
-    radius = 1.0 / abs(curvature)
-    inner = c.left_edge if curvature > 0.0 else -c.right_edge
-    if not radius > inner:
-        side = "left" if curvature > 0.0 else "right"
-        raise MapError(
-            f"road.segments[{i}]: arc radius {radius:g} m is not larger than the road's "
-            f"{side} (inner) edge offset {inner:g} m"
-        )
-
-
-def _speed_limit_postings(
-    spec: RoadSpec, segment_starts: list[float]
-) -> tuple[SpeedLimitPosting, ...]:
-    """Postings sorted by station: the road's limit at 0, each segment's at its start,
-    each speed-limit sign. Of several postings at one station the last listed wins."""
-    postings = [SpeedLimitPosting(0.0, spec.speed_limit)]
-    postings += [
-        SpeedLimitPosting(s0, seg.speed_limit)
-        for s0, seg in zip(segment_starts, spec.segments, strict=True)
-        if seg.speed_limit is not None
-    ]
-    postings += [
-        SpeedLimitPosting(f.s, f.limit) for f in spec.features if isinstance(f, SpeedLimitSign)
-    ]
-    by_station = {p.s: p for p in sorted(postings, key=lambda p: p.s)}  # later ones win
-    return tuple(by_station.values())

@@ -14,23 +14,21 @@ from __future__ import annotations
 import enum
 from dataclasses import dataclass, field
 
+from world.frames import Wheel
+from world.hdmap import (
+    Crosswalk,
+    Junction,
+    LightHead,
+    Side,
+    SpeedBump,
+    SpeedLimitSign,
+    StopSign,
+    Zone,
+)
+
 # ---------------------------------------------------------------------------------------
 # Road
 # ---------------------------------------------------------------------------------------
-
-
-class Zone(enum.Enum):
-    """Scenery style of a segment; it changes what is built beside the road, not the rules."""
-
-    HIGHWAY = "highway"
-    RAMP = "ramp"
-    CITY = "city"
-    JUNCTION = "junction"  # inside a town junction: no markings, the route's turn path
-
-
-class Side(enum.Enum):
-    RIGHT = "right"
-    LEFT = "left"
 
 
 @dataclass(frozen=True, slots=True)
@@ -54,103 +52,25 @@ class SegmentSpec:
 
 
 @dataclass(frozen=True, slots=True)
-class SpeedLimitSign:
-    s: float  # [m] station of the sign; the limit applies from here on
-    limit: float  # [m/s]
-
-
-@dataclass(frozen=True, slots=True)
-class StopSign:
-    s: float  # [m] station of the stop line; the sign stands on the right
-
-
-@dataclass(frozen=True, slots=True)
-class Crosswalk:
-    s: float  # [m] station of the near edge of the zebra
-    width: float  # [m] along the route
-
-
-@dataclass(frozen=True, slots=True)
-class SpeedBump:
-    s: float  # [m] station of the bump's centre
-    height: float  # [m]
-    length: float  # [m] along the route
-    pass_speed: float  # [m/s] the speed to take it at
-
-
-class LightColour(enum.Enum):
-    """The lit lamp of a traffic light."""
-
-    GREEN = "green"
-    YELLOW = "yellow"
-    RED = "red"
-
-
-@dataclass(frozen=True, slots=True)
-class LightHead:
-    """Where a traffic light's head stands: the centre of its housing (the yellow lamp) in
-    the map frame, and the way its lamps face (towards the traffic it controls)."""
-
-    x: float  # [m]
-    y: float  # [m]
-    z: float  # [m] above the ground
-    facing: float  # [rad] yaw of the lamps' outward normal
-
-
-@dataclass(frozen=True, slots=True)
-class TrafficLight:
-    """A signal for the traffic on the route at stop line `s`. The cycle starts green:
-    green, then yellow, then red; `phase` is the time into the cycle at t = 0."""
+class TrafficLightSpec:
+    """A signal for the traffic on the route at stop line `s`, with its signal plan (ground
+    truth: the world lights its lamps by it, the criteria judge by it; the stack's map has
+    only the light's place, `world.hdmap.TrafficLight`). The cycle starts green: green, then
+    yellow, then red; `phase` is the time into the cycle at t = 0."""
 
     s: float  # [m] station of the stop line
     green: float  # [s]
     yellow: float  # [s]
     red: float  # [s]
     phase: float  # [s] time into the cycle at t = 0
-    head: LightHead | None = None  # None: the map places it (`RoadMap.light_head`)
+    head: LightHead | None = None  # None: the map builder places it (`world.map.road`)
 
     @property
     def cycle(self) -> float:
         return self.green + self.yellow + self.red
 
 
-Feature = SpeedLimitSign | StopSign | Crosswalk | SpeedBump | TrafficLight
-
-
-class Manoeuvre(enum.Enum):
-    """What a route does at a town junction."""
-
-    STRAIGHT = "straight"
-    LEFT = "left"
-    RIGHT = "right"
-    U_TURN = "u_turn"
-
-
-class Control(enum.Enum):
-    """How a town junction is controlled (every approach alike)."""
-
-    NONE = "none"  # a bend at the town's corner: nothing to give way to
-    STOP_SIGNS = "stop_signs"  # all-way stop
-    TRAFFIC_LIGHTS = "traffic_lights"
-
-
-@dataclass(frozen=True, slots=True)
-class JunctionSpec:
-    """A town junction met along a route, in the route's stations (`world.map.town`).
-
-    The approach street runs along `heading` into the junction whose centre is (x, y); the
-    box is the square where the streets cross, `half_width` each side of the centre."""
-
-    index: tuple[int, int]  # (ix, iy) in the town grid
-    manoeuvre: Manoeuvre
-    control: Control
-    s_stop: float  # [m] station of the approach's stop line
-    s_enter: float  # [m] where the route's path starts to turn / enters the box
-    s_exit: float  # [m] where it has turned and left the box, in its new lane
-    x: float  # [m] the junction's centre
-    y: float  # [m]
-    heading: float  # [rad] the approach's direction of travel
-    half_width: float  # [m] half the street's width (kerb to kerb)
+FeatureSpec = SpeedLimitSign | StopSign | Crosswalk | SpeedBump | TrafficLightSpec
 
 
 @dataclass(frozen=True, slots=True)
@@ -163,10 +83,10 @@ class BuildingsSpec:
 class RoadSpec:
     segments: tuple[SegmentSpec, ...]
     speed_limit: float  # [m/s] posted at s = 0
-    features: tuple[Feature, ...] = ()
+    features: tuple[FeatureSpec, ...] = ()
     buildings: BuildingsSpec | None = None
     origin: tuple[float, float, float] = (0.0, 0.0, 0.0)  # [m, m, rad] the line's start pose
-    junctions: tuple[JunctionSpec, ...] = ()  # a town route's junctions, by station
+    junctions: tuple[Junction, ...] = ()  # a town route's junctions, by station
 
 
 @dataclass(frozen=True, slots=True)
@@ -282,13 +202,6 @@ class ActorSpec:
 class AcceleratorOverride:
     pedal: float  # [-] 0..1
     duration: float  # [s]
-
-
-class Wheel(enum.Enum):
-    FRONT_LEFT = "front_left"
-    FRONT_RIGHT = "front_right"
-    REAR_LEFT = "rear_left"
-    REAR_RIGHT = "rear_right"
 
 
 @dataclass(frozen=True, slots=True)

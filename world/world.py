@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import math
 import tempfile
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from pathlib import Path
 
 import cv2
@@ -26,8 +26,8 @@ from world.core.quiet import quiet_c_output
 from world.core.rendering import attach_renderer
 from world.ego.body import EgoBody, EgoParams, EgoTruth
 from world.ego.events import EgoEvents
-from world.hdmap import RoadMap
-from world.map.signals import light_colour
+from world.map.road import build_road_map, light_head
+from world.map.signals import light_colour, route_signals
 from world.map.town import TownLayout
 from world.scene.bump import BumpPlacement, build_speed_bumps, hull_vertices
 from world.scene.road_marks import build_road_marks
@@ -55,7 +55,7 @@ from world.sensors.gnss import GnssSensor, OdometrySensor
 from world.sensors.lidar import EGO_RAY_GROUP
 from world.sensors.rig import SensorRig
 from world.sensors.setup import SensorSetup
-from world.spec import ScenarioSpec, TownSpec, TrafficLight
+from world.spec import ScenarioSpec, TownSpec, TrafficLightSpec
 from world.truth import RouteTruth, route_truth
 
 TRIGGER_RATE = Rate("npc_triggers", 40)  # NPC actions' and ego events' triggers checked
@@ -80,7 +80,7 @@ class StaticScene:
     bump_bodies: frozenset[int] = frozenset()  # speed bumps: driven over, not collisions
     kerb_bodies: frozenset[int] = frozenset()  # a town's kerbed sidewalk slabs (the car
     #   touches one only when it mounts the kerb)
-    lights: tuple[TrafficLight, ...] = ()  # every traffic light's plan and head
+    lights: tuple[TrafficLightSpec, ...] = ()  # every traffic light's plan and head
 
     @property
     def static_bodies(self) -> frozenset[int]:
@@ -113,7 +113,8 @@ class World:
         self.renderer = attach_renderer(self.client) if cameras else None
         self.clock = Clock()
         self._step_physics = self.client.stepSimulation  # bound once: called every step
-        self.road = RoadMap.from_spec(spec.road)
+        self.road = build_road_map(spec.road)
+        self.signals = route_signals(spec.road, self.road)  # the route's lights (truth)
         self._tmp = tempfile.TemporaryDirectory(prefix="avsim-textures-")
         self._light_bodies: list[TrafficLightBody] = []
         self.scene = self._build_scene(np.random.default_rng(seeds[0]))
@@ -169,8 +170,7 @@ class World:
         obstacles |= {self._add_sign(sign) for sign in signs}
         stop_signs = tuple(layout_stop_signs(self.road))
         obstacles |= {self._add_stop_sign(i, sign) for i, sign in enumerate(stop_signs)}
-        lights = tuple(replace(f, head=self.road.light_head(f)) for f in self.road.features
-                       if isinstance(f, TrafficLight))
+        lights = self.signals
         obstacles |= self._add_lights(lights)
         return StaticScene(meshes, buildings, signs, ground, frozenset(obstacles),
                            stop_signs, tuple(bump for bump, _ in bumps), bump_bodies,
@@ -193,10 +193,10 @@ class World:
         return StaticScene(scene.meshes, scene.buildings, (), ground, frozenset(obstacles),
                            scene.stop_signs, kerb_bodies=kerbs, lights=lights)
 
-    def _add_lights(self, lights: tuple[TrafficLight, ...]) -> set[int]:
+    def _add_lights(self, lights: tuple[TrafficLightSpec, ...]) -> set[int]:
         """The traffic lights' bodies (pole and housing: obstacles), lamps lit by
         `_light_lamps`."""
-        self._light_bodies = [add_traffic_light(self.client, self.road.light_head(f),
+        self._light_bodies = [add_traffic_light(self.client, light_head(self.road, f),
                                                 Path(self._tmp.name)) for f in lights]
         return {b.body for b in self._light_bodies}
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -13,8 +14,8 @@ from avsim.criteria.base import (
     CriterionResult,
     TruthSample,
 )
-from world.hdmap import RoadMap
-from world.spec import ActorType, Crosswalk, SpeedBump, StopSign, TrafficLight
+from world.hdmap import Crosswalk, RoadMap, SpeedBump, StopSign
+from world.spec import ActorType, TrafficLightSpec
 
 
 class StopSigns(Criterion):
@@ -73,13 +74,14 @@ class RedLights(Criterion):
 
     Value: the least margin [s] to red over the lines crossed: at each crossing, the time
     left until the light turns red, or minus the time it has been red (fails). No line
-    crossed: value +inf, passed."""
+    crossed: value +inf, passed. The lights' signal plans are the world's (the truth), not
+    the stack's map, which has none."""
 
     name, unit = "red_lights", "s"
 
-    def __init__(self, road: RoadMap) -> None:
+    def __init__(self, lights: Sequence[TrafficLightSpec]) -> None:
         super().__init__()
-        self.lights = [f for f in road.features if isinstance(f, TrafficLight)]
+        self.lights = list(lights)
         self.margin = math.inf
         self._front: float | None = None  # [m] the front bumper's station at the last sample
 
@@ -100,7 +102,7 @@ class RedLights(Criterion):
                                self.unit, self.first_failure)
 
 
-def _margin_to_red(light: TrafficLight, t: float) -> float:
+def _margin_to_red(light: TrafficLightSpec, t: float) -> float:
     """[s] until `light` turns red at time t, or minus how long it has been red."""
     into = (t + light.phase) % light.cycle
     red_at = light.green + light.yellow

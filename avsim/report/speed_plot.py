@@ -30,7 +30,7 @@ from matplotlib.figure import Figure
 from numpy.typing import NDArray
 
 from planner.fsm.acc import AccMode
-from world.hdmap import RoadMap
+from world.map.road import build_road_map
 
 if TYPE_CHECKING:
     from avsim.run.runner import RunResult
@@ -94,7 +94,7 @@ def lead_speed(result: RunResult) -> FloatArray:
     t = log.array("t")
     stations = np.vstack(log.actor_station).astype(np.float64)  # (T, N)
     offsets = np.vstack(log.actor_offset).astype(np.float64)
-    road = RoadMap.from_spec(spec.road)
+    road = build_road_map(spec.road)
     ego_s = log.array("station")
     width = np.asarray(road.lane(0).width_at(ego_s), dtype=np.float64)
     ego_offset = np.asarray(log.lane, dtype=np.float64) * width + log.array("cross_track")

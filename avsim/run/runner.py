@@ -139,7 +139,7 @@ class Runner:
         self.collisions = NoCollision(names)
         crosswalks = Crosswalks(w.road)
         self.criteria = CriteriaSet([self.collisions, TyresInLane(w.road, TYRE_HALF_WIDTH),
-                                     SpeedLimit(w.road), StopSigns(w.road), RedLights(w.road),
+                                     SpeedLimit(w.road), StopSigns(w.road), RedLights(w.signals),
                                      crosswalks,
                                      SpeedBumps(w.road, self.car.front_axle, self.car.rear_axle),
                                      self.completes, *self._optional_criteria()])

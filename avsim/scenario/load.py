@@ -45,7 +45,7 @@ from avsim.scenario.model import (
     TrafficLightFeature,
     TriggerModel,
 )
-from world import spec
+from world import frames, hdmap, spec
 from world.map.town import TownError, TownLayout, compile_route
 
 REPO_ROOT = Path(__file__).resolve().parents[2]
@@ -664,27 +664,27 @@ def _segment_spec(segment: SegmentModel, road: RoadModel) -> spec.SegmentSpec:
         lane_width=road.lane_width,
         shoulder=_or(segment.shoulder, road.shoulder),
         speed_limit=None if limit is None else _kph(limit),
-        zone=None if segment.zone is None else spec.Zone(segment.zone),
-        exit=None if segment.exit is None else spec.Side(segment.exit),
+        zone=None if segment.zone is None else hdmap.Zone(segment.zone),
+        exit=None if segment.exit is None else hdmap.Side(segment.exit),
     )
 
 
-def _feature_spec(feature: FeatureModel) -> spec.Feature:
+def _feature_spec(feature: FeatureModel) -> spec.FeatureSpec:
     if isinstance(feature, SpeedLimitFeature):
-        return spec.SpeedLimitSign(s=feature.s, limit=_kph(feature.kph))
+        return hdmap.SpeedLimitSign(s=feature.s, limit=_kph(feature.kph))
     if isinstance(feature, StopSignFeature):
-        return spec.StopSign(s=feature.s)
+        return hdmap.StopSign(s=feature.s)
     if isinstance(feature, CrosswalkFeature):
-        return spec.Crosswalk(s=feature.s, width=feature.width)
+        return hdmap.Crosswalk(s=feature.s, width=feature.width)
     if isinstance(feature, SpeedBumpFeature):
-        return spec.SpeedBump(
+        return hdmap.SpeedBump(
             s=feature.s,
             height=feature.height,
             length=feature.length,
             pass_speed=_kph(feature.pass_kph),
         )
     assert isinstance(feature, TrafficLightFeature)
-    return spec.TrafficLight(
+    return spec.TrafficLightSpec(
         s=feature.s,
         green=feature.green,
         yellow=feature.yellow,
@@ -757,7 +757,7 @@ def _event_spec(event: EventModel) -> spec.EventSpec:
             trigger, spec.AcceleratorOverride(pedal=override.pedal, duration=override.duration)
         )
     assert event.flat_tire is not None
-    return spec.EventSpec(trigger, spec.FlatTire(wheel=spec.Wheel(event.flat_tire.wheel)))
+    return spec.EventSpec(trigger, spec.FlatTire(wheel=frames.Wheel(event.flat_tire.wheel)))
 
 
 def _sensors_spec(model: ScenarioModel) -> spec.SensorsSpec:
@@ -869,7 +869,7 @@ def _town_route(layout: TownLayout, key: str, start: tuple[int, int, str] | None
                 route: Sequence[str] | None) -> spec.RoadSpec:
     if start is None:
         raise _LocatedError(f"{key}.start", "required key missing in a town ([ix, iy, heading])")
-    turns = tuple(spec.Manoeuvre(turn) for turn in (route or ()))
+    turns = tuple(hdmap.Manoeuvre(turn) for turn in (route or ()))
     return compile_route(layout, (start[0], start[1], start[2]), turns, key)
 
 

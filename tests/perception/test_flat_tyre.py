@@ -23,7 +23,7 @@ from perception.flat_tyre import (
 )
 from world.core.client import PHYSICS_RATE
 from world.ego.body import ackermann
-from world.frames import Odometry
+from world.frames import Odometry, Wheel
 from world.sensors.gnss import GYRO_NOISE, STEERING_NOISE, WHEEL_SPEED_NOISE
 from world.spec import (
     EgoSpec,
@@ -33,7 +33,6 @@ from world.spec import (
     ScenarioSpec,
     SegmentSpec,
     TimeTrigger,
-    Wheel,
 )
 from world.world import TRIGGER_RATE, World
 

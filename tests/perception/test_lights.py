@@ -2,8 +2,8 @@
 the world model (a straight road with traffic light bodies, `tests.perception.light_scene`),
 and its pure projection helpers.
 
-The main light stands where the map puts it (`RoadMap.light_head`: 12 m past its stop line,
-1 m right of the paved edge, 3.5 m high, facing the traffic); the ego is posed on lane 0's
+The main light stands where the map puts it (`world.map.road.light_head`: 12 m past its
+stop line, 1 m right of the paved edge, 3.5 m high, facing the traffic); the ego is posed on lane 0's
 centre 10-50 m before it. One world is built for the module and each frame rendered once
 (the pose-error cases reuse the frames: the error is in the pose given to the detector).
 The renderer is whichever the machine has (EGL or TinyRenderer: both were measured the same).
@@ -38,12 +38,13 @@ from perception.messages import EgoState
 from tests.perception.light_scene import LightScene
 from tests.perception.render_scene import front_camera
 from world.frames import CameraFrame
-from world.hdmap import LightColour, LightHead, RoadMap, TrafficLight
+from world.hdmap import LightColour, LightHead
+from world.map.road import build_road_map, light_head
 from world.scene import traffic_light
-from world.spec import ActorSpec, ActorType, RoadSpec, SegmentSpec
+from world.spec import ActorSpec, ActorType, RoadSpec, SegmentSpec, TrafficLightSpec
 
 ROAD = RoadSpec(segments=(SegmentSpec(700.0, 0.0, 2, 1, 3.5, 2.5),), speed_limit=50.0 / 3.6)
-MAIN = RoadMap.from_spec(ROAD).light_head(TrafficLight(100.0, 20.0, 3.0, 20.0, 0.0))
+MAIN = light_head(build_road_map(ROAD), TrafficLightSpec(100.0, 20.0, 3.0, 20.0, 0.0))
 AWAY = replace(MAIN, x=MAIN.x + 150.0, facing=0.0)  # lamps point along the route
 LOW = replace(MAIN, x=MAIN.x + 300.0, z=2.8)  # a low post-mounted head, a red car under it
 LEFT = LightHead(MAIN.x + 30.0, 8.0, 3.5, math.pi)  # left of the road, facing the traffic

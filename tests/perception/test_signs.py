@@ -25,15 +25,9 @@ from perception.signs import (
 )
 from tests.perception.render_scene import front_camera, render, render_with_actors, world_for
 from world.frames import CameraFrame
+from world.hdmap import SpeedLimitSign, StopSign
 from world.scene import scenery
-from world.spec import (
-    ActorSpec,
-    ActorType,
-    RoadSpec,
-    SegmentSpec,
-    SpeedLimitSign,
-    StopSign,
-)
+from world.spec import ActorSpec, ActorType, RoadSpec, SegmentSpec
 from world.world import SIGN_POLE_RADIUS
 
 STOP_S = 200.0  # [m] station of the stop line (and sign)

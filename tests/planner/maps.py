@@ -7,11 +7,11 @@ tested even while `world.hdmap` is being reworked; the real map is used wherever
 from __future__ import annotations
 
 import numpy as np
-import pytest
 from numpy.typing import ArrayLike, NDArray
 
-from world.hdmap import Piece, RoadMap, SpeedLimitPosting
-from world.spec import RoadSpec, SegmentSpec, SpeedLimitSign
+from world.hdmap import Piece, RoadMap, SpeedLimitPosting, SpeedLimitSign
+from world.map.road import build_road_map
+from world.spec import RoadSpec, SegmentSpec
 
 KPH = 1.0 / 3.6  # [m/s per km/h]
 LANE_WIDTH = 3.5  # [m]
@@ -41,20 +41,8 @@ def road_spec(
     )
 
 
-try:
-    RoadMap.from_spec(road_spec([segment(10.0)], 50.0))
-    HDMAP_READY = True
-except NotImplementedError:
-    HDMAP_READY = False
-
-needs_hdmap = pytest.mark.skipif(
-    not HDMAP_READY,
-    reason="world.hdmap.RoadMap.from_spec still raises NotImplementedError (stub)",
-)
-
-
 def real_map(spec: RoadSpec) -> RoadMap:
-    return RoadMap.from_spec(spec)
+    return build_road_map(spec)
 
 
 class StraightLane:
@@ -112,7 +100,5 @@ def straight_road(
 ) -> RoadMap:
     """A straight road, as the real map (``kind == "real"``) or the double (``"double"``)."""
     if kind == "real":
-        if not HDMAP_READY:
-            pytest.skip("world.hdmap.RoadMap.from_spec still raises NotImplementedError (stub)")
         return real_map(road_spec([segment(length)], limit_kph, signs))
     return StraightRoad(length, limit_kph, signs)  # type: ignore[return-value]

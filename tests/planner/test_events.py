@@ -13,7 +13,7 @@ from planner.acc_layer import AccLayer
 from planner.events import EventMonitor, EventParams, Events
 from planner.fsm.acc import AccMode
 from tests.roads import KPH, W, make_map, seg
-from world.spec import Crosswalk, SpeedBump, StopSign, Zone
+from world.hdmap import Crosswalk, SpeedBump, StopSign, Zone
 
 P = EventParams()
 FEATURES = (StopSign(200.0), SpeedBump(300.0, 0.1, 0.9, 5 * KPH), Crosswalk(400.0, 4.0))

@@ -9,9 +9,10 @@ import pytest
 
 from perception.messages import LightDetection, ObjectClass, Track
 from planner.junctions import JunctionMonitor, JunctionParams
-from world.hdmap import LightColour, RoadMap
+from world.hdmap import LightColour, Manoeuvre, RoadMap
+from world.map.road import build_road_map
 from world.map.town import TownLayout, compile_route
-from world.spec import Manoeuvre, TownSpec
+from world.spec import TownSpec
 
 P = JunctionParams()
 LIGHTS = TownLayout(TownSpec(3, 2, 90.0, 2, 3.5, 40 / 3.6, "traffic_lights"))
@@ -19,7 +20,7 @@ STOPS = TownLayout(TownSpec(3, 2, 90.0, 2, 3.5, 40 / 3.6, "stop_signs"))
 
 
 def route(layout: TownLayout, manoeuvre: Manoeuvre) -> RoadMap:
-    return RoadMap.from_spec(compile_route(layout, (0, 1, "east"), (manoeuvre,), "ego"))
+    return build_road_map(compile_route(layout, (0, 1, "east"), (manoeuvre,), "ego"))
 
 
 def car(x: float, y: float, vx: float = 0.0, vy: float = 0.0) -> Track:

@@ -14,9 +14,10 @@ from planner.fsm.acc import AccParams
 from planner.fsm.motion import Motion
 from planner.motion_layer import MotionLayer, MotionLayerParams
 from tests.roads import W, make_map, seg
-from world.hdmap import SHOULDER, RoadMap
+from world.hdmap import SHOULDER, Manoeuvre, Side
+from world.map.road import build_road_map
 from world.map.town import TownLayout, compile_route
-from world.spec import Manoeuvre, Side, TownSpec
+from world.spec import TownSpec
 
 ROAD = make_map(seg(1000.0))
 V = 13.9  # [m/s]
@@ -123,7 +124,7 @@ def test_a_flat_tyre_pulls_over_lane_by_lane_onto_the_shoulder() -> None:
 def test_a_town_turn_from_the_stop_line_to_the_junction_exit(manoeuvre: str,
                                                              state: Motion) -> None:
     layout = TownLayout(TownSpec(3, 2, 90.0, 2, 3.5, 11.0, "stop_signs"))
-    road = RoadMap.from_spec(compile_route(layout, (0, 1, "east"), (Manoeuvre(manoeuvre),), "e"))
+    road = build_road_map(compile_route(layout, (0, 1, "east"), (Manoeuvre(manoeuvre),), "e"))
     j = road.junctions[0]
     m = MotionLayer(road, 0, AccParams(), MotionLayerParams())
     seen = []

@@ -10,7 +10,7 @@ import pytest
 from perception.messages import EgoState
 from planner.planner import LaneKeepingParams, LaneKeepingPlanner
 from planner.speed_planning import Binding, SpeedPlanner
-from tests.planner.maps import KPH, needs_hdmap, real_map, road_spec, segment, straight_road
+from tests.planner.maps import KPH, real_map, road_spec, segment, straight_road
 from world.hdmap import RoadMap
 
 KINDS = ["real"]  # the planner now needs the whole map (lanes, projection)
@@ -30,7 +30,6 @@ def planner(road: RoadMap, lane: int = 1, set_kph: float = 80.0,
                                                       camera=camera))
 
 
-@needs_hdmap
 def test_plan_on_an_arc() -> None:
     road = real_map(road_spec([segment(100.0), segment(200.0, 60.0), segment(100.0)], 100.0))
     p = planner(road)

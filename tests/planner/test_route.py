@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from planner.route import lane_path, path_stations
-from tests.planner.maps import LANE_WIDTH, needs_hdmap, real_map, road_spec, segment, straight_road
+from tests.planner.maps import LANE_WIDTH, real_map, road_spec, segment, straight_road
 
 R = 60.0  # [m]
 
@@ -17,7 +17,6 @@ def wrap(a: np.ndarray) -> np.ndarray:
     return np.mod(a + math.pi, 2.0 * math.pi) - math.pi
 
 
-@needs_hdmap
 @pytest.mark.parametrize("lane_index", [0, 1, -1])
 def test_path_on_lane_centre_through_straight_arc_straight(lane_index: int) -> None:
     road = real_map(road_spec([segment(100.0), segment(80.0, R), segment(100.0)], 50.0))

@@ -16,7 +16,7 @@ from planner.speed_planning import (
     braking_speed,
     curve_speed,
 )
-from tests.planner.maps import KPH, needs_hdmap, real_map, road_spec, segment, straight_road
+from tests.planner.maps import KPH, real_map, road_spec, segment, straight_road
 from world.hdmap import RoadMap
 
 P = SpeedPlanningParams()
@@ -147,7 +147,6 @@ def curve_road() -> RoadMap:
     return real_map(road_spec([segment(200.0), segment(150.0, R), segment(200.0)], 130.0))
 
 
-@needs_hdmap
 def test_curvature_speed_on_r60() -> None:
     t = target(curve_road(), 275.0, 120.0)
     assert t.binding is Binding.CURVE
@@ -156,7 +155,6 @@ def test_curvature_speed_on_r60() -> None:
     assert t.accel == 0.0
 
 
-@needs_hdmap
 @pytest.mark.parametrize(("left", "radius"), [(True, R - 3.5), (False, R + 3.5)])
 def test_curvature_speed_of_the_offset_lane(left: bool, radius: float) -> None:
     road = real_map(road_spec([segment(100.0), segment(150.0, R, left), segment(100.0)], 130.0))
@@ -165,7 +163,6 @@ def test_curvature_speed_of_the_offset_lane(left: bool, radius: float) -> None:
     assert t.speed == pytest.approx(math.sqrt(3.0 * radius))
 
 
-@needs_hdmap
 def test_curve_ahead_gives_braking_curve() -> None:
     d = 100.0  # [m] front axle -> arc start
     t = target(curve_road(), 200.0 - AXLE - d, 120.0)
@@ -178,7 +175,6 @@ def test_curve_ahead_gives_braking_curve() -> None:
     assert lo - 1e-9 <= t.speed <= hi + 1e-9
 
 
-@needs_hdmap
 def test_curve_within_brake_margin_and_curve_exit() -> None:
     road = curve_road()
     t = target(road, 200.0 - AXLE - 1.0, 120.0)
@@ -193,7 +189,6 @@ def test_curve_within_brake_margin_and_curve_exit() -> None:
     assert t.binding is Binding.SET_SPEED
 
 
-@needs_hdmap
 def test_lower_limit_at_the_curve_ties_go_to_limit() -> None:
     """Set speed below everything: the set speed binds even in the curve."""
     t = target(curve_road(), 275.0, 40.0)
@@ -249,7 +244,6 @@ def test_drive_through_50_to_30_posting(kind: str) -> None:
     assert v[-1] == pytest.approx((30.0 - 0.3) * KPH)
 
 
-@needs_hdmap
 def test_drive_into_r60_curve() -> None:
     road = curve_road()
     v0 = target(road, 0.0, 200.0).speed  # already on the braking curve of the arc
@@ -268,7 +262,6 @@ def test_suffix_argmin_takes_the_nearest_of_equal_minima() -> None:
     np.testing.assert_array_equal(_suffix_argmin(values), [1, 1, 3, 3, 5, 5, 6])
 
 
-@needs_hdmap
 def test_planner_equals_brute_force_over_every_sample() -> None:
     """At many stations of a winding road with postings, the target equals the plain rule
     evaluated over every map sample and posting ahead (no suffix minimum, no shortcuts)."""

@@ -14,7 +14,8 @@ import pytest
 from avsim.report.speed_plot import plot_speed_profile
 from avsim.run.runner import RunResult
 from tests.scenarios import golden
-from world.hdmap import SHOULDER, RoadMap
+from world.hdmap import SHOULDER
+from world.map.road import build_road_map
 
 pytestmark = pytest.mark.slow
 KPH = 1 / 3.6
@@ -78,7 +79,7 @@ def test_the_exit_ramp_and_the_city_limits(result: RunResult) -> None:
     assert FORK - 160.0 < s[int(np.searchsorted(t, right.t))] < FORK - 60.0
     # the lead kept the highway (the log has its station and offset along the road it is on)
     k = [a.id for a in result.spec.actors].index("lead")
-    road = RoadMap.from_spec(result.spec.road)
+    road = build_road_map(result.spec.road)
     lead_s, lead_d = np.array(log.actor_station)[:, k], np.array(log.actor_offset)[:, k]
     x, y, _ = road.through_line.pose(lead_s[city], lead_d[city])
     _, off_route = road.local_coordinates(np.column_stack([x, y]))

@@ -12,7 +12,7 @@ import pytest
 
 from avsim.run.runner import RunResult
 from tests.scenarios import golden
-from world.hdmap import RoadMap
+from world.map.road import build_road_map
 
 pytestmark = pytest.mark.slow
 KPH = 1 / 3.6
@@ -33,7 +33,7 @@ def test_every_criterion_passes(result: RunResult) -> None:
 def test_the_situation_happened(result: RunResult) -> None:
     """The car drove >= 1 km through a left and a right curve (R 250 m and <= 60 m) and
     through at least two posted speed changes, with two cars in the other lane."""
-    road = RoadMap.from_spec(result.spec.road)
+    road = build_road_map(result.spec.road)
     station = result.log.array("station")
     assert station[-1] - station[0] >= 1000.0
     k = road.curvature_at(station)

@@ -13,9 +13,10 @@ import pytest
 
 from avsim.run.runner import RunResult
 from tests.scenarios import golden
-from world.hdmap import JunctionSpec, RoadMap
+from world.hdmap import Junction, LightColour, StopSign
+from world.map.road import build_road_map
 from world.map.signals import light_colour
-from world.spec import LightColour, StopSign, TrafficLight
+from world.spec import TrafficLightSpec
 
 pytestmark = pytest.mark.slow
 FRONT = 2.4  # [m] the ego's centre -> front bumper (and an NPC car's: 4.6 m long)
@@ -41,18 +42,18 @@ def _actor_xy(r: RunResult, actor_id: str) -> np.ndarray:
     k = [a.id for a in r.spec.actors].index(actor_id)
     spec = r.spec.actors[k].road
     assert spec is not None
-    road = RoadMap.from_spec(spec)
+    road = build_road_map(spec)
     s = np.array(r.log.actor_station)[:, k]
     offset = np.array(r.log.actor_offset)[:, k]
     return road.position(s, offset)
 
 
-def _in_box(xy: np.ndarray, j: JunctionSpec, margin: float = 0.0) -> np.ndarray:
+def _in_box(xy: np.ndarray, j: Junction, margin: float = 0.0) -> np.ndarray:
     return (np.abs(xy[:, 0] - j.x) <= j.half_width + margin) & \
         (np.abs(xy[:, 1] - j.y) <= j.half_width + margin)
 
 
-def _entered(r: RunResult, j: JunctionSpec) -> float:
+def _entered(r: RunResult, j: Junction) -> float:
     """[s] when the ego's front bumper went over the junction's stop line."""
     t, s = r.log.array("t"), r.log.array("station")
     return float(t[np.argmax(s + FRONT > j.s_stop)])
@@ -89,8 +90,7 @@ def test_the_route_turns_left_right_and_back_in_order(route: RunResult) -> None:
 def test_it_stops_at_red_and_goes_on_green(route: RunResult) -> None:
     log = route.log
     t, v, s = log.array("t"), log.array("speed"), log.array("station")
-    road = RoadMap.from_spec(route.spec.road)
-    lights = [f for f in road.features if isinstance(f, TrafficLight)]
+    lights = [f for f in route.spec.road.features if isinstance(f, TrafficLightSpec)]
     stood_at_red = 0
     for light in lights:
         waiting = (v < 0.1) & (light.s - 6.0 < s + FRONT) & (s + FRONT <= light.s)
@@ -103,7 +103,7 @@ def test_it_stops_at_red_and_goes_on_green(route: RunResult) -> None:
 
 
 def test_the_left_turn_waits_for_the_oncoming_cars(route: RunResult) -> None:
-    road = RoadMap.from_spec(route.spec.road)
+    road = build_road_map(route.spec.road)
     left = road.junctions[0]
     t = route.log.array("t")
     entered = _entered(route, left)
@@ -119,15 +119,14 @@ def test_npcs_keep_to_lights_and_stop_signs(route: RunResult) -> None:
     met_red = stood = 0
     for k, actor in enumerate(route.spec.actors):
         assert actor.road is not None
-        road = RoadMap.from_spec(actor.road)
         front = np.array(route.log.actor_station)[:, k] + 2.3
         v = np.gradient(front, t)
-        for f in road.features:
+        for f in actor.road.features:  # the spec's: the lights with their signal plans
             if front[0] > f.s or not np.any(front > f.s):
                 continue  # already over it, or never reached it
             over = int(np.argmax(front > f.s))
             before = (front <= f.s) & (front > f.s - 5.0)
-            if isinstance(f, TrafficLight):
+            if isinstance(f, TrafficLightSpec):
                 assert light_colour(f, float(t[over])) is not LightColour.RED, actor.id
                 met_red += int(any(light_colour(f, x) is LightColour.RED for x in t[before]))
             elif isinstance(f, StopSign):
@@ -141,14 +140,13 @@ def test_npcs_keep_to_lights_and_stop_signs(route: RunResult) -> None:
 
 def test_with_an_oncoming_car_close_the_left_turn_waits(close_car: RunResult) -> None:
     assert all(c.passed for c in close_car.criteria), close_car.criteria
-    j = RoadMap.from_spec(close_car.spec.road).junctions[0]
+    j = build_road_map(close_car.spec.road).junctions[0]
     t = close_car.log.array("t")
     inside = _in_box(_actor_xy(close_car, "oncoming"), j)
     assert inside.any()
     entered = _entered(close_car, j)
     assert t[inside].max() < entered  # the oncoming car went through first
-    light = next(f for f in RoadMap.from_spec(close_car.spec.road).features
-                 if isinstance(f, TrafficLight))
+    light = next(f for f in close_car.spec.road.features if isinstance(f, TrafficLightSpec))
     green = t[np.array([light_colour(light, x) is LightColour.GREEN for x in t])].min()
     assert entered > green + 2.0  # green alone did not let it go: it gave way
     acc = _states(close_car, "acc")
@@ -159,7 +157,7 @@ def test_with_an_oncoming_car_close_the_left_turn_waits(close_car: RunResult) ->
 def test_with_the_oncoming_car_far_the_left_turn_goes_at_once(far_car: RunResult,
                                                               close_car: RunResult) -> None:
     assert all(c.passed for c in far_car.criteria), far_car.criteria
-    j = RoadMap.from_spec(far_car.spec.road).junctions[0]
+    j = build_road_map(far_car.spec.road).junctions[0]
     t = far_car.log.array("t")
     xy = _actor_xy(far_car, "oncoming")
     entered = _entered(far_car, j)

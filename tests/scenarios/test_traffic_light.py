@@ -11,8 +11,9 @@ import pytest
 
 from avsim.run.runner import RunResult
 from tests.scenarios import golden
+from world.hdmap import LightColour
 from world.map.signals import light_colour
-from world.spec import LightColour, TrafficLight
+from world.spec import TrafficLightSpec
 
 pytestmark = pytest.mark.slow
 FRONT = 2.4  # [m] the ego's centre -> front bumper
@@ -25,7 +26,7 @@ def run(run_scenario: Callable[..., RunResult]) -> RunResult:
 
 def test_it_stops_at_red_and_goes_on_green(run: RunResult) -> None:
     assert all(c.passed for c in run.criteria), run.criteria
-    light = next(f for f in run.spec.road.features if isinstance(f, TrafficLight))
+    light = next(f for f in run.spec.road.features if isinstance(f, TrafficLightSpec))
     t, v, s = run.log.array("t"), run.log.array("speed"), run.log.array("station")
     front = s + FRONT
     red = np.array([light_colour(light, x) is LightColour.RED for x in t])
@@ -43,7 +44,7 @@ def test_it_pulls_away_to_the_limit_without_overshoot(run: RunResult) -> None:
     assert c["speed_limit"].value < 0.5  # [km/h] over 50 (1.9 before the stop law's fix)
 
 
-def light_colour_change(light: TrafficLight, t: np.ndarray, colour: LightColour) -> float:
+def light_colour_change(light: TrafficLightSpec, t: np.ndarray, colour: LightColour) -> float:
     """[s] the first time in `t` the light shows `colour` after having shown another."""
     shown = np.array([light_colour(light, x) is colour for x in t])
     k = int(np.argmax(~shown))

@@ -12,9 +12,10 @@ import pytest
 
 from avsim.scenario.load import ScenarioError, load_scenario
 from tests.roads import KPH, SHOULDER, W, arc, seg
-from world.hdmap import RoadMap
+from world.hdmap import RoadMap, Side, Zone
+from world.map.road import build_road_map
 from world.scene.road_mesh import THROUGH_DROP, build_road_surface, build_through_roads
-from world.spec import RoadSpec, Side, Zone
+from world.spec import RoadSpec
 
 RAMP_RADIUS = 80.0
 
@@ -22,7 +23,7 @@ RAMP_RADIUS = 80.0
 def exit_map() -> RoadMap:
     ramp = replace(arc(RAMP_RADIUS, -40.0, lanes=1, oncoming=0), speed_limit=25 * KPH,
                    zone=Zone.RAMP, exit=Side.RIGHT)
-    return RoadMap.from_spec(RoadSpec((seg(200.0), ramp, seg(100.0, lanes=1, oncoming=0)),
+    return build_road_map(RoadSpec((seg(200.0), ramp, seg(100.0, lanes=1, oncoming=0)),
                                       90 * KPH, ()))
 
 

@@ -14,19 +14,12 @@ from numpy.typing import NDArray
 from tests.perception.render_scene import pose_ego
 from world.core.client import PHYSICS_RATE
 from world.frames import CameraFrame
+from world.hdmap import Crosswalk, SpeedBump, StopSign
 from world.scene.bump import bump_height_at
 from world.scene.scenery import octagon_corners
 from world.sensors.rig import vehicle_pose
 from world.sensors.setup import Profile, sensor_setup
-from world.spec import (
-    Crosswalk,
-    EgoSpec,
-    RoadSpec,
-    ScenarioSpec,
-    SegmentSpec,
-    SpeedBump,
-    StopSign,
-)
+from world.spec import EgoSpec, RoadSpec, ScenarioSpec, SegmentSpec
 from world.world import SIGN_POLE_RADIUS, World
 
 KPH = 1 / 3.6  # [m/s] per km/h

@@ -8,8 +8,9 @@ import numpy as np
 import pytest
 
 from tests.roads import KPH, SHOULDER, W, arc, make_map, seg
-from world.hdmap import MapError, RoadMap
-from world.spec import RoadSpec, SpeedLimitSign, StopSign, Zone
+from world.hdmap import RoadMap, SpeedLimitSign, StopSign, Zone
+from world.map.road import MapError, build_road_map
+from world.spec import RoadSpec
 
 
 @pytest.fixture
@@ -191,7 +192,7 @@ def test_arcs_beyond_a_full_turn_raise_map_error() -> None:
 
 def test_empty_road_raises_map_error() -> None:
     with pytest.raises(MapError):
-        RoadMap.from_spec(RoadSpec((), 10.0))
+        build_road_map(RoadSpec((), 10.0))
 
 
 def test_curvature_of_lanes() -> None:

@@ -23,6 +23,8 @@ from pybullet_utils.bullet_client import BulletClient
 from world.actors.behaviour import NpcMotion, TriggerContext
 from world.actors.town_traffic import TownDriver
 from world.hdmap import RoadMap
+from world.map.road import build_road_map
+from world.map.signals import route_signals
 from world.spec import ActorSpec, ActorType
 
 
@@ -73,7 +75,7 @@ class ActorSet:
         self._road = road
         self.specs = specs
         # in a town each actor drives its own route road; on a road, the route
-        self._maps = [road if a.road is None else RoadMap.from_spec(a.road) for a in specs]
+        self._maps = [road if a.road is None else build_road_map(a.road) for a in specs]
         self._own = np.array([a.road is not None for a in specs], dtype=bool)
         self.motions: list[NpcMotion] = []
         self.bodies: list[int] = []
@@ -91,7 +93,7 @@ class ActorSet:
              for a in specs]
         ).reshape(-1, 3)
         self._drivers = [
-            TownDriver(own_map, SIZES[a.type].length / 2)
+            TownDriver(own_map, route_signals(a.road, own_map), SIZES[a.type].length / 2)
             if a.road is not None and a.type in (ActorType.CAR, ActorType.TRUCK) else None
             for a, own_map in zip(specs, self._maps, strict=True)
         ]

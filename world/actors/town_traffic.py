@@ -26,14 +26,15 @@ the light's lamp from its timing and other cars' true poses.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
 
-from world.hdmap import RoadMap
+from world.hdmap import LightColour, RoadMap, StopSign, TrafficLight
 from world.map.signals import light_colour
-from world.spec import LightColour, StopSign, TrafficLight
+from world.spec import TrafficLightSpec
 
 STOP_DECEL = 2.5  # [m/s^2] the braking curve to a stop line or a car ahead
 STOP_MARGIN = 0.5  # [m] front bumper short of the stop line
@@ -52,21 +53,25 @@ FloatArray = NDArray[np.float64]
 @dataclass(slots=True)
 class _StopLine:
     s: float  # [m] station of the line on the NPC's route
-    light: TrafficLight | None  # None: a stop sign
+    light: TrafficLightSpec | None  # its signal plan; None: a stop sign
     box: tuple[float, float, float]  # (x, y, half width) of the junction's box
     stood_since: float | None = None  # [s] when it came to a stop at a stop sign
     passed: bool = False
 
 
 class TownDriver:
-    """The rules one NPC keeps on its route `road` (module doc)."""
+    """The rules one NPC keeps on its route `road` (module doc), whose lights have the
+    signal plans `signals` (by stop-line station)."""
 
-    def __init__(self, road: RoadMap, half_length: float) -> None:
+    def __init__(self, road: RoadMap, signals: Sequence[TrafficLightSpec],
+                 half_length: float) -> None:
         self.road = road
         self.half_length = half_length
         boxes = {j.s_stop: (j.x, j.y, j.half_width) for j in road.junctions}
+        plans = {light.s: light for light in signals}
         self._lines = [
-            _StopLine(f.s, f if isinstance(f, TrafficLight) else None, boxes.get(f.s, (0, 0, 0)))
+            _StopLine(f.s, plans[f.s] if isinstance(f, TrafficLight) else None,
+                      boxes.get(f.s, (0, 0, 0)))
             for f in road.features if isinstance(f, StopSign | TrafficLight)
         ]
         # the turn arcs: (start station, end station, curvature)

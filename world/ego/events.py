@@ -28,7 +28,8 @@ from __future__ import annotations
 import math
 
 from world.actors.behaviour import TriggerContext, trigger_holds
-from world.spec import AcceleratorOverride, AfterTrigger, EventSpec, FlatTire, GapTrigger, Wheel
+from world.frames import Wheel
+from world.spec import AcceleratorOverride, AfterTrigger, EventSpec, FlatTire, GapTrigger
 
 RELEASE_TOLERANCE = 1e-9  # [s] so that fired + duration summed in floats lands on its check
 

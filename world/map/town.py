@@ -47,19 +47,8 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
 
-from world.spec import (
-    Control,
-    Feature,
-    JunctionSpec,
-    LightHead,
-    Manoeuvre,
-    RoadSpec,
-    SegmentSpec,
-    StopSign,
-    TownSpec,
-    TrafficLight,
-    Zone,
-)
+from world.hdmap import Control, Junction, LightHead, Manoeuvre, StopSign, Zone
+from world.spec import FeatureSpec, RoadSpec, SegmentSpec, TownSpec, TrafficLightSpec
 
 RIGHT_TURN_RADIUS = 6.0  # [m] lane-centre radius of a right turn
 KERB_RADIUS = 6.0  # [m] a junction's rounded kerb corners
@@ -98,7 +87,7 @@ class Approach:
     heading: str  # the direction of travel into the junction
     stop_line: tuple[float, float]  # [m] centre of the stop line (across the lanes heading in)
     stop_sign: tuple[tuple[float, float], float] | None  # ([m] pole foot, [rad] plate yaw)
-    light: TrafficLight | None  # its signal plan and head; `s` is 0 (not on a route)
+    light: TrafficLightSpec | None  # its signal plan and head; `s` is 0 (not on a route)
 
 
 @dataclass(frozen=True, slots=True)
@@ -168,7 +157,7 @@ class TownLayout:
         c, s = math.cos(psi), math.sin(psi)
         return (x0 + along * c + right * s, y0 + along * s - right * c)
 
-    def signal(self, j: Index, heading: str) -> TrafficLight:
+    def signal(self, j: Index, heading: str) -> TrafficLightSpec:
         """The signal plan and head for the traffic heading into j (its `s` is 0)."""
         t = self.spec.lights
         offset = (j[0] * LIGHT_OFFSET_X + j[1] * LIGHT_OFFSET_Y) % t.cycle
@@ -179,7 +168,7 @@ class TownLayout:
         x, y = self.point(j, heading, corner, corner)
         head = LightHead(x, y, LIGHT_HEIGHT, _wrap(HEADINGS[heading] + math.pi))
         red = t.cycle - t.green - t.yellow
-        return TrafficLight(0.0, t.green, t.yellow, red, offset % t.cycle, head)
+        return TrafficLightSpec(0.0, t.green, t.yellow, red, offset % t.cycle, head)
 
     def approaches(self) -> list[Approach]:
         """Every approach of every controlled junction."""
@@ -255,8 +244,8 @@ def compile_route(layout: TownLayout, start: tuple[int, int, str],
         raise TownError(f"{key}.start", f"no street leaves junction {j} heading {heading}")
     b = _Builder(layout, [])
     origin = (*layout.point(j, heading, layout.mouth, layout.kerb_lane), HEADINGS[heading])
-    features: list[Feature] = []
-    junctions: list[JunctionSpec] = []
+    features: list[FeatureSpec] = []
+    junctions: list[Junction] = []
     for k, manoeuvre in enumerate(route):
         nxt = (j[0] + STEPS[heading][0], j[1] + STEPS[heading][1])
         _check_manoeuvre(layout, nxt, heading, manoeuvre, f"{key}.route.{k}")
@@ -307,13 +296,13 @@ def _lay_turn(b: _Builder, manoeuvre: Manoeuvre, heading: str) -> str:
 
 
 def _junction(layout: TownLayout, j: Index, heading: str, manoeuvre: Manoeuvre,
-              s_enter: float, s_exit: float) -> JunctionSpec:
+              s_enter: float, s_exit: float) -> Junction:
     x, y = layout.centre(j)
-    return JunctionSpec(j, manoeuvre, layout.control(j), s_enter - STOP_SETBACK, s_enter,
+    return Junction(j, manoeuvre, layout.control(j), s_enter - STOP_SETBACK, s_enter,
                         s_exit, x, y, HEADINGS[heading], layout.half_width)
 
 
-def _controls(layout: TownLayout, junction: JunctionSpec, heading: str) -> list[Feature]:
+def _controls(layout: TownLayout, junction: Junction, heading: str) -> list[FeatureSpec]:
     if junction.control is Control.STOP_SIGNS:
         return [StopSign(junction.s_stop)]
     if junction.control is Control.TRAFFIC_LIGHTS:

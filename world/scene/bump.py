@@ -18,9 +18,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from world.hdmap import RoadMap
+from world.hdmap import RoadMap, SpeedBump
 from world.scene.road_mesh import TexturedMesh
-from world.spec import SpeedBump
 
 FloatArray = NDArray[np.float64]
 

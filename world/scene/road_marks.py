@@ -23,9 +23,8 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-from world.hdmap import RoadMap
+from world.hdmap import Crosswalk, RoadMap, StopSign
 from world.scene.road_mesh import TexturedMesh
-from world.spec import Crosswalk, StopSign
 
 FloatArray = NDArray[np.float64]
 

@@ -17,8 +17,8 @@ import cv2
 import numpy as np
 from numpy.typing import NDArray
 
-from world.hdmap import RoadMap
-from world.spec import BuildingsSpec, StopSign
+from world.hdmap import RoadMap, StopSign
+from world.spec import BuildingsSpec
 
 FloatArray = NDArray[np.float64]
 

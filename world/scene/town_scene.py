@@ -62,7 +62,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from world.hdmap import RoadMap
+from world.hdmap import RoadMap, Zone
+from world.map.road import build_road_map
 from world.map.town import HEADINGS, STOP_SETBACK, TownLayout
 from world.scene.road_marks import MARK_Z, STOP_LINE_WIDTH, paint_texture
 from world.scene.road_mesh import (
@@ -83,7 +84,7 @@ from world.scene.scenery import (
     StopSignPlacement,
     _facade,
 )
-from world.spec import RoadSpec, SegmentSpec, Zone
+from world.spec import RoadSpec, SegmentSpec
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int32]
@@ -207,7 +208,7 @@ def street_road(layout: TownLayout, j: Index, heading: str) -> RoadMap:
     n, w = t.lanes, t.lane_width
     segment = SegmentSpec(t.block - 2.0 * layout.mouth, 0.0, n, n, w, 0.0, None, Zone.CITY)
     origin = (*layout.point(j, heading, layout.mouth, layout.kerb_lane), HEADINGS[heading])
-    return RoadMap.from_spec(RoadSpec((segment,), t.speed_limit, origin=origin))
+    return build_road_map(RoadSpec((segment,), t.speed_limit, origin=origin))
 
 
 # -- meshes ----------------------------------------------------------------------------------

@@ -39,7 +39,7 @@ import pybullet
 from numpy.typing import NDArray
 from pybullet_utils.bullet_client import BulletClient
 
-from world.spec import LightColour, LightHead
+from world.hdmap import LightColour, LightHead
 
 HOUSING_DEPTH = 0.25  # [m] along the facing
 HOUSING_WIDTH = 0.35  # [m]

@@ -13,8 +13,8 @@ from avsim.criteria.base import TruthSample
 from avsim.criteria.road_rules import Crosswalks, SpeedBumps, StopSigns
 from tests.roads import KPH, W, make_map, seg
 from world.actors.actor_set import ActorPoses
-from world.hdmap import RoadMap
-from world.spec import ActorType, Crosswalk, Feature, SpeedBump, StopSign
+from world.hdmap import Crosswalk, RoadMap, SpeedBump, StopSign
+from world.spec import ActorType, FeatureSpec
 
 DT = 1 / 40  # [s] the criteria rate
 HALF_LENGTH = 2.4  # [m] the ego's centre to its bumpers
@@ -24,7 +24,7 @@ PEDESTRIAN_HALF = (0.25, 0.3, 0.875)  # [m]
 STOP_S, ZEBRA_S, ZEBRA_W, BUMP_S = 100.0, 150.0, 4.0, 200.0  # [m]
 
 
-def road(*features: Feature) -> RoadMap:
+def road(*features: FeatureSpec) -> RoadMap:
     """300 m straight, 2 ego lanes and 1 oncoming (lane 0 centre at 0, lane 1 at 3.5 m)."""
     return make_map(seg(300.0), features=tuple(features))
 

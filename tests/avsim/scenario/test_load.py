@@ -309,7 +309,7 @@ def test_full_example_converts_once_everything_is_supported(
     monkeypatch.setattr(scenario_module, "UNSUPPORTED", {"town": "the town map kind"})
     loaded = load_scenario(_write(tmp_path, FULL_EXAMPLE))
     assert loaded.road.segments[3].exit == spec.Side.RIGHT
-    assert loaded.road.features[4] == spec.TrafficLight(600.0, 20.0, 3.0, 15.0, 0.0)
+    assert loaded.road.features[4] == spec.TrafficLightSpec(600.0, 20.0, 3.0, 15.0, 0.0)
     assert loaded.road.features[3].pass_speed == 5 * KPH  # type: ignore[union-attr]
     walker = loaded.actors[2]
     assert (walker.type, walker.lane, walker.offset) == (spec.ActorType.PEDESTRIAN, 0, -6.0)

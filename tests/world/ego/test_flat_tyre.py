@@ -26,6 +26,7 @@ from avsim.scenario.load import load_scenario
 from vehicle_urdf import WHEELS
 from world.core.client import PHYSICS_RATE
 from world.ego.events import EgoEvents
+from world.frames import Wheel
 from world.spec import (
     AcceleratorOverride,
     AfterTrigger,
@@ -37,7 +38,6 @@ from world.spec import (
     ScenarioSpec,
     SegmentSpec,
     TimeTrigger,
-    Wheel,
 )
 from world.world import TRIGGER_RATE, World
 

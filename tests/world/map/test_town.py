@@ -7,10 +7,11 @@ import math
 import numpy as np
 import pytest
 
-from world.hdmap import RoadMap
+from world.hdmap import Control, LightColour, Manoeuvre, Zone
+from world.map.road import build_road_map
 from world.map.signals import light_colour
 from world.map.town import OPPOSITE, TownError, TownLayout, compile_route
-from world.spec import Control, LightColour, Manoeuvre, TownSpec, Zone
+from world.spec import TownSpec
 
 M = Manoeuvre
 
@@ -32,7 +33,7 @@ def town(lanes: int = 1, junctions: str = "traffic_lights") -> TownLayout:
 )
 def test_turn_ends_in_lane_0_of_the_new_street(lanes, start, manoeuvre, heading_after) -> None:
     layout = town(lanes)
-    road = RoadMap.from_spec(compile_route(layout, start, (manoeuvre,), "ego"))
+    road = build_road_map(compile_route(layout, start, (manoeuvre,), "ego"))
     j = road.junctions[0]
     nxt = (j.index[0], j.index[1])
     expected = layout.point(nxt, heading_after, layout.mouth, layout.kerb_lane)
@@ -51,7 +52,7 @@ def test_turn_ends_in_lane_0_of_the_new_street(lanes, start, manoeuvre, heading_
 def test_the_route_starts_past_the_start_mouth_and_ends_at_the_next_stop_line() -> None:
     layout = town()
     spec = compile_route(layout, (0, 0, "east"), (M.STRAIGHT, M.LEFT), "ego")
-    road = RoadMap.from_spec(spec)
+    road = build_road_map(spec)
     np.testing.assert_allclose(road.position(0.0, 0.0), (layout.mouth, -1.75), atol=1e-9)
     end = layout.point((2, 1), "north", -layout.mouth - 1.0, layout.kerb_lane)
     np.testing.assert_allclose(road.position(road.length, 0.0), end, atol=1e-6)

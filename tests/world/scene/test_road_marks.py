@@ -11,7 +11,8 @@ import pytest
 from numpy.typing import NDArray
 
 from tests.roads import KPH, SHOULDER, W, arc, seg
-from world.hdmap import RoadMap
+from world.hdmap import Crosswalk, RoadMap, SpeedBump, StopSign
+from world.map.road import build_road_map
 from world.scene.bump import (
     VISUAL_LIFT,
     bump_height_at,
@@ -39,7 +40,7 @@ from world.scene.scenery import (
     octagon_corners,
     stop_sign_image,
 )
-from world.spec import Crosswalk, RoadSpec, SpeedBump, StopSign
+from world.spec import RoadSpec
 
 STOP_STRAIGHT, STOP_ARC = 60.0, 160.0  # [m] stations: on the first straight, on the arc
 ZEBRA_STRAIGHT, ZEBRA_ARC = 80.0, 180.0
@@ -54,7 +55,7 @@ def road() -> RoadMap:
         Crosswalk(ZEBRA_STRAIGHT, 4.0), Crosswalk(ZEBRA_ARC, 3.0),
         SpeedBump(BUMP_S, 0.1, 0.9, 5 * KPH),
     )
-    return RoadMap.from_spec(RoadSpec((seg(120.0), arc(60.0, 90.0), seg(50.0)), 50 * KPH,
+    return build_road_map(RoadSpec((seg(120.0), arc(60.0, 90.0), seg(50.0)), 50 * KPH,
                                       features))
 
 
@@ -104,7 +105,7 @@ def test_stop_line_lies_across_the_ego_lanes_from_its_station(road: RoadMap, s: 
 
 
 def test_zebra_bars_fill_the_paved_road_centred() -> None:
-    road = RoadMap.from_spec(RoadSpec((seg(100.0),), 50 * KPH))
+    road = build_road_map(RoadSpec((seg(100.0),), 50 * KPH))
     bars = zebra_bars(road, 50.0)
     right, left = -(W / 2 + SHOULDER), 2.5 * W  # 2 + 1 lanes: 12.75 m paved
     n = math.floor((left - right + ZEBRA_GAP) / (ZEBRA_BAR + ZEBRA_GAP))
@@ -157,7 +158,7 @@ def covered(road: RoadMap, mesh: TexturedMesh, s: float, d: float) -> bool:
 def test_build_road_marks_names_every_mark_in_station_order(road: RoadMap) -> None:
     names = [m.name for m in build_road_marks(road)]
     assert names == ["stop_line_0", "crosswalk_0", "stop_line_1", "crosswalk_1"]
-    assert build_road_marks(RoadMap.from_spec(RoadSpec((seg(50.0),), 10.0))) == []
+    assert build_road_marks(build_road_map(RoadSpec((seg(50.0),), 10.0))) == []
 
 
 # -- the stop sign -------------------------------------------------------------------------

@@ -7,7 +7,8 @@ import pytest
 from numpy.typing import NDArray
 
 from tests.roads import SHOULDER, W, arc, seg
-from world.hdmap import CrossSection, RoadMap
+from world.hdmap import CrossSection, RoadMap, Zone
+from world.map.road import build_road_map
 from world.scene.road_mesh import (
     DASH_LENGTH,
     DASH_PERIOD,
@@ -20,7 +21,7 @@ from world.scene.road_mesh import (
     make_road_texture,
     markings,
 )
-from world.spec import RoadSpec, Zone
+from world.spec import RoadSpec
 
 
 @pytest.fixture(scope="module")
@@ -35,7 +36,7 @@ def road() -> RoadMap:
         arc(25.0, 120.0),
         seg(500.0),
     )
-    return RoadMap.from_spec(RoadSpec(segments, 13.9))
+    return build_road_map(RoadSpec(segments, 13.9))
 
 
 @pytest.fixture(scope="module")
@@ -76,7 +77,7 @@ def test_triangles_face_up_and_are_not_degenerate(meshes: list[TexturedMesh]) ->
 
 
 def test_long_roads_are_split_under_the_vertex_limit() -> None:
-    road = RoadMap.from_spec(RoadSpec((seg(9000.0),), 13.9))
+    road = build_road_map(RoadSpec((seg(9000.0),), 13.9))
     meshes = build_road_surface(road)
     assert len(meshes) >= 3
     assert all(len(m.vertices) <= MAX_MESH_VERTICES for m in meshes)

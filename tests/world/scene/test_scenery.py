@@ -9,7 +9,8 @@ import pytest
 from numpy.typing import NDArray
 
 from tests.roads import KPH, arc, seg
-from world.hdmap import RoadMap
+from world.hdmap import RoadMap, SpeedLimitSign
+from world.map.road import build_road_map
 from world.scene.scenery import (
     DEPTH_RANGE,
     FRONTAGE_RANGE,
@@ -20,7 +21,7 @@ from world.scene.scenery import (
     layout_speed_limit_signs,
     speed_limit_sign_image,
 )
-from world.spec import BuildingsSpec, RoadSpec, SpeedLimitSign
+from world.spec import BuildingsSpec, RoadSpec
 
 
 @pytest.fixture(scope="module")
@@ -37,7 +38,7 @@ def road() -> RoadMap:
         seg(200.0),
     )
     features = (SpeedLimitSign(120.0, 40 * KPH), SpeedLimitSign(600.0, 30 * KPH))
-    return RoadMap.from_spec(RoadSpec(segments, 50 * KPH, features))
+    return build_road_map(RoadSpec(segments, 50 * KPH, features))
 
 
 def footprint_grid(box: BuildingBox, step: float = 0.5) -> NDArray[np.float64]:

@@ -13,7 +13,8 @@ import pytest
 from perception.lanes import LaneDetector
 from perception.objects import DetectorParams, ObjectDetector
 from tests.perception.render_scene import lane_truth, pose_ego
-from world.hdmap import RoadMap
+from world.hdmap import Manoeuvre
+from world.map.road import build_road_map
 from world.map.town import HEADINGS, STOP_SETBACK, TownLayout, compile_route
 from world.scene.road_marks import MARK_Z, STOP_LINE_WIDTH
 from world.scene.road_mesh import SURFACE_Z, TexturedMesh, build_road_surface
@@ -30,7 +31,7 @@ from world.scene.town_scene import (
 )
 from world.sensors.rig import vehicle_pose
 from world.sensors.setup import Profile, sensor_setup
-from world.spec import EgoSpec, Manoeuvre, ScenarioSpec, TownSpec
+from world.spec import EgoSpec, ScenarioSpec, TownSpec
 from world.world import World
 
 BLOCK = 90.0  # [m]
@@ -199,7 +200,7 @@ def test_every_approach_has_its_stop_line(kind: str) -> None:
 def test_the_routes_stop_station_is_on_the_towns_stop_line() -> None:
     t = layout()
     scene = build_town_scene(t, np.random.default_rng(0))
-    road = RoadMap.from_spec(compile_route(t, (0, 1, "east"), (Manoeuvre.LEFT,), "ego"))
+    road = build_road_map(compile_route(t, (0, 1, "east"), (Manoeuvre.LEFT,), "ego"))
     (junction,) = road.junctions
     at_line = road.position(junction.s_stop, 0.0)
     beyond = road.position(junction.s_stop + STOP_LINE_WIDTH, 0.0)
@@ -246,7 +247,7 @@ def test_sidewalks_wrap_every_block_corner_clear_of_the_right_turn(town: Town) -
                 behind = centre + radius * (np.cos(phi)[:, None] * u + np.sin(phi)[:, None] * v)
                 assert np.all(cover([slab.mesh], behind, up_only=True) == 1)
     # a right turn's path keeps at least w / 2 from the kerb corner, most at its middle
-    road = RoadMap.from_spec(compile_route(t, (0, 1, "east"), (Manoeuvre.RIGHT,), "ego"))
+    road = build_road_map(compile_route(t, (0, 1, "east"), (Manoeuvre.RIGHT,), "ego"))
     (junction,) = road.junctions
     path = road.position(np.linspace(junction.s_enter, junction.s_exit, 200), 0.0)
     kerb = corner_arc(t, (1, 1), 2)

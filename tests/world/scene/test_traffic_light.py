@@ -18,6 +18,7 @@ from pybullet_utils.bullet_client import BulletClient
 
 from world.core.client import add_ground, make_client
 from world.core.rendering import Renderer, attach_renderer
+from world.hdmap import LightColour, LightHead
 from world.map.signals import light_colour
 from world.scene.traffic_light import (
     HOUSING_DEPTH,
@@ -35,7 +36,7 @@ from world.scene.traffic_light import (
 )
 from world.sensors.camera import Camera
 from world.sensors.setup import Profile, sensor_setup
-from world.spec import LightColour, LightHead, TrafficLight
+from world.spec import TrafficLightSpec
 
 HEAD = LightHead(10.0, -5.0, 3.5, math.pi)  # facing -x
 
@@ -125,7 +126,7 @@ def test_lit_lamps_are_saturated_and_dim_ones_dark() -> None:
 
 # ---- timing ---------------------------------------------------------------------------------
 
-CYCLE = TrafficLight(s=50.0, green=10.0, yellow=3.0, red=12.0, phase=0.0)  # 25 s
+CYCLE = TrafficLightSpec(s=50.0, green=10.0, yellow=3.0, red=12.0, phase=0.0)  # 25 s
 
 
 @pytest.mark.parametrize(("phase", "t", "colour"), [
@@ -146,7 +147,7 @@ CYCLE = TrafficLight(s=50.0, green=10.0, yellow=3.0, red=12.0, phase=0.0)  # 25 
     (0.0, -1.0, LightColour.RED),  # before t = 0: the end of the previous cycle
 ])
 def test_light_colour_timing(phase: float, t: float, colour: LightColour) -> None:
-    light = TrafficLight(CYCLE.s, CYCLE.green, CYCLE.yellow, CYCLE.red, phase)
+    light = TrafficLightSpec(CYCLE.s, CYCLE.green, CYCLE.yellow, CYCLE.red, phase)
     assert light_colour(light, t) is colour
 
 
