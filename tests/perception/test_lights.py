@@ -3,8 +3,8 @@ the world model (a straight road with traffic light bodies, `tests.perception.li
 and its pure projection helpers.
 
 The main light stands where the map puts it (`world.map.road.light_head`: 12 m past its
-stop line, 1 m right of the paved edge, 3.5 m high, facing the traffic); the ego is posed on lane 0's
-centre 10-50 m before it. One world is built for the module and each frame rendered once
+stop line, 1 m right of the paved edge, 3.5 m high, facing the traffic); the ego is posed
+on lane 0's centre 10-50 m before it. One world is built for the module and each frame rendered once
 (the pose-error cases reuse the frames: the error is in the pose given to the detector).
 The renderer is whichever the machine has (EGL or TinyRenderer: both were measured the same).
 """
