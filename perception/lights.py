@@ -1,12 +1,12 @@
 """Traffic lights in a camera frame: the lit lamp's colour, looked for where the map says the
 light is.
 
-`TrafficLightDetector.detect(frame, ego, heads)` takes one `world.frames.CameraFrame`, the
-stack's pose estimate and the map's light heads near the route (`world.hdmap.TrafficLight`),
-and returns a `perception.messages.LightDetection` (the lit colour) for each head it sees,
-nearest first. Classical and stateless, one frame at a time: colour blobs in the light's
-expected image region. Only OpenCV and numpy; the housing's size is the standard one
-(`HOUSING_WIDTH` ...), not read from the world model.
+`TrafficLightDetector.detect(frame, ego)` takes one `world.frames.CameraFrame` and the
+stack's pose estimate, picks the map's light heads near the route itself
+(`world.hdmap.TrafficLight`), and returns a `perception.messages.LightDetection` (the lit
+colour) for each head it sees, nearest first. Classical and stateless, one frame at a time:
+colour blobs in the light's expected image region. Only OpenCV and numpy; the housing's
+size is the standard one (`HOUSING_WIDTH` ...), not read from the world model.
 
 The light: a dark housing ``HOUSING_WIDTH`` (0.35 m) wide, ``HOUSING_HEIGHT`` (1.0 m) tall and
 ``HOUSING_DEPTH`` (0.25 m) deep, centred on the head's point (which is the yellow lamp's
@@ -14,7 +14,9 @@ centre), its three round lamps ``LAMP_DIAMETER`` (0.22 m) across, ``LAMP_SPACING
 apart: red on top, yellow, green at the bottom. The head's ``facing`` is the yaw of the lamps'
 outward normal.
 
-1. **Which heads**. A head is looked for when it is within ``max_range`` (60 m) of the car's
+1. **Which heads**. The map's lights (`RoadMap.traffic_lights`) whose stop line is ahead of
+   the front bumper by at most ``stop_line_ahead`` (60 m; ``stop_line_behind``, 1 m, behind
+   it at most), looked for when the head is within ``max_range`` (60 m) of the car's
    centre, its lamps face the car (their normal within ``max_facing`` (60 deg) of the
    direction from the head to the car: from behind or side-on the lamps cannot be seen),
    its housing lies in front of the camera and its centre projects inside the image.
@@ -82,7 +84,7 @@ from numpy.typing import NDArray
 
 from perception.messages import EgoState, LightDetection
 from world.frames import CameraFrame, CameraInfo
-from world.hdmap import LightColour, LightHead
+from world.hdmap import LightColour, LightHead, RoadMap
 
 HOUSING_WIDTH = 0.35  # [m] (standard size)
 HOUSING_HEIGHT = 1.0  # [m]
@@ -105,6 +107,9 @@ class LightParams:
     """Thresholds of `TrafficLightDetector` (see the module docstring for each)."""
 
     # -- which heads
+    stop_line_ahead: float = 60.0  # [m] a light is looked for while its stop line is at
+    #   most this far ahead of the front bumper ...
+    stop_line_behind: float = 1.0  # [m] ... and less than this behind it
     max_range: float = 60.0  # [m] car centre to head, horizontal
     max_facing: float = math.radians(60.0)  # [rad] lamps' normal vs the direction to the car
     # -- where: the ROI
@@ -233,12 +238,31 @@ class TrafficLightDetector:
     """Finds the lit lamp of the map's traffic lights in the frames of one camera (see the
     module docstring)."""
 
-    def __init__(self, camera: CameraInfo, params: LightParams | None = None) -> None:
+    def __init__(self, camera: CameraInfo, road: RoadMap, front_overhang: float,
+                 params: LightParams | None = None) -> None:
+        """`road`: the HD map whose lights are looked for; `front_overhang` [m]: the car's
+        centre to its front bumper."""
         self.camera = camera
+        self.road = road
+        self.front_overhang = front_overhang
         self.params = params or LightParams()
 
-    def detect(self, frame: CameraFrame, ego: EgoState,
-               heads: Sequence[tuple[int, LightHead]]) -> tuple[LightDetection, ...]:
+    def heads_ahead(self, ego: EgoState) -> list[tuple[int, LightHead]]:
+        """(id, head) of the map's lights whose stop line is ahead of the front bumper
+        within ``stop_line_ahead`` (an id indexes `RoadMap.traffic_lights`)."""
+        p = self.params
+        station = float(self.road.local_coordinates(np.array([ego.x, ego.y]))[0])
+        front = station + self.front_overhang
+        return [(i, light.head) for i, light in enumerate(self.road.traffic_lights)
+                if -p.stop_line_behind < light.s - front <= p.stop_line_ahead]
+
+    def detect(self, frame: CameraFrame, ego: EgoState) -> tuple[LightDetection, ...]:
+        """The lit colour of each light of the map ahead (`heads_ahead`) seen in
+        ``frame``, nearest first. ``ego`` is the pose estimate at the frame's time."""
+        return self.detect_heads(frame, ego, self.heads_ahead(ego))
+
+    def detect_heads(self, frame: CameraFrame, ego: EgoState,
+                     heads: Sequence[tuple[int, LightHead]]) -> tuple[LightDetection, ...]:
         """The lit colour of each of ``heads`` ((id, head) pairs, map frame) seen in
         ``frame``, nearest first. ``ego`` is the pose estimate at the frame's time."""
         if frame.info != self.camera:

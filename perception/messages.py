@@ -183,3 +183,41 @@ class LightDetection:
     range: float  # [m] horizontal distance from the car's centre to the head (map and pose)
     confidence: float  # [0, 1] how clearly the lamp was seen (size, uniqueness, position)
     box: tuple[int, int, int, int]  # [px] (u0, v0, u1, v1) of the lamp's pixels, u1/v1 exclusive
+
+
+# ---- the one message the planner receives each tick ---------------------------------------
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class LaneView:
+    """The camera's latest lane estimate and the stack's pose estimate at its frame's time
+    (the estimate is in that pose's vehicle frame)."""
+
+    estimate: LaneEstimate
+    pose: EgoState
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class SignView:
+    """The traffic signs found in one camera frame and the pose estimate at its time."""
+
+    signs: tuple[SignDetection, ...]  # vehicle frame at `pose`
+    pose: EgoState
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class PlannerInput:
+    """What perception hands the planner each control tick.
+
+    `ego`, `lane` and `tracks` hold the latest estimates (the lane and tracks are as old as
+    the last camera frame / LiDAR scan, one sensor period or more). `signs` and `lights`
+    are what the frame delivered since the last tick showed, given once: None / empty on
+    the ticks between frames."""
+
+    ego: EgoState  # the pose and speed estimate now
+    lane: LaneView | None = None  # None before the camera's first lane (or without one)
+    tracks: tuple[Track, ...] = ()  # the confirmed tracks
+    signs: SignView | None = None  # the signs of a frame delivered this tick
+    lights: tuple[LightDetection, ...] = ()  # the lights of a frame delivered this tick
+    pedal: float = 0.0  # [-] 0..1, the driver's accelerator pedal position
+    flat_tyre: bool = False  # a flat tyre is detected (from the wheel speeds)

@@ -48,6 +48,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from planner.speed import SpeedRef
+
 
 @dataclass(frozen=True, slots=True)
 class AccControlParams:
@@ -66,12 +68,6 @@ class AccControlParams:
     v_standstill: float = 0.5  # [m/s] a lead slower than this counts as stopped (trail)
     stop_band: float = 1.0  # [m] behind a stopped lead, stop this far beyond d0 (trail)
     a_final: float = 0.5  # [m/s^2] the last metres' deceleration behind a stopped lead
-
-
-@dataclass(frozen=True, slots=True)
-class SpeedRef:
-    speed: float  # [m/s] target speed
-    accel: float  # [m/s^2] feed-forward, signed
 
 
 def trail(v_plan: float, d: float, d_des: float, v_l: float, d0: float,

@@ -20,7 +20,6 @@ from dataclasses import dataclass, field
 from planner.acc_control import (
     AccControlParams,
     EasedBrake,
-    SpeedRef,
     brake_cap,
     braking_need,
     pass_speed,
@@ -29,7 +28,9 @@ from planner.acc_control import (
 )
 from planner.events import Events
 from planner.fsm.acc import AccInput, AccMode, AccParams, gaps, transition
-from planner.messages import Lead, StateChange
+from planner.fsm.machine import Machine, StateChange
+from planner.messages import Lead, SpeedSource
+from planner.speed import PlannedSpeed, SpeedRef
 
 NO_EVENTS = Events()
 STOP_LAWS = frozenset({AccMode.STOP_SIGN, AccMode.PEDESTRIAN, AccMode.RED_LIGHT,
@@ -43,68 +44,79 @@ class AccLayerParams:
     control: AccControlParams = field(default_factory=AccControlParams)
 
 
+@dataclass(frozen=True, slots=True)
+class AccOutput:
+    """The ACC / event layer's result for one tick."""
+
+    speed: PlannedSpeed  # the reference after the mode's law
+    lead_gap: float  # [m] the lead's gap carried to now (+inf: no lead)
+
+
 class AccLayer:
     """Mode and controller state of the ACC / event layer for one run."""
 
     def __init__(self, params: AccLayerParams | None = None) -> None:
         self.params = params if params is not None else AccLayerParams()
-        self.mode = AccMode.ACC_OFF
+        self.machine = Machine("acc", AccMode.ACC_OFF)
         self._brake = EasedBrake()
-        self.lead_gap = float("inf")  # [m] the last update's lead gap, carried to its time
         self._flat: float | None = None  # [m/s] FLAT's ramped reference
 
+    @property
+    def mode(self) -> AccMode:
+        return self.machine.state
+
     def update(self, t: float, dt: float, v: float, set_speed: float, limit: float,
-               plan: SpeedRef, lead: Lead | None, driver_gap: float | None = None,
-               events: Events = NO_EVENTS) -> tuple[SpeedRef, tuple[StateChange, ...]]:
-        """The speed reference now [m/s, m/s^2] and the mode change made, if any.
+               plan: PlannedSpeed, lead: Lead | None, driver_gap: float | None = None,
+               events: Events = NO_EVENTS) -> tuple[AccOutput, tuple[StateChange, ...]]:
+        """The speed reference now and the mode change made, if any.
 
         `v` ego speed, `limit` the posted limit at the front bumper (V_GPS), `plan` the map's
         speed plan (set speed, limits, curves) [m/s]. `driver_gap` [m]: the driver's pedal
         overrides, and the trail law may close up to d_min + this instead of d_des."""
         d, v_l = (lead.gap + (lead.speed - v) * max(t - lead.t, 0.0), lead.speed) \
-            if lead is not None else (float("inf"), float("inf"))
-        self.lead_gap = d
+            if lead is not None else (math.inf, math.inf)
         x = AccInput(acc_on=set_speed > 0.0, v=v, v_s=set_speed, v_gps=limit, d=d, v_l=v_l,
-                     off_ramp=events.off_ramp, pedestrian=events.pedestrian,
-                     speed_bump=events.speed_bump, stop_sign=events.stop_sign,
-                     red_light=events.red_light, give_way=events.give_way,
-                     flat=events.flat)
-        changes: tuple[StateChange, ...] = ()
-        change = transition(self.mode, x, self.params.modes)
-        if change is not None:
-            changes = (StateChange(t, "acc", self.mode.value, change.to.value, change.reason),)
-            self.mode = change.to
+                     events=events.active)
+        changes = self.machine.apply(t, transition(self.mode, x, self.params.modes))
         if self.mode in EVENT_LAWS:
-            return self._event(x, dt, plan, events), changes
-        return self._control(x, dt, plan, driver_gap), changes
+            speed = self._event(x, dt, plan, events)
+        else:
+            speed = self._control(x, dt, plan, driver_gap)
+        return AccOutput(speed, d), changes
 
-    def _event(self, x: AccInput, dt: float, plan: SpeedRef, events: Events) -> SpeedRef:
+    def _event(self, x: AccInput, dt: float, planned: PlannedSpeed,
+               events: Events) -> PlannedSpeed:
         """The event mode's law, never above the trail law behind a vehicle ahead."""
         c, m = self.params.control, self.params.modes
+        plan = planned.ref
         self._brake.reset()
         if self.mode is AccMode.FLAT:  # down to a crawl until on the shoulder, then a stop
             floor = 0.0 if events.pulled_over else min(c.v_pull_over, plan.speed)
             self._flat = plan.speed if self._flat is None else self._flat
             self._flat = max(min(self._flat, x.v) - c.a_flat_plan * dt, floor)
-            ref = SpeedRef(self._flat, -c.a_flat_plan if self._flat > floor else 0.0)
+            out = PlannedSpeed(SpeedRef(self._flat, -c.a_flat_plan if self._flat > floor
+                                        else 0.0), SpeedSource.EVENT)
         elif self.mode is AccMode.SPEED_BUMP:
             v = pass_speed(events.bump_distance, events.bump_speed, plan.speed, c)
             braking = events.bump_speed < v < plan.speed  # on the braking curve
             ref = SpeedRef(v, -c.a_comf if braking else 0.0 if v < plan.speed else plan.accel)
+            out = PlannedSpeed(ref, SpeedSource.EVENT if v < plan.speed else planned.source)
         elif self.mode in STOP_LAWS:
             v = stop_speed(events.stop_distance, plan.speed, c)
             ref = SpeedRef(v, -c.a_comf if 0.0 < v < plan.speed else 0.0)
+            out = PlannedSpeed(ref, SpeedSource.EVENT if v < plan.speed else planned.source)
         else:
-            ref = plan
+            out = planned
         if math.isfinite(x.d):
             following = trail(plan.speed, x.d, gaps(x.v, x.v_l, m).d_des, x.v_l, m.d0, c)
-            if following.speed < ref.speed:
-                return following
-        return ref
+            if following.speed < out.ref.speed:
+                return PlannedSpeed(following, SpeedSource.FOLLOWING)
+        return out
 
-    def _control(self, x: AccInput, dt: float, plan: SpeedRef,
-                 driver_gap: float | None) -> SpeedRef:
+    def _control(self, x: AccInput, dt: float, planned: PlannedSpeed,
+                 driver_gap: float | None) -> PlannedSpeed:
         c, m = self.params.control, self.params.modes
+        plan = planned.ref
         if self.mode in (AccMode.BRAKE, AccMode.TRAIL):
             g = gaps(x.v, x.v_l, m)
             d_des = g.d_des if driver_gap is None else min(g.d_des, g.d_min + driver_gap)
@@ -112,10 +124,12 @@ class AccLayer:
         if self.mode is AccMode.BRAKE:
             need = braking_need(x.v, following.speed, x.d, c)
             ref = self._brake.step(x.v, need, dt, c, cap=brake_cap(x.v, x.v_l, x.d, c))
-            return ref if ref.speed < plan.speed else plan
+            return PlannedSpeed(ref, SpeedSource.FOLLOWING) if ref.speed < plan.speed \
+                else planned
         self._brake.reset()
         if self.mode is AccMode.TRAIL:
-            return following
+            source = SpeedSource.FOLLOWING if following.speed < plan.speed else planned.source
+            return PlannedSpeed(following, source)
         if self.mode is AccMode.ACC_OFF:
-            return SpeedRef(0.0, 0.0)
-        return plan
+            return PlannedSpeed(SpeedRef(0.0, 0.0), SpeedSource.SET_SPEED)
+        return planned

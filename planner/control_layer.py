@@ -21,7 +21,8 @@ from planner.fsm.control import (
     time_to_collision,
     transition,
 )
-from planner.messages import Lead, StateChange
+from planner.fsm.machine import Machine, StateChange
+from planner.messages import Lead
 
 
 @dataclass(frozen=True, slots=True)
@@ -47,7 +48,7 @@ class ControlLayer:
 
     def __init__(self, params: ControlLayerParams | None = None) -> None:
         self.params = params if params is not None else ControlLayerParams()
-        self.state = ControlState.STOP
+        self.machine = Machine("control", ControlState.STOP)
 
     @property
     def decel(self) -> float:
@@ -62,10 +63,5 @@ class ControlLayer:
             a_req = required_deceleration(v, gap, lead.speed, lead_accel, self.params.stop_gap)
             ttc = time_to_collision(gap, v, lead.speed)
         x = ControlInput(v=v, v_target=v_target, a_target=a_target, a_required=a_req, ttc=ttc)
-        change = transition(self.state, x, self.params.fsm)
-        changes: tuple[StateChange, ...] = ()
-        if change is not None:
-            changes = (StateChange(t, "control", self.state.value, change.to.value,
-                                   change.reason),)
-            self.state = change.to
-        return ControlOutput(self.state, a_req, ttc), changes
+        changes = self.machine.apply(t, transition(self.machine.state, x, self.params.fsm))
+        return ControlOutput(self.machine.state, a_req, ttc), changes

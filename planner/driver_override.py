@@ -25,7 +25,8 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from planner.acc_control import SpeedRef
+from planner.messages import SpeedSource
+from planner.speed import BINDING_SOURCE, PlannedSpeed, SpeedRef
 from planner.speed_planning import SpeedTarget
 
 
@@ -43,14 +44,18 @@ def overriding(pedal: float, p: OverrideParams) -> bool:
     return pedal > p.threshold
 
 
-def override_reference(pedal: float, v: float, cap: SpeedTarget, p: OverrideParams) -> SpeedRef:
+def override_reference(pedal: float, v: float, cap: SpeedTarget,
+                       p: OverrideParams) -> PlannedSpeed:
     """The speed reference for pedal position `pedal` at speed `v` [m/s] under the envelope
-    `cap` (the speed plan at the vehicle's maximum set speed)."""
+    `cap` (the speed plan at the vehicle's maximum set speed): the pedal's, or the
+    envelope's where it binds."""
     a_drv = min(max(pedal, 0.0), 1.0) * p.a_full
-    speed = min(cap.speed, v + a_drv * p.horizon)
+    asked = v + a_drv * p.horizon
+    speed = min(cap.speed, asked)
+    source = BINDING_SOURCE[cap.binding] if cap.speed <= asked else SpeedSource.PEDAL
     if cap.accel < 0.0:
-        return SpeedRef(speed, cap.accel)
-    return SpeedRef(speed, min(a_drv, max(cap.speed - v, 0.0) / p.tau))
+        return PlannedSpeed(SpeedRef(speed, cap.accel), source)
+    return PlannedSpeed(SpeedRef(speed, min(a_drv, max(cap.speed - v, 0.0) / p.tau)), source)
 
 
 class DriverOverride:
@@ -60,19 +65,19 @@ class DriverOverride:
         self.params = params if params is not None else OverrideParams()
         self._release: float | None = None  # [m/s] the ramp's speed after a release
 
-    def update(self, pedal: float, v: float, plan: SpeedRef, cap: Callable[[], SpeedTarget],
-               dt: float) -> tuple[SpeedRef, bool]:
+    def update(self, pedal: float, v: float, plan: PlannedSpeed,
+               cap: Callable[[], SpeedTarget], dt: float) -> tuple[PlannedSpeed, bool]:
         """The reference in place of `plan` (the map's at the set speed) and whether the
         driver overrides now; `cap()` gives the envelope at the vehicle's maximum speed."""
         p = self.params
         if overriding(pedal, p):
             ref = override_reference(pedal, v, cap(), p)
-            self._release = max(ref.speed, v)
+            self._release = max(ref.ref.speed, v)
             return ref, True
         if self._release is None:
             return plan, False
         self._release -= p.a_release * dt
-        if self._release <= plan.speed:
+        if self._release <= plan.ref.speed:
             self._release = None
             return plan, False
-        return SpeedRef(self._release, -p.a_release), False
+        return PlannedSpeed(SpeedRef(self._release, -p.a_release), SpeedSource.PEDAL), False

@@ -34,6 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from perception.messages import EgoState, ObjectClass, SignDetection, Track
+from planner.fsm.acc import NO_EVENTS, AccEvent
 from world.hdmap import Crosswalk, RoadMap, SpeedBump, StopSign, Zone
 
 
@@ -59,17 +60,17 @@ class EventParams:
 
 @dataclass(frozen=True, slots=True)
 class Events:
-    off_ramp: bool = False
-    stop_sign: bool = False
-    pedestrian: bool = False
-    speed_bump: bool = False
-    flat: bool = False
-    red_light: bool = False  # a traffic light ahead to stop for (`planner.junctions`)
-    give_way: bool = False  # a junction ahead to wait at for a gap (`planner.junctions`)
+    """The events that hold now, and the distances their laws need."""
+
+    active: frozenset[AccEvent] = NO_EVENTS  # this module's and `planner.junctions`'
     pulled_over: bool = False  # on the shoulder, the pull-over done (a flat tyre's stop)
     stop_distance: float = math.inf  # [m] front bumper to where the car must stand
     bump_distance: float = math.inf  # [m] front axle to where it must be at bump_speed
     bump_speed: float = math.inf  # [m/s]
+
+    def holds(self, event: AccEvent) -> bool:
+        """Whether `event` holds now."""
+        return event in self.active
 
 
 class EventMonitor:
@@ -118,12 +119,11 @@ class EventMonitor:
         crossing = self._crossing(front, approach, lane_offset, lane_width, tracks)
         bump = self._bump(station, approach)
         zone = self.road.cross_section_at(station).zone
+        happening = {AccEvent.OFF_RAMP: zone is Zone.RAMP, AccEvent.STOP_SIGN: stop is not None,
+                     AccEvent.PEDESTRIAN: crossing is not None,
+                     AccEvent.SPEED_BUMP: bump is not None, AccEvent.FLAT: flat}
         return Events(
-            off_ramp=zone is Zone.RAMP,
-            stop_sign=stop is not None,
-            pedestrian=crossing is not None,
-            speed_bump=bump is not None,
-            flat=flat,
+            active=frozenset(e for e, holds in happening.items() if holds),
             pulled_over=pulled_over,
             stop_distance=min(x for x in (stop, crossing, math.inf) if x is not None),
             bump_distance=bump[0] if bump is not None else math.inf,

@@ -51,14 +51,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from perception.messages import LightDetection, ObjectClass, Track
+from planner.fsm.acc import NO_EVENTS, AccEvent
 from world.hdmap import (
     Control,
     Junction,
     LightColour,
-    LightHead,
     Manoeuvre,
     RoadMap,
-    TrafficLight,
 )
 
 
@@ -83,10 +82,14 @@ class JunctionParams:
 
 @dataclass(frozen=True, slots=True)
 class JunctionEvents:
-    red_light: bool = False  # stopping for a light (red, yellow it can stop for, unread)
-    give_way: bool = False  # waiting for a gap before turning / entering
+    active: frozenset[AccEvent] = NO_EVENTS  # RED_LIGHT: stopping for a light (red, a
+    #   yellow it can stop for, unread); GIVE_WAY: waiting for a gap before turning / entering
     stop_distance: float = math.inf  # [m] front bumper to where the car must stand
     light: LightColour | None = None  # the next light's colour as last seen (None: unread)
+
+    def holds(self, event: AccEvent) -> bool:
+        """Whether `event` holds now."""
+        return event in self.active
 
 
 @dataclass(slots=True)
@@ -101,23 +104,13 @@ class JunctionMonitor:
     def __init__(self, road: RoadMap, params: JunctionParams | None = None) -> None:
         self.road = road
         self.params = params if params is not None else JunctionParams()
-        self.lights = sorted((f for f in road.features if isinstance(f, TrafficLight)),
-                             key=lambda f: f.s)
-        self.heads = tuple(f.head for f in self.lights)
+        self.lights = road.traffic_lights  # a detection's `light` indexes this
         self._seen: dict[int, _Seen] = {}  # the colour believed, per light
         self._last: dict[int, _Seen] = {}  # the last frame's colour, per light
         self._yellow_go: set[int] = set()  # lights whose yellow the car decided to go on
         self._stopping: set[int] = set()  # lights the car stops for until seen green
         self._waiting: set[int] = set()  # junctions (route order) the car gives way at
         self._committed: set[int] = set()  # junctions the car goes on through, come what may
-
-    def heads_ahead(self, station: float) -> list[tuple[int, LightHead]]:
-        """(id, `LightHead`) of the lights whose stop line is ahead within ``light_range``
-        (what the light detector is asked to look at)."""
-        p = self.params
-        front = station + p.front_overhang
-        return [(i, self.heads[i]) for i, f in enumerate(self.lights)
-                if -1.0 < f.s - front <= p.light_range]
 
     def see_lights(self, detections: Sequence[LightDetection]) -> None:
         """Take the camera's colours: red or yellow at once; green, which lets the car go,
@@ -141,9 +134,10 @@ class JunctionMonitor:
         light_stop, colour = self._light(t, front, v, approach)
         way_stop = self._give_way(front, v, approach, tracks)
         stops = [d for d in (light_stop, way_stop) if d is not None]
+        happening = {AccEvent.RED_LIGHT: light_stop is not None,
+                     AccEvent.GIVE_WAY: way_stop is not None}
         return JunctionEvents(
-            red_light=light_stop is not None,
-            give_way=way_stop is not None,
+            active=frozenset(e for e, holds in happening.items() if holds),
             stop_distance=min(stops) if stops else math.inf,
             light=colour,
         )

@@ -1,21 +1,43 @@
-"""What the planner hands to control. A leaf module: dataclasses only.
+"""What the planner hands to control: dataclasses and the state enums only.
 
 `Plan.ego` carries the state estimate the plan was made from, so that control needs no
-other input: arrows run one way, world frames -> perception -> planner -> control.
+other input: arrows run one way, world frames -> perception -> planner -> control. Every
+state in the plan is an enum of its machine (`planner.fsm`), and `speed_source` says which
+constraint set the target speed.
 """
 
 from __future__ import annotations
 
+import enum
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
 
 from perception.messages import EgoState
+from planner.fsm.acc import AccMode
 from planner.fsm.control import ControlState
+from planner.fsm.hazard import HazardLights
 from planner.fsm.lane_source import LaneSource
+from planner.fsm.machine import StateChange
+from planner.fsm.motion import Motion
 
-__all__ = ["ControlState", "EgoState", "Lead", "Plan", "ReferencePath", "StateChange"]
+__all__ = ["MACHINES", "AccMode", "ControlState", "EgoState", "HazardLights", "LaneSource",
+           "Lead", "Motion", "Plan", "ReferencePath", "SpeedSource", "StateChange"]
+
+
+class SpeedSource(enum.Enum):
+    """Which constraint set the plan's target speed (the last of the planner's speed chain
+    that lowered it, or the map's plan that it left alone)."""
+
+    SET_SPEED = "set_speed"  # the driver's set speed (capped at the vehicle's maximum)
+    LIMIT = "limit"  # a posted limit, in force or ahead (braking towards it)
+    CURVE = "curve"  # a curve's speed, here or ahead
+    FOLLOWING = "following"  # the ACC's trail or brake law behind the vehicle ahead
+    EVENT = "event"  # an event's law: a stop, a speed bump, a flat tyre's crawl
+    PEDAL = "pedal"  # the driver's accelerator pedal (or the ramp back after it)
+    DEGRADED = "degraded"  # the lane lost: the hold speed, then a stop in lane
+    EMERGENCY = "emergency"  # the control FSM's emergency stop
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -37,17 +59,6 @@ class Lead:
     speed: float  # [m/s] the lead's speed over ground along the ego's heading
 
 
-@dataclass(frozen=True, slots=True)
-class StateChange:
-    """One change of a planner state machine, with its reason (for the log and results)."""
-
-    t: float  # [s]
-    machine: str  # e.g. "lane_source", "motion", "control", "acc"
-    source: str  # the state left
-    target: str  # the state entered
-    reason: str
-
-
 @dataclass(frozen=True, slots=True, eq=False)
 class Plan:
     t: float  # [s] sim time the plan was made at
@@ -60,10 +71,23 @@ class Plan:
     lateral_error: float  # [m] the planner's view of the ego's offset from the path, left +
     lane_source: LaneSource = LaneSource.ACQUIRING  # where the path comes from
     lead: Lead | None = None  # the vehicle ahead in the lane, if a track shows one
-    acc_mode: str = "acc_off"  # the ACC / event layer's mode (`planner.fsm.acc.AccMode` value)
-    motion: str = "lane_keep"  # the motion FSM's state (`planner.fsm.motion.Motion` value)
+    acc_mode: AccMode = AccMode.ACC_OFF  # the ACC / event layer's mode
+    motion: Motion = Motion.LANE_KEEP  # the motion FSM's state
     lane: int = 0  # the lane kept, or moved into by a lane change
     origin_lane: int = 0  # the lane a lane change in hand leaves (== lane otherwise)
     control: ControlState = ControlState.SPEED_KEEPING  # the control FSM's state
-    hazard: bool = False  # the hazard lights: on from a flat tyre's detection
+    hazard: HazardLights = HazardLights.OFF  # on from a flat tyre's detection
+    speed_source: SpeedSource = SpeedSource.SET_SPEED  # what set `target_speed`
     changes: tuple[StateChange, ...] = ()  # state changes made in this tick
+
+    @property
+    def states(self) -> dict[str, enum.Enum]:
+        """Every state of the plan by its machine's name (`MACHINES`)."""
+        return {"lane_source": self.lane_source, "motion": self.motion, "acc": self.acc_mode,
+                "control": self.control, "hazard": self.hazard,
+                "speed_source": self.speed_source}
+
+
+MACHINES: dict[str, type[enum.Enum]] = {  # the plan's states: machine name -> its states
+    "lane_source": LaneSource, "motion": Motion, "acc": AccMode, "control": ControlState,
+    "hazard": HazardLights, "speed_source": SpeedSource}

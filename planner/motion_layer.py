@@ -29,6 +29,7 @@ import numpy as np
 
 from perception.messages import EgoState, Track
 from planner.fsm.acc import AccParams
+from planner.fsm.machine import Machine, StateChange
 from planner.fsm.motion import (
     LANE_CHANGES,
     TURNS,
@@ -47,8 +48,7 @@ from planner.lane_occupancy import (
     is_free,
     lane_traffic,
 )
-from planner.messages import StateChange
-from world.hdmap import SHOULDER, RoadMap
+from world.hdmap import SHOULDER, Junction, RoadMap
 from world.hdmap import Manoeuvre as JunctionManoeuvre
 
 
@@ -83,11 +83,9 @@ class MotionLayer:
         self.road = road
         self.acc = acc
         self.params = params if params is not None else MotionLayerParams()
-        self.motion = Motion.LANE_KEEP
+        self.machine = Machine("motion", Motion.LANE_KEEP)
         self.lane = self.origin = lane
         self.path: LaneChangePath | None = None
-        self._since = -math.inf  # [s] time of the last motion change (none yet)
-        self._pull_over = False
         self._blocked_since: float | None = None
         self._turn_end = math.inf  # [m] where the turn in hand ends (its junction's exit)
 
@@ -95,25 +93,28 @@ class MotionLayer:
                pull_over: bool = False) -> tuple[Manoeuvre, tuple[StateChange, ...]]:
         """Step with the ego estimate, the speed it wants [m/s], the confirmed tracks and
         whether to pull over onto the shoulder (a flat tyre)."""
-        self._pull_over = pull_over
         s, d = (float(a) for a in self.road.local_coordinates((ego.x, ego.y)))
-        lanes = self._lanes_around(s, ego.speed)
+        lanes = self._lanes_around(s, ego.speed, pull_over)
         traffic = lane_traffic(self.road, tracks, ego.t, s, ego.speed, lanes,
                                self.params.occupancy)
-        x = self._input(ego, s, d, v_want, traffic)
-        change = transition(self.motion, x, self.params.motion)
-        changes: tuple[StateChange, ...] = ()
+        x = self._input(ego, s, d, v_want, traffic, pull_over)
+        change = transition(self.machine.state, x, self.params.motion)
         if change is not None:
-            changes = (StateChange(ego.t, "motion", self.motion.value, change.to.value,
-                                   change.reason),)
-            self._enter(change.to, change.abort, ego)
+            # a lane change given up before it was done: back to the origin lane
+            abort = self.machine.state in LANE_CHANGES and not x.change_done
+            self._enter(change.to, abort, ego, s, pull_over)
         elif self.path is not None and self.motion is Motion.LANE_KEEP and s >= self.path.end:
             self.path = None  # the way back after an abort is done
             self.origin = self.lane
+        changes = self.machine.apply(ego.t, change)
         return Manoeuvre(self.motion, self.lane, self.origin, self.path,
                          self._leads(traffic, s, d)), changes
 
-    def _lanes_around(self, s: float, v: float) -> tuple[int, ...]:
+    @property
+    def motion(self) -> Motion:
+        return self.machine.state
+
+    def _lanes_around(self, s: float, v: float, pull_over: bool) -> tuple[int, ...]:
         """The lane kept, the origin, and the neighbours that go on for a whole change."""
         n_now = self.road.lanes_at(s)
         reach = min(s + max(v, 5.0) * self.params.lane_change.t_cap, self.road.length)
@@ -122,13 +123,14 @@ class MotionLayer:
         if self.lane != SHOULDER:
             near.update(k for k in (self.lane - 1, self.lane + 1)
                         if 0 <= k < min(n_now, n_later))
-        if self.lane == 0 and self._pull_over and self.road.shoulder.exists_at(s):
+        if self.lane == 0 and pull_over and self.road.shoulder.exists_at(s):
             near.add(SHOULDER)
         return tuple(sorted(near))
 
-    def _right_of(self, lane: int) -> int:
+    @staticmethod
+    def _right_of(lane: int, pull_over: bool) -> int:
         """The lane to the right of `lane`; from lane 0, the shoulder when pulling over."""
-        return SHOULDER if lane == 0 and self._pull_over else lane - 1
+        return SHOULDER if lane == 0 and pull_over else lane - 1
 
     def _lanes_ahead(self, s: float, v: float) -> int:
         """The fewest ego-direction lanes from `s` to `prepare` ahead (a lane that ends
@@ -139,7 +141,7 @@ class MotionLayer:
         return min(self.road.sections[i].lanes for i in range(first, last + 1))
 
     def _input(self, ego: EgoState, s: float, d: float, v_want: float,
-               traffic: dict[int, LaneTraffic]) -> MotionInput:
+               traffic: dict[int, LaneTraffic], pull_over: bool) -> MotionInput:
         p, v, t = self.params, ego.speed, ego.t
         blocked_now = is_blocked(traffic[self.lane], v, v_want, p.occupancy, self.acc)
         if not blocked_now:
@@ -148,14 +150,16 @@ class MotionLayer:
             self._blocked_since = t
         blocked = self._blocked_since is not None and t - self._blocked_since >= p.blocked_time
         left = traffic.get(self.lane + 1) if self.lane != SHOULDER else None
-        right = traffic.get(self._right_of(self.lane)) if self.lane != SHOULDER else None
+        right = traffic.get(self._right_of(self.lane, pull_over)) \
+            if self.lane != SHOULDER else None
         x = MotionInput(
-            t=t, since=self._since, overtake=p.overtake, blocked=blocked,
+            t=t, since=self.machine.since, overtake=p.overtake, blocked=blocked,
             left_free=left is not None and is_free(left, v, p.occupancy),
             right_free=right is not None and is_free(right, v, p.occupancy),
             route_lane=min(self._lanes_ahead(s, v) - 1 - self.lane, 0),
-            pull_over=self._pull_over and self.lane != SHOULDER,
-            turn=self._turn_at(s), turn_done=self.motion in TURNS and s >= self._turn_end,
+            pull_over=pull_over and self.lane != SHOULDER,
+            turn=_turn(self._junction_at(s)),
+            turn_done=self.motion in TURNS and s >= self._turn_end,
         )
         if self.motion not in LANE_CHANGES or self.path is None:
             return x
@@ -164,22 +168,27 @@ class MotionLayer:
         return replace(x, target_free=is_free(traffic[self.lane], v, p.occupancy),
                        committed=abs(d - centre) < 0.5 * width, change_done=s >= self.path.end)
 
-    def _turn_at(self, s: float) -> Turn | None:
-        """The route's turn at the town junction whose stop line the car's centre has
-        passed and whose exit it has not reached (None going straight, or elsewhere)."""
+    def _junction_at(self, s: float) -> Junction | None:
+        """The town junction whose stop line the car's centre has passed and whose exit it
+        has not reached, where the route turns (None going straight, or elsewhere)."""
         for j in self.road.junctions:
             if j.s_stop <= s < j.s_exit and j.manoeuvre is not JunctionManoeuvre.STRAIGHT:
-                self._turn_end = j.s_exit
-                return Turn(j.manoeuvre.value)
+                return j
         return None
 
-    def _enter(self, to: Motion, abort: bool, ego: EgoState) -> None:
-        self._since = ego.t
+    def _enter(self, to: Motion, abort: bool, ego: EgoState, s: float,
+               pull_over: bool) -> None:
+        """Set the lane, origin and path for entering `to` (the machine itself changes
+        after this)."""
         self._blocked_since = None
+        if to in TURNS:
+            junction = self._junction_at(s)
+            assert junction is not None  # a turn is entered inside its junction
+            self._turn_end = junction.s_exit
         if to in LANE_CHANGES:
             self.origin = self.lane
             self.lane = self.lane + 1 if to is Motion.LANE_CHANGE_LEFT else \
-                self._right_of(self.lane)
+                self._right_of(self.lane, pull_over)
             self.path = self._plan_into(self.lane, ego)
         elif abort:  # back to the origin; both lanes are in use until the path's end
             self.lane, self.origin = self.origin, self.lane
@@ -187,7 +196,6 @@ class MotionLayer:
         else:
             self.origin = self.lane
             self.path = None
-        self.motion = to
 
     def _plan_into(self, lane: int, ego: EgoState) -> LaneChangePath:
         return start_lane_change(self.road.lane(lane), lane, ego.x, ego.y, ego.heading,
@@ -204,3 +212,8 @@ class MotionLayer:
             lanes.append(self.origin)  # the car's body still overlaps the origin lane
         return tuple(n for k in lanes if k in traffic
                      for n in (traffic[k].ahead,) if n is not None)
+
+
+def _turn(junction: Junction | None) -> Turn | None:
+    """The route's command at `junction` (None: no junction)."""
+    return None if junction is None else Turn(junction.manoeuvre.value)

@@ -1,23 +1,30 @@
-"""The planner: the ICCAS dual FSM with the DECS ACC / event layer, for one route road.
+"""The planner's tick: the ICCAS dual FSM with the DECS ACC / event layer, for one route road.
 
-Each tick, from the ego estimate, the camera's lane, the confirmed tracks and the driver's
-accelerator pedal:
+`Planner.update` takes the one message perception hands it each control tick
+(`perception.messages.PlannerInput`: the ego estimate, the camera's lane, the confirmed
+tracks, the signs and light colours of a frame, the driver's accelerator pedal and the
+flat-tyre flag) and returns the `Plan`. Nothing else calls into it. Steps:
 
-1. the lane-source FSM (`planner.fsm.lane_source`) says where the lateral reference comes from:
-   the camera's lane (`planner.camera_lane`) when it is seen and agrees with the map's lane
-   kept, the map lane (`planner.route.lane_path`, placed by the GNSS + odometry estimate)
-   while it is acquired or lost;
-2. the motion FSM (`planner.motion_layer`) keeps the lane or changes lanes, from the lane
+1. the signs and light colours of a frame are matched with the map's stop lines and lights
+   (`planner.events`, `planner.junctions`);
+2. the lane-source FSM (`planner.fsm.lane_source`) says where the lateral reference comes
+   from: the camera's lane (`planner.camera_lane`) when it is seen and agrees with the map's
+   lane kept, the map lane (`planner.route.lane_path`, placed by the GNSS + odometry
+   estimate) while it is acquired or lost, or near a town junction;
+3. the motion FSM (`planner.motion_layer`) keeps the lane or changes lanes, from the lane
    occupancy of the tracks; a lane change (or its abort) replaces the path with its Hermite
    path (`planner.lane_change_path`) and makes the target lane the lane kept;
-3. the speed: the map's plan (`planner.speed_planning`, the lane kept's limits and curves),
-   raised by the driver's pedal up to the limit (`planner.driver_override`), through the
-   ACC / event layer (`planner.acc_layer`: cruise, trail or brake behind the lead vehicle,
-   `planner.lead`), ramped down at ``a_comf`` when the lane is lost (then a stop in lane);
-4. the control FSM (`planner.control_layer`) names the control action and, in an
-   emergency, asks for the emergency stop's deceleration instead.
-
-The path and the speed target are computed separately (`path_for`, `speed_for`).
+4. the speed, a chain of `planner.speed.PlannedSpeed`s, each link keeping what it was given
+   unless it lowers it: the map's plan (`planner.speed_planning`: set speed, the lane kept's
+   limits and curves), the driver's pedal (`planner.driver_override`: it raises the plan up
+   to the limit), the ACC / event law (`planner.acc_layer`: cruise, trail or brake behind
+   the lead vehicle, `planner.lead`; a stop, a bump's pass speed, a flat tyre's crawl),
+   the degraded lane's cap (ramped down at ``a_comf`` to the hold speed when the lane is
+   lost, then to a stop in lane) and the emergency stop; the plan's `speed_source` is the
+   link that set the speed;
+5. the control FSM (`planner.control_layer`) names the control action and, in an
+   emergency, asks for the emergency stop's deceleration instead; the hazard lights go on
+   with a flat tyre (`planner.fsm.hazard`).
 """
 
 from __future__ import annotations
@@ -28,33 +35,28 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from perception.messages import EgoState, LaneEstimate, Track
-from planner.acc_control import SpeedRef
+from perception.messages import EgoState, LaneView, PlannerInput, Track
 from planner.acc_layer import AccLayer, AccLayerParams
 from planner.camera_lane import camera_lane_path
 from planner.control_layer import ControlLayer
 from planner.driver_override import DriverOverride, OverrideParams
 from planner.events import EventMonitor, EventParams
-from planner.fsm.lane_source import LaneSource, LaneSourceInput, LaneSourceParams, transition
+from planner.fsm import hazard, lane_source
+from planner.fsm.hazard import HazardLights
+from planner.fsm.lane_source import LaneSource, LaneSourceInput, LaneSourceParams
+from planner.fsm.machine import Machine, StateChange
 from planner.junctions import JunctionMonitor, JunctionParams
 from planner.lead import LeadAccel, LeadParams, route_lead, select_lead
-from planner.messages import Lead, Plan, ReferencePath, StateChange
+from planner.messages import Lead, Plan, ReferencePath, SpeedSource
 from planner.motion_layer import Manoeuvre, MotionLayer, MotionLayerParams
 from planner.route import lane_path
+from planner.speed import BINDING_SOURCE, PlannedSpeed, SpeedRef
 from planner.speed_planning import SpeedPlanner, SpeedPlanningParams, SpeedTarget
 from world.hdmap import SHOULDER, RoadMap
 
 
-@dataclass(frozen=True, slots=True, eq=False)
-class LaneView:
-    """The camera's latest lane estimate and the ego estimate at its frame's time."""
-
-    estimate: LaneEstimate
-    pose: EgoState
-
-
 @dataclass(frozen=True, slots=True)
-class LaneKeepingParams:
+class PlannerParams:
     set_speed: float  # [m/s] the driver's desired (cruise) speed
     max_speed: float  # [m/s] the vehicle's maximum speed
     lane: int = 0  # ego-direction lane index to keep (0 rightmost)
@@ -77,12 +79,21 @@ class LaneKeepingParams:
     junction_after: float = 15.0  # [m] ... to after its exit, the map's path is followed
 
 
-class LaneKeepingPlanner:
-    """Follows lane ``params.lane`` of ``road``; stateless between ticks (see `reset`)."""
+@dataclass(frozen=True, slots=True, eq=False)
+class LateralChoice:
+    """The path of one tick and whether it is the camera's lane."""
 
-    def __init__(self, road: RoadMap, params: LaneKeepingParams) -> None:
+    path: ReferencePath
+    camera: bool  # the camera's lane is seen, agrees with the map's, and is the path
+
+
+class Planner:
+    """Follows lane ``params.lane`` of ``road`` from the perception message of each tick
+    (module doc); `reset` starts it over."""
+
+    def __init__(self, road: RoadMap, params: PlannerParams) -> None:
         if params.lane < 0:
-            raise ValueError(f"lane keeping needs an ego-direction lane, got {params.lane}")
+            raise ValueError(f"the planner needs an ego-direction lane, got {params.lane}")
         self.road = road
         self.params = params
         self._speed_planners: dict[int, SpeedPlanner] = {}
@@ -91,21 +102,21 @@ class LaneKeepingPlanner:
     def reset(self) -> None:
         """Back to ACQUIRING the lane (MAP without a camera) of `params.lane`, keeping it,
         with no speed cap."""
-        self.source = LaneSource.ACQUIRING if self.params.camera else LaneSource.MAP
-        self._since: float | None = None  # [s] time of the last lane-source change
+        p = self.params
+        self.source = Machine("lane_source",
+                              LaneSource.ACQUIRING if p.camera else LaneSource.MAP)
+        self._start: float | None = None  # [s] time of the first tick
         self._cap = math.inf  # [m/s] the ramped speed cap of the degraded modes
         self._last_t: float | None = None
-        self._keep(self.params.lane)
-        self.acc = AccLayer(self.params.acc)
-        self.motion = MotionLayer(self.road, self.params.lane, self.params.acc.modes,
-                                  self.params.motion)
+        self._keep(p.lane)
+        self.acc = AccLayer(p.acc)
+        self.motion = MotionLayer(self.road, p.lane, p.acc.modes, p.motion)
         self.control = ControlLayer()
         self.lead_accel = LeadAccel()
-        self.driver = DriverOverride(self.params.override)
-        self.events = EventMonitor(self.road, self.params.events)
-        self.junctions = JunctionMonitor(self.road, self.params.junctions)
-        self._camera_ok = False  # the camera's lane is seen and agrees with the map's
-        self._hazard = False  # the hazard lights (on from a flat tyre)
+        self.driver = DriverOverride(p.override)
+        self.events = EventMonitor(self.road, p.events)
+        self.junctions = JunctionMonitor(self.road, p.junctions)
+        self.hazard = Machine("hazard", HazardLights.OFF)
 
     def _keep(self, lane: int) -> None:
         """Make `lane` the lane whose stations, speed plan and map path are used."""
@@ -116,7 +127,7 @@ class LaneKeepingPlanner:
         self.speed_planner = self._speed_planners[lane]
 
     def localise(self, ego: EgoState) -> tuple[float, float]:
-        """(station [m], lateral offset [m], left +) of the ego's centre on the lane."""
+        """(station [m], lateral offset [m], left +) of the ego's centre on the lane kept."""
         s, r = self.lane.local_coordinates(np.array([ego.x, ego.y]))
         return float(np.asarray(s)), float(np.asarray(r))
 
@@ -129,107 +140,108 @@ class LaneKeepingPlanner:
         )
 
     def speed_for(self, station: float, set_speed: float | None = None) -> SpeedTarget:
-        """The speed target for the car's centre at ``station`` [m] (at ``set_speed``
+        """The map's speed target for the car's centre at ``station`` [m] (at ``set_speed``
         [m/s], by default the driver's set speed)."""
         p = self.params
         return self.speed_planner.target(
             station, set_speed=p.set_speed if set_speed is None else set_speed,
             max_speed=p.max_speed)
 
-    def update(self, ego: EgoState, view: LaneView | None = None,
-               tracks: Sequence[Track] = (), pedal: float = 0.0, flat: bool = False) -> Plan:
-        """The plan for this tick, made from ``ego`` (map frame, car centre), the camera's
-        lane ``view`` (None before the first frame), the confirmed ``tracks``, the driver's
-        accelerator ``pedal`` position (0..1, `planner.driver_override`) and whether a flat
-        tyre has been detected."""
+    def update(self, inp: PlannerInput) -> Plan:
+        """The plan for this tick (module doc)."""
+        ego, view, tracks = inp.ego, inp.lane, inp.tracks
         dt = 0.0 if self._last_t is None else max(ego.t - self._last_t, 0.0)
         self._last_t = ego.t
+        if inp.signs is not None:
+            self.events.see_signs(inp.signs.signs, inp.signs.pose)
+        if inp.lights:
+            self.junctions.see_lights(inp.lights)
         station, lateral = self.localise(ego)
         changes = self._update_source(ego.t, view, self.near_junction(station))
         target = self.speed_for(station)
         want = min(self.params.set_speed, target.limit_at_front)
-        manoeuvre, motion_changes = self.motion.update(ego, want, tracks, pull_over=flat)
+        manoeuvre, motion_changes = self.motion.update(ego, want, tracks,
+                                                       pull_over=inp.flat_tyre)
         if manoeuvre.lane != self.lane_index:  # a lane change began, ended or was aborted
             self._keep(manoeuvre.lane)
             station, lateral = self.localise(ego)
             target = self.speed_for(station)
-        path = self._path(ego, station, view, manoeuvre)
-        lead = self._lead(view, tracks, ego, manoeuvre)
-        plan_ref, driver = self.driver.update(
-            pedal, ego.speed, SpeedRef(target.speed, target.accel),
-            lambda: self.speed_for(station, self.params.max_speed), dt)
+        lateral_choice = self._path(ego, station, view, manoeuvre)
+        lead = self._lead(view, tracks, ego, manoeuvre, lateral_choice.camera)
+        planned = PlannedSpeed(SpeedRef(target.speed, target.accel),
+                               BINDING_SOURCE[target.binding])
+        planned, driver = self.driver.update(
+            inp.pedal, ego.speed, planned, lambda: self.speed_for(station, self.params.max_speed),
+            dt)
         events = self.events.update(ego.t, station, ego.speed,
                                     float(self.lane.offset_at(station)),
-                                    float(self.lane.width_at(station)), tracks, flat,
+                                    float(self.lane.width_at(station)), tracks, inp.flat_tyre,
                                     pulled_over=manoeuvre.lane == SHOULDER
                                     and manoeuvre.path is None)
         junction = self.junctions.update(ego.t, station, ego.speed, tracks)
-        events = replace(events, red_light=junction.red_light, give_way=junction.give_way,
+        events = replace(events, active=events.active | junction.active,
                          stop_distance=min(events.stop_distance, junction.stop_distance))
-        ref, acc_changes = self.acc.update(ego.t, dt, ego.speed, self.params.set_speed,
-                                           target.limit_at_front, plan_ref, lead,
+        acc, acc_changes = self.acc.update(ego.t, dt, ego.speed, self.params.set_speed,
+                                           target.limit_at_front, planned, lead,
                                            driver_gap=self.params.override.gap_margin
                                            if driver else None, events=events)
-        speed, accel = self._degraded_cap(ref.speed, ref.accel, ego.speed, dt)
+        speed = self._degraded_cap(acc.speed, ego.speed, dt)
         control, control_changes = self.control.update(
-            ego.t, ego.speed, speed, accel, self.acc.lead_gap, lead,
+            ego.t, ego.speed, speed.ref.speed, speed.ref.accel, acc.lead_gap, lead,
             self.lead_accel.update(lead))
         if control.emergency:
-            speed, accel = 0.0, -self.control.decel
-        if flat and not self._hazard:  # the hazard lights go on, and stay on
-            self._hazard = True
-            control_changes += (StateChange(ego.t, "hazard", "off", "on", "flat tyre"),)
+            speed = PlannedSpeed(SpeedRef(0.0, -self.control.decel), SpeedSource.EMERGENCY)
+        hazard_changes = self.hazard.apply(ego.t, hazard.transition(self.hazard.state,
+                                                                    inp.flat_tyre))
         return Plan(
             t=ego.t,
             ego=ego,
-            path=path,
-            target_speed=speed,
-            target_accel=accel,
+            path=lateral_choice.path,
+            target_speed=speed.ref.speed,
+            target_accel=speed.ref.accel,
             speed_limit=target.limit_at_front,
             station=station,
             lateral_error=lateral,
-            lane_source=self.source,
+            lane_source=self.source.state,
             lead=lead,
-            acc_mode=self.acc.mode.value,
-            motion=manoeuvre.motion.value,
+            acc_mode=self.acc.mode,
+            motion=manoeuvre.motion,
             lane=manoeuvre.lane,
             origin_lane=manoeuvre.origin,
             control=control.state,
-            hazard=self._hazard,
-            changes=changes + motion_changes + acc_changes + control_changes,
+            hazard=self.hazard.state,
+            speed_source=speed.source,
+            changes=changes + motion_changes + acc_changes + control_changes + hazard_changes,
         )
 
     def _path(self, ego: EgoState, station: float, view: LaneView | None,
-              manoeuvre: Manoeuvre) -> ReferencePath:
+              manoeuvre: Manoeuvre) -> LateralChoice:
         """The lane-change path in hand, else the camera's lane when it is seen and agrees
         with the map's lane kept (not yet re-found after a lane change: the map's), else
         the map's."""
         p = self.params
-        self._camera_ok = False
         if manoeuvre.path is not None:
             ahead = max(p.path_ahead_min, p.path_ahead_time * max(ego.speed, 0.0))
-            return manoeuvre.path.reference_path(self.lane, station, p.path_behind, ahead,
-                                                 p.path_spacing, self.road.length)
+            return LateralChoice(manoeuvre.path.reference_path(
+                self.lane, station, p.path_behind, ahead, p.path_spacing, self.road.length),
+                camera=False)
         # the camera's lane lies between painted lines: not the shoulder (no outer line)
-        if self.source is LaneSource.CAMERA and view is not None and \
+        if self.source.state is LaneSource.CAMERA and view is not None and \
                 self.lane_index != SHOULDER:
             _, r = self.localise(view.pose)
-            self._camera_ok = abs(view.estimate.offset - r) <= p.camera_agree
-            if self._camera_ok:
-                return self._camera_path(view)
-        return self.path_for(ego, station)
+            if abs(view.estimate.offset - r) <= p.camera_agree:
+                return LateralChoice(self._camera_path(view), camera=True)
+        return LateralChoice(self.path_for(ego, station), camera=False)
 
     def _update_source(self, t: float, view: LaneView | None,
                        junction: bool) -> tuple[StateChange, ...]:
-        if self._since is None:
-            self._since = t
+        if self._start is None:
+            self._start = t
         confidence = view.estimate.confidence if view is not None else 0.0
-        change = transition(self.source, LaneSourceInput(t, confidence, self._since, junction),
-                            self.params.source)
-        if change is None:
-            return ()
-        old, self.source, self._since = self.source, change.to, t
-        return (StateChange(t, "lane_source", old.value, change.to.value, change.reason),)
+        since = max(self.source.since, self._start)  # ACQUIRING counts from the start
+        x = LaneSourceInput(t, confidence, since, junction)
+        return self.source.apply(t, lane_source.transition(self.source.state, x,
+                                                           self.params.source))
 
     def _camera_path(self, view: LaneView) -> ReferencePath:
         p = self.params
@@ -237,9 +249,10 @@ class LaneKeepingPlanner:
                                 ahead=p.camera_ahead, spacing=p.path_spacing)
 
     def _lead(self, view: LaneView | None, tracks: Sequence[Track], ego: EgoState,
-              manoeuvre: Manoeuvre) -> Lead | None:
-        """The vehicle ahead in the lane (camera's lane, else straight ahead); during a lane
-        change the nearest ahead in the lanes the car occupies (`MotionLayer`)."""
+              manoeuvre: Manoeuvre, camera: bool) -> Lead | None:
+        """The vehicle ahead in the lane (the camera's lane when it is the path, else
+        straight ahead); during a lane change the nearest ahead in the lanes the car
+        occupies (`MotionLayer`)."""
         if manoeuvre.path is not None:
             if not manoeuvre.leads:
                 return None
@@ -248,10 +261,10 @@ class LaneKeepingPlanner:
             return Lead(n.track_id, n.t, gap, max(n.speed, 0.0))
         if not tracks:
             return None
-        if self.source is LaneSource.JUNCTION:  # on the map's path through the junction
+        if self.source.state is LaneSource.JUNCTION:  # on the map's path through the junction
             return route_lead(tracks, self.lane, self.localise(ego)[0], self.params.lead)
         centre: Callable[[float], float] = _straight_ahead
-        if view is not None and self._camera_ok:
+        if view is not None and camera:
             centre = view.estimate.centre_y
         return select_lead(tracks, centre, ego.heading, self.params.lead)
 
@@ -262,20 +275,22 @@ class LaneKeepingPlanner:
         return any(j.s_stop - p.junction_before <= station <= j.s_exit + p.junction_after
                    for j in self.road.junctions)
 
-    def _degraded_cap(self, speed: float, accel: float, ego_speed: float,
-                      dt: float) -> tuple[float, float]:
+    def _degraded_cap(self, planned: PlannedSpeed, ego_speed: float,
+                      dt: float) -> PlannedSpeed:
         """With the lane lost, ramp the target down at a_comf to the hold speed / to 0."""
         wanted = {LaneSource.MAP_HOLD: self.params.source.hold_speed,
-                  LaneSource.STOP_IN_LANE: 0.0}.get(self.source, math.inf)
+                  LaneSource.STOP_IN_LANE: 0.0}.get(self.source.state, math.inf)
+        speed = planned.ref.speed
         if math.isinf(wanted):
             self._cap = math.inf
-            return speed, accel
+            return planned
         a_comf = self.params.speed.a_comf
         start = min(self._cap, max(ego_speed, speed)) if math.isfinite(self._cap) else ego_speed
         self._cap = max(wanted, start - a_comf * dt)
         if self._cap < speed:
-            return self._cap, -a_comf if self._cap > wanted else 0.0
-        return speed, accel
+            accel = -a_comf if self._cap > wanted else 0.0
+            return PlannedSpeed(SpeedRef(self._cap, accel), SpeedSource.DEGRADED)
+        return planned
 
 
 def _straight_ahead(_x: float) -> float:

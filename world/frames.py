@@ -9,6 +9,10 @@ Frames:
   link origin), x forward, y left, z up; it moves with the body (pitch and roll included);
 - sensor: a sensor's own frame, placed on the vehicle by its `SensorMount`; x along the
   sensor's axis (a camera's optical axis), y left, z up.
+
+Conventions every stage shares (the stack may import this module): SI units inside, with
+the one speed conversion named (`MPS_PER_KPH`, `kph`, `to_kph`); angles in radians,
+headings and yaws wrapped to (-pi, pi] by `wrap_angle`.
 """
 
 from __future__ import annotations
@@ -20,8 +24,26 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["CameraFrame", "CameraInfo", "GnssFix", "LidarInfo", "LidarScan", "Odometry",
-           "SensorMount", "Wheel"]
+__all__ = ["MPS_PER_KPH", "CameraFrame", "CameraInfo", "GnssFix", "LidarInfo", "LidarScan",
+           "Odometry", "SensorMount", "Wheel", "kph", "to_kph", "wrap_angle"]
+
+MPS_PER_KPH = 1.0 / 3.6  # [m/s per km/h]
+
+
+def kph(speed_kph: float) -> float:
+    """[m/s] of a speed in km/h."""
+    return speed_kph * MPS_PER_KPH
+
+
+def to_kph(speed: float) -> float:
+    """[km/h] of a speed in m/s."""
+    return speed / MPS_PER_KPH
+
+
+def wrap_angle(angle: float) -> float:
+    """[rad] `angle` wrapped to (-pi, pi] (exact: IEEE remainder by 2 pi)."""
+    wrapped = math.remainder(angle, math.tau)
+    return math.pi if wrapped == -math.pi else wrapped
 
 
 class Wheel(enum.Enum):

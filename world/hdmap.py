@@ -455,6 +455,8 @@ class RoadMap:
     shoulder: Lane  # the paved right shoulder, as a lane (`SHOULDER`)
     oncoming: tuple[Lane, ...]  # oncoming lanes, [0] next to the centre line
     features: tuple[Feature, ...]  # sorted by station
+    traffic_lights: tuple[TrafficLight, ...]  # the features that are lights, by station; a
+    #   light's index here is its id (`perception.lights`, `planner.junctions`)
     speed_limits: tuple[SpeedLimitPosting, ...]  # sorted by station, first at s = 0
     sections: tuple[CrossSection, ...]  # per segment (= piece)
     exits: tuple[Exit, ...]  # sorted by station
@@ -476,6 +478,7 @@ class RoadMap:
         self.junctions = tuple(sorted(junctions, key=lambda j: j.s_stop))
         self.sections = sections
         self.features = features
+        self.traffic_lights = tuple(f for f in features if isinstance(f, TrafficLight))
         self.speed_limits = speed_limits
         self.line = ReferenceLine(pieces)
         self.exits = tuple(

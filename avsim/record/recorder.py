@@ -756,15 +756,17 @@ class Recorder:
             static=True,
         )
 
-    def log_state(self, t: float, machine: str, state: str, reason: str | None = None) -> None:
+    def log_state(self, t: float, machine: str, state: str, reason: str | None = None,
+                  text: bool = True) -> None:
         """FSM `machine` entered `state` at sim time t [s]: a StateChange on the lane
-        `/fsm/<machine>` (shown by the FSM state timeline view) and a TextLog line
-        "<machine>: <state> (<reason>)" at `/events` (without the parentheses if no reason).
-        `machine` must be one entity path part (no "/")."""
+        `/fsm/<machine>` (shown by the FSM state timeline view) and, with `text`, a TextLog
+        line "<machine>: <state> (<reason>)" at `/events` (without the parentheses if no
+        reason). `machine` must be one entity path part (no "/")."""
         self._check_open()
         self._rec.set_time(bp.TIMELINE, duration=t)
         self._rec.log(self._fsm_entity(machine), rr.StateChange(state=state))
-        self.log_event(t, f"{machine}: {state}" + (f" ({reason})" if reason else ""))
+        if text:
+            self.log_event(t, f"{machine}: {state}" + (f" ({reason})" if reason else ""))
         self._maybe_flush(t)
 
     def log_event(self, t: float, text: str, level: str = "INFO") -> None:

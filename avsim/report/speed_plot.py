@@ -2,7 +2,10 @@
 
 Speeds over time in km/h: the ego's (true), the lead vehicle's, the posted limit at the
 ego's front bumper and the driver's set speed, with the ACC / event layer's mode
-(`planner.fsm.acc.AccMode`) as coloured bands behind them, one colour per mode.
+(`planner.fsm.acc.AccMode`) as coloured bands behind them, one colour per mode; under them a
+strip of bands says which constraint set the plan's speed at each tick
+(`planner.messages.SpeedSource`: set speed, limit, curve, following, event, pedal, degraded
+lane, emergency).
 
 The lead vehicle at a tick is the nearest car or truck ahead of the ego in its lane, from the
 ground truth in the run's log, by the `min_gap` criterion's rule: its centre station is ahead
@@ -18,18 +21,21 @@ Pure: no PyBullet, no pyplot (a bare `Figure` on the Agg canvas, so no display i
 
 from __future__ import annotations
 
+import enum
 import math
 from collections.abc import Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Literal
 
 import numpy as np
+from matplotlib.axes import Axes
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.collections import PolyCollection
 from matplotlib.figure import Figure
 from numpy.typing import NDArray
 
 from planner.fsm.acc import AccMode
+from planner.messages import SpeedSource
 from world.map.road import build_road_map
 
 if TYPE_CHECKING:
@@ -56,6 +62,18 @@ MODE_COLOURS: dict[str, str] = {
     AccMode.YIELD.value: "#ff9800",
 }
 OTHER_MODE_COLOUR = "#9e9e9e"  # a mode this table does not know yet
+# one colour per speed source, by `SpeedSource` value (legend order: SpeedSource's)
+SOURCE_COLOURS: dict[str, str] = {
+    SpeedSource.SET_SPEED.value: "#66bb6a",
+    SpeedSource.LIMIT.value: "#ffca28",
+    SpeedSource.CURVE.value: "#8d6e63",
+    SpeedSource.FOLLOWING.value: "#42a5f5",
+    SpeedSource.EVENT.value: "#ab47bc",
+    SpeedSource.PEDAL.value: "#26c6da",
+    SpeedSource.DEGRADED.value: "#ff7043",
+    SpeedSource.EMERGENCY.value: "#d50000",
+}
+SOURCE_STRIP = 0.08  # [-] the speed-source strip's height, a fraction of the speed axes'
 LINES = {  # series -> (label, colour, style, width)
     "ego": ("ego speed", "#000000", "-", 2.0),
     "lead": ("lead speed", "#1a237e", "-", 1.5),
@@ -66,9 +84,10 @@ LINES = {  # series -> (label, colour, style, width)
 FloatArray = NDArray[np.float64]
 
 
-def mode_runs(t: Sequence[float], modes: Sequence[str]) -> list[tuple[str, float, float]]:
-    """(mode, start [s], end [s]) of each run of equal modes; a run ends where the next one
-    starts, the last one a tick after the last sample."""
+def mode_runs(t: Sequence[float],
+              modes: Sequence[enum.Enum]) -> list[tuple[str, float, float]]:
+    """(mode's value, start [s], end [s]) of each run of equal modes (or sources); a run
+    ends where the next one starts, the last one a tick after the last sample."""
     if not len(t):
         return []
     times = np.asarray(t, dtype=np.float64)
@@ -78,7 +97,7 @@ def mode_runs(t: Sequence[float], modes: Sequence[str]) -> list[tuple[str, float
     start = 0
     for i in range(1, len(modes) + 1):
         if i == len(modes) or modes[i] != modes[start]:
-            runs.append((modes[start], float(times[start]), float(ends[i - 1])))
+            runs.append((modes[start].value, float(times[start]), float(ends[i - 1])))
             start = i
     return runs
 
@@ -117,25 +136,26 @@ def _title(result: RunResult) -> str:
     return f"{result.spec.name} ({result.spec.situation}): {verdict}"
 
 
-def _draw_bands(fig: Figure, runs: list[tuple[str, float, float]]) -> None:
-    """One collection per mode over the axes' full height, and their legend."""
-    ax = fig.axes[0]
+def _draw_bands(fig: Figure, ax: Axes, runs: list[tuple[str, float, float]],
+                colours: dict[str, str], title: str,
+                loc: Literal["outside right lower", "outside lower center"]) -> None:
+    """One collection per mode (or source) over `ax`'s full height, and their legend, in
+    the order of `colours`."""
     by_mode: dict[str, list[tuple[float, float]]] = {}
     for mode, start, end in runs:
         by_mode.setdefault(mode, []).append((start, end))
-    known = [m.value for m in AccMode]
+    known = list(colours)
     order = sorted(by_mode, key=lambda m: (known.index(m) if m in known else len(known), m))
     handles = []
     for mode in order:
         verts = [[(a, 0.0), (b, 0.0), (b, 1.0), (a, 1.0)] for a, b in by_mode[mode]]
         band = PolyCollection(verts, transform=ax.get_xaxis_transform(), linewidths=0,
-                              facecolors=MODE_COLOURS.get(mode, OTHER_MODE_COLOUR),
+                              facecolors=colours.get(mode, OTHER_MODE_COLOUR),
                               alpha=BAND_ALPHA, zorder=0, label=mode.replace("_", " "))
         ax.add_collection(band, autolim=False)
         handles.append(band)
     if handles:
-        fig.legend(handles=handles, loc="outside right lower", title="ACC / event mode",
-                   fontsize="small")
+        fig.legend(handles=handles, loc=loc, title=title, fontsize="small")
 
 
 def speed_profile_figure(result: RunResult) -> Figure:
@@ -143,7 +163,7 @@ def speed_profile_figure(result: RunResult) -> Figure:
     log = result.log
     fig = Figure(figsize=SIZE, dpi=DPI, layout="constrained")
     FigureCanvasAgg(fig)
-    ax = fig.add_subplot()
+    ax, strip = fig.subplots(2, 1, sharex=True, height_ratios=(1.0, SOURCE_STRIP))
     t = log.array("t")
     limit = log.array("speed_limit")
     series = {
@@ -157,14 +177,18 @@ def speed_profile_figure(result: RunResult) -> Figure:
         ax.plot(t, values, style, color=colour, linewidth=width, label=label,
                 drawstyle="steps-post" if key == "limit" else "default", zorder=2)
     runs = mode_runs(log.t, log.acc_mode)
-    _draw_bands(fig, runs)
+    _draw_bands(fig, ax, runs, MODE_COLOURS, "ACC / event mode", "outside right lower")
+    _draw_bands(fig, strip, mode_runs(log.t, log.speed_source), SOURCE_COLOURS,
+                "speed set by", "outside lower center")
+    strip.set_yticks([])
+    strip.set_ylabel("speed set by", rotation=0, ha="right", va="center")
     top = max([float(np.nanmax(v)) for v in series.values() if np.isfinite(v).any()],
               default=50.0)
     ax.set_ylim(min(0.0, float(np.nanmin(series["ego"]))) if len(t) else 0.0,
                 top * 1.08 + 2.0)
     if runs:
         ax.set_xlim(runs[0][1], runs[-1][2])
-    ax.set_xlabel("time [s]")
+    strip.set_xlabel("time [s]")
     ax.set_ylabel("speed [km/h]")
     ax.set_title(_title(result))
     ax.grid(True, alpha=0.3, zorder=1)

@@ -13,7 +13,6 @@ command is held on the joints for the next 6 physics steps.
 
 from __future__ import annotations
 
-import enum
 import math
 import time
 from collections.abc import Callable
@@ -34,7 +33,7 @@ from avsim.record.recorder import Recorder
 from avsim.run.sensor_loop import FrameHook, SensorLoop, sensing_mode
 from avsim.run.stack import Stack, StackOutput
 from planner.fsm.motion import TURNS
-from planner.messages import StateChange
+from planner.messages import MACHINES, AccMode, HazardLights, Motion, Plan, SpeedSource, StateChange
 from world.core.client import PHYSICS_RATE, Rate
 from world.sensors.setup import Profile, sensor_setup
 from world.spec import FlatTire, ScenarioSpec
@@ -52,7 +51,6 @@ assert CRITERIA_RATE.every % CONTACT_RATE.every == 0, "criteria rate must divide
 END_MARGIN = 30.0  # [m] default `completes` station: the route's end less this
 TYRE_HALF_WIDTH = 0.105  # [m] half the tyre's tread (the URDF's wheel width)
 NEEDS_ACTORS = (MinGap, StandstillGap, TimeToResume)  # criteria that read the NPCs
-TURN_MOTIONS = frozenset(m.value for m in TURNS)  # the plan's `motion` in a turn
 SETTLE_AFTER_DONE = 1.0  # [s] the run goes on this long after `completes` is reached
 
 ProgressCallback = Callable[[float, float], None]  # (sim time, duration) [s]
@@ -77,9 +75,10 @@ class TrajectoryLog:
     drive_torque: list[float] = field(default_factory=list)  # [N m] commanded, total
     brake_torque: list[float] = field(default_factory=list)  # [N m] commanded, total
     wheel_spin: list[NDArray[np.float64]] = field(default_factory=list)  # [rad/s] (4,)
-    acc_mode: list[str] = field(default_factory=list)  # the ACC / event layer's mode
-    motion: list[str] = field(default_factory=list)  # the motion FSM's state
-    hazard: list[bool] = field(default_factory=list)  # the stack's hazard lights
+    acc_mode: list[AccMode] = field(default_factory=list)  # the ACC / event layer's mode
+    motion: list[Motion] = field(default_factory=list)  # the motion FSM's state
+    hazard: list[bool] = field(default_factory=list)  # the stack's hazard lights are on
+    speed_source: list[SpeedSource] = field(default_factory=list)  # what set the speed
     lane: list[int] = field(default_factory=list)  # the lane the stack keeps (cross_track's)
     changing: list[bool] = field(default_factory=list)  # a commanded lane change in hand
     pedal: list[float] = field(default_factory=list)  # [-] the driver's accelerator pedal
@@ -224,14 +223,20 @@ class Runner:
         out = self.stack.tick(w.t, CONTROL_RATE.every / PHYSICS_RATE)
         cmd = out.command
         w.ego.apply(cmd.steering_angle, cmd.drive_torque, cmd.brake_torque)
-        self._last = out
+        if self._last is None and self.recorder is not None:
+            self._record_machines(out.plan)
+        previous, self._last = self._last, out
         self._lane, self._origin_lane = out.plan.lane, out.plan.origin_lane
-        self._turning = out.plan.motion in TURN_MOTIONS
+        self._turning = out.plan.motion in TURNS
         self._log_tick(out)
         for change in out.plan.changes:
             self.state_changes.append(change)
             if self.recorder is not None:
                 self.recorder.log_state(change.t, change.machine, change.target, change.reason)
+        source = out.plan.speed_source
+        if self.recorder is not None and previous is not None and \
+                previous.plan.speed_source is not source:  # an attribution, not a state change
+            self.recorder.log_state(w.t, "speed_source", source.value, text=False)
 
     def _log_tick(self, out: StackOutput) -> None:
         w, log = self.world, self.log
@@ -254,8 +259,9 @@ class Runner:
         log.brake_torque.append(out.command.brake_torque)
         log.wheel_spin.append(truth.wheel_spin.copy())
         log.acc_mode.append(out.plan.acc_mode)
-        log.hazard.append(out.plan.hazard)
+        log.hazard.append(out.plan.hazard is HazardLights.ON)
         log.motion.append(out.plan.motion)
+        log.speed_source.append(out.plan.speed_source)
         log.lane.append(out.plan.lane)
         log.changing.append(out.plan.lane != out.plan.origin_lane)
         log.pedal.append(w.accelerator_pedal)
@@ -346,12 +352,17 @@ class Runner:
         lanes = [np.column_stack([lane.position(np.linspace(0, w.road.length, 400), 0.0),
                                   np.full(400, 0.02)]) for lane in w.road.lanes]
         rec.log_static_lines("/world/map/lanes", lanes, (90, 160, 255), 0.03)
-        p = self.stack.planner  # a lane per state machine, from the state it starts in
-        initial: dict[str, enum.Enum] = {"lane_source": p.source, "motion": p.motion.motion,
-                                         "acc": p.acc.mode, "control": p.control.state}
-        for machine, state in initial.items():
-            rec.log_state_machine(machine, [x.value for x in type(state)])
-            rec.log_state(0.0, machine, state.value, "initial state")
+
+    def _record_machines(self, plan: Plan) -> None:
+        """A lane per state machine of the plan, each from the state it starts in: the
+        first plan's, or what its first change left."""
+        rec = self.recorder
+        assert rec is not None
+        left = {c.machine: c.source for c in reversed(plan.changes)}
+        for machine, states in MACHINES.items():
+            rec.log_state_machine(machine, [x.value for x in states])
+            initial = left.get(machine, plan.states[machine].value)
+            rec.log_state(0.0, machine, initial, "initial state")
 
     def _record_tick(self, out: StackOutput) -> None:
         rec, w = self.recorder, self.world

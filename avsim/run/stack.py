@@ -23,7 +23,16 @@ from perception.flat_tyre import FlatTyreDetector, FlatTyreParams
 from perception.lanes import LaneDetector, LaneFilter
 from perception.lights import TrafficLightDetector
 from perception.localization import Localizer
-from perception.messages import Detection, EgoState, LaneEstimate, Track
+from perception.messages import (
+    Detection,
+    EgoState,
+    LaneEstimate,
+    LaneView,
+    LightDetection,
+    PlannerInput,
+    SignView,
+    Track,
+)
 from perception.objects import ObjectDetector
 from perception.signs import StopSignDetector
 from perception.tracking import MultiObjectTracker
@@ -31,7 +40,7 @@ from planner.events import EventParams
 from planner.junctions import JunctionParams
 from planner.messages import Plan
 from planner.motion_layer import MotionLayerParams
-from planner.planner import LaneKeepingParams, LaneKeepingPlanner, LaneView
+from planner.planner import Planner, PlannerParams
 from vehicle_urdf import CarGeometry
 from world.frames import CameraFrame, CameraInfo, GnssFix, LidarScan, Odometry
 from world.hdmap import RoadMap
@@ -65,15 +74,14 @@ class Stack:
                  front_camera: CameraInfo | None = None) -> None:
         """`front_camera`: the camera the lane is found in; None for a map-only stack."""
         self.localizer = Localizer()
-        self.planner = LaneKeepingPlanner(
-            road, LaneKeepingParams(set_speed=ego.set_speed, max_speed=ego.max_speed,
-                                    lane=ego.lane, camera=front_camera is not None,
-                                    motion=MotionLayerParams(overtake=ego.overtake),
-                                    events=EventParams(front_overhang=car.front_overhang,
-                                                       front_axle=car.front_axle,
-                                                       rear_axle=car.rear_axle),
-                                    junctions=JunctionParams(
-                                        front_overhang=car.front_overhang))
+        self.planner = Planner(
+            road, PlannerParams(set_speed=ego.set_speed, max_speed=ego.max_speed,
+                                lane=ego.lane, camera=front_camera is not None,
+                                motion=MotionLayerParams(overtake=ego.overtake),
+                                events=EventParams(front_overhang=car.front_overhang,
+                                                   front_axle=car.front_axle,
+                                                   rear_axle=car.rear_axle),
+                                junctions=JunctionParams(front_overhang=car.front_overhang))
         )
         lateral = StanleyParams(
             wheelbase=car.wheelbase, centre_to_front_axle=car.front_axle,
@@ -86,8 +94,8 @@ class Stack:
         self.lane_detector = LaneDetector(front_camera) if front_camera is not None else None
         self.sign_detector = StopSignDetector(front_camera) if front_camera is not None \
             else None
-        self.light_detector = TrafficLightDetector(front_camera) \
-            if front_camera is not None and self.planner.junctions.lights else None
+        self.light_detector = TrafficLightDetector(front_camera, road, car.front_overhang) \
+            if front_camera is not None and road.traffic_lights else None
         self.lane_filter = LaneFilter()
         self.object_detector = ObjectDetector()
         self.flat_detector = FlatTyreDetector(FlatTyreParams(track=car.track,
@@ -97,6 +105,8 @@ class Stack:
         self._poses: list[EgoState] = []
         self._view: LaneView | None = None
         self._tracks: tuple[Track, ...] = ()
+        self._signs: SignView | None = None  # the last frame's signs, for the next tick
+        self._lights: tuple[LightDetection, ...] = ()  # the last frame's lights, likewise
         self._pedal = 0.0  # [-] the driver's accelerator pedal, from the odometry
 
     def on_gnss(self, fix: GnssFix) -> None:
@@ -122,13 +132,9 @@ class Stack:
             lane = self.lane_filter.update(lane_raw, pose.speed, pose.yaw_rate)
             self._view = LaneView(lane, pose)
         if front is not None and self.sign_detector is not None:
-            signs = self.sign_detector.detect(front)
-            self.planner.events.see_signs(signs, pose)
+            self._signs = SignView(tuple(self.sign_detector.detect(front)), pose)
         if front is not None and self.light_detector is not None:
-            station, _ = self.planner.localise(pose)
-            heads = self.planner.junctions.heads_ahead(station)
-            if heads:
-                self.planner.junctions.see_lights(self.light_detector.detect(front, pose, heads))
+            self._lights = self.light_detector.detect(front, pose)
         detections = tracks = None
         if scan is not None:
             detections = self.object_detector.detect(scan)
@@ -137,10 +143,15 @@ class Stack:
         return PerceptionOutput(t, pose, lane_raw, lane, detections, tracks)
 
     def tick(self, t: float, dt: float) -> StackOutput:
+        """Plan and control on the estimate now and the latest perception; a frame's signs
+        and lights go to the planner once, at the tick after their delivery."""
         ego = self.localizer.estimate(t)
         self._remember(ego)
-        plan = self.planner.update(ego, self._view, self._tracks, self._pedal,
-                                   flat=self.flat_detector.state is not None)
+        plan = self.planner.update(PlannerInput(
+            ego=ego, lane=self._view, tracks=self._tracks, signs=self._signs,
+            lights=self._lights, pedal=self._pedal,
+            flat_tyre=self.flat_detector.state is not None))
+        self._signs, self._lights = None, ()
         return StackOutput(plan, self.controller.update(plan, dt))
 
     def _remember(self, ego: EgoState) -> None:

@@ -19,50 +19,58 @@ Gaps (the paper gives none; designed here, all in metres, speeds in m/s):
   d_des, with d_reach (10 m) of hysteresis.
 
 Transitions: every row of the paper's Table 2, plus the ones a sound chart needs and the
-table's "sample" leaves out (marked * below). Within a state they are tried in this order,
-and the first that holds is taken (Table 2's conditions overlap: out of BRAKE with the lead
-beyond d_max, Trail's row also holds, so Cruise and SpeedLimit are tried first):
+table's "sample" leaves out, and our two town modes (marked * below). Events are a set of
+`AccEvent`s, each with its mode (`EVENT_MODE`); they are tried by priority: pedestrian,
+stop sign, red light, give way, speed bump, off-ramp. An event mode stays while its own
+event holds, unless a higher one takes over; when it is over the car cruises (the chart's
+default ACC_ACTIVE state), and the next tick's rows settle the mode. For the state the car
+is in, the rows that leave it are tried in this order and the first that holds is taken
+(Table 2's conditions overlap: out of BRAKE with the lead beyond d_max, Trail's row also
+holds, so Cruise and SpeedLimit are tried first). `TABLE` is this table, as data:
 
-| from               | to          | when                                                   |
-|--------------------|-------------|--------------------------------------------------------|
-| ACC_OFF            | CRUISE      | ACC switched on (the chart's default state)            |
-| any but FLAT*      | ACC_OFF     | ACC switched off                                       |
-| any ACC_ON*        | FLAT        | flat tyre (Table 2: SpeedBump -> Flat)                 |
-| ACC_ACTIVE, OFF_RAMP, SPEED_BUMP, STOP_SIGN*, RED_LIGHT*, YIELD* | PEDESTRIAN | [Pedestrian] |
-| ACC_ACTIVE*, OFF_RAMP | STOP_SIGN | [StopS] (Table 2: OffRamp -> StopSign)                  |
-| ACC_ACTIVE*, OFF_RAMP*, YIELD* | RED_LIGHT | a light ahead to stop for (`planner.junctions`) |
-| ACC_ACTIVE*, OFF_RAMP*, RED_LIGHT*, STOP_SIGN* | YIELD | a gap to wait for at a junction (town) |
-| ACC_ACTIVE         | SPEED_BUMP  | [SpeedBump] (Table 2: Trail, Brake)                    |
-| ACC_ACTIVE*        | OFF_RAMP    | [Off_Ramp]                                             |
-| CRUISE, TRAIL*, SPEED_LIMIT* | BRAKE | d <= d_min (Table 2: Cruise -> Brake)           |
-| CRUISE             | TRAIL       | d < d_max and d > d_des and V_l < V_s                  |
-| CRUISE, TRAIL*     | SPEED_LIMIT | V_GPS < V_s and (d >= d_max or (V_GPS <= V_l and d > d_min)) |
-| TRAIL              | CRUISE      | V_GPS >= V_s and (d >= d_max or (V_s <= V_l and d > d_min)) |
-| BRAKE              | CRUISE      | V_GPS >= V_s and (d >= d_max or V_s <= V_l) and d > d_min |
-| BRAKE              | SPEED_LIMIT | V_GPS < V_s and (d >= d_max or V_s <= V_l) and d > d_min |
-| BRAKE              | TRAIL       | d > d_des and (V_l < V_s or V_l < V_GPS) and d > d_min |
-| SPEED_LIMIT        | CRUISE      | V_GPS >= V_s and (d >= d_max or (V_GPS <= V_l and d > d_min)) |
-| SPEED_LIMIT        | TRAIL       | (V_GPS < V_s or V_l < V_GPS) and d < d_max and d > d_des |
-| OFF_RAMP           | CRUISE      | [!Off_Ramp]                                            |
-| PEDESTRIAN         | CRUISE      | [!Pedestrian]                                          |
-| SPEED_BUMP         | CRUISE      | [!SpeedBump]                                           |
-| STOP_SIGN*         | CRUISE      | [!StopS] (the stop is done)                            |
-| RED_LIGHT*, YIELD* | CRUISE      | the light lets the car go / the gap has come           |
-| FLAT               | -           | none: the car stops on the shoulder ("Simulation Stops") |
+1. acc_off -> cruise: ACC switched on (the chart's default state)
+2. any ACC_ON but flat -> acc_off: ACC switched off *
+3. any ACC_ON but flat -> flat: [Flat] (Table 2: SpeedBump -> Flat; from any mode *)
+4. ACC_ACTIVE, off_ramp, speed_bump, stop_sign, red_light, yield -> pedestrian: [Pedestrian]
+   (from stop sign, red light, yield *)
+5. ACC_ACTIVE, off_ramp -> stop_sign: [StopS] (Table 2: OffRamp -> StopSign; from ACC_ACTIVE
+   *)
+6. ACC_ACTIVE, off_ramp, yield -> red_light: a light ahead to stop for (`planner.junctions`)
+   *
+7. ACC_ACTIVE, off_ramp -> yield: a gap to wait for at a junction (town) *
+8. stop_sign, red_light -> yield: a gap to wait for, the mode's own event over *
+9. ACC_ACTIVE -> speed_bump: [SpeedBump] (Table 2: Trail, Brake; Cruise, SpeedLimit *)
+10. ACC_ACTIVE -> off_ramp: [Off_Ramp] *
+11. off_ramp -> cruise: [!Off_Ramp]
+12. pedestrian -> cruise: [!Pedestrian]
+13. speed_bump -> cruise: [!SpeedBump]
+14. stop_sign -> cruise: [!StopS] (the stop is done) *
+15. red_light -> cruise: the light lets the car go *
+16. yield -> cruise: the gap has come *
+17. cruise, trail, speed_limit -> brake: d <= d_min (Table 2: Cruise -> Brake; Trail,
+    SpeedLimit *)
+18. cruise -> trail: d_des < d < d_max and V_l < V_s
+19. trail -> cruise: V_GPS >= V_s and (d >= d_max or (V_s <= V_l and d > d_min))
+20. brake -> cruise: V_GPS >= V_s and (d >= d_max or V_s <= V_l) and d > d_min
+21. brake -> speed_limit: V_GPS < V_s and (d >= d_max or V_s <= V_l) and d > d_min
+22. brake -> trail: d > d_des and (V_l < V_s or V_l < V_GPS) and d > d_min
+23. speed_limit -> cruise: V_GPS >= V_s and (d >= d_max or (V_GPS <= V_l and d > d_min))
+24. speed_limit -> trail: (V_GPS < V_s or V_l < V_GPS) and d_des < d < d_max
+25. cruise, trail -> speed_limit: V_GPS < V_s and (d >= d_max or (V_GPS <= V_l and d >
+    d_min)) (Trail *)
 
-The ACC_ACTIVE mode after an event is CRUISE (the chart's default); the next tick's
-transitions settle it. The events are decided upstream (perception and the map); this
-module only says which mode holds.
+FLAT has no row out: the car stops on the shoulder ("Simulation Stops"). The events are
+decided upstream (perception and the map); this module only says which mode holds.
 """
 
 from __future__ import annotations
 
 import enum
 import math
-from collections.abc import Callable
 from dataclasses import dataclass
 
-KPH = 1.0 / 3.6  # [m/s per km/h]
+from planner.fsm.machine import Row, Table, Transition, next_state, render
+from world.frames import to_kph
 
 
 class AccMode(enum.Enum):
@@ -80,9 +88,33 @@ class AccMode(enum.Enum):
     FLAT = "flat"
 
 
+class AccEvent(enum.Enum):
+    """A discrete event the ACC layer reacts to (decided upstream: `planner.events`,
+    `planner.junctions`)."""
+
+    PEDESTRIAN = "pedestrian"  # a pedestrian on or at the crossing ahead
+    STOP_SIGN = "stop_sign"  # a stop line ahead not yet stopped at
+    RED_LIGHT = "red_light"  # a light ahead to stop for (red, yellow, unread)
+    GIVE_WAY = "give_way"  # a junction ahead to wait at for a gap
+    SPEED_BUMP = "speed_bump"  # a speed bump ahead within its approach
+    OFF_RAMP = "off_ramp"  # on the exit ramp of the route
+    FLAT = "flat"  # a flat tyre detected
+
+
+EVENT_MODE = {  # each event's mode; the events in the order they are tried (priority)
+    AccEvent.PEDESTRIAN: AccMode.PEDESTRIAN,
+    AccEvent.STOP_SIGN: AccMode.STOP_SIGN,
+    AccEvent.RED_LIGHT: AccMode.RED_LIGHT,
+    AccEvent.GIVE_WAY: AccMode.YIELD,
+    AccEvent.SPEED_BUMP: AccMode.SPEED_BUMP,
+    AccEvent.OFF_RAMP: AccMode.OFF_RAMP,
+    AccEvent.FLAT: AccMode.FLAT,
+}
+MODE_EVENT = {mode: event for event, mode in EVENT_MODE.items()}
 ACC_ACTIVE = frozenset({AccMode.CRUISE, AccMode.TRAIL, AccMode.BRAKE, AccMode.SPEED_LIMIT})
-EDACC = frozenset({AccMode.OFF_RAMP, AccMode.PEDESTRIAN, AccMode.SPEED_BUMP, AccMode.STOP_SIGN,
-                   AccMode.RED_LIGHT, AccMode.YIELD, AccMode.FLAT})
+EDACC = frozenset(EVENT_MODE.values())
+ACC_ON = ACC_ACTIVE | EDACC
+NO_EVENTS: frozenset[AccEvent] = frozenset()
 
 
 @dataclass(frozen=True, slots=True)
@@ -101,13 +133,7 @@ class AccInput:
     v_gps: float  # [m/s] posted limit where the car is
     d: float = math.inf  # [m] gap to the vehicle ahead in the lane (+inf: none)
     v_l: float = math.inf  # [m/s] its speed over ground (+inf: none)
-    off_ramp: bool = False  # on the exit ramp of the route
-    pedestrian: bool = False  # a pedestrian on or at the crossing ahead
-    speed_bump: bool = False  # a speed bump ahead within its approach
-    stop_sign: bool = False  # a stop line ahead not yet stopped at
-    red_light: bool = False  # a light ahead to stop for (red, yellow, unread)
-    give_way: bool = False  # a junction ahead to wait at for a gap
-    flat: bool = False  # a flat tyre detected
+    events: frozenset[AccEvent] = NO_EVENTS  # the events that hold now
 
 
 @dataclass(frozen=True, slots=True)
@@ -119,7 +145,7 @@ class Gaps:
 
 def r157_min_gap(v: float) -> float:
     """[m] UN R157's minimum following distance at ego speed v [m/s]."""
-    t_front = 1.0 + max(v / KPH, 10.0) / 100.0
+    t_front = 1.0 + max(to_kph(v), 10.0) / 100.0
     return max(v * t_front, 2.0)
 
 
@@ -131,106 +157,158 @@ def gaps(v: float, v_l: float, p: AccParams) -> Gaps:
     return Gaps(d_min, d_des, d_des + closing + p.d_reach)
 
 
-@dataclass(frozen=True, slots=True)
-class AccChange:
-    to: AccMode
-    reason: str
+# -- the guards: (mode now, input, gaps) -> the row holds --------------------------------------
 
 
-Rule = tuple[AccMode, Callable[[AccInput, Gaps], bool], str]
+def _switched_on(_m: AccMode, x: AccInput, _g: Gaps) -> bool:
+    return x.acc_on
 
 
-def _following_rules() -> dict[AccMode, list[Rule]]:
-    """The ACC_ACTIVE rows of the table, per state, in the order they are tried."""
-    c, t, b, s = AccMode.CRUISE, AccMode.TRAIL, AccMode.BRAKE, AccMode.SPEED_LIMIT
-
-    def too_close(x: AccInput, g: Gaps) -> bool:
-        return x.d <= g.d_min
-
-    def to_limit(x: AccInput, g: Gaps) -> bool:
-        return x.v_gps < x.v_s and (x.d >= g.d_max or (x.v_gps <= x.v_l and x.d > g.d_min))
-
-    brake = (b, too_close, "gap at or below d_min")
-    limit = (s, to_limit, "the posted limit is below the set speed")
-    return {
-        c: [brake,
-            (t, lambda x, g: g.d_des < x.d < g.d_max and x.v_l < x.v_s,
-             "a slower vehicle ahead within d_max"),
-            limit],
-        t: [brake,
-            (c, lambda x, g: x.v_gps >= x.v_s and (
-                x.d >= g.d_max or (x.v_s <= x.v_l and x.d > g.d_min)),
-             "the lead is gone or faster than the set speed"),
-            limit],
-        b: [(c, lambda x, g: x.v_gps >= x.v_s and (x.d >= g.d_max or x.v_s <= x.v_l)
-             and x.d > g.d_min, "gap recovered, nothing slower ahead"),
-            (s, lambda x, g: x.v_gps < x.v_s and (x.d >= g.d_max or x.v_s <= x.v_l)
-             and x.d > g.d_min, "gap recovered, the posted limit binds"),
-            (t, lambda x, g: x.d > g.d_des and (x.v_l < x.v_s or x.v_l < x.v_gps)
-             and x.d > g.d_min, "gap recovered beyond d_des behind a slower vehicle")],
-        s: [brake,
-            (c, lambda x, g: x.v_gps >= x.v_s and (
-                x.d >= g.d_max or (x.v_gps <= x.v_l and x.d > g.d_min)),
-             "the posted limit is no longer below the set speed"),
-            (t, lambda x, g: (x.v_gps < x.v_s or x.v_l < x.v_gps) and g.d_des < x.d < g.d_max,
-             "a vehicle ahead within d_max")],
-    }
+def _switched_off(_m: AccMode, x: AccInput, _g: Gaps) -> bool:
+    return not x.acc_on
 
 
-_FOLLOWING = _following_rules()
-
-# event entries, by priority: (flag, mode, reason); OFF_RAMP and SPEED_BUMP only from
-# ACC_ACTIVE, PEDESTRIAN and STOP_SIGN also from the other events (Table 2)
-_EVENTS: tuple[tuple[str, AccMode, str], ...] = (
-    ("pedestrian", AccMode.PEDESTRIAN, "a pedestrian at the crossing ahead"),
-    ("stop_sign", AccMode.STOP_SIGN, "a stop line ahead"),
-    ("red_light", AccMode.RED_LIGHT, "a traffic light ahead to stop for"),
-    ("give_way", AccMode.YIELD, "giving way at the junction ahead"),
-    ("speed_bump", AccMode.SPEED_BUMP, "a speed bump ahead"),
-    ("off_ramp", AccMode.OFF_RAMP, "on the exit ramp"),
-)
-_ENTERED_FROM_EVENTS = {
-    AccMode.PEDESTRIAN: frozenset({AccMode.OFF_RAMP, AccMode.SPEED_BUMP, AccMode.STOP_SIGN,
-                                   AccMode.RED_LIGHT, AccMode.YIELD}),
-    AccMode.STOP_SIGN: frozenset({AccMode.OFF_RAMP}),
-    AccMode.RED_LIGHT: frozenset({AccMode.OFF_RAMP, AccMode.YIELD}),
-    AccMode.YIELD: frozenset({AccMode.OFF_RAMP, AccMode.RED_LIGHT, AccMode.STOP_SIGN}),
-}
-_CLEARS = {AccMode.OFF_RAMP: "off_ramp", AccMode.PEDESTRIAN: "pedestrian",
-           AccMode.SPEED_BUMP: "speed_bump", AccMode.STOP_SIGN: "stop_sign",
-           AccMode.RED_LIGHT: "red_light", AccMode.YIELD: "give_way"}
+def _own_event_over(m: AccMode, x: AccInput, _g: Gaps) -> bool:
+    return MODE_EVENT[m] not in x.events
 
 
-def transition(mode: AccMode, x: AccInput, p: AccParams) -> AccChange | None:
-    """The change of mode for input `x`, or None to stay (see the module doc's table)."""
-    if mode is AccMode.FLAT:
-        return None
-    if mode is AccMode.ACC_OFF:
-        return AccChange(AccMode.CRUISE, "ACC switched on") if x.acc_on else None
-    if not x.acc_on:
-        return AccChange(AccMode.ACC_OFF, "ACC switched off")
-    if x.flat:
-        return AccChange(AccMode.FLAT, "flat tyre")
-    event = _event_change(mode, x)
-    if event is not None:
-        return event
-    if mode in EDACC:
-        if getattr(x, _CLEARS[mode]):
-            return None  # the event still holds
-        return AccChange(AccMode.CRUISE, f"{mode.value} done")
-    g = gaps(x.v, x.v_l, p)
-    for to, holds, reason in _FOLLOWING[mode]:
-        if holds(x, g):
-            return AccChange(to, reason)
-    return None
+class _Event:
+    """The row holds while `event` does (and, `after_own`, once the mode's own is over)."""
+
+    def __init__(self, event: AccEvent, after_own: bool = False) -> None:
+        self.event, self.after_own = event, after_own
+
+    def __call__(self, m: AccMode, x: AccInput, g: Gaps) -> bool:
+        return self.event in x.events and (not self.after_own or _own_event_over(m, x, g))
 
 
-def _event_change(mode: AccMode, x: AccInput) -> AccChange | None:
-    for flag, to, reason in _EVENTS:
-        if not getattr(x, flag):
-            continue
-        if to is mode:
-            return None  # the mode's own event holds: only a higher one may take over
-        if mode in ACC_ACTIVE or mode in _ENTERED_FROM_EVENTS.get(to, frozenset()):
-            return AccChange(to, reason)
-    return None
+def _too_close(_m: AccMode, x: AccInput, g: Gaps) -> bool:
+    return x.d <= g.d_min
+
+
+def _to_limit(_m: AccMode, x: AccInput, g: Gaps) -> bool:
+    return x.v_gps < x.v_s and (x.d >= g.d_max or (x.v_gps <= x.v_l and x.d > g.d_min))
+
+
+def _cruise_to_trail(_m: AccMode, x: AccInput, g: Gaps) -> bool:
+    return g.d_des < x.d < g.d_max and x.v_l < x.v_s
+
+
+def _trail_to_cruise(_m: AccMode, x: AccInput, g: Gaps) -> bool:
+    return x.v_gps >= x.v_s and (x.d >= g.d_max or (x.v_s <= x.v_l and x.d > g.d_min))
+
+
+def _brake_to_cruise(_m: AccMode, x: AccInput, g: Gaps) -> bool:
+    return x.v_gps >= x.v_s and (x.d >= g.d_max or x.v_s <= x.v_l) and x.d > g.d_min
+
+
+def _brake_to_limit(_m: AccMode, x: AccInput, g: Gaps) -> bool:
+    return x.v_gps < x.v_s and (x.d >= g.d_max or x.v_s <= x.v_l) and x.d > g.d_min
+
+
+def _brake_to_trail(_m: AccMode, x: AccInput, g: Gaps) -> bool:
+    return x.d > g.d_des and (x.v_l < x.v_s or x.v_l < x.v_gps) and x.d > g.d_min
+
+
+def _limit_to_cruise(_m: AccMode, x: AccInput, g: Gaps) -> bool:
+    return x.v_gps >= x.v_s and (x.d >= g.d_max or (x.v_gps <= x.v_l and x.d > g.d_min))
+
+
+def _limit_to_trail(_m: AccMode, x: AccInput, g: Gaps) -> bool:
+    return (x.v_gps < x.v_s or x.v_l < x.v_gps) and g.d_des < x.d < g.d_max
+
+
+# -- the table --------------------------------------------------------------------------------
+
+M = AccMode
+AccRow = Row[AccMode, AccInput, Gaps]
+
+
+def _done(mode: AccMode, when: str) -> AccRow:
+    return Row(frozenset({mode}), M.CRUISE, _own_event_over, when, f"{mode.value} done")
+
+
+TABLE: Table[AccMode, AccInput, Gaps] = Table(AccMode, (
+    Row(frozenset({M.ACC_OFF}), M.CRUISE, _switched_on,
+        "ACC switched on (the chart's default state)", "ACC switched on"),
+    Row(ACC_ON - {M.FLAT}, M.ACC_OFF, _switched_off, "ACC switched off *",
+        "ACC switched off"),
+    Row(ACC_ON - {M.FLAT}, M.FLAT, _Event(AccEvent.FLAT),
+        "[Flat] (Table 2: SpeedBump -> Flat; from any mode *)", "flat tyre"),
+    Row(ACC_ACTIVE | {M.OFF_RAMP, M.SPEED_BUMP, M.STOP_SIGN, M.RED_LIGHT, M.YIELD},
+        M.PEDESTRIAN, _Event(AccEvent.PEDESTRIAN),
+        "[Pedestrian] (from stop sign, red light, yield *)",
+        "a pedestrian at the crossing ahead"),
+    Row(ACC_ACTIVE | {M.OFF_RAMP}, M.STOP_SIGN, _Event(AccEvent.STOP_SIGN),
+        "[StopS] (Table 2: OffRamp -> StopSign; from ACC_ACTIVE *)", "a stop line ahead"),
+    Row(ACC_ACTIVE | {M.OFF_RAMP, M.YIELD}, M.RED_LIGHT, _Event(AccEvent.RED_LIGHT),
+        "a light ahead to stop for (`planner.junctions`) *",
+        "a traffic light ahead to stop for"),
+    Row(ACC_ACTIVE | {M.OFF_RAMP}, M.YIELD, _Event(AccEvent.GIVE_WAY),
+        "a gap to wait for at a junction (town) *", "giving way at the junction ahead"),
+    Row(frozenset({M.RED_LIGHT, M.STOP_SIGN}), M.YIELD,
+        _Event(AccEvent.GIVE_WAY, after_own=True),
+        "a gap to wait for, the mode's own event over *", "giving way at the junction ahead"),
+    Row(ACC_ACTIVE, M.SPEED_BUMP, _Event(AccEvent.SPEED_BUMP),
+        "[SpeedBump] (Table 2: Trail, Brake; Cruise, SpeedLimit *)", "a speed bump ahead"),
+    Row(ACC_ACTIVE, M.OFF_RAMP, _Event(AccEvent.OFF_RAMP), "[Off_Ramp] *",
+        "on the exit ramp"),
+    _done(M.OFF_RAMP, "[!Off_Ramp]"),
+    _done(M.PEDESTRIAN, "[!Pedestrian]"),
+    _done(M.SPEED_BUMP, "[!SpeedBump]"),
+    _done(M.STOP_SIGN, "[!StopS] (the stop is done) *"),
+    _done(M.RED_LIGHT, "the light lets the car go *"),
+    _done(M.YIELD, "the gap has come *"),
+    Row(frozenset({M.CRUISE, M.TRAIL, M.SPEED_LIMIT}), M.BRAKE, _too_close,
+        "d <= d_min (Table 2: Cruise -> Brake; Trail, SpeedLimit *)",
+        "gap at or below d_min"),
+    Row(frozenset({M.CRUISE}), M.TRAIL, _cruise_to_trail,
+        "d_des < d < d_max and V_l < V_s", "a slower vehicle ahead within d_max"),
+    Row(frozenset({M.TRAIL}), M.CRUISE, _trail_to_cruise,
+        "V_GPS >= V_s and (d >= d_max or (V_s <= V_l and d > d_min))",
+        "the lead is gone or faster than the set speed"),
+    Row(frozenset({M.BRAKE}), M.CRUISE, _brake_to_cruise,
+        "V_GPS >= V_s and (d >= d_max or V_s <= V_l) and d > d_min",
+        "gap recovered, nothing slower ahead"),
+    Row(frozenset({M.BRAKE}), M.SPEED_LIMIT, _brake_to_limit,
+        "V_GPS < V_s and (d >= d_max or V_s <= V_l) and d > d_min",
+        "gap recovered, the posted limit binds"),
+    Row(frozenset({M.BRAKE}), M.TRAIL, _brake_to_trail,
+        "d > d_des and (V_l < V_s or V_l < V_GPS) and d > d_min",
+        "gap recovered beyond d_des behind a slower vehicle"),
+    Row(frozenset({M.SPEED_LIMIT}), M.CRUISE, _limit_to_cruise,
+        "V_GPS >= V_s and (d >= d_max or (V_GPS <= V_l and d > d_min))",
+        "the posted limit is no longer below the set speed"),
+    Row(frozenset({M.SPEED_LIMIT}), M.TRAIL, _limit_to_trail,
+        "(V_GPS < V_s or V_l < V_GPS) and d_des < d < d_max", "a vehicle ahead within d_max"),
+    Row(frozenset({M.CRUISE, M.TRAIL}), M.SPEED_LIMIT, _to_limit,
+        "V_GPS < V_s and (d >= d_max or (V_GPS <= V_l and d > d_min)) (Trail *)",
+        "the posted limit is below the set speed"),
+))
+
+
+def transition(mode: AccMode, x: AccInput, p: AccParams) -> Transition[AccMode] | None:
+    """The change of mode for input `x`, or None to stay (`TABLE`)."""
+    return next_state(TABLE, mode, x, gaps(x.v, x.v_l, p))
+
+
+def source_names(states: frozenset[AccMode]) -> str:
+    """A row's source states for the docs: the chart's groups by name where a row leaves a
+    whole group, then the single modes."""
+    parts, rest = [], set(states)
+    for name, group in (("any ACC_ON but flat", ACC_ON - {M.FLAT}),
+                        ("ACC_ACTIVE", ACC_ACTIVE)):
+        if group <= rest:
+            parts.append(name)
+            rest -= group
+    parts += [m.value for m in AccMode if m in rest]
+    return ", ".join(parts)
+
+
+def table_text() -> str:
+    """`TABLE` as the module doc shows it."""
+    return render(TABLE, names=source_names)
+
+
+if __name__ == "__main__":  # print the table for the module doc
+    print(table_text())

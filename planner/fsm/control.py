@@ -26,24 +26,21 @@ Terms (the thresholds are `ControlParams`):
 - on target: |v_target - v| <= keep_band and |a_target| <= accel_band (keep_band is
   narrower than speed_band: the hysteresis of SPEED_KEEPING).
 
-Transitions. Within a state they are tried in this order, and the first that holds is
-taken: the emergency first, then the stop, then the rest (whose conditions exclude each
-other):
+Transitions (`TABLE`, as data). For the state the car is in, the rows that leave it are
+tried in this order and the first that holds is taken: the emergency first, then the stop,
+then the rest (whose conditions exclude each other):
 
-| from                | to             | when                                               |
-|---------------------|----------------|----------------------------------------------------|
-| any but EMERGENCY_STOP | EMERGENCY_STOP | moving and a_required >= a_emergency_enter       |
-| any but EMERGENCY_STOP | EMERGENCY_STOP | moving and ttc < ttc_emergency                   |
-| EMERGENCY_STOP      | STOP           | v < v_stopped ("stopped", whatever the threat)     |
-| EMERGENCY_STOP      | DECELERATION   | moving and the threat is over                      |
-| ACCELERATION, DECELERATION, SPEED_KEEPING | STOP | v < v_stopped and v_target <= v_start     |
-| STOP                | ACCELERATION   | v_target > v_start and no threat                   |
-| SPEED_KEEPING       | ACCELERATION   | A                                                  |
-| SPEED_KEEPING       | DECELERATION   | D                                                  |
-| ACCELERATION        | DECELERATION   | D                                                  |
-| DECELERATION        | ACCELERATION   | A                                                  |
-| ACCELERATION        | SPEED_KEEPING  | on target                                          |
-| DECELERATION        | SPEED_KEEPING  | on target                                          |
+1. stop, acceleration, deceleration, speed_keeping -> emergency_stop: moving and a_required
+   >= a_emergency_enter
+2. stop, acceleration, deceleration, speed_keeping -> emergency_stop: moving and ttc <
+   ttc_emergency
+3. emergency_stop -> stop: v < v_stopped ("stopped", whatever the threat)
+4. emergency_stop -> deceleration: moving and the threat is over
+5. stop -> acceleration: v_target > v_start and no threat
+6. acceleration, deceleration, speed_keeping -> stop: v < v_stopped and v_target <= v_start
+7. deceleration, speed_keeping -> acceleration: speed up (A)
+8. acceleration, speed_keeping -> deceleration: slow down (D)
+9. acceleration, deceleration -> speed_keeping: on target
 
 Anything else stays. In particular STOP holds while v_target <= v_start (v_start above
 v_stopped is the start/stop hysteresis), and also when a stopped car creeps above v_stopped
@@ -57,6 +54,8 @@ import enum
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+
+from planner.fsm.machine import Row, Table, Transition, next_state, render
 
 
 class ControlState(enum.Enum):
@@ -86,12 +85,6 @@ class ControlInput:
     a_target: float = 0.0  # [m/s^2] its feed-forward acceleration, signed
     a_required: float = 0.0  # [m/s^2] >= 0: deceleration needed to avoid the lead (0: none)
     ttc: float = math.inf  # [s] time to collision with the lead (+inf: none or opening)
-
-
-@dataclass(frozen=True, slots=True)
-class ControlChange:
-    to: ControlState
-    reason: str
 
 
 def required_deceleration(v: float, d: float, v_l: float, a_l: float,
@@ -128,9 +121,6 @@ def time_to_collision(d: float, v: float, v_l: float) -> float:
     return math.inf
 
 
-Rule = tuple[ControlState, Callable[[ControlInput, ControlParams], bool], str]
-
-
 def _moving(x: ControlInput, p: ControlParams) -> bool:
     return x.v >= p.v_stopped
 
@@ -156,46 +146,74 @@ def _on_target(x: ControlInput, p: ControlParams) -> bool:
     return abs(x.v_target - x.v) <= p.keep_band and abs(x.a_target) <= p.accel_band
 
 
-def _rules() -> dict[ControlState, tuple[Rule, ...]]:
-    """The rows of the table, per state, in the order they are tried."""
-    s, e = ControlState.STOP, ControlState.EMERGENCY_STOP
-    a, d, k = (ControlState.ACCELERATION, ControlState.DECELERATION,
-               ControlState.SPEED_KEEPING)
-    emergency: tuple[Rule, ...] = (
-        (e, lambda x, p: _moving(x, p) and x.a_required >= p.a_emergency_enter,
-         "required deceleration at or above a_emergency_enter (beyond the ACC's braking)"),
-        (e, lambda x, p: _moving(x, p) and x.ttc < p.ttc_emergency,
-         "time to collision below ttc_emergency"),
-    )
-    stop: Rule = (s, lambda x, p: x.v < p.v_stopped and x.v_target <= p.v_start,
-                  "stopped with no target speed to start")
-    speed_up: Rule = (a, _speed_up, "target speed above the speed or the plan accelerates")
-    slow_down: Rule = (d, _slow_down, "target speed below the speed or the plan decelerates")
-    keep: Rule = (k, _on_target, "speed on target and the plan steady")
-    return {
-        s: (*emergency,
-            (a, lambda x, p: x.v_target > p.v_start and not _threat(x, p),
-             "target speed above v_start")),
-        e: ((s, lambda x, p: not _moving(x, p), "stopped"),
-            (d, lambda x, p: _moving(x, p) and _threat_over(x, p),
-             "threat over: required deceleration below a_emergency_exit and the gap "
-             "opening")),
-        a: (*emergency, stop, slow_down, keep),
-        d: (*emergency, stop, speed_up, keep),
-        k: (*emergency, stop, speed_up, slow_down),
-    }
+# -- the guards of the table: (state now, input, parameters) -> the row holds ------------------
 
 
-_RULES = _rules()
-
-# every (from, to) pair the table allows
-EDGES: frozenset[tuple[ControlState, ControlState]] = frozenset(
-    (state, rule[0]) for state, rules in _RULES.items() for rule in rules)
+def _hard_braking_needed(_s: ControlState, x: ControlInput, p: ControlParams) -> bool:
+    return _moving(x, p) and x.a_required >= p.a_emergency_enter
 
 
-def transition(state: ControlState, x: ControlInput, p: ControlParams) -> ControlChange | None:
-    """The change of state for input `x`, or None to stay (see the module doc's table)."""
-    for to, holds, reason in _RULES[state]:
-        if holds(x, p):
-            return ControlChange(to, reason)
-    return None
+def _collision_close(_s: ControlState, x: ControlInput, p: ControlParams) -> bool:
+    return _moving(x, p) and x.ttc < p.ttc_emergency
+
+
+def _stopped(_s: ControlState, x: ControlInput, p: ControlParams) -> bool:
+    return not _moving(x, p)
+
+
+def _moving_threat_over(_s: ControlState, x: ControlInput, p: ControlParams) -> bool:
+    return _moving(x, p) and _threat_over(x, p)
+
+
+def _start(_s: ControlState, x: ControlInput, p: ControlParams) -> bool:
+    return x.v_target > p.v_start and not _threat(x, p)
+
+
+def _stop(_s: ControlState, x: ControlInput, p: ControlParams) -> bool:
+    return x.v < p.v_stopped and x.v_target <= p.v_start
+
+
+def _guard(test: Callable[[ControlInput, ControlParams], bool]) -> ControlGuard:
+    def holds(_s: ControlState, x: ControlInput, p: ControlParams) -> bool:
+        return test(x, p)
+    return holds
+
+
+S = ControlState
+ControlGuard = Callable[[ControlState, ControlInput, ControlParams], bool]
+_DRIVING = frozenset({S.ACCELERATION, S.DECELERATION, S.SPEED_KEEPING})
+_EMERGENCY_FROM = _DRIVING | {S.STOP}
+
+TABLE: Table[ControlState, ControlInput, ControlParams] = Table(ControlState, (
+    Row(_EMERGENCY_FROM, S.EMERGENCY_STOP, _hard_braking_needed,
+        "moving and a_required >= a_emergency_enter",
+        "required deceleration at or above a_emergency_enter (beyond the ACC's braking)"),
+    Row(_EMERGENCY_FROM, S.EMERGENCY_STOP, _collision_close, "moving and ttc < ttc_emergency",
+        "time to collision below ttc_emergency"),
+    Row(frozenset({S.EMERGENCY_STOP}), S.STOP, _stopped,
+        "v < v_stopped (\"stopped\", whatever the threat)", "stopped"),
+    Row(frozenset({S.EMERGENCY_STOP}), S.DECELERATION, _moving_threat_over,
+        "moving and the threat is over",
+        "threat over: required deceleration below a_emergency_exit and the gap opening"),
+    Row(frozenset({S.STOP}), S.ACCELERATION, _start, "v_target > v_start and no threat",
+        "target speed above v_start"),
+    Row(_DRIVING, S.STOP, _stop, "v < v_stopped and v_target <= v_start",
+        "stopped with no target speed to start"),
+    Row(frozenset({S.DECELERATION, S.SPEED_KEEPING}), S.ACCELERATION, _guard(_speed_up),
+        "speed up (A)", "target speed above the speed or the plan accelerates"),
+    Row(frozenset({S.ACCELERATION, S.SPEED_KEEPING}), S.DECELERATION, _guard(_slow_down),
+        "slow down (D)", "target speed below the speed or the plan decelerates"),
+    Row(frozenset({S.ACCELERATION, S.DECELERATION}), S.SPEED_KEEPING, _guard(_on_target),
+        "on target", "speed on target and the plan steady"),
+))
+EDGES = TABLE.edges  # every (from, to) pair the table allows
+
+
+def transition(state: ControlState, x: ControlInput,
+               p: ControlParams) -> Transition[ControlState] | None:
+    """The change of state for input `x`, or None to stay (`TABLE`)."""
+    return next_state(TABLE, state, x, p)
+
+
+if __name__ == "__main__":  # print the table for the module doc
+    print(render(TABLE))

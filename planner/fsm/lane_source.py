@@ -1,18 +1,17 @@
 """Where the lateral reference comes from: the camera's lane, or the map when it is lost.
 
-An enum FSM with a pure transition function (table-tested):
+An enum FSM with its transition table as data (`TABLE`); for the state it is in, the rows
+that leave it are tried in this order and the first that holds is taken:
 
-| from         | to           | when                                                     |
-|--------------|--------------|----------------------------------------------------------|
-| ACQUIRING    | CAMERA       | confidence >= `acquire` (the first good lane estimate)   |
-| ACQUIRING    | MAP_HOLD     | no good estimate `acquire_time` after the start          |
-| CAMERA       | MAP_HOLD     | confidence < `lose` (hysteresis: `lose` < `acquire`)     |
-| MAP_HOLD     | CAMERA       | confidence >= `acquire` again                            |
-| MAP_HOLD     | STOP_IN_LANE | lost for `stop_after` seconds                            |
-| STOP_IN_LANE | CAMERA       | confidence >= `acquire` again                            |
-| any but MAP  | JUNCTION     | near a town junction (no lines inside; the map's turn path) |
-| JUNCTION     | CAMERA       | past the junction, confidence >= `acquire`               |
-| JUNCTION     | ACQUIRING    | past the junction, no good estimate yet                  |
+1. junction -> camera: past the junction, confidence >= `acquire`
+2. junction -> acquiring: past the junction, no good estimate yet
+3. acquiring, camera, map_hold, stop_in_lane -> junction: near a town junction (no lines
+   inside; the map's turn path)
+4. camera -> map_hold: confidence < `lose` (hysteresis: `lose` < `acquire`)
+5. acquiring, map_hold, stop_in_lane -> camera: confidence >= `acquire` (a good lane
+   estimate)
+6. acquiring -> map_hold: no good estimate `acquire_time` after the start
+7. map_hold -> stop_in_lane: lost for `stop_after` seconds
 
 MAP is the state of a stack built without a camera (GNSS + odometry on the HD map only):
 it never changes. ACQUIRING follows the map lane at the planned speed (the camera's first
@@ -27,6 +26,8 @@ from __future__ import annotations
 
 import enum
 from dataclasses import dataclass
+
+from planner.fsm.machine import Row, Table, Transition, next_state, render
 
 
 class LaneSource(enum.Enum):
@@ -55,38 +56,69 @@ class LaneSourceInput:
     junction: bool = False  # the car is near a town junction (`LaneKeepingPlanner`)
 
 
-@dataclass(frozen=True, slots=True)
-class Change:
-    to: LaneSource
-    reason: str
+def _good(x: LaneSourceInput, p: LaneSourceParams) -> bool:
+    return x.confidence >= p.acquire
 
 
-def transition(state: LaneSource, x: LaneSourceInput, p: LaneSourceParams) -> Change | None:
-    """The change of state for input `x`, or None to stay."""
-    good = x.confidence >= p.acquire
-    if state is LaneSource.MAP:
-        return None
-    if state is LaneSource.JUNCTION:
-        return None if x.junction else _past_junction(good, x.confidence)
-    if x.junction:
-        return Change(LaneSource.JUNCTION, "at a junction: the map's path")
-    if state is LaneSource.CAMERA:
-        if x.confidence < p.lose:
-            return Change(LaneSource.MAP_HOLD,
-                          f"lane confidence {x.confidence:.2f} < {p.lose}: holding on the map")
-        return None
-    if good:
-        return Change(LaneSource.CAMERA, f"lane found (confidence {x.confidence:.2f})")
-    if state is LaneSource.ACQUIRING and x.t - x.since >= p.acquire_time:
-        return Change(LaneSource.MAP_HOLD, f"no lane found in {p.acquire_time:.1f} s")
-    if state is LaneSource.MAP_HOLD and x.t - x.since >= p.stop_after:
-        return Change(LaneSource.STOP_IN_LANE,
-                      f"lane lost for {p.stop_after:.1f} s: stopping in lane")
-    return None
+def _past_found(_s: LaneSource, x: LaneSourceInput, p: LaneSourceParams) -> bool:
+    return not x.junction and _good(x, p)
 
 
-def _past_junction(good: bool, confidence: float) -> Change:
-    if good:
-        return Change(LaneSource.CAMERA, f"past the junction, lane found "
-                                         f"(confidence {confidence:.2f})")
-    return Change(LaneSource.ACQUIRING, "past the junction: looking for the lane")
+def _past(_s: LaneSource, x: LaneSourceInput, _p: LaneSourceParams) -> bool:
+    return not x.junction
+
+
+def _at_junction(_s: LaneSource, x: LaneSourceInput, _p: LaneSourceParams) -> bool:
+    return x.junction
+
+
+def _lost(_s: LaneSource, x: LaneSourceInput, p: LaneSourceParams) -> bool:
+    return x.confidence < p.lose
+
+
+def _found(_s: LaneSource, x: LaneSourceInput, p: LaneSourceParams) -> bool:
+    return _good(x, p)
+
+
+def _nothing_found(_s: LaneSource, x: LaneSourceInput, p: LaneSourceParams) -> bool:
+    return x.t - x.since >= p.acquire_time
+
+
+def _lost_too_long(_s: LaneSource, x: LaneSourceInput, p: LaneSourceParams) -> bool:
+    return x.t - x.since >= p.stop_after
+
+
+L = LaneSource
+_SEEKING = frozenset({L.ACQUIRING, L.MAP_HOLD, L.STOP_IN_LANE})  # looking for the lane
+
+TABLE: Table[LaneSource, LaneSourceInput, LaneSourceParams] = Table(LaneSource, (
+    Row(frozenset({L.JUNCTION}), L.CAMERA, _past_found,
+        "past the junction, confidence >= `acquire`",
+        lambda x, p: f"past the junction, lane found (confidence {x.confidence:.2f})"),
+    Row(frozenset({L.JUNCTION}), L.ACQUIRING, _past, "past the junction, no good estimate yet",
+        "past the junction: looking for the lane"),
+    Row(_SEEKING | {L.CAMERA}, L.JUNCTION, _at_junction,
+        "near a town junction (no lines inside; the map's turn path)",
+        "at a junction: the map's path"),
+    Row(frozenset({L.CAMERA}), L.MAP_HOLD, _lost,
+        "confidence < `lose` (hysteresis: `lose` < `acquire`)",
+        lambda x, p: f"lane confidence {x.confidence:.2f} < {p.lose}: holding on the map"),
+    Row(_SEEKING, L.CAMERA, _found, "confidence >= `acquire` (a good lane estimate)",
+        lambda x, p: f"lane found (confidence {x.confidence:.2f})"),
+    Row(frozenset({L.ACQUIRING}), L.MAP_HOLD, _nothing_found,
+        "no good estimate `acquire_time` after the start",
+        lambda x, p: f"no lane found in {p.acquire_time:.1f} s"),
+    Row(frozenset({L.MAP_HOLD}), L.STOP_IN_LANE, _lost_too_long,
+        "lost for `stop_after` seconds",
+        lambda x, p: f"lane lost for {p.stop_after:.1f} s: stopping in lane"),
+))
+
+
+def transition(state: LaneSource, x: LaneSourceInput,
+               p: LaneSourceParams) -> Transition[LaneSource] | None:
+    """The change of state for input `x`, or None to stay (`TABLE`)."""
+    return next_state(TABLE, state, x, p)
+
+
+if __name__ == "__main__":  # print the table for the module doc
+    print(render(TABLE))

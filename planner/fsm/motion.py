@@ -10,26 +10,28 @@ side", ICCAS 2020), the lane the route needs, and the progress of the manoeuvre 
 
 A lane change is *committed* once the car's centre has crossed into the target lane: before
 that, a target lane that stops being free aborts the change (back to LANE_KEEP in the origin
-lane, `MotionChange.abort`); after it, finishing is the safer way out.
+lane: an abort, a change to LANE_KEEP before the change is done); after it, finishing is
+the safer way out.
 
-| from              | to                | when                                                  |
-|-------------------|-------------------|-------------------------------------------------------|
-| LANE_KEEP         | LANE_CHANGE_RIGHT | a flat tyre: pull over (right lane, then shoulder)    |
-| LANE_KEEP         | TURN_RIGHT        | the route turns right at the junction being entered   |
-| LANE_KEEP         | TURN_LEFT         | the route turns left there                            |
-| LANE_KEEP         | U_TURN            | the route turns back there                            |
-| LANE_KEEP         | LANE_CHANGE_RIGHT | the route needs a lane to the right and it is free    |
-| LANE_KEEP         | LANE_CHANGE_LEFT  | the route needs a lane to the left and it is free     |
-| LANE_KEEP         | LANE_CHANGE_LEFT  | overtaking allowed, the lane blocked, the left free   |
-| LANE_KEEP         | LANE_CHANGE_RIGHT | overtaking allowed, the lane blocked, only the right free
-| LANE_CHANGE_LEFT  | LANE_KEEP         | the change is done (in the target lane)               |
-| LANE_CHANGE_LEFT  | LANE_KEEP (abort) | the target lane is no longer free, not yet committed  |
-| LANE_CHANGE_RIGHT | LANE_KEEP         | the change is done                                    |
-| LANE_CHANGE_RIGHT | LANE_KEEP (abort) | the target lane is no longer free, not yet committed  |
-| TURN_RIGHT, TURN_LEFT, U_TURN | LANE_KEEP | the turn is done (in the exit lane)           |
+1. lane_keep -> lane_change_right: a flat tyre: pull over (right lane, then shoulder), once
+   `route_keep_time` has passed and the lane to the right is free
+2. lane_keep -> turn_right: the route turns right at the junction being entered
+3. lane_keep -> turn_left: the route turns left there
+4. lane_keep -> u_turn: the route turns back there
+5. lane_keep -> lane_change_right: the route needs a lane to the right and it is free
+6. lane_keep -> lane_change_left: the route needs a lane to the left and it is free
+7. lane_keep -> lane_change_left: overtaking allowed, the lane blocked, the left free,
+   `keep_time` since the last change, and the route needs no other lane
+8. lane_keep -> lane_change_right: overtaking allowed, the lane blocked, only the right free
+   (as above)
+9. lane_change_left, lane_change_right -> lane_keep: the change is done (in the target lane)
+10. lane_change_left, lane_change_right -> lane_keep: abort: the target lane is no longer
+    free, not yet committed
+11. turn_right, turn_left, u_turn -> lane_keep: the turn is done (in the exit lane)
 
-Rows are tried top to bottom. A flat tyre comes first and stops everything else: the car
-moves right lane by lane (`right_free` then means the next lane, or the paved shoulder from
+For the state the car is in, the rows that leave it are tried in this order (`TABLE`, as
+data) and the first that holds is taken. A flat tyre comes first and stops everything else:
+the car moves right lane by lane (`right_free` then means the next lane, or the paved shoulder from
 lane 0) and stays on the shoulder. Out of LANE_KEEP, route needs come before overtaking, and
 overtaking waits `keep_time` after the last change (no weaving); a route lane change waits
 `route_keep_time` only.
@@ -39,6 +41,8 @@ from __future__ import annotations
 
 import enum
 from dataclasses import dataclass
+
+from planner.fsm.machine import Row, Table, Transition, next_state, render
 
 
 class Motion(enum.Enum):
@@ -87,48 +91,106 @@ class MotionInput:
     pull_over: bool = False  # a flat tyre: get onto the shoulder
 
 
-@dataclass(frozen=True, slots=True)
-class MotionChange:
-    to: Motion
-    reason: str
-    abort: bool = False  # a lane change given up: back in the origin lane
+def _waited(x: MotionInput) -> float:
+    """[s] since the last motion change."""
+    return x.t - x.since
 
 
-def transition(state: Motion, x: MotionInput, p: MotionParams) -> MotionChange | None:
-    """The change of state for input `x`, or None to stay (see the module doc's table)."""
-    if state is Motion.LANE_KEEP:
-        return _from_lane_keep(x, p)
-    if state in LANE_CHANGES:
-        if x.change_done:
-            return MotionChange(Motion.LANE_KEEP, "in the target lane")
-        if not x.target_free and not x.committed:
-            return MotionChange(Motion.LANE_KEEP, "the target lane is no longer free: abort",
-                                abort=True)
-        return None
-    if x.turn_done:
-        return MotionChange(Motion.LANE_KEEP, "the turn is done")
-    return None
+def _route_holds(x: MotionInput, p: MotionParams) -> bool:
+    """The route needs another lane now: the car waits for it rather than overtake away."""
+    return bool(x.route_lane) and _waited(x) >= p.route_keep_time
 
 
-def _from_lane_keep(x: MotionInput, p: MotionParams) -> MotionChange | None:
-    if x.pull_over:
-        if x.right_free and x.t - x.since >= p.route_keep_time:
-            return MotionChange(Motion.LANE_CHANGE_RIGHT, "a flat tyre: pull over")
-        return None
-    if x.turn is not None:
-        return MotionChange(_TURN_STATE[x.turn], f"the route turns {x.turn.value} here")
-    waited = x.t - x.since
-    if x.route_lane and waited >= p.route_keep_time:
-        if x.route_lane < 0 and x.right_free:
-            return MotionChange(Motion.LANE_CHANGE_RIGHT, "the route needs a lane to the right")
-        if x.route_lane > 0 and x.left_free:
-            return MotionChange(Motion.LANE_CHANGE_LEFT, "the route needs a lane to the left")
-        return None  # wait in lane for the gap: do not overtake away from the route
-    if not (x.overtake and x.blocked) or waited < p.keep_time:
-        return None
-    if x.left_free:
-        return MotionChange(Motion.LANE_CHANGE_LEFT, "a slower vehicle ahead, the left lane free")
-    if x.right_free:
-        return MotionChange(Motion.LANE_CHANGE_RIGHT,
-                            "a slower vehicle ahead, only the right lane free")
-    return None
+def _free_to_choose(x: MotionInput) -> bool:
+    """No flat tyre and no turn: the route and overtaking may move the car."""
+    return not x.pull_over and x.turn is None
+
+
+def _pull_over(_m: Motion, x: MotionInput, p: MotionParams) -> bool:
+    return x.pull_over and x.right_free and _waited(x) >= p.route_keep_time
+
+
+class _Turns:
+    def __init__(self, turn: Turn) -> None:
+        self.turn = turn
+
+    def __call__(self, _m: Motion, x: MotionInput, _p: MotionParams) -> bool:
+        return not x.pull_over and x.turn is self.turn
+
+
+def _route_right(_m: Motion, x: MotionInput, p: MotionParams) -> bool:
+    return _free_to_choose(x) and _route_holds(x, p) and x.route_lane < 0 and x.right_free
+
+
+def _route_left(_m: Motion, x: MotionInput, p: MotionParams) -> bool:
+    return _free_to_choose(x) and _route_holds(x, p) and x.route_lane > 0 and x.left_free
+
+
+def _may_overtake(x: MotionInput, p: MotionParams) -> bool:
+    return (_free_to_choose(x) and not _route_holds(x, p) and x.overtake and x.blocked
+            and _waited(x) >= p.keep_time)
+
+
+def _overtake_left(_m: Motion, x: MotionInput, p: MotionParams) -> bool:
+    return _may_overtake(x, p) and x.left_free
+
+
+def _overtake_right(_m: Motion, x: MotionInput, p: MotionParams) -> bool:
+    return _may_overtake(x, p) and x.right_free
+
+
+def _change_done(_m: Motion, x: MotionInput, _p: MotionParams) -> bool:
+    return x.change_done
+
+
+def _abort(_m: Motion, x: MotionInput, _p: MotionParams) -> bool:
+    return not x.target_free and not x.committed
+
+
+def _turn_done(_m: Motion, x: MotionInput, _p: MotionParams) -> bool:
+    return x.turn_done
+
+
+M = Motion
+_KEEP = frozenset({M.LANE_KEEP})
+
+TABLE: Table[Motion, MotionInput, MotionParams] = Table(Motion, (
+    Row(_KEEP, M.LANE_CHANGE_RIGHT, _pull_over,
+        "a flat tyre: pull over (right lane, then shoulder), once `route_keep_time` has "
+        "passed and the lane to the right is free", "a flat tyre: pull over"),
+    Row(_KEEP, M.TURN_RIGHT, _Turns(Turn.RIGHT),
+        "the route turns right at the junction being entered", "the route turns right here"),
+    Row(_KEEP, M.TURN_LEFT, _Turns(Turn.LEFT), "the route turns left there",
+        "the route turns left here"),
+    Row(_KEEP, M.U_TURN, _Turns(Turn.U_TURN), "the route turns back there",
+        "the route turns u_turn here"),
+    Row(_KEEP, M.LANE_CHANGE_RIGHT, _route_right,
+        "the route needs a lane to the right and it is free",
+        "the route needs a lane to the right"),
+    Row(_KEEP, M.LANE_CHANGE_LEFT, _route_left,
+        "the route needs a lane to the left and it is free",
+        "the route needs a lane to the left"),
+    Row(_KEEP, M.LANE_CHANGE_LEFT, _overtake_left,
+        "overtaking allowed, the lane blocked, the left free, `keep_time` since the last "
+        "change, and the route needs no other lane",
+        "a slower vehicle ahead, the left lane free"),
+    Row(_KEEP, M.LANE_CHANGE_RIGHT, _overtake_right,
+        "overtaking allowed, the lane blocked, only the right free (as above)",
+        "a slower vehicle ahead, only the right lane free"),
+    Row(LANE_CHANGES, M.LANE_KEEP, _change_done, "the change is done (in the target lane)",
+        "in the target lane"),
+    Row(LANE_CHANGES, M.LANE_KEEP, _abort,
+        "abort: the target lane is no longer free, not yet committed",
+        "the target lane is no longer free: abort"),
+    Row(TURNS, M.LANE_KEEP, _turn_done, "the turn is done (in the exit lane)",
+        "the turn is done"),
+))
+
+
+def transition(state: Motion, x: MotionInput, p: MotionParams) -> Transition[Motion] | None:
+    """The change of state for input `x`, or None to stay (`TABLE`)."""
+    return next_state(TABLE, state, x, p)
+
+
+if __name__ == "__main__":  # print the table for the module doc
+    print(render(TABLE))

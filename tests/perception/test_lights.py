@@ -44,7 +44,10 @@ from world.scene import traffic_light
 from world.spec import ActorSpec, ActorType, RoadSpec, SegmentSpec, TrafficLightSpec
 
 ROAD = RoadSpec(segments=(SegmentSpec(700.0, 0.0, 2, 1, 3.5, 2.5),), speed_limit=50.0 / 3.6)
-MAIN = light_head(build_road_map(ROAD), TrafficLightSpec(100.0, 20.0, 3.0, 20.0, 0.0))
+MAIN_LIGHT = TrafficLightSpec(100.0, 20.0, 3.0, 20.0, 0.0)
+MAP = build_road_map(replace(ROAD, features=(MAIN_LIGHT,)))  # MAIN is the map's only light
+MAIN = light_head(MAP, MAIN_LIGHT)
+FRONT = 2.4  # [m] the car's centre to its front bumper
 AWAY = replace(MAIN, x=MAIN.x + 150.0, facing=0.0)  # lamps point along the route
 LOW = replace(MAIN, x=MAIN.x + 300.0, z=2.8)  # a low post-mounted head, a red car under it
 LEFT = LightHead(MAIN.x + 30.0, 8.0, 3.5, math.pi)  # left of the road, facing the traffic
@@ -85,7 +88,7 @@ def render(scene: LightScene) -> Render:
 
 @pytest.fixture(scope="module")
 def detector() -> TrafficLightDetector:
-    return TrafficLightDetector(front_camera())
+    return TrafficLightDetector(front_camera(), MAP, FRONT)
 
 
 def lamp_pixel(ego: EgoState, head: LightHead, colour: LightColour) -> tuple[float, float]:
@@ -111,6 +114,25 @@ def test_housing_size_is_the_world_models() -> None:
         assert place == pytest.approx(0.5 - traffic_light.LAMP_HEIGHT[colour] / HOUSING_HEIGHT)
 
 
+# ---- which heads: the map's -----------------------------------------------------------------
+
+
+def _pose_at(x: float) -> EgoState:
+    return EgoState(0.0, x, 0.0, 0.0, 10.0, 0.0, 0.0, 0.1)
+
+
+def test_the_detector_looks_for_the_maps_lights_ahead_of_the_bumper() -> None:
+    detector = TrafficLightDetector(front_camera(), MAP, FRONT)
+    line = MAIN_LIGHT.s
+    assert detector.heads_ahead(_pose_at(line - FRONT - 30.0)) == [(0, MAIN)]
+    assert detector.heads_ahead(_pose_at(line - FRONT - 59.5)) == [(0, MAIN)]  # 60 m: in
+    assert detector.heads_ahead(_pose_at(line - FRONT - 60.5)) == []  # beyond 60 m
+    assert detector.heads_ahead(_pose_at(line - FRONT + 0.5)) == [(0, MAIN)]  # just over
+    assert detector.heads_ahead(_pose_at(line - FRONT + 2.0)) == []  # over it: not any more
+    no_lights = TrafficLightDetector(front_camera(), build_road_map(ROAD), FRONT)
+    assert no_lights.heads_ahead(_pose_at(50.0)) == []
+
+
 # ---- rendered frames ------------------------------------------------------------------------
 
 
@@ -120,7 +142,11 @@ def test_lit_colour_is_found_at_10_to_50_m(
     detector: TrafficLightDetector, render: Render, colour: LightColour, distance: float,
 ) -> None:
     frame, ego = render(0, distance, colour)
-    (found,) = detector.detect(frame, ego, [(7, MAIN)])
+    (found,) = detector.detect_heads(frame, ego, [(7, MAIN)])
+    # the map's light 0 is looked for until the bumper is over its stop line (12 m before
+    # the head: at 10 m from the head, the car is past it)
+    ahead = MAIN_LIGHT.s - (ego.x + FRONT) > -1.0
+    assert detector.detect(frame, ego) == ((replace(found, light=0),) if ahead else ())
     assert found.colour is colour
     assert found.light == 7
     assert found.t == frame.t
@@ -144,7 +170,7 @@ def test_pose_error_of_0_3_m_and_1_deg_is_tolerated(
     c, s = math.cos(ego.heading), math.sin(ego.heading)
     wrong = replace(ego, x=ego.x + c * forward - s * left, y=ego.y + s * forward + c * left,
                     heading=ego.heading + math.radians(heading))
-    (found,) = detector.detect(frame, wrong, [(0, MAIN)])
+    (found,) = detector.detect_heads(frame, wrong, [(0, MAIN)])
     assert found.colour is colour
 
 
@@ -155,12 +181,13 @@ def test_a_light_facing_away_is_not_detected(
     """Its lamps point along the route: the detector does not look, and there is nothing
     to see (the lamps are culled from behind)."""
     frame, ego = render(1, distance, LightColour.GREEN)
-    assert detector.detect(frame, ego, [(1, AWAY)]) == ()
+    assert detector.detect_heads(frame, ego, [(1, AWAY)]) == ()
     assert head_view(detector.camera, ego, AWAY, detector.params) is None
     looking = LightParams(max_facing=math.pi)
     view = head_view(detector.camera, ego, AWAY, looking)
     assert view is not None
-    blobs, hsv = TrafficLightDetector(detector.camera, looking).lamp_blobs(frame.rgb, view)
+    looking_detector = TrafficLightDetector(detector.camera, MAP, FRONT, looking)
+    blobs, hsv = looking_detector.lamp_blobs(frame.rgb, view)
     assert blobs == []
     assert (hsv[..., 2] <= 60).sum() > 10  # the housing's back was in the region
 
@@ -173,16 +200,16 @@ def test_a_light_outside_the_image_is_not_detected(
     it, behind the camera."""
     frame, ego = render(0, distance, LightColour.RED)
     assert head_view(detector.camera, ego, MAIN, detector.params) is None
-    assert detector.detect(frame, ego, [(0, MAIN)]) == ()
+    assert detector.detect_heads(frame, ego, [(0, MAIN)]) == ()
 
 
 def test_a_light_beyond_max_range_is_not_looked_for(
     detector: TrafficLightDetector, render: Render,
 ) -> None:
     frame, ego = render(0, 65.0, LightColour.RED)
-    assert detector.detect(frame, ego, [(0, MAIN)]) == ()
-    near = TrafficLightDetector(detector.camera, LightParams(max_range=70.0))
-    (found,) = near.detect(frame, ego, [(0, MAIN)])
+    assert detector.detect_heads(frame, ego, [(0, MAIN)]) == ()
+    near = TrafficLightDetector(detector.camera, MAP, FRONT, LightParams(max_range=70.0))
+    (found,) = near.detect_heads(frame, ego, [(0, MAIN)])
     assert found.colour is LightColour.RED
 
 
@@ -202,7 +229,7 @@ def test_a_red_car_under_a_green_light_does_not_turn_it_red(
     assert hsv[..., 1][car].max() < detector.params.min_saturation
     blobs, _ = detector.lamp_blobs(frame.rgb, view)
     assert {b.colour for b in blobs} == {LightColour.GREEN}
-    (found,) = detector.detect(frame, ego, [(2, LOW)])
+    (found,) = detector.detect_heads(frame, ego, [(2, LOW)])
     assert found.colour is LightColour.GREEN
 
 
@@ -216,7 +243,7 @@ def test_a_cross_street_head_seen_side_on_does_not_lend_its_colour(
     view = head_view(detector.camera, ego, MAIN, detector.params)
     assert view is not None
     blobs, _ = detector.lamp_blobs(frame.rgb, view)
-    (found,) = detector.detect(frame, ego, [(0, MAIN)])
+    (found,) = detector.detect_heads(frame, ego, [(0, MAIN)])
     assert found.colour is LightColour.RED, [b.colour for b in blobs]
 
 
@@ -224,7 +251,7 @@ def test_two_lights_come_nearest_first(detector: TrafficLightDetector, render: R
     """From 10 m before the main light, the one left of the road 30 m further on is in view
     too; the one facing away and the one beyond range are not reported."""
     frame, ego = render(0, 10.0, LightColour.YELLOW)
-    found = detector.detect(frame, ego, [(3, LEFT), (1, AWAY), (2, LOW), (0, MAIN)])
+    found = detector.detect_heads(frame, ego, [(3, LEFT), (1, AWAY), (2, LOW), (0, MAIN)])
     assert [d.light for d in found] == [0, 3]
     assert [d.colour for d in found] == [LightColour.YELLOW] * 2
     assert found[0].range < found[1].range
@@ -233,13 +260,14 @@ def test_two_lights_come_nearest_first(detector: TrafficLightDetector, render: R
 def test_frames_of_another_camera_are_refused(detector: TrafficLightDetector) -> None:
     cam = replace(front_camera(), name="left")
     with pytest.raises(ValueError, match="camera"):
-        detector.detect(CameraFrame(0.0, cam, np.zeros((480, 640, 3), np.uint8)),
-                        ego_at(MAIN.x - 20.0, 0.0, 0.0), [(0, MAIN)])
+        detector.detect_heads(CameraFrame(0.0, cam, np.zeros((480, 640, 3), np.uint8)),
+                              ego_at(MAIN.x - 20.0, 0.0, 0.0), [(0, MAIN)])
 
 
 def test_black_frame_has_no_light(detector: TrafficLightDetector) -> None:
     frame = CameraFrame(0.0, front_camera(), np.zeros((480, 640, 3), np.uint8))
-    assert detector.detect(frame, ego_at(MAIN.x - 20.0, 0.0, 0.0), [(0, MAIN)]) == ()
+    assert detector.detect_heads(frame, ego_at(MAIN.x - 20.0, 0.0, 0.0), [(0, MAIN)]) == ()
+    assert detector.detect(frame, ego_at(MAIN.x - 20.0, 0.0, 0.0)) == ()
 
 
 # ---- the pure helpers -----------------------------------------------------------------------

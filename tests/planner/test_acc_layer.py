@@ -8,10 +8,10 @@ import math
 import numpy as np
 import pytest
 
-from planner.acc_control import SpeedRef
 from planner.acc_layer import AccLayer
 from planner.fsm.acc import r157_min_gap
-from planner.messages import Lead
+from planner.messages import Lead, SpeedSource
+from planner.speed import PlannedSpeed, SpeedRef
 
 DT = 1.0 / 40.0  # [s] planner tick
 TAU = 0.5  # [s] speed-loop lag of the point mass
@@ -26,7 +26,11 @@ def drive(lead_speed: list[float], v0: float, gap0: float, set_speed: float,
     for k, vl in enumerate(lead_speed):
         t = k * DT
         lead = Lead(track_id=1, t=t - 0.1, gap=gap - (vl - v) * 0.1, speed=vl)  # 100 ms old
-        ref, changes = acc.update(t, DT, v, set_speed, limit, SpeedRef(set_speed, 0.0), lead)
+        plan = PlannedSpeed(SpeedRef(set_speed, 0.0), SpeedSource.SET_SPEED)
+        result, changes = acc.update(t, DT, v, set_speed, limit, plan, lead)
+        ref = result.speed.ref
+        assert (result.speed.source is SpeedSource.FOLLOWING) == bool(ref.speed < set_speed)
+        assert result.lead_gap == pytest.approx(gap)  # carried from the track's time to now
         modes += [c.target for c in changes]
         # the speed loop: the feed-forward, plus the lag on the reference it leaves behind
         a = float(np.clip(ref.accel + (ref.speed - v - ref.accel * DT) / TAU, -6.0, 3.0))

@@ -8,12 +8,17 @@ from dataclasses import replace
 import pytest
 
 from perception.messages import ObjectClass, Track
-from planner.acc_control import AccControlParams, SpeedRef, pass_speed, stop_speed
+from planner.acc_control import AccControlParams, pass_speed, stop_speed
 from planner.acc_layer import AccLayer
 from planner.events import EventMonitor, EventParams, Events
-from planner.fsm.acc import AccMode
+from planner.fsm.acc import AccEvent, AccMode
+from planner.messages import SpeedSource
+from planner.speed import PlannedSpeed, SpeedRef
 from tests.roads import KPH, W, make_map, seg
 from world.hdmap import Crosswalk, SpeedBump, StopSign, Zone
+
+FLAT, OFF_RAMP, PEDESTRIAN = AccEvent.FLAT, AccEvent.OFF_RAMP, AccEvent.PEDESTRIAN
+SPEED_BUMP, STOP_SIGN = AccEvent.SPEED_BUMP, AccEvent.STOP_SIGN
 
 P = EventParams()
 FEATURES = (StopSign(200.0), SpeedBump(300.0, 0.1, 0.9, 5 * KPH), Crosswalk(400.0, 4.0))
@@ -33,72 +38,81 @@ def at(m: EventMonitor, station: float, v: float = 8.0, t: float = 0.0,
 
 def test_a_stop_sign_counts_once_perception_confirmed_it_until_the_stop_is_done() -> None:
     m = EventMonitor(ROAD, P)
-    assert not at(m, 150.0).stop_sign  # not seen yet
+    assert not at(m, 150.0).holds(STOP_SIGN)  # not seen yet
     m.confirm_sign(200.0)
     e = at(m, 150.0)
-    assert e.stop_sign and e.stop_distance == pytest.approx(200.0 - 152.4 - 0.5)
-    assert not at(m, 100.0).stop_sign  # 97.6 m before the line: beyond the approach at 8 m/s
+    assert e.holds(STOP_SIGN) and e.stop_distance == pytest.approx(200.0 - 152.4 - 0.5)
+    assert not at(m, 100.0).holds(STOP_SIGN)  # 97.6 m before the line: beyond the approach at 8 m/s
     standing = 200.0 - 2.4 - 1.5  # front bumper 1.5 m before the line
-    assert at(m, standing, v=0.0, t=10.0).stop_sign
-    assert at(m, standing, v=0.0, t=11.4).stop_sign
-    assert not at(m, standing, v=0.0, t=11.6).stop_sign  # stood 1.5 s: done, go
-    assert not at(m, standing + 2.0, v=3.0, t=12.0).stop_sign
+    assert at(m, standing, v=0.0, t=10.0).holds(STOP_SIGN)
+    assert at(m, standing, v=0.0, t=11.4).holds(STOP_SIGN)
+    assert not at(m, standing, v=0.0, t=11.6).holds(STOP_SIGN)  # stood 1.5 s: done, go
+    assert not at(m, standing + 2.0, v=3.0, t=12.0).holds(STOP_SIGN)
 
 
 def test_a_bump_from_its_approach_until_the_rear_axle_is_past() -> None:
     m = EventMonitor(ROAD, P)
     e = at(m, 270.0, v=10.0)
     near = 300.0 - 0.45
-    assert e.speed_bump and e.bump_speed == pytest.approx(4.5 * KPH)
+    assert e.holds(SPEED_BUMP) and e.bump_speed == pytest.approx(4.5 * KPH)
     assert e.bump_distance == pytest.approx(near - 1.0 - (270.0 + 1.35))
-    assert at(m, 300.0 + 0.45 + 1.0 + 1.35 - 0.01, v=1.4).speed_bump
-    assert not at(m, 300.0 + 0.45 + 1.0 + 1.35 + 0.01, v=1.4).speed_bump
+    assert at(m, 300.0 + 0.45 + 1.0 + 1.35 - 0.01, v=1.4).holds(SPEED_BUMP)
+    assert not at(m, 300.0 + 0.45 + 1.0 + 1.35 + 0.01, v=1.4).holds(SPEED_BUMP)
 
 
 def test_a_pedestrian_on_or_walking_into_the_crossing_in_the_lane() -> None:
     m = EventMonitor(ROAD, P)
     on = at(m, 370.0, tracks=(walker(402.0, 0.5),))
-    assert on.pedestrian and on.stop_distance == pytest.approx(400.0 - 372.4 - 1.0)
-    assert not at(m, 370.0, tracks=(walker(402.0, -6.0),)).pedestrian  # on the pavement
+    assert on.holds(PEDESTRIAN) and on.stop_distance == pytest.approx(400.0 - 372.4 - 1.0)
+    assert not at(m, 370.0, tracks=(walker(402.0, -6.0),)).holds(PEDESTRIAN)  # on the pavement
     into = at(m, 370.0, tracks=(walker(402.0, -4.0, vy=1.4),))  # 2.8 m closer in 2 s
-    assert into.pedestrian
-    assert not at(m, 370.0, tracks=(walker(402.0, 4.0 + W, vy=1.4),)).pedestrian  # walking off
-    assert not at(m, 370.0, tracks=(walker(420.0, 0.0),)).pedestrian  # not at the crossing
-    assert not at(m, 398.0, tracks=(walker(402.0, 0.5),)).pedestrian  # already on it: go on
+    assert into.holds(PEDESTRIAN)
+    off = at(m, 370.0, tracks=(walker(402.0, 4.0 + W, vy=1.4),))  # walking off
+    assert not off.holds(PEDESTRIAN)
+    assert not at(m, 370.0, tracks=(walker(420.0, 0.0),)).holds(PEDESTRIAN)  # not at the crossing
+    assert not at(m, 398.0, tracks=(walker(402.0, 0.5),)).holds(PEDESTRIAN)  # already on it: go on
 
 
 def test_the_ramp_zone_is_the_off_ramp() -> None:
     m = EventMonitor(ROAD, P)
-    assert not at(m, 490.0).off_ramp and at(m, 510.0).off_ramp
+    assert not at(m, 490.0).holds(OFF_RAMP) and at(m, 510.0).holds(OFF_RAMP)
 
 
 C = AccControlParams()
+PLAN = PlannedSpeed(SpeedRef(12.0, 0.0), SpeedSource.LIMIT)  # the map's plan
 
 
 @pytest.mark.parametrize(("events", "mode", "speed"), [
-    (Events(stop_sign=True, stop_distance=20.0), AccMode.STOP_SIGN, stop_speed(20.0, 12.0, C)),
-    (Events(pedestrian=True, stop_distance=8.0), AccMode.PEDESTRIAN, stop_speed(8.0, 12.0, C)),
-    (Events(speed_bump=True, bump_distance=15.0, bump_speed=1.3), AccMode.SPEED_BUMP,
-     pass_speed(15.0, 1.3, 12.0, C)),
-    (Events(off_ramp=True), AccMode.OFF_RAMP, 12.0),
+    (Events(active=frozenset({STOP_SIGN}), stop_distance=20.0), AccMode.STOP_SIGN,
+     stop_speed(20.0, 12.0, C)),
+    (Events(active=frozenset({PEDESTRIAN}), stop_distance=8.0), AccMode.PEDESTRIAN,
+     stop_speed(8.0, 12.0, C)),
+    (Events(active=frozenset({SPEED_BUMP}), bump_distance=15.0, bump_speed=1.3),
+     AccMode.SPEED_BUMP, pass_speed(15.0, 1.3, 12.0, C)),
+    (Events(active=frozenset({OFF_RAMP})), AccMode.OFF_RAMP, 12.0),
 ])
 def test_the_event_modes_and_their_laws(events: Events, mode: AccMode, speed: float) -> None:
     layer = AccLayer()
-    layer.update(0.0, 0.025, 10.0, 15.0, 20.0, SpeedRef(12.0, 0.0), None)  # on: cruise
-    ref, changes = layer.update(0.025, 0.025, 10.0, 15.0, 20.0, SpeedRef(12.0, 0.0), None,
+    layer.update(0.0, 0.025, 10.0, 15.0, 20.0, PLAN, None)  # on: cruise
+    out, changes = layer.update(0.025, 0.025, 10.0, 15.0, 20.0, PLAN, None,
                                 events=events)
     assert layer.mode is mode and changes[0].target == mode.value
-    assert ref.speed == pytest.approx(speed)
+    assert out.speed.ref.speed == pytest.approx(speed)
+    # the event's law set the speed where it is below the plan's (the ramp: the plan's)
+    expected = SpeedSource.EVENT if speed < PLAN.ref.speed else PLAN.source
+    assert out.speed.source is expected
 
 
 def test_flat_eases_to_a_crawl_then_stops_once_pulled_over() -> None:
     layer = AccLayer()
-    layer.update(0.0, 0.025, 10.0, 15.0, 20.0, SpeedRef(12.0, 0.0), None)
+    layer.update(0.0, 0.025, 10.0, 15.0, 20.0, PLAN, None)
     v, t = 10.0, 0.0
     for k in range(800):
         t += 0.025
-        ref, _ = layer.update(t, 0.025, v, 15.0, 20.0, SpeedRef(12.0, 0.0), None,
-                              events=Events(flat=True, pulled_over=k >= 400))
+        out, _ = layer.update(t, 0.025, v, 15.0, 20.0, PLAN, None,
+                              events=Events(active=frozenset({FLAT}), pulled_over=k >= 400))
+        ref = out.speed.ref
+        assert out.speed.source is SpeedSource.EVENT
         assert ref.speed <= v and ref.accel >= -C.a_flat
         v = ref.speed
         if k == 399:  # 10 s on: crawling while it pulls over

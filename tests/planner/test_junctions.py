@@ -8,11 +8,14 @@ import math
 import pytest
 
 from perception.messages import LightDetection, ObjectClass, Track
+from planner.fsm.acc import AccEvent
 from planner.junctions import JunctionMonitor, JunctionParams
 from world.hdmap import LightColour, Manoeuvre, RoadMap
 from world.map.road import build_road_map
 from world.map.town import TownLayout, compile_route
 from world.spec import TownSpec
+
+GIVE_WAY, RED_LIGHT = AccEvent.GIVE_WAY, AccEvent.RED_LIGHT
 
 P = JunctionParams()
 LIGHTS = TownLayout(TownSpec(3, 2, 90.0, 2, 3.5, 40 / 3.6, "traffic_lights"))
@@ -68,7 +71,7 @@ def test_the_light_rules(colour: LightColour | None, before_line: float, v: floa
         m.see_lights([seen(colour, -0.1)])
         m.see_lights([seen(colour)])
     e = m.update(0.5, front_at(m, before_line), v)
-    assert e.red_light is stops
+    assert e.holds(RED_LIGHT) is stops
     assert e.light is colour
     if stops:
         assert e.stop_distance == pytest.approx(before_line - P.stop_margin)
@@ -77,24 +80,22 @@ def test_the_light_rules(colour: LightColour | None, before_line: float, v: floa
 def test_a_yellow_decision_to_go_holds_when_it_turns_red() -> None:
     m = JunctionMonitor(route(LIGHTS, Manoeuvre.STRAIGHT), P)
     m.see_lights([seen(LightColour.YELLOW, 0.0)])
-    assert not m.update(0.0, front_at(m, 12.0), 11.0).red_light
+    assert not m.update(0.0, front_at(m, 12.0), 11.0).holds(RED_LIGHT)
     m.see_lights([seen(LightColour.RED, 1.0)])
-    assert not m.update(1.0, front_at(m, 2.0), 11.0).red_light
+    assert not m.update(1.0, front_at(m, 2.0), 11.0).holds(RED_LIGHT)
 
 
 def test_a_colour_seen_too_long_ago_is_not_trusted() -> None:
     m = JunctionMonitor(route(LIGHTS, Manoeuvre.STRAIGHT), P)
     green(m, 0.0)
     # unread again: 8 m is within 5^2 / 6 + 5 = 9.2 m, where an unread light is stopped for
-    assert m.update(P.light_memory + 0.5, front_at(m, 8.0), 5.0).red_light
+    assert m.update(P.light_memory + 0.5, front_at(m, 8.0), 5.0).holds(RED_LIGHT)
 
 
 def test_the_light_over_the_line_is_no_longer_looked_at() -> None:
     m = JunctionMonitor(route(LIGHTS, Manoeuvre.STRAIGHT), P)
     m.see_lights([seen(LightColour.RED)])
-    assert not m.update(0.0, front_at(m, -0.5), 5.0).red_light
-    assert m.heads_ahead(front_at(m, 30.0)) == [(0, m.heads[0])]
-    assert m.heads_ahead(front_at(m, -2.0)) == []
+    assert not m.update(0.0, front_at(m, -0.5), 5.0).holds(RED_LIGHT)
 
 
 def oncoming(m: JunctionMonitor, distance: float, speed: float) -> Track:
@@ -121,8 +122,8 @@ def test_a_left_turn_waits_for_a_close_oncoming_car(manoeuvre: Manoeuvre, distan
     m = JunctionMonitor(route(LIGHTS, manoeuvre), P)
     green(m)
     e = m.update(0.0, front_at(m, 10.0), 6.0, [oncoming(m, distance, speed)])
-    assert e.give_way is waits
-    assert not e.red_light
+    assert e.holds(GIVE_WAY) is waits
+    assert not e.holds(RED_LIGHT)
     if waits:
         assert e.stop_distance == pytest.approx(10.0 - P.stop_margin)
 
@@ -130,7 +131,7 @@ def test_a_left_turn_waits_for_a_close_oncoming_car(manoeuvre: Manoeuvre, distan
 def test_once_over_the_line_the_turn_is_committed() -> None:
     m = JunctionMonitor(route(LIGHTS, Manoeuvre.LEFT), P)
     green(m)
-    assert not m.update(0.0, front_at(m, -1.0), 3.0, [oncoming(m, 20.0, 10.0)]).give_way
+    assert not m.update(0.0, front_at(m, -1.0), 3.0, [oncoming(m, 20.0, 10.0)]).holds(GIVE_WAY)
 
 
 @pytest.mark.parametrize(
@@ -149,14 +150,14 @@ def test_giving_way_is_decided_while_the_car_can_still_stop(
     m = JunctionMonitor(route(LIGHTS, Manoeuvre.LEFT), P)
     green(m)
     e = m.update(0.0, front_at(m, before_line), v, [oncoming(m, 30.0, 10.0)])
-    assert e.give_way is gives_way
+    assert e.holds(GIVE_WAY) is gives_way
 
 
 def test_once_committed_a_closing_gap_does_not_stop_the_car() -> None:
     m = JunctionMonitor(route(LIGHTS, Manoeuvre.LEFT), P)
     green(m)
-    assert not m.update(0.0, front_at(m, 2.0), 5.0).give_way  # no one coming; past its point
-    assert not m.update(0.1, front_at(m, 1.5), 5.0, [oncoming(m, 30.0, 10.0)]).give_way
+    assert not m.update(0.0, front_at(m, 2.0), 5.0).holds(GIVE_WAY)  # no one coming; past its point
+    assert not m.update(0.1, front_at(m, 1.5), 5.0, [oncoming(m, 30.0, 10.0)]).holds(GIVE_WAY)
 
 
 def test_a_car_already_waiting_goes_on_waiting_however_close_to_the_line() -> None:
@@ -165,8 +166,8 @@ def test_a_car_already_waiting_goes_on_waiting_however_close_to_the_line() -> No
     m = JunctionMonitor(route(LIGHTS, Manoeuvre.LEFT), P)
     green(m)
     car_coming = [oncoming(m, 30.0, 10.0)]
-    assert m.update(0.0, front_at(m, 12.0), 6.0, car_coming).give_way
-    assert m.update(0.1, front_at(m, 1.0), 2.0, car_coming).give_way
+    assert m.update(0.0, front_at(m, 12.0), 6.0, car_coming).holds(GIVE_WAY)
+    assert m.update(0.1, front_at(m, 1.0), 2.0, car_coming).holds(GIVE_WAY)
 
 
 @pytest.mark.parametrize(
@@ -178,32 +179,32 @@ def test_at_a_stop_sign_the_car_waits_for_the_box_to_clear(vx: float, vy: float,
     m = JunctionMonitor(route(STOPS, Manoeuvre.STRAIGHT), P)
     j = m.road.junctions[0]
     e = m.update(0.0, front_at(m, 1.0), 0.0, [car(j.x + 1.0, j.y - 2.0, vx, vy)])
-    assert e.give_way is waits
-    assert not m.update(0.0, front_at(m, 1.0), 0.0, []).give_way
+    assert e.holds(GIVE_WAY) is waits
+    assert not m.update(0.0, front_at(m, 1.0), 0.0, []).holds(GIVE_WAY)
     assert math.isinf(m.update(0.0, front_at(m, 1.0), 0.0, []).stop_distance)
 
 
 def test_an_unread_light_once_stopped_for_stays_so_until_read() -> None:
     m = JunctionMonitor(route(LIGHTS, Manoeuvre.STRAIGHT), P)
-    assert m.update(0.0, front_at(m, 25.0), 11.0).red_light
-    assert m.update(0.1, front_at(m, 24.0), 8.0).red_light  # slower: still stopping for it
+    assert m.update(0.0, front_at(m, 25.0), 11.0).holds(RED_LIGHT)
+    assert m.update(0.1, front_at(m, 24.0), 8.0).holds(RED_LIGHT)  # slower: still stopping for it
     green(m, 0.2)
-    assert not m.update(0.2, front_at(m, 23.0), 8.0).red_light
+    assert not m.update(0.2, front_at(m, 23.0), 8.0).holds(RED_LIGHT)
 
 
 def test_a_red_light_missed_for_a_while_is_still_stopped_for() -> None:
     m = JunctionMonitor(route(LIGHTS, Manoeuvre.STRAIGHT), P)
     m.see_lights([seen(LightColour.RED, 0.0)])
-    assert m.update(0.0, front_at(m, 55.0), 11.0).red_light
-    assert m.update(3.0, front_at(m, 50.0), 10.0).red_light  # not seen for 3 s, far away
+    assert m.update(0.0, front_at(m, 55.0), 11.0).holds(RED_LIGHT)
+    assert m.update(3.0, front_at(m, 50.0), 10.0).holds(RED_LIGHT)  # not seen for 3 s, far away
 
 
 def test_one_green_frame_does_not_let_the_car_go_through_a_red() -> None:
     m = JunctionMonitor(route(LIGHTS, Manoeuvre.STRAIGHT), P)
     m.see_lights([seen(LightColour.RED, 0.0)])
     m.see_lights([seen(LightColour.GREEN, 0.1)])  # a false green in one frame
-    assert m.update(0.15, front_at(m, 30.0), 8.0).red_light
+    assert m.update(0.15, front_at(m, 30.0), 8.0).holds(RED_LIGHT)
     m.see_lights([seen(LightColour.RED, 0.2)])
     m.see_lights([seen(LightColour.GREEN, 0.3)])
     m.see_lights([seen(LightColour.GREEN, 0.4)])  # it did turn green
-    assert not m.update(0.45, front_at(m, 30.0), 8.0).red_light
+    assert not m.update(0.45, front_at(m, 30.0), 8.0).holds(RED_LIGHT)

@@ -1,4 +1,4 @@
-"""The lane-keeping planner: station, lateral error, path window and speed target."""
+"""The planner's tick: station, lateral error, path window, speed target and what set it."""
 
 from __future__ import annotations
 
@@ -7,8 +7,9 @@ import math
 import numpy as np
 import pytest
 
-from perception.messages import EgoState
-from planner.planner import LaneKeepingParams, LaneKeepingPlanner
+from perception.messages import EgoState, PlannerInput
+from planner.messages import SpeedSource
+from planner.planner import Planner, PlannerParams
 from planner.speed_planning import Binding, SpeedPlanner
 from tests.planner.maps import KPH, real_map, road_spec, segment, straight_road
 from world.hdmap import RoadMap
@@ -24,17 +25,16 @@ def ego_on(road: RoadMap, lane: int, s: float, r: float, speed: float, t: float 
 
 
 def planner(road: RoadMap, lane: int = 1, set_kph: float = 80.0,
-            camera: bool = False) -> LaneKeepingPlanner:
+            camera: bool = False) -> Planner:
     """The map-only planner by default (these tests are about the map path and speed)."""
-    return LaneKeepingPlanner(road, LaneKeepingParams(set_kph * KPH, 180.0 * KPH, lane=lane,
-                                                      camera=camera))
+    return Planner(road, PlannerParams(set_kph * KPH, 180.0 * KPH, lane=lane, camera=camera))
 
 
 def test_plan_on_an_arc() -> None:
     road = real_map(road_spec([segment(100.0), segment(200.0, 60.0), segment(100.0)], 100.0))
     p = planner(road)
     ego = ego_on(road, 1, 150.0, 0.4, 20.0, t=3.5)
-    plan = p.update(ego)
+    plan = p.update(PlannerInput(ego))
     assert plan.t == 3.5
     assert plan.ego is ego
     assert plan.station == pytest.approx(150.0)
@@ -53,21 +53,24 @@ def test_plan_on_an_arc() -> None:
     assert plan.target_accel == 0.0
     assert plan.speed_limit == pytest.approx(100.0 * KPH)
     assert p.speed_for(150.0).binding is Binding.CURVE
+    assert plan.speed_source is SpeedSource.CURVE
 
 
 @pytest.mark.parametrize("kind", KINDS)
 def test_plan_on_a_straight(kind: str) -> None:
     road = straight_road(kind, 1000.0, 50.0, ((400.0, 30.0),))
     p = planner(road, lane=0)
-    plan = p.update(ego_on(road, 0, 200.0, -0.25, 3.0))
+    plan = p.update(PlannerInput(ego_on(road, 0, 200.0, -0.25, 3.0)))
     assert plan.station == pytest.approx(200.0)
     assert plan.lateral_error == pytest.approx(-0.25)
     assert plan.path.xy[0, 0] == pytest.approx(195.0)
     assert plan.path.xy[-1, 0] == pytest.approx(225.0)  # at least 25 m ahead
     assert plan.target_speed == pytest.approx(49.7 * KPH)
     assert plan.speed_limit == pytest.approx(50.0 * KPH)
-    ahead = p.update(ego_on(road, 0, 400.0 - 2.4 - 20.0, 0.0, 13.8))
+    assert plan.speed_source is SpeedSource.LIMIT
+    ahead = p.update(PlannerInput(ego_on(road, 0, 400.0 - 2.4 - 20.0, 0.0, 13.8)))
     assert ahead.target_accel == -1.5
+    assert ahead.speed_source is SpeedSource.LIMIT  # braking towards the lower posting
     assert ahead.speed_limit == pytest.approx(50.0 * KPH)
 
 
@@ -82,7 +85,7 @@ def test_closed_loop_point_mass_through_posting(kind: str) -> None:
     dt = 1.0 / 40.0
     s, v, t = 100.0, 49.7 * KPH, 0.0
     while s < 420.0:
-        plan = p.update(ego_on(road, 1, s, 0.0, v, t))
+        plan = p.update(PlannerInput(ego_on(road, 1, s, 0.0, v, t)))
         assert v - plan.target_speed <= (1.5 + 0.02) * dt  # decel <= a_comf + small
         if plan.station + 2.4 >= sign:
             assert plan.target_speed <= 30.0 * KPH
@@ -95,4 +98,4 @@ def test_closed_loop_point_mass_through_posting(kind: str) -> None:
 def test_rejects_oncoming_lane() -> None:
     road = straight_road("real", 100.0, 50.0)
     with pytest.raises(ValueError, match="ego-direction"):
-        LaneKeepingPlanner(road, LaneKeepingParams(10.0, 20.0, lane=-1))
+        Planner(road, PlannerParams(10.0, 20.0, lane=-1))

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import subprocess
 import sys
 from collections.abc import Callable
@@ -167,3 +168,28 @@ def test_results_match_golden(result: RunResult,
                  "normal_driving.25s")
     golden.check(run_scenario("normal_driving", record=False, profile=None),
                  "normal_driving.profile_none")
+
+
+def test_each_machine_and_the_speed_source_is_a_lane_in_the_recording(
+        result: RunResult) -> None:
+    """A state lane per machine of the plan (`planner.messages.MACHINES`), each starting
+    from its initial state at t = 0; the speed source follows the log tick by tick."""
+    from rerun.chunk import RrdReader
+
+    from planner.messages import MACHINES
+
+    assert result.recording is not None
+    store = RrdReader(result.recording).store()
+    for machine in MACHINES:
+        chunks = store.stream().filter(content=f"/fsm/{machine}",
+                                       components="StateChange:state").to_chunks()
+        rows = [(t, v[0]) for c in chunks for b in (c.to_record_batch(),)
+                for t, v in zip(b.column("sim_time").to_pylist(),
+                                b.column("StateChange:state").to_pylist(), strict=True)]
+        rows.sort(key=lambda r: r[0])
+        assert rows and rows[0][0].total_seconds() == 0.0, machine
+        if machine == "speed_source":
+            sources = [s.value for s in result.log.speed_source]
+            changes = [sources[0]] + [b for a, b in itertools.pairwise(sources) if a != b]
+            assert [v for _, v in rows] == changes
+    assert {s.value for s in result.log.speed_source} >= {"limit", "curve"}

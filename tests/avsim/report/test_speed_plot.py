@@ -25,6 +25,7 @@ from avsim.report import speed_plot as plot
 from avsim.run.runner import RunResult, TrajectoryLog
 from avsim.scenario.load import load_scenario
 from planner.fsm.acc import AccMode
+from planner.messages import SpeedSource
 from world.spec import ActorType
 
 REPO = Path(__file__).parents[3]
@@ -32,12 +33,15 @@ TRAFFIC_JAM = REPO / "scenarios" / "traffic_jam.yaml"
 RATE = 40.0  # [Hz] control ticks
 DURATION = 60.0  # [s]
 LANE_WIDTH = 3.5  # [m] traffic_jam's
-MODES = ((0.0, "cruise"), (20.0, "trail"), (40.0, "brake"), (45.0, "speed_limit"))
+MODES = ((0.0, AccMode.CRUISE), (20.0, AccMode.TRAIL), (40.0, AccMode.BRAKE),
+         (45.0, AccMode.SPEED_LIMIT))
+SOURCES = {AccMode.CRUISE: SpeedSource.SET_SPEED, AccMode.TRAIL: SpeedSource.FOLLOWING,
+           AccMode.BRAKE: SpeedSource.FOLLOWING, AccMode.SPEED_LIMIT: SpeedSource.LIMIT}
 LEAD_LEAVES = 50.0  # [s] the lead moves to lane 1
 EXIT_BAD_INPUT = 2
 
 
-def _mode_at(t: float) -> str:
+def _mode_at(t: float) -> AccMode:
     return [m for start, m in MODES if t >= start][-1]
 
 
@@ -58,6 +62,7 @@ def synthetic_result(passed: bool = True) -> RunResult:
         log.lane.append(0)
         log.speed_limit.append(50 / 3.6)
         log.acc_mode.append(_mode_at(t))
+        log.speed_source.append(SOURCES[_mode_at(t)])
         lead_offset = 0.0 if t < LEAD_LEAVES else LANE_WIDTH
         log.actor_station.append(np.array([lead_s, beside_s]))
         log.actor_offset.append(np.array([lead_offset, LANE_WIDTH]))
@@ -97,7 +102,8 @@ def test_lead_speed_without_vehicles_is_all_nan() -> None:
 
 
 def test_mode_runs_cover_the_run_without_gaps() -> None:
-    runs = plot.mode_runs([0.0, 1.0, 2.0, 3.0], ["cruise", "cruise", "trail", "cruise"])
+    c, t = AccMode.CRUISE, AccMode.TRAIL
+    runs = plot.mode_runs([0.0, 1.0, 2.0, 3.0], [c, c, t, c])
     assert runs == [("cruise", 0.0, 2.0), ("trail", 2.0, 3.0), ("cruise", 3.0, 4.0)]
     assert plot.mode_runs([], []) == []
 
@@ -105,6 +111,8 @@ def test_mode_runs_cover_the_run_without_gaps() -> None:
 def test_every_acc_mode_has_its_own_colour() -> None:
     assert set(plot.MODE_COLOURS) == {m.value for m in AccMode}
     assert len(set(plot.MODE_COLOURS.values())) == len(AccMode)
+    assert set(plot.SOURCE_COLOURS) == {s.value for s in SpeedSource}
+    assert len(set(plot.SOURCE_COLOURS.values())) == len(SpeedSource)
 
 
 def _band_pixels(png: np.ndarray, colour: str) -> int:
@@ -125,17 +133,24 @@ def test_plot_writes_a_png_of_the_expected_size_with_mode_bands(tmp_path: Path) 
     assert png.shape[:2] == (700, 1600)
     # each mode of the run covers a band of the plot (thousands of pixels; its legend
     # patch alone is a few hundred), the modes it never had do not appear at all
-    for mode in {m for _, m in MODES}:
+    for mode in {m.value for _, m in MODES}:
         assert _band_pixels(png, plot.MODE_COLOURS[mode]) > 5_000, mode
-    for mode in set(plot.MODE_COLOURS) - {m for _, m in MODES}:
+    for mode in set(plot.MODE_COLOURS) - {m.value for _, m in MODES}:
         assert _band_pixels(png, plot.MODE_COLOURS[mode]) < 50, mode
+    # the speed-source strip: a band per source the run had (a few hundred pixels: the strip
+    # is ~45 px high), none for the others
+    for source in {s.value for s in SOURCES.values()}:
+        assert _band_pixels(png, plot.SOURCE_COLOURS[source]) > 1_000, source
+    for source in set(plot.SOURCE_COLOURS) - {s.value for s in SOURCES.values()}:
+        assert _band_pixels(png, plot.SOURCE_COLOURS[source]) < 50, source
 
 
 def test_figure_title_axes_and_legends() -> None:
     fig = plot.speed_profile_figure(synthetic_result(passed=False))
-    ax = fig.axes[0]
+    ax, strip = fig.axes
     assert ax.get_title() == "traffic_jam (traffic_jam): FAIL (min_gap)"
-    assert ax.get_xlabel() == "time [s]" and ax.get_ylabel() == "speed [km/h]"
+    assert strip.get_xlabel() == "time [s]" and ax.get_ylabel() == "speed [km/h]"
+    assert strip.get_ylabel() == "speed set by"
     assert [line.get_label() for line in ax.get_lines()] == [
         "ego speed", "lead speed", "posted limit", "set speed"]
     ego, lead, limit, set_speed = (line.get_ydata() for line in ax.get_lines())
@@ -145,6 +160,7 @@ def test_figure_title_axes_and_legends() -> None:
     assert np.isnan(lead).any() and np.isfinite(lead).any()  # gaps in the lead's line
     legends = [[text.get_text() for text in legend.get_texts()] for legend in fig.legends]
     assert ["cruise", "trail", "brake", "speed limit"] in legends
+    assert ["set speed", "limit", "following"] in legends
     assert ax.get_xlim() == pytest.approx((0.0, DURATION))
 
 

@@ -1,6 +1,6 @@
-"""The DECS ACC / event layer: the gaps, and every transition of its chart as a table row
-(Table 2 of the paper and the completions the module doc lists), with rows that must not
-fire beside them."""
+"""The DECS ACC / event layer: the gaps, and every transition of its chart (`TABLE`: Table 2
+of the paper and the completions the module doc lists) walked row by row, with inputs that
+must not fire beside them; the module doc shows the table as it is in the data."""
 
 from __future__ import annotations
 
@@ -9,9 +9,13 @@ from dataclasses import replace
 
 import pytest
 
+from planner.fsm import acc
 from planner.fsm.acc import (
     ACC_ACTIVE,
     EDACC,
+    EVENT_MODE,
+    TABLE,
+    AccEvent,
     AccInput,
     AccMode,
     AccParams,
@@ -19,6 +23,8 @@ from planner.fsm.acc import (
     r157_min_gap,
     transition,
 )
+from planner.fsm.machine import fired_row
+from tests.planner.fsm.tables import doc_shows_table
 
 P = AccParams()
 M = AccMode
@@ -30,8 +36,10 @@ G = gaps(V, VL, P)  # the gaps behind it
 
 
 def x(**kw: object) -> AccInput:
-    """Defaults: ACC on, 12 m/s, set 15 m/s, limit 20 m/s, no lead, no event."""
-    base = AccInput(acc_on=True, v=V, v_s=15.0, v_gps=20.0)
+    """Defaults: ACC on, 12 m/s, set 15 m/s, limit 20 m/s, no lead, no event; an event by its
+    name (`stop_sign=True`)."""
+    events = frozenset(e for e in AccEvent if kw.pop(e.value, False))
+    base = AccInput(acc_on=True, v=V, v_s=15.0, v_gps=20.0, events=events)
     return replace(base, **kw)  # type: ignore[arg-type]
 
 
@@ -61,7 +69,7 @@ CLOSE = G.d_min - 1.0
 FAR = G.d_max + 5.0
 
 # (name, from, input, expected next mode or None to stay)
-TABLE = [
+TABLE_CASES = [
     # ACC_OFF <-> ACC_ON
     ("off_on", M.ACC_OFF, x(), M.CRUISE),
     ("off_stays_off", M.ACC_OFF, x(acc_on=False), None),
@@ -138,7 +146,8 @@ TABLE = [
 ]
 
 
-@pytest.mark.parametrize(("name", "state", "inp", "expected"), TABLE, ids=[r[0] for r in TABLE])
+@pytest.mark.parametrize(("name", "state", "inp", "expected"), TABLE_CASES,
+                         ids=[r[0] for r in TABLE_CASES])
 def test_transition_table(name: str, state: AccMode, inp: AccInput,
                           expected: AccMode | None) -> None:
     change = transition(state, inp, P)
@@ -147,9 +156,34 @@ def test_transition_table(name: str, state: AccMode, inp: AccInput,
         assert change.reason
 
 
+@pytest.mark.parametrize("k", range(len(TABLE.rows)), ids=[f"row_{k + 1}" for k in
+                                                            range(len(TABLE.rows))])
+def test_every_row_of_the_table_is_walked(k: int) -> None:
+    """Each row of the data fires for at least one case above, from a state it leaves, with
+    its own target and reason (a row added to the table needs a case here)."""
+    row = TABLE.rows[k]
+    walked = [name for name, state, inp, _ in TABLE_CASES
+              if fired_row(TABLE, state, inp, gaps(inp.v, inp.v_l, P)) is row]
+    assert walked, f"no case walks row {k + 1}: {row.when}"
+    for name, state, inp, expected in TABLE_CASES:
+        if name in walked:
+            change = transition(state, inp, P)
+            assert change is not None and change.to is row.target is expected
+            assert change.reason == row.reason_for(inp, gaps(inp.v, inp.v_l, P))
+
+
+def test_the_module_doc_shows_the_table_of_the_data() -> None:
+    assert doc_shows_table(acc, TABLE, acc.source_names)
+
+
+def test_each_event_has_its_mode_and_every_event_mode_its_event() -> None:
+    assert set(EVENT_MODE) == set(AccEvent)
+    assert set(EVENT_MODE.values()) == EDACC
+
+
 def test_every_state_is_left_and_entered_in_the_table() -> None:
-    sources = {row[1] for row in TABLE}
-    targets = {row[3] for row in TABLE if row[3] is not None}
+    sources = {row[1] for row in TABLE_CASES}
+    targets = {row[3] for row in TABLE_CASES if row[3] is not None}
     assert sources == set(AccMode)
     assert targets == set(AccMode)
     assert ACC_ACTIVE | EDACC | {AccMode.ACC_OFF} == set(AccMode)
@@ -160,5 +194,6 @@ def test_every_state_is_left_and_entered_in_the_table() -> None:
               (M.BRAKE, M.SPEED_BUMP), (M.SPEED_LIMIT, M.CRUISE), (M.SPEED_LIMIT, M.TRAIL),
               (M.OFF_RAMP, M.CRUISE), (M.OFF_RAMP, M.STOP_SIGN), (M.PEDESTRIAN, M.CRUISE),
               (M.SPEED_BUMP, M.CRUISE), (M.SPEED_BUMP, M.FLAT), (M.SPEED_BUMP, M.PEDESTRIAN)}
-    edges = {(row[1], row[3]) for row in TABLE if row[3] is not None}
+    edges = {(row[1], row[3]) for row in TABLE_CASES if row[3] is not None}
     assert table2 <= edges
+    assert edges <= TABLE.edges  # every case's change is an edge of the data

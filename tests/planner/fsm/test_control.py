@@ -8,8 +8,10 @@ from dataclasses import replace
 
 import pytest
 
+from planner.fsm import control
 from planner.fsm.control import (
     EDGES,
+    TABLE,
     ControlInput,
     ControlParams,
     ControlState,
@@ -17,6 +19,7 @@ from planner.fsm.control import (
     time_to_collision,
     transition,
 )
+from tests.planner.fsm.tables import doc_shows_table, unwalked_rows
 
 P = ControlParams()
 S = ControlState
@@ -88,7 +91,7 @@ def test_state_values() -> None:
 
 
 # (name, from, input, expected next state or None to stay)
-TABLE = [
+TABLE_CASES = [
     # any but EMERGENCY_STOP -> EMERGENCY_STOP, moving only
     ("stop_estop_a", STOP, x(v=0.3, v_target=0.0, a_required=6.0), ESTOP),
     ("stop_estop_ttc", STOP, x(v=P.v_stopped, v_target=0.0, ttc=0.5), ESTOP),
@@ -172,7 +175,8 @@ TABLE = [
 ]
 
 
-@pytest.mark.parametrize(("name", "state", "inp", "expected"), TABLE, ids=[r[0] for r in TABLE])
+@pytest.mark.parametrize(("name", "state", "inp", "expected"), TABLE_CASES,
+                         ids=[r[0] for r in TABLE_CASES])
 def test_transition_table(name: str, state: ControlState, inp: ControlInput,
                           expected: ControlState | None) -> None:
     change = transition(state, inp, P)
@@ -192,11 +196,20 @@ EXPECTED_EDGES = {
 
 
 def test_every_transition_has_a_row() -> None:
-    edges = {(row[1], row[3]) for row in TABLE if row[3] is not None}
+    edges = {(row[1], row[3]) for row in TABLE_CASES if row[3] is not None}
     assert edges == EXPECTED_EDGES
     assert EDGES == EXPECTED_EDGES  # the module's rules allow exactly these
-    stays = {row[1] for row in TABLE if row[3] is None}
+    stays = {row[1] for row in TABLE_CASES if row[3] is None}
     assert stays == set(S)  # every state has rows that must not fire
+
+
+def test_the_cases_walk_every_row_of_the_data() -> None:
+    cases = [(state, inp, expected) for _, state, inp, expected in TABLE_CASES]
+    assert unwalked_rows(TABLE, cases, lambda _: P) == []
+
+
+def test_the_module_doc_shows_the_table_of_the_data() -> None:
+    assert doc_shows_table(control, TABLE)
 
 
 def test_no_state_changes_to_itself() -> None:

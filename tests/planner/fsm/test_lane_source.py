@@ -4,13 +4,21 @@ from __future__ import annotations
 
 import pytest
 
-from planner.fsm.lane_source import LaneSource, LaneSourceInput, LaneSourceParams, transition
+from planner.fsm import lane_source
+from planner.fsm.lane_source import (
+    TABLE,
+    LaneSource,
+    LaneSourceInput,
+    LaneSourceParams,
+    transition,
+)
+from tests.planner.fsm.tables import doc_shows_table, unwalked_rows
 
 P = LaneSourceParams()
 S = LaneSource
 
 # (state, t, confidence, since) -> next state (None: stay); near a junction: JUNCTION_TABLE
-TABLE = [
+TABLE_CASES = [
     # ACQUIRING
     (S.ACQUIRING, 0.2, P.acquire, 0.0, S.CAMERA),
     (S.ACQUIRING, 0.2, P.acquire - 0.01, 0.0, None),
@@ -49,7 +57,7 @@ JUNCTION_TABLE = [
 ]
 
 
-@pytest.mark.parametrize(("state", "t", "confidence", "since", "expected"), TABLE)
+@pytest.mark.parametrize(("state", "t", "confidence", "since", "expected"), TABLE_CASES)
 def test_transition_table(state: LaneSource, t: float, confidence: float, since: float,
                           expected: LaneSource | None) -> None:
     change = transition(state, LaneSourceInput(t, confidence, since), P)
@@ -66,7 +74,7 @@ def test_junction_table(state: LaneSource, confidence: float, junction: bool,
 
 
 def test_every_state_and_edge_of_the_table_is_covered() -> None:
-    edges = {(row[0], row[4]) for row in TABLE if row[4] is not None}
+    edges = {(row[0], row[4]) for row in TABLE_CASES if row[4] is not None}
     edges |= {(row[0], row[3]) for row in JUNCTION_TABLE if row[3] is not None}
     assert edges == {(S.ACQUIRING, S.CAMERA), (S.ACQUIRING, S.MAP_HOLD),
                      (S.CAMERA, S.MAP_HOLD), (S.MAP_HOLD, S.CAMERA),
@@ -74,4 +82,16 @@ def test_every_state_and_edge_of_the_table_is_covered() -> None:
                      *((s, S.JUNCTION) for s in (S.CAMERA, S.MAP_HOLD, S.STOP_IN_LANE,
                                                  S.ACQUIRING)),
                      (S.JUNCTION, S.CAMERA), (S.JUNCTION, S.ACQUIRING)}
-    assert {row[0] for row in TABLE} | {row[0] for row in JUNCTION_TABLE} == set(LaneSource)
+    assert {row[0] for row in TABLE_CASES} | {row[0] for row in JUNCTION_TABLE} == set(LaneSource)
+
+
+def test_the_cases_walk_every_row_of_the_data() -> None:
+    cases = [(state, LaneSourceInput(t, confidence, since), expected)
+             for state, t, confidence, since, expected in TABLE_CASES]
+    cases += [(state, LaneSourceInput(100.0, confidence, 99.0, junction), expected)
+              for state, confidence, junction, expected in JUNCTION_TABLE]
+    assert unwalked_rows(TABLE, cases, lambda _: P) == []
+
+
+def test_the_module_doc_shows_the_table_of_the_data() -> None:
+    assert doc_shows_table(lane_source, TABLE)

@@ -6,7 +6,10 @@ from dataclasses import replace
 
 import pytest
 
-from planner.fsm.motion import Motion, MotionInput, MotionParams, Turn, transition
+from planner.fsm import motion
+from planner.fsm.machine import fired_row
+from planner.fsm.motion import TABLE, Motion, MotionInput, MotionParams, Turn, transition
+from tests.planner.fsm.tables import doc_shows_table, unwalked_rows
 
 P = MotionParams()
 M = Motion
@@ -19,7 +22,7 @@ def x(**kw: object) -> MotionInput:
 
 
 # (name, from, input, expected next state or None to stay, abort)
-TABLE = [
+TABLE_CASES = [
     # LANE_KEEP -> pull over (a flat tyre), before anything else
     ("keep_pull_over", M.LANE_KEEP, x(pull_over=True, right_free=True), M.LANE_CHANGE_RIGHT,
      False),
@@ -79,22 +82,38 @@ TABLE = [
 ]
 
 
-@pytest.mark.parametrize(("name", "state", "inp", "expected", "abort"), TABLE,
-                         ids=[r[0] for r in TABLE])
+ABORT = next(row for row in TABLE.rows if row.when.startswith("abort"))
+
+
+@pytest.mark.parametrize(("name", "state", "inp", "expected", "abort"), TABLE_CASES,
+                         ids=[r[0] for r in TABLE_CASES])
 def test_transition_table(name: str, state: Motion, inp: MotionInput, expected: Motion | None,
                           abort: bool) -> None:
     change = transition(state, inp, P)
     assert (change.to if change else None) is expected, name
     if change is not None:
-        assert change.reason and change.abort is abort
+        assert change.reason
+        assert (fired_row(TABLE, state, inp, P) is ABORT) is abort
+        assert abort is (not inp.change_done and state is not M.LANE_KEEP
+                         and state in {M.LANE_CHANGE_LEFT, M.LANE_CHANGE_RIGHT})
+
+
+def test_the_cases_walk_every_row_of_the_data() -> None:
+    cases = [(state, inp, expected) for _, state, inp, expected, _ in TABLE_CASES]
+    assert unwalked_rows(TABLE, cases, lambda _: P) == []
+
+
+def test_the_module_doc_shows_the_table_of_the_data() -> None:
+    assert doc_shows_table(motion, TABLE)
 
 
 def test_every_transition_of_the_table_has_a_row() -> None:
-    pairs = {(row[1], row[3]) for row in TABLE if row[3] is not None}
+    pairs = {(row[1], row[3]) for row in TABLE_CASES if row[3] is not None}
     assert pairs == {
         (M.LANE_KEEP, M.TURN_RIGHT), (M.LANE_KEEP, M.TURN_LEFT), (M.LANE_KEEP, M.U_TURN),
         (M.LANE_KEEP, M.LANE_CHANGE_LEFT), (M.LANE_KEEP, M.LANE_CHANGE_RIGHT),
         (M.LANE_CHANGE_LEFT, M.LANE_KEEP), (M.LANE_CHANGE_RIGHT, M.LANE_KEEP),
         (M.TURN_RIGHT, M.LANE_KEEP), (M.TURN_LEFT, M.LANE_KEEP), (M.U_TURN, M.LANE_KEEP),
     }
-    assert {row[1] for row in TABLE} == set(Motion)
+    assert {row[1] for row in TABLE_CASES} == set(Motion)
+    assert pairs == TABLE.edges
