@@ -24,6 +24,8 @@ import numpy as np
 from avsim.record.recorder import Recorder
 from avsim.scenario.load import load_scenario
 from planner.speed_planning import SpeedPlanner, SpeedPlanningParams
+from vehicle_urdf import read_geometry
+from world.ego.body import vehicle_info
 from world.map.road import build_road_map
 from world.spec import RoadSpec, SegmentSpec
 from world.world import World
@@ -55,7 +57,8 @@ def projection() -> float:
 def speed_planner() -> float:
     spec = load_scenario("normal_driving")
     road = build_road_map(spec.road)
-    planner = SpeedPlanner(road, road.lane(0), SpeedPlanningParams())
+    planner = SpeedPlanner(road, road.lane(0), SpeedPlanningParams(),
+                           vehicle_info(read_geometry()))
     stations = iter(np.tile(np.linspace(0.0, road.length, 1000), 20).tolist())
     return best_per_call(lambda: planner.target(next(stations), set_speed=13.9,
                                                 max_speed=15.0), 2000)

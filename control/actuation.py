@@ -25,10 +25,11 @@ GRAVITY = 9.81  # [m/s^2]
 
 @dataclass(frozen=True, slots=True)
 class VehicleParams:
-    """The car as the longitudinal inverse model sees it (defaults: the 1500 kg URDF car)."""
+    """The car as the longitudinal inverse model sees it (mass and wheel from its
+    `CarGeometry`)."""
 
-    mass: float = 1500.0  # [kg] total, with wheels
-    wheel_radius: float = 0.33  # [m] rolling radius
+    mass: float  # [kg] total, with wheels
+    wheel_radius: float  # [m] rolling radius
     rolling_resistance: float = 0.012  # [-] rolling resistance coefficient c_rr
     drag_area: float = 0.7  # [m^2] drag coefficient times frontal area, CdA
     air_density: float = 1.225  # [kg/m^3] sea level, 15 degC

@@ -27,9 +27,10 @@ Steps of `SpeedController.update` (all along the car's forward axis):
 
 The first step after `reset()` ramps from 0 m/s^2.
 
-Emergency stop (the planner's control FSM in EMERGENCY_STOP): the request is
--`emergency_decel` at once, under the wider `emergency_jerk` (the brake's own rise rate), the
-PID is reset; afterwards the jerk limit takes the request on from where it is.
+Emergency stop (the planner's control FSM in EMERGENCY_STOP): the request is the plan's
+feed-forward (its emergency deceleration, `planner.limits.A_EMERGENCY`) at once, under the
+wider `emergency_jerk` (the brake's own rise rate), the PID is reset; afterwards the jerk
+limit takes the request on from where it is.
 """
 
 from __future__ import annotations
@@ -65,7 +66,6 @@ class SpeedParams:
     stop_target_speed: float = 0.05  # [m/s] a target at or below this means "stop"
     standstill_speed: float = 0.3  # [m/s] below this (with a stop target) the car holds
     hold_decel: float = 3.0  # [m/s^2] positive, the request while holding (brake only)
-    emergency_decel: float = 8.0  # [m/s^2] positive, the emergency stop's request
     emergency_jerk: float = 40.0  # [m/s^3] its rise rate (full braking in 0.2 s)
 
     @property
@@ -105,12 +105,12 @@ class SpeedController:
     ) -> SpeedCommand:
         """One step: target_speed [m/s], target_accel [m/s^2] feed-forward, speed [m/s]
         measured forward speed, dt [s] -> the acceleration request. `emergency`: brake at
-        `emergency_decel` now (module doc)."""
+        `target_accel` (the plan's emergency deceleration) now (module doc)."""
         p = self.params
         if emergency:
             self._pid.reset()
             step = p.emergency_jerk * dt
-            accel = max(self._accel - step, -p.emergency_decel)
+            accel = max(self._accel - step, target_accel)
             self._accel, self._excess = accel, 0.0
             return SpeedCommand(accel=accel, hold=speed < p.standstill_speed)
         stop_requested = target_speed <= p.stop_target_speed

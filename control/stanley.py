@@ -180,12 +180,16 @@ def front_axle_error(
     )
 
 
+MAX_STEER = 0.61  # [rad] the controller's road-wheel angle limit (~35 deg)
+
+
 @dataclass(frozen=True, slots=True)
 class StanleyParams:
-    """Gains and limits of the Stanley + PID lateral controller (defaults: the 2.7 m car)."""
+    """The car's geometry (from its `CarGeometry`), and the gains and limits of the Stanley +
+    PID lateral controller."""
 
-    wheelbase: float = 2.7  # [m] rear to front axle
-    centre_to_front_axle: float = 1.35  # [m] car centre (the ego x, y) to front axle centre
+    wheelbase: float  # [m] rear to front axle
+    centre_to_front_axle: float  # [m] car centre (the ego x, y) to front axle centre
     kp: float = 2.5  # [1/s] cross-track gain (Hoffmann 2007: k = 2.5); e_fa decays at ~kp
     ki: float = 0.1  # [1/s^2] integral gain: removes offsets the kinematics miss (tyre slip)
     kd: float = 0.0  # [-] derivative gain on de_fa/dt (e_fa is already first order, see doc)
@@ -194,7 +198,7 @@ class StanleyParams:
     k_soft: float = 1.0  # [m/s] softening speed added to v_x (Hoffmann 2007)
     k_ff: float = 0.0  # [-] curvature feed-forward gain on atan(L kappa_p); see module doc
     k_yaw: float = 0.05  # [s] yaw-rate damping gain (Hoffmann 2007)
-    max_steer: float = 0.61  # [rad] road-wheel angle limit (~35 deg)
+    max_steer: float = MAX_STEER  # [rad] road-wheel angle limit
     max_steer_rate: float = 0.9  # [rad/s] steering rate limit (~50 deg/s)
     min_integration_speed: float = 1.0  # [m/s] below this the integrator is frozen
 
@@ -207,8 +211,8 @@ class StanleyParams:
 class StanleyPid:
     """Stanley + PID steering (ICCAS 2020 Eq. 1); see the module docstring for the law."""
 
-    def __init__(self, params: StanleyParams | None = None) -> None:
-        self.params = StanleyParams() if params is None else params
+    def __init__(self, params: StanleyParams) -> None:
+        self.params = params
         self._pid = Pid(self.params.pid)
         self._steer = 0.0  # [rad] previous command, for the rate limit
         self._excess = 0.0  # [rad] previous unlimited minus limited command

@@ -31,16 +31,16 @@ __all__ = ["VehicleController", "VehicleControllerParams"]
 class VehicleControllerParams:
     """Parameters of the three parts."""
 
-    lateral: StanleyParams = field(default_factory=StanleyParams)
+    lateral: StanleyParams
+    vehicle: VehicleParams
     longitudinal: SpeedParams = field(default_factory=SpeedParams)
-    vehicle: VehicleParams = field(default_factory=VehicleParams)
 
 
 class VehicleController:
     """Plan in, `VehicleCommand` out; keeps the path hint index between ticks."""
 
-    def __init__(self, params: VehicleControllerParams | None = None) -> None:
-        self.params = VehicleControllerParams() if params is None else params
+    def __init__(self, params: VehicleControllerParams) -> None:
+        self.params = params
         self.lateral = StanleyPid(self.params.lateral)
         self.longitudinal = SpeedController(self.params.longitudinal)
         self._path: ReferencePath | None = None  # the path `_hint` indexes

@@ -39,7 +39,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from world.frames import Odometry, Wheel
+from world.frames import Odometry, VehicleInfo, Wheel
 
 WHEELS = (Wheel.FRONT_LEFT, Wheel.FRONT_RIGHT, Wheel.REAR_LEFT, Wheel.REAR_RIGHT)  # odometry order
 PARTNER = (1, 0, 3, 2)  # the same axle's other wheel, by index
@@ -48,8 +48,6 @@ MAX_GAP = 0.25  # [s] a longer silence between samples starts the timing afresh
 
 @dataclass(frozen=True, slots=True)
 class FlatTyreParams:
-    track: float = 1.40  # [m] left to right wheel centre (the car's URDF)
-    wheelbase: float = 2.70  # [m] front to rear axle
     excess: float = 0.03  # [-] a wheel's corrected speed over its axle partner's, of the mean
     cross_excess: float = 0.015  # [-] ... and over the other axle's mean
     debounce: float = 0.5  # [s] net candidate time before a tyre is declared flat
@@ -109,7 +107,9 @@ def candidates(speeds: tuple[float, ...], params: FlatTyreParams) -> tuple[bool,
 class FlatTyreDetector:
     """Debounced flat-tyre detection from the wheel speeds (the module docstring)."""
 
-    def __init__(self, params: FlatTyreParams | None = None) -> None:
+    def __init__(self, vehicle: VehicleInfo, params: FlatTyreParams | None = None) -> None:
+        """`vehicle`: the car's track and wheelbase (the turn correction)."""
+        self.vehicle = vehicle
         self.params = params or FlatTyreParams()
         self.reset()
 
@@ -137,7 +137,7 @@ class FlatTyreDetector:
         if not 0.0 < dt <= MAX_GAP:
             return None
         p = self.params
-        speeds = corrected_speeds(odometry, p.track, p.wheelbase)
+        speeds = corrected_speeds(odometry, self.vehicle.track, self.vehicle.wheelbase)
         flags = candidates(speeds, p)
         if flags is None:
             return None

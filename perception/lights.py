@@ -83,7 +83,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from perception.messages import EgoState, LightDetection
-from world.frames import CameraFrame, CameraInfo
+from world.frames import CameraFrame, CameraInfo, VehicleInfo
 from world.hdmap import LightColour, LightHead, RoadMap
 
 HOUSING_WIDTH = 0.35  # [m] (standard size)
@@ -238,13 +238,13 @@ class TrafficLightDetector:
     """Finds the lit lamp of the map's traffic lights in the frames of one camera (see the
     module docstring)."""
 
-    def __init__(self, camera: CameraInfo, road: RoadMap, front_overhang: float,
+    def __init__(self, camera: CameraInfo, road: RoadMap, vehicle: VehicleInfo,
                  params: LightParams | None = None) -> None:
-        """`road`: the HD map whose lights are looked for; `front_overhang` [m]: the car's
-        centre to its front bumper."""
+        """`road`: the HD map whose lights are looked for; `vehicle`: the car's size (the
+        stop lines are measured from its front bumper)."""
         self.camera = camera
         self.road = road
-        self.front_overhang = front_overhang
+        self.vehicle = vehicle
         self.params = params or LightParams()
 
     def heads_ahead(self, ego: EgoState) -> list[tuple[int, LightHead]]:
@@ -252,7 +252,7 @@ class TrafficLightDetector:
         within ``stop_line_ahead`` (an id indexes `RoadMap.traffic_lights`)."""
         p = self.params
         station = float(self.road.local_coordinates(np.array([ego.x, ego.y]))[0])
-        front = station + self.front_overhang
+        front = station + self.vehicle.front_overhang
         return [(i, light.head) for i, light in enumerate(self.road.traffic_lights)
                 if -p.stop_line_behind < light.s - front <= p.stop_line_ahead]
 

@@ -48,17 +48,18 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from planner.limits import A_COMF, A_FIRM, A_FLAT, A_HARD
 from planner.speed import SpeedRef
 
 
 @dataclass(frozen=True, slots=True)
 class AccControlParams:
     k_gap: float = 0.25  # [1/s] trail: gap error to speed
-    a_comf: float = 1.5  # [m/s^2] comfortable deceleration (stops, bumps)
-    a_firm: float = 3.0  # [m/s^2] the most BRAKE plans unless a collision is imminent
-    a_hard: float = 5.0  # [m/s^2] the most BRAKE plans when it is
+    a_comf: float = A_COMF  # [m/s^2] comfortable deceleration (stops, bumps)
+    a_firm: float = A_FIRM  # [m/s^2] the most BRAKE plans unless a collision is imminent
+    a_hard: float = A_HARD  # [m/s^2] the most BRAKE plans when it is
     ttc_hard: float = 2.5  # [s] time to collision below which a_hard is allowed
-    a_flat: float = 4.0  # [m/s^2] the most FLAT may plan (DECS acceptance)
+    a_flat: float = A_FLAT  # [m/s^2] the most FLAT may plan (DECS acceptance)
     a_flat_plan: float = 2.0  # [m/s^2] the deceleration FLAT plans: a gentle stop
     v_pull_over: float = 3.0  # [m/s] FLAT's crawl while the car pulls onto the shoulder
     j_in: float = 4.0  # [m/s^3] how fast a hard deceleration eases in

@@ -22,13 +22,14 @@ from planner.fsm.control import (
     transition,
 )
 from planner.fsm.machine import Machine, StateChange
+from planner.limits import A_EMERGENCY
 from planner.messages import Lead
 
 
 @dataclass(frozen=True, slots=True)
 class ControlLayerParams:
     fsm: ControlParams = field(default_factory=ControlParams)
-    emergency_decel: float = 8.0  # [m/s^2] the emergency stop's deceleration (mu g ~ 9.8)
+    emergency_decel: float = A_EMERGENCY  # [m/s^2] the emergency stop's deceleration
     stop_gap: float = 1.0  # [m] the gap the required deceleration keeps to the lead
 
 

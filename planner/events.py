@@ -35,15 +35,14 @@ import numpy as np
 
 from perception.messages import EgoState, ObjectClass, SignDetection, Track
 from planner.fsm.acc import NO_EVENTS, AccEvent
+from planner.limits import A_COMF
+from world.frames import VehicleInfo
 from world.hdmap import Crosswalk, RoadMap, SpeedBump, StopSign, Zone
 
 
 @dataclass(frozen=True, slots=True)
 class EventParams:
-    front_overhang: float = 2.4  # [m] centre -> front bumper
-    front_axle: float = 1.35  # [m] centre -> front axle
-    rear_axle: float = 1.35  # [m] centre -> rear axle
-    a_comf: float = 1.5  # [m/s^2] approach braking
+    a_comf: float = A_COMF  # [m/s^2] approach braking
     approach_extra: float = 30.0  # [m]
     stop_margin: float = 0.5  # [m] stop this much (+ the controller's margin) before a line
     stopped_speed: float = 0.1  # [m/s]
@@ -76,8 +75,9 @@ class Events:
 class EventMonitor:
     """The events of one run (it remembers the stop lines done and the signs seen)."""
 
-    def __init__(self, road: RoadMap, params: EventParams | None = None) -> None:
-        self.road = road
+    def __init__(self, road: RoadMap, vehicle: VehicleInfo,
+                 params: EventParams | None = None) -> None:
+        self.road, self.vehicle = road, vehicle
         self.params = params if params is not None else EventParams()
         f = road.features
         self.stop_lines = sorted(x.s for x in f if isinstance(x, StopSign))
@@ -113,7 +113,7 @@ class EventMonitor:
         """`station` [m] of the car's centre, `lane_offset` [m] of the lane kept's centre from
         the reference line there, `tracks` the confirmed tracks."""
         p = self.params
-        front = station + p.front_overhang
+        front = station + self.vehicle.front_overhang
         approach = v * v / (2.0 * p.a_comf) + p.approach_extra
         stop = self._stop_sign(t, front, v, approach)
         crossing = self._crossing(front, approach, lane_offset, lane_width, tracks)
@@ -169,7 +169,8 @@ class EventMonitor:
 
     def _bump(self, station: float, approach: float) -> tuple[float, float] | None:
         p = self.params
-        front_axle, rear_axle = station + p.front_axle, station - p.rear_axle
+        v = self.vehicle
+        front_axle, rear_axle = station + v.front_axle, station - v.rear_axle
         for b in self.bumps:
             near, far = b.s - 0.5 * b.length, b.s + 0.5 * b.length
             if rear_axle > far + p.bump_margin:

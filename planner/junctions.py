@@ -19,10 +19,10 @@ from one frame, green (it lets the car go) from two in a row:
 - not seen (or not lately): stop as for red, from the distance the car needs to stop at
   ``yellow_decel`` plus ``unseen_margin`` on (and from then on, while it stays unread): a
   light the camera cannot read is not driven through, and one it reads in time costs
-  nothing. The yellow rule's deceleration, not ``a_comf``, because the camera reads a
-  light from ``light_range`` (60 m) on: at ``a_comf`` a car at 50 km/h would begin to
-  brake 69 m out, before it could see any light; at 3 m/s^2 it is 37 m, and the car reads
-  a light before it must brake for it up to 65 km/h.
+  nothing. The yellow rule's deceleration, not ``a_comf``, because the camera looks for a
+  light from 60 m before its stop line (`perception.lights`): at ``a_comf`` a car at 50 km/h
+  would begin to brake 69 m out, before it could see any light; at 3 m/s^2 it is 37 m, and
+  the car reads a light before it must brake for it up to 65 km/h.
 
 The stop is the ACC layer's stop law at ``L - f - stop_margin`` (event ``red_light``).
 
@@ -52,6 +52,8 @@ import numpy as np
 
 from perception.messages import LightDetection, ObjectClass, Track
 from planner.fsm.acc import NO_EVENTS, AccEvent
+from planner.limits import A_COMF, A_FIRM
+from world.frames import VehicleInfo
 from world.hdmap import (
     Control,
     Junction,
@@ -63,17 +65,15 @@ from world.hdmap import (
 
 @dataclass(frozen=True, slots=True)
 class JunctionParams:
-    front_overhang: float = 2.4  # [m] centre -> front bumper
-    a_comf: float = 1.5  # [m/s^2] approach braking
+    a_comf: float = A_COMF  # [m/s^2] approach braking
     approach_extra: float = 30.0  # [m]
     stop_margin: float = 0.5  # [m] stop this much (+ the controller's margin) before a line
-    light_range: float = 60.0  # [m] lights farther than this are not looked for
     light_memory: float = 1.0  # [s] a light's colour is trusted this long after it was seen
     green_frames_gap: float = 0.25  # [s] two green frames this close confirm green
-    yellow_decel: float = 3.0  # [m/s^2] the yellow rule's "can stop" deceleration
+    yellow_decel: float = A_FIRM  # [m/s^2] the yellow rule's "can stop" deceleration
     unseen_margin: float = 5.0  # [m] an unread light is stopped for from this + braking
     gap_time: float = 6.0  # [s] an oncoming vehicle nearer than this in time is waited for
-    commit_decel: float = 3.0  # [m/s^2] past where it could stop at this, the car goes on
+    commit_decel: float = A_FIRM  # [m/s^2] past where it could stop at this, it goes on
     oncoming_reach: float = 100.0  # [m] how far out along the far arm oncoming traffic counts
     moving: float = 0.5  # [m/s] slower than this towards the box: not coming ...
     near_box: float = 12.0  # [m] ... unless this near it (about to go: a light turning green)
@@ -101,8 +101,9 @@ class _Seen:
 class JunctionMonitor:
     """The junction rules of one run (it remembers the lights seen and yellow decisions)."""
 
-    def __init__(self, road: RoadMap, params: JunctionParams | None = None) -> None:
-        self.road = road
+    def __init__(self, road: RoadMap, vehicle: VehicleInfo,
+                 params: JunctionParams | None = None) -> None:
+        self.road, self.vehicle = road, vehicle
         self.params = params if params is not None else JunctionParams()
         self.lights = road.traffic_lights  # a detection's `light` indexes this
         self._seen: dict[int, _Seen] = {}  # the colour believed, per light
@@ -129,7 +130,7 @@ class JunctionMonitor:
     def update(self, t: float, station: float, v: float,
                tracks: Sequence[Track] = ()) -> JunctionEvents:
         p = self.params
-        front = station + p.front_overhang
+        front = station + self.vehicle.front_overhang
         approach = v * v / (2.0 * p.a_comf) + p.approach_extra
         light_stop, colour = self._light(t, front, v, approach)
         way_stop = self._give_way(front, v, approach, tracks)

@@ -29,6 +29,7 @@ import numpy as np
 
 from perception.messages import Track
 from planner.fsm.acc import AccParams, gaps, r157_min_gap
+from world.frames import VehicleInfo
 from world.hdmap import RoadMap
 
 
@@ -39,8 +40,6 @@ class OccupancyParams:
     rear_reaction: float = 0.4  # [s] t_B, UN R157
     rear_decel: float = 3.0  # [m/s^2] a_rear, UN R157
     rear_time_gap: float = 1.0  # [s] t_G, UN R157
-    ego_front: float = 2.4  # [m] the ego's centre -> front bumper
-    ego_rear: float = 2.4  # [m] the ego's centre -> rear bumper
     block_margin: float = 10.0 / 3.6  # [m/s] slower than wanted by this blocks the lane
 
 
@@ -63,9 +62,10 @@ class LaneTraffic:
 
 
 def lane_traffic(road: RoadMap, tracks: Sequence[Track], t: float, station: float, v: float,
-                 lanes: Sequence[int], p: OccupancyParams) -> dict[int, LaneTraffic]:
-    """The traffic in each of `lanes` (ego-direction lane indices) around the ego at
-    `station` [m] with speed `v` [m/s], now at time `t` [s]."""
+                 lanes: Sequence[int], p: OccupancyParams,
+                 vehicle: VehicleInfo) -> dict[int, LaneTraffic]:
+    """The traffic in each of `lanes` (ego-direction lane indices) around the ego (of
+    `vehicle`'s size) at `station` [m] with speed `v` [m/s], now at time `t` [s]."""
     out = {k: LaneTraffic(k) for k in lanes}
     if not tracks:
         return out
@@ -83,7 +83,8 @@ def lane_traffic(road: RoadMap, tracks: Sequence[Track], t: float, station: floa
             centre, width = float(lane.offset_at(s)), float(lane.width_at(s))
             if abs(d - centre) > 0.5 * width + half_wid - p.overlap:
                 continue
-            out[k] = _add(out[k], Neighbour(tr.id, tr.t, 0.0, speed), ahead, half_len, p)
+            out[k] = _add(out[k], Neighbour(tr.id, tr.t, 0.0, speed), ahead, half_len,
+                          vehicle)
     return out
 
 
@@ -95,15 +96,15 @@ def _half_extent(tr: Track, road_heading: float) -> tuple[float, float]:
 
 
 def _add(lt: LaneTraffic, n: Neighbour, ahead: float, half_len: float,
-         p: OccupancyParams) -> LaneTraffic:
-    if ahead - half_len >= p.ego_front:
-        gap = ahead - half_len - p.ego_front
+         vehicle: VehicleInfo) -> LaneTraffic:
+    if ahead - half_len >= vehicle.front_overhang:
+        gap = ahead - half_len - vehicle.front_overhang
         if lt.ahead is None or gap < lt.ahead.gap:
             return LaneTraffic(lt.lane, Neighbour(n.track_id, n.t, gap, n.speed), lt.behind,
                                lt.alongside)
         return lt
-    if -ahead - half_len >= p.ego_rear:
-        gap = -ahead - half_len - p.ego_rear
+    if -ahead - half_len >= vehicle.rear_overhang:
+        gap = -ahead - half_len - vehicle.rear_overhang
         if lt.behind is None or gap < lt.behind.gap:
             return LaneTraffic(lt.lane, lt.ahead, Neighbour(n.track_id, n.t, gap, n.speed),
                                lt.alongside)

@@ -26,21 +26,21 @@ from world.hdmap import Lane
 @dataclass(frozen=True, slots=True)
 class LeadParams:
     half_width: float = 1.6  # [m] a track is in the lane within this of its centre line
-    front_overhang: float = 2.4  # [m] the ego's centre -> front bumper
     path_reach: float = 60.0  # [m] along a map path, tracks farther ahead are not looked at
 
 
 def select_lead(tracks: Sequence[Track], centre_y: Callable[[float], float],
-                ego_heading: float, p: LeadParams) -> Lead | None:
+                ego_heading: float, p: LeadParams, front_overhang: float) -> Lead | None:
     """The nearest in-lane vehicle ahead; `centre_y(x)` is the lane centre's lateral position
-    [m] at x [m] ahead, in the vehicle frame of the tracks' time."""
+    [m] at x [m] ahead, in the vehicle frame of the tracks' time; `front_overhang` [m] the
+    ego's centre to its front bumper."""
     best: Lead | None = None
     for tr in tracks:
         if tr.cls is ObjectClass.OTHER or tr.rel_x <= 0.0:
             continue
         if abs(tr.rel_y - centre_y(tr.rel_x)) > p.half_width:
             continue
-        gap = tr.rel_x - p.front_overhang - 0.5 * tr.length
+        gap = tr.rel_x - front_overhang - 0.5 * tr.length
         if best is not None and gap >= best.gap:
             continue
         speed = max(0.0, tr.vx * math.cos(ego_heading) + tr.vy * math.sin(ego_heading))
@@ -48,8 +48,8 @@ def select_lead(tracks: Sequence[Track], centre_y: Callable[[float], float],
     return best
 
 
-def route_lead(tracks: Sequence[Track], lane: Lane, station: float,
-               p: LeadParams) -> Lead | None:
+def route_lead(tracks: Sequence[Track], lane: Lane, station: float, p: LeadParams,
+               front_overhang: float) -> Lead | None:
     """The nearest vehicle ahead on the map lane `lane` from the car's centre at `station`
     (the turn path through a town junction; map frame)."""
     vehicles = [tr for tr in tracks if tr.cls is not ObjectClass.OTHER]
@@ -61,7 +61,7 @@ def route_lead(tracks: Sequence[Track], lane: Lane, station: float,
         ahead = float(s_tr) - station
         if not 0.0 < ahead <= p.path_reach or abs(float(r_tr)) > p.half_width:
             continue
-        gap = ahead - p.front_overhang - 0.5 * tr.length
+        gap = ahead - front_overhang - 0.5 * tr.length
         if best is not None and gap >= best.gap:
             continue
         heading = float(lane.heading_at(float(s_tr)))

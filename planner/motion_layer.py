@@ -48,6 +48,7 @@ from planner.lane_occupancy import (
     is_free,
     lane_traffic,
 )
+from world.frames import VehicleInfo
 from world.hdmap import SHOULDER, Junction, RoadMap
 from world.hdmap import Manoeuvre as JunctionManoeuvre
 
@@ -56,7 +57,7 @@ from world.hdmap import Manoeuvre as JunctionManoeuvre
 class MotionLayerParams:
     overtake: bool = False  # the driver allows lane changes to pass slower vehicles
     blocked_time: float = 1.0  # [s] blocked this long before it counts
-    half_width: float = 0.9  # [m] half the ego's width, mirrors included
+    mirrors: float = 0.1  # [m] how far each mirror stands out beyond the body's side
     prepare_distance: float = 150.0  # [m] a lane ending this near ahead is left ...
     prepare_time: float = 12.0  # [s] ... or this many seconds ahead at the present speed
     motion: MotionParams = field(default_factory=MotionParams)
@@ -78,9 +79,9 @@ class Manoeuvre:
 class MotionLayer:
     """Motion state, lane and lane-change path of one run."""
 
-    def __init__(self, road: RoadMap, lane: int, acc: AccParams,
+    def __init__(self, road: RoadMap, lane: int, acc: AccParams, vehicle: VehicleInfo,
                  params: MotionLayerParams | None = None) -> None:
-        self.road = road
+        self.road, self.vehicle = road, vehicle
         self.acc = acc
         self.params = params if params is not None else MotionLayerParams()
         self.machine = Machine("motion", Motion.LANE_KEEP)
@@ -96,7 +97,7 @@ class MotionLayer:
         s, d = (float(a) for a in self.road.local_coordinates((ego.x, ego.y)))
         lanes = self._lanes_around(s, ego.speed, pull_over)
         traffic = lane_traffic(self.road, tracks, ego.t, s, ego.speed, lanes,
-                               self.params.occupancy)
+                               self.params.occupancy, self.vehicle)
         x = self._input(ego, s, d, v_want, traffic, pull_over)
         change = transition(self.machine.state, x, self.params.motion)
         if change is not None:
@@ -207,7 +208,7 @@ class MotionLayer:
             return ()
         lanes = [self.lane]
         origin = self.road.lane(self.origin)
-        clear = 0.5 * float(origin.width_at(s)) + self.params.half_width
+        clear = 0.5 * float(origin.width_at(s)) + 0.5 * self.vehicle.width + self.params.mirrors
         if abs(d - float(origin.offset_at(s))) < clear:
             lanes.append(self.origin)  # the car's body still overlaps the origin lane
         return tuple(n for k in lanes if k in traffic

@@ -52,6 +52,7 @@ from planner.motion_layer import Manoeuvre, MotionLayer, MotionLayerParams
 from planner.route import lane_path
 from planner.speed import BINDING_SOURCE, PlannedSpeed, SpeedRef
 from planner.speed_planning import SpeedPlanner, SpeedPlanningParams, SpeedTarget
+from world.frames import VehicleInfo
 from world.hdmap import SHOULDER, RoadMap
 
 
@@ -59,6 +60,7 @@ from world.hdmap import SHOULDER, RoadMap
 class PlannerParams:
     set_speed: float  # [m/s] the driver's desired (cruise) speed
     max_speed: float  # [m/s] the vehicle's maximum speed
+    vehicle: VehicleInfo  # the car's dimensions
     lane: int = 0  # ego-direction lane index to keep (0 rightmost)
     path_behind: float = 5.0  # [m] path sampled behind the car's centre
     path_ahead_min: float = 25.0  # [m] shortest path ahead of the car's centre
@@ -110,12 +112,12 @@ class Planner:
         self._last_t: float | None = None
         self._keep(p.lane)
         self.acc = AccLayer(p.acc)
-        self.motion = MotionLayer(self.road, p.lane, p.acc.modes, p.motion)
+        self.motion = MotionLayer(self.road, p.lane, p.acc.modes, p.vehicle, p.motion)
         self.control = ControlLayer()
         self.lead_accel = LeadAccel()
         self.driver = DriverOverride(p.override)
-        self.events = EventMonitor(self.road, p.events)
-        self.junctions = JunctionMonitor(self.road, p.junctions)
+        self.events = EventMonitor(self.road, p.vehicle, p.events)
+        self.junctions = JunctionMonitor(self.road, p.vehicle, p.junctions)
         self.hazard = Machine("hazard", HazardLights.OFF)
 
     def _keep(self, lane: int) -> None:
@@ -123,7 +125,8 @@ class Planner:
         self.lane_index = lane
         self.lane = self.road.lane(lane)
         if lane not in self._speed_planners:
-            self._speed_planners[lane] = SpeedPlanner(self.road, self.lane, self.params.speed)
+            self._speed_planners[lane] = SpeedPlanner(self.road, self.lane, self.params.speed,
+                                                      self.params.vehicle)
         self.speed_planner = self._speed_planners[lane]
 
     def localise(self, ego: EgoState) -> tuple[float, float]:
@@ -262,11 +265,13 @@ class Planner:
         if not tracks:
             return None
         if self.source.state is LaneSource.JUNCTION:  # on the map's path through the junction
-            return route_lead(tracks, self.lane, self.localise(ego)[0], self.params.lead)
+            return route_lead(tracks, self.lane, self.localise(ego)[0], self.params.lead,
+                              self.params.vehicle.front_overhang)
         centre: Callable[[float], float] = _straight_ahead
         if view is not None and camera:
             centre = view.estimate.centre_y
-        return select_lead(tracks, centre, ego.heading, self.params.lead)
+        return select_lead(tracks, centre, ego.heading, self.params.lead,
+                           self.params.vehicle.front_overhang)
 
     def near_junction(self, station: float) -> bool:
         """Whether the car's centre is near or in a town junction, where the map's path is

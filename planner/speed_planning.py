@@ -46,6 +46,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from planner.limits import A_COMF
+from world.frames import VehicleInfo
 from world.hdmap import FloatArray, IntArray, Lane, RoadMap
 
 KPH = 1.0 / 3.6  # [m/s per km/h]
@@ -66,13 +68,11 @@ _AHEAD = (Binding.LIMIT_AHEAD, Binding.CURVE_AHEAD)
 
 @dataclass(frozen=True, slots=True)
 class SpeedPlanningParams:
-    a_comf: float = 1.5  # [m/s^2] comfortable deceleration towards constraints ahead
+    a_comf: float = A_COMF  # [m/s^2] comfortable deceleration towards constraints ahead
     a_lat_max: float = 3.0  # [m/s^2] lateral acceleration allowed in curves
     limit_margin: float = 0.3 * KPH  # [m/s] target below a posted limit (see module doc)
     brake_margin: float = 3.0  # [m] the braking curve reaches v_c this far before d = 0
     sample_spacing: float = 0.5  # [m] station step of the curvature samples (map-fixed grid)
-    front_overhang: float = 2.4  # [m] car centre -> front bumper
-    front_axle: float = 1.35  # [m] car centre -> front axle
     min_curvature: float = 1e-6  # [1/m] below this |kappa| the lane is straight (no limit)
 
 
@@ -123,8 +123,9 @@ def _suffix_argmin(values: FloatArray) -> IntArray:
 class SpeedPlanner:
     """The target speed along one lane of a map (see the module doc for the rule)."""
 
-    def __init__(self, road: RoadMap, lane: Lane, params: SpeedPlanningParams) -> None:
-        self.road, self.lane, self.params = road, lane, params
+    def __init__(self, road: RoadMap, lane: Lane, params: SpeedPlanningParams,
+                 vehicle: VehicleInfo) -> None:
+        self.road, self.lane, self.params, self.vehicle = road, lane, params, vehicle
         spacing = params.sample_spacing
         grid = spacing * np.arange(math.floor(road.length / spacing) + 1, dtype=np.float64)
         starts = np.array([p.s0 for p in road.pieces], dtype=np.float64)
@@ -170,8 +171,8 @@ class SpeedPlanner:
         speed, limit, curve now, curve ahead, limit ahead.
         """
         p = self.params
-        s_front = self._station_ahead(s, p.front_overhang)
-        s_axle = self._station_ahead(s, p.front_axle)
+        s_front = self._station_ahead(s, self.vehicle.front_overhang)
+        s_axle = self._station_ahead(s, self.vehicle.front_axle)
         limit_at_front = float(self.road.speed_limit_at(s_front))
         candidates = [
             (set_speed, Binding.SET_SPEED, 0.0),

@@ -25,7 +25,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 __all__ = ["MPS_PER_KPH", "CameraFrame", "CameraInfo", "GnssFix", "LidarInfo", "LidarScan",
-           "Odometry", "SensorMount", "Wheel", "kph", "to_kph", "wrap_angle"]
+           "Odometry", "SensorMount", "VehicleInfo", "Wheel", "kph", "to_kph", "wrap_angle"]
 
 MPS_PER_KPH = 1.0 / 3.6  # [m/s per km/h]
 
@@ -53,6 +53,29 @@ class Wheel(enum.Enum):
     FRONT_RIGHT = "front_right"
     REAR_LEFT = "rear_left"
     REAR_RIGHT = "rear_right"
+
+
+@dataclass(frozen=True, slots=True)
+class VehicleInfo:
+    """The car's own dimensions, as the stack is configured with them (its calibration, like
+    a camera's `CameraInfo`); the world makes it from the URDF's `CarGeometry`."""
+
+    length: float  # [m] body, bumper to bumper
+    width: float  # [m] body, mirrors excluded
+    wheelbase: float  # [m] front to rear axle
+    track: float  # [m] left to right wheel centre
+    front_axle: float  # [m] the car's centre to the front axle
+    rear_axle: float  # [m] the car's centre to the rear axle (a positive distance)
+
+    @property
+    def front_overhang(self) -> float:
+        """[m] the car's centre to its front bumper."""
+        return self.length / 2
+
+    @property
+    def rear_overhang(self) -> float:
+        """[m] the car's centre to its rear bumper."""
+        return self.length / 2
 
 
 @dataclass(frozen=True, slots=True)

@@ -17,9 +17,9 @@ from dataclasses import dataclass
 
 from control.actuation import VehicleParams
 from control.command import VehicleCommand
-from control.stanley import StanleyParams
+from control.stanley import MAX_STEER, StanleyParams
 from control.vehicle_controller import VehicleController, VehicleControllerParams
-from perception.flat_tyre import FlatTyreDetector, FlatTyreParams
+from perception.flat_tyre import FlatTyreDetector
 from perception.lanes import LaneDetector, LaneFilter
 from perception.lights import TrafficLightDetector
 from perception.localization import Localizer
@@ -36,12 +36,11 @@ from perception.messages import (
 from perception.objects import ObjectDetector
 from perception.signs import StopSignDetector
 from perception.tracking import MultiObjectTracker
-from planner.events import EventParams
-from planner.junctions import JunctionParams
 from planner.messages import Plan
 from planner.motion_layer import MotionLayerParams
 from planner.planner import Planner, PlannerParams
 from vehicle_urdf import CarGeometry
+from world.ego.body import vehicle_info
 from world.frames import CameraFrame, CameraInfo, GnssFix, LidarScan, Odometry
 from world.hdmap import RoadMap
 from world.spec import EgoSpec
@@ -74,32 +73,27 @@ class Stack:
                  front_camera: CameraInfo | None = None) -> None:
         """`front_camera`: the camera the lane is found in; None for a map-only stack."""
         self.localizer = Localizer()
+        vehicle = vehicle_info(car)
         self.planner = Planner(
             road, PlannerParams(set_speed=ego.set_speed, max_speed=ego.max_speed,
-                                lane=ego.lane, camera=front_camera is not None,
-                                motion=MotionLayerParams(overtake=ego.overtake),
-                                events=EventParams(front_overhang=car.front_overhang,
-                                                   front_axle=car.front_axle,
-                                                   rear_axle=car.rear_axle),
-                                junctions=JunctionParams(front_overhang=car.front_overhang))
+                                vehicle=vehicle, lane=ego.lane,
+                                camera=front_camera is not None,
+                                motion=MotionLayerParams(overtake=ego.overtake))
         )
         lateral = StanleyParams(
             wheelbase=car.wheelbase, centre_to_front_axle=car.front_axle,
-            max_steer=min(StanleyParams().max_steer, car.max_steer),
+            max_steer=min(MAX_STEER, car.max_steer),
         )
-        vehicle = VehicleParams(mass=car.mass, wheel_radius=car.wheel_radius)
-        self.controller = VehicleController(
-            VehicleControllerParams(lateral=lateral, vehicle=vehicle)
-        )
+        self.controller = VehicleController(VehicleControllerParams(
+            lateral=lateral, vehicle=VehicleParams(mass=car.mass, wheel_radius=car.wheel_radius)))
         self.lane_detector = LaneDetector(front_camera) if front_camera is not None else None
         self.sign_detector = StopSignDetector(front_camera) if front_camera is not None \
             else None
-        self.light_detector = TrafficLightDetector(front_camera, road, car.front_overhang) \
+        self.light_detector = TrafficLightDetector(front_camera, road, vehicle) \
             if front_camera is not None and road.traffic_lights else None
         self.lane_filter = LaneFilter()
         self.object_detector = ObjectDetector()
-        self.flat_detector = FlatTyreDetector(FlatTyreParams(track=car.track,
-                                                             wheelbase=car.wheelbase))
+        self.flat_detector = FlatTyreDetector(vehicle)
         self.tracker = MultiObjectTracker()
         self._times: list[float] = []  # [s] of the poses below, increasing
         self._poses: list[EgoState] = []

@@ -70,6 +70,7 @@ import math
 from dataclasses import dataclass
 
 from planner.fsm.machine import Row, Table, Transition, next_state, render
+from planner.limits import A_COMF
 from world.frames import to_kph
 
 
@@ -121,7 +122,7 @@ NO_EVENTS: frozenset[AccEvent] = frozenset()
 class AccParams:
     d0: float = 4.0  # [m] standstill gap of d_des
     tau: float = 1.5  # [s] time gap of d_des
-    a_comf: float = 1.5  # [m/s^2] comfortable deceleration (d_max)
+    a_comf: float = A_COMF  # [m/s^2] comfortable deceleration (d_max)
     d_reach: float = 10.0  # [m] hysteresis beyond the braking distance (d_max)
 
 

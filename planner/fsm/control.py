@@ -56,6 +56,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 from planner.fsm.machine import Row, Table, Transition, next_state, render
+from planner.limits import A_HARD
 
 
 class ControlState(enum.Enum):
@@ -68,7 +69,7 @@ class ControlState(enum.Enum):
 
 @dataclass(frozen=True, slots=True)
 class ControlParams:
-    a_emergency_enter: float = 5.0  # [m/s^2] required deceleration at/above it: an emergency
+    a_emergency_enter: float = A_HARD  # [m/s^2] required deceleration at/above it: emergency
     ttc_emergency: float = 1.2  # [s] time to collision below it: an emergency
     a_emergency_exit: float = 2.5  # [m/s^2] the threat is over below it (and the gap opens)
     v_stopped: float = 0.1  # [m/s] below it the car is stopped

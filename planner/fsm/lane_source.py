@@ -53,7 +53,7 @@ class LaneSourceInput:
     t: float  # [s] now
     confidence: float  # [-] of the latest lane estimate (0 when there is none)
     since: float  # [s] time of the last change of state (the start, for ACQUIRING)
-    junction: bool = False  # the car is near a town junction (`LaneKeepingPlanner`)
+    junction: bool = False  # the car is near a town junction (`Planner.near_junction`)
 
 
 def _good(x: LaneSourceInput, p: LaneSourceParams) -> bool:

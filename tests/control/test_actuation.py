@@ -8,7 +8,7 @@ import pytest
 
 from control.actuation import GRAVITY, VehicleParams, longitudinal_force, wheel_torques
 
-P = VehicleParams()
+P = VehicleParams(mass=1500.0, wheel_radius=0.33)  # the example car of the figures below
 F_ROLL = 0.012 * 1500.0 * GRAVITY  # [N] ~176.6
 
 

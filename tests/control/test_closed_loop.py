@@ -17,11 +17,11 @@ from dataclasses import dataclass, replace
 import numpy as np
 import pytest
 
-from control.stanley import StanleyParams
 from control.vehicle_controller import VehicleController, VehicleControllerParams
 from perception.messages import EgoState
 from planner.messages import Plan, ReferencePath
 from tests.control.paths import straight, straight_then_arc
+from tests.vehicle import controller_params, stanley_params
 
 WHEELBASE = 2.7  # [m]
 STEER_LAG = 0.1  # [s] first-order time constant of the steering actuator
@@ -93,7 +93,7 @@ def drive(
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Run the loop; return time [s], distance travelled [m] and the true front-axle error [m]
     after each control tick, and check the steering command's limits on the way."""
-    controller = VehicleController(params)
+    controller = VehicleController(params if params is not None else controller_params())
     lat = controller.params.lateral
     times, travelled, errors = [], [], []
     t, previous = 0.0, 0.0
@@ -140,8 +140,8 @@ def test_circle_r60_at_12_mps_steady_state(left: bool) -> None:
 def test_curvature_feed_forward_on_top_of_eq1_double_counts_the_arc() -> None:
     """Why `k_ff` defaults to 0: the front-axle heading term already holds the arc's steer."""
     radius, speed = 60.0, 12.0
-    lateral = replace(StanleyParams(), k_ff=1.0, ki=0.0)
-    params = VehicleControllerParams(lateral=lateral)
+    lateral = replace(stanley_params(), k_ff=1.0, ki=0.0)
+    params = controller_params(lateral=lateral)
     path = straight_then_arc(0.0, radius, 1.9 * math.pi)
     car = KinematicBicycle.from_centre(0.0, 0.0, 0.0, speed)
     times, _, errors = drive(path, car, 25.0, circle_error(0.0, radius, radius), params)

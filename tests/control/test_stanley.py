@@ -8,9 +8,10 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from control.stanley import FrontAxleError, StanleyParams, StanleyPid, front_axle_error, wrap_angle
+from control.stanley import FrontAxleError, StanleyPid, front_axle_error, wrap_angle
 from planner.messages import ReferencePath
 from tests.control.paths import straight, straight_then_arc
+from tests.vehicle import stanley_params
 
 L = 2.7  # [m] wheelbase
 DT = 0.05  # [s]
@@ -147,7 +148,7 @@ def test_duplicate_points_do_not_break_the_projection() -> None:
 
 # --- StanleyPid ---------------------------------------------------------------------------------
 
-WIDE = StanleyParams(ki=0.0, k_yaw=0.0, max_steer=math.pi / 2, max_steer_rate=1e6)
+WIDE = stanley_params(ki=0.0, k_yaw=0.0, max_steer=math.pi / 2, max_steer_rate=1e6)
 
 
 def error(e_fa: float = 0.0, theta_p: float = 0.0, curvature: float = 0.0) -> FrontAxleError:
@@ -174,7 +175,7 @@ def test_stanley_law_table(
 
 
 def test_left_of_path_gives_negative_steer_with_defaults() -> None:
-    assert StanleyPid().update(error(e_fa=-1.0), 0.0, 10.0, 0.0, DT) < 0.0
+    assert StanleyPid(stanley_params()).update(error(e_fa=-1.0), 0.0, 10.0, 0.0, DT) < 0.0
 
 
 def test_softening_keeps_low_speed_steer_below_the_plain_law() -> None:
@@ -182,14 +183,14 @@ def test_softening_keeps_low_speed_steer_below_the_plain_law() -> None:
     soft = StanleyPid(WIDE).update(error(e_fa=1.0), 0.0, 0.1, 0.0, DT)
     assert soft == pytest.approx(math.atan(2.5 / 1.1))
     assert soft < plain - 0.3
-    limited = StanleyPid()
+    limited = StanleyPid(stanley_params())
     for _ in range(100):
         steer = limited.update(error(e_fa=1.0), 0.0, 0.1, 0.0, DT)
         assert abs(steer) <= limited.params.max_steer + 1e-12
 
 
 def test_angle_and_rate_limits_are_honoured() -> None:
-    ctrl = StanleyPid()
+    ctrl = StanleyPid(stanley_params())
     p = ctrl.params
     previous = 0.0
     sequence = [error(e_fa=5.0)] * 40 + [error(e_fa=-5.0)] * 60 + [error()] * 40
@@ -198,19 +199,19 @@ def test_angle_and_rate_limits_are_honoured() -> None:
         assert abs(steer) <= p.max_steer + 1e-12
         assert abs(steer - previous) <= p.max_steer_rate * DT + 1e-12
         previous = steer
-    first = StanleyPid().update(error(e_fa=5.0), 0.0, 3.0, 0.0, DT)
+    first = StanleyPid(stanley_params()).update(error(e_fa=5.0), 0.0, 3.0, 0.0, DT)
     assert first == pytest.approx(p.max_steer_rate * DT)
 
 
 def test_saturates_at_the_angle_limit() -> None:
-    ctrl = StanleyPid()
+    ctrl = StanleyPid(stanley_params())
     for _ in range(100):
         steer = ctrl.update(error(e_fa=-5.0), 0.0, 3.0, 0.0, DT)
     assert steer == pytest.approx(-ctrl.params.max_steer)
 
 
 def test_reset_starts_the_rate_limit_from_the_given_angle() -> None:
-    ctrl = StanleyPid()
+    ctrl = StanleyPid(stanley_params())
     ctrl.reset(steering_angle=0.3)
     steer = ctrl.update(error(), 0.0, 10.0, 0.0, DT)
     assert steer == pytest.approx(0.3 - ctrl.params.max_steer_rate * DT)
@@ -240,14 +241,14 @@ def test_integral_acts_and_is_clamped() -> None:
 
 
 def test_integrator_frozen_at_low_speed() -> None:
-    ctrl = StanleyPid(replace(StanleyParams(), ki=1.0))
+    ctrl = StanleyPid(replace(stanley_params(), ki=1.0))
     for _ in range(100):
         ctrl.update(error(e_fa=1.0), 0.0, 0.5, 0.0, DT)
     assert ctrl.integral_term == 0.0
 
 
 def test_integrator_frozen_while_saturated() -> None:
-    ctrl = StanleyPid(replace(StanleyParams(), ki=1.0, integral_limit=10.0))
+    ctrl = StanleyPid(replace(stanley_params(), ki=1.0, integral_limit=10.0))
     for _ in range(200):
         steer = ctrl.update(error(e_fa=3.0), 0.0, 5.0, 0.0, DT)
     assert steer == pytest.approx(ctrl.params.max_steer)

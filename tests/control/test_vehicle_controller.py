@@ -15,6 +15,7 @@ from control.vehicle_controller import VehicleController
 from perception.messages import EgoState
 from planner.messages import Plan, ReferencePath
 from tests.control.paths import straight
+from tests.vehicle import controller_params
 
 DT = 1.0 / 40.0  # [s]
 
@@ -50,14 +51,14 @@ def plan(
 
 
 def test_composes_a_lateral_and_a_longitudinal_controller() -> None:
-    controller = VehicleController()
+    controller = VehicleController(controller_params())
     assert isinstance(controller.lateral, StanleyPid)
     assert isinstance(controller.longitudinal, SpeedController)
     assert type(controller).__mro__ == (VehicleController, object)
 
 
 def test_command_on_the_path_at_speed() -> None:
-    command = VehicleController().update(plan(straight(50.0)), DT)
+    command = VehicleController(controller_params()).update(plan(straight(50.0)), DT)
     assert isinstance(command, VehicleCommand)
     assert command.steering_angle == pytest.approx(0.0)
     assert command.drive_torque > 0.0  # holds speed against rolling resistance and drag
@@ -65,7 +66,7 @@ def test_command_on_the_path_at_speed() -> None:
 
 
 def test_left_of_path_steers_right_and_too_fast_brakes() -> None:
-    controller = VehicleController()
+    controller = VehicleController(controller_params())
     for _ in range(40):
         command = controller.update(plan(straight(50.0), y=0.5, speed=14.0), DT)
     assert command.steering_angle < 0.0
@@ -75,7 +76,7 @@ def test_left_of_path_steers_right_and_too_fast_brakes() -> None:
 
 
 def test_hint_is_kept_on_the_same_path_and_dropped_for_a_new_one() -> None:
-    controller = VehicleController()
+    controller = VehicleController(controller_params())
     loop = straight(100.0)
     controller.update(plan(loop, x=20.0), DT)
     assert controller.last_error is not None
@@ -97,7 +98,7 @@ def test_hint_follows_the_car_onto_the_second_lap_of_a_looped_path() -> None:
         heading=np.concatenate([a, a]),
         curvature=np.full(2 * n, 1.0 / radius),
     )
-    controller = VehicleController()
+    controller = VehicleController(controller_params())
     for k in range(int(1.5 * n)):
         angle = k * math.tau / n  # car centre on the circle, heading along it
         ego_plan = plan(path, x=radius * math.sin(angle), y=radius * (1.0 - math.cos(angle)))
@@ -109,7 +110,7 @@ def test_hint_follows_the_car_onto_the_second_lap_of_a_looped_path() -> None:
 
 
 def test_standstill_hold_brakes_without_drive() -> None:
-    controller = VehicleController()
+    controller = VehicleController(controller_params())
     for _ in range(40):
         command = controller.update(plan(straight(50.0), speed=0.0, target_speed=0.0), DT)
     assert command.drive_torque == 0.0
@@ -118,7 +119,7 @@ def test_standstill_hold_brakes_without_drive() -> None:
 
 
 def test_first_update_rate_limits_from_the_measured_steering_angle() -> None:
-    controller = VehicleController()
+    controller = VehicleController(controller_params())
     command = controller.update(plan(straight(50.0), steering_angle=0.3), DT)
     assert command.steering_angle == pytest.approx(0.3 - 0.9 * DT)
     controller.reset()

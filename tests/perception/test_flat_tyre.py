@@ -21,6 +21,7 @@ from perception.flat_tyre import (
     ackermann_split,
     corrected_speeds,
 )
+from tests.vehicle import VEHICLE
 from world.core.client import PHYSICS_RATE
 from world.ego.body import ackermann
 from world.frames import Odometry, Wheel
@@ -66,7 +67,7 @@ def kinematic_odometry(t: float, speed: float, delta: float, radii: tuple[float,
 
 def run(samples: Iterator[Odometry], detector: FlatTyreDetector | None = None
         ) -> FlatTyreState | None:
-    detector = detector or FlatTyreDetector()
+    detector = detector or FlatTyreDetector(VEHICLE)
     found = None
     for odometry in samples:
         found = detector.update(odometry)
@@ -149,7 +150,7 @@ def _normal_driving(t: float) -> tuple[float, float]:
 def test_no_flat_in_a_minute_of_normal_driving_with_curves(seed: int) -> None:
     samples = drive(60.0, lambda t: _normal_driving(t)[0], lambda t: _normal_driving(t)[1],
                     lambda t: (R_WHEEL,) * 4, seed)
-    detector = FlatTyreDetector()
+    detector = FlatTyreDetector(VEHICLE)
     assert run(samples, detector) is None
 
 
@@ -188,7 +189,7 @@ def test_a_locking_wheel_does_not_make_its_partner_look_flat() -> None:
 
 
 def test_the_detection_is_latched_and_reset_forgets_it() -> None:
-    detector = FlatTyreDetector()
+    detector = FlatTyreDetector(VEHICLE)
     found = run(drive(3.0, lambda t: 50 * KPH, lambda t: 0.0, _flat_at(0.5, 1), seed=4),
                 detector)
     assert found is not None and found.wheel == Wheel.FRONT_RIGHT
@@ -200,7 +201,7 @@ def test_the_detection_is_latched_and_reset_forgets_it() -> None:
 
 def test_a_gap_in_the_samples_restarts_the_timing() -> None:
     """Samples 0.3 s apart (beyond MAX_GAP) give no evidence: 10 of them are not 3 s."""
-    detector = FlatTyreDetector()
+    detector = FlatTyreDetector(VEHICLE)
     flat = (R_WHEEL, R_WHEEL, R_FLAT, R_WHEEL)
     for k in range(10):
         assert detector.update(kinematic_odometry(0.3 * k, 50 * KPH, 0.0, flat, None)) is None
@@ -228,7 +229,7 @@ def _sim(world: World, phases: list[tuple[float, float]], v_set: float
     """Drive the world's car through (duration [s], turn radius [m] or inf) phases at 40 Hz
     with fixed steering and a speed-holding torque (test scaffolding, true speed), feeding
     its odometry to a detector. The detection and the largest evidence seen [s]."""
-    detector = FlatTyreDetector()
+    detector = FlatTyreDetector(VEHICLE)
     found, evidence = None, 0.0
     try:
         for seconds, radius in phases:

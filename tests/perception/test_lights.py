@@ -37,6 +37,7 @@ from perception.lights import (
 from perception.messages import EgoState
 from tests.perception.light_scene import LightScene
 from tests.perception.render_scene import front_camera
+from tests.vehicle import VEHICLE
 from world.frames import CameraFrame
 from world.hdmap import LightColour, LightHead
 from world.map.road import build_road_map, light_head
@@ -47,7 +48,7 @@ ROAD = RoadSpec(segments=(SegmentSpec(700.0, 0.0, 2, 1, 3.5, 2.5),), speed_limit
 MAIN_LIGHT = TrafficLightSpec(100.0, 20.0, 3.0, 20.0, 0.0)
 MAP = build_road_map(replace(ROAD, features=(MAIN_LIGHT,)))  # MAIN is the map's only light
 MAIN = light_head(MAP, MAIN_LIGHT)
-FRONT = 2.4  # [m] the car's centre to its front bumper
+FRONT = VEHICLE.front_overhang  # [m] the car's centre to its front bumper
 AWAY = replace(MAIN, x=MAIN.x + 150.0, facing=0.0)  # lamps point along the route
 LOW = replace(MAIN, x=MAIN.x + 300.0, z=2.8)  # a low post-mounted head, a red car under it
 LEFT = LightHead(MAIN.x + 30.0, 8.0, 3.5, math.pi)  # left of the road, facing the traffic
@@ -88,7 +89,7 @@ def render(scene: LightScene) -> Render:
 
 @pytest.fixture(scope="module")
 def detector() -> TrafficLightDetector:
-    return TrafficLightDetector(front_camera(), MAP, FRONT)
+    return TrafficLightDetector(front_camera(), MAP, VEHICLE)
 
 
 def lamp_pixel(ego: EgoState, head: LightHead, colour: LightColour) -> tuple[float, float]:
@@ -122,14 +123,14 @@ def _pose_at(x: float) -> EgoState:
 
 
 def test_the_detector_looks_for_the_maps_lights_ahead_of_the_bumper() -> None:
-    detector = TrafficLightDetector(front_camera(), MAP, FRONT)
+    detector = TrafficLightDetector(front_camera(), MAP, VEHICLE)
     line = MAIN_LIGHT.s
     assert detector.heads_ahead(_pose_at(line - FRONT - 30.0)) == [(0, MAIN)]
     assert detector.heads_ahead(_pose_at(line - FRONT - 59.5)) == [(0, MAIN)]  # 60 m: in
     assert detector.heads_ahead(_pose_at(line - FRONT - 60.5)) == []  # beyond 60 m
     assert detector.heads_ahead(_pose_at(line - FRONT + 0.5)) == [(0, MAIN)]  # just over
     assert detector.heads_ahead(_pose_at(line - FRONT + 2.0)) == []  # over it: not any more
-    no_lights = TrafficLightDetector(front_camera(), build_road_map(ROAD), FRONT)
+    no_lights = TrafficLightDetector(front_camera(), build_road_map(ROAD), VEHICLE)
     assert no_lights.heads_ahead(_pose_at(50.0)) == []
 
 
@@ -186,7 +187,7 @@ def test_a_light_facing_away_is_not_detected(
     looking = LightParams(max_facing=math.pi)
     view = head_view(detector.camera, ego, AWAY, looking)
     assert view is not None
-    looking_detector = TrafficLightDetector(detector.camera, MAP, FRONT, looking)
+    looking_detector = TrafficLightDetector(detector.camera, MAP, VEHICLE, looking)
     blobs, hsv = looking_detector.lamp_blobs(frame.rgb, view)
     assert blobs == []
     assert (hsv[..., 2] <= 60).sum() > 10  # the housing's back was in the region
@@ -208,7 +209,7 @@ def test_a_light_beyond_max_range_is_not_looked_for(
 ) -> None:
     frame, ego = render(0, 65.0, LightColour.RED)
     assert detector.detect_heads(frame, ego, [(0, MAIN)]) == ()
-    near = TrafficLightDetector(detector.camera, MAP, FRONT, LightParams(max_range=70.0))
+    near = TrafficLightDetector(detector.camera, MAP, VEHICLE, LightParams(max_range=70.0))
     (found,) = near.detect_heads(frame, ego, [(0, MAIN)])
     assert found.colour is LightColour.RED
 

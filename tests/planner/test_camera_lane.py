@@ -10,6 +10,9 @@ import pytest
 from perception.messages import EgoState, LaneEstimate, ObjectClass, Track
 from planner.camera_lane import camera_lane_path
 from planner.lead import LeadParams, select_lead
+from tests.vehicle import VEHICLE
+
+FRONT = VEHICLE.front_overhang  # [m]
 
 
 def pose(x: float = 10.0, y: float = -3.0, heading: float = 0.7) -> EgoState:
@@ -58,14 +61,14 @@ def test_lead_is_the_nearest_in_lane_track_ahead() -> None:
     p = LeadParams()
     tracks = [track(40.0, 0.3, 8.0, 1), track(25.0, 3.5, 5.0, 2), track(-10.0, 0.0, 9.0, 3),
               track(60.0, -5.0, 8.0, 4)]
-    lead = select_lead(tracks, lambda x: 0.0, 0.0, p)
+    lead = select_lead(tracks, lambda x: 0.0, 0.0, p, FRONT)
     assert lead is not None and lead.track_id == 1
-    assert lead.gap == pytest.approx(40.0 - p.front_overhang - 2.3)
+    assert lead.gap == pytest.approx(40.0 - FRONT - 2.3)
     assert lead.speed == pytest.approx(8.0) and lead.t == 1.0
     # its speed is along the ego's heading: a car crossing at right angles has none
-    assert select_lead(tracks, lambda x: 0.0, math.pi / 2, p).speed == pytest.approx(0.0)
+    assert select_lead(tracks, lambda x: 0.0, math.pi / 2, p, FRONT).speed == pytest.approx(0.0)
     # the lane bends right: the car at (60, -5) is in it, the one at (40, 0.3) is not
-    lead = select_lead(tracks, lambda x: -5.0 * (x / 60.0) ** 2, 0.0, p)
+    lead = select_lead(tracks, lambda x: -5.0 * (x / 60.0) ** 2, 0.0, p, FRONT)
     assert lead is not None and lead.track_id == 4
     assert select_lead([track(30.0, 0.0, 5.0, cls=ObjectClass.OTHER)], lambda x: 0.0, 0.0,
-                       p) is None
+                       p, FRONT) is None

@@ -15,6 +15,7 @@ from planner.fsm.acc import AccEvent, AccMode
 from planner.messages import SpeedSource
 from planner.speed import PlannedSpeed, SpeedRef
 from tests.roads import KPH, W, make_map, seg
+from tests.vehicle import VEHICLE
 from world.hdmap import Crosswalk, SpeedBump, StopSign, Zone
 
 FLAT, OFF_RAMP, PEDESTRIAN = AccEvent.FLAT, AccEvent.OFF_RAMP, AccEvent.PEDESTRIAN
@@ -37,7 +38,7 @@ def at(m: EventMonitor, station: float, v: float = 8.0, t: float = 0.0,
 
 
 def test_a_stop_sign_counts_once_perception_confirmed_it_until_the_stop_is_done() -> None:
-    m = EventMonitor(ROAD, P)
+    m = EventMonitor(ROAD, VEHICLE, P)
     assert not at(m, 150.0).holds(STOP_SIGN)  # not seen yet
     m.confirm_sign(200.0)
     e = at(m, 150.0)
@@ -51,7 +52,7 @@ def test_a_stop_sign_counts_once_perception_confirmed_it_until_the_stop_is_done(
 
 
 def test_a_bump_from_its_approach_until_the_rear_axle_is_past() -> None:
-    m = EventMonitor(ROAD, P)
+    m = EventMonitor(ROAD, VEHICLE, P)
     e = at(m, 270.0, v=10.0)
     near = 300.0 - 0.45
     assert e.holds(SPEED_BUMP) and e.bump_speed == pytest.approx(4.5 * KPH)
@@ -61,7 +62,7 @@ def test_a_bump_from_its_approach_until_the_rear_axle_is_past() -> None:
 
 
 def test_a_pedestrian_on_or_walking_into_the_crossing_in_the_lane() -> None:
-    m = EventMonitor(ROAD, P)
+    m = EventMonitor(ROAD, VEHICLE, P)
     on = at(m, 370.0, tracks=(walker(402.0, 0.5),))
     assert on.holds(PEDESTRIAN) and on.stop_distance == pytest.approx(400.0 - 372.4 - 1.0)
     assert not at(m, 370.0, tracks=(walker(402.0, -6.0),)).holds(PEDESTRIAN)  # on the pavement
@@ -74,7 +75,7 @@ def test_a_pedestrian_on_or_walking_into_the_crossing_in_the_lane() -> None:
 
 
 def test_the_ramp_zone_is_the_off_ramp() -> None:
-    m = EventMonitor(ROAD, P)
+    m = EventMonitor(ROAD, VEHICLE, P)
     assert not at(m, 490.0).holds(OFF_RAMP) and at(m, 510.0).holds(OFF_RAMP)
 
 
@@ -123,7 +124,7 @@ def test_flat_eases_to_a_crawl_then_stops_once_pulled_over() -> None:
 def test_a_camera_stop_sign_confirms_the_map_line_near_it() -> None:
     from perception.messages import EgoState, SignDetection
 
-    m = EventMonitor(ROAD, P)
+    m = EventMonitor(ROAD, VEHICLE, P)
     pose = EgoState(t=5.0, x=160.0, y=0.0, heading=0.0, speed=8.0, yaw_rate=0.0,
                     steering_angle=0.0, position_sigma=0.05)
     left = SignDetection(5.0, "stop", 41.0, 4.0, 2.0, 41.2, (0, 0, 1, 1), 0.9)

@@ -10,6 +10,7 @@ import pytest
 from perception.messages import LightDetection, ObjectClass, Track
 from planner.fsm.acc import AccEvent
 from planner.junctions import JunctionMonitor, JunctionParams
+from tests.vehicle import VEHICLE
 from world.hdmap import LightColour, Manoeuvre, RoadMap
 from world.map.road import build_road_map
 from world.map.town import TownLayout, compile_route
@@ -46,7 +47,7 @@ def seen(colour: LightColour, t: float = 0.0) -> LightDetection:
 def front_at(m: JunctionMonitor, before_line: float) -> float:
     """The car's centre station with its front bumper `before_line` [m] before the first
     junction's stop line."""
-    return m.road.junctions[0].s_stop - before_line - P.front_overhang
+    return m.road.junctions[0].s_stop - before_line - VEHICLE.front_overhang
 
 
 @pytest.mark.parametrize(
@@ -66,7 +67,7 @@ def front_at(m: JunctionMonitor, before_line: float) -> float:
 )
 def test_the_light_rules(colour: LightColour | None, before_line: float, v: float,
                          stops: bool) -> None:
-    m = JunctionMonitor(route(LIGHTS, Manoeuvre.STRAIGHT), P)
+    m = JunctionMonitor(route(LIGHTS, Manoeuvre.STRAIGHT), VEHICLE, P)
     if colour is not None:
         m.see_lights([seen(colour, -0.1)])
         m.see_lights([seen(colour)])
@@ -78,7 +79,7 @@ def test_the_light_rules(colour: LightColour | None, before_line: float, v: floa
 
 
 def test_a_yellow_decision_to_go_holds_when_it_turns_red() -> None:
-    m = JunctionMonitor(route(LIGHTS, Manoeuvre.STRAIGHT), P)
+    m = JunctionMonitor(route(LIGHTS, Manoeuvre.STRAIGHT), VEHICLE, P)
     m.see_lights([seen(LightColour.YELLOW, 0.0)])
     assert not m.update(0.0, front_at(m, 12.0), 11.0).holds(RED_LIGHT)
     m.see_lights([seen(LightColour.RED, 1.0)])
@@ -86,14 +87,14 @@ def test_a_yellow_decision_to_go_holds_when_it_turns_red() -> None:
 
 
 def test_a_colour_seen_too_long_ago_is_not_trusted() -> None:
-    m = JunctionMonitor(route(LIGHTS, Manoeuvre.STRAIGHT), P)
+    m = JunctionMonitor(route(LIGHTS, Manoeuvre.STRAIGHT), VEHICLE, P)
     green(m, 0.0)
     # unread again: 8 m is within 5^2 / 6 + 5 = 9.2 m, where an unread light is stopped for
     assert m.update(P.light_memory + 0.5, front_at(m, 8.0), 5.0).holds(RED_LIGHT)
 
 
 def test_the_light_over_the_line_is_no_longer_looked_at() -> None:
-    m = JunctionMonitor(route(LIGHTS, Manoeuvre.STRAIGHT), P)
+    m = JunctionMonitor(route(LIGHTS, Manoeuvre.STRAIGHT), VEHICLE, P)
     m.see_lights([seen(LightColour.RED)])
     assert not m.update(0.0, front_at(m, -0.5), 5.0).holds(RED_LIGHT)
 
@@ -119,7 +120,7 @@ def oncoming(m: JunctionMonitor, distance: float, speed: float) -> Track:
 )
 def test_a_left_turn_waits_for_a_close_oncoming_car(manoeuvre: Manoeuvre, distance: float,
                                                     speed: float, waits: bool) -> None:
-    m = JunctionMonitor(route(LIGHTS, manoeuvre), P)
+    m = JunctionMonitor(route(LIGHTS, manoeuvre), VEHICLE, P)
     green(m)
     e = m.update(0.0, front_at(m, 10.0), 6.0, [oncoming(m, distance, speed)])
     assert e.holds(GIVE_WAY) is waits
@@ -129,7 +130,7 @@ def test_a_left_turn_waits_for_a_close_oncoming_car(manoeuvre: Manoeuvre, distan
 
 
 def test_once_over_the_line_the_turn_is_committed() -> None:
-    m = JunctionMonitor(route(LIGHTS, Manoeuvre.LEFT), P)
+    m = JunctionMonitor(route(LIGHTS, Manoeuvre.LEFT), VEHICLE, P)
     green(m)
     assert not m.update(0.0, front_at(m, -1.0), 3.0, [oncoming(m, 20.0, 10.0)]).holds(GIVE_WAY)
 
@@ -147,14 +148,14 @@ def test_once_over_the_line_the_turn_is_committed() -> None:
 def test_giving_way_is_decided_while_the_car_can_still_stop(
     before_line: float, v: float, gives_way: bool,
 ) -> None:
-    m = JunctionMonitor(route(LIGHTS, Manoeuvre.LEFT), P)
+    m = JunctionMonitor(route(LIGHTS, Manoeuvre.LEFT), VEHICLE, P)
     green(m)
     e = m.update(0.0, front_at(m, before_line), v, [oncoming(m, 30.0, 10.0)])
     assert e.holds(GIVE_WAY) is gives_way
 
 
 def test_once_committed_a_closing_gap_does_not_stop_the_car() -> None:
-    m = JunctionMonitor(route(LIGHTS, Manoeuvre.LEFT), P)
+    m = JunctionMonitor(route(LIGHTS, Manoeuvre.LEFT), VEHICLE, P)
     green(m)
     assert not m.update(0.0, front_at(m, 2.0), 5.0).holds(GIVE_WAY)  # no one coming; past its point
     assert not m.update(0.1, front_at(m, 1.5), 5.0, [oncoming(m, 30.0, 10.0)]).holds(GIVE_WAY)
@@ -163,7 +164,7 @@ def test_once_committed_a_closing_gap_does_not_stop_the_car() -> None:
 def test_a_car_already_waiting_goes_on_waiting_however_close_to_the_line() -> None:
     """Hysteresis: braking for the gap, it reaches its stop point still moving; the
     commitment rule must not release it there."""
-    m = JunctionMonitor(route(LIGHTS, Manoeuvre.LEFT), P)
+    m = JunctionMonitor(route(LIGHTS, Manoeuvre.LEFT), VEHICLE, P)
     green(m)
     car_coming = [oncoming(m, 30.0, 10.0)]
     assert m.update(0.0, front_at(m, 12.0), 6.0, car_coming).holds(GIVE_WAY)
@@ -176,7 +177,7 @@ def test_a_car_already_waiting_goes_on_waiting_however_close_to_the_line() -> No
 )
 def test_at_a_stop_sign_the_car_waits_for_the_box_to_clear(vx: float, vy: float,
                                                            waits: bool) -> None:
-    m = JunctionMonitor(route(STOPS, Manoeuvre.STRAIGHT), P)
+    m = JunctionMonitor(route(STOPS, Manoeuvre.STRAIGHT), VEHICLE, P)
     j = m.road.junctions[0]
     e = m.update(0.0, front_at(m, 1.0), 0.0, [car(j.x + 1.0, j.y - 2.0, vx, vy)])
     assert e.holds(GIVE_WAY) is waits
@@ -185,7 +186,7 @@ def test_at_a_stop_sign_the_car_waits_for_the_box_to_clear(vx: float, vy: float,
 
 
 def test_an_unread_light_once_stopped_for_stays_so_until_read() -> None:
-    m = JunctionMonitor(route(LIGHTS, Manoeuvre.STRAIGHT), P)
+    m = JunctionMonitor(route(LIGHTS, Manoeuvre.STRAIGHT), VEHICLE, P)
     assert m.update(0.0, front_at(m, 25.0), 11.0).holds(RED_LIGHT)
     assert m.update(0.1, front_at(m, 24.0), 8.0).holds(RED_LIGHT)  # slower: still stopping for it
     green(m, 0.2)
@@ -193,14 +194,14 @@ def test_an_unread_light_once_stopped_for_stays_so_until_read() -> None:
 
 
 def test_a_red_light_missed_for_a_while_is_still_stopped_for() -> None:
-    m = JunctionMonitor(route(LIGHTS, Manoeuvre.STRAIGHT), P)
+    m = JunctionMonitor(route(LIGHTS, Manoeuvre.STRAIGHT), VEHICLE, P)
     m.see_lights([seen(LightColour.RED, 0.0)])
     assert m.update(0.0, front_at(m, 55.0), 11.0).holds(RED_LIGHT)
     assert m.update(3.0, front_at(m, 50.0), 10.0).holds(RED_LIGHT)  # not seen for 3 s, far away
 
 
 def test_one_green_frame_does_not_let_the_car_go_through_a_red() -> None:
-    m = JunctionMonitor(route(LIGHTS, Manoeuvre.STRAIGHT), P)
+    m = JunctionMonitor(route(LIGHTS, Manoeuvre.STRAIGHT), VEHICLE, P)
     m.see_lights([seen(LightColour.RED, 0.0)])
     m.see_lights([seen(LightColour.GREEN, 0.1)])  # a false green in one frame
     assert m.update(0.15, front_at(m, 30.0), 8.0).holds(RED_LIGHT)

@@ -15,6 +15,7 @@ from planner.lane_occupancy import (
     lane_traffic,
 )
 from tests.roads import W, make_map, seg
+from tests.vehicle import VEHICLE
 
 P = OccupancyParams()
 ROAD = make_map(seg(400.0))  # 2 lanes: lane 0 centre y = 0, lane 1 centre y = 3.5
@@ -29,7 +30,7 @@ def car(x: float, y: float, vx: float, ident: int = 1, t: float = 1.0) -> Track:
 
 
 def traffic(*tracks: Track, t: float = 1.0) -> dict[int, LaneTraffic]:
-    return lane_traffic(ROAD, tracks, t, EGO_S, V, (0, 1), P)
+    return lane_traffic(ROAD, tracks, t, EGO_S, V, (0, 1), P, VEHICLE)
 
 
 def test_neighbours_ahead_behind_and_alongside() -> None:

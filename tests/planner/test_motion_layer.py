@@ -14,6 +14,7 @@ from planner.fsm.acc import AccParams
 from planner.fsm.motion import Motion
 from planner.motion_layer import MotionLayer, MotionLayerParams
 from tests.roads import W, make_map, seg
+from tests.vehicle import VEHICLE
 from world.hdmap import SHOULDER, Manoeuvre, Side
 from world.map.road import build_road_map
 from world.map.town import TownLayout, compile_route
@@ -35,7 +36,7 @@ def car(t: float, x: float, y: float, vx: float, ident: int) -> Track:
 
 
 def layer(overtake: bool = True) -> MotionLayer:
-    return MotionLayer(ROAD, 0, AccParams(), MotionLayerParams(overtake=overtake))
+    return MotionLayer(ROAD, 0, AccParams(), VEHICLE, MotionLayerParams(overtake=overtake))
 
 
 def drive(m: MotionLayer, t0: float, t1: float, slow_x0: float,
@@ -93,7 +94,8 @@ def test_aborts_when_the_target_lane_stops_being_free() -> None:
 def test_moves_to_the_lane_that_goes_on_before_an_exit() -> None:
     ramp = replace(seg(100.0, lanes=1, oncoming=0), exit=Side.RIGHT)
     road = make_map(seg(600.0), ramp)
-    m = MotionLayer(road, 1, AccParams(), MotionLayerParams())  # no overtaking: a route need
+    # no overtaking: a route need
+    m = MotionLayer(road, 1, AccParams(), VEHICLE, MotionLayerParams())
     far = m.update(ego(0.0, 100.0 + V * 0.0, W), V, [])[0]  # 500 m before the fork
     assert far.motion is Motion.LANE_KEEP
     man, changes = m.update(ego(1.0, 450.0, W), V, [])  # 150 m before it
@@ -102,7 +104,7 @@ def test_moves_to_the_lane_that_goes_on_before_an_exit() -> None:
 
 
 def test_a_flat_tyre_pulls_over_lane_by_lane_onto_the_shoulder() -> None:
-    m = MotionLayer(ROAD, 1, AccParams(), MotionLayerParams())
+    m = MotionLayer(ROAD, 1, AccParams(), VEHICLE, MotionLayerParams())
     t, x, y, lanes = 0.0, 100.0, W, []
     while t < 20.0:
         man, _ = m.update(ego(t, x, y), V, [], pull_over=True)
@@ -126,7 +128,7 @@ def test_a_town_turn_from_the_stop_line_to_the_junction_exit(manoeuvre: str,
     layout = TownLayout(TownSpec(3, 2, 90.0, 2, 3.5, 11.0, "stop_signs"))
     road = build_road_map(compile_route(layout, (0, 1, "east"), (Manoeuvre(manoeuvre),), "e"))
     j = road.junctions[0]
-    m = MotionLayer(road, 0, AccParams(), MotionLayerParams())
+    m = MotionLayer(road, 0, AccParams(), VEHICLE, MotionLayerParams())
     seen = []
     for k, s in enumerate(np.arange(j.s_stop - 10.0, j.s_exit + 10.0, 0.5)):
         x, y = road.position(s, 0.0)

@@ -12,6 +12,7 @@ from planner.messages import SpeedSource
 from planner.planner import Planner, PlannerParams
 from planner.speed_planning import Binding, SpeedPlanner
 from tests.planner.maps import KPH, real_map, road_spec, segment, straight_road
+from tests.vehicle import VEHICLE
 from world.hdmap import RoadMap
 
 KINDS = ["real"]  # the planner now needs the whole map (lanes, projection)
@@ -27,7 +28,8 @@ def ego_on(road: RoadMap, lane: int, s: float, r: float, speed: float, t: float 
 def planner(road: RoadMap, lane: int = 1, set_kph: float = 80.0,
             camera: bool = False) -> Planner:
     """The map-only planner by default (these tests are about the map path and speed)."""
-    return Planner(road, PlannerParams(set_kph * KPH, 180.0 * KPH, lane=lane, camera=camera))
+    return Planner(road, PlannerParams(set_kph * KPH, 180.0 * KPH, VEHICLE, lane=lane,
+                                       camera=camera))
 
 
 def test_plan_on_an_arc() -> None:
@@ -45,7 +47,7 @@ def test_plan_on_an_arc() -> None:
     assert s[0] == pytest.approx(145.0)
     assert s[-1] == pytest.approx(150.0 + 2.5 * 20.0)  # 2.5 s at 20 m/s > 25 m
     # the speed target is the speed planner's, for the same station
-    expected = SpeedPlanner(road, lane, p.params.speed).target(
+    expected = SpeedPlanner(road, lane, p.params.speed, VEHICLE).target(
         150.0, set_speed=80.0 * KPH, max_speed=180.0 * KPH
     )
     assert plan.target_speed == pytest.approx(expected.speed)
@@ -98,4 +100,4 @@ def test_closed_loop_point_mass_through_posting(kind: str) -> None:
 def test_rejects_oncoming_lane() -> None:
     road = straight_road("real", 100.0, 50.0)
     with pytest.raises(ValueError, match="ego-direction"):
-        Planner(road, PlannerParams(10.0, 20.0, lane=-1))
+        Planner(road, PlannerParams(10.0, 20.0, VEHICLE, lane=-1))

@@ -17,13 +17,14 @@ from planner.speed_planning import (
     curve_speed,
 )
 from tests.planner.maps import KPH, real_map, road_spec, segment, straight_road
+from tests.vehicle import VEHICLE
 from world.hdmap import RoadMap
 
 P = SpeedPlanningParams()
 A = P.a_comf
 MARGIN = P.brake_margin
-FRONT = P.front_overhang
-AXLE = P.front_axle
+FRONT = VEHICLE.front_overhang
+AXLE = VEHICLE.front_axle
 R = 60.0  # [m]
 V_R60 = math.sqrt(180.0)  # [m/s] sqrt(a_lat_max * R)
 SIGN = 500.0  # [m] station of the lower posting
@@ -39,7 +40,7 @@ def target(
     """The target at ``s``, from one planner per (road, lane) (the map is sampled once)."""
     key = (id(road), lane)
     if key not in _PLANNERS or _PLANNERS[key].road is not road:
-        _PLANNERS[key] = SpeedPlanner(road, road.lane(lane), P)
+        _PLANNERS[key] = SpeedPlanner(road, road.lane(lane), P, VEHICLE)
     return _PLANNERS[key].target(s, set_speed=set_kph * KPH, max_speed=max_kph * KPH)
 
 
@@ -273,7 +274,7 @@ def test_planner_equals_brute_force_over_every_sample() -> None:
     seen = set()
     for lane_index in (0, 1):
         lane = road.lane(lane_index)
-        planner = SpeedPlanner(road, lane, P)
+        planner = SpeedPlanner(road, lane, P, VEHICLE)
         samples = np.array(planner._stations)
         kappa = np.asarray(lane.curvature_at(samples))
         metric = 1.0 / (1.0 + kappa * np.asarray(lane.offset_at(samples)))

@@ -54,6 +54,7 @@ from pybullet_utils.bullet_client import BulletClient
 
 from vehicle_urdf import URDF_PATH, WHEELS, CarGeometry, read_geometry
 from world.core.client import GRAVITY
+from world.frames import VehicleInfo
 
 AIR_DENSITY = 1.2  # [kg/m^3]
 STEER_TORQUE = 4000.0  # [N m] steering hinge servo force limit
@@ -332,3 +333,10 @@ def bicycle_angle(left: float, right: float) -> float:
     if tl * tr <= 0.0:  # straight ahead, or hinges passing through zero
         return 0.5 * (left + right)
     return math.atan(2.0 * tl * tr / (tl + tr))
+
+
+def vehicle_info(geometry: CarGeometry) -> VehicleInfo:
+    """The stack's view of the car's dimensions (`world.frames.VehicleInfo`), from the URDF's."""
+    return VehicleInfo(length=geometry.body_length, width=geometry.body_width,
+                       wheelbase=geometry.wheelbase, track=geometry.track,
+                       front_axle=geometry.front_axle, rear_axle=geometry.rear_axle)
