@@ -5,9 +5,10 @@ The models mirror the YAML exactly, key for key, in the file's units (`*_kph` km
 degrees, everything else SI). They are strict: unknown keys are rejected, text is never
 coerced into a number (an integer is accepted where a float is expected), and every field
 carries a description with its unit and default, which the JSON Schema (`avsim schema`)
-shows. `avsim.scenario.load` validates a file with `ScenarioModel`, applies the cross-field
-checks (lanes at a station, stations on the route, ...) and converts it into
-`world.spec.ScenarioSpec` (SI units, radians, resolved defaults).
+shows. `avsim.scenario.load` validates a file with `ScenarioModel`
+(`avsim.scenario.validation`), applies the cross-field checks (lanes at a station, stations
+on the route, ...; `avsim.scenario.checks`) and converts it into `world.spec.ScenarioSpec`
+(SI units, radians, resolved defaults; `avsim.scenario.convert`).
 
 One-key mappings of the format (a segment `straight:` / `arc:`, a trigger `time:` / ...,
 an action `speed:` / ..., an event) are models whose alternatives are optional fields; a
@@ -61,7 +62,7 @@ Identifier = Annotated[str, Field(pattern=NAME_PATTERN)]
 
 def problem(message: str, key: str | None = None) -> PydanticCustomError:
     """A validation error with a ready-made message; `key` (if given) is the offending key
-    below the location of the model that raises it. `avsim.scenario.load` formats it."""
+    below the location of the model that raises it. `avsim.scenario.validation` formats it."""
     context: dict[str, Any] = {"problem": message}
     if key is not None:
         context["key"] = key

@@ -13,10 +13,12 @@ import pytest
 import yaml
 from pydantic import BaseModel
 
+from avsim.scenario import convert as conversion
+from avsim.scenario import files as scenario_files
 from avsim.scenario import load as scenario_module
 from avsim.scenario import model as scenario_model
+from avsim.scenario.files import SCENARIO_DIR
 from avsim.scenario.load import (
-    SCENARIO_DIR,
     UNSUPPORTED,
     ScenarioError,
     bundled_scenarios,
@@ -30,7 +32,7 @@ from world import spec
 HERE = Path(__file__).parents[1]
 BAD_DIR = HERE / "bad_scenarios"
 DOC = HERE.parents[1] / "docs" / "scenario-format.md"
-KPH = scenario_module.MPS_PER_KPH  # [m/s] per [km/h], checked against 1 / 3.6 below
+KPH = conversion.MPS_PER_KPH  # [m/s] per [km/h], checked against 1 / 3.6 below
 
 
 # SCENARIO_FORMAT.md's complete example, verbatim but for the comments.
@@ -378,7 +380,7 @@ def test_bundled_names_resolve(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) 
     assert scenario_path("cut_in_then_out") == SCENARIO_DIR / "cut_in_then_out.yaml"
     assert scenario_path("my/file.yaml") == Path("my/file.yaml")
     assert all(p.parent == SCENARIO_DIR and p.suffix == ".yaml" for p in bundled_scenarios())
-    monkeypatch.setattr(scenario_module, "SCENARIO_DIR", tmp_path)
+    monkeypatch.setattr(scenario_files, "SCENARIO_DIR", tmp_path)
     _write(tmp_path, MINIMAL, "minimal.yaml")
     assert load_scenario("minimal").name == "minimal"
     assert scenario_module.bundled_scenarios() == [tmp_path / "minimal.yaml"]
