@@ -17,11 +17,11 @@ def _clean(x: float) -> float | None:
 def result_json(result: RunResult, file: str | Path, recording: Path, profile: str) -> dict[
     str, object
 ]:
-    spec = result.spec
+    scenario = result.scenario
     return {
-        "scenario": spec.name,
+        "scenario": scenario.name,
         "file": str(file),
-        "seed": spec.seed,
+        "seed": scenario.seed,
         "profile": profile,
         "renderer": result.renderer,
         "passed": result.passed,

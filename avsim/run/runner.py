@@ -33,11 +33,12 @@ from avsim.criteria.speed import MaxDecel, SpeedLimit
 from avsim.record.recorder import Recorder
 from avsim.run.sensor_loop import FrameHook, SensorLoop, sensing_mode
 from avsim.run.stack import Stack, StackOutput
+from avsim.scenario.scenario import Scenario
 from planner.fsm.motion import TURNS
 from planner.messages import StateChange
 from world.core.client import PHYSICS_RATE, Rate
 from world.sensors.setup import Profile, sensor_setup
-from world.spec import FlatTire, ScenarioSpec
+from world.spec import FlatTire
 from world.truth import touching
 from world.world import World
 
@@ -95,7 +96,7 @@ class TrajectoryLog:
 
 @dataclass(frozen=True, slots=True, eq=False)
 class RunResult:
-    spec: ScenarioSpec
+    scenario: Scenario
     criteria: list[CriterionResult]
     metrics: dict[str, float]
     sim_time: float  # [s]
@@ -114,27 +115,28 @@ class RunResult:
 class Runner:
     """Runs one scenario to its end (duration, or `completes` reached) and judges it."""
 
-    def __init__(self, spec: ScenarioSpec, recording: Path | None = None,
+    def __init__(self, scenario: Scenario, recording: Path | None = None,
                  profile: Profile | None = Profile.DEFAULT, sensing: str = "auto",
                  frame_hook: FrameHook | None = None) -> None:
         """`profile`: the sensor set-up (None: no cameras or LiDAR, the stack drives on
         GNSS + odometry and the map); `sensing`: where cameras render ('auto', 'inline' or
         'process', see `world.sensors.pipeline`); `frame_hook`: alters the camera frames the stack
         gets (fault injection in tests)."""
-        self.spec = spec
+        self.scenario = scenario
+        spec = scenario.world
         self.setup = sensor_setup(profile, spec.sensors.lidar) if profile is not None else None
         mode = sensing_mode(sensing)
         self.world = World(spec, self.setup, cameras=mode == "inline")
         w = self.world
         self.car = w.ego.geometry
         front = self.setup.camera("front") if self.setup is not None else None
-        self.stack = Stack(w.road, spec.ego, self.car, front)
+        self.stack = Stack(w.road, spec.ego, scenario.driver, self.car, front)
         self.log = TrajectoryLog()
         names = {b: "building or sign" for b in w.scene.obstacle_bodies}
         names.update({b: "kerb" for b in w.scene.kerb_bodies})
         names.update({b: f"actor {a.id}" for b, a in zip(w.actors.bodies, spec.actors,
                                                           strict=True)})
-        reach = spec.criteria.reach_s
+        reach = scenario.criteria.reach_s
         self.completes = Completes(reach if reach is not None else w.road.length - END_MARGIN)
         self.collisions = NoCollision(names)
         crosswalks = Crosswalks(w.road)
@@ -145,7 +147,7 @@ class Runner:
                                      self.completes, *self._optional_criteria()])
         self._gap_criteria = crosswalks.needs_actors or any(
             isinstance(c, NEEDS_ACTORS) for c in self.criteria.items)
-        self.recorder = Recorder(recording, recording_name=spec.name) if recording else None
+        self.recorder = Recorder(recording, recording_name=scenario.name) if recording else None
         self.sensors = None if self.setup is None else SensorLoop(
             w, self.setup, self.stack, mode, self.recorder, frame_hook)
         self.state_changes: list[StateChange] = []
@@ -156,7 +158,7 @@ class Runner:
         self._turning = False  # the stack's motion FSM is in a turn
 
     def _optional_criteria(self) -> list[Criterion]:
-        c, road, length = self.spec.criteria, self.world.road, self.car.body_length
+        c, road, length = self.scenario.criteria, self.world.road, self.car.body_length
         items: list[Criterion] = []
         if c.max_decel is not None:
             items.append(MaxDecel(c.max_decel, CRITERIA_RATE.hz))
@@ -168,7 +170,8 @@ class Runner:
         if c.standstill_gap is not None:
             items.append(StandstillGap(*c.standstill_gap, road, length))
         if c.resume_within is not None:
-            items.append(TimeToResume(c.resume_within, self.spec.ego.set_speed, road, length))
+            items.append(TimeToResume(c.resume_within, self.scenario.driver.set_speed, road,
+                                      length))
         return items
 
     # -- the loop ------------------------------------------------------------------------------
@@ -178,7 +181,7 @@ class Runner:
         w = self.world
         if self.recorder is not None:
             self._record_static()
-        steps = round(self.spec.duration * PHYSICS_RATE)
+        steps = round(self.scenario.duration * PHYSICS_RATE)
         done_at: float | None = None
         try:
             # one control period per pass: decide on this snapshot, then hold the command
@@ -194,7 +197,7 @@ class Runner:
                 if done_at is not None and w.t >= done_at + SETTLE_AFTER_DONE:
                     break
                 if progress is not None and w.clock.step % PHYSICS_RATE == 0:
-                    progress(w.t, self.spec.duration)
+                    progress(w.t, self.scenario.duration)
         finally:
             if self.sensors is not None:
                 self.sensors.close()
@@ -204,7 +207,7 @@ class Runner:
             sim_time = w.t
             w.close()
         return RunResult(
-            spec=self.spec, criteria=self.criteria.results(), metrics=self._metrics(),
+            scenario=self.scenario, criteria=self.criteria.results(), metrics=self._metrics(),
             sim_time=sim_time, wall_time=time.perf_counter() - start, log=self.log,
             recording=self.recorder.path if self.recorder else None,
             state_changes=tuple(self.state_changes),
@@ -300,7 +303,8 @@ class Runner:
     def _flat_fired(self) -> bool:
         """A flat tyre event has happened to the ego (truth, for `completes`)."""
         return any(t is not None and isinstance(e.event, FlatTire)
-                   for t, e in zip(self.world.event_fired_at, self.spec.events, strict=True))
+                   for t, e in zip(self.world.event_fired_at, self.scenario.world.events,
+                                   strict=True))
 
     # -- results -------------------------------------------------------------------------------
 

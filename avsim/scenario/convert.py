@@ -37,6 +37,7 @@ from avsim.scenario.model import (
     TrafficLightFeature,
     TriggerModel,
 )
+from avsim.scenario.scenario import CriteriaSpec, DriverSettings, Scenario
 from world import frames, hdmap, spec
 from world.map.town import TownError, TownLayout, compile_route
 
@@ -44,14 +45,14 @@ MPS_PER_KPH = 1000.0 / 3600.0  # [m/s] per [km/h]
 TOWN_START_S = 5.0  # [m] default station of a car on its town route (past the start mouth)
 
 
-def convert(model: ScenarioModel) -> spec.ScenarioSpec:
-    """Check what spans several keys and convert the validated model into the world spec."""
+def convert(model: ScenarioModel) -> Scenario:
+    """Check what spans several keys and convert the validated model into a scenario."""
     if model.road is None:
         return _convert_town(model)
     road_spec = _road_spec(model.road)
     check_road(model, model.road, road_spec.segments)
-    return _scenario_spec(model, road_spec,
-                          tuple(_actor_spec(i, actor) for i, actor in enumerate(model.actors)))
+    return _scenario(model, road_spec,
+                     tuple(_actor_spec(i, actor) for i, actor in enumerate(model.actors)))
 
 
 def _kph(value: float) -> float:
@@ -187,40 +188,42 @@ def _sensors_spec(model: ScenarioModel) -> spec.SensorsSpec:
     )
 
 
-def _scenario_spec(model: ScenarioModel, road_spec: spec.RoadSpec,
-                   actors: tuple[spec.ActorSpec, ...],
-                   town: spec.TownSpec | None = None) -> spec.ScenarioSpec:
+def _scenario(model: ScenarioModel, road_spec: spec.RoadSpec,
+              actors: tuple[spec.ActorSpec, ...],
+              town: spec.TownSpec | None = None) -> Scenario:
     ego = model.ego
     criteria = model.criteria
-    return spec.ScenarioSpec(
+    world = spec.WorldSpec(
+        road=road_spec,
+        ego=spec.EgoSpec(
+            lane=given_or(ego.lane, 0),
+            s=float(given_or(ego.s, 0.0)) if town is None else given_or(ego.s, TOWN_START_S),
+            speed=_kph(ego.speed_kph),
+            max_speed=_kph(ego.max_speed_kph),
+        ),
+        seed=model.seed,
+        actors=actors,
+        sensors=_sensors_spec(model),
+        events=tuple(_event_spec(event) for event in model.events),
+        town=town,
+    )
+    return Scenario(
         name=model.name,
         description=model.description,
         situation=model.situation,
         duration=float(model.duration),
-        seed=model.seed,
-        road=road_spec,
-        ego=spec.EgoSpec(
-            lane=given_or(ego.lane, 0),
-            s=float(given_or(ego.s, 0.0)),
-            speed=_kph(ego.speed_kph),
-            set_speed=_kph(ego.set_speed_kph),
-            max_speed=_kph(ego.max_speed_kph),
-            overtake=ego.overtake,
-        ),
-        actors=actors,
-        sensors=_sensors_spec(model),
-        events=tuple(_event_spec(event) for event in model.events),
-        criteria=spec.CriteriaSpec(
+        world=world,
+        driver=DriverSettings(set_speed=_kph(ego.set_speed_kph), overtake=ego.overtake),
+        criteria=CriteriaSpec(
             min_gap=criteria.min_gap, max_decel=criteria.max_decel, reach_s=criteria.reach_s,
             lane_change=None if criteria.lane_change is None else (
                 criteria.lane_change.max_duration, criteria.lane_change.max_lateral_accel),
             standstill_gap=criteria.standstill_gap, resume_within=criteria.resume_within,
         ),
-        town=town,
     )
 
 
-def _convert_town(model: ScenarioModel) -> spec.ScenarioSpec:
+def _convert_town(model: ScenarioModel) -> Scenario:
     """A town: each car's `start` and `route` compile into its own route road
     (`world.map.town`); the ego's is the scenario's `road`."""
     assert model.town is not None  # the model has exactly one map
@@ -239,8 +242,7 @@ def _convert_town(model: ScenarioModel) -> spec.ScenarioSpec:
     actors = tuple(
         replace(_actor_spec(index, actor), s=given_or(actor.s, TOWN_START_S), road=road)
         for index, (actor, road) in enumerate(zip(model.actors, roads, strict=True)))
-    scenario = _scenario_spec(model, ego_road, actors, town)
-    return replace(scenario, ego=replace(scenario.ego, s=given_or(model.ego.s, TOWN_START_S)))
+    return _scenario(model, ego_road, actors, town)
 
 
 def _town_route(layout: TownLayout, key: str, start: tuple[int, int, str] | None,

@@ -1,8 +1,8 @@
 """Load a scenario file: find it, read its YAML, apply overrides, validate it strictly, refuse
 what is not simulated yet, check what spans several keys and convert it.
 
-`load_scenario(path_or_name)` returns a `world.spec.ScenarioSpec` (SI units, radians, every
-default resolved) or raises `ScenarioError`, whose message is one line
+`load_scenario(path_or_name)` returns a `Scenario` (`avsim.scenario.scenario`: SI units,
+radians, every default resolved) or raises `ScenarioError`, whose message is one line
 `<file>: <key.path>: <problem>`, e.g.
 
     scenarios/x.yaml: actors.0.lane: lane 3 does not exist at s = 55 m (the road has 2 lanes there)
@@ -33,8 +33,8 @@ from avsim.scenario.files import (
     shown_name,
 )
 from avsim.scenario.overrides import apply_overrides
+from avsim.scenario.scenario import Scenario
 from avsim.scenario.validation import validate
-from world import spec
 
 __all__ = ["UNSUPPORTED", "ScenarioError", "bundled_scenarios", "load_scenario", "scenario_path"]
 
@@ -49,7 +49,7 @@ UNSUPPORTED: dict[str, str] = {
 
 def load_scenario(
     path_or_name: str | Path, overrides: Mapping[str, object] | None = None
-) -> spec.ScenarioSpec:
+) -> Scenario:
     """Load, validate and convert a scenario file.
 
     `path_or_name` is a file path or the name of a bundled scenario (`scenarios/<name>.yaml`

@@ -7,8 +7,9 @@ coerced into a number (an integer is accepted where a float is expected), and ev
 carries a description with its unit and default, which the JSON Schema (`avsim schema`)
 shows. `avsim.scenario.load` validates a file with `ScenarioModel`
 (`avsim.scenario.validation`), applies the cross-field checks (lanes at a station, stations
-on the route, ...; `avsim.scenario.checks`) and converts it into `world.spec.ScenarioSpec`
-(SI units, radians, resolved defaults; `avsim.scenario.convert`).
+on the route, ...; `avsim.scenario.checks`) and converts it into a
+`avsim.scenario.scenario.Scenario` (SI units, radians, resolved defaults;
+`avsim.scenario.convert`).
 
 One-key mappings of the format (a segment `straight:` / `arc:`, a trigger `time:` / ...,
 an action `speed:` / ..., an event) are models whose alternatives are optional fields; a
