@@ -28,6 +28,7 @@ def result_json(result: RunResult, file: str | Path, recording: Path, profile: s
         "sim_time": round(result.sim_time, 4),
         "wall_time": round(result.wall_time, 3),
         "criteria": [c.as_json() for c in result.criteria],
+        "infractions": [i.as_json() for i in result.infractions],
         "metrics": {k: _clean(v) for k, v in result.metrics.items()},
         "state_changes": [
             {"t": round(c.t, 4), "machine": c.machine, "from": c.source, "to": c.target,

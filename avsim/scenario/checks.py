@@ -1,8 +1,8 @@
 """Checks that span several keys of a validated scenario file, which the models alone cannot
-make: a lane exists at its station, stations lie on the route, `after` names an earlier
-action, arcs are wider than the road, actor ids are unique, speeds fit the car, a speed
-action's acceleration has the sign its change of speed needs, and in a town every car
-starts on its route.
+make: a lane exists at its station, stations lie on the route (so does a criteria setting
+declared a station, `reach_s`), `after` names an earlier action, arcs are wider than the
+road, actor ids are unique, speeds fit the car, a speed action's acceleration has the sign
+its change of speed needs, and in a town every car starts on its route.
 
 Each check raises the first problem it finds as a `LocatedError` at its key; the order of
 the checks is the order in which a file's problems are reported. Stations are metres along
@@ -14,6 +14,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import TypeVar
 
+from avsim.criteria.registry import keyed
 from avsim.scenario.errors import LocatedError, fmt
 from avsim.scenario.model import ActorModel, RoadModel, ScenarioModel, TriggerModel
 from world import spec
@@ -46,8 +47,7 @@ def check_town(model: ScenarioModel, ego_road: spec.RoadSpec,
     length = route_length(ego_road.segments)
     for index, event in enumerate(model.events):
         _check_trigger(f"events.{index}.trigger", event.trigger, index, length, "event")
-    if model.criteria.reach_s is not None:
-        _check_station("criteria.reach_s", model.criteria.reach_s, length)
+    _check_criteria_stations(model, length)
     for key in ("speed_kph", "set_speed_kph"):
         if getattr(model.ego, key) > model.ego.max_speed_kph:
             raise LocatedError(f"ego.{key}", f"must be <= max_speed_kph "
@@ -201,8 +201,15 @@ def _check_rest(
             raise LocatedError(
                 f"events.{index}.trigger.gap", "only for actors (the gap to the ego)"
             )
-    if model.criteria.reach_s is not None:
-        _check_station("criteria.reach_s", model.criteria.reach_s, length)
+    _check_criteria_stations(model, length)
+
+
+def _check_criteria_stations(model: ScenarioModel, length: float) -> None:
+    """A criteria setting that is a station (`reach_s`) lies on the route."""
+    for declaration in keyed():
+        value = getattr(model.criteria, str(declaration.key))
+        if declaration.on_route and value is not None:
+            _check_station(f"criteria.{declaration.key}", value, length)
 
 
 def speed_accels(key: str, actor: ActorModel) -> dict[int, float]:

@@ -14,6 +14,7 @@ import math
 from collections.abc import Sequence
 from dataclasses import replace
 
+from avsim.criteria.registry import CriteriaSettings, keyed
 from avsim.scenario.checks import (
     DEFAULT_SPEED_UP,
     check_road,
@@ -37,7 +38,7 @@ from avsim.scenario.model import (
     TrafficLightFeature,
     TriggerModel,
 )
-from avsim.scenario.scenario import CriteriaSpec, DriverSettings, Scenario
+from avsim.scenario.scenario import DriverSettings, Scenario
 from world import frames, hdmap, spec
 from world.map.town import TownError, TownLayout, compile_route
 
@@ -192,7 +193,6 @@ def _scenario(model: ScenarioModel, road_spec: spec.RoadSpec,
               actors: tuple[spec.ActorSpec, ...],
               town: spec.TownSpec | None = None) -> Scenario:
     ego = model.ego
-    criteria = model.criteria
     world = spec.WorldSpec(
         road=road_spec,
         ego=spec.EgoSpec(
@@ -214,12 +214,8 @@ def _scenario(model: ScenarioModel, road_spec: spec.RoadSpec,
         duration=float(model.duration),
         world=world,
         driver=DriverSettings(set_speed=_kph(ego.set_speed_kph), overtake=ego.overtake),
-        criteria=CriteriaSpec(
-            min_gap=criteria.min_gap, max_decel=criteria.max_decel, reach_s=criteria.reach_s,
-            lane_change=None if criteria.lane_change is None else (
-                criteria.lane_change.max_duration, criteria.lane_change.max_lateral_accel),
-            standstill_gap=criteria.standstill_gap, resume_within=criteria.resume_within,
-        ),
+        criteria=CriteriaSettings.of({str(d.key): getattr(model.criteria, str(d.key))
+                                      for d in keyed()}),
     )
 
 

@@ -6,16 +6,15 @@ resolved); the runner, the batch jobs, the CLI and the reports take it. The worl
 (`world.spec.WorldSpec`: roads or a town, the ego car's body, actors, events, sensors, the
 seed) is what `world.World` is built from; the driver's settings configure the driving
 stack (`avsim.run.stack`); the criteria settings choose and tune the criteria
-(`avsim.criteria`).
+(`avsim.criteria.registry`).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+from avsim.criteria.registry import CriteriaSettings
 from world.spec import WorldSpec
-
-R157 = "r157"
 
 
 @dataclass(frozen=True, slots=True)
@@ -28,16 +27,6 @@ class DriverSettings:
 
 
 @dataclass(frozen=True, slots=True)
-class CriteriaSpec:
-    min_gap: float | str | None = None  # [m] or "r157"; None: criterion off
-    max_decel: float | None = None  # [m/s^2]; None: criterion off
-    reach_s: float | None = None  # [m]; None: end of route less 30 m
-    lane_change: tuple[float, float] | None = None  # ([s] duration, [m/s^2] lateral accel)
-    standstill_gap: tuple[float, float] | None = None  # [m] (low, high)
-    resume_within: float | None = None  # [s]
-
-
-@dataclass(frozen=True, slots=True)
 class Scenario:
     """One scenario: what the run simulates, for how long, and how it is judged."""
 
@@ -47,7 +36,7 @@ class Scenario:
     duration: float  # [s] simulated time limit
     world: WorldSpec
     driver: DriverSettings
-    criteria: CriteriaSpec = field(default_factory=CriteriaSpec)
+    criteria: CriteriaSettings = field(default_factory=CriteriaSettings)
 
     @property
     def seed(self) -> int:

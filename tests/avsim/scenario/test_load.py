@@ -13,6 +13,7 @@ import pytest
 import yaml
 from pydantic import BaseModel
 
+from avsim.criteria.registry import CriteriaSettings
 from avsim.scenario import convert as conversion
 from avsim.scenario import files as scenario_files
 from avsim.scenario import load as scenario_module
@@ -25,7 +26,7 @@ from avsim.scenario.load import (
     load_scenario,
     scenario_path,
 )
-from avsim.scenario.scenario import CriteriaSpec, DriverSettings
+from avsim.scenario.scenario import DriverSettings
 from avsim.scenario.schema import scenario_json_schema
 from tests.avsim.texts import MINIMAL
 from world import spec
@@ -264,7 +265,7 @@ def test_minimal_file_and_defaults(tmp_path: Path) -> None:
     assert loaded.driver == DriverSettings(set_speed=40 * KPH, overtake=False)
     assert loaded.world.seed == 0
     assert loaded.world.sensors == spec.SensorsSpec()
-    assert loaded.criteria == CriteriaSpec()
+    assert loaded.criteria == CriteriaSettings()
     assert loaded.world.actors == ()
     assert loaded.world.events == ()
 
@@ -306,7 +307,8 @@ def test_example_converts(tmp_path: Path) -> None:
         spec.EventSpec(spec.TimeTrigger(20.0), spec.AcceleratorOverride(pedal=1.0, duration=5.0)),
         spec.EventSpec(spec.TimeTrigger(38.0), spec.FlatTire(spec.Wheel.REAR_LEFT)),
     )
-    assert loaded.criteria == CriteriaSpec(min_gap="r157", max_decel=5.0, reach_s=560.0)
+    assert loaded.criteria == CriteriaSettings.of({"min_gap": "r157", "max_decel": 5.0,
+                                                   "reach_s": 560.0})
 
 
 def test_full_example_converts_once_everything_is_supported(
@@ -326,7 +328,7 @@ def test_full_example_converts_once_everything_is_supported(
         spec.TimeTrigger(38.0), spec.FlatTire(spec.Wheel.REAR_LEFT)
     )
     assert loaded.world.sensors.lidar == spec.LidarNoiseSpec(range_sigma=0.02, dropout=0.0)
-    assert loaded.criteria.min_gap == "r157"
+    assert loaded.criteria.get("min_gap") == "r157"
 
 
 @pytest.mark.parametrize("pattern", sorted(UNSUPPORTED))
