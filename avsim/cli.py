@@ -76,10 +76,10 @@ def run(scenario: str, out: Path | None, json_path: Path | None, profile: str, s
     """Run SCENARIO (a file or a bundled name) and judge it."""
     overrides = {"seed": seed} if seed is not None else None
     try:
-        spec = load_scenario(scenario, overrides)
+        loaded = load_scenario(scenario, overrides)
     except ScenarioError as exc:
         _bad_input(str(exc))
-    out = out if out is not None else Path("runs") / f"{spec.name}.rrd"
+    out = out if out is not None else Path("runs") / f"{loaded.name}.rrd"
     json_path = json_path if json_path is not None else out.with_suffix(".json")
     _writable(out, "--out")
     _writable(json_path, "--json")
@@ -95,8 +95,8 @@ def run(scenario: str, out: Path | None, json_path: Path | None, profile: str, s
 
     out.parent.mkdir(parents=True, exist_ok=True)
     partial = out.with_name(f".{out.name}.partial")
-    runner = Runner(spec, partial, None if profile == "none" else Profile(profile), sensing)
-    result = _run_with_progress(runner, spec.duration, not no_progress)
+    runner = Runner(loaded, partial, None if profile == "none" else Profile(profile), sensing)
+    result = _run_with_progress(runner, loaded.duration, not no_progress)
     partial.replace(out)
     payload = result_json(result, scenario, out, profile)
     write_atomic(json_path, json.dumps(payload, indent=2) + "\n")
@@ -115,7 +115,7 @@ def _run_with_progress(runner: Runner, duration: float, show: bool) -> RunResult
     columns = (TextColumn("[bold]{task.description}"), BarColumn(),
                TextColumn("{task.completed:.0f}/{task.total:.0f} s sim"), TimeElapsedColumn())
     with Progress(*columns, console=console, transient=True) as bar:
-        task = bar.add_task(runner.spec.name, total=duration)
+        task = bar.add_task(runner.scenario.name, total=duration)
         return runner.run(lambda t, _d: bar.update(task, completed=t))
 
 
@@ -140,11 +140,11 @@ def list_scenarios() -> None:
     """Bundled scenarios, one per line: name, situation, description."""
     for path in bundled_scenarios():
         try:
-            spec = load_scenario(path)
+            loaded = load_scenario(path)
         except ScenarioError as exc:
             click.echo(f"{path.stem}\t(invalid)\t{exc}")
             continue
-        click.echo(f"{spec.name}\t{spec.situation}\t{spec.description}")
+        click.echo(f"{loaded.name}\t{loaded.situation}\t{loaded.description}")
 
 
 @main.command()

@@ -55,8 +55,7 @@ def projection() -> float:
 
 
 def speed_planner() -> float:
-    spec = load_scenario("normal_driving")
-    road = build_road_map(spec.road)
+    road = build_road_map(load_scenario("normal_driving").world.road)
     planner = SpeedPlanner(road, road.lane(0), SpeedPlanningParams(),
                            vehicle_info(read_geometry()))
     stations = iter(np.tile(np.linspace(0.0, road.length, 1000), 20).tolist())
@@ -65,7 +64,7 @@ def speed_planner() -> float:
 
 
 def actors() -> float:
-    world = World(load_scenario("normal_driving"))
+    world = World(load_scenario("normal_driving").world)
     try:
         t = iter(np.arange(1, 20001) / 120.0)
         return best_per_call(lambda: world.actors.step(next(t), 1 / 120.0), 2000)

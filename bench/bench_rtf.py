@@ -31,7 +31,7 @@ SCENARIO = "normal_driving"
 
 def floor_rtf(log: TrajectoryLog) -> float:
     """Raw PyBullet stepping of the same scene, the run's joint commands replayed."""
-    world = World(load_scenario(SCENARIO))
+    world = World(load_scenario(SCENARIO).world)
     try:
         step, apply = world.client.stepSimulation, world.ego.apply
         every = CONTROL_RATE.every
@@ -49,10 +49,10 @@ def floor_rtf(log: TrajectoryLog) -> float:
 
 def stack_rtf(record: bool) -> tuple[float, RunResult]:
     """(RTF, the run) of a full run, with or without the recording."""
-    spec = load_scenario(SCENARIO)
+    scenario = load_scenario(SCENARIO)
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp) / "bench.rrd" if record else None
-        runner = Runner(spec, out, profile=None)  # issue A: no cameras or LiDAR
+        runner = Runner(scenario, out, profile=None)  # issue A: no cameras or LiDAR
         start = time.perf_counter()
         result = runner.run()
         wall = time.perf_counter() - start

@@ -53,11 +53,11 @@ def _timed(fn: Callable[..., Any], into: list[float]) -> Callable[..., Any]:
 def full_run(profile: Profile, seconds: float, record: bool) -> tuple[float, RunResult,
                                                                       dict[str, float]]:
     """(RTF, the run, stage latencies [ms]) of the closed loop."""
-    spec = dataclasses.replace(load_scenario(SCENARIO), duration=seconds)
+    scenario = dataclasses.replace(load_scenario(SCENARIO), duration=seconds)
     lanes: list[float] = []
     objects: list[float] = []
     with tempfile.TemporaryDirectory() as tmp:
-        runner = Runner(spec, Path(tmp) / "bench.rrd" if record else None, profile=profile)
+        runner = Runner(scenario, Path(tmp) / "bench.rrd" if record else None, profile=profile)
         stack = runner.stack
         assert stack.lane_detector is not None
         stack.lane_detector.detect = _timed(stack.lane_detector.detect, lanes)  # type: ignore[method-assign]
@@ -79,7 +79,7 @@ def full_run(profile: Profile, seconds: float, record: bool) -> tuple[float, Run
 def floor_rtf(profile: Profile, run: RunResult, mode: str) -> float:
     """Physics + the profile's sensors at their rates, the run's commands replayed."""
     setup = sensor_setup(profile)
-    world = World(run.spec, setup, cameras=mode == "inline")
+    world = World(run.scenario.world, setup, cameras=mode == "inline")
     sensing: Sensing = InlineSensing(world) if mode == "inline" else ProcessSensing(world, setup)
     schedule = SensorSchedule(setup)
     log = run.log

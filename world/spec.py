@@ -1,8 +1,11 @@
-"""The world's description of a scenario: validated, resolved, in SI units.
+"""What a world is built from: roads or a town, the ego car's body at its start, the actors
+and their scripts, the events that happen to the ego, the sensors' noise, and the seed of
+the world's randomness. Validated, resolved, in SI units.
 
-`avsim.scenario.load` parses and validates the user's YAML (the public format, with `*_kph` and
-`*_deg` keys and defaults) and converts it into these frozen dataclasses. Everything in
-`world/` builds from them; nothing here knows about files or YAML.
+`avsim.scenario` parses and validates the user's YAML (the public format, with `*_kph` and
+`*_deg` keys and defaults) and converts it into these frozen dataclasses (a scenario also
+has a name, a duration, the driver's settings and its criteria: `avsim.scenario.scenario`).
+Everything in `world/` builds from them; nothing here knows about files or YAML.
 
 Conventions: metres, seconds, radians, m/s. Stations `s` are metres along the route's
 reference line (the centre line of lane 0, the rightmost lane of the ego's direction) from
@@ -219,18 +222,19 @@ class EventSpec:
 
 
 # ---------------------------------------------------------------------------------------
-# Ego, sensors, criteria, the whole scenario
+# Ego, sensors, the whole world
 # ---------------------------------------------------------------------------------------
 
 
 @dataclass(frozen=True, slots=True)
 class EgoSpec:
+    """The ego car's body at the start (where the driver wants to go is not the world's:
+    `avsim.scenario.scenario.DriverSettings`)."""
+
     lane: int
     s: float  # [m] station of the car's centre
     speed: float  # [m/s] initial speed
-    set_speed: float  # [m/s] the driver's desired (cruise) speed
     max_speed: float  # [m/s] vehicle limit
-    overtake: bool = False  # may change lanes to pass a slower vehicle
 
 
 @dataclass(frozen=True, slots=True)
@@ -252,30 +256,14 @@ class SensorsSpec:
     lidar: LidarNoiseSpec = field(default_factory=LidarNoiseSpec)
 
 
-R157 = "r157"
-
-
 @dataclass(frozen=True, slots=True)
-class CriteriaSpec:
-    min_gap: float | str | None = None  # [m] or "r157"; None: criterion off
-    max_decel: float | None = None  # [m/s^2]; None: criterion off
-    reach_s: float | None = None  # [m]; None: end of route less 30 m
-    lane_change: tuple[float, float] | None = None  # ([s] duration, [m/s^2] lateral accel)
-    standstill_gap: tuple[float, float] | None = None  # [m] (low, high)
-    resume_within: float | None = None  # [s]
+class WorldSpec:
+    """A whole world: `World(spec)` builds it (`world.world`)."""
 
-
-@dataclass(frozen=True, slots=True)
-class ScenarioSpec:
-    name: str
-    description: str
-    situation: str
-    duration: float  # [s]
-    seed: int
-    road: RoadSpec
+    road: RoadSpec  # the ego's route (in a town: its route through the town)
     ego: EgoSpec
+    seed: int = 0  # of the world's randomness: scenery layout, sensor noise
     actors: tuple[ActorSpec, ...] = ()
     sensors: SensorsSpec = field(default_factory=SensorsSpec)
-    events: tuple[EventSpec, ...] = ()
-    criteria: CriteriaSpec = field(default_factory=CriteriaSpec)
+    events: tuple[EventSpec, ...] = ()  # what happens to the ego car
     town: TownSpec | None = None  # map kind 2: `road` is then the ego's route through it

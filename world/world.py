@@ -1,6 +1,6 @@
 """The physics world of one scenario: road, scenery, the ego car, NPCs and the GNSS/odometry.
 
-`World(spec)` builds everything from a `ScenarioSpec` into its own `BulletClient`; `step()`
+`World(spec)` builds everything from a `WorldSpec` into its own `BulletClient`; `step()`
 advances physics by one fixed 240 Hz step (ego forces, Bullet step, NPC behaviours, the
 ego's events). Ground truth for criteria and the recording is in `world.truth`; the stack
 only ever sees what `world.sensors.gnss` measures (the accelerator pedal an ego event holds is one
@@ -55,7 +55,7 @@ from world.sensors.gnss import GnssSensor, OdometrySensor
 from world.sensors.lidar import EGO_RAY_GROUP
 from world.sensors.rig import SensorRig
 from world.sensors.setup import SensorSetup
-from world.spec import ScenarioSpec, TownSpec, TrafficLightSpec
+from world.spec import TownSpec, TrafficLightSpec, WorldSpec
 from world.truth import RouteTruth, route_truth
 
 TRIGGER_RATE = Rate("npc_triggers", 40)  # NPC actions' and ego events' triggers checked
@@ -102,7 +102,7 @@ class WorldSnapshot:
 class World:
     """One scenario's world in its own physics client."""
 
-    def __init__(self, spec: ScenarioSpec, sensors: SensorSetup | None = None, *,
+    def __init__(self, spec: WorldSpec, sensors: SensorSetup | None = None, *,
                  cameras: bool = True, lidar: bool = True) -> None:
         """`sensors`: build a sensor rig in this client too, with its cameras (the renderer
         is attached before anything else, as EGL requires) and / or its LiDAR."""

@@ -23,7 +23,7 @@ from avsim.files import write_atomic
 from avsim.scenario.load import ScenarioError, load_scenario
 
 if TYPE_CHECKING:
-    from world.spec import ScenarioSpec
+    from avsim.scenario.scenario import Scenario
 
 
 class Status(Enum):
@@ -135,12 +135,12 @@ def run_job(job: RunJob, into: Path | None = None,
     the job's own paths either way. `progress` is called as the simulation advances."""
     start = time.perf_counter()
     try:
-        spec = load_scenario(job.scenario, dict(job.overrides))
+        scenario = load_scenario(job.scenario, dict(job.overrides))
     except ScenarioError as exc:
         return RunOutcome(job, Status.BAD_INPUT, error=str(exc),
                           wall_time=time.perf_counter() - start)
     try:
-        result = _simulate(job, spec, into or job.out_dir, progress)
+        result = _simulate(job, scenario, into or job.out_dir, progress)
     except Exception as exc:  # a crash is this run's outcome, not the batch's
         last = traceback.format_exception_only(exc)[-1].strip()
         return RunOutcome(job, Status.ERROR, error=f"{job.name}: {last}",
@@ -149,7 +149,7 @@ def run_job(job: RunJob, into: Path | None = None,
     return RunOutcome(job, status, result, wall_time=time.perf_counter() - start)
 
 
-def _simulate(job: RunJob, spec: ScenarioSpec, into: Path,
+def _simulate(job: RunJob, scenario: Scenario, into: Path,
               progress: ProgressCallback | None) -> dict[str, object]:
     from world.core.quiet import quiet_c_output
 
@@ -163,7 +163,7 @@ def _simulate(job: RunJob, spec: ScenarioSpec, into: Path,
     recording = into / job.recording.name
     partial = into / f".{recording.name}.partial"
     profile = None if job.profile == "none" else Profile(job.profile)
-    result = Runner(spec, partial, profile, job.sensing).run(progress)
+    result = Runner(scenario, partial, profile, job.sensing).run(progress)
     partial.replace(recording)
     payload = result_json(result, job.scenario, job.recording, job.profile)
     write_atomic(into / job.result_file.name, json.dumps(payload, indent=2) + "\n")

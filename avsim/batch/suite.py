@@ -59,14 +59,14 @@ def plan(entries: Sequence[tuple[str | None, str, Mapping[str, object]]], out_di
     planned: list[RunJob] = []
     names: dict[str, str] = {}
     for name, scenario, overrides in entries:
-        spec = load_scenario(scenario, dict(overrides))
-        job_name = name or spec.name
+        loaded = load_scenario(scenario, dict(overrides))
+        job_name = name or loaded.name
         if job_name in names:
             raise BatchError(f"{scenario}: name: {job_name!r} is also the name of "
                              f"{names[job_name]} (their files would collide in {out_dir})")
         names[job_name] = scenario
         planned.append(RunJob(job_name, scenario, out_dir, dict(overrides), profile,
-                              duration=spec.duration))
+                              duration=loaded.duration))
     return planned
 
 

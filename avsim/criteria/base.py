@@ -1,25 +1,47 @@
-"""The criteria's common types: the ground-truth sample they watch, a verdict, the base
-class and the set of a run.
+"""The criteria's common types: the ground-truth sample they watch, what they may need from
+the run, a verdict, an infraction, the base class and the set of a run.
 
 Each criterion sees a `TruthSample` at the criteria rate (and `no_collision` sees every
 contact onset) and keeps what it needs; `result()` returns a `CriterionResult`. The run's
-verdict is the conjunction. Definitions follow SCENARIO_FORMAT.md (default criteria) and
+verdict is the conjunction. When a criterion is broken it says so at once: an `Infraction`
+(when, which criterion, what happened, where), which the runner collects after each update
+and the recording logs at its sim time. A threshold criterion reports its first failure (a
+limit exceeded for several seconds is one infraction, at its start); an event that breaks a
+rule each time it happens (a contact, a stop line run, a red light entered, a wait too
+long) is reported every time. Definitions follow SCENARIO_FORMAT.md (default criteria) and
 the ICCAS normal-driving rule (tyres must not leave the lane).
 """
 
 from __future__ import annotations
 
+import enum
 import math
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, TypeVar
 
 import numpy as np
 from numpy.typing import NDArray
 
-from world.actors.actor_set import ActorPoses
+if TYPE_CHECKING:
+    from world.actors.actor_set import ActorPoses
 
 KPH = 1 / 3.6  # [m/s] per km/h
 SPEED_TOLERANCE_KPH = 1.0  # [km/h] the speed_limit rule's tolerance
 DECEL_WINDOW = 0.2  # [s] moving average of the max_decel criterion
+
+
+class Need(enum.Enum):
+    """What a criterion needs from the run besides the ego's truth in each sample. The
+    value is the name of the `avsim.criteria.declaration.RunInputs` field it is built from,
+    or (`ACTORS`) of the `TruthSample` field the run fills for it."""
+
+    MAP = "road"  # the route's static map (`world.hdmap.RoadMap`)
+    CAR = "car"  # the ego's geometry (`vehicle_urdf.CarGeometry`)
+    RATE = "rate"  # [Hz] the criteria rate
+    SIGNALS = "signals"  # the route's signal plans (`World.signals`, ground truth)
+    SET_SPEED = "set_speed"  # [m/s] the driver's set speed
+    BODIES = "bodies"  # what each body the ego may touch is (body id -> name)
+    ACTORS = "actors"  # the NPCs' true poses in every sample (costly: only when needed)
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -35,7 +57,8 @@ class TruthSample:
     tyre_offsets: NDArray[np.float64]  # [m] (4,) their offsets from the reference line, left +
     touching: frozenset[int]  # body ids in contact with the ego (ground excluded)
     offset: float = 0.0  # [m] ego centre offset from the reference line, left +
-    actors: ActorPoses | None = None  # every NPC now (for gap criteria)
+    actors: ActorPoses | None = None  # every NPC now; None unless a criterion needs them
+    #   (`Need.ACTORS`)
     lane: int = 0  # the lane the stack keeps, or moves into (its plan's command)
     origin_lane: int = 0  # the lane a commanded lane change leaves (== lane otherwise)
     turning: bool = False  # the stack's motion FSM is in a commanded turn (a town junction)
@@ -46,6 +69,22 @@ class TruthSample:
     #   centre as the front bumper is ahead of it (the body is centred on the car's centre)
     axle_stations: tuple[float, float] | None = None  # [m] (front, rear) axle stations;
     #   None: the centre station plus / less the criterion's axle distances
+    xy: tuple[float, float] | None = None  # [m] the ego's centre, map frame; None: unknown
+
+
+@dataclass(frozen=True, slots=True)
+class Infraction:
+    """A criterion broken at one moment, reported when it happens."""
+
+    t: float  # [s] sim time
+    kind: str  # the criterion's name (`no_collision`, `speed_limit`, ...)
+    message: str  # what happened, one line with its values and units
+    where: tuple[float, float] | None  # [m] map frame (x, y): the ego's centre then
+
+    def as_json(self) -> dict[str, object]:
+        where = None if self.where is None else [round(x, 3) + 0.0 for x in self.where]  # no -0
+        return {"t": round(self.t, 4), "kind": self.kind, "message": self.message,
+                "where": where}
 
 
 @dataclass(frozen=True, slots=True)
@@ -75,13 +114,17 @@ def _round(x: float) -> float:
 
 
 class Criterion:
-    """Base of the criteria: a name, a unit, `update` per sample and a `result`."""
+    """Base of the criteria: a name, a unit, `update` per sample and a `result`; failures
+    and infractions through `_fail` and `_infraction`."""
 
     name = ""
     unit = ""
 
     def __init__(self) -> None:
-        self.first_failure: float | None = None
+        self.first_failure: float | None = None  # [s]
+        self.idle = False  # this run gives it nothing to watch (no such feature on the map):
+        #   the samples need not carry what only it needs
+        self._new: list[Infraction] = []  # not yet taken by the run
 
     def update(self, sample: TruthSample) -> None:
         raise NotImplementedError
@@ -89,9 +132,25 @@ class Criterion:
     def result(self) -> CriterionResult:
         raise NotImplementedError
 
-    def _fail(self, t: float) -> None:
+    def take_infractions(self) -> list[Infraction]:
+        """The infractions since the last call, in the order they happened."""
+        new, self._new = self._new, []
+        return new
+
+    def _fail(self, sample: TruthSample, message: str) -> None:
+        """It fails now; its first failure is an infraction, later ones (the same
+        condition going on, or again) are not."""
         if self.first_failure is None:
-            self.first_failure = t
+            self._infraction(sample, message)
+
+    def _infraction(self, sample: TruthSample, message: str) -> None:
+        """An infraction now (it fails too): for an event that breaks the rule each time."""
+        if self.first_failure is None:
+            self.first_failure = sample.t
+        self._new.append(Infraction(sample.t, self.name, message, sample.xy))
+
+
+C = TypeVar("C", bound=Criterion)
 
 
 @dataclass
@@ -99,13 +158,23 @@ class CriteriaSet:
     """All criteria of a run; `verdict` is their conjunction."""
 
     items: list[Criterion] = field(default_factory=list)
+    needs: frozenset[Need] = frozenset()  # what the samples must carry for them
 
-    def update(self, sample: TruthSample) -> None:
+    def update(self, sample: TruthSample) -> list[Infraction]:
+        """Every criterion sees the sample; the infractions it brought, in criteria order."""
         for c in self.items:
             c.update(sample)
+        return [i for c in self.items for i in c.take_infractions()]
 
     def results(self) -> list[CriterionResult]:
         return [c.result() for c in self.items]
+
+    def find(self, kind: type[C]) -> C:
+        """The set's criterion of class `kind` (the first, if there are several)."""
+        for c in self.items:
+            if isinstance(c, kind):
+                return c
+        raise LookupError(f"the set has no {kind.__name__}")
 
     @property
     def passed(self) -> bool:

@@ -1,21 +1,30 @@
-"""Following criteria, against the vehicle ahead in the ego's lane: the gap while moving, the
-gap at a standstill, and the time to resume once the lane clears."""
+"""Following criteria, against the vehicle ahead in the ego's lane: the gap while moving
+(`min_gap`), the gap at a standstill (`standstill_gap`), and the time to resume once the
+lane clears (`resume_within`, criterion `time_to_resume`); each when the scenario sets
+its key. They read the NPCs' true poses (`Need.ACTORS`)."""
 
 from __future__ import annotations
 
 import math
+from typing import Annotated, Any, Literal
 
 import numpy as np
+from pydantic import AfterValidator, BeforeValidator, Field
 
 from avsim.criteria.base import (
     KPH,
     SPEED_TOLERANCE_KPH,
     Criterion,
     CriterionResult,
+    Need,
     TruthSample,
 )
+from avsim.criteria.declaration import Declaration
+from avsim.scenario.fields import NonNegFloat, PosFloat, problem
 from planner.fsm.acc import r157_min_gap
 from world.hdmap import RoadMap
+
+R157 = "r157"  # the min_gap setting for UN R157's d_min(v)
 
 
 class MinGap(Criterion):
@@ -32,7 +41,7 @@ class MinGap(Criterion):
     def __init__(self, threshold: float | str, road: RoadMap, ego_length: float,
                  grace: float = 10.0) -> None:
         super().__init__()
-        self.fixed = None if threshold == "r157" else float(threshold)
+        self.fixed = None if threshold == R157 else float(threshold)
         self.road = road
         self.ego_length = ego_length
         self.grace = grace
@@ -59,7 +68,7 @@ class MinGap(Criterion):
         if gap - d_min < self.margin:
             self.margin, self.gap, self.threshold = gap - d_min, gap, d_min
         if gap < d_min:
-            self._fail(sample.t)
+            self._fail(sample, f"gap {gap:.1f} m to {name} under {d_min:.1f} m")
 
     def result(self) -> CriterionResult:
         return CriterionResult(self.name, self.first_failure is None, self.gap,
@@ -111,7 +120,8 @@ class StandstillGap(Criterion):
             return
         self.gaps.append(gap)
         if not self.low <= gap <= self.high:
-            self._fail(sample.t)
+            self._fail(sample, f"standing {gap:.1f} m behind the vehicle ahead, outside "
+                               f"[{self.low:g}, {self.high:g}] m")
 
     def result(self) -> CriterionResult:
         if not self.gaps:
@@ -153,16 +163,18 @@ class TimeToResume(Criterion):
             g <= reach and a.speeds[a.ids.index(name)] < want - SPEED_TOLERANCE_KPH * KPH
             for name, g, _ in vehicles_ahead(sample, self.road, self.ego_length).values())
         if self._clear_at is not None and (not slow or blocking):
-            self._close(sample.t)
+            self._close(sample)
         if self._clear_at is None and slow and not blocking and self._was_blocked:
             self._clear_at = sample.t
         self._was_blocked = blocking
 
-    def _close(self, t: float) -> None:
+    def _close(self, sample: TruthSample) -> None:
         assert self._clear_at is not None
-        self.waits.append(t - self._clear_at)
-        if self.waits[-1] > self.threshold:
-            self._fail(t)
+        wait = sample.t - self._clear_at
+        self.waits.append(wait)
+        if wait > self.threshold:
+            self._infraction(sample, f"{wait:.1f} s to resume after the lane ahead cleared, "
+                                     f"over {self.threshold:g} s")
         self._clear_at = None
 
     def result(self) -> CriterionResult:
@@ -173,3 +185,43 @@ class TimeToResume(Criterion):
         value = max(waits)
         return CriterionResult(self.name, value <= self.threshold, value, self.threshold,
                                self.unit, self.first_failure)
+
+
+def _r157_or_metres(value: Any) -> Any:
+    is_number = isinstance(value, int | float) and not isinstance(value, bool)
+    if value == R157 or (is_number and value > 0):
+        return value
+    raise problem(f"must be r157 or a number of metres > 0, got {value!r}")
+
+
+def _low_below_high(value: tuple[float, float]) -> tuple[float, float]:
+    if not value[0] < value[1]:
+        raise problem(f"low must be below high, got {list(value)}")
+    return value
+
+
+MinGapSetting = Annotated[Literal["r157"] | PosFloat, BeforeValidator(_r157_or_metres)]
+StandstillGapSetting = Annotated[tuple[NonNegFloat, PosFloat], Field(strict=False),
+                                 AfterValidator(_low_below_high)]
+
+MIN_GAP: Declaration[float | str] = Declaration(
+    build=lambda threshold, run: [MinGap(threshold, run.road, run.car.body_length)],
+    needs=frozenset({Need.MAP, Need.CAR, Need.ACTORS}), key="min_gap", setting=MinGapSetting,
+    doc="`r157` (UN R157 d_min(v)) or a number [m] > 0: minimum bumper gap to the vehicle "
+    "ahead. Default: off.", example=R157)
+
+STANDSTILL_GAP: Declaration[tuple[float, float]] = Declaration(
+    build=lambda band, run: [StandstillGap(*band, run.road, run.car.body_length)],
+    needs=frozenset({Need.MAP, Need.CAR, Need.ACTORS}), key="standstill_gap",
+    setting=StandstillGapSetting,
+    doc="[m] `[low, high]`: the bumper gap to the vehicle ahead each time the ego stands "
+    "behind it; it must stand at least once. Default: off.", example=[2.0, 6.0])
+
+RESUME_WITHIN: Declaration[float] = Declaration(
+    build=lambda threshold, run: [TimeToResume(threshold, run.set_speed, run.road,
+                                               run.car.body_length)],
+    needs=frozenset({Need.MAP, Need.CAR, Need.SET_SPEED, Need.ACTORS}), key="resume_within",
+    setting=PosFloat,
+    doc="[s] once the lane ahead clears, the ego is back at its wanted speed within this, "
+    "> 0; the lane must clear at least once with the ego slowed. Default: off.",
+    example=15.0)

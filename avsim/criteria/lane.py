@@ -1,4 +1,6 @@
-"""Lane criteria: the tyres stay inside the lane markings; lane changes are quick and gentle."""
+"""Lane criteria: the tyres stay inside the lane markings (`tyres_in_lane`, always); lane
+changes are quick and gentle (`lane_change_duration` and `lane_change_lateral_accel`, when
+the scenario sets `lane_change`)."""
 
 from __future__ import annotations
 
@@ -7,16 +9,21 @@ from collections import deque
 
 import numpy as np
 from numpy.typing import NDArray
+from pydantic import Field
 
 from avsim.criteria.base import (
     DECEL_WINDOW,
     Criterion,
     CriterionResult,
+    Need,
     TruthSample,
 )
+from avsim.criteria.declaration import Declaration, RunInputs
+from avsim.scenario.fields import FormatModel, PosFloat
 from world.hdmap import RoadMap
 
 LINE_HALF_WIDTH = 0.075  # [m] half a painted lane line: a tyre touching paint is out
+TYRE_HALF_WIDTH = 0.105  # [m] half the tyre's tread (the URDF's wheel width)
 
 
 class TyresInLane(Criterion):
@@ -44,7 +51,8 @@ class TyresInLane(Criterion):
         margin -= self.tyre_half_width
         self.margin = min(self.margin, margin)
         if margin < 0:
-            self._fail(sample.t)
+            self._fail(sample, f"a tyre {-margin:.2f} m past the inner edge of the line (lane "
+                               f"{sample.lane})")
 
     def result(self) -> CriterionResult:
         return CriterionResult(self.name, self.margin >= 0, self.margin, 0.0, self.unit,
@@ -94,7 +102,8 @@ class LaneChangeDuration(Criterion):
                 self._left = sample.t
             return
         if sample.t - self._left > self.threshold:
-            self._fail(sample.t)
+            self._fail(sample, f"the lane change from lane {origin} to {target} takes over "
+                               f"{self.threshold:g} s")
         if np.min(lane_margins(self.road, sample, target, target)) >= w:
             self.durations.append(sample.t - self._left)
             self._change = self._left = None
@@ -136,9 +145,41 @@ class LaneChangeLateralAccel(Criterion):
             a = abs(sum(self.window) / len(self.window))
             self.peak = max(self.peak, a)
             if a > self.threshold:
-                self._fail(sample.t)
+                self._fail(sample, f"lane change lateral acceleration {a:.2f} m/s^2 over "
+                                   f"{self.threshold:g} m/s^2")
 
     def result(self) -> CriterionResult:
         return CriterionResult(self.name, self.changes > 0 and self.peak <= self.threshold,
                                self.peak, self.threshold, self.unit, self.first_failure,
                                None if self.changes else "no lane change was made")
+
+
+class LaneChangeSetting(FormatModel):
+    """Bounds on every commanded lane change; at least one must happen."""
+
+    max_duration: PosFloat = Field(
+        default=5.0,
+        description="[s] from the first tyre leaving the origin lane to all tyres inside the "
+        "target lane, > 0. Default 5.",
+    )
+    max_lateral_accel: PosFloat = Field(
+        default=1.0,
+        description="[m/s^2] the lateral acceleration the change adds (0.2 s average), > 0. "
+        "Default 1.",
+    )
+
+
+def _lane_change(setting: LaneChangeSetting, run: RunInputs) -> list[Criterion]:
+    return [LaneChangeDuration(run.road, TYRE_HALF_WIDTH, setting.max_duration),
+            LaneChangeLateralAccel(setting.max_lateral_accel, run.rate)]
+
+
+TYRES_IN_LANE: Declaration[None] = Declaration(
+    build=lambda _, run: [TyresInLane(run.road, TYRE_HALF_WIDTH)], needs=frozenset({Need.MAP}),
+    always=True)
+
+LANE_CHANGE: Declaration[LaneChangeSetting] = Declaration(
+    build=_lane_change, needs=frozenset({Need.MAP, Need.RATE}), key="lane_change",
+    setting=LaneChangeSetting,
+    doc="`{max_duration, max_lateral_accel}`: bounds on each lane change; at least one must "
+    "happen. Default: off.", example={"max_duration": 5.0, "max_lateral_accel": 1.0})

@@ -1,4 +1,6 @@
-"""Road rules at the map's features: stop lines, traffic lights, crosswalks, speed bumps."""
+"""Road rules at the map's features: stop lines (`stop_signs`), traffic lights
+(`red_lights`), crosswalks (`crosswalks`), speed bumps (`speed_bumps`). They always apply;
+a map without the feature gives them nothing to watch."""
 
 from __future__ import annotations
 
@@ -12,8 +14,10 @@ from avsim.criteria.base import (
     SPEED_TOLERANCE_KPH,
     Criterion,
     CriterionResult,
+    Need,
     TruthSample,
 )
+from avsim.criteria.declaration import Declaration
 from world.hdmap import Crosswalk, RoadMap, SpeedBump, StopSign
 from world.spec import ActorType, TrafficLightSpec
 
@@ -52,7 +56,8 @@ class StopSigns(Criterion):
             if front > s:
                 self._over[i] = self.judged[i] = True
                 if self.longest[i] < self.HOLD:  # over it without the stop
-                    self._fail(sample.t)
+                    self._infraction(sample, f"over the stop line at s = {s:.0f} m after a "
+                                             f"{self.longest[i]:.1f} s stop (1 s needed)")
             elif sample.speed < self.STOPPED and front >= s - self.ZONE:
                 since = self._since[i]
                 if since is None:
@@ -95,7 +100,8 @@ class RedLights(Criterion):
                 margin = _margin_to_red(light, sample.t)
                 self.margin = min(self.margin, margin)
                 if margin < 0.0:
-                    self._fail(sample.t)
+                    self._infraction(sample, f"entered the junction at s = {light.s:.0f} m "
+                                             f"{-margin:.1f} s into red")
 
     def result(self) -> CriterionResult:
         return CriterionResult(self.name, self.first_failure is None, self.margin, 0.0,
@@ -132,11 +138,7 @@ class Crosswalks(Criterion):
         self.crosswalks = [(f.s, f.s + f.width) for f in road.features
                            if isinstance(f, Crosswalk)]
         self.worst: float | None = None
-
-    @property
-    def needs_actors(self) -> bool:
-        """Whether it reads the actors (only when the map has a crosswalk)."""
-        return bool(self.crosswalks)
+        self.idle = not self.crosswalks  # no crosswalk: no pedestrians to watch
 
     def update(self, sample: TruthSample) -> None:
         a = sample.actors
@@ -159,7 +161,8 @@ class Crosswalks(Criterion):
             overlap = min(sample.front_station, c1) - max(rear, c0)
             self.worst = overlap if self.worst is None else max(self.worst, overlap)
             if overlap > 0.0:
-                self._fail(sample.t)
+                self._fail(sample, f"{overlap:.1f} m onto the crosswalk at s = {c0:.0f} m "
+                                   f"with a pedestrian on it")
 
     def _ego_lanes(self, sample: TruthSample, s: float) -> tuple[float, float]:
         """([m] right, [m] left) offsets of the band of ego-direction lanes the tyres are
@@ -206,9 +209,25 @@ class SpeedBumps(Criterion):
             excess = (sample.speed - pass_speed) / KPH
             self.worst = excess if self.worst is None else max(self.worst, excess)
             if excess > SPEED_TOLERANCE_KPH:
-                self._fail(sample.t)
+                self._fail(sample, f"speed {sample.speed / KPH:.1f} km/h over the bump "
+                                   f"{pass_speed / KPH:.0f} km/h by {excess:.1f} km/h")
 
     def result(self) -> CriterionResult:
         value = 0.0 if self.worst is None else self.worst
         return CriterionResult(self.name, self.first_failure is None, value,
                                SPEED_TOLERANCE_KPH, self.unit, self.first_failure)
+
+
+STOP_SIGNS: Declaration[None] = Declaration(
+    build=lambda _, run: [StopSigns(run.road)], needs=frozenset({Need.MAP}), always=True)
+
+RED_LIGHTS: Declaration[None] = Declaration(
+    build=lambda _, run: [RedLights(run.signals)], needs=frozenset({Need.SIGNALS}), always=True)
+
+CROSSWALKS: Declaration[None] = Declaration(
+    build=lambda _, run: [Crosswalks(run.road)], needs=frozenset({Need.MAP, Need.ACTORS}),
+    always=True)
+
+SPEED_BUMPS: Declaration[None] = Declaration(
+    build=lambda _, run: [SpeedBumps(run.road, run.car.front_axle, run.car.rear_axle)],
+    needs=frozenset({Need.MAP, Need.CAR}), always=True)

@@ -1,4 +1,6 @@
-"""`completes`: the ego gets where the route goes (or stops as a flat tyre demands)."""
+"""`completes`: the ego gets where the route goes (or stops as a flat tyre demands). It
+always applies; the scenario's `reach_s` sets the station to reach (default: the route's
+end less `END_MARGIN`)."""
 
 from __future__ import annotations
 
@@ -7,8 +9,13 @@ import math
 from avsim.criteria.base import (
     Criterion,
     CriterionResult,
+    Need,
     TruthSample,
 )
+from avsim.criteria.declaration import Declaration
+from avsim.scenario.fields import PosFloat
+
+END_MARGIN = 30.0  # [m] default station to reach: the route's end less this
 
 
 class Completes(Criterion):
@@ -42,3 +49,11 @@ class Completes(Criterion):
         note = "stopped after a flat tyre" if self.stopped_flat else None
         return CriterionResult(self.name, self.done, self.farthest, self.reach_s, self.unit,
                                note=note)
+
+
+COMPLETES: Declaration[float | None] = Declaration(
+    build=lambda reach_s, run: [Completes(reach_s if reach_s is not None
+                                          else run.road.length - END_MARGIN)],
+    needs=frozenset({Need.MAP}), key="reach_s", always=True, on_route=True, setting=PosFloat,
+    doc="[m] station the ego must reach, > 0, on the route. Default: the end of the route "
+    "less 30 m.", example=300.0)

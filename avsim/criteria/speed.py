@@ -1,4 +1,5 @@
-"""Speed criteria: the posted limit and the deceleration."""
+"""Speed criteria: the posted limit (`speed_limit`, always) and the deceleration
+(`max_decel`, when the scenario sets it)."""
 
 from __future__ import annotations
 
@@ -11,8 +12,11 @@ from avsim.criteria.base import (
     SPEED_TOLERANCE_KPH,
     Criterion,
     CriterionResult,
+    Need,
     TruthSample,
 )
+from avsim.criteria.declaration import Declaration
+from avsim.scenario.fields import PosFloat
 from world.hdmap import RoadMap
 
 
@@ -32,7 +36,8 @@ class SpeedLimit(Criterion):
         excess = (sample.speed - limit) / KPH
         self.excess = max(self.excess, excess)
         if excess > SPEED_TOLERANCE_KPH:
-            self._fail(sample.t)
+            self._fail(sample, f"speed {sample.speed / KPH:.1f} km/h over the limit "
+                               f"{limit / KPH:.0f} km/h by {excess:.1f} km/h")
 
     def result(self) -> CriterionResult:
         return CriterionResult(self.name, self.excess <= SPEED_TOLERANCE_KPH, self.excess,
@@ -58,8 +63,19 @@ class MaxDecel(Criterion):
             decel = (self._speeds[0] - self._speeds[-1]) * self._rate / self._window
             self.peak = max(self.peak, decel)
             if decel > self.threshold:
-                self._fail(sample.t)
+                self._fail(sample, f"deceleration {decel:.2f} m/s^2 over {self.threshold:g} "
+                                   f"m/s^2")
 
     def result(self) -> CriterionResult:
         return CriterionResult(self.name, self.peak <= self.threshold, self.peak,
                                self.threshold, self.unit, self.first_failure)
+
+
+SPEED_LIMIT: Declaration[None] = Declaration(
+    build=lambda _, run: [SpeedLimit(run.road)], needs=frozenset({Need.MAP}), always=True)
+
+MAX_DECEL: Declaration[float] = Declaration(
+    build=lambda threshold, run: [MaxDecel(threshold, run.rate)], needs=frozenset({Need.RATE}),
+    key="max_decel", setting=PosFloat,
+    doc="[m/s^2] the ego's deceleration (0.2 s average) never exceeds it, > 0. Default: off.",
+    example=5.0)

@@ -47,6 +47,7 @@ TRACK_VELOCITY = "/world/tracks/velocity"  # Arrows3D over sim_time: 1 s of moti
 PERCEPTION = "/world/perception"  # perception outputs in the map frame
 LANE_LINES = "/world/perception/lanes"  # LineStrips3D over sim_time: detected lane lines
 DETECTIONS = "/world/perception/detections"  # Boxes3D over sim_time: raw detections
+INFRACTIONS = "/world/infractions"  # Points3D over sim_time: every infraction so far, where
 METRICS = "/metrics"  # /metrics/<name>: Scalars over sim_time, SeriesLines static
 EVENTS = "/events"  # TextLog over sim_time
 FSM_ROOT = "/fsm"  # /fsm/<machine>: StateChange over sim_time (StateConfiguration static)

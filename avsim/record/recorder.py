@@ -40,9 +40,10 @@ Entity paths (constants in `avsim.record.blueprint`), map frame z up, SI units:
 | `/world/tracks/velocity` | Arrows3D from the box centres, 1 s of motion | buffered |
 | `/world/perception/lanes` | LineStrips3D: detected lane lines | buffered |
 | `/world/perception/detections` | Boxes3D wireframes, class = kind | buffered |
+| `/world/infractions` | Points3D: every infraction so far where it was, label = kind | direct |
 | `/metrics/<name>` | Scalars; SeriesLines (name, colour) | buffered; style static |
 | `/fsm/<machine>` | StateChange; StateConfiguration (optional) | direct; static |
-| `/events` | TextLog (also one line per FSM state change) | direct |
+| `/events` | TextLog: events, FSM state changes, infractions (ERROR) | direct |
 
 "Direct" data is logged with `RecordingStream.log` but, like all batched log calls, only
 becomes chunks at the sim-time flushes.
@@ -125,6 +126,10 @@ JPEG_QUALITY = 75  # [-] default JPEG quality of the camera images (1..100)
 RIDE_HEIGHT = 0.33  # [m] default height of the base link (`/world/ego`) over the ground
 IMAGE_PLANE_DISTANCE = 0.5  # [m] distance of a camera's image plane in the 3D views
 TEXT_LOG_LEVELS = frozenset({"TRACE", "DEBUG", "INFO", "WARN", "ERROR", "CRITICAL"})
+INFRACTION_HEIGHT = 2.5  # [m] of an infraction's marker over the ground: above the car's
+#   roof (1.4 m), which would hide a marker at the car's centre
+INFRACTION_RADIUS = 0.5  # [m]
+INFRACTION_RGB = (230, 30, 30)
 
 
 class MeshLike(Protocol):
@@ -339,6 +344,7 @@ class Recorder:
         self._detections = _BoxBuffer()
         self._lanes = _StripBuffer()
         self._cameras: dict[str, _CameraSetup] = {}  # name -> static set-up last logged
+        self._infractions: list[tuple[tuple[float, float, float], str]] = []  # marker, kind
         self.path.parent.mkdir(parents=True, exist_ok=True)
         # No wall-clock batching: batched log calls (static data, events) become chunks only
         # at the sim-time flushes, so identical runs give identically chunked files.
@@ -779,6 +785,22 @@ class Recorder:
             raise ValueError(f"log_event: level {level!r} not in {sorted(TEXT_LOG_LEVELS)}")
         self._rec.set_time(bp.TIMELINE, duration=t)
         self._rec.log(bp.EVENTS, rr.TextLog(text, level=level))
+
+    def log_infraction(self, t: float, kind: str, message: str,
+                       where: Sequence[float] | None) -> None:
+        """An infraction at sim time t [s]: an ERROR line `<kind>: <message>` at `/events`
+        and, when it happened at a place (`where`: map frame (x, y) [m]), a marker there at
+        `/world/infractions`, which from t on shows every infraction so far, labelled by
+        kind (the criterion's name)."""
+        self.log_event(t, f"{kind}: {message}", "ERROR")
+        if where is None:
+            return
+        self._infractions.append(((float(where[0]), float(where[1]), INFRACTION_HEIGHT), kind))
+        positions = [p for p, _ in self._infractions]
+        labels = [k for _, k in self._infractions]
+        self._rec.set_time(bp.TIMELINE, duration=t)
+        self._rec.log(bp.INFRACTIONS, rr.Points3D(positions, radii=INFRACTION_RADIUS,
+                                                  colors=INFRACTION_RGB, labels=labels))
 
     def flush(self) -> None:
         """Send the buffered columns now (normally done every FLUSH_INTERVAL and at close)."""

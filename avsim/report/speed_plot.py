@@ -105,15 +105,15 @@ def mode_runs(t: Sequence[float],
 def lead_speed(result: RunResult) -> FloatArray:
     """[m/s] per tick: the speed of the nearest car or truck ahead in the ego's lane (truth),
     NaN where there is none (see the module's doc for the rule)."""
-    log, spec = result.log, result.spec
+    log, world = result.log, result.scenario.world
     n = len(log.t)
-    vehicles = np.array([a.type.value in VEHICLES for a in spec.actors], dtype=bool)
+    vehicles = np.array([a.type.value in VEHICLES for a in world.actors], dtype=bool)
     if n < 2 or not vehicles.any() or len(log.actor_station) != n:
         return np.full(n, math.nan)
     t = log.array("t")
     stations = np.vstack(log.actor_station).astype(np.float64)  # (T, N)
     offsets = np.vstack(log.actor_offset).astype(np.float64)
-    road = build_road_map(spec.road)
+    road = build_road_map(world.road)
     ego_s = log.array("station")
     width = np.asarray(road.lane(0).width_at(ego_s), dtype=np.float64)
     ego_offset = np.asarray(log.lane, dtype=np.float64) * width + log.array("cross_track")
@@ -133,7 +133,7 @@ def lead_speed(result: RunResult) -> FloatArray:
 def _title(result: RunResult) -> str:
     failed = [c.name for c in result.criteria if not c.passed]
     verdict = "PASS" if not failed else "FAIL (" + ", ".join(failed) + ")"
-    return f"{result.spec.name} ({result.spec.situation}): {verdict}"
+    return f"{result.scenario.name} ({result.scenario.situation}): {verdict}"
 
 
 def _draw_bands(fig: Figure, ax: Axes, runs: list[tuple[str, float, float]],
@@ -170,7 +170,7 @@ def speed_profile_figure(result: RunResult) -> Figure:
         "ego": log.array("speed") * KPH,
         "lead": lead_speed(result) * KPH,
         "limit": np.where(np.isfinite(limit), limit, math.nan) * KPH,
-        "set": np.full(len(t), result.spec.ego.set_speed * KPH),
+        "set": np.full(len(t), result.scenario.driver.set_speed * KPH),
     }
     for key, values in series.items():
         label, colour, style, width = LINES[key]

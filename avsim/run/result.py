@@ -17,17 +17,18 @@ def _clean(x: float) -> float | None:
 def result_json(result: RunResult, file: str | Path, recording: Path, profile: str) -> dict[
     str, object
 ]:
-    spec = result.spec
+    scenario = result.scenario
     return {
-        "scenario": spec.name,
+        "scenario": scenario.name,
         "file": str(file),
-        "seed": spec.seed,
+        "seed": scenario.seed,
         "profile": profile,
         "renderer": result.renderer,
         "passed": result.passed,
         "sim_time": round(result.sim_time, 4),
         "wall_time": round(result.wall_time, 3),
         "criteria": [c.as_json() for c in result.criteria],
+        "infractions": [i.as_json() for i in result.infractions],
         "metrics": {k: _clean(v) for k, v in result.metrics.items()},
         "state_changes": [
             {"t": round(c.t, 4), "machine": c.machine, "from": c.source, "to": c.target,

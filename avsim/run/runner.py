@@ -7,6 +7,11 @@ Rates (all divide the 240 Hz physics rate; checked by `Rate`):
   (contact onsets) at 120 Hz;
 - the recording logs the ego pose, scalars and the plan at 20 Hz, NPC boxes at 10 Hz.
 
+The criteria are the scenario's set (`avsim.criteria.registry`); a sample carries the NPCs'
+true poses only when one of them needs them. After each sample the runner keeps the
+infractions the criteria report (the result's `infractions`), and the recording logs each at
+its sim time; the verdicts are logged at the end.
+
 Each control tick decides on one snapshot (the sensor frames of this tick), then the
 command is held on the joints for the next 6 physics steps.
 """
@@ -22,21 +27,20 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from avsim.criteria.base import CriteriaSet, Criterion, CriterionResult, TruthSample
+from avsim.criteria.base import CriterionResult, Infraction, Need, TruthSample
 from avsim.criteria.collision import NoCollision
-from avsim.criteria.following import MinGap, StandstillGap, TimeToResume
-from avsim.criteria.lane import LaneChangeDuration, LaneChangeLateralAccel, TyresInLane
-from avsim.criteria.road_rules import Crosswalks, RedLights, SpeedBumps, StopSigns
+from avsim.criteria.declaration import RunInputs
+from avsim.criteria.registry import build_criteria
 from avsim.criteria.route import Completes
-from avsim.criteria.speed import MaxDecel, SpeedLimit
 from avsim.record.recorder import Recorder
 from avsim.run.sensor_loop import FrameHook, SensorLoop, sensing_mode
 from avsim.run.stack import Stack, StackOutput
+from avsim.scenario.scenario import Scenario
 from planner.fsm.motion import TURNS
 from planner.messages import MACHINES, AccMode, HazardLights, Motion, Plan, SpeedSource, StateChange
 from world.core.client import PHYSICS_RATE, Rate
 from world.sensors.setup import Profile, sensor_setup
-from world.spec import FlatTire, ScenarioSpec
+from world.spec import FlatTire
 from world.truth import touching
 from world.world import World
 
@@ -48,9 +52,6 @@ RECORD_RATE = Rate("record", 20)
 ACTOR_RECORD_RATE = Rate("record_actors", 10)
 # criteria samples are taken at contact checks
 assert CRITERIA_RATE.every % CONTACT_RATE.every == 0, "criteria rate must divide the contacts'"
-END_MARGIN = 30.0  # [m] default `completes` station: the route's end less this
-TYRE_HALF_WIDTH = 0.105  # [m] half the tyre's tread (the URDF's wheel width)
-NEEDS_ACTORS = (MinGap, StandstillGap, TimeToResume)  # criteria that read the NPCs
 SETTLE_AFTER_DONE = 1.0  # [s] the run goes on this long after `completes` is reached
 
 ProgressCallback = Callable[[float, float], None]  # (sim time, duration) [s]
@@ -94,7 +95,7 @@ class TrajectoryLog:
 
 @dataclass(frozen=True, slots=True, eq=False)
 class RunResult:
-    spec: ScenarioSpec
+    scenario: Scenario
     criteria: list[CriterionResult]
     metrics: dict[str, float]
     sim_time: float  # [s]
@@ -102,6 +103,7 @@ class RunResult:
     log: TrajectoryLog
     recording: Path | None
     state_changes: tuple[StateChange, ...] = ()  # every FSM change, in time order
+    infractions: tuple[Infraction, ...] = ()  # every infraction, in time order
     profile: str | None = None  # the sensor profile (None: map + GNSS only)
     renderer: str | None = None  # "egl" or "tiny" when cameras rendered
 
@@ -113,62 +115,41 @@ class RunResult:
 class Runner:
     """Runs one scenario to its end (duration, or `completes` reached) and judges it."""
 
-    def __init__(self, spec: ScenarioSpec, recording: Path | None = None,
+    def __init__(self, scenario: Scenario, recording: Path | None = None,
                  profile: Profile | None = Profile.DEFAULT, sensing: str = "auto",
                  frame_hook: FrameHook | None = None) -> None:
         """`profile`: the sensor set-up (None: no cameras or LiDAR, the stack drives on
         GNSS + odometry and the map); `sensing`: where cameras render ('auto', 'inline' or
         'process', see `world.sensors.pipeline`); `frame_hook`: alters the camera frames the stack
         gets (fault injection in tests)."""
-        self.spec = spec
+        self.scenario = scenario
+        spec = scenario.world
         self.setup = sensor_setup(profile, spec.sensors.lidar) if profile is not None else None
         mode = sensing_mode(sensing)
         self.world = World(spec, self.setup, cameras=mode == "inline")
         w = self.world
         self.car = w.ego.geometry
         front = self.setup.camera("front") if self.setup is not None else None
-        self.stack = Stack(w.road, spec.ego, self.car, front)
+        self.stack = Stack(w.road, spec.ego, scenario.driver, self.car, front)
         self.log = TrajectoryLog()
         names = {b: "building or sign" for b in w.scene.obstacle_bodies}
         names.update({b: "kerb" for b in w.scene.kerb_bodies})
         names.update({b: f"actor {a.id}" for b, a in zip(w.actors.bodies, spec.actors,
                                                           strict=True)})
-        reach = spec.criteria.reach_s
-        self.completes = Completes(reach if reach is not None else w.road.length - END_MARGIN)
-        self.collisions = NoCollision(names)
-        crosswalks = Crosswalks(w.road)
-        self.criteria = CriteriaSet([self.collisions, TyresInLane(w.road, TYRE_HALF_WIDTH),
-                                     SpeedLimit(w.road), StopSigns(w.road), RedLights(w.signals),
-                                     crosswalks,
-                                     SpeedBumps(w.road, self.car.front_axle, self.car.rear_axle),
-                                     self.completes, *self._optional_criteria()])
-        self._gap_criteria = crosswalks.needs_actors or any(
-            isinstance(c, NEEDS_ACTORS) for c in self.criteria.items)
-        self.recorder = Recorder(recording, recording_name=spec.name) if recording else None
+        self.criteria = build_criteria(scenario.criteria, RunInputs(
+            road=w.road, car=self.car, rate=CRITERIA_RATE.hz, signals=w.signals,
+            set_speed=scenario.driver.set_speed, bodies=names))
+        self.completes = self.criteria.find(Completes)  # reached: the run may end
+        self.collisions = self.criteria.find(NoCollision)  # its count is a metric
+        self.infractions: list[Infraction] = []
+        self.recorder = Recorder(recording, recording_name=scenario.name) if recording else None
         self.sensors = None if self.setup is None else SensorLoop(
             w, self.setup, self.stack, mode, self.recorder, frame_hook)
         self.state_changes: list[StateChange] = []
         self._touching: frozenset[int] = frozenset()
-        self._logged_events = 0  # collision events already sent to the recording
         self._last: StackOutput | None = None
         self._lane = self._origin_lane = spec.ego.lane  # the stack's lane command
         self._turning = False  # the stack's motion FSM is in a turn
-
-    def _optional_criteria(self) -> list[Criterion]:
-        c, road, length = self.spec.criteria, self.world.road, self.car.body_length
-        items: list[Criterion] = []
-        if c.max_decel is not None:
-            items.append(MaxDecel(c.max_decel, CRITERIA_RATE.hz))
-        if c.min_gap is not None:
-            items.append(MinGap(c.min_gap, road, length))
-        if c.lane_change is not None:
-            items += [LaneChangeDuration(road, TYRE_HALF_WIDTH, c.lane_change[0]),
-                      LaneChangeLateralAccel(c.lane_change[1], CRITERIA_RATE.hz)]
-        if c.standstill_gap is not None:
-            items.append(StandstillGap(*c.standstill_gap, road, length))
-        if c.resume_within is not None:
-            items.append(TimeToResume(c.resume_within, self.spec.ego.set_speed, road, length))
-        return items
 
     # -- the loop ------------------------------------------------------------------------------
 
@@ -177,7 +158,7 @@ class Runner:
         w = self.world
         if self.recorder is not None:
             self._record_static()
-        steps = round(self.spec.duration * PHYSICS_RATE)
+        steps = round(self.scenario.duration * PHYSICS_RATE)
         done_at: float | None = None
         try:
             # one control period per pass: decide on this snapshot, then hold the command
@@ -193,7 +174,7 @@ class Runner:
                 if done_at is not None and w.t >= done_at + SETTLE_AFTER_DONE:
                     break
                 if progress is not None and w.clock.step % PHYSICS_RATE == 0:
-                    progress(w.t, self.spec.duration)
+                    progress(w.t, self.scenario.duration)
         finally:
             if self.sensors is not None:
                 self.sensors.close()
@@ -203,10 +184,10 @@ class Runner:
             sim_time = w.t
             w.close()
         return RunResult(
-            spec=self.spec, criteria=self.criteria.results(), metrics=self._metrics(),
+            scenario=self.scenario, criteria=self.criteria.results(), metrics=self._metrics(),
             sim_time=sim_time, wall_time=time.perf_counter() - start, log=self.log,
             recording=self.recorder.path if self.recorder else None,
-            state_changes=tuple(self.state_changes),
+            state_changes=tuple(self.state_changes), infractions=tuple(self.infractions),
             profile=self.setup.profile.value if self.setup is not None else None,
             renderer=self.sensors.sensing.renderer.value if self.sensors is not None else None,
         )
@@ -277,23 +258,21 @@ class Runner:
         if now != self._touching:
             self._touching = now
             self._sample()
-            new = self.collisions.events[self._logged_events:]
-            self._logged_events = len(self.collisions.events)
-            for t, what in new:
-                if self.recorder is not None:
-                    self.recorder.log_event(t, f"collision with {what}", "ERROR")
         elif CRITERIA_RATE.fires(step):
             self._sample()
 
     def _sample(self) -> None:
+        """The criteria see the truth now (with the NPCs' poses only when one needs them);
+        the infractions they report are kept and logged at their time."""
         w = self.world
         truth, route = w.ego_truth, w.ego_route
-        self.criteria.update(TruthSample(
+        actors = w.actors.poses if Need.ACTORS in self.criteria.needs else None
+        infractions = self.criteria.update(TruthSample(
             t=w.t, speed=truth.speed, station=route.station,
             front_station=route.station + self.car.front_overhang,
             tyres=route.tyres, tyre_stations=route.tyre_stations,
             tyre_offsets=route.tyre_offsets, touching=self._touching,
-            offset=float(route.offsets[0]), actors=w.actors.poses if self._gap_criteria else None,
+            offset=float(route.offsets[0]), actors=actors,
             lane=self._lane, origin_lane=self._origin_lane, turning=self._turning,
             lateral_accel=truth.speed * truth.yaw_rate,
             road_curvature=float(w.road.curvature_at(route.station)),
@@ -301,12 +280,18 @@ class Runner:
             axle_stations=(float(route.stations[1]),
                            float(np.mean(route.stations[4:6]))),
             flat=self._flat_fired(),
+            xy=(float(truth.position[0]), float(truth.position[1])),
         ))
+        self.infractions += infractions
+        if self.recorder is not None:
+            for i in infractions:
+                self.recorder.log_infraction(i.t, i.kind, i.message, i.where)
 
     def _flat_fired(self) -> bool:
         """A flat tyre event has happened to the ego (truth, for `completes`)."""
         return any(t is not None and isinstance(e.event, FlatTire)
-                   for t, e in zip(self.world.event_fired_at, self.spec.events, strict=True))
+                   for t, e in zip(self.world.event_fired_at, self.scenario.world.events,
+                                   strict=True))
 
     # -- results -------------------------------------------------------------------------------
 

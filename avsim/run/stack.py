@@ -15,6 +15,7 @@ from __future__ import annotations
 import bisect
 from dataclasses import dataclass
 
+from avsim.scenario.scenario import DriverSettings
 from control.actuation import VehicleParams
 from control.command import VehicleCommand
 from control.stanley import MAX_STEER, StanleyParams
@@ -69,16 +70,17 @@ class PerceptionOutput:
 class Stack:
     """Localizer, lane and object perception, lane-keeping planner, vehicle controller."""
 
-    def __init__(self, road: RoadMap, ego: EgoSpec, car: CarGeometry,
+    def __init__(self, road: RoadMap, ego: EgoSpec, driver: DriverSettings, car: CarGeometry,
                  front_camera: CameraInfo | None = None) -> None:
-        """`front_camera`: the camera the lane is found in; None for a map-only stack."""
+        """`ego`: the car's start and limits; `driver`: what the driver asks of the stack;
+        `front_camera`: the camera the lane is found in; None for a map-only stack."""
         self.localizer = Localizer()
         vehicle = vehicle_info(car)
         self.planner = Planner(
-            road, PlannerParams(set_speed=ego.set_speed, max_speed=ego.max_speed,
+            road, PlannerParams(set_speed=driver.set_speed, max_speed=ego.max_speed,
                                 vehicle=vehicle, lane=ego.lane,
                                 camera=front_camera is not None,
-                                motion=MotionLayerParams(overtake=ego.overtake))
+                                motion=MotionLayerParams(overtake=driver.overtake))
         )
         lateral = StanleyParams(
             wheelbase=car.wheelbase, centre_to_front_axle=car.front_axle,

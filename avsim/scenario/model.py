@@ -5,9 +5,11 @@ The models mirror the YAML exactly, key for key, in the file's units (`*_kph` km
 degrees, everything else SI). They are strict: unknown keys are rejected, text is never
 coerced into a number (an integer is accepted where a float is expected), and every field
 carries a description with its unit and default, which the JSON Schema (`avsim schema`)
-shows. `avsim.scenario.load` validates a file with `ScenarioModel`, applies the cross-field
-checks (lanes at a station, stations on the route, ...) and converts it into
-`world.spec.ScenarioSpec` (SI units, radians, resolved defaults).
+shows. `avsim.scenario.load` validates a file with `ScenarioModel`
+(`avsim.scenario.validation`), applies the cross-field checks (lanes at a station, stations
+on the route, ...; `avsim.scenario.checks`) and converts it into a
+`avsim.scenario.scenario.Scenario` (SI units, radians, resolved defaults;
+`avsim.scenario.convert`).
 
 One-key mappings of the format (a segment `straight:` / `arc:`, a trigger `time:` / ...,
 an action `speed:` / ..., an event) are models whose alternatives are optional fields; a
@@ -18,10 +20,20 @@ the message (`problem`) and optionally the offending key (`key`) below the model
 
 from __future__ import annotations
 
-from typing import Annotated, Any, Literal
+from typing import TYPE_CHECKING, Annotated, Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
-from pydantic_core import PydanticCustomError
+from pydantic import BaseModel, ConfigDict, Field, create_model, field_validator, model_validator
+
+from avsim.criteria.registry import keyed
+from avsim.scenario.fields import (
+    FormatModel,
+    Fraction,
+    NonNegFloat,
+    NonNegInt,
+    PosFloat,
+    PosInt,
+    problem,
+)
 
 FORMAT = "avsim/1"
 NAME_PATTERN = r"^[a-z0-9_]+$"
@@ -49,34 +61,12 @@ TRIGGER_KINDS = ("time", "ego_s", "gap", "after")
 ACTION_KINDS = ("speed", "lane_change", "walk", "stop")
 EVENT_KINDS = ("accelerator_override", "flat_tire")
 
-# Constrained scalars. Strict mode (model config) refuses text for numbers and floats for
-# ints; a float field accepts an int.
-PosFloat = Annotated[float, Field(gt=0)]
-NonNegFloat = Annotated[float, Field(ge=0)]
-NonNegInt = Annotated[int, Field(ge=0)]
-PosInt = Annotated[int, Field(ge=1)]
-Fraction = Annotated[float, Field(ge=0, le=1)]
 Identifier = Annotated[str, Field(pattern=NAME_PATTERN)]
-
-
-def problem(message: str, key: str | None = None) -> PydanticCustomError:
-    """A validation error with a ready-made message; `key` (if given) is the offending key
-    below the location of the model that raises it. `avsim.scenario.load` formats it."""
-    context: dict[str, Any] = {"problem": message}
-    if key is not None:
-        context["key"] = key
-    return PydanticCustomError("avsim", "{problem}", context)
 
 
 def _one_of(names: tuple[str, ...]) -> dict[str, Any]:
     """JSON Schema fragment: exactly one of `names` is present."""
     return {"oneOf": [{"required": [name]} for name in names]}
-
-
-class _Model(BaseModel):
-    """Base of every scenario model: strict, no unknown keys, no NaN/inf, immutable."""
-
-    model_config = ConfigDict(strict=True, extra="forbid", allow_inf_nan=False, frozen=True)
 
 
 def _present(model: BaseModel, names: tuple[str, ...]) -> list[str]:
@@ -118,7 +108,7 @@ def _exactly_one(model: BaseModel, kinds: tuple[str, ...], what: str) -> str:
 # ---------------------------------------------------------------------------------------
 
 
-class ArcModel(_Model):
+class ArcModel(FormatModel):
     """A constant-curvature arc of the route's reference line (lane 0's centre line)."""
 
     radius: PosFloat = Field(
@@ -138,7 +128,7 @@ class ArcModel(_Model):
         return value
 
 
-class SegmentModel(_Model):
+class SegmentModel(FormatModel):
     """One piece of the route, `- straight: 300` or `- {arc: {radius, angle_deg}, ...}`."""
 
     model_config = ConfigDict(json_schema_extra=_one_of(("straight", "arc")))
@@ -186,7 +176,7 @@ class SegmentModel(_Model):
         return self
 
 
-class SpeedLimitFeature(_Model):
+class SpeedLimitFeature(FormatModel):
     """A speed limit sign: the limit applies from its station on."""
 
     type: Literal["speed_limit"] = Field(description="Feature type `speed_limit`.")
@@ -194,14 +184,14 @@ class SpeedLimitFeature(_Model):
     kph: PosFloat = Field(description="[km/h] the posted limit; required, > 0.")
 
 
-class StopSignFeature(_Model):
+class StopSignFeature(FormatModel):
     """A stop line across the route with a stop sign on the right."""
 
     type: Literal["stop_sign"] = Field(description="Feature type `stop_sign`.")
     s: NonNegFloat = Field(description="[m] station of the stop line; required, on the route.")
 
 
-class CrosswalkFeature(_Model):
+class CrosswalkFeature(FormatModel):
     """A zebra crossing from `s` to `s + width`."""
 
     type: Literal["crosswalk"] = Field(description="Feature type `crosswalk`.")
@@ -209,7 +199,7 @@ class CrosswalkFeature(_Model):
     width: PosFloat = Field(default=4.0, description="[m] extent along the route, > 0. Default 4.")
 
 
-class SpeedBumpFeature(_Model):
+class SpeedBumpFeature(FormatModel):
     """A speed bump across the road."""
 
     type: Literal["speed_bump"] = Field(description="Feature type `speed_bump`.")
@@ -223,7 +213,7 @@ class SpeedBumpFeature(_Model):
     )
 
 
-class TrafficLightFeature(_Model):
+class TrafficLightFeature(FormatModel):
     """A traffic light with a stop line; a fixed green-yellow-red cycle. Not supported yet."""
 
     type: Literal["traffic_light"] = Field(description="Feature type `traffic_light`.")
@@ -243,7 +233,7 @@ FeatureModel = Annotated[
 ]
 
 
-class BuildingsModel(_Model):
+class BuildingsModel(FormatModel):
     """Scenery buildings along both sides of the road."""
 
     density: Fraction = Field(
@@ -256,7 +246,7 @@ class BuildingsModel(_Model):
     )
 
 
-class RoadModel(_Model):
+class RoadModel(FormatModel):
     """Map kind 1: one route road of straight and arc segments laid end to end from the
     origin, heading +x."""
 
@@ -286,7 +276,7 @@ class RoadModel(_Model):
     )
 
 
-class TownModel(_Model):
+class TownModel(FormatModel):
     """Map kind 2: a grid town of two-way streets, junctions, stop signs and lights."""
 
     blocks_x: PosInt = Field(description="Blocks along x, >= 1; required.")
@@ -314,7 +304,7 @@ TownStart = Annotated[
 # ---------------------------------------------------------------------------------------
 
 
-class TriggerModel(_Model):
+class TriggerModel(FormatModel):
     """When an action or event fires: `{time: t}`, `{ego_s: s}`, `{gap: d}` or
     `{after: i, delay: t}`. It fires once, when it first holds."""
 
@@ -357,7 +347,7 @@ class TriggerModel(_Model):
         return _present(self, TRIGGER_KINDS)[0]
 
 
-class SpeedActionModel(_Model):
+class SpeedActionModel(FormatModel):
     """Change speed to `kph` at a signed acceleration."""
 
     kph: NonNegFloat = Field(description="[km/h] target speed, >= 0; required.")
@@ -376,7 +366,7 @@ class SpeedActionModel(_Model):
         return value
 
 
-class LaneChangeActionModel(_Model):
+class LaneChangeActionModel(FormatModel):
     """Move to another lane at a constant lateral speed."""
 
     to_lane: int = Field(description="Target lane index; required, must exist.")
@@ -385,7 +375,7 @@ class LaneChangeActionModel(_Model):
     )
 
 
-class WalkActionModel(_Model):
+class WalkActionModel(FormatModel):
     """Walk across the road to a lateral offset from the actor's lane centre, at a walking
     speed (reached and left at 1.5 m/s^2), facing the walking direction; then stand."""
 
@@ -396,7 +386,7 @@ class WalkActionModel(_Model):
     speed_kph: PosFloat = Field(default=5.0, description="[km/h] walking speed, > 0. Default 5.")
 
 
-class StopActionModel(_Model):
+class StopActionModel(FormatModel):
     """Brake to a standstill, written `stop: {}`."""
 
     decel: PosFloat = Field(
@@ -404,7 +394,7 @@ class StopActionModel(_Model):
     )
 
 
-class ActionModel(_Model):
+class ActionModel(FormatModel):
     """One scripted action of an actor: a `trigger` and exactly one action key."""
 
     model_config = ConfigDict(json_schema_extra=_one_of(ACTION_KINDS))
@@ -440,7 +430,7 @@ class ActionModel(_Model):
         return _present(self, ACTION_KINDS)[0]
 
 
-class AcceleratorOverrideModel(_Model):
+class AcceleratorOverrideModel(FormatModel):
     """An external disturbance: the accelerator pedal is held at `pedal` for `duration`
     seconds, then released. The car is drive-by-wire: the pedal is a sensor the driving stack
     reads and arbitrates (its speed limiter); the world adds no torque for it."""
@@ -449,7 +439,7 @@ class AcceleratorOverrideModel(_Model):
     duration: PosFloat = Field(description="[s] how long, > 0; required.")
 
 
-class FlatTireModel(_Model):
+class FlatTireModel(FormatModel):
     """A tyre goes flat."""
 
     wheel: WheelName = Field(
@@ -457,7 +447,7 @@ class FlatTireModel(_Model):
     )
 
 
-class EventModel(_Model):
+class EventModel(FormatModel):
     """Something that happens to the ego car: a `trigger` (not `gap`: there is no actor)
     and exactly one event key. `accelerator_override` is simulated; `flat_tire` is not
     supported yet."""
@@ -492,7 +482,7 @@ class EventModel(_Model):
 # ---------------------------------------------------------------------------------------
 
 
-class EgoModel(_Model):
+class EgoModel(FormatModel):
     """The car under test. On a road: `lane` and `s`; in a town: `start` and `route`."""
 
     lane: NonNegInt | None = Field(
@@ -530,7 +520,7 @@ class EgoModel(_Model):
     )
 
 
-class ActorModel(_Model):
+class ActorModel(FormatModel):
     """Another road user or a static obstacle."""
 
     id: Identifier = Field(description="Unique name, [a-z0-9_]+; required.")
@@ -566,7 +556,7 @@ class ActorModel(_Model):
     )
 
 
-class GnssModel(_Model):
+class GnssModel(FormatModel):
     """GNSS / odometry noise."""
 
     sigma: NonNegFloat = Field(
@@ -581,7 +571,7 @@ class GnssModel(_Model):
     ] = Field(default=(0.0, 0.0), description="[m] constant (x, y) offset. Default [0, 0].")
 
 
-class LidarModel(_Model):
+class LidarModel(FormatModel):
     """LiDAR noise (the beam layout comes from `--profile`)."""
 
     range_sigma: NonNegFloat = Field(
@@ -592,7 +582,7 @@ class LidarModel(_Model):
     )
 
 
-class SensorsModel(_Model):
+class SensorsModel(FormatModel):
     """Sensor noise; keys left out come from the run's `--profile`."""
 
     gnss: GnssModel | None = Field(
@@ -603,70 +593,23 @@ class SensorsModel(_Model):
     )
 
 
-class LaneChangeCriteriaModel(_Model):
-    """Bounds on every commanded lane change; at least one must happen."""
-
-    max_duration: PosFloat = Field(
-        default=5.0,
-        description="[s] from the first tyre leaving the origin lane to all tyres inside the "
-        "target lane, > 0. Default 5.",
-    )
-    max_lateral_accel: PosFloat = Field(
-        default=1.0,
-        description="[m/s^2] the lateral acceleration the change adds (0.2 s average), > 0. "
-        "Default 1.",
-    )
+def _criteria_model() -> type[FormatModel]:
+    """The `criteria:` section: one optional key per criteria declaration that has one
+    (`avsim.criteria.registry`), with the declaration's setting type and description."""
+    fields: dict[str, Any] = {
+        str(d.key): (d.setting | None,
+                     Field(default=None, description=d.doc, examples=[d.example]))
+        for d in keyed()
+    }
+    return create_model("CriteriaModel", __base__=FormatModel, __module__=__name__,
+                        __doc__="Optional criteria; the default criteria always apply.",
+                        **fields)
 
 
-class CriteriaModel(_Model):
-    """Optional criteria; the default criteria always apply."""
-
-    min_gap: Literal["r157"] | PosFloat | None = Field(
-        default=None,
-        description="`r157` (UN R157 d_min(v)) or a number [m] > 0: minimum bumper gap to the "
-        "vehicle ahead. Default: off.",
-    )
-    lane_change: LaneChangeCriteriaModel | None = Field(
-        default=None,
-        description="`{max_duration, max_lateral_accel}`: bounds on each lane change; at "
-        "least one must happen. Default: off.",
-    )
-    standstill_gap: Annotated[tuple[NonNegFloat, PosFloat], Field(strict=False)] | None = Field(
-        default=None,
-        description="[m] `[low, high]`: the bumper gap to the vehicle ahead each time the ego "
-        "stands behind it; it must stand at least once. Default: off.",
-    )
-    resume_within: PosFloat | None = Field(
-        default=None,
-        description="[s] once the lane ahead clears, the ego is back at its wanted speed "
-        "within this, > 0; the lane must clear at least once with the ego slowed. "
-        "Default: off.",
-    )
-    max_decel: PosFloat | None = Field(
-        default=None,
-        description="[m/s^2] the ego's deceleration (0.2 s average) never exceeds it, > 0. "
-        "Default: off.",
-    )
-    reach_s: PosFloat | None = Field(
-        default=None,
-        description="[m] station the ego must reach, > 0, on the route. Default: the end of "
-        "the route less 30 m.",
-    )
-
-    @field_validator("standstill_gap")
-    @classmethod
-    def _low_below_high(cls, value: Any) -> Any:
-        if value is not None and not value[0] < value[1]:
-            raise problem(f"low must be below high, got {list(value)}")
-        return value
-
-    @field_validator("min_gap", mode="before")
-    @classmethod
-    def _r157_or_metres(cls, value: Any) -> Any:
-        is_number = isinstance(value, int | float) and not isinstance(value, bool)
-        if value is None or value == "r157" or (is_number and value > 0):
-            return value
-        raise problem(f"must be r157 or a number of metres > 0, got {value!r}")
+if TYPE_CHECKING:  # a model made at import: its keys are the registry's, read with getattr
+    CriteriaModel = FormatModel
+else:
+    CriteriaModel = _criteria_model()
 
 
 # ---------------------------------------------------------------------------------------
@@ -674,7 +617,7 @@ class CriteriaModel(_Model):
 # ---------------------------------------------------------------------------------------
 
 
-class ScenarioModel(_Model):
+class ScenarioModel(FormatModel):
     """A scenario file, format `avsim/1`: exactly one map (`road` or `town`), the ego, and
     optionally actors, sensors, events and criteria."""
 
@@ -712,7 +655,9 @@ class ScenarioModel(_Model):
     )
     criteria: CriteriaModel = Field(
         default_factory=CriteriaModel,
-        description="Optional criteria `{min_gap, max_decel, reach_s}`. Default: none added.",
+        description="Criteria to add or tune, by key: "
+        + ", ".join(str(d.key) for d in keyed())
+        + ". The default criteria always apply. Default: none added.",
     )
 
     @model_validator(mode="after")

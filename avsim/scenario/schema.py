@@ -3,7 +3,7 @@
 `avsim schema` prints it. It describes the whole public format, including the keys the
 simulator does not simulate yet (`avsim.scenario.load.UNSUPPORTED`); checks that span several
 keys (a lane exists at a station, `after` names an earlier action, ...) are made by
-`avsim.scenario.load.load_scenario`, not by the schema.
+`avsim.scenario.checks` when a file is loaded, not by the schema.
 """
 
 from __future__ import annotations

@@ -29,7 +29,7 @@ class LightScene:
 
     def __init__(self, road: RoadSpec, heads: Sequence[LightHead],
                  actors: tuple[ActorSpec, ...] = (), profile: Profile = Profile.DEFAULT) -> None:
-        spec = replace(load_scenario(BASE_SCENARIO), road=road, actors=actors, events=())
+        spec = replace(load_scenario(BASE_SCENARIO).world, road=road, actors=actors, events=())
         self.world = World(spec, sensor_setup(profile))
         self.heads = tuple(heads)
         self.lights: tuple[TrafficLightBody, ...] = tuple(

@@ -50,7 +50,7 @@ class Scene:
 def normal_driving_road() -> RoadSpec:
     """The road of `normal_driving`: straight to s 250, R 250 m left to 403, straight, R 50 m
     right from 603 to 672, ..."""
-    return load_scenario(BASE_SCENARIO).road
+    return load_scenario(BASE_SCENARIO).world.road
 
 
 def front_camera(profile: Profile = Profile.DEFAULT) -> CameraInfo:
@@ -61,7 +61,7 @@ def world_for(road: RoadSpec, profile: Profile = Profile.DEFAULT) -> World:
     """The cached sensor world of ``road`` (built on first use)."""
     key = (road, profile)
     if key not in _WORLDS:
-        spec = replace(load_scenario(BASE_SCENARIO), road=road, actors=(), events=())
+        spec = replace(load_scenario(BASE_SCENARIO).world, road=road, actors=(), events=())
         _WORLDS[key] = World(spec, sensor_setup(profile))
     return _WORLDS[key]
 
@@ -124,7 +124,7 @@ def render_with_actors(road: RoadSpec, actors: tuple[ActorSpec, ...], s: float, 
     (road, actors, profile) and closed at exit, is never stepped)."""
     key = (road, actors, profile)
     if key not in _ACTOR_WORLDS:
-        spec = replace(load_scenario(BASE_SCENARIO), road=road, actors=actors, events=())
+        spec = replace(load_scenario(BASE_SCENARIO).world, road=road, actors=actors, events=())
         _ACTOR_WORLDS[key] = World(spec, sensor_setup(profile))
     world = _ACTOR_WORLDS[key]
     pose_ego(world, lane, s, 0.0, 0.0)

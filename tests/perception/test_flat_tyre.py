@@ -31,9 +31,9 @@ from world.spec import (
     EventSpec,
     FlatTire,
     RoadSpec,
-    ScenarioSpec,
     SegmentSpec,
     TimeTrigger,
+    WorldSpec,
 )
 from world.world import TRIGGER_RATE, World
 
@@ -216,11 +216,8 @@ def _world(kph: float, events: tuple[EventSpec, ...] = ()) -> World:
     road = RoadSpec(segments=(SegmentSpec(length=3000.0, curvature=0.0, lanes=2,
                                           oncoming_lanes=0, lane_width=3.5, shoulder=2.5),),
                     speed_limit=30.0)
-    spec = ScenarioSpec(name="flat_detection", description="", situation="other",
-                        duration=60.0, seed=7, road=road,
-                        ego=EgoSpec(lane=0, s=20.0, speed=kph * KPH, set_speed=kph * KPH,
-                                    max_speed=30.0),
-                        events=events)
+    spec = WorldSpec(road=road, ego=EgoSpec(lane=0, s=20.0, speed=kph * KPH, max_speed=30.0),
+                     seed=7, events=events)
     return World(spec)
 
 

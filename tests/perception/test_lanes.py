@@ -408,7 +408,7 @@ def test_a_yellow_truck_beside_is_not_a_line(detector: LaneDetector) -> None:
     from world.spec import ActorSpec, ActorType
     from world.world import World
 
-    spec = load_scenario("normal_driving")
+    spec = load_scenario("normal_driving").world
     truck = ActorSpec(id="truck", type=ActorType.TRUCK, lane=1, s=100.0, offset=0.0,
                       speed=0.0, actions=())
     world = World(replace(spec, actors=(truck,)), sensor_setup(Profile.DEFAULT), lidar=False)

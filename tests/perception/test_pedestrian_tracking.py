@@ -99,7 +99,7 @@ def run(case: Crossing, tmp_path: Path) -> list[Sample]:
     path = tmp_path / "crossing.yaml"
     path.write_text(SCENARIO.format(ego_s=EGO_S, ego_kph=case.ego_kph, s=EGO_S + case.ahead,
                                     start=case.start, end=case.end, trigger=case.trigger))
-    spec = load_scenario(path)
+    spec = load_scenario(path).world
     world = World(spec, sensor_setup(Profile.DEFAULT, spec.sensors.lidar), cameras=False)
     assert world.rig is not None
     detector, tracker = ObjectDetector(), MultiObjectTracker()

@@ -23,9 +23,9 @@ def run_scenario(tmp_path_factory: pytest.TempPathFactory) -> Callable[..., RunR
             frame_hook: FrameHook | None = None, **overrides: object) -> RunResult:
         key = repr((name, record, profile, frame_hook, sorted(overrides.items())))
         if key not in cache:
-            spec = load_scenario(name, overrides or None)
+            scenario = load_scenario(name, overrides or None)
             out: Path | None = tmp_path_factory.mktemp("runs") / f"{name}.rrd" if record else None
-            cache[key] = Runner(spec, out, profile=profile, frame_hook=frame_hook).run()
+            cache[key] = Runner(scenario, out, profile=profile, frame_hook=frame_hook).run()
         return cache[key]
 
     return run

@@ -40,7 +40,7 @@ def record(result: RunResult) -> dict[str, object]:
     changes = [{"t": c.t, "machine": c.machine, "from": c.source, "to": c.target,
                 "reason": c.reason} for c in result.state_changes]
     return {
-        "scenario": result.spec.name,
+        "scenario": result.scenario.name,
         "profile": result.profile,
         "passed": result.passed,
         "sim_time": result.sim_time,

@@ -24,7 +24,7 @@ def result(run_scenario: Callable[..., RunResult]) -> RunResult:
 def test_the_cut_in_and_out_happened(result: RunResult) -> None:
     log = result.log
     t, ego_s = log.array("t"), log.array("station")
-    k = [a.id for a in result.spec.actors].index("cutter")
+    k = [a.id for a in result.scenario.world.actors].index("cutter")
     offset = np.array(log.actor_offset)[:, k]
     gap = np.array(log.actor_station)[:, k] - ego_s - 4.7
     in_lane = np.abs(offset) < 1.0  # the ego's lane 0 is the reference line

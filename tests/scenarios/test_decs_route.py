@@ -30,7 +30,7 @@ def result(run_scenario: Callable[..., RunResult]) -> RunResult:
 
 def _lead(r: RunResult) -> tuple[np.ndarray, np.ndarray]:
     log = r.log
-    k = [a.id for a in r.spec.actors].index("lead")
+    k = [a.id for a in r.scenario.world.actors].index("lead")
     lead_s = np.array(log.actor_station)[:, k]
     return np.gradient(lead_s, log.array("t")), lead_s
 
@@ -78,8 +78,8 @@ def test_the_exit_ramp_and_the_city_limits(result: RunResult) -> None:
     t = log.array("t")
     assert FORK - 160.0 < s[int(np.searchsorted(t, right.t))] < FORK - 60.0
     # the lead kept the highway (the log has its station and offset along the road it is on)
-    k = [a.id for a in result.spec.actors].index("lead")
-    road = build_road_map(result.spec.road)
+    k = [a.id for a in result.scenario.world.actors].index("lead")
+    road = build_road_map(result.scenario.world.road)
     lead_s, lead_d = np.array(log.actor_station)[:, k], np.array(log.actor_offset)[:, k]
     x, y, _ = road.through_line.pose(lead_s[city], lead_d[city])
     _, off_route = road.local_coordinates(np.column_stack([x, y]))
@@ -93,7 +93,7 @@ def test_stop_sign_pedestrian_and_bump(result: RunResult) -> None:
     front = s + 2.4
     at_line = (STOP_LINE - front >= 0.0) & (STOP_LINE - front <= 4.0) & (v < 0.1)
     assert at_line.sum() * 0.025 >= 1.0  # stood >= 1 s, 0-4 m before the line
-    k = [a.id for a in result.spec.actors].index("walker")
+    k = [a.id for a in result.scenario.world.actors].index("walker")
     walker = np.array(log.actor_offset)[:, k]
     crossing = (walker > -2.5) & (walker < 6.0)  # on the road
     waited = crossing & (v < 0.1) & (front < CROSSWALK)

@@ -52,7 +52,7 @@ def test_following_the_pedal_closes_up_but_never_below_d_min(following: RunResul
     assert all(c.passed for c in following.criteria), following.criteria
     log = following.log
     v = log.array("speed")
-    k = [a.id for a in following.spec.actors].index("lead")
+    k = [a.id for a in following.scenario.world.actors].index("lead")
     gap = np.array(log.actor_station)[:, k] - log.array("station") - (4.6 + 4.8) / 2
     pressed = _pressed(following)
     start = int(np.argmax(pressed))

@@ -25,7 +25,7 @@ def result(run_scenario: Callable[..., RunResult]) -> RunResult:
 def test_the_ego_overtook_the_slower_car(result: RunResult) -> None:
     log = result.log
     t, s, v = log.array("t"), log.array("station"), log.array("speed")
-    k = [a.id for a in result.spec.actors].index("slow")
+    k = [a.id for a in result.scenario.world.actors].index("slow")
     slow_s = np.array(log.actor_station)[:, k]
     slow_offset = np.array(log.actor_offset)[:, k]
     assert np.abs(slow_offset).max() < 0.1  # it kept the ego's lane 0 throughout

@@ -34,7 +34,7 @@ def test_every_criterion_passes(result: RunResult) -> None:
 def test_the_situation_happened(result: RunResult) -> None:
     """The car drove >= 1 km through a left and a right curve (R 250 m and <= 60 m) and
     through at least two posted speed changes, with two cars in the other lane."""
-    road = build_road_map(result.spec.road)
+    road = build_road_map(result.scenario.world.road)
     station = result.log.array("station")
     assert station[-1] - station[0] >= 1000.0
     k = road.curvature_at(station)
@@ -42,8 +42,8 @@ def test_the_situation_happened(result: RunResult) -> None:
     limits = road.speed_limit_at(station)
     changes = np.count_nonzero(np.diff(limits))
     assert changes >= 2
-    assert len(result.spec.actors) == 2
-    assert all(a.lane == 1 for a in result.spec.actors)
+    assert len(result.scenario.world.actors) == 2
+    assert all(a.lane == 1 for a in result.scenario.world.actors)
 
 
 def test_cross_track_error(result: RunResult) -> None:

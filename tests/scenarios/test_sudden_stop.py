@@ -26,7 +26,7 @@ def result(request: pytest.FixtureRequest,
 def _lead(result: RunResult) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     log = result.log
     t = log.array("t")
-    k = [a.id for a in result.spec.actors].index("lead")
+    k = [a.id for a in result.scenario.world.actors].index("lead")
     lead_s = np.array(log.actor_station)[:, k]
     gap = lead_s - log.array("station") - (4.6 + 4.8) / 2
     return t, lead_s, np.gradient(lead_s, t), gap
@@ -34,7 +34,7 @@ def _lead(result: RunResult) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.nda
 
 def test_the_lead_braked_hard_from_50_close_ahead(result: RunResult) -> None:
     t, _, lead_v, gap = _lead(result)
-    t_brake, nominal_gap = CASES[result.spec.name]
+    t_brake, nominal_gap = CASES[result.scenario.name]
     i = int(np.searchsorted(t, t_brake))
     assert lead_v[i - 1] == pytest.approx(50 * KPH, abs=0.1)
     # the ego keeps its distance until then (it may start to open the gap)
@@ -49,7 +49,7 @@ def test_no_contact_and_the_ego_stops_short(result: RunResult) -> None:
     assert all(c.passed for c in result.criteria), result.criteria
     t, _, lead_v, gap = _lead(result)
     v = result.log.array("speed")
-    t_brake, _ = CASES[result.spec.name]
+    t_brake, _ = CASES[result.scenario.name]
     after = t > t_brake
     assert float(gap.min()) >= 0.5
     standing = after & (v < 0.05) & (lead_v < 0.05)
@@ -61,10 +61,10 @@ def test_no_contact_and_the_ego_stops_short(result: RunResult) -> None:
 def test_the_control_fsm_brakes_to_a_stop(result: RunResult) -> None:
     control = [c.target for c in result.state_changes if c.machine == "control"]
     assert "stop" in control[control.index("deceleration"):]
-    if result.spec.name == "sudden_stop":  # 12 m at 50 km/h: beyond the ACC's braking
+    if result.scenario.name == "sudden_stop":  # 12 m at 50 km/h: beyond the ACC's braking
         assert "emergency_stop" in control
         assert result.metrics["max_decel"] > 6.0
 
 
 def test_result_matches_golden(result: RunResult) -> None:
-    golden.check(result, result.spec.name)
+    golden.check(result, result.scenario.name)

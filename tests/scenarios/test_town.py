@@ -39,8 +39,8 @@ def far_car(run_scenario: Callable[..., RunResult]) -> RunResult:
 
 def _actor_xy(r: RunResult, actor_id: str) -> np.ndarray:
     """(T, 2) [m] an NPC's centre at each control tick, from its own route road."""
-    k = [a.id for a in r.spec.actors].index(actor_id)
-    spec = r.spec.actors[k].road
+    k = [a.id for a in r.scenario.world.actors].index(actor_id)
+    spec = r.scenario.world.actors[k].road
     assert spec is not None
     road = build_road_map(spec)
     s = np.array(r.log.actor_station)[:, k]
@@ -90,7 +90,7 @@ def test_the_route_turns_left_right_and_back_in_order(route: RunResult) -> None:
 def test_it_stops_at_red_and_goes_on_green(route: RunResult) -> None:
     log = route.log
     t, v, s = log.array("t"), log.array("speed"), log.array("station")
-    lights = [f for f in route.spec.road.features if isinstance(f, TrafficLightSpec)]
+    lights = [f for f in route.scenario.world.road.features if isinstance(f, TrafficLightSpec)]
     stood_at_red = 0
     for light in lights:
         waiting = (v < 0.1) & (light.s - 6.0 < s + FRONT) & (s + FRONT <= light.s)
@@ -103,7 +103,7 @@ def test_it_stops_at_red_and_goes_on_green(route: RunResult) -> None:
 
 
 def test_the_left_turn_waits_for_the_oncoming_cars(route: RunResult) -> None:
-    road = build_road_map(route.spec.road)
+    road = build_road_map(route.scenario.world.road)
     left = road.junctions[0]
     t = route.log.array("t")
     entered = _entered(route, left)
@@ -117,7 +117,7 @@ def test_the_left_turn_waits_for_the_oncoming_cars(route: RunResult) -> None:
 def test_npcs_keep_to_lights_and_stop_signs(route: RunResult) -> None:
     t = route.log.array("t")
     met_red = stood = 0
-    for k, actor in enumerate(route.spec.actors):
+    for k, actor in enumerate(route.scenario.world.actors):
         assert actor.road is not None
         front = np.array(route.log.actor_station)[:, k] + 2.3
         v = np.gradient(front, t)
@@ -140,13 +140,14 @@ def test_npcs_keep_to_lights_and_stop_signs(route: RunResult) -> None:
 
 def test_with_an_oncoming_car_close_the_left_turn_waits(close_car: RunResult) -> None:
     assert all(c.passed for c in close_car.criteria), close_car.criteria
-    j = build_road_map(close_car.spec.road).junctions[0]
+    j = build_road_map(close_car.scenario.world.road).junctions[0]
     t = close_car.log.array("t")
     inside = _in_box(_actor_xy(close_car, "oncoming"), j)
     assert inside.any()
     entered = _entered(close_car, j)
     assert t[inside].max() < entered  # the oncoming car went through first
-    light = next(f for f in close_car.spec.road.features if isinstance(f, TrafficLightSpec))
+    light = next(f for f in close_car.scenario.world.road.features
+                 if isinstance(f, TrafficLightSpec))
     green = t[np.array([light_colour(light, x) is LightColour.GREEN for x in t])].min()
     assert entered > green + 2.0  # green alone did not let it go: it gave way
     acc = _states(close_car, "acc")
@@ -157,7 +158,7 @@ def test_with_an_oncoming_car_close_the_left_turn_waits(close_car: RunResult) ->
 def test_with_the_oncoming_car_far_the_left_turn_goes_at_once(far_car: RunResult,
                                                               close_car: RunResult) -> None:
     assert all(c.passed for c in far_car.criteria), far_car.criteria
-    j = build_road_map(far_car.spec.road).junctions[0]
+    j = build_road_map(far_car.scenario.world.road).junctions[0]
     t = far_car.log.array("t")
     xy = _actor_xy(far_car, "oncoming")
     entered = _entered(far_car, j)

@@ -24,7 +24,7 @@ def result(run_scenario: Callable[..., RunResult]) -> RunResult:
 def test_the_situation_happened(result: RunResult) -> None:
     """>= 5 cars in several lanes at several speeds; the overtaker came from behind and
     passed the ego; the ego passed the slower cars on its right."""
-    spec = result.spec
+    spec = result.scenario.world
     cars = [a for a in spec.actors if a.type.value in ("car", "truck")]
     assert len(cars) >= 5
     assert len({a.lane for a in cars}) >= 4 and len({a.speed for a in cars}) >= 5

@@ -31,7 +31,7 @@ def _intervals(mask: np.ndarray, t: np.ndarray) -> list[tuple[float, float]]:
 def test_stop_and_go_twice(result: RunResult) -> None:
     log = result.log
     t, v, s = log.array("t"), log.array("speed"), log.array("station")
-    k = [a.id for a in result.spec.actors].index("lead")
+    k = [a.id for a in result.scenario.world.actors].index("lead")
     lead_s = np.array(log.actor_station)[:, k]
     lead_v = np.gradient(lead_s, t)
     gap = lead_s - s - (4.6 + 4.8) / 2

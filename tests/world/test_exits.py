@@ -78,7 +78,7 @@ def _scenario(tmp_path: Path, exit_on: int, side: str) -> Path:
 
 
 def test_scenarios_with_exits_load_and_bad_ones_say_why(tmp_path: Path) -> None:
-    spec = load_scenario(str(_scenario(tmp_path, 1, "right")))
+    spec = load_scenario(str(_scenario(tmp_path, 1, "right"))).world
     assert spec.road.segments[1].exit is Side.RIGHT
     with pytest.raises(ScenarioError, match=r"road\.segments\.1\.exit: not supported yet"):
         load_scenario(str(_scenario(tmp_path, 1, "left")))
@@ -101,7 +101,7 @@ def test_traffic_before_the_fork_keeps_the_road_traffic_after_it_the_ramp(
             "  - {id: on_ramp, type: car, lane: 0, s: 230, speed_kph: 36}\n")
     path = tmp_path / "exit.yaml"
     path.write_text(text, encoding="utf-8")
-    world = World(load_scenario(str(path)))
+    world = World(load_scenario(str(path)).world)
     try:
         for _ in range(5 * 240):  # 5 s: 100 m for the first, 50 m for the second
             world.step()

@@ -19,7 +19,7 @@ from world.scene.bump import bump_height_at
 from world.scene.scenery import octagon_corners
 from world.sensors.rig import vehicle_pose
 from world.sensors.setup import Profile, sensor_setup
-from world.spec import EgoSpec, RoadSpec, ScenarioSpec, SegmentSpec
+from world.spec import EgoSpec, RoadSpec, SegmentSpec, WorldSpec
 from world.world import SIGN_POLE_RADIUS, World
 
 KPH = 1 / 3.6  # [m/s] per km/h
@@ -28,17 +28,15 @@ BUMP = SpeedBump(BUMP_S, 0.1, 0.9, 5 * KPH)
 LANES, LANE_WIDTH, SHOULDER = 2, 3.5, 2.5
 
 
-def spec(ego_s: float, speed: float = 0.0, lanes: int = LANES) -> ScenarioSpec:
+def spec(ego_s: float, speed: float = 0.0, lanes: int = LANES) -> WorldSpec:
     road = RoadSpec(
         segments=(SegmentSpec(length=200.0, curvature=0.0, lanes=lanes, oncoming_lanes=0,
                               lane_width=LANE_WIDTH, shoulder=SHOULDER),),
         speed_limit=50 * KPH,
         features=(StopSign(STOP_S), Crosswalk(ZEBRA_S, 4.0), BUMP),
     )
-    return ScenarioSpec(name="features", description="", situation="other", duration=30.0,
-                        seed=0, road=road,
-                        ego=EgoSpec(lane=0, s=ego_s, speed=speed, set_speed=10.0,
-                                    max_speed=15.0))
+    return WorldSpec(road=road, ego=EgoSpec(lane=0, s=ego_s, speed=speed, max_speed=15.0),
+                     seed=0)
 
 
 @pytest.fixture(scope="module")

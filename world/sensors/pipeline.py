@@ -24,7 +24,7 @@ from world.core.rendering import Renderer
 from world.sensors import worker as sensing_worker
 from world.sensors.rig import Due, SensorData
 from world.sensors.setup import SensorSetup
-from world.spec import ScenarioSpec
+from world.spec import WorldSpec
 from world.world import World
 
 
@@ -123,7 +123,7 @@ class ProcessSensing:
         return payload
 
 
-def serve(conn: Connection, spec: ScenarioSpec, setup: SensorSetup) -> None:
+def serve(conn: Connection, spec: WorldSpec, setup: SensorSetup) -> None:
     """The worker: build the mirror world, then render on request until told to close."""
     try:
         world = World(spec, setup, lidar=False)

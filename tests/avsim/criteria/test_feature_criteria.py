@@ -168,7 +168,7 @@ def crosswalk_run(*where: tuple[float, float], stop_front: float | None = None,
     """The ego drives at 5 m/s over the crosswalk (or stops with its front bumper at
     `stop_front`) while actors stand at `where` (station, offset) the whole time."""
     c = Crosswalks(road(Crosswalk(ZEBRA_S, ZEBRA_W)))
-    assert c.needs_actors
+    assert not c.idle  # it watches the pedestrians: the samples carry the actors
     actors = walkers(*where, kinds=kinds)
     profile = ((lambda t: (120.0 + 5.0 * t, 5.0)) if stop_front is None else
                approach_and_stop(stop_front, t_stop=6.0, hold=100.0, start_front=120.0))
@@ -223,7 +223,7 @@ def test_other_actors_on_the_crosswalk_do_not_count() -> None:
 
 def test_no_crosswalk_passes_with_value_zero() -> None:
     c = Crosswalks(road(StopSign(STOP_S)))
-    assert not c.needs_actors
+    assert c.idle  # no crosswalk: the samples need not carry the actors
     drive(c, lambda t: (120.0 + 5.0 * t, 5.0), 12.0, actors=walkers((ZEBRA_S, 0.0)))
     r = c.result()
     assert r.passed and r.value == 0.0 and r.first_failure is None

@@ -614,3 +614,30 @@ def test_bad_sensor_input_is_rejected(tmp_path: Path) -> None:
             rec.log_lane_lines(0.0, [np.zeros((2, 3))] * 2, [(1, 2, 3)] * 3)
         with pytest.raises(ValueError, match="machine"):
             rec.log_state(0.0, "a/b", "X")
+
+
+def test_infractions_are_logged_at_their_time_and_place(tmp_path: Path) -> None:
+    """Each infraction is an ERROR line at /events at its sim time; one with a place adds a
+    marker at /world/infractions, which then shows every infraction placed so far."""
+    path = tmp_path / "infractions.rrd"
+    with Recorder(path, recording_id="infractions") as rec:
+        rec.log_event(0.5, "an ordinary event")
+        rec.log_infraction(1.25, "speed_limit", "speed 55.0 km/h over the limit", (12.0, -1.5))
+        rec.log_infraction(2.0, "completes", "nowhere in particular", None)
+        rec.log_infraction(3.5, "no_collision", "collision with actor lead", (40.0, 0.25))
+    events = column(path, bp.EVENTS, "TextLog:text")
+    assert [row[0] for row in events.values] == [
+        "an ordinary event", "speed_limit: speed 55.0 km/h over the limit",
+        "completes: nowhere in particular", "no_collision: collision with actor lead"]
+    assert events.times is not None
+    np.testing.assert_array_equal(events.times, nanos(np.array([0.5, 1.25, 2.0, 3.5])))
+    levels = column(path, bp.EVENTS, "TextLog:level")
+    assert [row[0] for row in levels.values] == ["INFO", "ERROR", "ERROR", "ERROR"]
+    markers = column(path, bp.INFRACTIONS, "Points3D:positions")
+    assert markers.times is not None
+    np.testing.assert_array_equal(markers.times, nanos(np.array([1.25, 3.5])))
+    first, both = (np.array(row) for row in markers.values)
+    np.testing.assert_allclose(first[:, :2], [[12.0, -1.5]])
+    np.testing.assert_allclose(both[:, :2], [[12.0, -1.5], [40.0, 0.25]])
+    labels = column(path, bp.INFRACTIONS, "Points3D:labels")
+    assert labels.values == [["speed_limit"], ["speed_limit", "no_collision"]]

@@ -26,7 +26,7 @@ from avsim.run.runner import RunResult, TrajectoryLog
 from avsim.scenario.load import load_scenario
 from planner.fsm.acc import AccMode
 from planner.messages import SpeedSource
-from world.spec import ActorType
+from world.spec import ActorSpec, ActorType
 
 REPO = Path(__file__).parents[3]
 TRAFFIC_JAM = REPO / "scenarios" / "traffic_jam.yaml"
@@ -46,8 +46,8 @@ def _mode_at(t: float) -> AccMode:
 
 
 def synthetic_result(passed: bool = True) -> RunResult:
-    spec = load_scenario(TRAFFIC_JAM)
-    assert [a.id for a in spec.actors] == ["lead", "beside"]
+    scenario = load_scenario(TRAFFIC_JAM)
+    assert [a.id for a in scenario.world.actors] == ["lead", "beside"]
     log = TrajectoryLog()
     ego_s, lead_s, beside_s = 20.0, 50.0, 120.0
     dt = 1.0 / RATE
@@ -71,7 +71,7 @@ def synthetic_result(passed: bool = True) -> RunResult:
         beside_s += 15.0 * dt
     criteria = [CriterionResult("no_collision", True, 0.0, 0.0, "-"),
                 CriterionResult("min_gap", passed, 12.0, 14.0, "m")]
-    return RunResult(spec=spec, criteria=criteria, metrics={"max_speed": 9.0},
+    return RunResult(scenario=scenario, criteria=criteria, metrics={"max_speed": 9.0},
                      sim_time=DURATION, wall_time=1.0, log=log, recording=None)
 
 
@@ -91,13 +91,19 @@ def test_lead_speed_is_the_nearest_vehicle_ahead_in_the_lane() -> None:
 
 def test_lead_speed_without_vehicles_is_all_nan() -> None:
     result = synthetic_result()
-    alone = dataclasses.replace(result, spec=dataclasses.replace(result.spec, actors=()))
+    world = result.scenario.world
+
+    def with_actors(*actors: ActorSpec) -> RunResult:
+        scenario = dataclasses.replace(result.scenario,
+                                       world=dataclasses.replace(world, actors=actors))
+        return dataclasses.replace(result, scenario=scenario)
+
+    alone = with_actors()
     assert np.isnan(plot.lead_speed(alone)).all()
     # a pedestrian or an obstacle is never a lead
-    walker = dataclasses.replace(result.spec.actors[0], type=ActorType.PEDESTRIAN)
-    box = dataclasses.replace(result.spec.actors[1], type=ActorType.OBSTACLE)
-    others = dataclasses.replace(result, spec=dataclasses.replace(result.spec,
-                                                                   actors=(walker, box)))
+    walker = dataclasses.replace(world.actors[0], type=ActorType.PEDESTRIAN)
+    box = dataclasses.replace(world.actors[1], type=ActorType.OBSTACLE)
+    others = with_actors(walker, box)
     assert np.isnan(plot.lead_speed(others)).all()
 
 
@@ -166,8 +172,8 @@ def test_figure_title_axes_and_legends() -> None:
 
 def test_an_empty_run_still_plots(tmp_path: Path) -> None:
     result = synthetic_result()
-    empty = RunResult(spec=result.spec, criteria=[], metrics={}, sim_time=0.0, wall_time=0.0,
-                      log=TrajectoryLog(), recording=None)
+    empty = RunResult(scenario=result.scenario, criteria=[], metrics={}, sim_time=0.0,
+                      wall_time=0.0, log=TrajectoryLog(), recording=None)
     path = plot.plot_speed_profile(empty, tmp_path / "empty.png")
     assert mpimg.imread(path).shape[:2] == (700, 1600)
 
@@ -179,8 +185,8 @@ class FakeRunner:
     """Stands in for `avsim.run.runner.Runner`: writes a recording stub, returns the
     synthetic run."""
 
-    def __init__(self, spec: object, recording: Path, *_args: object) -> None:
-        self.spec = spec
+    def __init__(self, scenario: object, recording: Path, *_args: object) -> None:
+        self.scenario = scenario
         recording.write_bytes(b"rrd")
 
     def run(self, _progress: object = None) -> RunResult:

@@ -13,16 +13,20 @@ import pytest
 import yaml
 from pydantic import BaseModel
 
+from avsim.criteria.registry import CriteriaSettings
+from avsim.scenario import convert as conversion
+from avsim.scenario import files as scenario_files
 from avsim.scenario import load as scenario_module
 from avsim.scenario import model as scenario_model
+from avsim.scenario.files import SCENARIO_DIR
 from avsim.scenario.load import (
-    SCENARIO_DIR,
     UNSUPPORTED,
     ScenarioError,
     bundled_scenarios,
     load_scenario,
     scenario_path,
 )
+from avsim.scenario.scenario import DriverSettings
 from avsim.scenario.schema import scenario_json_schema
 from tests.avsim.texts import MINIMAL
 from world import spec
@@ -30,7 +34,7 @@ from world import spec
 HERE = Path(__file__).parents[1]
 BAD_DIR = HERE / "bad_scenarios"
 DOC = HERE.parents[1] / "docs" / "scenario-format.md"
-KPH = scenario_module.MPS_PER_KPH  # [m/s] per [km/h], checked against 1 / 3.6 below
+KPH = conversion.MPS_PER_KPH  # [m/s] per [km/h], checked against 1 / 3.6 below
 
 
 # SCENARIO_FORMAT.md's complete example, verbatim but for the comments.
@@ -248,7 +252,7 @@ def test_minimal_file_and_defaults(tmp_path: Path) -> None:
         0,
     )
     assert loaded.duration == 10.0
-    (segment,) = loaded.road.segments
+    (segment,) = loaded.world.road.segments
     assert (segment.length, segment.curvature, segment.lanes, segment.oncoming_lanes) == (
         100.0,
         0.0,
@@ -256,17 +260,19 @@ def test_minimal_file_and_defaults(tmp_path: Path) -> None:
         0,
     )
     assert (segment.lane_width, segment.shoulder, segment.speed_limit) == (3.5, 2.5, None)
-    assert loaded.road.speed_limit == 50 * KPH
-    assert loaded.ego == spec.EgoSpec(lane=0, s=10.0, speed=0.0, set_speed=40 * KPH, max_speed=15.0)
-    assert loaded.sensors == spec.SensorsSpec()
-    assert loaded.criteria == spec.CriteriaSpec()
-    assert loaded.actors == ()
-    assert loaded.events == ()
+    assert loaded.world.road.speed_limit == 50 * KPH
+    assert loaded.world.ego == spec.EgoSpec(lane=0, s=10.0, speed=0.0, max_speed=15.0)
+    assert loaded.driver == DriverSettings(set_speed=40 * KPH, overtake=False)
+    assert loaded.world.seed == 0
+    assert loaded.world.sensors == spec.SensorsSpec()
+    assert loaded.criteria == CriteriaSettings()
+    assert loaded.world.actors == ()
+    assert loaded.world.events == ()
 
 
 def test_example_converts(tmp_path: Path) -> None:
     loaded = load_scenario(_write(tmp_path, _stripped_example()))
-    road = loaded.road
+    road = loaded.world.road
     straight, left, straight2, ramp, city = road.segments
     assert (straight.length, straight.curvature, straight.lanes) == (300.0, 0.0, 2)
     assert left.curvature == pytest.approx(1 / 250)
@@ -279,9 +285,11 @@ def test_example_converts(tmp_path: Path) -> None:
     assert (straight2.lanes, straight2.speed_limit, straight2.zone) == (2, None, None)
     assert road.features == (spec.SpeedLimitSign(s=150.0, limit=40 * KPH),)
     assert road.buildings == spec.BuildingsSpec(density=0.6, setback=6.0)
-    assert loaded.ego.speed == pytest.approx(50 / 3.6)
-    assert loaded.ego.max_speed == pytest.approx(15.0)
-    cutter, parked = loaded.actors
+    assert loaded.world.ego.speed == pytest.approx(50 / 3.6)
+    assert loaded.world.ego.max_speed == pytest.approx(15.0)
+    assert loaded.driver == DriverSettings(set_speed=50 * KPH)
+    assert (loaded.seed, loaded.world.seed) == (3, 3)
+    cutter, parked = loaded.world.actors
     assert (cutter.id, cutter.type, cutter.lane, cutter.s) == ("cutter", spec.ActorType.CAR, 1, 55)
     assert cutter.speed == 30 * KPH
     assert cutter.actions == (
@@ -294,12 +302,13 @@ def test_example_converts(tmp_path: Path) -> None:
         0.0,
         (),
     )
-    assert loaded.sensors.gnss.heading_sigma == pytest.approx(math.radians(0.2))
-    assert loaded.events == (
+    assert loaded.world.sensors.gnss.heading_sigma == pytest.approx(math.radians(0.2))
+    assert loaded.world.events == (
         spec.EventSpec(spec.TimeTrigger(20.0), spec.AcceleratorOverride(pedal=1.0, duration=5.0)),
         spec.EventSpec(spec.TimeTrigger(38.0), spec.FlatTire(spec.Wheel.REAR_LEFT)),
     )
-    assert loaded.criteria == spec.CriteriaSpec(min_gap="r157", max_decel=5.0, reach_s=560.0)
+    assert loaded.criteria == CriteriaSettings.of({"min_gap": "r157", "max_decel": 5.0,
+                                                   "reach_s": 560.0})
 
 
 def test_full_example_converts_once_everything_is_supported(
@@ -308,18 +317,18 @@ def test_full_example_converts_once_everything_is_supported(
     """Shrinking `UNSUPPORTED` is all it takes for the loader to convert those keys."""
     monkeypatch.setattr(scenario_module, "UNSUPPORTED", {"town": "the town map kind"})
     loaded = load_scenario(_write(tmp_path, FULL_EXAMPLE))
-    assert loaded.road.segments[3].exit == spec.Side.RIGHT
-    assert loaded.road.features[4] == spec.TrafficLightSpec(600.0, 20.0, 3.0, 15.0, 0.0)
-    assert loaded.road.features[3].pass_speed == 5 * KPH  # type: ignore[union-attr]
-    walker = loaded.actors[2]
+    assert loaded.world.road.segments[3].exit == spec.Side.RIGHT
+    assert loaded.world.road.features[4] == spec.TrafficLightSpec(600.0, 20.0, 3.0, 15.0, 0.0)
+    assert loaded.world.road.features[3].pass_speed == 5 * KPH  # type: ignore[union-attr]
+    walker = loaded.world.actors[2]
     assert (walker.type, walker.lane, walker.offset) == (spec.ActorType.PEDESTRIAN, 0, -6.0)
     assert walker.actions[0].trigger == spec.EgoStationTrigger(s=430.0)
     assert walker.actions[0].action == spec.WalkAction(to_offset=9.0, speed=5 * KPH)
-    assert loaded.events[1] == spec.EventSpec(
+    assert loaded.world.events[1] == spec.EventSpec(
         spec.TimeTrigger(38.0), spec.FlatTire(spec.Wheel.REAR_LEFT)
     )
-    assert loaded.sensors.lidar == spec.LidarNoiseSpec(range_sigma=0.02, dropout=0.0)
-    assert loaded.criteria.min_gap == "r157"
+    assert loaded.world.sensors.lidar == spec.LidarNoiseSpec(range_sigma=0.02, dropout=0.0)
+    assert loaded.criteria.get("min_gap") == "r157"
 
 
 @pytest.mark.parametrize("pattern", sorted(UNSUPPORTED))
@@ -352,14 +361,14 @@ def test_speed_and_stop_action_defaults(tmp_path: Path) -> None:
             ],
         }
     ]
-    actions = [a.action for a in load_scenario(_write(tmp_path, data)).actors[0].actions]
+    actions = [a.action for a in load_scenario(_write(tmp_path, data)).world.actors[0].actions]
     assert actions == [
         spec.SpeedAction(speed=50 * KPH, accel=2.0),
         spec.SpeedAction(speed=20 * KPH, accel=3.0),
         spec.StopAction(decel=6.0),
         spec.SpeedAction(speed=10 * KPH, accel=1.5),
     ]
-    triggers = [a.trigger for a in load_scenario(_write(tmp_path, data)).actors[0].actions]
+    triggers = [a.trigger for a in load_scenario(_write(tmp_path, data)).world.actors[0].actions]
     assert triggers[1:3] == [spec.GapTrigger(gap=10.0), spec.AfterTrigger(index=1, delay=0.0)]
 
 
@@ -367,7 +376,7 @@ def test_oncoming_lane_for_actors_only(tmp_path: Path) -> None:
     data: dict[str, Any] = yaml.safe_load(MINIMAL)
     data["road"]["oncoming_lanes"] = 1
     data["actors"] = [{"id": "oncoming", "type": "car", "lane": -1, "s": 90, "speed_kph": 40}]
-    assert load_scenario(_write(tmp_path, data)).actors[0].lane == -1
+    assert load_scenario(_write(tmp_path, data)).world.actors[0].lane == -1
     data["actors"][0]["lane"] = -2
     error = _error(_write(tmp_path, data))
     assert error.key == "actors.0.lane"
@@ -378,7 +387,7 @@ def test_bundled_names_resolve(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) 
     assert scenario_path("cut_in_then_out") == SCENARIO_DIR / "cut_in_then_out.yaml"
     assert scenario_path("my/file.yaml") == Path("my/file.yaml")
     assert all(p.parent == SCENARIO_DIR and p.suffix == ".yaml" for p in bundled_scenarios())
-    monkeypatch.setattr(scenario_module, "SCENARIO_DIR", tmp_path)
+    monkeypatch.setattr(scenario_files, "SCENARIO_DIR", tmp_path)
     _write(tmp_path, MINIMAL, "minimal.yaml")
     assert load_scenario("minimal").name == "minimal"
     assert scenario_module.bundled_scenarios() == [tmp_path / "minimal.yaml"]
@@ -400,11 +409,11 @@ def test_overrides_set_paths(tmp_path: Path) -> None:
             "duration": 20,
         },
     )
-    assert loaded.actors[0].speed == 40 * KPH
-    assert loaded.road.segments[1].curvature == pytest.approx(1 / 500)
-    assert loaded.actors[1].offset == 0.5
+    assert loaded.world.actors[0].speed == 40 * KPH
+    assert loaded.world.road.segments[1].curvature == pytest.approx(1 / 500)
+    assert loaded.world.actors[1].offset == 0.5
     assert loaded.duration == 20.0
-    assert load_scenario(path).actors[0].speed == 30 * KPH  # file untouched
+    assert load_scenario(path).world.actors[0].speed == 30 * KPH  # file untouched
 
 
 @pytest.mark.parametrize(

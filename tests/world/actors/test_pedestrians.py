@@ -306,7 +306,7 @@ def write(tmp_path: Path, text: str = SCENARIO) -> Path:
 def test_pedestrians_and_walks_load(tmp_path: Path) -> None:
     assert "actors.*.type=pedestrian" not in scenario_module.UNSUPPORTED
     assert "actors.*.actions.*.walk" not in scenario_module.UNSUPPORTED
-    spec = load_scenario(write(tmp_path))
+    spec = load_scenario(write(tmp_path)).world
     walker_, bend, stroller, parked = spec.actors
     assert (walker_.type, walker_.lane, walker_.s, walker_.offset, walker_.speed) == (
         ActorType.PEDESTRIAN, 0, 40.0, -6.0, 0.0)
@@ -337,7 +337,7 @@ class WorldTrace:
 @pytest.fixture(scope="module")
 def world_run(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[World, WorldTrace]]:
     """The scenario for 14 s, the ego held by its brakes; poses sampled every 0.1 s."""
-    spec = load_scenario(write(tmp_path_factory.mktemp("walk")))
+    spec = load_scenario(write(tmp_path_factory.mktemp("walk"))).world
     w = World(spec)
     trace = WorldTrace()
     try:

@@ -9,7 +9,7 @@ import pytest
 
 from world.core.client import PHYSICS_RATE
 from world.ego.body import ackermann, bicycle_angle
-from world.spec import EgoSpec, RoadSpec, ScenarioSpec, SegmentSpec
+from world.spec import EgoSpec, RoadSpec, SegmentSpec, WorldSpec
 from world.world import World
 
 
@@ -19,9 +19,7 @@ def _straight_world(speed: float = 0.0) -> World:
                               lane_width=3.5, shoulder=2.5),),
         speed_limit=30.0,
     )
-    spec = ScenarioSpec(name="ego_test", description="", situation="other", duration=60.0,
-                        seed=0, road=road,
-                        ego=EgoSpec(lane=0, s=20.0, speed=speed, set_speed=15.0, max_speed=15.0))
+    spec = WorldSpec(road=road, ego=EgoSpec(lane=0, s=20.0, speed=speed, max_speed=15.0), seed=0)
     return World(spec)
 
 

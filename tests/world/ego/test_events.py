@@ -25,9 +25,9 @@ from world.spec import (
     EgoStationTrigger,
     EventSpec,
     GapTrigger,
-    ScenarioSpec,
     TimeTrigger,
     Trigger,
+    WorldSpec,
 )
 from world.world import TRIGGER_RATE, World
 
@@ -183,7 +183,7 @@ def _write(tmp_path: Path, text: str) -> Path:
 
 def test_an_accelerator_override_loads(tmp_path: Path) -> None:
     loaded = load_scenario(_write(tmp_path, SCENARIO))
-    assert loaded.events == (
+    assert loaded.world.events == (
         override(TimeTrigger(0.5), 0.7, 1.0),
         override(EgoStationTrigger(42.0), 0.4, 0.5),
         override(AfterTrigger(index=1, delay=0.25), 1.0, 0.25),
@@ -218,13 +218,13 @@ class Run:
     ended_at: tuple[float | None, ...]
 
 
-def _drive(spec: ScenarioSpec) -> Run:
-    """Coast with zero commands (no steering, drive or brake) for the scenario's duration."""
+def _drive(spec: WorldSpec, duration: float) -> Run:
+    """Coast with zero commands (no steering, drive or brake) for `duration` [s]."""
     world = World(spec)
     run = Run([], [], [], [], [], [], [], (), ())
     try:
         world.ego.apply(0.0, 0.0, 0.0)
-        for _ in range(round(spec.duration * PHYSICS_RATE)):
+        for _ in range(round(duration * PHYSICS_RATE)):
             world.step()
             if world.clock.step % TRIGGER_RATE.every:
                 continue
@@ -246,8 +246,9 @@ def _drive(spec: ScenarioSpec) -> Run:
 @pytest.fixture(scope="module")
 def runs(tmp_path_factory: pytest.TempPathFactory) -> tuple[Run, Run]:
     """The scenario with its events, and the same without them."""
-    spec = load_scenario(_write(tmp_path_factory.mktemp("pedal"), SCENARIO))
-    return _drive(spec), _drive(dataclasses.replace(spec, events=()))
+    scenario = load_scenario(_write(tmp_path_factory.mktemp("pedal"), SCENARIO))
+    spec, duration = scenario.world, scenario.duration
+    return _drive(spec, duration), _drive(dataclasses.replace(spec, events=()), duration)
 
 
 def test_the_pedal_follows_the_triggers_in_the_world(runs: tuple[Run, Run]) -> None:

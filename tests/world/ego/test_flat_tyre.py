@@ -35,9 +35,9 @@ from world.spec import (
     EventSpec,
     FlatTire,
     RoadSpec,
-    ScenarioSpec,
     SegmentSpec,
     TimeTrigger,
+    WorldSpec,
 )
 from world.world import TRIGGER_RATE, World
 
@@ -47,17 +47,14 @@ HOLD_50 = 86.0  # [N m] total drive torque that holds the intact car at 50 km/h 
 T_FLAT = 1.0  # [s] when the tyre is punctured
 
 
-def _spec(speed: float, events: tuple[EventSpec, ...] = ()) -> ScenarioSpec:
+def _spec(speed: float, events: tuple[EventSpec, ...] = ()) -> WorldSpec:
     road = RoadSpec(
         segments=(SegmentSpec(length=3000.0, curvature=0.0, lanes=2, oncoming_lanes=0,
                               lane_width=3.5, shoulder=2.5),),
         speed_limit=30.0,
     )
-    return ScenarioSpec(name="flat_tyre", description="", situation="other", duration=60.0,
-                        seed=0, road=road,
-                        ego=EgoSpec(lane=0, s=20.0, speed=speed, set_speed=speed,
-                                    max_speed=30.0),
-                        events=events)
+    return WorldSpec(road=road, ego=EgoSpec(lane=0, s=20.0, speed=speed, max_speed=30.0),
+                     seed=0, events=events)
 
 
 Command = Callable[[float, float], tuple[float, float, float]]  # (t, speed) -> apply's args
@@ -308,13 +305,13 @@ class ScenarioRun:
     ended_at: tuple[float | None, ...]
 
 
-def _run_scenario(spec: ScenarioSpec) -> ScenarioRun:
-    """Hold 86 N m (50 km/h) for the scenario's duration, reading the ego every tick."""
+def _run_scenario(spec: WorldSpec, duration: float) -> ScenarioRun:
+    """Hold 86 N m (50 km/h) for `duration` [s], reading the ego every tick."""
     world = World(spec)
     poses = []
     flats_at = []
     try:
-        for step in range(round(spec.duration * PHYSICS_RATE)):
+        for step in range(round(duration * PHYSICS_RATE)):
             if step % TICK == 0:
                 world.ego.apply(0.0, HOLD_50, 0.0)
             world.step()
@@ -331,16 +328,17 @@ def _run_scenario(spec: ScenarioSpec) -> ScenarioRun:
 def test_the_flat_tire_event_of_a_scenario_file_deflates_the_tyre(tmp_path: Path) -> None:
     path = tmp_path / "flat.yaml"
     path.write_text(FLAT_SCENARIO, encoding="utf-8")
-    spec = load_scenario(path)
+    scenario = load_scenario(path)
+    spec, duration = scenario.world, scenario.duration
     assert spec.events == (_flat(TimeTrigger(1.0), Wheel.REAR_LEFT),)
-    run = _run_scenario(spec)
+    run = _run_scenario(spec, duration)
     assert run.fired_at == (1.0,) and run.ended_at == (1.0,)
     check = round(1.0 * TRIGGER_RATE.hz) - 1  # the tick of the check at 1 s
     assert run.flats[check - 1] == () and run.flats[check] == ("rear_left",)
     spin = np.array(run.poses)[:, 7:]
     assert spin[-1, 2] / spin[-1, 3] == pytest.approx(0.33 / 0.31, rel=0.002)
-    assert _run_scenario(spec).poses == run.poses  # deterministic, bit for bit
-    without = _run_scenario(dataclasses.replace(spec, events=()))
+    assert _run_scenario(spec, duration).poses == run.poses  # deterministic, bit for bit
+    without = _run_scenario(dataclasses.replace(spec, events=()), duration)
     assert without.flats[-1] == ()
     assert without.poses[:check + 1] == run.poses[:check + 1]  # the same up to the puncture
     assert without.poses[-1] != run.poses[-1]

@@ -31,7 +31,7 @@ from world.scene.town_scene import (
 )
 from world.sensors.rig import vehicle_pose
 from world.sensors.setup import Profile, sensor_setup
-from world.spec import EgoSpec, ScenarioSpec, TownSpec
+from world.spec import EgoSpec, TownSpec, WorldSpec
 from world.world import World
 
 BLOCK = 90.0  # [m]
@@ -316,13 +316,12 @@ def test_buildings_are_deterministic_for_the_rng() -> None:
 # ---- a town World: camera and LiDAR ----------------------------------------------------------
 
 
-def town_spec() -> ScenarioSpec:
+def town_spec() -> WorldSpec:
     town = TownSpec(blocks_x=2, blocks_y=2, block=90, lanes=1, lane_width=3.5,
                     speed_limit=11.1, junctions="stop_signs")
-    return ScenarioSpec(
-        name="town_scene", description="", situation="town", duration=10, seed=1,
+    return WorldSpec(
         road=compile_route(TownLayout(town), (0, 1, "east"), (Manoeuvre.STRAIGHT,), "ego"),
-        ego=EgoSpec(lane=0, s=5.0, speed=0, set_speed=10, max_speed=15), town=town)
+        ego=EgoSpec(lane=0, s=5.0, speed=0, max_speed=15), seed=1, town=town)
 
 
 @pytest.fixture(scope="module")

@@ -27,7 +27,7 @@ from world.scene.road_mesh import EDGE_LINE_INSET, SURFACE_Z
 from world.sensors.camera import Camera
 from world.sensors.rig import vehicle_pose
 from world.sensors.setup import Profile, SensorSetup, sensor_setup
-from world.spec import ScenarioSpec
+from world.spec import WorldSpec
 from world.world import World
 
 CAMERAS = ("front", "left", "right")
@@ -52,8 +52,8 @@ def crop(rgb: NDArray[np.uint8], region: Region) -> NDArray[np.float64]:
     return out.reshape(-1, 3).astype(np.float64)
 
 
-def spec_without_actors() -> ScenarioSpec:
-    return replace(load_scenario("normal_driving"), actors=(), events=())
+def spec_without_actors() -> WorldSpec:
+    return replace(load_scenario("normal_driving").world, actors=(), events=())
 
 
 @pytest.fixture(scope="module")

@@ -20,7 +20,7 @@ from world.world import World
 @pytest.fixture(scope="module")
 def world() -> World:
     """normal_driving with a car parked 20 m ahead in the ego's lane, LiDAR only."""
-    spec = load_scenario("normal_driving")
+    spec = load_scenario("normal_driving").world
     parked = ActorSpec(id="parked", type=ActorType.CAR, lane=0, s=spec.ego.s + 20.0,
                        offset=0.0, speed=0.0, actions=())
     spec = replace(spec, actors=(*spec.actors, parked))
@@ -89,7 +89,7 @@ def test_culled_cast_equals_casting_every_ray(world: World) -> None:
 
 
 def test_noise_and_dropout_are_seeded() -> None:
-    spec = replace(load_scenario("normal_driving"), actors=())
+    spec = replace(load_scenario("normal_driving").world, actors=())
     quiet = sensor_setup(Profile.FAST)
     noisy = replace(quiet, lidar=replace(quiet.lidar, range_sigma=0.1, dropout=0.25))
     scans = []

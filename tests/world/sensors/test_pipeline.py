@@ -15,7 +15,7 @@ from world.world import World
 
 def drive(mode: str, seconds: float = 2.0) -> list[tuple[float, SensorData]]:
     """(delivery time, data) of a car accelerating on normal_driving for `seconds`."""
-    spec = load_scenario("normal_driving")
+    spec = load_scenario("normal_driving").world
     setup = sensor_setup(Profile.DEFAULT)
     world = World(spec, setup, cameras=mode == "inline")
     sensing = InlineSensing(world) if mode == "inline" else ProcessSensing(world, setup)
@@ -58,7 +58,7 @@ def test_inline_and_process_sensing_are_bitwise_equal() -> None:
 
 
 def test_a_failing_worker_raises() -> None:
-    spec = load_scenario("normal_driving")
+    spec = load_scenario("normal_driving").world
     setup = sensor_setup(Profile.DEFAULT)
     world = World(spec, setup, cameras=False)
     sensing = ProcessSensing(world, setup)

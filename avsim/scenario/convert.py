@@ -1,0 +1,250 @@
+"""Conversion of a validated scenario file into what the run is built from.
+
+The file's units become SI (km/h into m/s, degrees into radians), every default is
+resolved, an arc becomes a signed curvature `sign(angle_deg) / radius` and a length
+`radius x |angle|`, and each segment's lane layout is resolved from the road's defaults.
+In a town each car's `start` and `route` compile into its own route road
+(`world.map.town`); the ego's is the scenario's road. The checks that span several keys
+(`avsim.scenario.checks`) run here, between the steps whose results they need.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import replace
+
+from avsim.criteria.registry import CriteriaSettings, keyed
+from avsim.scenario.checks import (
+    DEFAULT_SPEED_UP,
+    check_road,
+    check_town,
+    given_or,
+    speed_accels,
+)
+from avsim.scenario.errors import LocatedError
+from avsim.scenario.model import (
+    ActionModel,
+    ActorModel,
+    CrosswalkFeature,
+    EventModel,
+    FeatureModel,
+    RoadModel,
+    ScenarioModel,
+    SegmentModel,
+    SpeedBumpFeature,
+    SpeedLimitFeature,
+    StopSignFeature,
+    TrafficLightFeature,
+    TriggerModel,
+)
+from avsim.scenario.scenario import DriverSettings, Scenario
+from world import frames, hdmap, spec
+from world.map.town import TownError, TownLayout, compile_route
+
+MPS_PER_KPH = 1000.0 / 3600.0  # [m/s] per [km/h]
+TOWN_START_S = 5.0  # [m] default station of a car on its town route (past the start mouth)
+
+
+def convert(model: ScenarioModel) -> Scenario:
+    """Check what spans several keys and convert the validated model into a scenario."""
+    if model.road is None:
+        return _convert_town(model)
+    road_spec = _road_spec(model.road)
+    check_road(model, model.road, road_spec.segments)
+    return _scenario(model, road_spec,
+                     tuple(_actor_spec(i, actor) for i, actor in enumerate(model.actors)))
+
+
+def _kph(value: float) -> float:
+    return value * MPS_PER_KPH
+
+
+def _segment_spec(segment: SegmentModel, road: RoadModel) -> spec.SegmentSpec:
+    if segment.arc is not None:
+        angle = math.radians(segment.arc.angle_deg)
+        length = segment.arc.radius * abs(angle)
+        curvature = math.copysign(1.0 / segment.arc.radius, angle)
+    else:
+        length, curvature = float(given_or(segment.straight, 0.0)), 0.0
+    limit = segment.speed_limit_kph
+    return spec.SegmentSpec(
+        length=length,
+        curvature=curvature,
+        lanes=given_or(segment.lanes, road.lanes),
+        oncoming_lanes=given_or(segment.oncoming_lanes, road.oncoming_lanes),
+        lane_width=road.lane_width,
+        shoulder=given_or(segment.shoulder, road.shoulder),
+        speed_limit=None if limit is None else _kph(limit),
+        zone=None if segment.zone is None else hdmap.Zone(segment.zone),
+        exit=None if segment.exit is None else hdmap.Side(segment.exit),
+    )
+
+
+def _feature_spec(feature: FeatureModel) -> spec.FeatureSpec:
+    if isinstance(feature, SpeedLimitFeature):
+        return hdmap.SpeedLimitSign(s=feature.s, limit=_kph(feature.kph))
+    if isinstance(feature, StopSignFeature):
+        return hdmap.StopSign(s=feature.s)
+    if isinstance(feature, CrosswalkFeature):
+        return hdmap.Crosswalk(s=feature.s, width=feature.width)
+    if isinstance(feature, SpeedBumpFeature):
+        return hdmap.SpeedBump(
+            s=feature.s,
+            height=feature.height,
+            length=feature.length,
+            pass_speed=_kph(feature.pass_kph),
+        )
+    assert isinstance(feature, TrafficLightFeature)
+    return spec.TrafficLightSpec(
+        s=feature.s,
+        green=feature.green,
+        yellow=feature.yellow,
+        red=feature.red,
+        phase=feature.phase,
+    )
+
+
+def _road_spec(road: RoadModel) -> spec.RoadSpec:
+    buildings = road.buildings
+    return spec.RoadSpec(
+        segments=tuple(_segment_spec(segment, road) for segment in road.segments),
+        speed_limit=_kph(road.speed_limit_kph),
+        features=tuple(_feature_spec(feature) for feature in road.features),
+        buildings=None
+        if buildings is None
+        else spec.BuildingsSpec(density=buildings.density, setback=buildings.setback),
+    )
+
+
+def _trigger_spec(trigger: TriggerModel) -> spec.Trigger:
+    kind = trigger.kind
+    if kind == "time":
+        return spec.TimeTrigger(time=float(given_or(trigger.time, 0.0)))
+    if kind == "ego_s":
+        return spec.EgoStationTrigger(s=float(given_or(trigger.ego_s, 0.0)))
+    if kind == "gap":
+        return spec.GapTrigger(gap=float(given_or(trigger.gap, 0.0)))
+    return spec.AfterTrigger(index=given_or(trigger.after, 0),
+                             delay=float(given_or(trigger.delay, 0.0)))
+
+
+def _action_spec(action: ActionModel, accel: float | None) -> spec.Action:
+    if action.speed is not None:
+        magnitude = abs(given_or(accel, DEFAULT_SPEED_UP))
+        return spec.SpeedAction(speed=_kph(action.speed.kph), accel=magnitude)
+    if action.lane_change is not None:
+        return spec.LaneChangeAction(
+            to_lane=action.lane_change.to_lane, lateral_speed=action.lane_change.lateral_speed
+        )
+    if action.walk is not None:
+        return spec.WalkAction(to_offset=action.walk.to_offset, speed=_kph(action.walk.speed_kph))
+    assert action.stop is not None
+    return spec.StopAction(decel=action.stop.decel)
+
+
+def _actor_spec(index: int, actor: ActorModel) -> spec.ActorSpec:
+    accels = speed_accels(f"actors.{index}", actor)
+    actions = tuple(
+        spec.ActionSpec(
+            trigger=_trigger_spec(action.trigger), action=_action_spec(action, accels.get(number))
+        )
+        for number, action in enumerate(actor.actions)
+    )
+    return spec.ActorSpec(
+        id=actor.id,
+        type=spec.ActorType(actor.type),
+        lane=given_or(actor.lane, 0),
+        s=float(given_or(actor.s, 0.0)),
+        offset=actor.offset,
+        speed=_kph(actor.speed_kph),
+        actions=actions,
+    )
+
+
+def _event_spec(event: EventModel) -> spec.EventSpec:
+    trigger = _trigger_spec(event.trigger)
+    if event.accelerator_override is not None:
+        override = event.accelerator_override
+        return spec.EventSpec(
+            trigger, spec.AcceleratorOverride(pedal=override.pedal, duration=override.duration)
+        )
+    assert event.flat_tire is not None
+    return spec.EventSpec(trigger, spec.FlatTire(wheel=frames.Wheel(event.flat_tire.wheel)))
+
+
+def _sensors_spec(model: ScenarioModel) -> spec.SensorsSpec:
+    gnss, lidar = model.sensors.gnss, model.sensors.lidar
+    return spec.SensorsSpec(
+        gnss=spec.GnssSpec()
+        if gnss is None
+        else spec.GnssSpec(
+            sigma=gnss.sigma,
+            heading_sigma=math.radians(gnss.heading_sigma_deg),
+            bias=(float(gnss.bias[0]), float(gnss.bias[1])),
+        ),
+        lidar=spec.LidarNoiseSpec()
+        if lidar is None
+        else spec.LidarNoiseSpec(range_sigma=lidar.range_sigma, dropout=lidar.dropout),
+    )
+
+
+def _scenario(model: ScenarioModel, road_spec: spec.RoadSpec,
+              actors: tuple[spec.ActorSpec, ...],
+              town: spec.TownSpec | None = None) -> Scenario:
+    ego = model.ego
+    world = spec.WorldSpec(
+        road=road_spec,
+        ego=spec.EgoSpec(
+            lane=given_or(ego.lane, 0),
+            s=float(given_or(ego.s, 0.0)) if town is None else given_or(ego.s, TOWN_START_S),
+            speed=_kph(ego.speed_kph),
+            max_speed=_kph(ego.max_speed_kph),
+        ),
+        seed=model.seed,
+        actors=actors,
+        sensors=_sensors_spec(model),
+        events=tuple(_event_spec(event) for event in model.events),
+        town=town,
+    )
+    return Scenario(
+        name=model.name,
+        description=model.description,
+        situation=model.situation,
+        duration=float(model.duration),
+        world=world,
+        driver=DriverSettings(set_speed=_kph(ego.set_speed_kph), overtake=ego.overtake),
+        criteria=CriteriaSettings.of({str(d.key): getattr(model.criteria, str(d.key))
+                                      for d in keyed()}),
+    )
+
+
+def _convert_town(model: ScenarioModel) -> Scenario:
+    """A town: each car's `start` and `route` compile into its own route road
+    (`world.map.town`); the ego's is the scenario's `road`."""
+    assert model.town is not None  # the model has exactly one map
+    t = model.town
+    town = spec.TownSpec(t.blocks_x, t.blocks_y, float(t.block), t.lanes, float(t.lane_width),
+                         _kph(t.speed_limit_kph), t.junctions)
+    layout = TownLayout(town)
+    try:
+        layout.check("town")
+        ego_road = _town_route(layout, "ego", model.ego.start, model.ego.route)
+        roads = [_town_route(layout, f"actors.{i}", a.start, a.route)
+                 for i, a in enumerate(model.actors)]
+    except TownError as error:
+        raise LocatedError(error.key, error.problem) from None
+    check_town(model, ego_road, roads)
+    actors = tuple(
+        replace(_actor_spec(index, actor), s=given_or(actor.s, TOWN_START_S), road=road)
+        for index, (actor, road) in enumerate(zip(model.actors, roads, strict=True)))
+    return _scenario(model, ego_road, actors, town)
+
+
+def _town_route(layout: TownLayout, key: str, start: tuple[int, int, str] | None,
+                route: Sequence[str] | None) -> spec.RoadSpec:
+    if start is None:
+        raise LocatedError(f"{key}.start", "required key missing in a town ([ix, iy, heading])")
+    turns = tuple(hdmap.Manoeuvre(turn) for turn in (route or ()))
+    return compile_route(layout, (start[0], start[1], start[2]), turns, key)
+

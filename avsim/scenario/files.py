@@ -1,0 +1,114 @@
+"""Finding a scenario file and reading its YAML.
+
+A scenario argument is a file path, or the name of a bundled scenario in `<repo>/scenarios/`
+(`SCENARIO_DIR`). The YAML is read with a strict safe loader: a key written twice in one
+mapping is an error (PyYAML would keep the last). Problems are `LocatedError`s keyed
+`(file)` or `line N`.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Hashable
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from avsim.scenario.errors import FILE_KEY, LocatedError, show
+
+REPO_ROOT = Path(__file__).resolve().parents[2]
+SCENARIO_DIR = REPO_ROOT / "scenarios"
+
+
+def bundled_scenarios() -> list[Path]:
+    """The bundled scenario files, `<repo>/scenarios/*.yaml`, sorted by name."""
+    return sorted(SCENARIO_DIR.glob("*.yaml"))
+
+
+def scenario_path(path_or_name: str | Path) -> Path:
+    """The file a scenario argument names: a path (anything with a `/`, a `.yaml` / `.yml`
+    suffix, or an existing file), else the bundled `<repo>/scenarios/<name>.yaml`."""
+    candidate = Path(path_or_name)
+    if looks_like_path(path_or_name) or candidate.exists():
+        return candidate
+    return SCENARIO_DIR / f"{candidate.name}.yaml"
+
+
+def looks_like_path(path_or_name: str | Path) -> bool:
+    """Whether a scenario argument is meant as a path (not a bundled scenario's name)."""
+    text = str(path_or_name)
+    is_file_name = Path(text).suffix in {".yaml", ".yml"}
+    return isinstance(path_or_name, Path) or is_file_name or "/" in text or os.sep in text
+
+
+def shown_name(path_or_name: str | Path, path: Path) -> str:
+    """How the file is named in messages: as the user wrote it, or for a bundled name its
+    path relative to the working directory when it lies below it."""
+    if looks_like_path(path_or_name) or not path.is_relative_to(SCENARIO_DIR):
+        return str(path_or_name)
+    try:
+        return str(path.relative_to(Path.cwd()))
+    except ValueError:
+        return str(path)
+
+
+_MERGE_TAG = "tag:yaml.org,2002:merge"
+
+
+class _StrictLoader(yaml.SafeLoader):
+    """A safe YAML loader that refuses duplicate keys instead of keeping the last one."""
+
+    def construct_mapping(self, node: yaml.MappingNode, deep: bool = False) -> dict[Hashable, Any]:
+        seen: dict[Hashable, yaml.Node] = {}
+        for key_node, _ in node.value:
+            if key_node.tag == _MERGE_TAG:  # `<<: *anchor`; its keys may be overridden
+                continue
+            key = self.construct_object(key_node, deep=deep)
+            if isinstance(key, Hashable) and key in seen:
+                first = seen[key].start_mark.line + 1
+                line = key_node.start_mark.line + 1
+                raise LocatedError(
+                    f"line {line}", f"duplicate key {key!r} (first at line {first})"
+                )
+            if isinstance(key, Hashable):
+                seen[key] = key_node
+        return super().construct_mapping(node, deep=deep)
+
+
+def read_raw(path: Path) -> dict[str, Any]:
+    """The file's YAML as a mapping, or a `LocatedError` keyed `(file)` or `line N`."""
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise LocatedError(FILE_KEY, "no such file") from None
+    except IsADirectoryError:
+        raise LocatedError(FILE_KEY, "is a directory, not a file") from None
+    except UnicodeDecodeError:
+        raise LocatedError(FILE_KEY, "not UTF-8 text") from None
+    except OSError as exc:
+        raise LocatedError(FILE_KEY, f"cannot read it ({exc.strerror})") from None
+    try:
+        data = yaml.load(text, Loader=_StrictLoader)
+    except yaml.MarkedYAMLError as exc:
+        raise _yaml_problem(exc) from None
+    except yaml.YAMLError as exc:
+        raise LocatedError(FILE_KEY, f"YAML error: {exc}") from None
+    if data is None:
+        raise LocatedError(FILE_KEY, "empty file")
+    if not isinstance(data, dict):
+        raise LocatedError(
+            FILE_KEY, f"must be a mapping of keys (format, name, ...), got {show(data)}"
+        )
+    return data
+
+
+def _yaml_problem(exc: yaml.MarkedYAMLError) -> LocatedError:
+    """`line N: YAML syntax error: <what> (<context> at line M)` from PyYAML's error."""
+    mark = exc.problem_mark or exc.context_mark
+    key = f"line {mark.line + 1}" if mark is not None else FILE_KEY
+    what = exc.problem or exc.context or "malformed YAML"
+    if exc.problem and exc.context and exc.context_mark is not None:
+        what += f" ({exc.context} at line {exc.context_mark.line + 1})"
+    return LocatedError(key, f"YAML syntax error: {what}")
+

@@ -1,0 +1,64 @@
+"""Overrides: values set into a scenario file's data before it is validated.
+
+`avsim sweep --set PATH=V` and `avsim run --seed` give them as dotted key paths with list
+indices (`actors.0.speed_kph`). Every mapping and list on the way must exist and list
+indices be in range; the last key may be new (validation then rejects it if the format has
+no such key). A bad path is a `LocatedError` at that path.
+"""
+
+from __future__ import annotations
+
+import copy
+from collections.abc import Mapping
+from typing import Any
+
+from avsim.scenario.errors import LocatedError, show
+
+
+def apply_overrides(raw: dict[str, Any], overrides: Mapping[str, object]) -> dict[str, Any]:
+    """A copy of `raw` with each dotted `path` set to its value (before validation).
+
+    Every mapping and list on the way must exist and list indices be in range; the last key
+    may be new (validation then rejects it if the format has no such key)."""
+    data = copy.deepcopy(raw)
+    for path, value in overrides.items():
+        _set_path(data, path, copy.deepcopy(value))
+    return data
+
+
+def _set_path(data: dict[str, Any], path: str, value: object) -> None:
+    parts = path.split(".")
+    if not all(parts):
+        raise LocatedError(path or "(override)", "override path is empty or has an empty part")
+    node: object = data
+    for depth, part in enumerate(parts[:-1]):
+        node = _child(node, part, ".".join(parts[: depth + 1]), path)
+    last = parts[-1]
+    if isinstance(node, list):
+        node[_index(node, last, path)] = value
+    elif isinstance(node, dict):
+        node[last] = value
+    else:
+        raise LocatedError(
+            path, f"cannot set: {'.'.join(parts[:-1])} is {show(node)}, not a mapping or list"
+        )
+
+
+def _child(node: object, part: str, where: str, path: str) -> object:
+    """The item `part` of the mapping or list `node` on the way along an override path."""
+    if isinstance(node, list):
+        return node[_index(node, part, path)]
+    if isinstance(node, dict):
+        if part not in node:
+            raise LocatedError(path, f"cannot set: the file has no key {where}")
+        return node[part]
+    raise LocatedError(
+        path, f"cannot set: {where.rpartition('.')[0]} is {show(node)}, not a mapping or list"
+    )
+
+
+def _index(node: list[Any], part: str, path: str) -> int:
+    if not part.isdigit() or int(part) >= len(node):
+        raise LocatedError(path, f"cannot set: {part!r} is not an index of a list of {len(node)}")
+    return int(part)
+

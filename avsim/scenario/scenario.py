@@ -1,0 +1,44 @@
+"""A scenario as a run takes it: its name and duration, the world it happens in, what the
+driver asks of the car, and the criteria it is judged by.
+
+`avsim.scenario.load.load_scenario` returns one (SI units, radians, every default
+resolved); the runner, the batch jobs, the CLI and the reports take it. The world's part
+(`world.spec.WorldSpec`: roads or a town, the ego car's body, actors, events, sensors, the
+seed) is what `world.World` is built from; the driver's settings configure the driving
+stack (`avsim.run.stack`); the criteria settings choose and tune the criteria
+(`avsim.criteria.registry`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from avsim.criteria.registry import CriteriaSettings
+from world.spec import WorldSpec
+
+
+@dataclass(frozen=True, slots=True)
+class DriverSettings:
+    """What the driver asks of the car's driving stack (the file's `ego.set_speed_kph` and
+    `ego.overtake`); the car's own limits and start are the world's (`world.spec.EgoSpec`)."""
+
+    set_speed: float  # [m/s] the desired (cruise) speed
+    overtake: bool = False  # may change lanes to pass a slower vehicle
+
+
+@dataclass(frozen=True, slots=True)
+class Scenario:
+    """One scenario: what the run simulates, for how long, and how it is judged."""
+
+    name: str  # [a-z0-9_]+
+    description: str  # one line for humans
+    situation: str  # which driving situation it exercises (the file's `situation`)
+    duration: float  # [s] simulated time limit
+    world: WorldSpec
+    driver: DriverSettings
+    criteria: CriteriaSettings = field(default_factory=CriteriaSettings)
+
+    @property
+    def seed(self) -> int:
+        """The seed of the world's randomness (the file's `seed`)."""
+        return self.world.seed
