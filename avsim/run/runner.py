@@ -1,14 +1,15 @@
 """The closed loop: world -> sensors -> stack -> joints, criteria on ground truth, recording.
 
-Rates (all divide the 240 Hz physics rate; checked by `Rate`):
-- GNSS 10 Hz, odometry and the stack (decide-then-apply) 40 Hz;
-- criteria sample ground truth at 40 Hz (the control ticks' snapshots, so the log, the
-  criteria and the NPC triggers share one projection of the ego onto the route), collisions
-  (contact onsets) at 120 Hz;
-- the recording logs the ego pose, scalars and the plan at 20 Hz, NPC boxes at 10 Hz.
+Rates (the table `world.core.rates`; each divides the physics rate):
+- the sensor loop (`avsim.run.sensor_loop`: every sensor, GNSS and odometry included) and
+  the stack (decide-then-apply) at the control rate;
+- criteria sample ground truth at the criteria rate (the control ticks' snapshots, so the
+  log, the criteria and the NPC triggers share one projection of the ego onto the route),
+  collisions (contact onsets) at the contact rate;
+- the recording logs the ego pose, scalars and the plan at its rate, NPC boxes at theirs.
 
 Each control tick decides on one snapshot (the sensor frames of this tick), then the
-command is held on the joints for the next 6 physics steps.
+command is held on the joints for the control period's physics steps.
 """
 
 from __future__ import annotations
@@ -35,20 +36,19 @@ from avsim.run.sensor_loop import FrameHook, SensorLoop, sensing_mode
 from avsim.run.stack import Stack, StackOutput
 from planner.fsm.motion import TURNS
 from planner.messages import StateChange
-from world.core.client import PHYSICS_RATE, Rate
+from world.core.rates import (
+    ACTOR_RECORD_RATE,
+    CONTACT_RATE,
+    CONTROL_RATE,
+    CRITERIA_RATE,
+    PHYSICS_RATE,
+    RECORD_RATE,
+)
 from world.sensors.setup import Profile, sensor_setup
 from world.spec import FlatTire, ScenarioSpec
 from world.truth import touching
 from world.world import World
 
-GNSS_RATE = Rate("gnss", 10)
-CONTROL_RATE = Rate("control", 40)
-CRITERIA_RATE = Rate("criteria", 40)
-CONTACT_RATE = Rate("contacts", 120)
-RECORD_RATE = Rate("record", 20)
-ACTOR_RECORD_RATE = Rate("record_actors", 10)
-# criteria samples are taken at contact checks
-assert CRITERIA_RATE.every % CONTACT_RATE.every == 0, "criteria rate must divide the contacts'"
 END_MARGIN = 30.0  # [m] default `completes` station: the route's end less this
 TYRE_HALF_WIDTH = 0.105  # [m] half the tyre's tread (the URDF's wheel width)
 NEEDS_ACTORS = (MinGap, StandstillGap, TimeToResume)  # criteria that read the NPCs
@@ -146,8 +146,7 @@ class Runner:
         self._gap_criteria = crosswalks.needs_actors or any(
             isinstance(c, NEEDS_ACTORS) for c in self.criteria.items)
         self.recorder = Recorder(recording, recording_name=spec.name) if recording else None
-        self.sensors = None if self.setup is None else SensorLoop(
-            w, self.setup, self.stack, mode, self.recorder, frame_hook)
+        self.sensors = SensorLoop(w, self.setup, self.stack, mode, self.recorder, frame_hook)
         self.state_changes: list[StateChange] = []
         self._touching: frozenset[int] = frozenset()
         self._logged_events = 0  # collision events already sent to the recording
@@ -196,32 +195,28 @@ class Runner:
                 if progress is not None and w.clock.step % PHYSICS_RATE == 0:
                     progress(w.t, self.spec.duration)
         finally:
-            if self.sensors is not None:
-                self.sensors.close()
+            self.sensors.close()
             if self.recorder is not None:
                 self._record_criteria()
                 self.recorder.close()
             sim_time = w.t
             w.close()
+        renderer = self.sensors.sensing.renderer
         return RunResult(
             spec=self.spec, criteria=self.criteria.results(), metrics=self._metrics(),
             sim_time=sim_time, wall_time=time.perf_counter() - start, log=self.log,
             recording=self.recorder.path if self.recorder else None,
             state_changes=tuple(self.state_changes),
             profile=self.setup.profile.value if self.setup is not None else None,
-            renderer=self.sensors.sensing.renderer.value if self.sensors is not None else None,
+            renderer=renderer.value if renderer is not None else None,
         )
 
     def _tick(self) -> None:
-        """A control tick: sensors at their rates, then decide and apply."""
+        """A control tick: the sensors' frames due now reach the stack, then decide and
+        apply."""
         w = self.world
-        if self.sensors is not None:
-            self.sensors.tick()
-        truth = w.ego_truth
-        if GNSS_RATE.fires(w.clock.step):
-            self.stack.on_gnss(w.gnss.measure(w.t, truth))
-        self.stack.on_odometry(w.odometry.measure(w.t, truth))
-        out = self.stack.tick(w.t, CONTROL_RATE.every / PHYSICS_RATE)
+        self.sensors.tick()
+        out = self.stack.tick(w.t, CONTROL_RATE.period)
         cmd = out.command
         w.ego.apply(cmd.steering_angle, cmd.drive_torque, cmd.brake_torque)
         self._last = out
@@ -308,7 +303,7 @@ class Runner:
         keeping = ~np.asarray(self.log.changing, dtype=bool)  # lane changes are not errors
         xte = self.log.array("cross_track")[keeping]
         speed = self.log.array("speed")
-        dt = CONTROL_RATE.every / PHYSICS_RATE
+        dt = CONTROL_RATE.period
         decel = -np.diff(speed) / dt if len(speed) > 1 else np.zeros(1)
         window = max(1, round(0.2 / dt))
         smooth = np.convolve(decel, np.ones(window) / window, mode="valid") if len(decel) else decel
@@ -322,7 +317,7 @@ class Runner:
             "max_speed": float(np.max(speed)) if len(speed) else 0.0,
             "distance": float(self.log.station[-1] - self.log.station[0]) if xte.size else 0.0,
             "collisions": float(self.collisions.count),
-        } | (self.sensors.metrics() if self.sensors is not None else {})
+        } | (self.sensors.metrics() if self.setup is not None else {})
 
     # -- recording -----------------------------------------------------------------------------
 
@@ -374,7 +369,7 @@ class Runner:
     def _record_criteria(self) -> None:
         rec = self.recorder
         assert rec is not None
-        if self.sensors is not None:
+        if self.setup is not None:
             scores = ", ".join(f"{k} {v:.3f}" for k, v in self.sensors.metrics().items())
             rec.log_event(self.world.t, f"perception against the truth: {scores}", "INFO")
         for r in self.criteria.results():
