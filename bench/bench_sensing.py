@@ -35,7 +35,7 @@ from avsim.scenario.load import load_scenario
 from world.core.rates import CONTROL_RATE, PHYSICS_RATE
 from world.sensors.pipeline import InlineSensing, ProcessSensing, Sensing
 from world.sensors.schedule import SensorSchedule
-from world.sensors.setup import Profile, sensor_rates, sensor_setup
+from world.sensors.setup import Profile, sensor_setup, sensor_timings
 from world.world import World
 
 SCENARIO = "normal_driving"
@@ -82,7 +82,7 @@ def floor_rtf(profile: Profile, run: RunResult, mode: str) -> float:
     setup = sensor_setup(profile)
     world = World(run.spec, setup, cameras=mode == "inline")
     sensing: Sensing = InlineSensing(world) if mode == "inline" else ProcessSensing(world, setup)
-    schedule = SensorSchedule(sensor_rates(setup), CONTROL_RATE)
+    schedule = SensorSchedule(sensor_timings(setup), CONTROL_RATE)
     log = run.log
     try:
         start = time.perf_counter()
@@ -96,7 +96,7 @@ def floor_rtf(profile: Profile, run: RunResult, mode: str) -> float:
             world.ego.apply(steering, drive, brake)
             for _ in range(CONTROL_RATE.every):
                 world.step()
-        sensing.collect(world.clock.step + max(t.latency_steps for _, t in sensor_rates(setup)))
+        sensing.collect(world.clock.step + max(t.latency_steps for _, t in sensor_timings(setup)))
         wall = time.perf_counter() - start
     finally:
         sensing.close()

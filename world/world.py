@@ -148,13 +148,13 @@ class World:
         sensors: list[Sensor] = []
         if setup is not None and self.renderer is not None:
             sensors += [CameraSensor(Camera(self.client, info, self.renderer),
-                                     setup.rate(info.name), ride_height)
+                                     setup.timing(info.name), ride_height)
                         for info in setup.cameras]
         if setup is not None and lidar:
             caster = Lidar(self.client, setup.lidar, np.random.default_rng(seeds[3]),
                            self.actors.bodies, self.scene.ground,
                            sorted(self.scene.static_bodies))
-            sensors.append(LidarSensor(caster, setup.rate(LIDAR), ride_height))
+            sensors.append(LidarSensor(caster, setup.timing(LIDAR), ride_height))
         events = self._events
         sensors += [GnssSensor(self.spec.sensors.gnss, np.random.default_rng(seeds[1])),
                     OdometrySensor(self.ego.geometry.wheel_radius,

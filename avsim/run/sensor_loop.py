@@ -1,15 +1,16 @@
 """The sensor side of the closed loop: capture, delivery to the stack, scoring, recording.
 
-At each control tick the loop (1) hands the stack the captures whose delivery step has come
-(camera frames and LiDAR scans taken one `world.core.rates.FRAME_LATENCY` earlier: a real
-sensor's latency, and room for the rendering worker to run while the main process steps
-physics and runs the stack), (2) submits the captures the schedule has due now
-(`world.sensors.schedule`, from the rates table: every sensor of the car, GNSS and odometry
-included) to the sensing pipeline (`world.sensors.pipeline`), and (3) hands over those due
-at once (GNSS, odometry). The ground truth of each capture instant whose data arrives late is
-kept until its delivery, to score perception (`avsim.run.scoring`) on exactly the instant
-the data shows. The recording keeps every `record_every`-th frame of each sensor (its entry
-in the rates table), by frame type: camera images, LiDAR points.
+At each control tick the loop collects from the sensing pipeline (`world.sensors.pipeline`)
+the captures whose delivery step has come (camera frames and LiDAR scans taken one
+`world.core.rates.FRAME_LATENCY` earlier: a real sensor's latency, and room for the
+rendering worker to run while the main process steps physics and runs the stack), submits
+the captures the schedule has due now (`world.sensors.schedule`, from the rates table: every
+sensor of the car, GNSS and odometry included), then hands the stack, in this order, the
+captures collected and those due at once (GNSS, odometry). The ground truth of each capture
+instant whose data arrives late is kept until its delivery, to score perception
+(`avsim.run.scoring`) on exactly the instant the data shows. The recording keeps every
+`record_every`-th frame of each sensor (its entry in the rates table), by frame type: camera
+images, LiDAR points.
 
 `frame_hook` lets a test (or a fault-injection study) alter the camera frames the stack
 receives, e.g. a blinded camera; the scoring and the recording keep the true frames.
@@ -32,7 +33,7 @@ from world.frames import CameraFrame, Frame, LidarScan
 from world.sensors.lidar import LidarTruth
 from world.sensors.pipeline import Capture, InlineSensing, ProcessSensing, Sensing
 from world.sensors.schedule import Due, SensorSchedule
-from world.sensors.setup import SensorSetup, sensor_rates
+from world.sensors.setup import SensorSetup, sensor_timings
 from world.world import World
 
 FrameHook = Callable[[CameraFrame], CameraFrame]
@@ -60,7 +61,7 @@ class SensorLoop:
         """`mode`: 'inline' or 'process' (`world.sensors.pipeline`; without cameras there is
         nothing to render elsewhere, and every sensor captures inline)."""
         self.world, self.setup, self.stack = world, setup, stack
-        self.schedule = SensorSchedule(sensor_rates(setup), CONTROL_RATE)
+        self.schedule = SensorSchedule(sensor_timings(setup), CONTROL_RATE)
         self.sensing: Sensing = (ProcessSensing(world, setup)
                                  if mode == "process" and setup is not None and setup.cameras
                                  else InlineSensing(world))

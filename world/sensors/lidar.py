@@ -36,6 +36,7 @@ from world.ego.body import EgoTruth
 from world.frames import LidarInfo, LidarScan
 from world.sensors.ray_culling import Box, ground_distance, rays_to_cast
 from world.sensors.sensor import Reading, vehicle_pose
+from world.sensors.setup import LIDAR
 
 MAX_BATCH = 16_383  # rays per rayTestBatch call
 EGO_RAY_GROUP = 0x40  # collision group of the ego's links; the rays' mask leaves it out
@@ -144,7 +145,7 @@ class LidarSensor:
     lidar: Lidar
     timing: SensorTiming  # its entry in the rates table
     ride_height: float  # [m] the base link's origin above the vehicle frame's (the ground)
-    name: str = "lidar"
+    name: str = LIDAR
 
     @property
     def rate(self) -> Rate:

@@ -2,7 +2,7 @@
 reaches the stack.
 
 Built from the rates table's entries (`world.core.rates.SensorTiming`, as
-`world.sensors.setup.sensor_rates` lists them): a sensor captures at the steps where its
+`world.sensors.setup.sensor_timings` lists them): a sensor captures at the steps where its
 rate fires, and its capture is delivered `latency` later. The sensors due at one step with
 the same latency form one `Due`: they are captured together and reach the stack together.
 The schedule is consulted on the steps of a `tick` rate (the control rate), so every sensor's

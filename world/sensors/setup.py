@@ -49,7 +49,7 @@ class SensorSetup:
     profile: Profile
     cameras: tuple[CameraInfo, ...]  # front first
     lidar: LidarInfo
-    rates: tuple[tuple[str, SensorTiming], ...]  # (name, timing) of each camera (in
+    timings: tuple[tuple[str, SensorTiming], ...]  # (name, timing) of each camera (in
     #   `cameras` order) and of the LiDAR: the profile's entries in the rates table
 
     def camera(self, name: str) -> CameraInfo:
@@ -58,9 +58,9 @@ class SensorSetup:
                 return c
         raise KeyError(f"no camera {name!r} in profile {self.profile.value}")
 
-    def rate(self, name: str) -> SensorTiming:
+    def timing(self, name: str) -> SensorTiming:
         """The timing of the camera or LiDAR `name`."""
-        for n, timing in self.rates:
+        for n, timing in self.timings:
             if n == name:
                 return timing
         raise KeyError(f"no sensor {name!r} in profile {self.profile.value}")
@@ -110,8 +110,8 @@ def sensor_setup(profile: Profile, lidar_noise: LidarNoiseSpec | None = None) ->
     return SensorSetup(profile, cameras, lidar, tuple((n, table[n]) for n in names))
 
 
-def sensor_rates(setup: SensorSetup | None) -> tuple[tuple[str, SensorTiming], ...]:
+def sensor_timings(setup: SensorSetup | None) -> tuple[tuple[str, SensorTiming], ...]:
     """(name, timing) of every sensor of the car, in the order a capture lists them: the
     profile's cameras (front first) and LiDAR (none without a profile), then the sensors on
     every car (GNSS, odometry)."""
-    return (setup.rates if setup is not None else ()) + tuple(CAR_SENSORS.items())
+    return (setup.timings if setup is not None else ()) + tuple(CAR_SENSORS.items())

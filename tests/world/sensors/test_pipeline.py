@@ -15,7 +15,7 @@ from world.frames import CameraFrame, GnssFix, LidarScan, Odometry
 from world.sensors.lidar import LidarTruth
 from world.sensors.pipeline import Capture, InlineSensing, ProcessSensing, SensingError
 from world.sensors.schedule import SensorSchedule
-from world.sensors.setup import Profile, sensor_rates, sensor_setup
+from world.sensors.setup import Profile, sensor_setup, sensor_timings
 from world.world import World
 
 LATE = round(FRAME_LATENCY * PHYSICS_RATE)  # [steps]
@@ -28,7 +28,7 @@ def drive(mode: str, seconds: float = 2.0) -> list[tuple[int, Capture]]:
     setup = sensor_setup(Profile.DEFAULT)
     world = World(spec, setup, cameras=mode == "inline")
     sensing = InlineSensing(world) if mode == "inline" else ProcessSensing(world, setup)
-    schedule = SensorSchedule(sensor_rates(setup), CONTROL_RATE)
+    schedule = SensorSchedule(sensor_timings(setup), CONTROL_RATE)
     out = []
     try:
         world.ego.apply(0.0, 1500.0 * 2.0 * 0.33, 0.0)
@@ -106,7 +106,7 @@ def test_inline_and_process_sensing_are_bitwise_equal() -> None:
 def test_a_capture_must_be_submitted_at_its_step() -> None:
     world = World(load_scenario("normal_driving"))  # no profile: GNSS and odometry only
     sensing = InlineSensing(world)
-    schedule = SensorSchedule(sensor_rates(None), CONTROL_RATE)
+    schedule = SensorSchedule(sensor_timings(None), CONTROL_RATE)
     try:
         assert sensing.renderer is None
         (due,) = schedule.due(0)
@@ -125,7 +125,7 @@ def test_a_failing_worker_raises(monkeypatch: pytest.MonkeyPatch) -> None:
     sensing = ProcessSensing(world, setup)
     try:
         monkeypatch.setattr(world, "snapshot", lambda: "not a snapshot")  # a broken request
-        for due in SensorSchedule(sensor_rates(setup), CONTROL_RATE).due(0):
+        for due in SensorSchedule(sensor_timings(setup), CONTROL_RATE).due(0):
             sensing.submit(due)
         assert [c.due.sensors for c in sensing.collect(0)] == [("gnss", "odometry")]
         with pytest.raises(SensingError, match="sensing worker failed"):

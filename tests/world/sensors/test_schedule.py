@@ -11,7 +11,7 @@ import pytest
 
 from world.core.rates import CONTROL_RATE, PHYSICS_RATE, Rate, SensorTiming
 from world.sensors.schedule import Due, SensorSchedule
-from world.sensors.setup import Profile, sensor_rates, sensor_setup
+from world.sensors.setup import Profile, sensor_setup, sensor_timings
 
 CAMERAS_LIDAR = ("front", "left", "right", "lidar")
 CAR = ("gnss", "odometry")
@@ -19,7 +19,7 @@ CAR = ("gnss", "odometry")
 
 def schedule(profile: Profile | None = Profile.DEFAULT) -> SensorSchedule:
     setup = sensor_setup(profile) if profile is not None else None
-    return SensorSchedule(sensor_rates(setup), CONTROL_RATE)
+    return SensorSchedule(sensor_timings(setup), CONTROL_RATE)
 
 
 # Row by row: the `default` profile (front and LiDAR at 10 Hz, the sides at 2 Hz, frames

@@ -15,7 +15,7 @@ from world.sensors.gnss import GnssSensor
 from world.sensors.lidar import LidarSensor, LidarTruth
 from world.sensors.odometry import OdometrySensor
 from world.sensors.sensor import Reading, Sensor
-from world.sensors.setup import Profile, sensor_rates, sensor_setup
+from world.sensors.setup import Profile, sensor_setup, sensor_timings
 from world.world import World
 
 FRAME_TYPES = {CameraSensor: CameraFrame, LidarSensor: LidarScan, GnssSensor: GnssFix,
@@ -33,7 +33,7 @@ def world() -> Iterator[World]:
 
 
 def test_the_rig_holds_every_sensor_of_the_table(world: World) -> None:
-    table = dict(sensor_rates(sensor_setup(Profile.DEFAULT)))
+    table = dict(sensor_timings(sensor_setup(Profile.DEFAULT)))
     assert sorted(world.rig.names) == sorted(table)
     kinds = {name: type(world.rig.sensor(name)) for name in world.rig.names}
     assert kinds == {"front": CameraSensor, "left": CameraSensor, "right": CameraSensor,
@@ -44,7 +44,7 @@ def test_the_rig_holds_every_sensor_of_the_table(world: World) -> None:
 def test_each_sensor_implements_the_interface(world: World, name: str) -> None:
     sensor = world.rig.sensor(name)
     assert isinstance(sensor, Sensor)
-    timing = dict(sensor_rates(sensor_setup(Profile.DEFAULT)))[name]
+    timing = dict(sensor_timings(sensor_setup(Profile.DEFAULT)))[name]
     assert sensor.name == name
     assert sensor.rate is timing.rate
     assert sensor.latency == timing.latency

@@ -13,7 +13,7 @@ import pytest
 from vehicle_urdf import URDF_PATH, read_geometry
 from world.core.rates import FRAME_LATENCY, GNSS, ODOMETRY, PROFILE_SENSORS
 from world.frames import SensorMount
-from world.sensors.setup import Profile, SensorSetup, sensor_rates, sensor_setup
+from world.sensors.setup import Profile, SensorSetup, sensor_setup, sensor_timings
 from world.spec import LidarNoiseSpec
 
 
@@ -65,7 +65,7 @@ def test_profile_cameras_match_the_table(profile: Profile) -> None:
     if row.sides is not None:
         expected |= {"left": row.sides, "right": row.sides}
     assert setup.cameras[0].name == "front"  # front first
-    assert {c.name: (c.width, c.height, setup.rate(c.name).rate.hz)
+    assert {c.name: (c.width, c.height, setup.timing(c.name).rate.hz)
             for c in setup.cameras} == expected
     assert len(setup.cameras) == len(expected)
     for cam in setup.cameras:
@@ -85,7 +85,7 @@ def test_profile_lidar_is_vlp16_like(profile: Profile) -> None:
                                atol=1e-12)
     assert list(lidar.elevations) == sorted(lidar.elevations)  # ascending
     assert lidar.max_range == 100.0
-    assert sensor_setup(profile).rate("lidar").rate.hz == 10
+    assert sensor_setup(profile).timing("lidar").rate.hz == 10
     assert lidar.rays == 16 * TABLE[profile].columns
     assert 360.0 / lidar.azimuth_steps == pytest.approx(0.4 if profile is Profile.FAST else 0.2)
 
@@ -140,21 +140,33 @@ def test_camera_lookup() -> None:
 
 
 @pytest.mark.parametrize("profile", list(Profile))
-def test_setup_rates_are_the_profiles_entries_in_the_rates_table(profile: Profile) -> None:
+def test_setup_timings_are_the_profiles_entries_in_the_rates_table(profile: Profile) -> None:
     setup = sensor_setup(profile)
     names = [c.name for c in setup.cameras] + ["lidar"]
-    assert [name for name, _ in setup.rates] == names  # the cameras in order, then the LiDAR
-    assert dict(setup.rates) == PROFILE_SENSORS[profile.value]
-    for name, timing in setup.rates:
-        assert setup.rate(name) is timing
+    assert [name for name, _ in setup.timings] == names  # the cameras in order, then the LiDAR
+    assert dict(setup.timings) == PROFILE_SENSORS[profile.value]
+    for name, timing in setup.timings:
+        assert setup.timing(name) is timing
         assert timing.latency == FRAME_LATENCY  # frames reach the stack one period late
     with pytest.raises(KeyError, match=profile.value):
-        setup.rate("gnss")  # on every car, not in the profile
+        setup.timing("gnss")  # on every car, not in the profile
 
 
 def test_every_sensor_of_the_car_in_capture_order() -> None:
     setup = sensor_setup(Profile.DEFAULT)
-    assert sensor_rates(setup) == (*setup.rates, ("gnss", GNSS), ("odometry", ODOMETRY))
-    assert [n for n, _ in sensor_rates(setup)] == ["front", "left", "right", "lidar", "gnss",
+    assert sensor_timings(setup) == (*setup.timings, ("gnss", GNSS), ("odometry", ODOMETRY))
+    assert [n for n, _ in sensor_timings(setup)] == ["front", "left", "right", "lidar", "gnss",
                                                    "odometry"]
-    assert sensor_rates(None) == (("gnss", GNSS), ("odometry", ODOMETRY))  # no profile
+    assert sensor_timings(None) == (("gnss", GNSS), ("odometry", ODOMETRY))  # no profile
+
+
+def test_a_profile_and_its_rates_table_entry_must_name_the_same_sensors(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    from world.sensors import setup as setup_module
+
+    table = dict(PROFILE_SENSORS)
+    table["default"] = {k: v for k, v in PROFILE_SENSORS["default"].items() if k != "left"}
+    monkeypatch.setattr(setup_module, "PROFILE_SENSORS", table)
+    with pytest.raises(ValueError, match="profile default: the rates table has"):
+        sensor_setup(Profile.DEFAULT)
+    assert sensor_setup(Profile.FAST).timing("front") is PROFILE_SENSORS["fast"]["front"]
