@@ -25,6 +25,7 @@ from avsim.record.recorder import Recorder
 from avsim.scenario.load import load_scenario
 from planner.speed_planning import SpeedPlanner, SpeedPlanningParams
 from vehicle_urdf import read_geometry
+from world.core.rates import ACTOR_RATE, CONTROL_RATE
 from world.ego.body import vehicle_info
 from world.map.road import build_road_map
 from world.spec import RoadSpec, SegmentSpec
@@ -66,15 +67,15 @@ def speed_planner() -> float:
 def actors() -> float:
     world = World(load_scenario("normal_driving").world)
     try:
-        t = iter(np.arange(1, 20001) / 120.0)
-        return best_per_call(lambda: world.actors.step(next(t), 1 / 120.0), 2000)
+        t = iter(np.arange(1, 20001) / ACTOR_RATE.hz)
+        return best_per_call(lambda: world.actors.step(next(t), ACTOR_RATE.period), 2000)
     finally:
         world.close()
 
 
 def recorder(tmp: Path) -> float:
-    """[us] per 40 Hz tick over 60 s of sim time, close included (one batch)."""
-    rate, ids = 40.0, ("npc_0", "npc_1", "ped_0")
+    """[us] per control tick over 60 s of sim time, close included (one batch)."""
+    rate, ids = CONTROL_RATE.hz, ("npc_0", "npc_1", "ped_0")
     half = np.array([[2.4, 0.9, 0.75], [4.0, 1.2, 1.5], [0.3, 0.3, 0.9]])
     quats = np.tile([0.0, 0.0, 0.0, 1.0], (3, 1))
     n = int(60 * rate)

@@ -21,9 +21,9 @@ import tempfile
 import time
 from pathlib import Path
 
-from avsim.run.runner import CONTROL_RATE, Runner, RunResult, TrajectoryLog
+from avsim.run.runner import Runner, RunResult, TrajectoryLog
 from avsim.scenario.load import load_scenario
-from world.core.client import PHYSICS_RATE
+from world.core.rates import CONTROL_RATE, PHYSICS_RATE
 from world.world import World
 
 SCENARIO = "normal_driving"

@@ -4,9 +4,10 @@ For each profile (`fast`, `default`, `paper`), on `normal_driving` cut to `--sec
 simulated time:
 
 - floor: the world with the profile's sensors, the stack's own joint commands of the full
-  run replayed at the control rate (same path), physics and the sensors at their rates and
-  nothing else. Two floors: `inline` (one process, serial) and `process` (cameras rendered
-  in the worker process, LiDAR in the main one: the pipeline the runner uses);
+  run replayed at the control rate (same path), physics and the sensors (GNSS and odometry
+  included) at their rates and nothing else. Two floors: `inline` (one process, serial)
+  and `process` (cameras rendered in the worker process, the rest in the main one: the
+  pipeline the runner uses);
 - full stack: the closed loop with perception, planner, control and scoring, no recording;
 - full stack + recording.
 
@@ -29,12 +30,12 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from avsim.run.runner import CONTROL_RATE, Runner, RunResult
+from avsim.run.runner import Runner, RunResult
 from avsim.scenario.load import load_scenario
-from world.core.client import PHYSICS_RATE
+from world.core.rates import CONTROL_RATE, PHYSICS_RATE
 from world.sensors.pipeline import InlineSensing, ProcessSensing, Sensing
-from world.sensors.rig import SensorSchedule
-from world.sensors.setup import Profile, sensor_setup
+from world.sensors.schedule import SensorSchedule
+from world.sensors.setup import Profile, sensor_setup, sensor_timings
 from world.world import World
 
 SCENARIO = "normal_driving"
@@ -81,20 +82,21 @@ def floor_rtf(profile: Profile, run: RunResult, mode: str) -> float:
     setup = sensor_setup(profile)
     world = World(run.scenario.world, setup, cameras=mode == "inline")
     sensing: Sensing = InlineSensing(world) if mode == "inline" else ProcessSensing(world, setup)
-    schedule = SensorSchedule(setup)
+    schedule = SensorSchedule(sensor_timings(setup), CONTROL_RATE)
     log = run.log
     try:
         start = time.perf_counter()
         for steering, drive, brake in zip(log.steering, log.drive_torque, log.brake_torque,
                                           strict=True):
-            due = schedule.due(world.clock.step)
-            if due:
-                sensing.collect()
-                sensing.submit(world.t, due)
+            step = world.clock.step
+            sensing.collect(step)
+            for due in schedule.due(step):
+                sensing.submit(due)
+            sensing.collect(step)
             world.ego.apply(steering, drive, brake)
             for _ in range(CONTROL_RATE.every):
                 world.step()
-        sensing.collect()
+        sensing.collect(world.clock.step + max(t.latency_steps for _, t in sensor_timings(setup)))
         wall = time.perf_counter() - start
     finally:
         sensing.close()

@@ -20,6 +20,7 @@ from __future__ import annotations
 import enum
 import math
 from dataclasses import dataclass
+from typing import TypeAlias
 
 import numpy as np
 from numpy.typing import NDArray
@@ -151,7 +152,6 @@ class CameraInfo:
     height: int  # [px]
     fov_x: float  # [rad] horizontal field of view
     mount: SensorMount
-    rate: float  # [Hz] frames per second
     near: float = 0.1  # [m] clipping distance of the renderer
     far: float = 250.0  # [m]
 
@@ -199,7 +199,6 @@ class LidarInfo:
     elevations: tuple[float, ...]  # [rad] per channel (ring), ascending
     azimuth_steps: int  # [-] columns per revolution
     max_range: float  # [m]
-    rate: float  # [Hz] revolutions per second
     mount: SensorMount
     range_sigma: float = 0.02  # [m] range noise, 1-sigma
     dropout: float = 0.0  # [-] fraction of returns lost
@@ -226,3 +225,7 @@ class LidarScan:
     points: NDArray[np.float32]  # [m] (N, 3) in the sensor frame
     ring: NDArray[np.uint8]  # (N,) channel index into info.elevations
     column: NDArray[np.uint16]  # (N,) azimuth step, 0 .. info.azimuth_steps - 1
+
+
+# What a sensor hands to the stack: one capture of one sensor (`world.sensors.sensor.Sensor`).
+Frame: TypeAlias = CameraFrame | LidarScan | GnssFix | Odometry

@@ -1,11 +1,11 @@
-"""The physics world of one scenario: road, scenery, the ego car, NPCs and the GNSS/odometry.
+"""The physics world of one scenario: road, scenery, the ego car, NPCs and the car's sensors.
 
 `World(spec)` builds everything from a `WorldSpec` into its own `BulletClient`; `step()`
-advances physics by one fixed 240 Hz step (ego forces, Bullet step, NPC behaviours, the
-ego's events). Ground truth for criteria and the recording is in `world.truth`; the stack
-only ever sees what `world.sensors.gnss` measures (the accelerator pedal an ego event holds is one
-of those signals: the world applies no force for it; a flat tyre an ego event makes is
-physical, and no signal says it).
+advances physics by one fixed step of `world.core.rates.PHYSICS_RATE` (ego forces, Bullet
+step, NPC behaviours, the ego's events). Ground truth for criteria and the recording is in
+`world.truth`; the stack only ever sees what the sensor rig (`world.sensors`) measures (the
+accelerator pedal an ego event holds is one of the odometry's signals: the world applies no
+force for it; a flat tyre an ego event makes is physical, and no signal says it).
 """
 
 from __future__ import annotations
@@ -21,8 +21,9 @@ import pybullet
 from numpy.typing import NDArray
 
 from world.actors.actor_set import ActorSet
-from world.core.client import GROUND_FRICTION, Clock, Rate, add_ground, make_client
+from world.core.client import GROUND_FRICTION, Clock, add_ground, make_client
 from world.core.quiet import quiet_c_output
+from world.core.rates import ACTOR_RATE, TRIGGER_RATE
 from world.core.rendering import attach_renderer
 from world.ego.body import EgoBody, EgoParams, EgoTruth
 from world.ego.events import EgoEvents
@@ -51,15 +52,16 @@ from world.scene.scenery import (
 )
 from world.scene.town_scene import Pavement, build_town_scene
 from world.scene.traffic_light import TrafficLightBody, add_traffic_light
-from world.sensors.gnss import GnssSensor, OdometrySensor
-from world.sensors.lidar import EGO_RAY_GROUP
+from world.sensors.camera import Camera, CameraSensor
+from world.sensors.gnss import GnssSensor
+from world.sensors.lidar import EGO_RAY_GROUP, Lidar, LidarSensor
+from world.sensors.odometry import OdometrySensor
 from world.sensors.rig import SensorRig
-from world.sensors.setup import SensorSetup
+from world.sensors.sensor import Sensor
+from world.sensors.setup import LIDAR, SensorSetup
 from world.spec import TownSpec, TrafficLightSpec, WorldSpec
 from world.truth import RouteTruth, route_truth
 
-TRIGGER_RATE = Rate("npc_triggers", 40)  # NPC actions' and ego events' triggers checked
-ACTOR_RATE = Rate("npc_motion", 120)  # NPC motion integrated and bodies moved
 SIGN_POLE_RADIUS = 0.04  # [m]
 SIGN_SEGMENTS = 24  # triangles in a round sign plate
 POLE_RGBA = (0.6, 0.6, 0.62, 1.0)  # [-] galvanised steel
@@ -104,8 +106,8 @@ class World:
 
     def __init__(self, spec: WorldSpec, sensors: SensorSetup | None = None, *,
                  cameras: bool = True, lidar: bool = True) -> None:
-        """`sensors`: build a sensor rig in this client too, with its cameras (the renderer
-        is attached before anything else, as EGL requires) and / or its LiDAR."""
+        """`sensors`: the profile's cameras (the renderer is attached before anything else,
+        as EGL requires) and / or LiDAR join the rig's GNSS and odometry in this client."""
         self.spec = spec
         seeds = np.random.SeedSequence(spec.seed).spawn(4)
         self.client = make_client()
@@ -129,24 +131,36 @@ class World:
         for link in range(-1, self.client.getNumJoints(self.ego.body)):
             self.client.setCollisionFilterGroupMask(self.ego.body, link, EGO_RAY_GROUP, 0xFFFF)
         self.actors = ActorSet(self.client, self.road, spec.actors)
-        self.gnss = GnssSensor(spec.sensors.gnss, np.random.default_rng(seeds[1]))
-        self._events = events = EgoEvents(spec.events)
-        self.odometry = OdometrySensor(
-            self.ego.geometry.wheel_radius, np.random.default_rng(seeds[2]),
-            pedal=lambda: events.pedal,
-        )
-        self.rig = None if sensors is None else SensorRig(
-            self.client, sensors, self.ego.geometry.ride_height, renderer=self.renderer,
-            lidar_rng=np.random.default_rng(seeds[3]) if lidar else None,
-            actor_bodies=self.actors.bodies, ground=self.scene.ground,
-            static_bodies=sorted(self.scene.static_bodies),
-        )
+        self._events = EgoEvents(spec.events)
+        self.rig = self._build_rig(sensors, lidar, seeds)
         self._truth: EgoTruth | None = None
         self._route: RouteTruth | None = None
         self.ego_s = self.ego_route.station
         self.started_actions: list[tuple[str, int]] = []  # (actor id, action) at the last check
 
     # -- building ----------------------------------------------------------------------------
+
+    def _build_rig(self, setup: SensorSetup | None, lidar: bool,
+                   seeds: list[np.random.SeedSequence]) -> SensorRig:
+        """The car's sensors in this client: the profile's cameras (with a renderer) and
+        LiDAR (with `lidar`), GNSS and odometry; each draws its noise from its own child of
+        the scenario's seed (LiDAR 3, GNSS 1, odometry 2)."""
+        ride_height = self.ego.geometry.ride_height
+        sensors: list[Sensor] = []
+        if setup is not None and self.renderer is not None:
+            sensors += [CameraSensor(Camera(self.client, info, self.renderer),
+                                     setup.timing(info.name), ride_height)
+                        for info in setup.cameras]
+        if setup is not None and lidar:
+            caster = Lidar(self.client, setup.lidar, np.random.default_rng(seeds[3]),
+                           self.actors.bodies, self.scene.ground,
+                           sorted(self.scene.static_bodies))
+            sensors.append(LidarSensor(caster, setup.timing(LIDAR), ride_height))
+        events = self._events
+        sensors += [GnssSensor(self.spec.sensors.gnss, np.random.default_rng(seeds[1])),
+                    OdometrySensor(self.ego.geometry.wheel_radius,
+                                   np.random.default_rng(seeds[2]), pedal=lambda: events.pedal)]
+        return SensorRig(sensors)
 
     def _build_scene(self, rng: np.random.Generator) -> StaticScene:
         if self.spec.town is not None:

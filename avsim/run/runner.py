@@ -1,11 +1,12 @@
 """The closed loop: world -> sensors -> stack -> joints, criteria on ground truth, recording.
 
-Rates (all divide the 240 Hz physics rate; checked by `Rate`):
-- GNSS 10 Hz, odometry and the stack (decide-then-apply) 40 Hz;
-- criteria sample ground truth at 40 Hz (the control ticks' snapshots, so the log, the
-  criteria and the NPC triggers share one projection of the ego onto the route), collisions
-  (contact onsets) at 120 Hz;
-- the recording logs the ego pose, scalars and the plan at 20 Hz, NPC boxes at 10 Hz.
+Rates (the table `world.core.rates`; each divides the physics rate):
+- the sensor loop (`avsim.run.sensor_loop`: every sensor, GNSS and odometry included) and
+  the stack (decide-then-apply) at the control rate;
+- criteria sample ground truth at the criteria rate (the control ticks' snapshots, so the
+  log, the criteria and the NPC triggers share one projection of the ego onto the route),
+  collisions (contact onsets) at the contact rate;
+- the recording logs the ego pose, scalars and the plan at its rate, NPC boxes at theirs.
 
 The criteria are the scenario's set (`avsim.criteria.registry`); a sample carries the NPCs'
 true poses only when one of them needs them. After each sample the runner keeps the
@@ -13,7 +14,7 @@ infractions the criteria report (the result's `infractions`), and the recording 
 its sim time; the verdicts are logged at the end.
 
 Each control tick decides on one snapshot (the sensor frames of this tick), then the
-command is held on the joints for the next 6 physics steps.
+command is held on the joints for the control period's physics steps.
 """
 
 from __future__ import annotations
@@ -38,20 +39,19 @@ from avsim.run.stack import Stack, StackOutput
 from avsim.scenario.scenario import Scenario
 from planner.fsm.motion import TURNS
 from planner.messages import MACHINES, AccMode, HazardLights, Motion, Plan, SpeedSource, StateChange
-from world.core.client import PHYSICS_RATE, Rate
+from world.core.rates import (
+    ACTOR_RECORD_RATE,
+    CONTACT_RATE,
+    CONTROL_RATE,
+    CRITERIA_RATE,
+    PHYSICS_RATE,
+    RECORD_RATE,
+)
 from world.sensors.setup import Profile, sensor_setup
 from world.spec import FlatTire
 from world.truth import touching
 from world.world import World
 
-GNSS_RATE = Rate("gnss", 10)
-CONTROL_RATE = Rate("control", 40)
-CRITERIA_RATE = Rate("criteria", 40)
-CONTACT_RATE = Rate("contacts", 120)
-RECORD_RATE = Rate("record", 20)
-ACTOR_RECORD_RATE = Rate("record_actors", 10)
-# criteria samples are taken at contact checks
-assert CRITERIA_RATE.every % CONTACT_RATE.every == 0, "criteria rate must divide the contacts'"
 SETTLE_AFTER_DONE = 1.0  # [s] the run goes on this long after `completes` is reached
 
 ProgressCallback = Callable[[float, float], None]  # (sim time, duration) [s]
@@ -143,8 +143,7 @@ class Runner:
         self.collisions = self.criteria.find(NoCollision)  # its count is a metric
         self.infractions: list[Infraction] = []
         self.recorder = Recorder(recording, recording_name=scenario.name) if recording else None
-        self.sensors = None if self.setup is None else SensorLoop(
-            w, self.setup, self.stack, mode, self.recorder, frame_hook)
+        self.sensors = SensorLoop(w, self.setup, self.stack, mode, self.recorder, frame_hook)
         self.state_changes: list[StateChange] = []
         self._touching: frozenset[int] = frozenset()
         self._last: StackOutput | None = None
@@ -176,32 +175,28 @@ class Runner:
                 if progress is not None and w.clock.step % PHYSICS_RATE == 0:
                     progress(w.t, self.scenario.duration)
         finally:
-            if self.sensors is not None:
-                self.sensors.close()
+            self.sensors.close()
             if self.recorder is not None:
                 self._record_criteria()
                 self.recorder.close()
             sim_time = w.t
             w.close()
+        renderer = self.sensors.sensing.renderer
         return RunResult(
             scenario=self.scenario, criteria=self.criteria.results(), metrics=self._metrics(),
             sim_time=sim_time, wall_time=time.perf_counter() - start, log=self.log,
             recording=self.recorder.path if self.recorder else None,
             state_changes=tuple(self.state_changes), infractions=tuple(self.infractions),
             profile=self.setup.profile.value if self.setup is not None else None,
-            renderer=self.sensors.sensing.renderer.value if self.sensors is not None else None,
+            renderer=renderer.value if renderer is not None else None,
         )
 
     def _tick(self) -> None:
-        """A control tick: sensors at their rates, then decide and apply."""
+        """A control tick: the sensors' frames due now reach the stack, then decide and
+        apply."""
         w = self.world
-        if self.sensors is not None:
-            self.sensors.tick()
-        truth = w.ego_truth
-        if GNSS_RATE.fires(w.clock.step):
-            self.stack.on_gnss(w.gnss.measure(w.t, truth))
-        self.stack.on_odometry(w.odometry.measure(w.t, truth))
-        out = self.stack.tick(w.t, CONTROL_RATE.every / PHYSICS_RATE)
+        self.sensors.tick()
+        out = self.stack.tick(w.t, CONTROL_RATE.period)
         cmd = out.command
         w.ego.apply(cmd.steering_angle, cmd.drive_torque, cmd.brake_torque)
         if self._last is None and self.recorder is not None:
@@ -299,7 +294,7 @@ class Runner:
         keeping = ~np.asarray(self.log.changing, dtype=bool)  # lane changes are not errors
         xte = self.log.array("cross_track")[keeping]
         speed = self.log.array("speed")
-        dt = CONTROL_RATE.every / PHYSICS_RATE
+        dt = CONTROL_RATE.period
         decel = -np.diff(speed) / dt if len(speed) > 1 else np.zeros(1)
         window = max(1, round(0.2 / dt))
         smooth = np.convolve(decel, np.ones(window) / window, mode="valid") if len(decel) else decel
@@ -313,7 +308,7 @@ class Runner:
             "max_speed": float(np.max(speed)) if len(speed) else 0.0,
             "distance": float(self.log.station[-1] - self.log.station[0]) if xte.size else 0.0,
             "collisions": float(self.collisions.count),
-        } | (self.sensors.metrics() if self.sensors is not None else {})
+        } | (self.sensors.metrics() if self.setup is not None else {})
 
     # -- recording -----------------------------------------------------------------------------
 
@@ -370,7 +365,7 @@ class Runner:
     def _record_criteria(self) -> None:
         rec = self.recorder
         assert rec is not None
-        if self.sensors is not None:
+        if self.setup is not None:
             scores = ", ".join(f"{k} {v:.3f}" for k, v in self.sensors.metrics().items())
             rec.log_event(self.world.t, f"perception against the truth: {scores}", "INFO")
         for r in self.criteria.results():

@@ -1,14 +1,19 @@
-"""The sensor side of the closed loop: capture, late delivery to the stack, scoring, recording.
+"""The sensor side of the closed loop: capture, delivery to the stack, scoring, recording.
 
-At each sensor instant (a multiple of the control period) the loop first collects the
-capture submitted one sensor period earlier and hands it to the stack's perception, then
-submits the capture of this instant (`world.sensors.pipeline`): a real sensor's latency, and
-room for the rendering worker to run while the main process steps physics and runs the stack. The
-ground truth of each capture instant is kept until its data is delivered, to score
-perception (`avsim.run.scoring`) on exactly the instant the data shows.
+At each control tick the loop collects from the sensing pipeline (`world.sensors.pipeline`)
+the captures whose delivery step has come (camera frames and LiDAR scans taken one
+`world.core.rates.FRAME_LATENCY` earlier: a real sensor's latency, and room for the
+rendering worker to run while the main process steps physics and runs the stack), submits
+the captures the schedule has due now (`world.sensors.schedule`, from the rates table: every
+sensor of the car, GNSS and odometry included), then hands the stack, in this order, the
+captures collected and those due at once (GNSS, odometry). The ground truth of each capture
+instant whose data arrives late is kept until its delivery, to score perception
+(`avsim.run.scoring`) on exactly the instant the data shows. The recording keeps every
+`record_every`-th frame of each sensor (its entry in the rates table), by frame type: camera
+images, LiDAR points.
 
-`frame_hook` lets a test (or a fault-injection study) alter what the stack receives, e.g.
-a blinded camera; the scoring and the recording keep the true frames.
+`frame_hook` lets a test (or a fault-injection study) alter the camera frames the stack
+receives, e.g. a blinded camera; the scoring and the recording keep the true frames.
 """
 
 from __future__ import annotations
@@ -23,17 +28,16 @@ from avsim.record.recorder import Recorder
 from avsim.run.scoring import CaptureTruth, PerceptionScore
 from avsim.run.stack import PerceptionOutput, Stack
 from perception.messages import Detection
-from world.frames import CameraFrame
-from world.sensors.pipeline import InlineSensing, ProcessSensing, Sensing
-from world.sensors.rig import SensorData, SensorSchedule
-from world.sensors.setup import SensorSetup
+from world.core.rates import CONTROL_RATE
+from world.frames import CameraFrame, Frame, LidarScan
+from world.sensors.lidar import LidarTruth
+from world.sensors.pipeline import Capture, InlineSensing, ProcessSensing, Sensing
+from world.sensors.schedule import Due, SensorSchedule
+from world.sensors.setup import SensorSetup, sensor_timings
 from world.world import World
 
 FrameHook = Callable[[CameraFrame], CameraFrame]
 
-RECORD_FRONT_EVERY = 5  # record every 5th front frame (2 Hz at 10 Hz)
-RECORD_SIDE_EVERY = 4  # every 4th side frame (0.5 Hz at 2 Hz)
-RECORD_LIDAR_EVERY = 10  # every 10th scan (1 Hz at 10 Hz)
 RECORD_LIDAR_POINTS = 6000  # [-] at most this many points per recorded scan (even stride)
 JUNCTION_UNSCORED = (10.0, 15.0)  # [m] before a town stop line, after the junction exit:
 #   the lane is not scored there (the stack follows the map's path, `LaneSource.JUNCTION`)
@@ -49,34 +53,40 @@ def sensing_mode(requested: str) -> str:
 
 
 class SensorLoop:
-    """Sensing pipeline + perception delivery + scoring + sensor recording for one run."""
+    """Sensing pipeline + delivery to the stack + perception scoring + sensor recording for
+    one run: every sensor of the car (`setup`'s cameras and LiDAR, if any; GNSS, odometry)."""
 
-    def __init__(self, world: World, setup: SensorSetup, stack: Stack, mode: str,
+    def __init__(self, world: World, setup: SensorSetup | None, stack: Stack, mode: str,
                  recorder: Recorder | None = None, frame_hook: FrameHook | None = None) -> None:
+        """`mode`: 'inline' or 'process' (`world.sensors.pipeline`; without cameras there is
+        nothing to render elsewhere, and every sensor captures inline)."""
         self.world, self.setup, self.stack = world, setup, stack
-        self.schedule = SensorSchedule(setup)
-        self.sensing: Sensing = (InlineSensing(world) if mode == "inline"
-                                 else ProcessSensing(world, setup))
+        self.schedule = SensorSchedule(sensor_timings(setup), CONTROL_RATE)
+        self.sensing: Sensing = (ProcessSensing(world, setup)
+                                 if mode == "process" and setup is not None and setup.cameras
+                                 else InlineSensing(world))
         self.mode = mode
         self.recorder = recorder
         self.frame_hook = frame_hook
         self.score = PerceptionScore()
-        self._truth: dict[float, CaptureTruth] = {}
-        self._counts = {"front": 0, "left": 0, "right": 0, "lidar": 0}
+        self._truth: dict[Due, CaptureTruth] = {}  # of the captures delivered late, till then
         self.last: PerceptionOutput | None = None
 
-    def tick(self) -> PerceptionOutput | None:
-        """At a control tick: deliver and submit if a sensor instant is due now."""
-        w = self.world
-        due = self.schedule.due(w.clock.step)
-        if not due:
-            return None
-        data = self.sensing.collect()
-        self._truth[w.t] = self._capture_truth()
-        self.sensing.submit(w.t, due)
-        if data is None:
-            return None
-        return self._deliver(data)
+    def tick(self) -> None:
+        """At a control tick: the earlier captures due now reach the stack, then those
+        captured now and due at once. The captures due now are submitted before the stack
+        perceives anything, so that a worker renders while it does."""
+        step = self.world.clock.step
+        arrived = self.sensing.collect(step)
+        dues = self.schedule.due(step)
+        late = [due for due in dues if due.deliver > step]
+        if late:
+            truth = self._capture_truth()
+            self._truth.update((due, truth) for due in late)
+        for due in dues:
+            self.sensing.submit(due)
+        self._deliver(arrived)
+        self._deliver(self.sensing.collect(step))
 
     def close(self) -> None:
         self.sensing.close()
@@ -86,23 +96,31 @@ class SensorLoop:
 
     # -- delivery --------------------------------------------------------------------------
 
-    def _deliver(self, data: SensorData) -> PerceptionOutput | None:
-        truth = self._truth.pop(data.t)
-        frames = data.frames
-        if self.frame_hook is not None:
-            frames = tuple(self.frame_hook(f) for f in frames)
-        out = self.stack.on_sensors(data.t, frames, data.scan)
-        if out is None:
-            return None
-        self.last = out
-        if data.frame("front") is not None:
+    def _deliver(self, captures: tuple[Capture, ...]) -> None:
+        for capture in captures:
+            truth = self._truth.pop(capture.due, None)
+            frames: tuple[Frame, ...] = capture.frames
+            if self.frame_hook is not None:
+                hook = self.frame_hook
+                frames = tuple(hook(f) if isinstance(f, CameraFrame) else f for f in frames)
+            out = self.stack.on_frames(capture.t, frames)
+            if out is None:
+                continue
+            self.last = out
+            if truth is None:  # delivered at once: the truth is the present's
+                truth = self._capture_truth()
+            self._score(capture, out, truth)
+            if self.recorder is not None:
+                self._record(capture, out)
+                self._record_scores(out, truth)
+
+    def _score(self, capture: Capture, out: PerceptionOutput, truth: CaptureTruth) -> None:
+        if out.lane_raw is not None:  # a frame of the stack's lane camera was perceived
             self.score.lane(out.lane_raw, out.lane, truth)
-        if out.detections is not None and out.tracks is not None and data.scan_truth is not None:
-            self.score.objects(out.detections, out.tracks, truth, data.scan_truth)
-        if self.recorder is not None:
-            self._record(data, out)
-            self._record_scores(out, truth)
-        return out
+        scan_truth = next((r.truth for r in capture.readings
+                           if isinstance(r.truth, LidarTruth)), None)
+        if out.detections is not None and out.tracks is not None and scan_truth is not None:
+            self.score.objects(out.detections, out.tracks, truth, scan_truth)
 
     def _record_scores(self, out: PerceptionOutput, truth: CaptureTruth) -> None:
         """Perception against the truth at the capture instant, as time series."""
@@ -138,35 +156,38 @@ class SensorLoop:
 
     # -- recording -------------------------------------------------------------------------
 
-    def _record(self, data: SensorData, out: PerceptionOutput) -> None:
+    def _kept(self, sensor: str, step: int) -> bool:
+        """Whether the recording keeps the frame `sensor` captured at `step`: every
+        `record_every`-th of its frames, the first one included."""
+        timing = self.schedule.timings[sensor]
+        return timing.record_every > 0 and (step // timing.rate.every) % timing.record_every == 0
+
+    def _record(self, capture: Capture, out: PerceptionOutput) -> None:
         rec = self.recorder
         assert rec is not None
-        t = data.t
-        for frame in data.frames:
-            name = frame.info.name
-            every = RECORD_FRONT_EVERY if name == "front" else RECORD_SIDE_EVERY
-            if self._counts[name] % every == 0:
+        t = capture.t
+        for reading in capture.readings:
+            frame = reading.frame
+            if not self._kept(reading.sensor, capture.step):
+                continue
+            if isinstance(frame, CameraFrame):
                 info = frame.info
                 m = info.mount
-                rec.log_camera_image(t, name, frame.rgb, info.fx, info.fy, info.cx, info.cy,
+                rec.log_camera_image(t, info.name, frame.rgb, info.fx, info.fy, info.cx, info.cy,
                                      mount_xyz=(m.x, m.y, m.z), mount_rpy=(m.roll, m.pitch, m.yaw))
-            self._counts[name] += 1
-        if data.scan is not None:
-            if self._counts["lidar"] % RECORD_LIDAR_EVERY == 0:
-                self._record_lidar(data, out)
-            self._counts["lidar"] += 1
+            elif isinstance(frame, LidarScan):
+                self._record_lidar(t, frame, out)
         if out.tracks is not None:
             self._record_tracks(t, out)
         if out.lane is not None:
             self._record_lane(t, out)
 
-    def _record_lidar(self, data: SensorData, out: PerceptionOutput) -> None:
-        assert self.recorder is not None and data.scan is not None
-        scan = data.scan
+    def _record_lidar(self, t: float, scan: LidarScan, out: PerceptionOutput) -> None:
+        assert self.recorder is not None
         stride = max(1, math.ceil(len(scan.points) / RECORD_LIDAR_POINTS))
         local = scan.info.mount.to_vehicle(scan.points[::stride].astype(np.float64))
         colours = _cluster_colours(local, out.detections or ())
-        self.recorder.log_lidar(data.t, _to_map(local, out), colours)
+        self.recorder.log_lidar(t, _to_map(local, out), colours)
 
     def _record_tracks(self, t: float, out: PerceptionOutput) -> None:
         assert self.recorder is not None and out.tracks is not None

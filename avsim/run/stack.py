@@ -1,8 +1,9 @@
 """The driving stack, wired: perception -> planner -> control.
 
-It is fed only sensor data (`GnssFix`, `Odometry`, camera frames, LiDAR scans) and the
-static HD map, and returns a `VehicleCommand`. The runner hands it data at their rates and
-applies its command to the ego's joints.
+It is fed only sensor data (`GnssFix`, `Odometry`, camera frames, LiDAR scans: the frames
+`on_frames` takes, each to its consumer) and the static HD map, and returns a
+`VehicleCommand`. The sensor loop hands it the frames at their rates, the runner applies
+its command to the ego's joints.
 
 Camera and LiDAR data arrive one sensor period after their capture (`world.sensors.pipeline`); the
 stack keeps its own pose estimates of the last seconds, so that each frame is interpreted in
@@ -13,6 +14,7 @@ Without a sensor set-up (no profile) the stack is GNSS + odometry on the map onl
 from __future__ import annotations
 
 import bisect
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 from avsim.scenario.scenario import DriverSettings
@@ -42,7 +44,7 @@ from planner.motion_layer import MotionLayerParams
 from planner.planner import Planner, PlannerParams
 from vehicle_urdf import CarGeometry
 from world.ego.body import vehicle_info
-from world.frames import CameraFrame, CameraInfo, GnssFix, LidarScan, Odometry
+from world.frames import CameraFrame, CameraInfo, Frame, GnssFix, LidarScan, Odometry
 from world.hdmap import RoadMap
 from world.spec import EgoSpec
 
@@ -104,6 +106,25 @@ class Stack:
         self._signs: SignView | None = None  # the last frame's signs, for the next tick
         self._lights: tuple[LightDetection, ...] = ()  # the last frame's lights, likewise
         self._pedal = 0.0  # [-] the driver's accelerator pedal, from the odometry
+
+    def on_frames(self, t: float, frames: Sequence[Frame]) -> PerceptionOutput | None:
+        """One delivery: the frames captured together at time `t` [s], each to its
+        consumer. GNSS fixes and odometry go to the localiser (in their order); camera frames
+        and a LiDAR scan are perceived together (`on_sensors`; None if there are none)."""
+        cameras: list[CameraFrame] = []
+        scan: LidarScan | None = None
+        for frame in frames:
+            if isinstance(frame, GnssFix):
+                self.on_gnss(frame)
+            elif isinstance(frame, Odometry):
+                self.on_odometry(frame)
+            elif isinstance(frame, CameraFrame):
+                cameras.append(frame)
+            else:
+                scan = frame
+        if not cameras and scan is None:
+            return None
+        return self.on_sensors(t, tuple(cameras), scan)
 
     def on_gnss(self, fix: GnssFix) -> None:
         self.localizer.on_gnss(fix)

@@ -39,7 +39,7 @@ def lidar_info(columns: int = 1800, range_sigma: float = 0.02, dropout: float = 
                mount: SensorMount = LIDAR_MOUNT) -> LidarInfo:
     """The VLP-16-like LiDAR of the simulator (1800 or 900 columns)."""
     return LidarInfo(elevations=LIDAR_ELEVATIONS, azimuth_steps=columns, max_range=100.0,
-                     rate=10.0, mount=mount, range_sigma=range_sigma, dropout=dropout)
+                     mount=mount, range_sigma=range_sigma, dropout=dropout)
 
 
 @dataclass(frozen=True, slots=True)

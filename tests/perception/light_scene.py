@@ -45,8 +45,8 @@ class LightScene:
         world = self.world
         pose_ego(world, 0, s, offset, heading_error)
         truth = world.ego.truth()
-        assert world.rig is not None
-        frame = world.rig.capture(world.t, truth, ["front"], False).frames[0]
+        frame = world.rig.capture(["front"], world.t, truth)[0].frame
+        assert isinstance(frame, CameraFrame)
         ego = EgoState(t=world.t, x=float(truth.position[0]), y=float(truth.position[1]),
                        heading=float(truth.yaw), speed=0.0, yaw_rate=0.0, steering_angle=0.0,
                        position_sigma=0.05)

@@ -99,8 +99,8 @@ def render(road: RoadSpec, s: float, offset: float = 0.0, heading_error: float =
     """The front camera's frame with the ego posed on ``road`` (see module doc)."""
     world = world_for(road, profile)
     pose_ego(world, lane, s, offset, heading_error)
-    assert world.rig is not None
-    frame = world.rig.capture(world.t, world.ego.truth(), ["front"], False).frames[0]
+    frame = world.rig.capture(["front"], world.t, world.ego.truth())[0].frame
+    assert isinstance(frame, CameraFrame)
     return Scene(frame, lane_truth(world, lane))
 
 
@@ -128,8 +128,9 @@ def render_with_actors(road: RoadSpec, actors: tuple[ActorSpec, ...], s: float, 
         _ACTOR_WORLDS[key] = World(spec, sensor_setup(profile))
     world = _ACTOR_WORLDS[key]
     pose_ego(world, lane, s, 0.0, 0.0)
-    assert world.rig is not None
-    return world.rig.capture(world.t, world.ego.truth(), ["front"], False).frames[0]
+    frame = world.rig.capture(["front"], world.t, world.ego.truth())[0].frame
+    assert isinstance(frame, CameraFrame)
+    return frame
 
 
 @atexit.register

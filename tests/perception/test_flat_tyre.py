@@ -2,8 +2,8 @@
 
 Two kinds of input: odometry synthesised from the kinematics of a car rolling without slip
 (each wheel's speed from the body's speed, yaw rate and the Ackermann geometry, with the
-encoders', gyro's and steering encoder's noise of `world.sensors.gnss`), and the simulated car in a
-`World` (a puncture by `EgoBody.puncture`, read by the world's `OdometrySensor`).
+encoders', gyro's and steering encoder's noise of `world.sensors.odometry`), and the simulated
+car in a `World` (a puncture by `EgoBody.puncture`, read by the world's `OdometrySensor`).
 """
 
 from __future__ import annotations
@@ -22,10 +22,10 @@ from perception.flat_tyre import (
     corrected_speeds,
 )
 from tests.vehicle import VEHICLE
-from world.core.client import PHYSICS_RATE
+from world.core.rates import PHYSICS_RATE, TRIGGER_RATE
 from world.ego.body import ackermann
 from world.frames import Odometry, Wheel
-from world.sensors.gnss import GYRO_NOISE, STEERING_NOISE, WHEEL_SPEED_NOISE
+from world.sensors.odometry import GYRO_NOISE, STEERING_NOISE, WHEEL_SPEED_NOISE
 from world.spec import (
     EgoSpec,
     EventSpec,
@@ -35,7 +35,7 @@ from world.spec import (
     TimeTrigger,
     WorldSpec,
 )
-from world.world import TRIGGER_RATE, World
+from world.world import World
 
 KPH = 1 / 3.6  # [m/s] per [km/h]
 R_WHEEL = 0.33  # [m] the car's rolling radius
@@ -234,7 +234,8 @@ def _sim(world: World, phases: list[tuple[float, float]], v_set: float
             for _ in range(round(seconds * TRIGGER_RATE.hz)):
                 truth = world.ego_truth
                 world.ego.apply(delta, 90.0 + 1500.0 * 0.33 * 2.0 * (v_set - truth.speed), 0.0)
-                found = found or detector.update(world.odometry.measure(world.t, truth))
+                odo = world.rig.capture(["odometry"], world.t, truth)[0].frame
+                found = found or detector.update(odo)
                 evidence = max(evidence, *detector.evidence)
                 for _ in range(TRIGGER_RATE.every):
                     world.step()
@@ -270,7 +271,8 @@ def test_the_world_odometry_is_unchanged_by_a_flat_before_it() -> None:
         try:
             for _ in range(round(2.0 * TRIGGER_RATE.hz)):
                 world.ego.apply(0.0, 86.0, 0.0)
-                odometry.append(world.odometry.measure(world.t, world.ego_truth))
+                (reading,) = world.rig.capture(["odometry"], world.t, world.ego_truth)
+                odometry.append(reading.frame)
                 for _ in range(PHYSICS_RATE // TRIGGER_RATE.hz):
                     world.step()
         finally:

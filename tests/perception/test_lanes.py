@@ -47,8 +47,7 @@ def pinhole(camera: CameraInfo, xyz: np.ndarray) -> np.ndarray:
 CAMERAS = {
     "front_640": front_camera(),
     "pitched_yawed": CameraInfo("test", 800, 600, math.radians(70.0),
-                                SensorMount(1.2, 0.3, 1.6, roll=0.01, pitch=0.08, yaw=-0.03),
-                                10.0),
+                                SensorMount(1.2, 0.3, 1.6, roll=0.01, pitch=0.08, yaw=-0.03)),
 }
 
 
@@ -417,8 +416,8 @@ def test_a_yellow_truck_beside_is_not_a_line(detector: LaneDetector) -> None:
             world.actors.motions[0].s = 100.0 + ahead
             world.actors._place(force=True)
             pose_ego(world, 0, 100.0, 0.0, 0.0)
-            assert world.rig is not None
-            frame = world.rig.capture(0.0, world.ego.truth(), ["front"], False).frames[0]
+            frame = world.rig.capture(["front"], 0.0, world.ego.truth())[0].frame
+            assert isinstance(frame, CameraFrame)
             left = frame.rgb[150:300, 0:200].astype(int)
             assert (left[..., 0] - left[..., 2]).mean() > 60  # the yellow truck fills the left
             est = detector.detect(frame)

@@ -23,6 +23,8 @@ from perception.messages import Detection, EgoState, ObjectClass, Track
 from perception.objects import ObjectDetector
 from perception.tracking import MultiObjectTracker
 from world.actors.behaviour import LATERAL_ACCEL
+from world.frames import LidarScan
+from world.sensors.lidar import LidarTruth
 from world.sensors.setup import Profile, sensor_setup
 from world.world import World
 
@@ -101,7 +103,6 @@ def run(case: Crossing, tmp_path: Path) -> list[Sample]:
                                     start=case.start, end=case.end, trigger=case.trigger))
     spec = load_scenario(path).world
     world = World(spec, sensor_setup(Profile.DEFAULT, spec.sensors.lidar), cameras=False)
-    assert world.rig is not None
     detector, tracker = ObjectDetector(), MultiObjectTracker()
     samples = []
     try:
@@ -112,15 +113,16 @@ def run(case: Crossing, tmp_path: Path) -> list[Sample]:
             if world.clock.step % SCAN_EVERY:
                 continue
             truth = world.ego_truth
-            data = world.rig.capture(world.t, truth, (), lidar=True)
-            assert data.scan is not None and data.scan_truth is not None
+            (data,) = world.rig.capture(["lidar"], world.t, truth)
+            scan, scan_truth = data.frame, data.truth
+            assert isinstance(scan, LidarScan) and isinstance(scan_truth, LidarTruth)
             ego = EgoState(t=world.t, x=float(truth.position[0]), y=float(truth.position[1]),
                            heading=truth.yaw, speed=truth.speed, yaw_rate=truth.yaw_rate,
                            steering_angle=0.0, position_sigma=0.0)
-            detections = detector.detect(data.scan)
+            detections = detector.detect(scan)
             centre = world.actors.poses.centres[0]
             samples.append(Sample(t=world.t, ego=ego, truth=(float(centre[0]), float(centre[1])),
-                                  returns=int(np.count_nonzero(data.scan_truth.actor == 0)),
+                                  returns=int(np.count_nonzero(scan_truth.actor == 0)),
                                   detections=detections,
                                   tracks=tracker.update(world.t, ego, detections)))
     finally:

@@ -12,12 +12,12 @@ import pytest
 from numpy.typing import NDArray
 
 from tests.perception.render_scene import pose_ego
-from world.core.client import PHYSICS_RATE
+from world.core.rates import PHYSICS_RATE
 from world.frames import CameraFrame
 from world.hdmap import Crosswalk, SpeedBump, StopSign
 from world.scene.bump import bump_height_at
 from world.scene.scenery import octagon_corners
-from world.sensors.rig import vehicle_pose
+from world.sensors.sensor import vehicle_pose
 from world.sensors.setup import Profile, sensor_setup
 from world.spec import EgoSpec, RoadSpec, SegmentSpec, WorldSpec
 from world.world import SIGN_POLE_RADIUS, World
@@ -123,8 +123,8 @@ def test_front_camera_sees_a_red_octagon_where_the_sign_is() -> None:
     try:
         mount_x = sensor_setup(Profile.DEFAULT).camera("front").mount.x
         pose_ego(w, 0, STOP_S - 20.0 - mount_x, 0.0, 0.0)
-        assert w.rig is not None
-        frame = w.rig.capture(w.t, w.ego.truth(), ["front"], False).frames[0]
+        frame = w.rig.capture(["front"], w.t, w.ego.truth())[0].frame
+        assert isinstance(frame, CameraFrame)
         (sign,) = w.scene.stop_signs
         normal = np.array([math.cos(sign.yaw), math.sin(sign.yaw), 0.0])
         across = np.array([-math.sin(sign.yaw), math.cos(sign.yaw), 0.0])  # a viewer's right

@@ -1,6 +1,6 @@
 """NPC bodies in the physics world, moved along the route by their scripted behaviour.
 
-NPCs are kinematic: static (mass 0) boxes placed at `world.ACTOR_RATE` from their
+NPCs are kinematic: static (mass 0) boxes placed at `world.core.rates.ACTOR_RATE` from their
 `NpcMotion` in route coordinates. The ego collides with them like with a wall, and contact
 queries see them. (Only the ego must drive through its joints; NPCs are scripted traffic.)
 Pedestrians are boxes too (0.5 m deep, 0.6 m wide, 1.75 m tall), placed by station and

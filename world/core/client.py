@@ -12,14 +12,12 @@ connection; every call goes through the `BulletClient` passed around explicitly.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-
 import pybullet
 from pybullet_utils.bullet_client import BulletClient
 
 from world.core.quiet import quiet_c_output
+from world.core.rates import PHYSICS_RATE
 
-PHYSICS_RATE = 240  # [Hz] fixed physics step
 GRAVITY = 9.81  # [m/s^2]
 GROUND_EXTENT = 2000.0  # [m] half size of the visible ground
 GROUND_FRICTION = 1.0  # [-] dry asphalt; Bullet multiplies it with the tyre's (URDF) friction
@@ -50,23 +48,6 @@ def add_ground(client: BulletClient) -> int:
     body = client.createMultiBody(0.0, shape, visual, useMaximalCoordinates=True)
     client.changeDynamics(body, -1, lateralFriction=GROUND_FRICTION)
     return int(body)
-
-
-@dataclass(frozen=True, slots=True)
-class Rate:
-    """A rate that divides the physics rate: it fires every `PHYSICS_RATE / hz` steps."""
-
-    name: str
-    hz: int  # [Hz]
-    every: int = field(init=False)  # [steps] between firings
-
-    def __post_init__(self) -> None:
-        if self.hz <= 0 or PHYSICS_RATE % self.hz:
-            raise ValueError(f"rate {self.name} = {self.hz} Hz must divide {PHYSICS_RATE} Hz")
-        object.__setattr__(self, "every", PHYSICS_RATE // self.hz)
-
-    def fires(self, step: int) -> bool:
-        return step % self.every == 0
 
 
 class Clock:

@@ -14,11 +14,12 @@ car's own signals (the wheel speeds). A puncture is an instant: the event ends w
 (so `after: i` counts from it). A later override does not replace it, nor it an override.
 
 Triggers mean what they mean for the NPC actions and are evaluated by the same code
-(`world.actors.behaviour.trigger_holds`), at the same checks (`world.world.TRIGGER_RATE`): `time`
-[s], `ego_s` (the ego's centre station on the route) and `after: i, delay: t` (event i ended
-t seconds ago; an override ends when its duration is over, or when a later override replaces
-it). `gap` needs an actor: the loader refuses it for events, and so does this class. Each
-event fires once, at the first check where its trigger holds.
+(`world.actors.behaviour.trigger_holds`), at the same checks
+(`world.core.rates.TRIGGER_RATE`): `time` [s], `ego_s` (the ego's centre station on the route)
+and `after: i, delay: t` (event i ended t seconds ago; an override ends when its duration is
+over, or when a later override replaces it). `gap` needs an actor: the loader refuses it for
+events, and so does this class. Each event fires once, at the first check where its trigger
+holds.
 
 Pure (no PyBullet) and deterministic: the state is a function of the checks' (t, ego_s).
 """

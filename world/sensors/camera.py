@@ -1,5 +1,8 @@
 """Cameras: a pinhole `CameraInfo` rendered from the car's true pose by PyBullet.
 
+`Camera` renders one `CameraInfo` in one client; `CameraSensor` is that camera on the car, a
+`world.sensors.sensor.Sensor` with the profile's rate and latency (`world.core.rates`).
+
 The camera's world pose is the body's pose (from the physics, pitch and roll included)
 composed with the mount; the view matrix looks along the mount's x axis with its z axis up,
 and the projection has the camera's vertical field of view and aspect. Lighting is Bullet's
@@ -9,6 +12,7 @@ default (no shadows: they triple TinyRenderer's cost and add nothing the lane fi
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 import pybullet
@@ -16,8 +20,11 @@ from numpy.typing import NDArray
 from pybullet_utils.bullet_client import BulletClient
 
 from world.core.quiet import quiet_c_output
+from world.core.rates import Rate, SensorTiming
 from world.core.rendering import Renderer
+from world.ego.body import EgoTruth
 from world.frames import CameraFrame, CameraInfo
+from world.sensors.sensor import Reading, vehicle_pose
 
 
 class Camera:
@@ -25,6 +32,7 @@ class Camera:
 
     def __init__(self, client: BulletClient, info: CameraInfo, renderer: Renderer) -> None:
         self.info = info
+        self.renderer = renderer
         self._c = client
         self._renderer = renderer.flag
         self._projection = client.computeProjectionMatrixFOV(
@@ -50,3 +58,27 @@ class Camera:
             )
         rgb = np.asarray(rgba, dtype=np.uint8).reshape(info.height, info.width, 4)[..., :3]
         return CameraFrame(t=t, info=info, rgb=np.ascontiguousarray(rgb))
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class CameraSensor:
+    """A `Camera` on the car: captures a frame from the ego's true pose."""
+
+    camera: Camera
+    timing: SensorTiming  # its entry in the rates table
+    ride_height: float  # [m] the base link's origin above the vehicle frame's (the ground)
+
+    @property
+    def name(self) -> str:
+        return self.camera.info.name
+
+    @property
+    def rate(self) -> Rate:
+        return self.timing.rate
+
+    @property
+    def latency(self) -> float:
+        return self.timing.latency
+
+    def capture(self, t: float, ego: EgoTruth) -> Reading:
+        return Reading(self.name, self.camera.render(t, *vehicle_pose(ego, self.ride_height)))

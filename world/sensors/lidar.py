@@ -15,6 +15,9 @@ Returns: range = hit fraction x max range, plus Gaussian range noise (``range_si
 ``dropout`` fraction of returns lost, both from the world's seeded generator. Points are in
 the sensor frame. The body each return hit is kept beside the scan as ground truth (for
 perception scoring and the recording; never given to the stack).
+
+`Lidar` casts one `LidarInfo` in one client; `LidarSensor` is that LiDAR on the car, a
+`world.sensors.sensor.Sensor` with the profile's rate and latency (`world.core.rates`).
 """
 
 from __future__ import annotations
@@ -28,8 +31,12 @@ import numpy as np
 from numpy.typing import NDArray
 from pybullet_utils.bullet_client import BulletClient
 
+from world.core.rates import Rate, SensorTiming
+from world.ego.body import EgoTruth
 from world.frames import LidarInfo, LidarScan
 from world.sensors.ray_culling import Box, ground_distance, rays_to_cast
+from world.sensors.sensor import Reading, vehicle_pose
+from world.sensors.setup import LIDAR
 
 MAX_BATCH = 16_383  # rays per rayTestBatch call
 EGO_RAY_GROUP = 0x40  # collision group of the ego's links; the rays' mask leaves it out
@@ -128,6 +135,29 @@ class Lidar:
             body[idx] = np.array(list(map(itemgetter(0), results)), dtype=np.int32)
             fraction[idx] = np.array(list(map(itemgetter(2), results)), dtype=np.float64)
         return body, fraction
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class LidarSensor:
+    """A `Lidar` on the car: casts a revolution from the ego's true pose; what each return
+    hit rides beside the scan as its ground truth."""
+
+    lidar: Lidar
+    timing: SensorTiming  # its entry in the rates table
+    ride_height: float  # [m] the base link's origin above the vehicle frame's (the ground)
+    name: str = LIDAR
+
+    @property
+    def rate(self) -> Rate:
+        return self.timing.rate
+
+    @property
+    def latency(self) -> float:
+        return self.timing.latency
+
+    def capture(self, t: float, ego: EgoTruth) -> Reading:
+        scan, truth = self.lidar.scan(t, *vehicle_pose(ego, self.ride_height))
+        return Reading(self.name, scan, truth)
 
 
 def _aabb(client: BulletClient, body: int) -> Box:

@@ -1,28 +1,36 @@
-"""Sensing pipelines: when and where the sensor rig captures, and when the stack gets it.
+"""Sensing pipelines: where the sensor rig captures, and when the stack gets each capture.
 
-A capture is taken at the sensors' instants on the ego's true pose and delivered to the
-stack ONE SENSOR PERIOD LATER (100 ms at 10 Hz): the time a real camera / LiDAR pipeline
-needs to expose, read out and hand over a frame. The stack compensates with its own motion
-estimate. Two interchangeable pipelines give bitwise the same data:
+The sensor loop submits each `Due` of the schedule (`world.sensors.schedule`) at its step; a
+pipeline captures its sensors on the ego's true pose at that step and hands the `Capture`
+back when its delivery step has come: at once for GNSS and odometry, one 10 Hz period later
+for camera frames and LiDAR scans (`world.core.rates.FRAME_LATENCY`, the time a real camera /
+LiDAR pipeline needs to expose, read out and hand over a frame; the stack compensates with
+its own motion estimate). Two interchangeable pipelines give bitwise the same data:
 
-- `InlineSensing`: the rig in the simulated world's own client, captured at submission;
-- `ProcessSensing`: the cameras in a worker process holding a MIRROR of the world (built from
-  the same scenario, posed from a `WorldSnapshot` at each capture), the LiDAR in the
-  simulated world's own client (ray casting is a physics query). Rendering runs on the
+- `InlineSensing`: every sensor in the simulated world's own rig, captured at submission;
+- `ProcessSensing`: the sensors the simulated world's rig does not hold (the cameras: it is
+  built without them) in a worker process holding a MIRROR of the world (built from the
+  same scenario, posed from a `WorldSnapshot` at each capture), the rest (LiDAR: ray casting
+  is a physics query; GNSS, odometry) in the simulated world's own rig. Rendering runs on the
   second core while the main process casts the LiDAR, steps physics and runs the stack; the
-  main process waits for the frames only when they are due, one period later.
+  main process waits for the frames only when they are due.
 """
 
 from __future__ import annotations
 
 import multiprocessing as mp
 import traceback
+from collections import deque
+from dataclasses import dataclass
 from multiprocessing.connection import Connection
 from typing import Protocol
 
 from world.core.rendering import Renderer
+from world.frames import Frame
 from world.sensors import worker as sensing_worker
-from world.sensors.rig import Due, SensorData
+from world.sensors.lidar import LidarSensor
+from world.sensors.schedule import Due
+from world.sensors.sensor import Reading
 from world.sensors.setup import SensorSetup
 from world.spec import WorldSpec
 from world.world import World
@@ -32,78 +40,133 @@ class SensingError(RuntimeError):
     """The sensing worker failed (its traceback is in the message)."""
 
 
+@dataclass(frozen=True, slots=True, eq=False)
+class Capture:
+    """What the sensors of one `Due` produced: it reaches the stack as one delivery."""
+
+    due: Due  # which sensors, when captured, when delivered
+    readings: tuple[Reading, ...]  # in the `Due`'s order
+
+    @property
+    def step(self) -> int:
+        """[steps] physics step of the capture."""
+        return self.due.step
+
+    @property
+    def t(self) -> float:
+        """[s] sim time of the capture."""
+        return self.due.t
+
+    @property
+    def frames(self) -> tuple[Frame, ...]:
+        return tuple(r.frame for r in self.readings)
+
+
 class Sensing(Protocol):
-    renderer: Renderer
+    renderer: Renderer | None  # the cameras' renderer (None: no cameras)
 
-    def submit(self, t: float, due: Due) -> None:
-        """Capture what is `due` now (the simulated world's current state)."""
+    def submit(self, due: Due) -> None:
+        """Capture the sensors of `due` now (the simulated world is at step `due.step`)."""
 
-    def collect(self) -> SensorData | None:
-        """The capture submitted last (None if there is none), and forget it."""
+    def collect(self, step: int) -> tuple[Capture, ...]:
+        """The captures whose delivery step has come by physics step `step`, in the order
+        they were submitted, and forget them."""
 
     def close(self) -> None: ...
 
 
+def _check_now(world: World, due: Due) -> None:
+    if due.step != world.clock.step:
+        raise ValueError(f"a capture due at step {due.step} submitted at {world.clock.step}")
+
+
 class InlineSensing:
-    """Captures in the simulated world itself (its rig must have cameras and LiDAR)."""
+    """Captures every sensor in the simulated world's own rig."""
 
     def __init__(self, world: World) -> None:
-        if world.rig is None or world.renderer is None or not world.rig.has_lidar:
-            raise ValueError("InlineSensing needs a World built with cameras and LiDAR")
         self._world = world
-        self._rig = world.rig
-        self.renderer = world.renderer
-        self._pending: SensorData | None = None
+        self.renderer: Renderer | None = world.renderer
+        self._pending: list[tuple[int, Capture]] = []  # (delivery step, capture)
 
-    def submit(self, t: float, due: Due) -> None:
+    def submit(self, due: Due) -> None:
         w = self._world
-        self._pending = self._rig.capture(t, w.ego_truth, due.cameras, due.lidar)
+        _check_now(w, due)
+        readings = w.rig.capture(due.sensors, due.t, w.ego_truth)
+        self._pending.append((due.deliver, Capture(due, readings)))
 
-    def collect(self) -> SensorData | None:
-        data, self._pending = self._pending, None
-        return data
+    def collect(self, step: int) -> tuple[Capture, ...]:
+        ready = tuple(capture for deliver, capture in self._pending if deliver <= step)
+        self._pending = [(d, c) for d, c in self._pending if d > step]
+        return ready
 
     def close(self) -> None:
-        self._pending = None
+        self._pending = []
+
+
+@dataclass(slots=True, eq=False)
+class _Pending:
+    """A submitted `Due`: its local readings, and the worker's once received."""
+
+    due: Due
+    remote: tuple[str, ...]  # the sensors the worker captures
+    local: tuple[Reading, ...] = ()
+    received: tuple[Reading, ...] | None = None
 
 
 class ProcessSensing:
-    """Cameras in a worker process on a mirror of `world`, LiDAR in `world` (which must have
-    been built with a LiDAR-only rig: `World(spec, setup, cameras=False)`)."""
+    """The sensors `world`'s rig lacks (its cameras: `world` must be built without them,
+    `World(spec, setup, cameras=False)`) in a worker process on a mirror of `world`, the
+    others in `world`."""
 
     def __init__(self, world: World, setup: SensorSetup) -> None:
-        if world.rig is None or world.rig.has_cameras or not world.rig.has_lidar:
-            raise ValueError("ProcessSensing needs a World with a LiDAR-only rig")
+        if world.renderer is not None:
+            raise ValueError("ProcessSensing needs a World built without cameras")
         self._world = world
-        self._rig = world.rig
-        self._rig.lidar_threads = 1  # the other core renders: no oversubscription
+        for sensor in world.rig:
+            if isinstance(sensor, LidarSensor):
+                sensor.lidar.threads = 1  # the other core renders: no oversubscription
         ctx = mp.get_context("spawn")  # a fresh interpreter: no inherited physics or GL state
         self._conn, child = ctx.Pipe()
         self._proc = ctx.Process(target=sensing_worker.main, args=(child, world.spec, setup),
                                  name="avsim-sensing", daemon=True)
         self._proc.start()
         child.close()
-        self.renderer = Renderer(self._receive())
-        self._pending: SensorData | None = None  # the LiDAR part, waiting for the frames
+        self.renderer: Renderer | None = Renderer(self._receive())
+        self._pending: list[_Pending] = []  # in submission order
+        self._awaiting: deque[_Pending] = deque()  # sent to the worker, unanswered, in order
 
-    def submit(self, t: float, due: Due) -> None:
-        if self._pending is not None:
-            raise RuntimeError("collect the last capture before submitting the next")
-        self._conn.send(("capture", t, self._world.snapshot(), due.cameras))
-        self._pending = self._rig.capture(t, self._world.ego_truth, (), due.lidar)
+    def submit(self, due: Due) -> None:
+        w = self._world
+        _check_now(w, due)
+        pending = _Pending(due, tuple(n for n in due.sensors if n not in w.rig))
+        if pending.remote:  # first, so that the worker renders while this process casts
+            self._conn.send(("capture", due.t, w.snapshot(), pending.remote))
+            self._awaiting.append(pending)
+        pending.local = w.rig.capture([n for n in due.sensors if n in w.rig], due.t,
+                                      w.ego_truth)
+        self._pending.append(pending)
 
-    def collect(self) -> SensorData | None:
-        lidar, self._pending = self._pending, None
-        if lidar is None:
-            return None
-        frames = self._receive()
-        assert isinstance(frames, SensorData)
-        return SensorData(lidar.t, frames.frames, lidar.scan, lidar.scan_truth)
+    def collect(self, step: int) -> tuple[Capture, ...]:
+        ready = [p for p in self._pending if p.due.deliver <= step]
+        self._pending = [p for p in self._pending if p.due.deliver > step]
+        return tuple(self._assemble(p) for p in ready)
+
+    def _assemble(self, pending: _Pending) -> Capture:
+        """The capture of `pending`, its worker's readings received (the worker answers in
+        the order it was asked)."""
+        while pending.remote and pending.received is None:
+            readings = self._receive()
+            assert isinstance(readings, tuple)
+            self._awaiting.popleft().received = readings
+        by_name = {r.sensor: r for r in (*pending.local, *(pending.received or ()))}
+        due = pending.due
+        return Capture(due, tuple(by_name[name] for name in due.sensors))
 
     def close(self) -> None:
         if self._proc.is_alive():
             try:
-                if self._pending is not None:
+                while self._awaiting:
+                    self._awaiting.popleft()
                     self._receive()
                 self._conn.send(("close",))
             except (OSError, EOFError, SensingError):
@@ -124,18 +187,19 @@ class ProcessSensing:
 
 
 def serve(conn: Connection, spec: WorldSpec, setup: SensorSetup) -> None:
-    """The worker: build the mirror world, then render on request until told to close."""
+    """The worker: build the mirror world (cameras, no LiDAR), then capture on request until
+    told to close."""
     try:
         world = World(spec, setup, lidar=False)
-        assert world.rig is not None and world.renderer is not None
+        assert world.renderer is not None
         conn.send(("ready", world.renderer.value))
         while True:
             message = conn.recv()
             if message[0] == "close":
                 break
-            _, t, snapshot, cameras = message
+            _, t, snapshot, names = message
             world.apply_snapshot(snapshot)
-            conn.send(("data", world.rig.capture(t, world.ego_truth, cameras, False)))
+            conn.send(("data", world.rig.capture(names, t, world.ego_truth)))
         world.close()
     except Exception:  # report any failure to the main process, which raises it
         conn.send(("error", traceback.format_exc()))

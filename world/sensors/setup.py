@@ -8,6 +8,10 @@ Profiles (`--profile`):
 | `default` | 640x480 @ 10 Hz    | 320x240 @ 2 Hz      | 1800 columns (0.2 deg)     |
 | `paper`   | 1280x960 @ 10 Hz   | 1280x960 @ 10 Hz    | 1800 columns (0.2 deg)     |
 
+The rates (and when frames reach the stack, and which the recording keeps) are the rates
+table's (`world.core.rates.PROFILE_SENSORS`); GNSS and odometry are on every car, with or
+without a profile (`world.core.rates.CAR_SENSORS`).
+
 Cameras have an 80 deg horizontal field of view. The LiDAR is VLP-16-like: channels from
 -15 to +15 deg every 2 deg, 360 deg, 100 m. Mounts come from the URDF's sensor links (the
 vehicle frame's origin is on the ground, the base link's origin `CarGeometry.ride_height`
@@ -22,13 +26,14 @@ import math
 from dataclasses import dataclass, replace
 
 from vehicle_urdf import MountPose, read_geometry, read_sensor_mounts
+from world.core.rates import CAR_SENSORS, PROFILE_SENSORS, SensorTiming
 from world.frames import CameraInfo, LidarInfo, SensorMount
 from world.spec import LidarNoiseSpec
 
 CAMERA_FOV = math.radians(80.0)  # [rad] horizontal
 LIDAR_ELEVATIONS = tuple(math.radians(e) for e in range(-15, 16, 2))  # [rad] 16 channels
 LIDAR_RANGE = 100.0  # [m]
-LIDAR_RATE = 10.0  # [Hz]
+LIDAR = "lidar"  # the LiDAR's name (a camera's is its `CameraInfo.name`)
 
 
 class Profile(enum.Enum):
@@ -44,6 +49,8 @@ class SensorSetup:
     profile: Profile
     cameras: tuple[CameraInfo, ...]  # front first
     lidar: LidarInfo
+    timings: tuple[tuple[str, SensorTiming], ...]  # (name, timing) of each camera (in
+    #   `cameras` order) and of the LiDAR: the profile's entries in the rates table
 
     def camera(self, name: str) -> CameraInfo:
         for c in self.cameras:
@@ -51,21 +58,27 @@ class SensorSetup:
                 return c
         raise KeyError(f"no camera {name!r} in profile {self.profile.value}")
 
+    def timing(self, name: str) -> SensorTiming:
+        """The timing of the camera or LiDAR `name`."""
+        for n, timing in self.timings:
+            if n == name:
+                return timing
+        raise KeyError(f"no sensor {name!r} in profile {self.profile.value}")
+
 
 @dataclass(frozen=True, slots=True)
 class _CameraSpec:
     name: str
-    width: int
-    height: int
-    rate: float
+    width: int  # [px]
+    height: int  # [px]
 
 
 _PROFILES: dict[Profile, tuple[tuple[_CameraSpec, ...], int]] = {
-    Profile.FAST: ((_CameraSpec("front", 640, 480, 10.0),), 900),
-    Profile.DEFAULT: ((_CameraSpec("front", 640, 480, 10.0), _CameraSpec("left", 320, 240, 2.0),
-                       _CameraSpec("right", 320, 240, 2.0)), 1800),
-    Profile.PAPER: ((_CameraSpec("front", 1280, 960, 10.0), _CameraSpec("left", 1280, 960, 10.0),
-                     _CameraSpec("right", 1280, 960, 10.0)), 1800),
+    Profile.FAST: ((_CameraSpec("front", 640, 480),), 900),
+    Profile.DEFAULT: ((_CameraSpec("front", 640, 480), _CameraSpec("left", 320, 240),
+                       _CameraSpec("right", 320, 240)), 1800),
+    Profile.PAPER: ((_CameraSpec("front", 1280, 960), _CameraSpec("left", 1280, 960),
+                     _CameraSpec("right", 1280, 960)), 1800),
 }
 
 
@@ -82,11 +95,23 @@ def sensor_setup(profile: Profile, lidar_noise: LidarNoiseSpec | None = None) ->
     cams_spec, columns = _PROFILES[profile]
     cameras = tuple(
         CameraInfo(name=c.name, width=c.width, height=c.height, fov_x=CAMERA_FOV,
-                   mount=_mount(mounts[f"camera_{c.name}_link"], ride_height), rate=c.rate)
+                   mount=_mount(mounts[f"camera_{c.name}_link"], ride_height))
         for c in cams_spec
     )
     lidar = LidarInfo(elevations=LIDAR_ELEVATIONS, azimuth_steps=columns, max_range=LIDAR_RANGE,
-                      rate=LIDAR_RATE, mount=_mount(mounts["lidar_link"], ride_height))
+                      mount=_mount(mounts["lidar_link"], ride_height))
     if lidar_noise is not None:
         lidar = replace(lidar, range_sigma=lidar_noise.range_sigma, dropout=lidar_noise.dropout)
-    return SensorSetup(profile, cameras, lidar)
+    table = PROFILE_SENSORS[profile.value]
+    names = [*(c.name for c in cameras), LIDAR]
+    if set(table) != set(names):
+        raise ValueError(f"profile {profile.value}: the rates table has {sorted(table)}, "
+                         f"the profile {sorted(names)}")
+    return SensorSetup(profile, cameras, lidar, tuple((n, table[n]) for n in names))
+
+
+def sensor_timings(setup: SensorSetup | None) -> tuple[tuple[str, SensorTiming], ...]:
+    """(name, timing) of every sensor of the car, in the order a capture lists them: the
+    profile's cameras (front first) and LiDAR (none without a profile), then the sensors on
+    every car (GNSS, odometry)."""
+    return (setup.timings if setup is not None else ()) + tuple(CAR_SENSORS.items())

@@ -27,6 +27,7 @@ from world.actors.behaviour import (
     NpcMotion,
     TriggerContext,
 )
+from world.core.rates import TRIGGER_RATE
 from world.spec import (
     Action,
     ActionSpec,
@@ -39,7 +40,7 @@ from world.spec import (
     Trigger,
     WalkAction,
 )
-from world.world import TRIGGER_RATE, World
+from world.world import World
 
 RATE = 120  # [Hz] the world's NPC motion rate
 DT = 1.0 / RATE  # [s]

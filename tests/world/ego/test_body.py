@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from world.core.client import PHYSICS_RATE
+from world.core.rates import PHYSICS_RATE
 from world.ego.body import ackermann, bicycle_angle
 from world.spec import EgoSpec, RoadSpec, SegmentSpec, WorldSpec
 from world.world import World

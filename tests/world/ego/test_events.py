@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from avsim.scenario.load import ScenarioError, load_scenario
-from world.core.client import PHYSICS_RATE
+from world.core.rates import PHYSICS_RATE, TRIGGER_RATE
 from world.ego.events import EgoEvents
 from world.spec import (
     AcceleratorOverride,
@@ -29,7 +29,7 @@ from world.spec import (
     Trigger,
     WorldSpec,
 )
-from world.world import TRIGGER_RATE, World
+from world.world import World
 
 CHECK_HZ = TRIGGER_RATE.hz  # [Hz] trigger checks, one every TRIGGER_RATE.every physics steps
 
@@ -229,7 +229,7 @@ def _drive(spec: WorldSpec, duration: float) -> Run:
             if world.clock.step % TRIGGER_RATE.every:
                 continue
             truth = world.ego_truth
-            odo = world.odometry.measure(world.t, truth)
+            odo = world.rig.capture(["odometry"], world.t, truth)[0].frame
             run.t.append(world.t)
             run.ego_s.append(world.ego_s)
             run.pedal.append(world.accelerator_pedal)

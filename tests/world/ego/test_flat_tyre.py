@@ -24,7 +24,7 @@ from numpy.typing import NDArray
 
 from avsim.scenario.load import load_scenario
 from vehicle_urdf import WHEELS
-from world.core.client import PHYSICS_RATE
+from world.core.rates import PHYSICS_RATE, TRIGGER_RATE
 from world.ego.events import EgoEvents
 from world.frames import Wheel
 from world.spec import (
@@ -39,7 +39,7 @@ from world.spec import (
     TimeTrigger,
     WorldSpec,
 )
-from world.world import TRIGGER_RATE, World
+from world.world import World
 
 KPH = 1 / 3.6  # [m/s] per [km/h]
 TICK = TRIGGER_RATE.every  # [steps] the runner's control tick (40 Hz)

@@ -13,6 +13,7 @@ import pytest
 from perception.lanes import LaneDetector
 from perception.objects import DetectorParams, ObjectDetector
 from tests.perception.render_scene import lane_truth, pose_ego
+from world.frames import CameraFrame, LidarScan
 from world.hdmap import Manoeuvre
 from world.map.road import build_road_map
 from world.map.town import HEADINGS, STOP_SETBACK, TownLayout, compile_route
@@ -29,7 +30,7 @@ from world.scene.town_scene import (
     junction_outline,
     street_road,
 )
-from world.sensors.rig import vehicle_pose
+from world.sensors.sensor import vehicle_pose
 from world.sensors.setup import Profile, sensor_setup
 from world.spec import EgoSpec, TownSpec, WorldSpec
 from world.world import World
@@ -354,8 +355,8 @@ MID_BLOCK = 20.0  # [m] route station: the camera's view (5..35 m) and the LiDAR
 @pytest.mark.parametrize("offset", [-0.3, 0.0, 0.3])
 def test_the_camera_finds_the_ego_lane_not_the_sidewalks(world: World, offset: float) -> None:
     pose_ego(world, 0, MID_BLOCK, offset, 0.0)
-    assert world.rig is not None
-    frame = world.rig.capture(world.t, world.ego.truth(), ["front"], False).frames[0]
+    frame = world.rig.capture(["front"], world.t, world.ego.truth())[0].frame
+    assert isinstance(frame, CameraFrame)
     detector = LaneDetector(frame.info)
     est = detector.detect(frame)
     truth = lane_truth(world, 0)
@@ -381,10 +382,9 @@ def test_the_lidar_sees_kerbs_and_sidewalks_as_ground(world: World, s: float) ->
     """Sidewalk returns are 0.12 m up, and no object is found on the street or its sidewalks
     but the stop signs' poles."""
     pose_ego(world, 0, s, 0.0, 0.0)
-    assert world.rig is not None
     truth = world.ego.truth()
-    scan = world.rig.capture(world.t, truth, [], True).scan
-    assert scan is not None
+    scan = world.rig.capture(["lidar"], world.t, truth)[0].frame
+    assert isinstance(scan, LidarScan)
     origin, rotation = vehicle_pose(truth, world.ego.geometry.ride_height)
     points = scan.info.mount.to_vehicle(scan.points) @ rotation.T + origin
     t = TownLayout(world.spec.town)  # type: ignore[arg-type]

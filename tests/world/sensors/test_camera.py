@@ -20,12 +20,13 @@ import pytest
 from numpy.typing import NDArray
 
 from avsim.scenario.load import load_scenario
-from world.core.client import PHYSICS_RATE, make_client
+from world.core.client import make_client
+from world.core.rates import PHYSICS_RATE
 from world.core.rendering import Renderer, attach_renderer
 from world.frames import CameraFrame, CameraInfo
 from world.scene.road_mesh import EDGE_LINE_INSET, SURFACE_Z
 from world.sensors.camera import Camera
-from world.sensors.rig import vehicle_pose
+from world.sensors.sensor import vehicle_pose
 from world.sensors.setup import Profile, SensorSetup, sensor_setup
 from world.spec import WorldSpec
 from world.world import World
@@ -73,9 +74,9 @@ def world(setup: SensorSetup) -> Iterator[World]:
 
 @pytest.fixture(scope="module")
 def frames(world: World) -> dict[str, CameraFrame]:
-    assert world.rig is not None
-    data = world.rig.capture(world.t, world.ego_truth, CAMERAS, lidar=False)
-    return {f.info.name: f for f in data.frames}
+    readings = world.rig.capture(CAMERAS, world.t, world.ego_truth)
+    assert all(isinstance(r.frame, CameraFrame) for r in readings)
+    return {r.sensor: r.frame for r in readings}  # type: ignore[misc]
 
 
 def camera_pose(world: World, info: CameraInfo) -> tuple[NDArray[np.float64],
@@ -170,8 +171,9 @@ def check_right_edge_line(world: World, frame: CameraFrame) -> None:
 def test_renderer_and_frames(world: World, setup: SensorSetup,
                              frames: dict[str, CameraFrame]) -> None:
     assert world.renderer in (Renderer.EGL, Renderer.TINY)
-    assert world.rig is not None and world.rig.renderer is world.renderer
-    assert world.rig.has_cameras and not world.rig.has_lidar
+    assert set(world.rig.names) == {*CAMERAS, "gnss", "odometry"}  # cameras, no LiDAR
+    assert all(world.rig.sensor(name).camera.renderer is world.renderer  # type: ignore[attr-defined]
+               for name in CAMERAS)
     assert world.ego.truth().speed == pytest.approx(0.0, abs=0.01)  # at rest
     assert set(frames) == set(CAMERAS)
     for name, frame in frames.items():
@@ -240,13 +242,12 @@ class _ViewSpy:
 def check_render_pose_is_link_pose(world: World, monkeypatch: pytest.MonkeyPatch) -> None:
     """For each camera: the pose `Camera.render` looks from (eye, view direction, up) and
     vehicle_pose + mount both equal the camera link's pose in PyBullet."""
-    assert world.rig is not None
     truth = world.ego.truth()
     for name in CAMERAS:
-        camera: Camera = world.rig._cameras[name]
+        camera: Camera = world.rig.sensor(name).camera  # type: ignore[attr-defined]
         spy = _ViewSpy(camera._c)
         monkeypatch.setattr(camera, "_c", spy)
-        world.rig.capture(world.t, truth, [name], lidar=False)
+        world.rig.capture([name], world.t, truth)
         monkeypatch.undo()
         (eye, target, up), = spy.views
         link_xyz, link_rot = link_pose(world, name)
@@ -285,10 +286,10 @@ def test_tiny_renderer(world: World, setup: SensorSetup, frames: dict[str, Camer
     tiny_world = World(spec_without_actors(), setup, lidar=False)
     try:
         assert tiny_world.renderer is Renderer.TINY
-        assert tiny_world.rig is not None and tiny_world.rig.renderer is Renderer.TINY
+        assert tiny_world.rig.sensor("front").camera.renderer is Renderer.TINY  # type: ignore[attr-defined]
         tiny_world.apply_snapshot(world.snapshot())  # the same pose, nothing simulated
-        tiny = tiny_world.rig.capture(tiny_world.t, tiny_world.ego_truth, ["front"],
-                                      lidar=False).frames[0]
+        tiny = tiny_world.rig.capture(["front"], tiny_world.t, tiny_world.ego_truth)[0].frame
+        assert isinstance(tiny, CameraFrame)
         assert tiny.rgb.shape == (480, 640, 3) and tiny.rgb.dtype == np.uint8
         check_sky_and_asphalt(tiny)
         check_right_edge_line(tiny_world, tiny)

@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 from avsim.scenario.load import load_scenario
-from world.sensors.lidar import RAY_MASK, beam_directions
-from world.sensors.rig import vehicle_pose
+from world.sensors.lidar import RAY_MASK, Lidar, beam_directions
+from world.sensors.sensor import vehicle_pose
 from world.sensors.setup import Profile, sensor_setup
 from world.spec import ActorSpec, ActorType
 from world.world import World
@@ -30,8 +30,8 @@ def world() -> World:
 
 
 def scan(w: World):  # type: ignore[no-untyped-def]
-    assert w.rig is not None and w.rig._lidar is not None
-    lidar = w.rig._lidar
+    lidar = w.rig.sensor("lidar").lidar  # type: ignore[attr-defined]
+    assert isinstance(lidar, Lidar)
     return lidar, lidar.scan(w.t, *vehicle_pose(w.ego_truth, w.ego.geometry.ride_height))
 
 
@@ -68,7 +68,7 @@ def test_car_ahead_ground_and_truth(world: World) -> None:
 
 def test_culled_cast_equals_casting_every_ray(world: World) -> None:
     """At several poses along the route, buildings, signs and the parked car in view."""
-    lidar = world.rig._lidar  # type: ignore[union-attr]
+    lidar = world.rig.sensor("lidar").lidar  # type: ignore[attr-defined]
     for _ in range(4):
         for _ in range(240):
             world.ego.apply(0.0, 1500.0 * 2.0 * 0.33, 0.0)

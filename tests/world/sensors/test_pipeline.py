@@ -1,74 +1,145 @@
-"""Sensing pipelines: inline and in a worker process give bitwise the same data, one
-sensor period late; worker failures surface as errors, not hangs."""
+"""Sensing pipelines: inline and in a worker process give bitwise the same data, camera
+frames and LiDAR scans one sensor period late, GNSS and odometry at once; worker failures
+surface as errors, not hangs."""
 
 from __future__ import annotations
+
+import itertools
 
 import numpy as np
 import pytest
 
 from avsim.scenario.load import load_scenario
-from world.sensors.pipeline import InlineSensing, ProcessSensing, SensingError
-from world.sensors.rig import SensorData, SensorSchedule
-from world.sensors.setup import Profile, sensor_setup
+from world.core.rates import CONTROL_RATE, FRAME_LATENCY, PHYSICS_RATE
+from world.frames import CameraFrame, GnssFix, LidarScan, Odometry
+from world.sensors.lidar import LidarTruth
+from world.sensors.pipeline import Capture, InlineSensing, ProcessSensing, SensingError
+from world.sensors.schedule import SensorSchedule
+from world.sensors.setup import Profile, sensor_setup, sensor_timings
 from world.world import World
 
+LATE = round(FRAME_LATENCY * PHYSICS_RATE)  # [steps]
 
-def drive(mode: str, seconds: float = 2.0) -> list[tuple[float, SensorData]]:
-    """(delivery time, data) of a car accelerating on normal_driving for `seconds`."""
+
+def drive(mode: str, seconds: float = 2.0) -> list[tuple[int, Capture]]:
+    """(delivery step, capture) of a car accelerating on normal_driving for `seconds`, the
+    pipeline asked at every control tick as the sensor loop asks it."""
     spec = load_scenario("normal_driving").world
     setup = sensor_setup(Profile.DEFAULT)
     world = World(spec, setup, cameras=mode == "inline")
     sensing = InlineSensing(world) if mode == "inline" else ProcessSensing(world, setup)
-    schedule = SensorSchedule(setup)
+    schedule = SensorSchedule(sensor_timings(setup), CONTROL_RATE)
     out = []
     try:
         world.ego.apply(0.0, 1500.0 * 2.0 * 0.33, 0.0)
-        for _ in range(round(seconds * 240)):
+        for _ in range(round(seconds * PHYSICS_RATE)):
             world.step()
-            due = schedule.due(world.clock.step)
-            if due:
-                data = sensing.collect()
-                if data is not None:
-                    out.append((world.t, data))
-                sensing.submit(world.t, due)
+            step = world.clock.step
+            if step % CONTROL_RATE.every:
+                continue
+            arrived = sensing.collect(step)
+            for due in schedule.due(step):
+                sensing.submit(due)
+            out += [(step, c) for c in (*arrived, *sensing.collect(step))]
     finally:
         sensing.close()
         world.close()
     return out
 
 
+def assert_same(a: object, b: object) -> None:
+    """Two frames (or truths) bitwise equal."""
+    assert type(a) is type(b)
+    if isinstance(a, CameraFrame) and isinstance(b, CameraFrame):
+        assert a.t == b.t and a.info == b.info and np.array_equal(a.rgb, b.rgb)
+    elif isinstance(a, LidarScan) and isinstance(b, LidarScan):
+        assert a.t == b.t and a.info == b.info
+        assert np.array_equal(a.points, b.points) and np.array_equal(a.ring, b.ring)
+        assert np.array_equal(a.column, b.column)
+    elif isinstance(a, LidarTruth) and isinstance(b, LidarTruth):
+        assert np.array_equal(a.actor, b.actor)
+    else:
+        assert a == b
+
+
 def test_inline_and_process_sensing_are_bitwise_equal() -> None:
     inline, process = drive("inline"), drive("process")
-    assert len(inline) == len(process) == 19  # 10 Hz over 2 s, the first one still pending
-    for (t_a, a), (t_b, b) in zip(inline, process, strict=True):
-        assert t_a == t_b and a.t == b.t
-        assert t_a == pytest.approx(a.t + 0.1)  # delivered one sensor period late
-        assert [f.info.name for f in a.frames] == [f.info.name for f in b.frames]
-        for fa, fb in zip(a.frames, b.frames, strict=True):
-            assert np.array_equal(fa.rgb, fb.rgb)
-        assert a.scan is not None and b.scan is not None
-        assert np.array_equal(a.scan.points, b.scan.points)
-        assert np.array_equal(a.scan.ring, b.scan.ring)
-        assert a.scan_truth is not None and b.scan_truth is not None
-        assert np.array_equal(a.scan_truth.actor, b.scan_truth.actor)
-    names = [tuple(f.info.name for f in d.frames) for _, d in inline]
+    assert len(inline) == len(process)
+    for (at_a, a), (at_b, b) in zip(inline, process, strict=True):
+        assert at_a == at_b and a.due == b.due and a.t == b.t
+        assert [r.sensor for r in a.readings] == [r.sensor for r in b.readings] \
+            == list(a.due.sensors)
+        for ra, rb in zip(a.readings, b.readings, strict=True):
+            assert_same(ra.frame, rb.frame)
+            assert_same(ra.truth, rb.truth)
+            assert ra.frame.t == a.t  # every frame is stamped with its capture time
+    frames = [(at, c) for at, c in inline if c.due.deliver > c.step]
+    at_once = [(at, c) for at, c in inline if c.due.deliver == c.step]
+    # cameras and LiDAR at 10 Hz over 2 s, the last one still pending, one period late
+    assert len(frames) == 19
+    assert all(at == c.step + LATE for at, c in frames)
+    names = [c.due.sensors for _, c in frames]
     # the sides at 2 Hz: captured at t = 0.5, 1.0, 1.5 and 2.0 (still pending at the end)
-    assert names.count(("front", "left", "right")) == 3
-    assert all(n[0] == "front" for n in names)
+    assert names.count(("front", "left", "right", "lidar")) == 3
+    assert names.count(("front", "lidar")) == 16
+    for _, c in frames:
+        assert isinstance(c.readings[0].frame, CameraFrame)
+        assert isinstance(c.readings[-1].frame, LidarScan)
+        assert isinstance(c.readings[-1].truth, LidarTruth)
+        assert all(r.truth is None for r in c.readings[:-1])
+    # GNSS with odometry at 10 Hz, odometry alone at the other control ticks, at once
+    assert all(at == c.step for at, c in at_once)
+    assert [c.due.sensors for _, c in at_once].count(("gnss", "odometry")) == 20
+    assert [c.due.sensors for _, c in at_once].count(("odometry",)) == 60
+    for _, c in at_once:
+        assert isinstance(c.readings[-1].frame, Odometry)
+        if len(c.readings) == 2:
+            assert isinstance(c.readings[0].frame, GnssFix)
+    # in a tick, the frames captured earlier come before those captured at once
+    ticks = [at for at, _ in inline]
+    assert ticks == sorted(ticks)
+    for (at, c), (at_next, c_next) in itertools.pairwise(inline):
+        if at == at_next:
+            assert c.due.deliver > c.step and c_next.due.deliver == c_next.step
 
 
-def test_a_failing_worker_raises() -> None:
+def test_a_capture_must_be_submitted_at_its_step() -> None:
+    world = World(load_scenario("normal_driving").world)  # no profile: GNSS and odometry only
+    sensing = InlineSensing(world)
+    schedule = SensorSchedule(sensor_timings(None), CONTROL_RATE)
+    try:
+        assert sensing.renderer is None
+        (due,) = schedule.due(0)
+        world.step()
+        with pytest.raises(ValueError, match="submitted at 1"):
+            sensing.submit(due)
+        assert sensing.collect(0) == ()
+    finally:
+        world.close()
+
+
+def test_a_failing_worker_raises(monkeypatch: pytest.MonkeyPatch) -> None:
     spec = load_scenario("normal_driving").world
     setup = sensor_setup(Profile.DEFAULT)
     world = World(spec, setup, cameras=False)
     sensing = ProcessSensing(world, setup)
     try:
-        schedule = SensorSchedule(setup)
-        due = schedule.due(0)
-        sensing._conn.send(("capture", 0.0, "not a snapshot", due.cameras))  # a broken request
-        sensing._pending = world.rig.capture(0.0, world.ego_truth, (), True)  # type: ignore[union-attr]
+        monkeypatch.setattr(world, "snapshot", lambda: "not a snapshot")  # a broken request
+        for due in SensorSchedule(sensor_timings(setup), CONTROL_RATE).due(0):
+            sensing.submit(due)
+        assert [c.due.sensors for c in sensing.collect(0)] == [("gnss", "odometry")]
         with pytest.raises(SensingError, match="sensing worker failed"):
-            sensing.collect()
+            sensing.collect(LATE)
     finally:
         sensing.close()
+        world.close()
+
+
+def test_process_sensing_needs_a_world_without_cameras() -> None:
+    setup = sensor_setup(Profile.FAST)
+    world = World(load_scenario("normal_driving").world, setup, lidar=False)
+    try:
+        with pytest.raises(ValueError, match="without cameras"):
+            ProcessSensing(world, setup)
+    finally:
         world.close()

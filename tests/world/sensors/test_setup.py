@@ -1,21 +1,19 @@
-"""The sensor profiles: cameras, LiDAR and mounts as `world.sensors.setup` documents them, and
-the sensor schedule that fires them at their rates on the 240 Hz physics steps."""
+"""The sensor profiles: cameras, LiDAR, mounts and rates as `world.sensors.setup` documents
+them (the rates from the rates table), and every sensor of the car in capture order."""
 
 from __future__ import annotations
 
 import math
 import xml.etree.ElementTree as ET
-from collections import Counter
 from dataclasses import dataclass, replace
 
 import numpy as np
 import pytest
 
 from vehicle_urdf import URDF_PATH, read_geometry
-from world.core.client import PHYSICS_RATE
+from world.core.rates import FRAME_LATENCY, GNSS, ODOMETRY, PROFILE_SENSORS
 from world.frames import SensorMount
-from world.sensors.rig import Due, SensorSchedule
-from world.sensors.setup import Profile, SensorSetup, sensor_setup
+from world.sensors.setup import Profile, SensorSetup, sensor_setup, sensor_timings
 from world.spec import LidarNoiseSpec
 
 
@@ -67,7 +65,8 @@ def test_profile_cameras_match_the_table(profile: Profile) -> None:
     if row.sides is not None:
         expected |= {"left": row.sides, "right": row.sides}
     assert setup.cameras[0].name == "front"  # front first
-    assert {c.name: (c.width, c.height, c.rate) for c in setup.cameras} == expected
+    assert {c.name: (c.width, c.height, setup.timing(c.name).rate.hz)
+            for c in setup.cameras} == expected
     assert len(setup.cameras) == len(expected)
     for cam in setup.cameras:
         assert cam.fov_x == pytest.approx(math.radians(80.0))
@@ -86,7 +85,7 @@ def test_profile_lidar_is_vlp16_like(profile: Profile) -> None:
                                atol=1e-12)
     assert list(lidar.elevations) == sorted(lidar.elevations)  # ascending
     assert lidar.max_range == 100.0
-    assert lidar.rate == 10.0
+    assert sensor_setup(profile).timing("lidar").rate.hz == 10
     assert lidar.rays == 16 * TABLE[profile].columns
     assert 360.0 / lidar.azimuth_steps == pytest.approx(0.4 if profile is Profile.FAST else 0.2)
 
@@ -124,58 +123,6 @@ def test_lidar_noise_block_is_applied() -> None:
     assert default.lidar == sensor_setup(Profile.FAST).lidar
 
 
-@pytest.mark.parametrize("profile", list(Profile))
-def test_schedule_fires_each_sensor_at_its_rate(profile: Profile) -> None:
-    setup = sensor_setup(profile)
-    schedule = SensorSchedule(setup)
-    assert PHYSICS_RATE == 240
-    seconds = 10
-    fired: dict[str, list[int]] = {name: [] for name in [c.name for c in setup.cameras]
-                                   + ["lidar"]}
-    for step in range(seconds * PHYSICS_RATE):
-        due = schedule.due(step)
-        assert isinstance(due, Due)
-        assert bool(due) == (bool(due.cameras) or due.lidar)
-        assert len(set(due.cameras)) == len(due.cameras)
-        for name in due.cameras:
-            fired[name].append(step)
-        if due.lidar:
-            fired["lidar"].append(step)
-        if due:  # the loop may only look at the fastest sensor's instants
-            assert step % schedule.every == 0
-    rates = {c.name: c.rate for c in setup.cameras} | {"lidar": setup.lidar.rate}
-    for name, steps in fired.items():
-        assert len(steps) == seconds * rates[name], name
-        assert steps[0] == 0
-        assert set(np.diff(steps).tolist()) == {round(PHYSICS_RATE / rates[name])}, name
-    assert schedule.every == 24  # 10 Hz is the fastest in every profile
-
-
-def test_schedule_of_the_default_profile_step_by_step() -> None:
-    schedule = SensorSchedule(sensor_setup(Profile.DEFAULT))
-    assert schedule.due(0) == Due(("front", "left", "right"), True)
-    assert schedule.due(24) == Due(("front",), True)
-    assert schedule.due(120) == Due(("front", "left", "right"), True)
-    assert not schedule.due(1) and not schedule.due(23) and not schedule.due(121)
-    counts = Counter(schedule.due(step) for step in range(240) if schedule.due(step))
-    assert counts == {Due(("front", "left", "right"), True): 2, Due(("front",), True): 8}
-
-
-def test_schedule_rejects_rates_that_do_not_fit() -> None:
-    setup = sensor_setup(Profile.FAST)
-    front = setup.cameras[0]
-    for rate in (7.0, 0.0):  # does not divide 240 Hz; no rate
-        bad = replace(setup, cameras=(replace(front, rate=rate),))
-        with pytest.raises(ValueError, match="must divide"):
-            SensorSchedule(bad)
-    # 16 Hz divides 240 Hz (15 steps) but the LiDAR's 24 steps are no multiple of it
-    odd = replace(setup, cameras=(replace(front, rate=16.0),))
-    with pytest.raises(ValueError, match="multiple"):
-        SensorSchedule(odd)
-    # 20 Hz (12 steps) with the LiDAR's 24: fine, the fastest period is 12
-    assert SensorSchedule(replace(setup, cameras=(replace(front, rate=20.0),))).every == 12
-
-
 def test_camera_lookup() -> None:
     default = sensor_setup(Profile.DEFAULT)
     assert isinstance(default, SensorSetup)
@@ -190,3 +137,36 @@ def test_camera_lookup() -> None:
             fast.camera(name)
     with pytest.raises(KeyError):
         default.camera("Front")  # names are exact
+
+
+@pytest.mark.parametrize("profile", list(Profile))
+def test_setup_timings_are_the_profiles_entries_in_the_rates_table(profile: Profile) -> None:
+    setup = sensor_setup(profile)
+    names = [c.name for c in setup.cameras] + ["lidar"]
+    assert [name for name, _ in setup.timings] == names  # the cameras in order, then the LiDAR
+    assert dict(setup.timings) == PROFILE_SENSORS[profile.value]
+    for name, timing in setup.timings:
+        assert setup.timing(name) is timing
+        assert timing.latency == FRAME_LATENCY  # frames reach the stack one period late
+    with pytest.raises(KeyError, match=profile.value):
+        setup.timing("gnss")  # on every car, not in the profile
+
+
+def test_every_sensor_of_the_car_in_capture_order() -> None:
+    setup = sensor_setup(Profile.DEFAULT)
+    assert sensor_timings(setup) == (*setup.timings, ("gnss", GNSS), ("odometry", ODOMETRY))
+    assert [n for n, _ in sensor_timings(setup)] == ["front", "left", "right", "lidar", "gnss",
+                                                   "odometry"]
+    assert sensor_timings(None) == (("gnss", GNSS), ("odometry", ODOMETRY))  # no profile
+
+
+def test_a_profile_and_its_rates_table_entry_must_name_the_same_sensors(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    from world.sensors import setup as setup_module
+
+    table = dict(PROFILE_SENSORS)
+    table["default"] = {k: v for k, v in PROFILE_SENSORS["default"].items() if k != "left"}
+    monkeypatch.setattr(setup_module, "PROFILE_SENSORS", table)
+    with pytest.raises(ValueError, match="profile default: the rates table has"):
+        sensor_setup(Profile.DEFAULT)
+    assert sensor_setup(Profile.FAST).timing("front") is PROFILE_SENSORS["fast"]["front"]

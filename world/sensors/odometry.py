@@ -1,0 +1,62 @@
+"""Odometry: with GNSS (`world.sensors.gnss`), the only pose information the stack gets.
+
+Wheel spin rates (encoders, 0.5 % scale noise), gyro yaw rate (0.002 rad/s noise), the
+steering encoder and the accelerator pedal sensor (exact: a position the world's ego events
+hold, `world.ego.events`), sampled together at the odometry rate
+(`world.core.rates.ODOMETRY`), delivered at once. Noise is drawn from the sensor's own seeded
+generator, so a run is reproducible.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from world.core.rates import ODOMETRY, Rate
+from world.ego.body import EgoTruth
+from world.frames import Odometry
+from world.sensors.sensor import Reading
+
+WHEEL_SPEED_NOISE = 0.005  # [-] relative 1-sigma noise of the wheel encoders
+GYRO_NOISE = 0.002  # [rad/s] 1-sigma
+STEERING_NOISE = 0.001  # [rad] 1-sigma
+
+
+def _released() -> float:
+    return 0.0
+
+
+@dataclass(frozen=True, slots=True)
+class OdometrySensor:
+    wheel_radius: float  # [m]
+    rng: np.random.Generator
+    pedal: Callable[[], float] = _released  # [-] 0..1, the accelerator pedal position now
+
+    @property
+    def name(self) -> str:
+        return "odometry"
+
+    @property
+    def rate(self) -> Rate:
+        return ODOMETRY.rate
+
+    @property
+    def latency(self) -> float:
+        return ODOMETRY.latency
+
+    def capture(self, t: float, ego: EgoTruth) -> Reading:
+        return Reading(self.name, self.measure(t, ego))
+
+    def measure(self, t: float, truth: EgoTruth) -> Odometry:
+        noise = self.rng.normal(0.0, 1.0, 6)
+        spins = truth.wheel_spin * (1.0 + WHEEL_SPEED_NOISE * noise[:4])
+        return Odometry(
+            t=t,
+            wheel_speeds=(float(spins[0]), float(spins[1]), float(spins[2]), float(spins[3])),
+            wheel_radius=self.wheel_radius,
+            yaw_rate=truth.yaw_rate + GYRO_NOISE * float(noise[4]),
+            steering_angle=truth.steering_angle + STEERING_NOISE * float(noise[5]),
+            accelerator_pedal=self.pedal(),
+        )
