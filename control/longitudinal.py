@@ -107,8 +107,9 @@ class SpeedController:
         *, emergency: bool = False,
     ) -> SpeedCommand:
         """One step: target_speed [m/s], target_accel [m/s^2] feed-forward, speed [m/s]
-        measured forward speed, dt [s] -> the acceleration request. `emergency`: brake at
-        `target_accel` (the plan's emergency deceleration) now (module doc)."""
+        measured forward speed, dt [s] -> the acceleration request. `emergency`: brake
+        towards `target_accel` (the plan's emergency deceleration) at `emergency_jerk`
+        (module doc)."""
         p = self.params
         if emergency:
             self._pid.reset()

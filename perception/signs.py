@@ -52,9 +52,10 @@ which the colour test finds, is `STOP_FIELD_WIDTH` across.
 
 4. **Confidence** in [0, 1]: a size factor, rising from 0.6 at ``min_size_px`` to 1 at
    ``polygon_min_px``, times the mean of a colour score (red fill / 0.85, at most 1), a shape
-   score (the mean of the extent's nearness to the octagon's, the solidity, and the outline:
-   1 for 8 vertices, else 0.6, or the circularity's margin over ``min_circularity``) and a
-   letters score (1 when seen, 0.5 when too small to tell).
+   score and a letters score (1 when seen, 0.5 when too small to tell). The shape score is
+   the mean of 1 - |extent - `OCTAGON_AREA_FACTOR`| / 0.1 (at least 0), the solidity, and
+   the outline's score: 1 for 8 vertices, else 0.6; below ``polygon_min_px``, (circularity
+   - ``min_circularity``) / 0.1, at most 1.
 
 `match_sign` (`SignDetection.match`, which the planner can reach) moves a detection into the
 map frame with the ego's pose and takes the nearest map sign within ``tolerance`` across the
