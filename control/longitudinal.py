@@ -1,36 +1,38 @@
 """Speed control: feed-forward acceleration plus a speed PID, clamped and jerk limited.
 
-Steps of `SpeedController.update` (all along the car's forward axis):
+Input per tick: the plan's target speed [m/s] and feed-forward acceleration [m/s^2], the
+measured forward speed [m/s] and dt [s]. Output: a `SpeedCommand`, the acceleration request
+[m/s^2] along the car's x axis and whether the car holds at a stop.
 
-1. Hold guard: when the target speed is ~0 (<= `stop_target_speed`) and the car is slower
-   than `standstill_speed`, the car is holding at a stop: the PID is reset (no windup while
-   parked) and the request is -`hold_decel`, flagged `hold` so that actuation applies brake
-   only.
-2. Otherwise accel = target_accel (the planner's feed-forward) + PID(target_speed - speed).
+Steps of `SpeedController.update`:
+
+1. Hold guard: when the target speed is at most ``stop_target_speed`` and the car is slower
+   than ``standstill_speed``, the car holds at a stop: the PID is reset (no windup while
+   parked) and the desired request is -``hold_decel``, flagged ``hold`` so that actuation
+   applies brake only.
+2. Otherwise desired = target_accel (the planner's feed-forward) + PID(target_speed - speed).
    Conditional integration (anti-windup on top of the PID's clamp): the integrator runs only
-   within |error| <= `integration_band`, and is frozen while the previous request was cut by
-   the limits in the direction the error pushes. Without the band, a step from 0 to
-   13.9 m/s charges the integrator on the way up and overshoots by ~0.5 m/s; with it, ~0.1.
-   Stall: a car that has been asked to speed up (a request of at least `stall_rise`) for
-   `stall_delay` and is still below `stall_speed` and its target is held back by something
-   (a speed bump's face): the integrator runs whatever the error, as a driver presses on
-   until the car moves. A car pulling away passes `stall_speed` well within `stall_delay`
-   (0.5 m/s needs 0.2 s at 2.5 m/s^2). A test on one tick's rise of the estimated speed
-   (lagging, noisy) took the pull-away after a red light for a stall: the integrator
-   charged to its clamp in ~0.2 s and the car overshot 50 km/h by 0.6 m/s.
-3. Clamp to [-max_decel, max_accel] (defaults 6 and 5 m/s^2; ICCAS 2020 drives with at most
-   5 m/s^2 acceleration).
-4. Jerk limit: the request moves by at most max_jerk * dt per step. The default 10 m/s^3 is
-   an actuator guard, not a comfort setting (ride comfort is the planner's job, through
-   target_accel): it keeps torque steps and PID noise off the drivetrain while still letting
-   an emergency stop reach the full 6 m/s^2 in 0.6 s.
+   within |error| <= ``integration_band`` (a large speed step would charge it on the way up
+   and overshoot), and is frozen while the previous request was cut by the limits in the
+   direction the error pushes. Stall: once the request has been at least ``stall_rise`` for
+   ``stall_delay`` with the car still below ``stall_speed`` and its target (held back by a
+   speed bump's face, a kerb), the integrator runs whatever the error, as a driver presses
+   on until the car moves; a car pulling away passes ``stall_speed`` well within
+   ``stall_delay``. The stall test reads the request and the time, not the rise of the
+   estimated speed, which lags and is noisy and would take a pull-away for a stall.
+3. Clamp to [-``max_decel``, ``max_accel``] (ICCAS 2020 drives with at most 5 m/s^2).
+4. Jerk limit: the request moves by at most ``max_jerk`` dt per step. ``max_jerk`` is an
+   actuator guard, not a comfort setting (ride comfort is the planner's job, through
+   target_accel): it keeps torque steps and PID noise off the drivetrain while letting hard
+   braking reach ``max_decel`` within a fraction of a second.
 
 The first step after `reset()` ramps from 0 m/s^2.
 
-Emergency stop (the planner's control FSM in EMERGENCY_STOP): the request is the plan's
-feed-forward (its emergency deceleration, `planner.limits.A_EMERGENCY`) at once, under the
-wider `emergency_jerk` (the brake's own rise rate), the PID is reset; afterwards the jerk
-limit takes the request on from where it is.
+Emergency stop (``emergency``: the planner's control FSM in EMERGENCY_STOP): the PID is reset
+and steps 1-4 are skipped. The request falls towards the plan's feed-forward (its emergency
+deceleration, `planner.limits.A_EMERGENCY`, which may exceed ``max_decel``) by at most
+``emergency_jerk`` dt per step (the brake's own rise rate), never below it; ``hold`` is set
+below ``standstill_speed``. Afterwards the jerk limit takes the request on from where it is.
 """
 
 from __future__ import annotations
@@ -58,7 +60,8 @@ class SpeedParams:
     integration_band: float = 1.0  # [m/s] the integrator only runs within this speed error
     stall_speed: float = 0.5  # [m/s] ... or when slower than this, below the target,
     stall_rise: float = 0.2  # [m/s^2] asked for at least this much acceleration
-    stall_delay: float = 0.5  # [s] for this long: held back (a bump, a kerb)
+    stall_delay: float = 0.5  # [s] for this long: held back (a bump, a kerb); longer than a
+    #   pull-away needs to pass stall_speed
     derivative_tau: float = 0.2  # [s] low-pass on the error derivative
     max_accel: float = 5.0  # [m/s^2] ICCAS 2020: max 5 m/s^2
     max_decel: float = 6.0  # [m/s^2] positive number, braking limit
@@ -66,7 +69,7 @@ class SpeedParams:
     stop_target_speed: float = 0.05  # [m/s] a target at or below this means "stop"
     standstill_speed: float = 0.3  # [m/s] below this (with a stop target) the car holds
     hold_decel: float = 3.0  # [m/s^2] positive, the request while holding (brake only)
-    emergency_jerk: float = 40.0  # [m/s^3] its rise rate (full braking in 0.2 s)
+    emergency_jerk: float = 40.0  # [m/s^3] the emergency request's rise rate (the brake's)
 
     @property
     def pid(self) -> PidParams:
@@ -104,8 +107,9 @@ class SpeedController:
         *, emergency: bool = False,
     ) -> SpeedCommand:
         """One step: target_speed [m/s], target_accel [m/s^2] feed-forward, speed [m/s]
-        measured forward speed, dt [s] -> the acceleration request. `emergency`: brake at
-        `target_accel` (the plan's emergency deceleration) now (module doc)."""
+        measured forward speed, dt [s] -> the acceleration request. `emergency`: brake
+        towards `target_accel` (the plan's emergency deceleration) at `emergency_jerk`
+        (module doc)."""
         p = self.params
         if emergency:
             self._pid.reset()

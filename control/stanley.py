@@ -9,43 +9,41 @@ Off-Road Driving", ACC 2007):
           + k_ff * atan(L * kappa_p)                        (extension, off by default)
           + k_yaw * (v_x * kappa_p - yaw_rate)              (Hoffmann 2007 yaw damping)
 
+- delta [rad] is the road-wheel angle of the bicycle model, left +; v_x [m/s] the forward
+  speed (a negative one taken as 0); L [m] the wheelbase.
 - theta_p [rad] is the path tangent at the point closest to the front axle and theta [rad]
-  the car's heading; their difference is wrapped to (-pi, pi].
+  the car's heading, both in the map frame; their difference is wrapped to (-pi, pi].
+  kappa_p [1/m] is the path's curvature there, > 0 turning left.
 - e_fa [m] is the signed distance from the front axle centre to the path, > 0 when the front
   axle is to the RIGHT of the path, so that a positive (left) steer corrects it.
-- k_soft [m/s] (Hoffmann's softening constant) is added to the speed. The plain law's
-  cross-track gain kp / v_x grows without bound as v_x -> 0: at 0.1 m/s a 1 m error asks for
-  atan(25) ~ 88 deg, so the car slams the wheel to the stop and over-steers as soon as it
-  rolls. With k_soft the gain is at most kp / k_soft.
-- Curvature feed-forward k_ff * atan(L * kappa_p): a documented extension to Eq. 1, with
-  k_ff = 0 by default, and on purpose. Because theta_p is taken at the FRONT axle, the heading
-  term already carries the whole kinematic steady-state steer on an arc: a car turning about
-  O with its front axle on the circle has its front wheel pointing along the circle's tangent
-  there, so theta_p - theta = delta_ss = atan(L / R_rear) exactly. Adding atan(L kappa) on top
-  counts the arc twice and leaves a steady offset e_fa ~ -(v + k_soft) L kappa / kp (0.23 m
-  at 12 m/s on R = 60 m) that the integrator must then work off
-  (tests/control/test_closed_loop.py shows both).
-  k_ff = 1 suits only a formulation whose heading term does not carry the arc (e.g. theta_p
-  taken at the rear axle); understeer at speed is left to the integrator.
+- k_soft [m/s] (Hoffmann's softening constant) is added to the speed: the plain law's
+  cross-track gain kp / v_x grows without bound as v_x -> 0, so a car at a crawl would slam
+  the wheel to the stop and over-steer as soon as it rolls. With k_soft the gain is at most
+  kp / k_soft.
+- Curvature feed-forward k_ff * atan(L * kappa_p): an extension to Eq. 1, off (k_ff = 0) on
+  purpose. Because theta_p is taken at the FRONT axle, the heading term already carries the
+  whole kinematic steady-state steer on an arc: a car turning about O with its front axle on
+  the circle has its front wheel pointing along the circle's tangent there, so theta_p -
+  theta = delta_ss = atan(L / R_rear) exactly. Adding atan(L kappa) on top counts the arc
+  twice and leaves a steady offset e_fa ~ -(v + k_soft) L kappa / kp that the integrator
+  must then work off (tests/control/test_closed_loop.py shows both). k_ff = 1 suits only a
+  formulation whose heading term does not carry the arc (e.g. theta_p taken at the rear
+  axle); understeer at speed is left to the integrator.
 - k_yaw [s] damps the yaw rate against the path's, v_x * kappa_p (Hoffmann 2007).
 
-The result is clamped to +-max_steer [rad] and rate limited to max_steer_rate [rad/s].
-Anti-windup: the integral term is clamped (`integral_limit`), frozen below
-`min_integration_speed` (a car at rest cannot reduce its error), and frozen while the
+The result is clamped to +-``max_steer`` and rate limited to ``max_steer_rate``.
+Anti-windup: the integral term is clamped (``integral_limit``), frozen below
+``min_integration_speed`` (a car at rest cannot reduce its error), and frozen while the
 previous command was limited in the direction the error pushes.
 
-Gains (defaults, checked by the closed-loop tests on a kinematic bicycle with a 0.1 s
-steering lag). With this law the front axle moves sideways at -v sin(atan(u / (v + k_soft))),
-so e_fa decays as a first-order system at a rate of about kp v / (v + k_soft):
-
-- kp = 2.5 1/s (Hoffmann's k): a 1 m offset at 10 m/s is within 5 cm after ~12 m.
-- kd = 0: e_fa is already first order in the kinematic loop, and a derivative only slows it
-  (within 5 cm after 15 m with kd = 0.2, 18 m with kd = 0.5). Kept for Eq. 1 and the real car.
-- ki = 0.1 1/s^2, small: an integrator charged by a large initial error overshoots and then
-  decays slowly (1 m offset: ~1.3 cm overshoot at ki = 0.1, ~3.4 cm at 0.3); its job is a
-  small bias such as tyre slip.
-- k_yaw = 0.05 s: halves the peak error on entering an R = 60 m arc at 12 m/s (3.8 -> 1.8 cm).
-- k_soft = 1 m/s: the gain is kp v / (v + 1), 91 % of the plain law's at 10 m/s.
+Gains (checked by tests/control/test_closed_loop.py on a kinematic bicycle with a steering
+lag): with this law the front axle moves sideways at -v sin(atan(u / (v + k_soft))), u the
+numerator, so e_fa decays as a first-order system at a rate of about kp v / (v + k_soft).
+kp sets that rate (Hoffmann's k). kd is 0: e_fa is already first order in the kinematic
+loop, and a derivative only slows its decay (the term stays for Eq. 1 and a real car). ki is
+small: an integrator charged by a large initial error overshoots and then decays slowly, and
+its job is a small bias such as tyre slip. k_yaw damps the error on entering an arc. k_soft
+is small against cruising speeds, where the gain stays near the plain law's.
 
 Two pieces: `front_axle_error` is pure (projection of the front axle onto the path polyline;
 it returns the segment index for the caller to keep as the next search hint), and

@@ -1,37 +1,34 @@
 """Flat-tyre detection from the wheel-speed sensors (an indirect TPMS).
 
 A flat tyre rolls on a smaller radius, so at the same ground speed it spins faster than the
-others (the simulated car: 0.33 m -> 0.31 m, +6.5 %; real flats a few per cent). This
-detector uses the wheel speeds only (`Odometry.wheel_speeds`), with the gyro's yaw rate and
-the steering encoder to take the turn out; it needs no tyre-pressure sensor.
+others (a few per cent). This detector uses the wheel speeds only (`Odometry.wheel_speeds`,
+[rad/s] FL, FR, RL, RR), with the gyro's yaw rate and the steering encoder to take the turn
+out; it needs no tyre-pressure sensor.
 
 Per odometry sample:
 
-1. Each wheel's speed `u = omega * r` (r the car's nominal rolling radius) is turned into
+1. Each wheel's speed u = omega r (r the car's nominal rolling radius) [m/s] is turned into
    the body's forward speed at the centre line, which every wheel sees the same way when
-   all roll true. A wheel at lateral offset `y` (left +, +-track/2) moves forward at
-   `v_x - yaw_rate * y` (the outer wheel of a turn runs faster), and a front wheel rolls
-   along its steered heading `delta_i` (the Ackermann split of the measured bicycle angle),
-   so: rear `v_x = u + yaw_rate * y`, front `v_x = u cos(delta_i) + yaw_rate * y`.
-   On a 150 m curve at 50 km/h the yaw term is 0.47 % of the speed; on a 20 m bend at
-   30 km/h it is 3.5 %, as much as a flat: without it the outer wheels would look flat.
+   all roll true. A wheel at lateral offset y (left +, +-track/2) moves forward at
+   v_x - yaw_rate y (the outer wheel of a turn runs faster), and a front wheel rolls along
+   its steered heading delta_i (the Ackermann split of the measured bicycle angle), so:
+   rear v_x = u + yaw_rate y, front v_x = u cos(delta_i) + yaw_rate y. The yaw term is
+   (track / 2) / R of the speed on a radius R, on a tight bend as much as a flat: without it
+   the outer wheels would look flat.
 2. Gates (a sample outside them leaves the evidence as it is): the mean corrected speed is
-   at least `min_speed` (5 m/s: below it the encoders' quantisation and the gyro's noise
-   dominate), and no wheel is more than `max_slip` (15 %) off the median of the four (a
-   locked or spinning wheel, not a tyre).
+   at least ``min_speed`` (below it the encoders' quantisation and the gyro's noise
+   dominate), and no wheel is more than ``max_slip`` off the median of the four (a locked or
+   spinning wheel, not a tyre).
 3. A wheel is a candidate when its corrected speed exceeds its axle partner's by at least
-   `excess` (3 % of the axle's mean: 4 sigma of the difference of two encoders with 0.5 %
-   noise, half of the simulated flat's 6.5 %) and the other axle's mean by at least
-   `cross_excess` (1.5 %; so a partner that slows, e.g. locking under braking, does not
-   make the other wheel look flat).
-4. Debounce: each wheel's evidence grows by the sample interval while it is a candidate and
-   shrinks by it otherwise (not below 0); at `debounce` (0.5 s) the tyre is declared flat.
-   One noisy sample costs two, so the flat's evidence still builds; a false candidate needs
-   0.5 s net of them (at 4 sigma per sample: never, in practice). The first wheel declared
-   is latched: a flat tyre does not heal; `reset()` forgets it.
-
-Timing: with the simulated car's deflation (its rolling radius drops ~0.25 s after the
-puncture) the flat is declared 0.75 s after it at 40 Hz odometry (measured at 30-80 km/h).
+   ``excess`` of the axle's mean, and the other axle's mean by at least ``cross_excess`` of
+   that mean (so that a partner that slows, e.g. locking under braking, does not make the
+   other wheel look flat).
+4. Debounce: each wheel's evidence [s] grows by the sample interval while it is a candidate
+   and shrinks by it otherwise, within [0, ``debounce``]; at ``debounce`` the tyre is
+   declared flat. One noisy sample costs two, so a flat's evidence still builds, while a
+   false candidate needs ``debounce`` net of them. The first wheel declared is latched: a
+   flat tyre does not heal; `reset()` forgets it. A sample more than `MAX_GAP` after the
+   previous one (or not after it) is skipped.
 """
 
 from __future__ import annotations
@@ -43,13 +40,16 @@ from world.frames import Odometry, VehicleInfo, Wheel
 
 WHEELS = (Wheel.FRONT_LEFT, Wheel.FRONT_RIGHT, Wheel.REAR_LEFT, Wheel.REAR_RIGHT)  # odometry order
 PARTNER = (1, 0, 3, 2)  # the same axle's other wheel, by index
-MAX_GAP = 0.25  # [s] a longer silence between samples starts the timing afresh
+MAX_GAP = 0.25  # [s] a sample after a longer silence is skipped; timing restarts from it
 
 
 @dataclass(frozen=True, slots=True)
 class FlatTyreParams:
-    excess: float = 0.03  # [-] a wheel's corrected speed over its axle partner's, of the mean
-    cross_excess: float = 0.015  # [-] ... and over the other axle's mean
+    """Thresholds of `FlatTyreDetector`, by step of the module docstring."""
+
+    excess: float = 0.03  # [-] a wheel's corrected speed over its axle partner's, of their
+    #   mean: 4 sigma of two encoders' difference at 0.5 % noise each, half a flat's excess
+    cross_excess: float = 0.015  # [-] ... and over the other axle's mean, of that mean
     debounce: float = 0.5  # [s] net candidate time before a tyre is declared flat
     min_speed: float = 5.0  # [m/s] no evidence below this
     max_slip: float = 0.15  # [-] a wheel this far off the median: slip, not a tyre

@@ -1,98 +1,75 @@
 """Lane finding on the front camera: the ego lane's boundaries, offset, heading and curvature.
 
-The classic camera pipeline (ICCAS paper, Fig. 4(a)), one frame at a time (`LaneDetector`),
-then a temporal filter (`LaneFilter`).
+The camera pipeline of ICCAS 2020 Fig. 4(a): `LaneDetector` works one frame at a time,
+`LaneFilter` filters its output over time. Input: a `CameraFrame`, (H, W, 3) RGB. Output: a
+`LaneEstimate` in the vehicle frame at the frame's time (x forward from the car's centre, y
+left, origin on the ground), in m, rad and 1/m.
 
-1. **Binary mask** of lane paint, computed only on the band of image rows the bird's-eye view
-   can see (rows from the far edge of the view down to ``x_min``; the ego car's hood covers
-   the ground nearer than ~4.5 m, so ``x_min = 5 m`` leaves the hood out of the band). The
-   image is converted to OpenCV's 8-bit HLS (hue 0..179 in units of 2 deg, lightness and
-   saturation 0..255). A pixel is paint if any of:
+1. **Paint mask**, on the band of image rows the bird's-eye view sees (from beyond the hood),
+   in OpenCV's 8-bit HLS (hue 0..179 in 2 deg units, lightness L and saturation S 0..255).
+   Paint is white (L >= ``white_min_lightness``, S <= ``white_max_saturation``: bright and
+   grey, where asphalt is darker and grass saturated), yellow (hue in ``yellow_hue``, S >=
+   ``yellow_min_saturation``, L >= ``yellow_min_lightness``) or a ridge: a grey pixel (S <=
+   ``white_max_saturation``, L >= ``ridge_min_lightness``) with a rising edge within
+   ``ridge_max_width`` px to its left and a falling one within as far to its right, an edge
+   being |Sobel x| / 4 (3 x 3 kernel: the vertically smoothed L(u + 1) - L(u - 1)) >=
+   ``ridge_min_gradient``. Ridges keep the distant lines that texture filtering blurs below
+   the white test, over their whole width (their two flanks alone, of unequal contrast, would
+   bias the position); the border of the shoulder or the grass is one step, not a pair.
 
-   - white: lightness >= ``white_min_lightness`` (130) and saturation <= ``white_max_saturation``
-     (60). Paint renders at L ~ 230 near the car; asphalt at L ~ 55-65, the shoulder ~ 74,
-     grass ~ 68 (saturated green), the sky and building walls are above the horizon or
-     beyond the view;
-   - yellow: hue in ``yellow_hue`` (15..35, i.e. 30..70 deg), saturation >=
-     ``yellow_min_saturation`` (80) and lightness >= ``yellow_min_lightness`` (60); the centre
-     line renders at hue ~ 22, S ~ 90-170;
-   - ridge (gradient): a greyish pixel (saturation <= 60, lightness >= ``ridge_min_lightness``,
-     75) with a rising edge at most ``ridge_max_width`` (12 px) to its left and a falling
-     edge at most 12 px to its right, an edge being where ``|Sobel x| / 4`` (3 x 3 kernel:
-     the vertically smoothed L(u + 1) - L(u - 1), lightness units) >= ``ridge_min_gradient``
-     (5). This keeps distant lines, which texture filtering blurs to L ~ 80-110 on a
-     background of ~ 60-78, and marks a line's whole width (not only its two flanks, whose
-     unequal contrast would bias its position); the asphalt's texture noise stays darker
-     than the lightness gate and the shoulder's or grass's border is a single step, not a
-     rising-falling pair.
+2. **Bird's-eye view** (`perception.birdseye`): the mask is warped (bilinear) onto ``grid``
+   on the ground plane z = 0; a cell is paint where the warp reaches ``mask_min_coverage``,
+   except in runs across the view (along y) at least ``max_paint_width`` wide (`narrow_only`):
+   a line is 0.15 m wide and the double centre line 0.45 m, but a vertical face (a truck's
+   side, which may pass the colour tests) smears over metres of the ground plane.
 
-2. **Bird's-eye view** (`perception.birdseye`): the mask is remapped onto a metric grid of
-   the ground plane z = 0 of the vehicle frame (default x 5..35 m ahead of the car's centre,
-   y -7..+7 m, 0.05 m per cell), with the homography computed from the camera's intrinsics
-   and mount (precomputed once). A cell is paint when the bilinear warp of the 0/255 mask
-   reaches ``mask_min_coverage`` (128), unless it belongs to a run across the view (along y)
-   of at least ``max_paint_width`` (1.0 m): lines are 0.15 m wide, the double centre line
-   0.45 m, but a vertical face (a truck's side, yellow ones pass the colour test) smears
-   over metres of the ground plane in this view (`narrow_only`).
+3. **Bases**: the view is cut into windows of ``window_length`` along x. In the windows up to
+   ``base_reach`` beyond the nearest (dashed lines have 3 m of paint every 12 m), a histogram
+   of the paint's y (bins of ``base_bin``) on each side, |y| in [``base_inner``,
+   ``base_outer``], gives the side's base in the first window with a bin of
+   ``base_min_pixels``: the bin nearest the car (the ego lane's boundaries are the nearest
+   lines), its y the mean of the paint within ``base_refine``. A prior with confidence >=
+   ``prior_min_confidence`` moves the search to within ``prior_margin`` of its boundary, and
+   the bin nearest that boundary is taken.
 
-3. **Base positions**: the view is cut into windows along x of ``window_length`` (2 m). From
-   the nearest window up to ``base_reach`` (16 m) ahead of ``x_min``, a histogram of the
-   paint's y (``base_bin`` 0.1 m bins) is taken on each side of the car, |y| between
-   ``base_inner`` (0.3 m) and ``base_outer`` (3.2 m): the ego lane's boundaries are the
-   lines nearest left and right of the car (~1.75 m each side). The first window with a bin
-   of at least ``base_min_pixels`` (12) gives that side's base: the bin nearest the car
-   (its y refined to the mean of the paint within 0.3 m). With a trusted prior estimate
-   (confidence >= ``prior_min_confidence``, 0.3) the search is instead within
-   ``prior_margin`` (0.7 m) of where the prior puts the boundary, and the bin nearest that
-   is taken. Searching several windows copes with the gaps of dashed lines (3 m of paint
-   every 12 m).
+4. **Sliding windows**: window by window from its base, each side takes the cells within a
+   margin of a predicted line; ``window_min_pixels`` of them make a hit, which adds their
+   centroid. The prediction is the fit of the side's own centroids (quadratic from a span of
+   ``quadratic_min_span``, linear from ``linear_min_span``); while that fit is shorter than
+   the other side's and not quadratic, the other side's fit moved through this side's last
+   centroid (the boundaries are parallel: a dashed line follows a solid one through its
+   gaps); before any fit, the prior's boundary (else a line parallel to the car) through the
+   base. The margin is ``window_margin`` plus ``window_margin_growth`` per metre since the
+   last hit, at most ``window_margin_max``. A side stops when its prediction leaves the view.
 
-4. **Sliding windows**: from its base window up the view, each side keeps the paint within
-   a lateral margin of a predicted line; a window with at least ``window_min_pixels`` (20)
-   such cells is a hit and adds its centroid. The prediction is a polynomial fit of the
-   side's own hit centroids (quadratic once they span ``quadratic_min_span``, 8 m; linear
-   from ``linear_min_span``, 1 m), or, when the other side's centroids span farther, the
-   other side's fit shifted through this side's last centroid (the boundaries are
-   parallel: a dashed line follows the solid one through its gaps), or the prior's
-   boundary (else a line parallel to the car) through the base. The margin is
-   ``window_margin`` (0.35 m), growing by ``window_margin_growth`` (0.06 m per m) with the
-   distance since the last hit, up to ``window_margin_max`` (1.0 m; the next line is >= 3.3
-   m away). A side stops when its prediction leaves the view.
+5. **Fits**: each boundary y = c0 + c1 x + c2 x^2 by least squares on its hit cells (degree
+   by span as in step 4, else 0), refitted once without the cells farther than
+   ``outlier_distance`` from the first fit. A cell's weight (1 / sigma) is
+   d^-``weight_power``, d [m] its depth in front of the camera: a pixel's ground footprint
+   grows as d across and d^2 along, texture filtering displaces far lines and a quadratic fits
+   less well far ahead, so the near lines decide the offset and heading, the far ones the
+   curvature. With both boundaries, the centre line y = a0 + a1 x + a2 x^2 is one weighted fit
+   of both boundaries' cells as curves concentric with it (own c0 each, a0 their mean, shared
+   a1, a2 scaled by 1 / (1 - 2 a2 d) for a boundary d left of the centre): the better-seen
+   line carries the shape. At x = 0: offset = -a0 (car left of the centre +), heading_error =
+   -atan(a1), curvature = 2 a2 (left turn +), width = (c0_left - c0_right) cos(atan(a1)); the
+   pair is trusted if the width is within [``min_width``, ``max_width``] and the pair
+   straddles the car (c0_left > 0 > c0_right). Otherwise, or with one boundary, the other is
+   searched again (steps 3-4) a lane width (the prior's, else ``default_width``) across from
+   the one first seen nearest the car (of equals, the better-seen): on a tight curve a dashed
+   line whose first dash is far may have crossed the car's axis, where step 3 misses it.
+   Failing that, the centre is that line shifted half a width across.
 
-5. **Fits** in metres in the vehicle frame: each boundary y = c0 + c1 x + c2 x^2 by weighted
-   least squares on its hit cells (quadratic when they span >= 8 m, linear when >= 1 m, else
-   constant), refitted once without the cells farther than ``outlier_distance`` (0.25 m) from
-   the first fit. A cell's weight (1 / sigma) is ``d^-weight_power`` (power 3) with d [m] its
-   depth in front of the camera: an image pixel's footprint on the ground grows as d across and
-   d^2 along the road, the renderer's texture filtering displaces far lines (beyond ~15 m) by
-   up to ~0.15 m, and a single quadratic holds less well far ahead where the curvature may
-   change; so the near lines decide the offset and heading at x = 0, the far ones mostly the
-   curvature. With both boundaries, the lane centre comes from a joint fit (same weights) of
-   the two as parallel curves (own c0 each, shared c1 and c2): the better-seen line carries the
-   shape. Centre line y = a0 + a1 x + a2 x^2 at the car's centre (x = 0): offset = -a0 (car
-   left of the centre +), heading_error = -atan(a1), curvature = 2 a2 (left turn +), width =
-   (c0_left - c0_right) cos(atan(a1)). A pair whose width is outside [``min_width``,
-   ``max_width``] (2.5..4.5 m), or that does not straddle the car (c0_left > 0 > c0_right), is
-   not trusted. When a boundary is missing or the pair is not trusted, the other boundary is
-   searched again (steps 3-4) around the one first seen nearest the car (of equals, the
-   better-seen) shifted a lane width across (the prior's width, else ``default_width``, 3.5 m):
-   on a tight curve a dashed line whose first dash is far may already have crossed the car's
-   axis, where the nearest-line rule of step 3 misses it. Failing that, the centre is that line
-   shifted by half that width across.
+6. **Confidence** in [0, 1]: per side min(1, hits / ``full_windows``) min(1, span /
+   ``full_span``), span being the fitted length along x; the mean of both sides (a missing
+   side scores 0, so one boundary gives at most 0.5).
 
-6. **Confidence** in [0, 1]: per side ``min(1, hits / full_windows) * min(1, span /
-   full_span)`` (``full_windows`` 4 windows with paint, ``full_span`` 15 m of fitted length);
-   the mean of both sides (a missing side scores 0, so one boundary gives <= 0.5).
+`LaneFilter` then runs a Kalman filter on (offset, heading_error, curvature, width).
 
-`LaneFilter` then runs a Kalman filter on (offset, heading_error, curvature, width); see its
-docstring. Everything is in SI units (m, rad, 1/m) in the vehicle frame of the frame's time.
-
-Limits: the ground is taken as the plane z = 0 of the vehicle frame (the body's pitch and
-roll on its suspension, and the camera's height error when the car sits lower than its
-mount says, scale the lateral metres: 1 cm of height is ~0.7 %); one quadratic cannot follow
-a curvature step (straight into a 50 m arc) inside the view, so within ~15 m of such a step
-the heading at the car can be off by a few degrees (the filter's gate and smoothing damp
-it). Cost: ~3 ms per 640 x 480 frame, ~4 ms per 1280 x 960 (the view's size is fixed).
+Limits: the ground is taken as the plane z = 0 of the vehicle frame, so the body's pitch and
+roll, and a camera height error, scale the lateral metres (as 1 / camera height); one
+quadratic cannot follow a curvature step (a straight into an arc) inside the view, so near
+such a step the heading at the car is biased (the filter's gate and smoothing damp it).
 """
 
 from __future__ import annotations
@@ -118,22 +95,22 @@ LEFT, RIGHT = 1, -1  # side signs: y of the side's boundary has this sign
 
 @dataclass(frozen=True, slots=True)
 class LaneParams:
-    """Thresholds of `LaneDetector` (see the module docstring for each step)."""
+    """Thresholds of `LaneDetector`, by step of the module docstring."""
 
-    grid: BevGrid = field(default_factory=BevGrid)  # the bird's-eye view (metres)
+    grid: BevGrid = field(default_factory=BevGrid)  # [m] the bird's-eye view, vehicle frame
     # -- mask, OpenCV 8-bit HLS: hue [2 deg units] 0..179, lightness and saturation 0..255
-    white_min_lightness: int = 130  # [0..255]
+    white_min_lightness: int = 130  # [0..255] above asphalt, shoulder and grass
     white_max_saturation: int = 60  # [0..255] also the ridge pixels' greyness limit
     yellow_hue: tuple[int, int] = (15, 35)  # [2 deg] inclusive band
     yellow_min_saturation: int = 80  # [0..255]
     yellow_min_lightness: int = 60  # [0..255]
-    ridge_min_lightness: int = 85  # [0..255]
+    ridge_min_lightness: int = 85  # [0..255] above the asphalt's texture noise
     ridge_min_gradient: float = 5.0  # [lightness] |Sobel x| / 4 at a ridge's two flanks
     ridge_max_width: int = 12  # [px] rising to falling flank, in the image
     mask_min_coverage: int = 128  # [0..255] of the warped 0/255 mask
     max_paint_width: float = 1.0  # [m] wider runs across the view are not paint (car sides)
     # -- base search
-    base_reach: float = 16.0  # [m] searched from x_min up to x_min + base_reach
+    base_reach: float = 16.0  # [m] windows searched beyond the nearest (> a dash's gap)
     base_bin: float = 0.1  # [m] histogram bin
     base_min_pixels: int = 12  # [cells] in a bin
     base_inner: float = 0.3  # [m] nearest |y| of a base (no prior)
@@ -145,7 +122,7 @@ class LaneParams:
     window_length: float = 2.0  # [m] along x
     window_margin: float = 0.35  # [m] half width around the prediction after a hit
     window_margin_growth: float = 0.06  # [m/m] per metre since the last hit
-    window_margin_max: float = 1.0  # [m]
+    window_margin_max: float = 1.0  # [m] well short of the next line, a lane width away
     window_min_pixels: int = 20  # [cells] for a hit
     # -- fits
     quadratic_min_span: float = 8.0  # [m] x range for a quadratic (fits and predictions)
@@ -313,15 +290,15 @@ def _find_base(win: _Windows, side: int, guide: Coefficients | None,
 class _Side:
     """One boundary's search state (mutable while the windows run)."""
 
-    sign: int  # LEFT or RIGHT
-    start: int  # first window index
+    sign: int  # [-] LEFT or RIGHT
+    start: int  # [-] first window index
     guide: Coefficients  # shape before own hits: the prior's boundary or a line through the base
     anchor: tuple[float, float]  # [m] (x, y) the borrowed shapes are moved through
     centroids_x: list[float] = field(default_factory=list)  # [m] hit window centroids
     centroids_y: list[float] = field(default_factory=list)  # [m]
-    chunks: list[IntArray] = field(default_factory=list)  # cell indices of hit windows
+    chunks: list[IntArray] = field(default_factory=list)  # [-] cell indices of hit windows
     last_x: float = 0.0  # [m] centre of the last hit window (or the base window)
-    hits: int = 0  # windows with paint
+    hits: int = 0  # [-] windows with paint
     active: bool = True
     fit: tuple[Coefficients, float] | None = None  # centroid fit and its x span [m]
 
@@ -588,7 +565,7 @@ class LaneFilterParams:
     min_confidence: float = 0.2  # [-] measurements below this are not used (predict only)
     confidence_floor: float = 0.1  # [-] measurement noise is divided by max(this, confidence)
     gate_probability: float = 0.999  # [-] chi-square gate on the innovation
-    max_rejections: int = 3  # consecutive gated-out measurements before re-initialising
+    max_rejections: int = 3  # [-] consecutive gated-out measurements to re-initialise on
     agree_offset: float = 0.3  # [m] ... if those measurements agree this well (offsets)
     agree_heading: float = 0.035  # [rad] ... and headings (2 deg)
     confidence_gain: float = 0.5  # [-] share of the measurement's confidence taken per update
@@ -600,25 +577,28 @@ class LaneFilterParams:
 class LaneFilter:
     """Kalman filter on x = (offset [m], heading_error [rad], curvature [1/m], width [m]).
 
-    Prediction over dt [s]: random walks (``*_walk``); with the car's ``speed`` [m/s] the
-    offset also moves by ``speed dt sin(heading_error)`` (linearised), and with its
-    ``yaw_rate`` [rad/s] the heading error by ``(yaw_rate - speed curvature) dt``.
-    Update: offset, heading and curvature always, the width only when both boundaries were
-    seen; the noise is the ``*_sigma`` divided by the measurement's confidence. Gating: an
-    innovation whose squared Mahalanobis distance exceeds the chi-square quantile
-    ``gate_probability`` is rejected (predict only); after ``max_rejections`` consecutive
-    rejections that agree with each other (offsets within ``agree_offset``, headings within
-    ``agree_heading``) the filter re-initialises on the measurement (a lane change, a new
-    lane); rejections that scatter (a vehicle's side, glare) only ever predict.
-    Frames with confidence below ``min_confidence`` only predict. Ego-lane re-assignment:
-    once the car's centre is more than ``reassign_margin`` past a boundary of the lane
-    tracked (|offset| > width / 2 + margin: a lane change), the state moves to the lane
-    beyond that line (offset -+ width, the covariance with it); the detector's next search
-    follows, as the filtered estimate is its prior, and the lines it tracked stay in view as
-    the new lane's other boundary. The output confidence
-    moves by ``confidence_gain`` towards each accepted measurement's and decays as
-    ``exp(-dt / confidence_tau)`` while predicting, so it goes to ~0 when lines vanish for
-    a few seconds and recovers within a few frames when they come back.
+    Per detection (`update`), at its time t [s]:
+
+    1. Initialise on the first detection with confidence >= ``min_confidence`` (the width's
+       sigma is ``init_width_sigma`` when one boundary was seen).
+    2. Predict over dt [s]: random walks of ``*_walk``; with the car's ``speed`` v [m/s],
+       offset += v dt heading_error (sin linearised); with its ``yaw_rate`` r [rad/s],
+       heading_error += (r - v curvature) dt.
+    3. Correct with offset, heading and curvature, and the width when both boundaries were
+       seen; the noise is ``*_sigma`` / max(``confidence_floor``, confidence). A detection
+       below ``min_confidence`` only predicts. Gate: an innovation whose squared Mahalanobis
+       distance exceeds the chi-square quantile ``gate_probability`` is rejected (predict
+       only), unless it is the ``max_rejections``-th in a row and those agree (offsets within
+       ``agree_offset``, headings within ``agree_heading``): then the filter re-initialises on
+       it (a lane change, a new lane); rejections that scatter (a vehicle's side, glare) only
+       predict.
+    4. Ego-lane re-assignment, after an accepted detection: when |offset| > width / 2 +
+       ``reassign_margin`` (the car's centre past a boundary: a lane change), the state moves
+       to the lane beyond that line (offset -+ width, the covariance with it). The detector
+       follows, as the filtered estimate is its prior, and the lines it tracked stay in view
+       as the new lane's other boundary.
+    5. The confidence moves by ``confidence_gain`` towards each accepted detection's and
+       decays as exp(-dt / ``confidence_tau``) while predicting.
     """
 
     def __init__(self, params: LaneFilterParams | None = None) -> None:
@@ -628,12 +608,12 @@ class LaneFilter:
                                   p.width_sigma])
         self._walk = np.array([p.offset_walk, p.heading_walk, p.curvature_walk, p.width_walk])
         self._gate = {n: float(chi2.ppf(p.gate_probability, n)) for n in (3, 4)}
-        self.x = np.zeros(DIM)  # state, see class doc
-        self.P = np.eye(DIM)  # covariance
+        self.x = np.zeros(DIM)  # (4,) state, see class doc
+        self.P = np.eye(DIM)  # (4, 4) covariance
         self.t = 0.0  # [s] time of the state
         self.confidence = 0.0  # [0, 1]
         self.initialised = False
-        self.rejections = 0  # consecutive gated-out measurements
+        self.rejections = 0  # [-] consecutive gated-out measurements
         self._rejected: list[LaneEstimate] = []  # the last of them
 
     def reset(self) -> None:

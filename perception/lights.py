@@ -1,75 +1,59 @@
 """Traffic lights in a camera frame: the lit lamp's colour, looked for where the map says the
 light is.
 
-`TrafficLightDetector.detect(frame, ego)` takes one `world.frames.CameraFrame` and the
-stack's pose estimate, picks the map's light heads near the route itself
-(`world.hdmap.TrafficLight`), and returns a `perception.messages.LightDetection` (the lit
-colour) for each head it sees, nearest first. Classical and stateless, one frame at a time:
-colour blobs in the light's expected image region. Only OpenCV and numpy; the housing's
-size is the standard one (`HOUSING_WIDTH` ...), not read from the world model.
+`TrafficLightDetector.detect(frame, ego)` takes one `CameraFrame`, (H, W, 3) RGB, and the
+stack's pose estimate at its time, picks the map's light heads ahead (`world.hdmap.LightHead`)
+and returns a `LightDetection` (the lit colour) for each head it sees, nearest first.
+Classical and stateless, one frame at a time: colour blobs in the light's expected image
+region. OpenCV and numpy only; the housing's size is the standard one, not read from the
+world model.
 
-The light: a dark housing ``HOUSING_WIDTH`` (0.35 m) wide, ``HOUSING_HEIGHT`` (1.0 m) tall and
-``HOUSING_DEPTH`` (0.25 m) deep, centred on the head's point (which is the yellow lamp's
-centre), its three round lamps ``LAMP_DIAMETER`` (0.22 m) across, ``LAMP_SPACING`` (0.3 m)
-apart: red on top, yellow, green at the bottom. The head's ``facing`` is the yaw of the lamps'
-outward normal.
+The light: a dark housing `HOUSING_WIDTH` wide, `HOUSING_HEIGHT` tall and `HOUSING_DEPTH`
+deep, centred on the head's point (the yellow lamp's centre), with three round lamps
+`LAMP_DIAMETER` across, `LAMP_SPACING` apart: red on top, yellow, green at the bottom. The
+head's ``facing`` [rad] is the map-frame yaw of the lamps' outward normal.
 
-1. **Which heads**. The map's lights (`RoadMap.traffic_lights`) whose stop line is ahead of
-   the front bumper by at most ``stop_line_ahead`` (60 m; ``stop_line_behind``, 1 m, behind
-   it at most), looked for when the head is within ``max_range`` (60 m) of the car's
-   centre, its lamps face the car (their normal within ``max_facing`` (60 deg) of the
-   direction from the head to the car: from behind or side-on the lamps cannot be seen),
-   its housing lies in front of the camera and its centre projects inside the image.
+1. **Which heads** (`heads_ahead`, `head_view`): the map's lights (`RoadMap.traffic_lights`)
+   whose stop line is at most ``stop_line_ahead`` ahead of the front bumper along the road
+   (or less than ``stop_line_behind`` behind it), and whose head is within ``max_range`` of
+   the car's centre, faces the car (the lamps' normal within ``max_facing`` of the direction
+   from the head to the car: from behind or side-on the lamps cannot be seen), lies beyond
+   the camera's near plane and has its centre project inside the image.
 
-2. **Where** (`head_view`). The housing's eight corners go from the map frame to the vehicle
-   frame by the pose estimate (x, y, heading; the ground at z = 0, the body's pitch and
-   roll unknown), to the camera frame by the mount, and to pixels (``u = cx - fx Y / X``,
-   ``v = cy - fy Z / X``): their bounding box is the expected housing. The region searched
-   (ROI) is the box grown by ``position_pad`` (0.5 m) on every side before projecting (the
-   position error), then by ``fx tan(angle_pad)`` (1.5 deg: the heading error, and the body's
-   pitch, which the pose does not have) and ``pixel_pad`` (3 px) in the image.
+2. **Where** (`head_view`): the housing's eight corners go from the map frame to the vehicle
+   frame by the pose estimate (x, y, heading; the ground at z = 0, the body's pitch and roll
+   unknown), to the camera frame by the mount, and to pixels (u = cx - fx Y / X, v = cy - fy
+   Z / X): their bounding box is the expected housing. The region searched (ROI) is the
+   housing grown by ``position_pad`` on every side before projecting (the position error),
+   then by fx tan(``angle_pad``) (the heading error and the body's pitch) and ``pixel_pad``
+   in the image.
 
-3. **Lamp blobs** (`lamp_blobs`). In the ROI, OpenCV's 8-bit HSV (hue 0..179 in 2 deg units):
-   bright (V >= ``min_value``, 100) and fully saturated (S >= ``min_saturation``, 240) pixels
-   of red (H 0..8), yellow (H 15..30) or green (H 55..95); each colour's 8-connected
-   components are the candidate lamps, at most ``max_blob_factor`` (4) times the lamp's
-   expected area (+ 4 px). Measured in rendered frames (the world model's lamps, every 45 deg
-   of facing, 10-70 m; EGL and TinyRenderer alike): a lit lamp is S 255, H 1 (red), 21-22
-   (yellow), 73-74 (green), V 153-204 by how its face turns to the renderer's fixed light
-   (every pixel of one lamp the same: no antialiasing); an unlit lamp is the same hue at
-   V 33-45; the housing V 9-18. Painted things do not reach the saturation: a red NPC car
-   is H 2, S <= 211 at V 128-189 (as bright as a lamp, so brightness alone cannot tell
-   them apart; saturation does), a truck H 20-21, S <= 228, a pedestrian H 66, S <= 184,
-   a stop sign H 177, S ~235 (outside the red band too), grass S ~113, facades S < 180;
-   the orange obstacle block reaches S 243 but at H 13, between the red and yellow bands.
+3. **Lamp blobs** (`lamp_blobs`): in the ROI, in OpenCV's 8-bit HSV (hue 0..179 in 2 deg
+   units, S and V 0..255), the pixels with V >= ``min_value``, S >= ``min_saturation`` and a
+   hue in ``red_hue``, ``yellow_hue`` or ``green_hue``; each colour's 8-connected components,
+   up to ``max_blob_factor`` times the lamp's expected area (+ 4 px), are the candidates.
+   Saturation is what sets a lit lamp apart: lamps render fully saturated, while painted
+   surfaces (a red car as bright as a lamp, a truck, a pedestrian, a stop sign, grass,
+   facades) stay below ``min_saturation``; unlit lamps and the housing are dark. The hue
+   bands also leave out the stop sign's red and the orange of obstacle blocks.
 
-4. **The lit lamp**: the largest blob. When the housing is at least ``slot_min_px`` (12 px)
-   tall, the lamp's vertical place in it must match its colour (red in the top third,
-   yellow in the middle, green at the bottom: within ``slot_tolerance`` (0.15) of the
-   housing's height from 0.2, 0.5, 0.8 of the way down). The housing used for that is its
-   dark silhouette (V <= ``dark_max_value``, 60, with the lamps) around the blob when that
-   has about the housing's projected height (``silhouette_ratio``), else the projection:
-   the body's pitch, which the pose estimate lacks, moves the projection by 6.7 px per
-   degree, more than a lamp spacing beyond ~17 m. A blob out of its place is passed over
-   for the next.
+4. **The lit lamp**: the candidates are tried nearest first to where their colour's lamp
+   projects (a lamp of another head seen side-on through the padded ROI lies off it), then
+   largest first. When the housing is at least ``slot_min_px`` tall, a blob's place down it
+   must match its colour's (`SLOT`: red in the top third, yellow in the middle, green at the
+   bottom) within ``slot_tolerance`` of its height, else the next blob is tried. The housing
+   for that is its dark silhouette (V <= ``dark_max_value``, with the lamps) around the blob
+   when that is about the housing's projected height (``silhouette_ratio``), else the
+   projection: the body's pitch, which the pose lacks, shifts the projection by fx tan(pitch)
+   pixels while a lamp spacing shrinks as fx `LAMP_SPACING` / X.
 
-5. **Confidence** in [0, 1]: the product of a size factor (the blob's area against the
-   lamp's expected area, from 0.5 up to 1), a uniqueness factor (the blob's share of all
-   lit-lamp pixels in the ROI) and a position factor (1 when the place was checked, 0.8
+5. **Confidence** in [0, 1]: the product of a size factor (0.5 + 0.5 x the blob's area over
+   the lamp's expected area, at most 1), a uniqueness factor (the blob's share of all the
+   candidates' pixels in the ROI) and a position factor (1 when the place was checked, 0.8
    when the housing was too small to tell).
 
 ``range`` is the horizontal distance from the car's centre to the head by the map and the
 pose estimate (a lamp of a few pixels is too small to range by).
-
-Measured (the default profile's 640 x 480, 80 deg front camera; the map's placement, 12 m past
-the stop line, 1 m right of the paved edge (5.25 m right of the car), 3.5 m high; every 1 m,
-EGL and TinyRenderer alike): each colour is found, and right, from 8 m (nearer, the head
-leaves the view's side) to ``max_range`` (60 m; the lamp is 1.7 px across at 50 m, and is
-found to ~68 m, after which single frames start to miss it); with the pose off by up to
-0.5 m and 1.5 deg, from 9 m. A red car parked right under a green light (in the ROI, as
-bright as a lamp) never gives a red blob. Confidence >= 0.55; ~0.25 ms per frame for one
-head at 30 m (0.5 ms at 10 m, where the ROI is larger), ~0.8 ms for four, nothing without
-heads (the HSV conversion and labelling of the ROIs only).
 """
 
 from __future__ import annotations
@@ -104,7 +88,7 @@ Box = tuple[int, int, int, int]  # [px] u0, v0, u1, v1 (exclusive)
 
 @dataclass(frozen=True, slots=True)
 class LightParams:
-    """Thresholds of `TrafficLightDetector` (see the module docstring for each)."""
+    """Thresholds of `TrafficLightDetector`, by step of the module docstring."""
 
     # -- which heads
     stop_line_ahead: float = 60.0  # [m] a light is looked for while its stop line is at
@@ -115,18 +99,18 @@ class LightParams:
     # -- where: the ROI
     position_pad: float = 0.5  # [m] pose position error allowed for
     angle_pad: float = math.radians(1.5)  # [rad] heading (and body pitch) error allowed for
-    pixel_pad: int = 3  # [px]
+    pixel_pad: int = 3  # [px] added in the image, after the two pads above
     # -- lamp colour, OpenCV 8-bit HSV: hue [2 deg units] 0..179, saturation and value 0..255
-    min_saturation: int = 240
-    min_value: int = 100
-    red_hue: tuple[int, int] = (0, 8)
-    yellow_hue: tuple[int, int] = (15, 30)
-    green_hue: tuple[int, int] = (55, 95)
+    min_saturation: int = 240  # [0..255] lit lamps render fully saturated, paint stays below
+    min_value: int = 100  # [0..255] unlit lamps and the housing are darker
+    red_hue: tuple[int, int] = (0, 8)  # [2 deg] inclusive band
+    yellow_hue: tuple[int, int] = (15, 30)  # [2 deg]
+    green_hue: tuple[int, int] = (55, 95)  # [2 deg]
     max_blob_factor: float = 4.0  # [-] blob area / the lamp's expected area (+ 4 px) at most
     # -- position check
     slot_min_px: float = 12.0  # [px] housing height from which the lamp's place is checked
     slot_tolerance: float = 0.15  # [-] of the housing's height
-    dark_max_value: int = 60  # housing silhouette: V at most this
+    dark_max_value: int = 60  # [0..255] housing silhouette: V at most this
     silhouette_ratio: tuple[float, float] = (0.7, 1.4)  # [-] its height / the projected one
 
     def hues(self) -> dict[LightColour, tuple[int, int]]:
@@ -154,7 +138,7 @@ class HeadView:
 class LampBlob:
     """One lit-lamp candidate in a ROI (image pixels)."""
 
-    colour: LightColour
+    colour: LightColour  # the hue band it fell in
     area: int  # [px]
     box: Box  # [px] in the image
     centroid: tuple[float, float]  # [px] (u, v), pixel centres at i + 0.5
@@ -248,8 +232,9 @@ class TrafficLightDetector:
         self.params = params or LightParams()
 
     def heads_ahead(self, ego: EgoState) -> list[tuple[int, LightHead]]:
-        """(id, head) of the map's lights whose stop line is ahead of the front bumper
-        within ``stop_line_ahead`` (an id indexes `RoadMap.traffic_lights`)."""
+        """(id, head) of the map's lights whose stop line is at most ``stop_line_ahead``
+        ahead of the front bumper, or less than ``stop_line_behind`` behind it, by station
+        along the road (an id indexes `RoadMap.traffic_lights`)."""
         p = self.params
         station = float(self.road.local_coordinates(np.array([ego.x, ego.y]))[0])
         front = station + self.vehicle.front_overhang

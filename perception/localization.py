@@ -6,15 +6,18 @@ rad/s]``, heading counter-clockwise from +x, wrapped to (-pi, pi].
 Steps:
 
 1. The first GNSS fix initialises the state (speed and yaw rate from the latest odometry
-   sample, if one came before it). Odometry before that is only remembered.
-2. Predict at every odometry sample (40 Hz) with a unicycle model evaluated at the midpoint
-   heading (``x += v dt cos(psi + w dt / 2)``, ...): it matches the exact constant-turn-rate
-   (CTRV) chord up to a relative length error of ``(w dt)^2 / 24`` (< 1e-6 at 40 Hz), and its
-   Jacobian has no ``w -> 0`` singularity. Process noise: white longitudinal and yaw
-   acceleration plus a small random walk on position and heading (slip, tyre radius error).
-3. Update with the odometry speed (mean rear wheel spin x nominal radius) and the gyro yaw
-   rate, then (10 Hz) with the GNSS position and heading; the heading innovation is wrapped
-   to (-pi, pi].
+   sample, if one came before it, else zero with ``init_*_sigma``). Odometry before that is
+   only remembered.
+2. Predict to every sample's time with a unicycle model evaluated at the midpoint heading
+   (``x += v dt cos(psi + w dt / 2)``, ...): it matches the exact constant-turn-rate (CTRV)
+   chord up to a relative length error of ``(w dt)^2 / 24``, negligible at odometry rates,
+   and its Jacobian has no ``w -> 0`` singularity. Process noise: white longitudinal and yaw
+   acceleration (``accel_sigma``, ``yaw_accel_sigma``) plus a random walk on position and
+   heading (``position_walk``, ``heading_walk``: slip, tyre radius error).
+3. Update at every odometry sample with its speed (mean rear wheel spin x nominal radius)
+   and the gyro yaw rate, and at every GNSS fix with its position and heading (the noise the
+   larger of the fix's own sigma and ``gnss_sigma`` / ``gnss_heading_sigma``); the heading
+   innovation is wrapped to (-pi, pi].
 
 A constant GNSS bias is NOT observable here: odometry measures only speed and yaw rate, never
 absolute position, so the estimate follows the biased fixes (offset by the bias). Removing it
@@ -140,7 +143,7 @@ def _hx_odo(x: FloatArray) -> FloatArray:
 
 
 class Localizer:
-    """EKF pose estimate from `GnssFix` (10 Hz) and `Odometry` (40 Hz); see module doc."""
+    """EKF pose estimate from `GnssFix` and `Odometry` samples; see the module docstring."""
 
     def __init__(self, params: LocalizerParams | None = None) -> None:
         self.params = params if params is not None else LocalizerParams()
@@ -183,8 +186,8 @@ class Localizer:
     def on_gnss(self, fix: GnssFix) -> None:
         """Initialise from the first fix; later, predict to ``fix.t`` and update with it.
 
-        A fix older than the filter time is applied at the filter time (no retrodiction):
-        at 12 m/s a 25 ms delay is 0.3 m, so the sensor model must stamp fixes on time.
+        A fix older than the filter time is applied at the filter time (no retrodiction): a
+        fix d [s] late is off by speed x d, so the sensor model must stamp fixes on time.
         """
         if not self._initialised:
             self._initialise(fix)

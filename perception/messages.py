@@ -46,11 +46,12 @@ class LaneBoundary:
 class LaneEstimate:
     """The ego lane as the front camera sees it, in the vehicle frame at time ``t``.
 
-    The lane centre is y = c0 + c1 x + c2 x^2 (vehicle frame: x forward from the car's
-    centre, y left). ``offset`` is where the car's centre is relative to that centre line
-    (left +: the car is left of the lane centre), ``heading_error`` the car's heading minus
-    the lane's (left +), ``curvature`` the lane's (left turn +). With ``confidence`` below the
-    consumer's threshold the numbers are the filter's prediction, not a measurement.
+    The lane centre is y(x) = -offset - tan(heading_error) x + curvature x^2 / 2 (`centre_y`;
+    vehicle frame: x forward from the car's centre, y left). ``offset`` is where the car's
+    centre is relative to that centre line (left +: the car is left of the lane centre),
+    ``heading_error`` the car's heading minus the lane's (left +), ``curvature`` the lane's
+    (left turn +). With ``confidence`` below the consumer's threshold the numbers are the
+    filter's prediction, not a measurement.
     """
 
     t: float  # [s] sim time of the camera frame
@@ -58,7 +59,7 @@ class LaneEstimate:
     heading_error: float  # [rad] car heading minus lane heading, left +
     curvature: float  # [1/m] lane curvature at the car, left turn +
     width: float  # [m] lane width
-    confidence: float  # [0, 1] how much of the lane was seen (both lines, length, fit)
+    confidence: float  # [0, 1] how much of the lane was seen (both lines, windows, length)
     left: LaneBoundary | None  # the left boundary fit, if found in this frame
     right: LaneBoundary | None  # the right boundary fit, if found in this frame
 
@@ -91,7 +92,7 @@ class Detection:
     width: float  # [m]
     height: float  # [m]
     yaw: float  # [rad] box heading in the vehicle frame, in (-pi/2, pi/2] (no front/back)
-    cls: ObjectClass
+    cls: ObjectClass  # coarse class from the box size
     points: int  # [-] LiDAR returns in the cluster
 
 
@@ -100,7 +101,7 @@ class Track:
     """A tracked object: filtered position and velocity over ground, in the map frame, and
     the same relative to the ego (vehicle frame at the track's time)."""
 
-    id: int  # stable while the track lives
+    id: int  # [-] stable while the track lives, never reused
     t: float  # [s] time of the state
     x: float  # [m] map frame, box centre
     y: float  # [m]
@@ -114,7 +115,7 @@ class Track:
     width: float  # [m]
     height: float  # [m]
     yaw: float  # [rad] map frame box heading
-    cls: ObjectClass
+    cls: ObjectClass  # majority class of the track's detections
     hits: int  # [-] scans this track was updated in
     misses: int  # [-] consecutive scans without a detection (coasting)
     position_sigma: float  # [m] 1-sigma of the position (largest axis)
@@ -134,7 +135,7 @@ class SignDetection:
     time ``t`` (x forward from the car's centre, y left, z up from the ground below it)."""
 
     t: float  # [s] sim time of the camera frame
-    kind: str  # "stop"
+    kind: str  # [-] "stop"
     x: float  # [m] vehicle frame, plate centre ahead of the car's centre
     y: float  # [m] vehicle frame, left of the car's centre
     z: float  # [m] plate centre above the ground
@@ -178,8 +179,9 @@ class LightDetection:
     """The lit lamp of one map traffic light, as seen in one camera frame."""
 
     t: float  # [s] sim time of the camera frame
-    light: int  # the caller's id of the light's head (`TrafficLightDetector.detect`'s heads)
-    colour: LightColour
+    light: int  # [-] the caller's id of the light's head (`TrafficLightDetector.detect`: its
+    #   index in `RoadMap.traffic_lights`)
+    colour: LightColour  # the lit lamp's colour
     range: float  # [m] horizontal distance from the car's centre to the head (map and pose)
     confidence: float  # [0, 1] how clearly the lamp was seen (size, uniqueness, position)
     box: tuple[int, int, int, int]  # [px] (u0, v0, u1, v1) of the lamp's pixels, u1/v1 exclusive
@@ -193,8 +195,8 @@ class LaneView:
     """The camera's latest lane estimate and the stack's pose estimate at its frame's time
     (the estimate is in that pose's vehicle frame)."""
 
-    estimate: LaneEstimate
-    pose: EgoState
+    estimate: LaneEstimate  # vehicle frame at `pose`
+    pose: EgoState  # map frame, at the camera frame's time
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -202,7 +204,7 @@ class SignView:
     """The traffic signs found in one camera frame and the pose estimate at its time."""
 
     signs: tuple[SignDetection, ...]  # vehicle frame at `pose`
-    pose: EgoState
+    pose: EgoState  # map frame, at the camera frame's time
 
 
 @dataclass(frozen=True, slots=True, eq=False)

@@ -1,91 +1,72 @@
 """Object detection in one LiDAR scan: oriented, class-completed boxes in the vehicle frame.
 
-Input: a `LidarScan` (points in the sensor frame). Output: `Detection` boxes in the vehicle
-frame (x forward, y left, z up, origin on the ground below the car's centre), sorted by
-horizontal range from the sensor. Every threshold below is a field of `DetectorParams`
-(defaults in brackets); all lengths in metres, angles in radians (degrees where stated).
+Input: a `LidarScan`, (N, 3) points [m] in the sensor frame. Output: `Detection` boxes in the
+vehicle frame (x forward, y left, z up, origin on the ground below the car's centre), sorted
+by horizontal range from the sensor. Lengths in metres, angles in radians; the thresholds
+named below are fields of `DetectorParams`.
 
-Steps:
+1. **Vehicle frame and region of interest**: ``mount.to_vehicle``; keep |x| <= ``roi_x`` and
+   |y| <= ``roi_y``.
+2. **Ground plane**: the ground is flat, but the body pitches and rolls, so in the vehicle
+   frame it is a plane z = a x + b y + c near z = 0, fitted by RANSAC: ``ground_hypotheses``
+   planes through three of ``ground_sample`` ROI points (an even stride), drawn by a generator
+   seeded with ``ground_seed`` at every call (a scan always gives the same plane). A plane is
+   admissible if its normal is within ``ground_max_tilt`` of vertical and it passes within
+   ``ground_max_offset`` of the vehicle origin, so that walls and car roofs cannot win; the
+   one with the most sample points within ``ground_threshold`` is refined twice by least
+   squares on its inliers among all ROI points. No admissible plane: z = 0. A point's height
+   is z - (a x + b y + c); points below ``ground_clearance`` are ground, points above
+   ``roi_height`` are dropped (it lies well above ``max_height``: a wall cropped lower would
+   look like a row of posts).
+3. **Clustering** on the horizontal coordinates, as objects stand on the ground and do not
+   stack (a 16-channel LiDAR's rings are metres apart at range and would split a car in 3D):
+   the points are averaged per ``voxel`` x ``voxel`` grid cell (each point's cell kept), the
+   centroids clustered by Open3D's ``cluster_dbscan`` (eps ``cluster_eps``, ``min_points =
+   1``: single-linkage Euclidean clustering), and the labels go back to the points.
+4. **Cluster gate**: clusters with fewer than ``min_points`` returns, whose highest point is
+   below ``min_top`` or above ``max_height`` (buildings), or whose axis-aligned extent exceeds
+   ``max_length`` sqrt(2) are dropped before fitting.
+5. **Oriented rectangle (L-shape fitting)**: the heading in [0, pi/2) that maximises the
+   closeness criterion of Zhang et al. 2017 ("Efficient L-shape fitting for vehicle detection
+   using laser scanners"): the points are projected on the two rectangle axes, each axis
+   keeps the edge its points are closer to (norm of the distance vector), and the score is
+   sum 1 / max(min(d1, d2), ``closeness_d0``). It is searched every ``coarse_step``, then
+   every ``fine_step`` within one coarse step of the best, on at most ``fit_max_points``
+   points (an even stride). The criterion chases the extreme (noisiest) points, so the
+   heading is then refitted ``refine_iterations`` times by least squares: each point goes to
+   the nearer of the two kept edges, and the two perpendicular lines minimising the summed
+   squared distances have the normal n = the eigenvector of the smallest eigenvalue of S_1 -
+   S_2 (the scatter matrices of the two point sets; closed form).
+6. **Candidate classes** from the observed extents a >= b and the highest point h (lower
+   bounds: a LiDAR sees only the near faces and, far away, one or two rings): none (not an
+   object) if a > ``max_length`` or h > ``max_height``; if a <= ``small_footprint``,
+   PEDESTRIAN when a <= ``pedestrian_footprint`` and ``pedestrian_min_height`` <= h <=
+   ``pedestrian_max_height``, else OTHER (obstacles, poles); TRUCK alone if h > ``car.height``
+   + ``height_margin``, a > ``truck_min_length`` or b > ``truck_min_width``; otherwise CAR or
+   TRUCK.
+7. **Box completion**: each candidate class's box is grown to its size prior (``car``,
+   ``truck``, ``pedestrian``; never shrunk below what was seen; OTHER: a square of the longer
+   observed side), with either rectangle axis as the length. Each axis grows away from the
+   sensor, so that the faces seen stay where they were seen: if the sensor projects onto the
+   axis outside the observed interval, the interval's end nearer the sensor is kept; if inside
+   (a face seen head-on, both its ends visible), the interval grows symmetrically. The
+   hypothesis of least cost = silhouette growth + ``overshoot_weight`` x overshoot (+
+   ``truck_bias`` for trucks) wins: the silhouette growth [m] is how far the box sticks out
+   sideways beyond the seen points as viewed from the sensor (azimuth growth x mean range; a
+   rightly completed box hides behind its visible faces), the overshoot [m] how much the seen
+   extents exceed the prior's. This decides, e.g., whether a lone face a car wide is a car's
+   rear (grown away: no growth) or part of its side (grown sideways). Height: the prior's, or
+   the observed one if larger; z is half the height.
+8. **Fragments**: a surface seen at grazing incidence breaks into clusters of one azimuth
+   column each (a truck's side seen from just behind it). Walking the detections from the
+   most points down, one whose points lie mostly (>= 50 %) inside a kept box grown by
+   ``fragment_margin`` is dropped (two objects cannot overlap).
 
-1. **Vehicle frame and region of interest.** ``mount.to_vehicle``; keep ``|x| <= roi_x``
-   (60 m) and ``|y| <= roi_y`` (60 m).
-2. **Ground plane.** The ground is flat, but the body pitches and rolls (braking,
-   cornering), so in the vehicle frame it is a plane near ``z = 0`` that must be fitted.
-   RANSAC in numpy: ``ground_hypotheses`` (40) planes through three points drawn from
-   ``ground_sample`` (~1500, an even stride of the ROI points), with a generator seeded by
-   ``ground_seed`` at every call (a scan always gives the same plane). A hypothesis is
-   admissible only if its normal is within ``ground_max_tilt`` (6 deg) of vertical and it
-   passes within ``ground_max_offset`` (0.5 m) of the vehicle origin: walls (vertical) and
-   car roofs (1.5 m up) cannot win. The one with the most sample points within
-   ``ground_threshold`` (0.10 m) is refined twice by least squares (``z = a x + b y + c``)
-   on its inliers among all ROI points. No admissible hypothesis (no ground seen): ``z =
-   0``. A point's height is ``z - (a x + b y + c)``; points below ``ground_clearance``
-   (0.2 m) are ground; points above ``roi_height`` (8 m) are dropped. The ceiling is well
-   above ``max_height`` (4.5 m) on purpose: a wall cropped at 5 m would look like a row of
-   4-5 m posts; kept whole, its upper rings make it too tall and it is rejected.
-3. **Clustering.** Objects stand on the ground and do not stack, so clustering is done on
-   the horizontal coordinates: at 20-50 m a VLP-16's rings are 0.7-1.7 m apart vertically,
-   which would split a car in 3D. The points are averaged per ``voxel`` x ``voxel``
-   (0.15 m) grid cell (centroids, the cell of each point kept), then the centroids are
-   clustered with Open3D's ``cluster_dbscan`` (``eps = cluster_eps`` 0.6 m, ``min_points
-   = 1``: single-linkage Euclidean clustering) and the labels go back to the points.
-   0.6 m bridges the column spacing of the 0.4 deg LiDAR at 60 m (0.42 m) and still
-   separates two cars in adjacent lanes (1.5 m apart).
-4. **Cluster gate.** Clusters with fewer than ``min_points`` (4) returns, whose highest
-   point is lower than ``min_top`` (0.3 m) or higher than ``max_height`` (4.5 m:
-   buildings), or whose axis-aligned extent exceeds ``max_length * sqrt(2)`` (17 m) are
-   dropped before fitting.
-5. **Oriented rectangle (L-shape fitting).** The heading that maximises the closeness
-   criterion of Zhang et al. 2017 ("Efficient L-shape fitting for vehicle detection using
-   laser scanners"): for each candidate heading in [0, pi/2) the points are projected on
-   the two rectangle axes, each axis keeps the edge its points are closer to (norm of the
-   distance vector), and the score is ``sum 1 / max(min(d1, d2), closeness_d0)`` (d0 =
-   0.01 m). Search every ``coarse_step`` (3 deg), then every ``fine_step`` (0.25 deg)
-   within one coarse step of the best, on at most ``fit_max_points`` (400) points (an even
-   stride). The criterion chases the extreme (noisiest) points, so the heading is then
-   refitted ``refine_iterations`` (2) times by least squares: each point is given to the
-   nearer of the two kept edges, and the two perpendicular lines minimising the summed
-   squared distances have the normal ``n`` = eigenvector of the smallest eigenvalue of
-   ``S_1 - S_2`` (the scatter matrices of the two point sets; closed form). This takes the
-   yaw error of a car seen from behind at 50 m from up to ~8 deg to ~2.5 deg.
-6. **Candidate classes** from the observed extents ``a >= b`` and the highest point ``h``
-   (observed sizes are lower bounds: a LiDAR sees only the near faces and, far away, one
-   or two rings): none (not an object) if ``a > max_length`` (12 m) or ``h > max_height``
-   (4.5 m); if ``a <= small_footprint`` (1.3 m): ``PEDESTRIAN`` when ``a <=
-   pedestrian_footprint`` (0.85 m) and ``pedestrian_min_height <= h <=
-   pedestrian_max_height`` (0.9-2.2 m), else ``OTHER`` (obstacles, poles); ``TRUCK`` alone
-   if ``h > car.height + height_margin`` (1.9 m), ``a > truck_min_length`` (5.6 m) or ``b
-   > truck_min_width`` (2.2 m); otherwise ``CAR`` or ``TRUCK``.
-7. **Box completion.** A LiDAR sees the near faces only, so each candidate class's box is
-   grown to its size prior (``car`` 4.6 x 1.8 x 1.5 m, ``truck`` 9.0 x 2.5 x 3.4 m,
-   ``pedestrian`` 0.5 x 0.6 x 1.75 m; never shrunk below what was seen; ``OTHER``: a
-   square of the longer observed side), with either rectangle axis as the length. Each
-   axis is grown AWAY from the sensor, so that the faces that were seen stay where they
-   were seen: if the sensor projects onto the axis outside the observed interval, the
-   interval's end nearer to the sensor is kept; if inside (a face seen head-on, both its
-   ends visible), the interval grows symmetrically. Among these hypotheses the one of
-   least cost wins: ``cost = silhouette growth + overshoot_weight (2) x overshoot (+
-   truck_bias 0.1 m for trucks)``, where the silhouette growth is how far the box sticks
-   out sideways beyond the seen points as viewed from the sensor (azimuth growth x mean
-   range; a correctly completed box hides behind its visible faces and adds ~0) and the
-   overshoot is how much the seen extents exceed the prior's. This decides, e.g., whether
-   a lone 1.8 m face is a car's rear (grown away: no growth) or part of its side (grown
-   sideways: 2.8 m growth), and whether a 2.4 m rear is a truck's or a too-wide car's.
-   Height: the prior height (or the observed one if larger); ``z`` is half the height.
-8. **Fragments.** A surface seen at grazing incidence breaks into separate clusters, each
-   one azimuth column (e.g. a truck's side seen from just behind it: one column every
-   1-2 m). Walking the detections from the most points down, one whose points lie mostly
-   (>= 50 %) inside an already kept box grown by ``fragment_margin`` (0.2 m) is dropped
-   (two objects cannot overlap).
+The yaw is the length axis's heading, wrapped to (-pi/2, pi/2] (front and back are not told
+apart). Limits: a distant pedestrian hit by one ring only, below ``pedestrian_min_height``,
+comes out as OTHER, and one with fewer than ``min_points`` returns is not seen at all.
 
-The yaw is the length axis's heading, wrapped to (-pi/2, pi/2] (front and back are not
-told apart). Limits: a pedestrian beyond ~30 m is seen by one ring at < 0.9 m and comes
-out as ``OTHER``, and beyond ~40 m (fewer than 4 returns) not at all; far (> ~45 m)
-vehicles on the 900-column LiDAR get only 4-5 returns across their rear.
-
-Open3D is imported lazily on the first scan (~1 s), after loading a libusb-1.0 into the
-process (Open3D links against it; the same preload as `avsim.deps`, which perception may not
-import).
+Open3D is imported lazily, on the first scan, by `perception.open3d_loader`.
 """
 
 from __future__ import annotations
@@ -116,11 +97,12 @@ class SizePrior:
 
 @dataclass(frozen=True, slots=True)
 class DetectorParams:
-    """Thresholds of the detector (see the module docstring for their roles)."""
+    """Thresholds of the detector, by step of the module docstring."""
 
     roi_x: float = 60.0  # [m] keep |x| <= roi_x (vehicle frame)
     roi_y: float = 60.0  # [m] keep |y| <= roi_y
-    roi_height: float = 8.0  # [m] drop points higher than this above the ground
+    roi_height: float = 8.0  # [m] drop points higher than this above the ground (well above
+    #   max_height: a wall stays whole, too tall to be an object)
     ground_hypotheses: int = 40  # [-] RANSAC plane hypotheses
     ground_sample: int = 1500  # [-] ROI points the hypotheses are drawn from and scored on
     ground_threshold: float = 0.10  # [m] RANSAC / refit inlier distance
@@ -129,7 +111,8 @@ class DetectorParams:
     ground_clearance: float = 0.2  # [m] points lower than this above the plane are ground
     ground_seed: int = 0  # [-] RANSAC generator seed (fixed: deterministic output)
     voxel: float = 0.15  # [m] horizontal grid cell of the downsampling before clustering
-    cluster_eps: float = 0.6  # [m] DBSCAN neighbourhood radius (horizontal)
+    cluster_eps: float = 0.6  # [m] DBSCAN neighbourhood radius (horizontal): wider than the
+    #   column spacing of a 0.4 deg LiDAR at roi range, narrower than two cars a lane apart
     min_points: int = 4  # [-] fewest returns in a detected cluster
     min_top: float = 0.3  # [m] a cluster's highest point must be at least this high
     max_length: float = 12.0  # [m] longer clusters are structures, not objects
@@ -149,9 +132,9 @@ class DetectorParams:
     closeness_d0: float = 0.01  # [m] closeness criterion distance floor
     refine_iterations: int = 2  # [-] least-squares refits of the L-shape heading
     fragment_margin: float = 0.2  # [m] a box absorbs smaller clusters within this of it
-    car: SizePrior = field(default_factory=lambda: SizePrior(4.6, 1.8, 1.5))
-    truck: SizePrior = field(default_factory=lambda: SizePrior(9.0, 2.5, 3.4))
-    pedestrian: SizePrior = field(default_factory=lambda: SizePrior(0.5, 0.6, 1.75))
+    car: SizePrior = field(default_factory=lambda: SizePrior(4.6, 1.8, 1.5))  # [m] size prior
+    truck: SizePrior = field(default_factory=lambda: SizePrior(9.0, 2.5, 3.4))  # [m]
+    pedestrian: SizePrior = field(default_factory=lambda: SizePrior(0.5, 0.6, 1.75))  # [m]
 
     def prior(self, cls: ObjectClass) -> SizePrior | None:
         """The size prior of ``cls`` (None for `ObjectClass.OTHER`)."""
@@ -362,11 +345,11 @@ def grow_interval(lo: float, hi: float, size: float, sensor: float) -> tuple[flo
 class Footprint:
     """A cluster's fitted rectangle and how the sensor sees it (vehicle frame)."""
 
-    axes: FloatArray  # (2, 2) rows: the rectangle's unit axes
+    axes: FloatArray  # (2, 2) [-] rows: the rectangle's unit axes, vehicle frame
     lo: tuple[float, float]  # [m] observed interval of the points along each axis
     hi: tuple[float, float]  # [m]
     sensor: FloatArray  # (2,) [m] the sensor's position (x, y)
-    view: FloatArray  # (2, 2) rotation into a frame whose x points from the sensor to the points
+    view: FloatArray  # (2, 2) [-] rotation into a frame whose x points from the sensor to them
     azimuth: tuple[float, float]  # [rad] the points' azimuth interval in that frame
     distance: float  # [m] mean horizontal range of the points
 
@@ -405,7 +388,7 @@ class Hypothesis:
     """One completed box for a cluster: class, which fitted axis is the length, bounds."""
 
     cost: float  # [m] silhouette growth + overshoot weight x overshoot (+ truck bias)
-    cls: ObjectClass
+    cls: ObjectClass  # the candidate class whose size prior the box was grown to
     axis1_length: bool  # the first fitted axis is the box's length axis
     bounds: tuple[tuple[float, float], tuple[float, float]]  # [m] (lo, hi) along each axis
 

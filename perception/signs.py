@@ -1,83 +1,66 @@
 """Stop signs in a camera frame, by colour and shape, and their match with the map's signs.
 
-`StopSignDetector.detect(frame)` takes one `world.frames.CameraFrame` and returns the stop
-signs it sees as `perception.messages.SignDetection` (vehicle frame, nearest first). It is
-classical and stateless, one frame at a time; `match_sign` pairs a detection with a sign of
-the HD map. Only OpenCV and numpy: nothing here knows the simulator (the plate's size is
-the standard one, `STOP_PLATE_DIAMETER`, not read from the world model).
+`StopSignDetector.detect(frame)` takes one `CameraFrame`, (H, W, 3) RGB, and returns the stop
+signs it sees as `SignDetection`s, nearest first: the plate's centre [m] in the vehicle frame
+(x forward from the car's centre, y left, z up from the ground). Classical and stateless, one
+frame at a time, OpenCV and numpy only: the plate's size is the standard one, not read from
+the world model. `match_sign` pairs a detection with a sign of the HD map.
 
-The sign: a regular octagon, flat on top, `STOP_PLATE_DIAMETER` (0.75 m) across the flats,
-red with a white border (`STOP_BORDER_FRACTION` of the width, 4 %) and the white word STOP,
-its centre ~2 m above the ground. The red field, the part the colour test finds, is
-``STOP_FIELD_WIDTH = 0.69 m`` across.
+The sign: a regular octagon, flat on top, `STOP_PLATE_DIAMETER` across the flats, red with a
+white border (`STOP_BORDER_FRACTION` of that width) and the white word STOP. The red field,
+which the colour test finds, is `STOP_FIELD_WIDTH` across.
 
-1. **Red mask** in OpenCV's 8-bit HSV (hue 0..179 in units of 2 deg): hue <= ``hue_low_max``
-   (6, i.e. 12 deg) or >= ``hue_high_min`` (170), saturation >= ``min_saturation`` (100) and
-   value >= ``min_value`` (60). Measured in rendered frames (EGL and TinyRenderer alike):
-   the plate's red is H 177-178, S ~235, V ~150; an anti-aliased edge pixel half on the sky
-   has S ~110, so the floor of 100 cuts the plate close to its true outline (the range
-   estimate relies on that). Brick facades render at H 8-14, S 120-175 (the narrow low hue
-   band leaves them out); NPC cars at H ~2, S ~211 (they pass the colour test and fail the
-   shape tests). A **morphological close** (3 x 3) mends the one-pixel gaps that the STOP
-   letters or a pole drawn through a distant plate leave. Then the **external contours** of
-   the closed mask.
+1. **Red mask** in OpenCV's 8-bit HSV (hue 0..179 in 2 deg units, S and V 0..255): hue <=
+   ``hue_low_max`` or >= ``hue_high_min``, S >= ``min_saturation`` and V >= ``min_value``.
+   The saturation floor cuts the plate close to its true outline (anti-aliased edge pixels
+   fall below it), which the range estimate relies on; the narrow hue band leaves brick
+   facades out; red cars pass and fail the shape tests. A morphological close
+   (``close_kernel`` square) mends the one-pixel gaps that the letters or a pole drawn through
+   a distant plate leave; then the external contours of the closed mask.
 
 2. **Per blob** (a contour and its filled inside, the "plate"):
 
-   - size: the plate's bounding box at least ``min_size_px`` on its smaller side and at
-     most ``max_size_px`` on its larger, both computed from the intrinsics: the red field
-     at ``max_range`` (50 m) and at ``min_range`` (3 m) (a 640 x 480, 80 deg camera has
-     fx = 381 px: 5.3 px at 50 m, 7 px at 40 m, 13 px at 20 m, 88 px at 3 m);
-   - colour: a saturated core (some pixel with S >= ``core_saturation``, 190: the plate's
-     red keeps S >= 200 out to 45 m, a lit brick wall reaches ~175) and red over at least
-     ``min_red_fill`` (0.6) of the plate: the STOP letters are a small part of the field
-     (red fill 0.8-0.95), whereas a speed-limit sign's red ring encloses a white disc (red
-     fill ~0.4);
-   - shape: bounding-box aspect (width / height) within ``aspect`` (0.75..1.33); solidity
-     (contour area / convex hull area) >= ``min_solidity`` (0.85); extent (plate pixels /
-     bounding-box pixels) within ``extent`` (0.70..0.92): an octagon fills 0.83 of its
-     box, a rectangle (the back of a red car, a facade) ~1; and, when the blob is at least
-     ``polygon_min_px`` (20 px) across so that corners are resolvable, the convex hull's
-     ``approxPolyDP`` (epsilon ``polygon_epsilon``, 2.5 % of its perimeter) has 7..9
-     vertices. Below that the circularity of the hull (4 pi A / P^2, an octagon 0.95, a
-     square 0.79) must reach ``min_circularity`` (0.80);
-   - white inside: when the blob is at least ``white_min_px`` (14 px) across, where the
-     letters are resolved, low-saturation bright pixels (S <= ``white_max_saturation``, V >=
-     ``min_value``) make at least ``min_white_fill`` (2 %) of the plate (the STOP letters);
-     at a distance they blur into pink and the cue is not asked for.
+   - size: the bounding box's smaller side >= ``min_size_px`` and larger side <=
+     ``max_size_px``, the red field's width in pixels, fy `STOP_FIELD_WIDTH` / X, at
+     ``max_range`` and at ``min_range``;
+   - colour: a saturated core (a pixel with S >= ``core_saturation``, which the plate's red
+     reaches and a lit brick wall does not) and red over at least ``min_red_fill`` of the
+     plate (the letters are a small part of the field; a speed-limit sign's red ring encloses
+     a white disc);
+   - shape: box aspect (width / height) within ``aspect``; solidity (contour area / hull
+     area) >= ``min_solidity``; extent (plate pixels / box pixels) within ``extent`` (an
+     octagon fills `OCTAGON_AREA_FACTOR` = 2 (sqrt 2 - 1) = 0.83 of its box, a rectangle such
+     as a car's back or a facade all of it); from ``polygon_min_px`` across, where corners are
+     resolved, the convex hull's ``approxPolyDP`` (epsilon ``polygon_epsilon`` of its
+     perimeter) has a vertex count within ``polygon_vertices``, and below that the hull's
+     circularity 4 pi A / P^2 (an octagon 0.95, a square 0.79) reaches ``min_circularity``;
+   - white inside: from ``white_min_px`` across, where the letters are resolved, pixels with
+     S <= ``white_max_saturation`` and V >= ``min_value`` make at least ``min_white_fill`` of
+     the plate; smaller, the letters blur into pink and are not asked for.
 
-3. **Position**. The plate faces the traffic, so it stands about parallel to the image
-   plane of a forward camera and its apparent size gives the depth. The red field's
-   width in pixels comes from the plate's pixel count N (a count of pixel centres inside
-   the outline is an unbiased area, unlike the extremes of the contour, which lose a pixel
-   per side, and it averages over the whole outline, which matters at 7 px): the
-   octagon's area is ``OCTAGON_AREA_FACTOR`` (2 (sqrt 2 - 1) = 0.828) times its width
-   squared, so ``width_px = sqrt(N / 0.828)``. (A plate seen at an angle a is foreshortened
-   by cos a across, so its range comes out 1 / sqrt(cos a) too long: +2 % at 20 deg.) The
-   depth along the optical axis is ``X = fy STOP_FIELD_WIDTH / width_px``; the plate's
-   centroid (u, v) gives ``Y = -(u - cx) X / fx`` and ``Z = -(v - cy) X / fy`` in the
-   camera's frame, and the mount (position and yaw / pitch / roll) takes that to the
-   vehicle frame of the car's centre. ``range`` is the horizontal distance from the car's
-   centre. A plate whose centre then lies outside ``plate_height`` (1.0..4.0 m above the
-   ground) is not a sign: a red patch of a sign's apparent size but another true size sits
-   at the wrong depth, which puts it underground or in the air.
+3. **Position**: the plate faces the traffic, about parallel to a forward camera's image
+   plane, so its apparent size gives the depth. The red field's width comes from the plate's
+   pixel count N, an unbiased area that averages over the whole outline (the contour's
+   extremes lose a pixel per side): width_px = sqrt(N / `OCTAGON_AREA_FACTOR`). The depth
+   along the optical axis is X = fy `STOP_FIELD_WIDTH` / width_px; the centroid (u, v) gives
+   Y = -(u - cx) X / fx and Z = -(v - cy) X / fy in the camera frame, and the mount takes
+   them to the vehicle frame; ``range`` is the horizontal distance from the car's centre. A
+   plate seen at an angle a is foreshortened by cos a across, so its range comes out
+   1 / sqrt(cos a) too long. A plate centre outside ``plate_height`` above the ground is not a
+   sign: a red patch of a sign's apparent size but another true size sits at the wrong depth,
+   underground or in the air.
 
-4. **Confidence** in [0, 1]: the mean of a colour score (red fill), a shape score (extent
-   and solidity near the octagon's, the polygon's vertex count or the circularity) and the
-   white cue's (1 when the letters are seen, 0.5 when too small to tell), times a size
-   factor rising from 0.6 at ``min_size_px`` to 1 at ``polygon_min_px``.
+4. **Confidence** in [0, 1]: a size factor, rising from 0.6 at ``min_size_px`` to 1 at
+   ``polygon_min_px``, times the mean of a colour score (red fill / 0.85, at most 1), a shape
+   score and a letters score (1 when seen, 0.5 when too small to tell). The shape score is
+   the mean of 1 - |extent - `OCTAGON_AREA_FACTOR`| / 0.1 (at least 0), the solidity, and
+   the outline's score: 1 for 8 vertices, else 0.6; below ``polygon_min_px``, (circularity
+   - ``min_circularity``) / 0.1, at most 1.
 
-Measured (the default profile's 640 x 480 front camera, a straight road, the plate 4.75 m
-right of the car's centre, EGL and TinyRenderer): found from 8 m (nearer, it leaves the
-80 deg view) to 45 m (at 50 m it is 5 px across); range error within -3 .. +3 %, lateral
-within 0.2 m, height within 0.1 m; nothing found on a speed-limit sign, red NPC cars or a
-built-up roadside; ~0.8 ms per frame (0.7 ms without a sign), the HSV conversion most of it.
-
-`match_sign` (the same as `SignDetection.match`, which the planner can reach) moves a
-detection into the map frame with the ego's pose and takes the nearest map sign whose
-offset from it lies within ``tolerance`` (5 m) across the line of sight and within
-``tolerance + range_tolerance * range`` (15 % of the range more) along it: the apparent size
-gives the range to a few percent (a pixel of a 7 px plate is 14 %), the bearing much better.
+`match_sign` (`SignDetection.match`, which the planner can reach) moves a detection into the
+map frame with the ego's pose and takes the nearest map sign within ``tolerance`` across the
+line of sight and ``tolerance + range_tolerance * range`` along it: the apparent size gives
+the range to a few per cent (a pixel is much of a small plate's width), the bearing better.
 """
 
 from __future__ import annotations
@@ -105,31 +88,31 @@ UInt8Array = NDArray[np.uint8]
 
 @dataclass(frozen=True, slots=True)
 class StopSignParams:
-    """Thresholds of `StopSignDetector` (see the module docstring for each)."""
+    """Thresholds of `StopSignDetector`, by step of the module docstring."""
 
     # -- red mask, OpenCV 8-bit HSV: hue [2 deg units] 0..179, saturation and value 0..255
-    hue_low_max: int = 6
-    hue_high_min: int = 170
-    min_saturation: int = 100
-    min_value: int = 60
+    hue_low_max: int = 6  # [2 deg] top of the low red band (below brick facades' hue)
+    hue_high_min: int = 170  # [2 deg] bottom of the high red band (hue wraps at 180)
+    min_saturation: int = 100  # [0..255] anti-aliased edge pixels fall below: a true outline
+    min_value: int = 60  # [0..255] also the white letters' floor
     close_kernel: int = 3  # [px] square structuring element of the morphological close
     # -- size, from the intrinsics
     min_range: float = 3.0  # [m] nearest plate looked for (sets the largest blob)
     max_range: float = 50.0  # [m] farthest plate looked for (sets the smallest blob)
     # -- colour
-    core_saturation: int = 190
+    core_saturation: int = 190  # [0..255] the plate's red reaches it, a lit brick wall not
     min_red_fill: float = 0.6  # [-] red pixels / plate pixels
-    white_max_saturation: int = 80
+    white_max_saturation: int = 80  # [0..255] the white letters
     white_min_px: float = 14.0  # [px] blob size from which the letters are asked for
     min_white_fill: float = 0.02  # [-] white pixels / plate pixels
     # -- shape
     aspect: tuple[float, float] = (0.75, 1.33)  # [-] box width / height
-    min_solidity: float = 0.85
+    min_solidity: float = 0.85  # [-] contour area / convex hull area
     extent: tuple[float, float] = (0.70, 0.92)  # [-] plate pixels / box pixels
     polygon_min_px: float = 20.0  # [px] blob size from which the octagon's corners are sought
     polygon_epsilon: float = 0.025  # [-] approxPolyDP tolerance / hull perimeter
-    polygon_vertices: tuple[int, int] = (7, 9)
-    min_circularity: float = 0.80
+    polygon_vertices: tuple[int, int] = (7, 9)  # [-] inclusive band of the hull's polygon
+    min_circularity: float = 0.80  # [-] 4 pi A / P^2 of the hull (octagon 0.95, square 0.79)
     # -- position
     plate_height: tuple[float, float] = (1.0, 4.0)  # [m] plate centre above the ground
 

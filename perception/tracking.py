@@ -1,48 +1,46 @@
 """Multi-object tracking of LiDAR detections in the map frame.
 
-Input, every scan: the time ``t`` [s], the localiser's `EgoState` at ``t`` and the scan's
-`Detection` boxes (vehicle frame of the ego at ``t``). Output: the confirmed `Track`s.
+Input, every scan: the time t [s], the localiser's `EgoState` at t and the scan's `Detection`
+boxes (vehicle frame of the ego at t). Output: the confirmed `Track`s, by id.
 
 Model (one linear Kalman filter per track, filterpy's `KalmanFilter`):
 
-- state ``[x, y, vx, vy]`` [m, m, m/s, m/s] in the map frame (over ground: parked cars stand
-  still whatever the ego does), constant velocity: ``x' = x + vx dt``;
+- state [x, y, vx, vy] [m, m, m/s, m/s] in the map frame (over ground: parked cars stand
+  still whatever the ego does), constant velocity: x' = x + vx dt;
 - process noise: continuous white acceleration of spectral density ``accel_psd`` [m^2/s^3]
-  on each axis, ``Q = q [[dt^3/3, dt^2/2], [dt^2/2, dt]]`` per axis;
-- measurement: the box centre, converted to the map frame with the ego pose,
-  ``R = position_sigma^2 I`` (the box completion puts car centres within ~0.1-0.2 m; the
-  ego pose error is small next to that and is not added);
-- a new track starts at the detection with zero velocity and ``init_speed_sigma``
-  [m/s] velocity uncertainty.
+  on each axis, Q = q [[dt^3/3, dt^2/2], [dt^2/2, dt]] per axis;
+- measurement: the box centre, moved to the map frame with the ego pose, R =
+  ``position_sigma``^2 I (the box completion's centre error; the ego pose error is smaller
+  and is not added);
+- a new track starts at its detection with zero velocity, ``init_speed_sigma`` per axis.
 
 Steps of `MultiObjectTracker.update`:
 
-1. Predict every track to ``t``.
-2. Association: cost = Mahalanobis distance squared of each detection centre to each
-   track's predicted centre (innovation covariance ``S = H P H^T + R``); pairs beyond the
-   chi-square gate ``gate`` (9.21: 99 % for 2 degrees of freedom) are not allowed; the
-   assignment is `scipy.optimize.linear_sum_assignment` (global minimum of the summed
-   cost).
+1. Predict every track to t.
+2. Associate: the cost is the squared Mahalanobis distance of each detection's centre to
+   each track's predicted centre (S = H P H^T + R); pairs beyond the chi-square gate
+   ``gate`` are not allowed; `scipy.optimize.linear_sum_assignment` finds the least summed
+   cost.
 3. Update the matched tracks: the filter; the box size (exponential smoothing with weight
-   ``size_alpha``); the box heading (the same smoothing on the doubled angle, so that the
-   front/back ambiguity of a box does not matter); the class (majority vote over the
-   track's detections, ties to the most recent class).
-4. Track management. A track is born TENTATIVE from every unmatched detection and is
-   CONFIRMED once ``confirm_hits`` (3) of its first ``confirm_window`` (5) scans matched;
-   a tentative track that can no longer reach that is deleted. A confirmed track coasts
-   (predicted only) through misses and is deleted when it has not been matched for more
-   than ``max_coast`` (0.5 s: 5 scans at 10 Hz), or when it is farther than
-   ``max_distance`` (80 m) from the ego (no track is born there either). Ids are
+   ``size_alpha``); the box heading (the same smoothing on the doubled angle, so that a box's
+   front/back ambiguity does not matter); the class (majority vote over the track's
+   detections, ties to the most recent class, then to the enum's order).
+4. Manage: a track is CONFIRMED once ``confirm_hits`` of its first ``confirm_window`` scans
+   matched; a tentative track that can no longer reach that is deleted. A confirmed track
+   coasts (predicted only) through misses and is deleted once unmatched for more than
+   ``max_coast``. A track farther than ``max_distance`` from the ego is deleted. Then every
+   unmatched detection within ``max_distance`` of the ego starts a TENTATIVE track. Ids are
    consecutive integers from 1, never reused.
 5. Output: the confirmed tracks (coasting ones included, with ``misses`` > 0), by id. The
    yaw is the smoothed box heading (map frame); when the track moves faster than
    ``heading_min_speed`` it is the one of the two box directions closer to the velocity.
    ``rel_x, rel_y`` are the centre in the ego's vehicle frame; ``rel_vx, rel_vy`` the
-   object's velocity minus the ego's (``ego.speed`` along ``ego.heading``), rotated into
-   the vehicle frame (the rotation of the frame itself, ``yaw_rate x r``, is not included).
+   object's velocity minus the ego's (``ego.speed`` along ``ego.heading``), rotated into the
+   vehicle frame (the frame's own rotation, yaw_rate x r, is not included);
+   ``position_sigma`` is the square root of the position covariance's largest eigenvalue.
 
-Everything is deterministic: no random numbers; tracks are kept and processed by id,
-detections in the order given.
+Deterministic: no random numbers; tracks are kept and processed by id, detections in the
+order given.
 """
 
 from __future__ import annotations
@@ -115,7 +113,7 @@ class MapDetection:
     length: float  # [m]
     width: float  # [m]
     height: float  # [m]
-    cls: ObjectClass
+    cls: ObjectClass  # the detection's class
 
 
 def to_map(det: Detection, ego: EgoState) -> MapDetection:
