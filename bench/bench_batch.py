@@ -35,7 +35,7 @@ from avsim.batch.suite import comparable, plan
 
 SCENARIO = "cut_in_out"
 GAPS = (20, 40)  # [m] the cut-in trigger gap
-CUTTER_KPH = (30, 45)  # [km/h] the cutter's speed (the ego drives at 60)
+CUTTER_KPH = (30, 45)  # [km/h] the cutter's speed (the ego's set speed is 60 km/h)
 
 
 def batch(out: Path, seconds: float, profile: str) -> list[RunJob]:
@@ -61,6 +61,8 @@ def _children_cpu() -> float:
 
 def figures(wall: float, cpu: float, outcomes: list[RunOutcome],
             local: bool) -> dict[str, float]:
+    """The batch's figures (module doc) from its wall and CPU times [s] and its outcomes;
+    cores busy only for a `local` executor (NaN otherwise)."""
     sim = sum(o.sim_time for o in outcomes)
     overhead = [o.wall_time - o.run_time for o in outcomes if o.result is not None]
     return {"wall_s": wall, "runs_per_min": 60.0 * len(outcomes) / wall,

@@ -1,8 +1,8 @@
 """Per-call cost of the hot parts of the loop, in microseconds (best of several batches).
 
-These are the budgets the real-time factor rests on; they were timed tests once, but these
-machines are shared and noisy, so they live here and are reported, not asserted:
-- map projection of 4 points on a ~12-piece road (criteria / log / triggers, 40 Hz);
+These are the budgets the real-time factor rests on. They are reported, not asserted: the
+machines are shared and noisy.
+- map projection of 4 points on a 12-segment road (criteria / log / triggers, 40 Hz);
 - the speed planner's target on normal_driving (40 Hz);
 - stepping and placing the NPCs of normal_driving (120 Hz);
 - the recorder: ego pose + 5 scalars + 3 actor boxes per 40 Hz tick, flushes included.

@@ -52,7 +52,7 @@ def stack_rtf(record: bool) -> tuple[float, RunResult]:
     scenario = load_scenario(SCENARIO)
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp) / "bench.rrd" if record else None
-        runner = Runner(scenario, out, profile=None)  # issue A: no cameras or LiDAR
+        runner = Runner(scenario, out, profile=None)  # no cameras or LiDAR: map + GNSS only
         start = time.perf_counter()
         result = runner.run()
         wall = time.perf_counter() - start

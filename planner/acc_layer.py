@@ -1,15 +1,22 @@
-"""The ACC / event layer in the planner: the mode FSM (`planner.fsm.acc`) fed from the map and
-the lead track, and the mode's controller (`planner.acc_control`) giving the target speed.
+"""The ACC / event layer in the planner: the mode FSM (`planner.fsm.acc`) fed from the map,
+the events and the lead track, and the mode's law (`planner.acc_control`) giving the target
+speed [m/s] and feed-forward acceleration [m/s^2].
 
-Per tick: the lead's gap is carried from its track's time to now with the relative speed
-(``d_now = d + (V_l - v) (t - t_track)``: tracks are one sensor period old); V_GPS is the
-posted limit at the front bumper; V_s the set speed. The FSM steps once; the mode's law gives
-the speed reference, never above the map's plan. The events (`planner.events`) enter the
-event modes; their laws (`planner.acc_control`): OFF_RAMP the map's plan (the ramp's limit
-is a posting), STOP_SIGN and PEDESTRIAN a stop at the event's stop point, SPEED_BUMP the
-pass speed at the bump, FLAT down at ``a_flat_plan`` to ``v_pull_over`` while the car pulls
-over, then to a stop on the shoulder. A vehicle ahead still counts in an
-event mode: the reference is the lower of the event's law and the trail law behind it.
+Per tick:
+
+1. the lead's bumper gap is carried from its track's time t_track to now with the relative
+   speed, ``d_now = d + (V_l - v) (t - t_track)`` (tracks are one sensor period old);
+   V_GPS is the posted limit at the front bumper, V_s the set speed (ACC is on while
+   V_s > 0);
+2. the FSM steps once;
+3. the mode's law gives the reference: ACC_OFF 0; CRUISE and SPEED_LIMIT the speed plan;
+   TRAIL and BRAKE their laws behind the lead; OFF_RAMP the speed plan (the ramp's limit
+   is a posting); STOP_SIGN, PEDESTRIAN, RED_LIGHT and YIELD a stop at the events' stop
+   point; SPEED_BUMP the pass speed at the bump; FLAT down at ``a_flat_plan`` to
+   ``v_pull_over`` while the car pulls over, then to a stop on the shoulder. A vehicle
+   ahead still counts in an event mode: the reference is the lower of the event's law and
+   the trail law behind it. The plan's `SpeedSource` is the law's where it lowers the
+   speed plan (FLAT's always), the plan's own otherwise.
 """
 
 from __future__ import annotations
@@ -40,8 +47,8 @@ EVENT_LAWS = frozenset({AccMode.OFF_RAMP, AccMode.SPEED_BUMP, AccMode.FLAT}) | S
 
 @dataclass(frozen=True, slots=True)
 class AccLayerParams:
-    modes: AccParams = field(default_factory=AccParams)
-    control: AccControlParams = field(default_factory=AccControlParams)
+    modes: AccParams = field(default_factory=AccParams)  # the mode FSM's gaps
+    control: AccControlParams = field(default_factory=AccControlParams)  # the modes' laws
 
 
 @dataclass(frozen=True, slots=True)
@@ -70,9 +77,11 @@ class AccLayer:
                events: Events = NO_EVENTS) -> tuple[AccOutput, tuple[StateChange, ...]]:
         """The speed reference now and the mode change made, if any.
 
-        `v` ego speed, `limit` the posted limit at the front bumper (V_GPS), `plan` the map's
-        speed plan (set speed, limits, curves) [m/s]. `driver_gap` [m]: the driver's pedal
-        overrides, and the trail law may close up to d_min + this instead of d_des."""
+        `t` now and `dt` since the last tick [s]; `v` ego speed, `set_speed` (V_s, 0: ACC
+        off), `limit` the posted limit at the front bumper (V_GPS) [m/s]; `plan` the speed
+        plan so far (the map's, after the driver's pedal); `lead` from its track; `events`
+        the events now. `driver_gap` [m]: the driver's pedal overrides, and TRAIL and BRAKE
+        may close up to d_min + this instead of d_des."""
         d, v_l = (lead.gap + (lead.speed - v) * max(t - lead.t, 0.0), lead.speed) \
             if lead is not None else (math.inf, math.inf)
         x = AccInput(acc_on=set_speed > 0.0, v=v, v_s=set_speed, v_gps=limit, d=d, v_l=v_l,

@@ -1,7 +1,9 @@
 """The lane-keeping path from the camera's lane estimate (ICCAS Fig. 4a).
 
-The estimate is the lane centre in the vehicle frame at the camera frame's time, y(x) =
--offset - tan(heading_error) x + curvature x^2 / 2. The stack's pose estimate AT THAT TIME
+The estimate is the lane centre in the vehicle frame (x forward, y left, [m]) at the camera
+frame's time, y(x) = -offset - tan(heading_error) x + curvature x^2 / 2. The path samples
+it every ``spacing`` metres of x, with heading ``pose.heading + atan(y'(x))`` [rad] and
+curvature ``curvature / (1 + y'^2)^1.5`` [1/m]. The stack's pose estimate AT THAT TIME
 places it in the map frame, so the path stays where the lane is while the car moves on
 (the frame is one sensor period old when it arrives): the lateral reference is the camera's,
 the pose estimate only carries it over the car's own motion since the frame.

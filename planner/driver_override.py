@@ -3,9 +3,8 @@ disturbance, "an external acceleration command issued by a gas pedal or a contro
 
 The car is drive-by-wire: the pedal position p in [0, 1] is a vehicle signal the stack reads
 with the odometry, and it adds no torque by itself. It asks for an acceleration
-``a_drv = p * a_full`` (a_full 3 m/s^2, about a mid-size car's full-throttle acceleration at
-town speeds). Above ``threshold`` the driver overrides the cruise set speed, and the
-reference becomes
+``a_drv = p * a_full`` [m/s^2]. Above ``threshold`` the driver overrides the cruise set
+speed, and the reference [m/s] and feed-forward [m/s^2] become
 
     v_ref = min(v_cap, v + a_drv * horizon)
     a_ff  = min(a_drv, max(v_cap - v, 0) / tau)      (a_ff = the envelope's while it brakes)
@@ -16,8 +15,8 @@ the speed up to the limit and never past it, and the feed-forward fades over the
 ``tau * a_drv`` m/s so that the car reaches the limit without overshoot. The ACC layer keeps
 its modes and laws on top of this reference, with the driver's shorter gap: it lets the
 pedal close up on a lead to ``d_min + gap_margin``, never to d_min (`planner.acc_layer`).
-When the pedal is released above the set speed, the reference comes back down to the plan
-at ``a_release`` (1 m/s^2), not in a step.
+When the pedal is released above the plan's speed, the reference comes back down to the
+plan at ``a_release``, not in a step.
 """
 
 from __future__ import annotations
@@ -33,7 +32,8 @@ from planner.speed_planning import SpeedTarget
 @dataclass(frozen=True, slots=True)
 class OverrideParams:
     threshold: float = 0.05  # [-] pedal positions above this override the set speed
-    a_full: float = 3.0  # [m/s^2] the acceleration the full pedal asks for
+    a_full: float = 3.0  # [m/s^2] the acceleration the full pedal asks for (about a mid-size
+    #   car's full-throttle acceleration at town speeds)
     horizon: float = 0.5  # [s] the reference leads the speed by a_drv * horizon
     tau: float = 1.0  # [s] the feed-forward fades within a_drv * tau of the limit
     gap_margin: float = 2.0  # [m] following, the driver may close up to d_min + this
@@ -41,6 +41,7 @@ class OverrideParams:
 
 
 def overriding(pedal: float, p: OverrideParams) -> bool:
+    """Whether pedal position `pedal` [-] overrides the set speed."""
     return pedal > p.threshold
 
 
@@ -68,7 +69,8 @@ class DriverOverride:
     def update(self, pedal: float, v: float, plan: PlannedSpeed,
                cap: Callable[[], SpeedTarget], dt: float) -> tuple[PlannedSpeed, bool]:
         """The reference in place of `plan` (the map's at the set speed) and whether the
-        driver overrides now; `cap()` gives the envelope at the vehicle's maximum speed."""
+        driver overrides now, for pedal position `pedal` [-], speed `v` [m/s] and `dt` [s]
+        since the last tick; `cap()` gives the envelope at the vehicle's maximum speed."""
         p = self.params
         if overriding(pedal, p):
             ref = override_reference(pedal, v, cap(), p)

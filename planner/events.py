@@ -1,23 +1,26 @@
 """The DECS events for the ACC layer, from the HD map and what perception found: the exit
 ramp, a stop sign, a pedestrian at a crosswalk, a speed bump, a flat tyre.
 
-Each tick (stations along the route; the car's front bumper f, front axle a_f, rear axle a_r):
+Positions are stations [m] along the route's reference line (the car's centre s, its front
+bumper f, its axles); tracks are in the map frame. Each tick
+(`EventMonitor.update`, parameters `EventParams`):
 
 - off_ramp: the car's centre is on a segment of zone `ramp` (the paper's [Off_Ramp]).
-- stop_sign: the next stop line of the map ahead, at L, once perception has confirmed its
-  sign (`see_signs`: the camera's stop sign, placed on the map, near the line), from
-  ``approach(v)`` before it until the car has stood (below ``stopped_speed``) for
-  ``stop_hold`` with its front bumper 0 to 4 m before the line; then the line is done
-  until the car has passed it. The car aims to stand ``stop_margin`` +
-  the controller's margin before the line (`stop_distance` = L - f - stop_margin).
-- pedestrian: a crosswalk ahead (from ``approach(v)`` before it, while the front bumper has
-  not reached it) with a pedestrian track on it or within ``crossing_margin`` of it along
-  the route, whose centre is, or will be within ``look_ahead`` at its velocity, inside the
-  lane kept widened by ``lane_margin`` on each side; the car stops ``crossing_stop`` before
-  the zebra and waits until it is clear.
-- speed_bump: from ``approach(v)`` before a bump's near edge until the rear axle is
-  ``bump_margin`` past its far edge; the speed at the bump is its pass speed less
-  ``bump_undershoot``, reached ``bump_margin`` before the near edge by the front axle.
+- stop_sign: the next stop line L of the map ahead, once perception has confirmed its sign
+  (`see_signs`: a camera stop sign, placed on the map, near the line and right of the
+  route), from ``approach(v)`` before it until the car has stood (below ``stopped_speed``)
+  for ``stop_hold`` with its front bumper 0 to ``stop_zone`` before the line; the line is
+  then done until the front bumper is past it. The car aims to stand ``stop_margin`` plus
+  the law's margin before the line (`stop_distance` = L - f - stop_margin).
+- pedestrian: the next crosswalk ahead, from ``approach(v)`` before it while the front
+  bumper has not reached it, with a pedestrian track on it or within ``crossing_margin`` of
+  it along the route whose centre is inside the lane kept widened by ``lane_margin`` on each
+  side, now or ``look_ahead`` ahead at its velocity, or crosses the lane's centre line in
+  between; the car stops ``crossing_stop`` before the crosswalk and waits until it is clear.
+- speed_bump: from ``approach(v)`` before a bump's near edge (front axle) until the rear
+  axle is ``bump_margin`` past its far edge; the speed at the bump is its pass speed less
+  ``bump_undershoot`` (at least 0.5 m/s), to be reached by the front axle ``bump_margin``
+  before the near edge.
 - flat: a flat tyre detected from the car's own signals; pulled_over once the motion layer
   has brought the car onto the shoulder.
 
@@ -43,16 +46,17 @@ from world.hdmap import Crosswalk, RoadMap, SpeedBump, StopSign, Zone
 @dataclass(frozen=True, slots=True)
 class EventParams:
     a_comf: float = A_COMF  # [m/s^2] approach braking
-    approach_extra: float = 30.0  # [m]
-    stop_margin: float = 0.5  # [m] stop this much (+ the controller's margin) before a line
-    stopped_speed: float = 0.1  # [m/s]
+    approach_extra: float = 30.0  # [m] added to the braking distance: room to settle
+    stop_margin: float = 0.5  # [m] stop this much (+ the law's margin) before a line
+    stopped_speed: float = 0.1  # [m/s] below this the car stands at a stop line
     stop_hold: float = 1.5  # [s] standing this long at the line completes the stop
     stop_zone: float = 4.0  # [m] the front bumper within this before the line counts
     crossing_margin: float = 1.0  # [m] along the route, a pedestrian this near counts
-    lane_margin: float = 1.5  # [m] across, beyond the lane's edges
+    lane_margin: float = 1.5  # [m] across, a pedestrian this far beyond the lane's edges counts
     look_ahead: float = 2.0  # [s] a pedestrian walking into the lane within this counts
-    crossing_stop: float = 1.0  # [m] stop this much (+ the controller's margin) before it
-    bump_margin: float = 1.0  # [m] the criterion's reach around a bump
+    crossing_stop: float = 1.0  # [m] stop this much (+ the law's margin) before a crosswalk
+    bump_margin: float = 1.0  # [m] pass speed from this before a bump to this past it (the
+    #   speed_bumps criterion's reach)
     bump_undershoot: float = 0.5 / 3.6  # [m/s] aim this far below the pass speed
     sign_match: float = 5.0  # [m] a seen sign this near a stop line (along) is its sign
 
@@ -65,7 +69,7 @@ class Events:
     pulled_over: bool = False  # on the shoulder, the pull-over done (a flat tyre's stop)
     stop_distance: float = math.inf  # [m] front bumper to where the car must stand
     bump_distance: float = math.inf  # [m] front axle to where it must be at bump_speed
-    bump_speed: float = math.inf  # [m/s]
+    bump_speed: float = math.inf  # [m/s] the speed to cross the bump at
 
     def holds(self, event: AccEvent) -> bool:
         """Whether `event` holds now."""
@@ -93,8 +97,8 @@ class EventMonitor:
 
     def see_signs(self, signs: Sequence[SignDetection], pose: EgoState) -> None:
         """Match the camera's stop signs (vehicle frame at `pose`, the pose the frame was
-        taken in) with the map's: a sign whose station is within ``sign_match`` (or 20 % of
-        its range) of a stop line, right of the route, confirms that line."""
+        taken in) with the map's: a sign right of the route whose station is within the larger
+        of ``sign_match`` and 20 % of its range [m] of a stop line confirms that line."""
         p = self.params
         c, s = math.cos(pose.heading), math.sin(pose.heading)
         for d in signs:
@@ -110,8 +114,10 @@ class EventMonitor:
     def update(self, t: float, station: float, v: float, lane_offset: float, lane_width: float,
                tracks: Sequence[Track] = (), flat: bool = False,
                pulled_over: bool = False) -> Events:
-        """`station` [m] of the car's centre, `lane_offset` [m] of the lane kept's centre from
-        the reference line there, `tracks` the confirmed tracks."""
+        """The events at time `t` [s] for the car's centre at `station` [m] with speed `v`
+        [m/s]; `lane_offset` [m] of the lane kept's centre from the reference line there
+        (left +) and its `lane_width` [m]; `tracks` the confirmed tracks (map frame); `flat`
+        a flat tyre detected, `pulled_over` the car on the shoulder."""
         p = self.params
         front = station + self.vehicle.front_overhang
         approach = v * v / (2.0 * p.a_comf) + p.approach_extra

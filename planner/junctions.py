@@ -2,44 +2,49 @@
 
 The HD map lists the route's junctions (`RoadMap.junctions`: stop line, where the turn
 starts and ends, the manoeuvre, the control) and the route's traffic lights (their stop
-lines and where their heads stand). Each tick, for the car's front bumper f (stations
-along the route):
+lines and where their heads stand). Positions are stations [m] along the route (the car's
+front bumper f, a stop line L); tracks and the junction box are in the map frame. Each tick
+(`JunctionMonitor.update`, parameters `JunctionParams`):
 
-**Traffic lights.** The next light whose stop line L the front has not crossed, once
-within ``approach(v)`` (as `planner.events`). Its colour is the camera's
-(`see_lights`, `perception.lights`), if seen within ``light_memory``; red and yellow count
-from one frame, green (it lets the car go) from two in a row:
+**Traffic lights** (event ``red_light``): the next light whose stop line L the front has not
+crossed, once within ``approach(v)`` (as `planner.events`). Its colour is the camera's
+(`see_lights`, `perception.lights`) if seen within ``light_memory``; red and yellow count
+from one frame, green (which lets the car go) from two in a row within
+``green_frames_gap``. The car stops, by the ACC's stop law at ``L - f - stop_margin``:
 
-- green: go;
-- yellow: decided once, when first seen: stop if the car can stop before the line at
-  ``yellow_decel`` (3 m/s^2: v^2 / (2 (L - f - stop_margin)) <= yellow_decel), else go
-  on (it then crosses the line well within the yellow phase: from the braking distance
-  at 3 m/s^2 at 11 m/s, 20 m, it needs 1.8 s of a 3 s yellow);
-- red: stop, unless the front is already over the line;
-- not seen (or not lately): stop as for red, from the distance the car needs to stop at
-  ``yellow_decel`` plus ``unseen_margin`` on (and from then on, while it stays unread): a
-  light the camera cannot read is not driven through, and one it reads in time costs
-  nothing. The yellow rule's deceleration, not ``a_comf``, because the camera looks for a
-  light from 60 m before its stop line (`perception.lights`): at ``a_comf`` a car at 50 km/h
-  would begin to brake 69 m out, before it could see any light; at 3 m/s^2 it is 37 m, and
-  the car reads a light before it must brake for it up to 65 km/h.
+- for red, unless it decided to go on this light's yellow;
+- for yellow, if it can still stop before the line at ``yellow_decel``
+  (v^2 <= 2 yellow_decel (L - f - stop_margin)), checked each tick; once it cannot, it goes
+  on and keeps to that until the light is seen green (it is then near enough to clear the
+  line within the yellow phase);
+- for an unread light (not seen, or not lately), from the distance it needs to stop at
+  ``yellow_decel`` plus ``unseen_margin``: a light the camera cannot read is not driven
+  through, and one it reads in time costs nothing. Not at ``a_comf``: the camera reads a
+  light only from a fixed distance before its stop line (`perception.lights`), and at town
+  speeds the braking distance at ``a_comf`` reaches beyond it: the car would brake for
+  lights it has not yet had the chance to read.
 
-The stop is the ACC layer's stop law at ``L - f - stop_margin`` (event ``red_light``).
+Once stopping for a light, the car stops until the camera sees it green (or it decides to
+go on its yellow): a missed frame or the colour's memory running out does not let it go.
 
-**Giving way** (event ``give_way``, a stop at the same line). Before a left turn or a
-U-turn, at a junction of any control: an oncoming vehicle track (on the far arm of the
-street, in the lanes heading towards the car, ``oncoming_reach`` out) that will reach the
-box within ``gap_time`` (6 s, a common critical gap for a left turn from a standstill plus
-margin) at its speed towards it, or stands within ``near_box`` of it (at its stop line: it
-goes when the light turns green, as the car's does), or any vehicle track inside the box
-that is not moving the car's way. At a stop-sign junction, also for going straight or
-turning right: a vehicle track inside the box, not moving the car's way. The car waits at
-the line. Like the yellow rule, the decision to give way is taken while the car can still
-stop before the line at ``commit_decel``: once it is moving (faster than ``moving``) and
-cannot (v^2 > 2 commit_decel (L - f - stop_margin)) without having been waiting, or once
-its front is over the line, it is committed to the junction and goes on (the control FSM's
-emergency stop still covers a vehicle in its path). A gap that closes after that point is
-not chased with a stop the car cannot make.
+**Giving way** (event ``give_way``, a stop at the junction's stop line L). The car waits at
+the line:
+
+- before a left turn or a U-turn, at a junction of any control: for an oncoming vehicle
+  track (on the far arm, in the lanes heading towards the car, up to ``oncoming_reach``
+  beyond the box) that will reach the box within ``gap_time`` at its speed towards it, or
+  is within ``near_box`` of it whatever its speed (e.g. at its own stop line, about to go
+  when the light turns green, as the car's does), or for any vehicle track inside the box
+  that is not moving the car's way;
+- at a stop-sign junction, also going straight or turning right: for a vehicle track inside
+  the box that is not moving the car's way.
+
+Like the yellow rule, the decision to give way is taken only while the car can still stop
+before the line at ``commit_decel``: once it is moving (faster than ``moving``) and cannot
+(v^2 > 2 commit_decel (L - f - stop_margin)) without already waiting, or once its front is
+over the line, it is committed to the junction and goes on (the control FSM's emergency
+stop still covers a vehicle in its path). A gap that closes after that point is not chased
+with a stop the car cannot make.
 """
 
 from __future__ import annotations
@@ -66,17 +71,18 @@ from world.hdmap import (
 @dataclass(frozen=True, slots=True)
 class JunctionParams:
     a_comf: float = A_COMF  # [m/s^2] approach braking
-    approach_extra: float = 30.0  # [m]
-    stop_margin: float = 0.5  # [m] stop this much (+ the controller's margin) before a line
+    approach_extra: float = 30.0  # [m] added to the braking distance: room to settle
+    stop_margin: float = 0.5  # [m] stop this much (+ the law's margin) before a line
     light_memory: float = 1.0  # [s] a light's colour is trusted this long after it was seen
     green_frames_gap: float = 0.25  # [s] two green frames this close confirm green
     yellow_decel: float = A_FIRM  # [m/s^2] the yellow rule's "can stop" deceleration
     unseen_margin: float = 5.0  # [m] an unread light is stopped for from this + braking
     gap_time: float = 6.0  # [s] an oncoming vehicle nearer than this in time is waited for
+    #   (a left turn's critical gap from a standstill, plus margin)
     commit_decel: float = A_FIRM  # [m/s^2] past where it could stop at this, it goes on
     oncoming_reach: float = 100.0  # [m] how far out along the far arm oncoming traffic counts
-    moving: float = 0.5  # [m/s] slower than this towards the box: not coming ...
-    near_box: float = 12.0  # [m] ... unless this near it (about to go: a light turning green)
+    moving: float = 0.5  # [m/s] slower than this, a track (or the ego) is not moving
+    near_box: float = 12.0  # [m] an oncoming track this near the box counts, moving or not
     same_way: float = 0.7  # [-] cos of the angle within which a track moves the car's way
 
 
@@ -129,6 +135,8 @@ class JunctionMonitor:
 
     def update(self, t: float, station: float, v: float,
                tracks: Sequence[Track] = ()) -> JunctionEvents:
+        """The junction events at time `t` [s] for the car's centre at `station` [m] with
+        speed `v` [m/s]; `tracks` the confirmed tracks (map frame)."""
         p = self.params
         front = station + self.vehicle.front_overhang
         approach = v * v / (2.0 * p.a_comf) + p.approach_extra

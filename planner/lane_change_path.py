@@ -21,14 +21,12 @@ its peak is at an end, in closed form (``dr = -r0`` the lateral distance to cove
     r''(s0)     = (6 dr - 4 L m0) / L^2,    r''(s0 + L) = (-6 dr + 2 L m0) / L^2,
     a_peak      = v^2 max(|6 dr - 4 L m0|, |6 dr - 2 L m0|) / L^2.
 
-From parallel (m0 = 0) and above the floor, ``a_peak = 6 |dr| / T^2``: a 3.5 m change at
-``a_lat_design`` = 0.85 m/s^2 needs T >= 4.97 s. The duration T is the smallest on a grid
-(``T_STEP`` = 0.05 s) from ``t_min`` whose ``a_peak`` <= ``a_lat_design``. Lateral
-acceleration wins over duration: if no T up to ``t_max`` meets it, the grid goes on up to
-the hard cap ``t_cap``, and if even that fails, T = ``t_cap`` and the peak exceeds the design
-value (check `peak_lateral_accel`). Design margin: 0.85 against the 1 m/s^2 acceptance leaves
-room for the controller's tracking. The curvature of the path steps by ``r''`` at both ends
-of the cubic (a cubic Hermite has no end-curvature conditions).
+From parallel (m0 = 0) and above the floor, ``a_peak = 6 |dr| / T^2``. The duration T is
+the smallest on a grid (step ``T_STEP``) from ``t_min`` whose ``a_peak`` <= ``a_lat_design``.
+Lateral acceleration wins over duration: the grid goes on past the nominal longest change
+``t_max`` up to the hard cap ``t_cap``, and if even that fails, T = ``t_cap`` and the peak
+exceeds the design value (check `peak_lateral_accel`). The curvature of the path steps by
+``r''`` at both ends of the cubic (a cubic Hermite has no end-curvature conditions).
 
 Small-offset approximation: station metres are taken as path metres, and the scale
 ``(1 - k r)`` of curves offset from the lane's centre is ignored: the heading is
@@ -54,8 +52,9 @@ T_STEP = 0.05  # [s] grid of the duration search
 @dataclass(frozen=True, slots=True)
 class LaneChangeParams:
     a_lat_design: float = 0.85  # [m/s^2] peak lateral acceleration of the planned path
+    #   (below the acceptance: room for the controller's tracking)
     t_min: float = 3.0  # [s] shortest lane change
-    t_max: float = 5.0  # [s] nominal longest lane change
+    t_max: float = 5.0  # [s] nominal longest lane change; the search goes past it if needed
     t_cap: float = 8.0  # [s] hard cap when the acceleration needs more than t_max
     min_length: float = 15.0  # [m] shortest path, for low speeds
 

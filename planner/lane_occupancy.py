@@ -1,18 +1,20 @@
 """Which lanes are taken, from the tracks and the HD map: the motion FSM's view of the side.
 
-Each confirmed track is placed on the map (its box centre projected onto the route's
-reference line) and counted in every lane its box overlaps by at least ``overlap`` across.
-Per lane, the nearest vehicle ahead of the ego and the nearest behind it give bumper gaps
-along the route (stations, carried from the track's time to now at the relative speed) and
-speeds along the route.
+Each confirmed track (map frame) is placed on the map (its box centre projected onto the
+route's reference line: station [m], offset [m], left +) and counted in every lane its box
+overlaps by at least ``overlap`` across. Per lane, the nearest vehicle ahead of the ego and
+the nearest behind it give bumper gaps [m] along the route (stations, carried from the
+track's time to now at the relative speed) and speeds [m/s] along the route; a box that
+overlaps the ego's along the route is alongside.
 
 A lane is *free* for the ego to move into when nothing is alongside and
 
 - ahead: gap >= d_min(v) + max(v - V_ahead, 0) * ``front_time`` (UN R157's minimum gap, plus
   the closing during the change);
-- behind: gap >= dv * t_B + dv^2 / (2 a_rear) + v * t_G with dv = max(V_behind - v, 0): UN R157
-  (5.2.5) asks that an approaching vehicle need not brake harder than a_rear = 3 m/s^2 after
-  t_B = 0.4 s, and keeps a time gap t_G = 1 s behind the ego at the end.
+- behind: gap >= dv * t_B + dv^2 / (2 a_rear) + v * t_G with dv = max(V_behind - v, 0): UN
+  R157 (5.2.5) asks that an approaching vehicle need not brake harder than a_rear after a
+  reaction time t_B, and keep a time gap t_G behind the ego at the end (the parameters'
+  defaults are R157's values).
 
 The ego's own lane is *blocked* when the vehicle ahead in it moves slower than the speed
 the ego wants by more than ``block_margin`` and is within the ACC's d_max (the gap inside
@@ -47,7 +49,7 @@ class OccupancyParams:
 class Neighbour:
     """A vehicle in a lane, relative to the ego."""
 
-    track_id: int
+    track_id: int  # the track's id
     t: float  # [s] the track's time
     gap: float  # [m] bumper to bumper along the route, now
     speed: float  # [m/s] along the route
@@ -55,7 +57,7 @@ class Neighbour:
 
 @dataclass(frozen=True, slots=True)
 class LaneTraffic:
-    lane: int
+    lane: int  # [-] ego-direction lane index
     ahead: Neighbour | None = None  # nearest vehicle ahead
     behind: Neighbour | None = None  # nearest vehicle behind
     alongside: bool = False  # a vehicle overlapping the ego along the route

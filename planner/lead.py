@@ -1,13 +1,15 @@
 """The vehicle ahead in the ego's lane, from the LiDAR tracks (the ACC layer's d and V_l).
 
-The lead is the nearest confirmed track ahead whose centre lies within ``half_width`` of the
-ego lane's centre line (the camera's lane when it is seen, else straight ahead); its gap is
-bumper to bumper along the ego's heading, its speed the track's over ground along the ego's
-heading (>= 0), both at the track's time.
+`select_lead`: the lead is the nearest confirmed track ahead (vehicle frame of the track's
+time, x forward, y left; not of class OTHER) whose centre lies within ``half_width`` of the
+ego lane's centre line (the camera's lane when it is the path, else straight ahead); its
+gap [m] is bumper to bumper along the ego's heading, its speed [m/s] the track's over
+ground along the ego's heading (>= 0), both at the track's time.
 
-Through a town junction the lane is the map's turn path (`route_lead`): the lead is the
-nearest track ahead along the map lane kept whose centre is within ``half_width`` of it;
-its gap is along the lane, its speed along the lane's heading where it is.
+`route_lead`, through a town junction, where the lane is the map's turn path: the lead is
+the nearest track (map frame) up to ``path_reach`` ahead along the map lane kept whose
+centre is within ``half_width`` of it; its gap is along the lane, its speed along the
+lane's heading where it is.
 """
 
 from __future__ import annotations

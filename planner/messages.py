@@ -53,10 +53,11 @@ class ReferencePath:
 class Lead:
     """The vehicle ahead in the ego's lane, as the tracks show it."""
 
-    track_id: int
+    track_id: int  # the track's id
     t: float  # [s] time of the track it comes from
-    gap: float  # [m] ego front bumper to the lead's rear, along the ego's heading
-    speed: float  # [m/s] the lead's speed over ground along the ego's heading
+    gap: float  # [m] ego front bumper to the lead's rear, along the ego's heading (along the
+    #   route or the map lane during a lane change or through a junction)
+    speed: float  # [m/s] the lead's speed over ground along that same direction, >= 0
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -65,16 +66,16 @@ class Plan:
     ego: EgoState  # the estimate the plan was made from
     path: ReferencePath  # the path to follow (map frame)
     target_speed: float  # [m/s] speed to hold now
-    target_accel: float  # [m/s^2] feed-forward acceleration, signed (< 0 braking ahead of a limit)
+    target_accel: float  # [m/s^2] feed-forward acceleration, signed (< 0: braking)
     speed_limit: float  # [m/s] posted limit in force at the front bumper
     station: float  # [m] the ego's station on the route (from the map and its own estimate)
-    lateral_error: float  # [m] the planner's view of the ego's offset from the path, left +
+    lateral_error: float  # [m] the ego's offset from the lane kept's map centre line, left +
     lane_source: LaneSource = LaneSource.ACQUIRING  # where the path comes from
     lead: Lead | None = None  # the vehicle ahead in the lane, if a track shows one
     acc_mode: AccMode = AccMode.ACC_OFF  # the ACC / event layer's mode
     motion: Motion = Motion.LANE_KEEP  # the motion FSM's state
-    lane: int = 0  # the lane kept, or moved into by a lane change
-    origin_lane: int = 0  # the lane a lane change in hand leaves (== lane otherwise)
+    lane: int = 0  # [-] the lane kept, or moved into by a lane change (ego-direction index)
+    origin_lane: int = 0  # [-] the lane a lane change in hand leaves (== lane otherwise)
     control: ControlState = ControlState.SPEED_KEEPING  # the control FSM's state
     hazard: HazardLights = HazardLights.OFF  # on from a flat tyre's detection
     speed_source: SpeedSource = SpeedSource.SET_SPEED  # what set `target_speed`

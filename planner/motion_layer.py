@@ -1,22 +1,34 @@
 """The motion FSM in the planner: lane occupancy in, the lane to keep and the path out.
 
-Per tick: the tracks are placed in the ego's lane and its neighbours
-(`planner.lane_occupancy`); the ego lane is *blocked* once a slower vehicle has blocked it for
-``blocked_time``; the motion FSM (`planner.fsm.motion`) steps once. Entering a lane change makes
-the target lane the lane kept (its speed plan and, once done, its camera lane) and plans the
-Hermite path into it from the car's pose (`planner.lane_change_path`); the change is done
-when the car reaches the path's end. An abort plans the same kind of path back to the origin
-lane, followed in LANE_KEEP until its end.
+Positions are stations s [m] along the route's reference line and lateral offsets d [m]
+from it (left +); lanes are ego-direction lane indices (0 rightmost, `SHOULDER` the paved
+shoulder). Per tick:
 
-While the car changes lanes, the vehicles ahead in the target lane and, until the car's
-centre has crossed into the target lane, in the origin lane are both leads for the ACC
-(`leads`): the car does not run into the vehicle it is leaving.
+1. the tracks are placed in the lane kept, the origin lane and the neighbours that go on
+   for a whole change (`planner.lane_occupancy`), and the shoulder when a flat tyre pulls
+   the car over from lane 0;
+2. the inputs of the motion FSM (`planner.fsm.motion`): the lane kept is *blocked* once a
+   slower vehicle has blocked it for ``blocked_time``; the lanes left and right are free or
+   not; the route needs the car to move right when the lane kept does not go on to
+   max(``prepare_distance``, ``prepare_time`` v) ahead (a lane that ends at an exit or a
+   lane drop is left in time); the route's turn at a junction; during a change, whether
+   the target lane is still free, whether the car's centre is inside it (committed) and
+   whether the path is done;
+3. the motion FSM steps once.
+
+Entering a lane change makes the target lane the lane kept (its speed plan and, once done,
+its camera lane) and plans the Hermite path into it from the car's pose
+(`planner.lane_change_path`); the change is done when the car's station reaches the path's
+end. An abort plans the same kind of path back to the origin lane, followed in LANE_KEEP
+until its end. While a path is followed, the vehicles ahead in the lane kept and, while the
+car's body (mirrors included) still overlaps the origin lane, in the origin lane are both
+leads for the ACC (`leads`): the car does not run into the vehicle it is leaving.
 
 At a town junction where the route turns, the turn is entered when the car's centre passes
 the stop line and done at the junction's exit (`RoadMap.junctions`); its path is the map's
 lane 0, which turns along the junction's arc (`world.map.town`), so the path needs nothing
-planned here. Lane 0 is the only lane through a turn: the route lane change has already
-brought the car into it ("a lane ends ahead").
+planned here. Lane 0 is the only lane through a turn: the route lane change brings the car
+into it before the junction ("a lane ends ahead").
 """
 
 from __future__ import annotations
@@ -70,10 +82,10 @@ class Manoeuvre:
     """The motion layer's output for one tick."""
 
     motion: Motion
-    lane: int  # the lane kept, or moved into
-    origin: int  # the lane left by a lane change in hand (== lane otherwise)
+    lane: int  # [-] the lane kept, or moved into (ego-direction index, `SHOULDER`)
+    origin: int  # [-] the lane left by a lane change in hand (== lane otherwise)
     path: LaneChangePath | None  # the lane-change (or abort) path being followed
-    leads: tuple[Neighbour, ...] = ()  # during a change: the vehicles ahead in both lanes
+    leads: tuple[Neighbour, ...] = ()  # on a path: the vehicles ahead in the lanes occupied
 
 
 class MotionLayer:
@@ -116,7 +128,8 @@ class MotionLayer:
         return self.machine.state
 
     def _lanes_around(self, s: float, v: float, pull_over: bool) -> tuple[int, ...]:
-        """The lane kept, the origin, and the neighbours that go on for a whole change."""
+        """The lane kept, the origin, the neighbours that go on for a whole change (at
+        max(v, 5 m/s) for ``t_cap``), and the shoulder when pulling over from lane 0."""
         n_now = self.road.lanes_at(s)
         reach = min(s + max(v, 5.0) * self.params.lane_change.t_cap, self.road.length)
         n_later = self.road.lanes_at(reach)
@@ -134,8 +147,9 @@ class MotionLayer:
         return SHOULDER if lane == 0 and pull_over else lane - 1
 
     def _lanes_ahead(self, s: float, v: float) -> int:
-        """The fewest ego-direction lanes from `s` to `prepare` ahead (a lane that ends
-        there, at an exit or a lane drop, must be left in time)."""
+        """The fewest ego-direction lanes from station `s` [m] to max(`prepare_distance`,
+        `prepare_time` * `v`) ahead, `v` [m/s] (a lane that ends there, at an exit or a lane
+        drop, must be left in time)."""
         end = s + max(self.params.prepare_distance, self.params.prepare_time * v)
         line = self.road.line
         first, last = (int(i) for i in line.segment_index(np.array([s, min(end, line.length)])))

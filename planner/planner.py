@@ -3,26 +3,32 @@
 `Planner.update` takes the one message perception hands it each control tick
 (`perception.messages.PlannerInput`: the ego estimate, the camera's lane, the confirmed
 tracks, the signs and light colours of a frame, the driver's accelerator pedal and the
-flat-tyre flag) and returns the `Plan`. Nothing else calls into it. Steps:
+flat-tyre flag) and returns the `Plan` (`planner.messages`). Nothing else calls into it.
+Positions are in the map frame, stations [m] along the route's reference line, speeds
+[m/s]. Steps:
 
 1. the signs and light colours of a frame are matched with the map's stop lines and lights
    (`planner.events`, `planner.junctions`);
-2. the lane-source FSM (`planner.fsm.lane_source`) says where the lateral reference comes
-   from: the camera's lane (`planner.camera_lane`) when it is seen and agrees with the map's
-   lane kept, the map lane (`planner.route.lane_path`, placed by the GNSS + odometry
-   estimate) while it is acquired or lost, or near a town junction;
-3. the motion FSM (`planner.motion_layer`) keeps the lane or changes lanes, from the lane
-   occupancy of the tracks; a lane change (or its abort) replaces the path with its Hermite
-   path (`planner.lane_change_path`) and makes the target lane the lane kept;
-4. the speed, a chain of `planner.speed.PlannedSpeed`s, each link keeping what it was given
+2. the car is placed on the lane kept (station, lateral offset); the lane-source FSM
+   (`planner.fsm.lane_source`) says where the lateral reference comes from: the camera's
+   lane, or the map lane (`planner.route.lane_path`, placed by the GNSS + odometry
+   estimate) while the camera's is acquired or lost, or near a town junction;
+3. the motion FSM (`planner.motion_layer`) keeps the lane, changes lanes from the lane
+   occupancy of the tracks, turns at a junction or pulls over; a lane change (or its
+   abort) makes its target lane the lane kept and its Hermite path
+   (`planner.lane_change_path`) the path. Otherwise the path is the camera's lane
+   (`planner.camera_lane`) when the source is CAMERA, the lane is not the shoulder and the
+   camera's offset agrees with the map's within ``camera_agree``, else the map lane;
+4. the lead vehicle (`planner.lead`: in the path's lane, or along the map lane through a
+   junction, or in the lanes a lane change occupies);
+5. the speed, a chain of `planner.speed.PlannedSpeed`s, each link keeping what it was given
    unless it lowers it: the map's plan (`planner.speed_planning`: set speed, the lane kept's
    limits and curves), the driver's pedal (`planner.driver_override`: it raises the plan up
    to the limit), the ACC / event law (`planner.acc_layer`: cruise, trail or brake behind
-   the lead vehicle, `planner.lead`; a stop, a bump's pass speed, a flat tyre's crawl),
-   the degraded lane's cap (ramped down at ``a_comf`` to the hold speed when the lane is
-   lost, then to a stop in lane) and the emergency stop; the plan's `speed_source` is the
-   link that set the speed;
-5. the control FSM (`planner.control_layer`) names the control action and, in an
+   the lead; a stop, a bump's pass speed, a flat tyre's crawl), the degraded lane's cap
+   (ramped down at ``a_comf`` to the hold speed in MAP_HOLD, to a stop in STOP_IN_LANE) and
+   the emergency stop; the plan's `speed_source` is the link that set the speed;
+6. the control FSM (`planner.control_layer`) names the control action and, in an
    emergency, asks for the emergency stop's deceleration instead; the hazard lights go on
    with a flat tyre (`planner.fsm.hazard`).
 """
@@ -61,7 +67,7 @@ class PlannerParams:
     set_speed: float  # [m/s] the driver's desired (cruise) speed
     max_speed: float  # [m/s] the vehicle's maximum speed
     vehicle: VehicleInfo  # the car's dimensions
-    lane: int = 0  # ego-direction lane index to keep (0 rightmost)
+    lane: int = 0  # [-] ego-direction lane index to keep (0 rightmost)
     path_behind: float = 5.0  # [m] path sampled behind the car's centre
     path_ahead_min: float = 25.0  # [m] shortest path ahead of the car's centre
     path_ahead_time: float = 2.5  # [s] path ahead = max(path_ahead_min, this * speed)
@@ -135,7 +141,8 @@ class Planner:
         return float(np.asarray(s)), float(np.asarray(r))
 
     def path_for(self, ego: EgoState, station: float) -> ReferencePath:
-        """The lane centre from ``path_behind`` behind to max(25 m, 2.5 s * speed) ahead."""
+        """The lane kept's centre from ``path_behind`` behind the car's centre at `station`
+        [m] to max(``path_ahead_min``, ``path_ahead_time`` * speed) ahead."""
         p = self.params
         ahead = max(p.path_ahead_min, p.path_ahead_time * max(ego.speed, 0.0))
         return lane_path(
@@ -254,8 +261,9 @@ class Planner:
     def _lead(self, view: LaneView | None, tracks: Sequence[Track], ego: EgoState,
               manoeuvre: Manoeuvre, camera: bool) -> Lead | None:
         """The vehicle ahead in the lane (the camera's lane when it is the path, else
-        straight ahead); during a lane change the nearest ahead in the lanes the car
-        occupies (`MotionLayer`)."""
+        straight ahead); through a junction, along the map lane kept; during a lane change
+        (or the way back from an abort), the nearest ahead in the lanes the car occupies
+        (`MotionLayer`)."""
         if manoeuvre.path is not None:
             if not manoeuvre.leads:
                 return None

@@ -1,7 +1,8 @@
 """Lane-keeping reference paths sampled from the HD map.
 
-The path runs with the route (increasing station) whatever the lane's travel direction: the
-ego always drives with the route, also when it borrows an oncoming lane to overtake.
+Stations s [m] run along the route's reference line; points are in the map frame. The path
+runs with the route (increasing station) whatever the lane's travel direction, an oncoming
+lane's (index < 0, `RoadMap.lane`) too: the ego drives with the route.
 """
 
 from __future__ import annotations

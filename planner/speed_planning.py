@@ -1,6 +1,7 @@
 """Target speed for lane keeping: set speed, vehicle limit, posted limits and curves.
 
-The target is the minimum of
+Along one lane of the map (parameters `SpeedPlanningParams`; speeds [m/s], distances [m]),
+the target is the minimum of
 
 * the driver's set speed and the vehicle's maximum speed,
 * the posted limit in force at the FRONT BUMPER, less ``limit_margin``,
@@ -13,12 +14,10 @@ The target is the minimum of
   curvature-speed samples beyond the front axle (``d`` from the front axle).
 
 ``brake_margin`` makes the braking curve reach ``v_c`` that many metres before the
-constraint, room for the speed loop's lag behind a falling target.
-
-``limit_margin`` (0.3 km/h) keeps the target just under a posted limit. The speed loop
-holds its target with a small ripple, and the speed_limit rule tolerates +1 km/h over the
-limit: aiming 0.3 km/h below gives the ripple 1.3 km/h of room above the target (instead of
-1 km/h) for a loss of only 0.3 km/h of progress.
+constraint: room for the speed loop's lag behind a falling target. ``limit_margin`` keeps
+the target just under a posted limit, so that the speed loop's ripple about its target
+stays within the speed-limit rule's small tolerance above the limit. The feed-forward
+acceleration is -a_comf while a braking curve binds (beyond ``brake_margin``), else 0.
 
 Distances along the lane are metres of the lane's centre line: a station step ``ds`` on a
 lane offset from the reference line is ``(1 - k_ref * offset) ds = ds / (1 + kappa * offset)``
@@ -70,7 +69,7 @@ _AHEAD = (Binding.LIMIT_AHEAD, Binding.CURVE_AHEAD)
 class SpeedPlanningParams:
     a_comf: float = A_COMF  # [m/s^2] comfortable deceleration towards constraints ahead
     a_lat_max: float = 3.0  # [m/s^2] lateral acceleration allowed in curves
-    limit_margin: float = 0.3 * KPH  # [m/s] target below a posted limit (see module doc)
+    limit_margin: float = 0.3 * KPH  # [m/s] target below a posted limit: room for ripple
     brake_margin: float = 3.0  # [m] the braking curve reaches v_c this far before d = 0
     sample_spacing: float = 0.5  # [m] station step of the curvature samples (map-fixed grid)
     min_curvature: float = 1e-6  # [1/m] below this |kappa| the lane is straight (no limit)

@@ -1,12 +1,14 @@
-"""Write the ego car's URDF from named dimensions (the ICCAS 2020 test car).
+"""Write the ego car's URDF from named dimensions (`CarDimensions`: the ICCAS 2020 test car).
 
-The car: 4.8 x 1.6 m body, 2.7 m wheelbase, about 1500 kg, low centre of mass; four wheels on
-continuous joints (axis y, the wheel's axle); two front steering hinges (axis z) carrying the
-front wheels; fixed links for a roof LiDAR and front, left and right cameras.
+The car: a box body with a cabin; two front steering hinges (axis z, revolute,
++-``max_steer``) to knuckles that carry the front wheels; four wheels on continuous joints
+(axis y, the wheel's axle), each with a flat-tyre contact link fixed to it; fixed links for
+a roof LiDAR and front, left and right cameras.
 
-Frames (URDF/ROS): x forward, y left, z up. The base link's origin is the centre of the body's
-footprint at wheel-centre height, so the car's "centre" (the station of the scenario format)
-is the base origin. Inertias are those of solid boxes / cylinders of the given masses.
+Frames (URDF/ROS): x forward, y left, z up, metres and radians. The base link's origin is the
+centre of the body's footprint at wheel-centre height, midway between the axles, so the
+car's "centre" (the station of the scenario format) is the base origin. Inertias are those
+of solid boxes / cylinders / spheres of the given masses [kg].
 
 `python -m vehicle_urdf` rewrites `car.urdf`; a test checks the committed file equals
 `build_urdf(CarDimensions())`.
@@ -24,13 +26,13 @@ URDF_PATH = Path(__file__).with_name("car.urdf")
 @dataclass(frozen=True, slots=True)
 class CarDimensions:
     body_length: float = 4.8  # [m] bumper to bumper
-    body_width: float = 1.6  # [m]
+    body_width: float = 1.6  # [m] side to side
     body_height: float = 1.45  # [m] ground to roof
     ground_clearance: float = 0.16  # [m] ground to the underbody
     wheelbase: float = 2.7  # [m] front to rear axle
     track: float = 1.40  # [m] left to right wheel centre
     wheel_radius: float = 0.33  # [m] rolling radius
-    wheel_width: float = 0.21  # [m]
+    wheel_width: float = 0.21  # [m] tyre tread width
     body_mass: float = 1400.0  # [kg] sprung mass
     wheel_mass: float = 22.0  # [kg] each, with hub and brake
     knuckle_mass: float = 6.0  # [kg] each steering knuckle
@@ -104,11 +106,12 @@ def _body_link(d: CarDimensions) -> str:
 def _wheel_link(name: str, d: CarDimensions) -> str:
     """A wheel: a cylinder to look at, a sphere to roll on.
 
-    Bullet's cylinder-plane contact jumps between edge points and chatters (measured: normal
-    forces alternating 0 / 100 kN at 240 Hz); a sphere of the rolling radius gives one smooth
-    contact point on the road. The tyre's friction and vertical compliance live in the
-    URDF's <contact> block: the compliance spreads the load over all four wheels (a rigid
-    four-point stance is statically indeterminate and leaves one diagonal unloaded).
+    Bullet's cylinder-plane contact jumps between edge points and chatters (the normal force
+    alternates between none and very large from step to step); a sphere of the rolling
+    radius gives one smooth contact point on the road. The tyre's friction and vertical
+    compliance live in the URDF's <contact> block: the compliance spreads the load over all
+    four wheels (a rigid four-point stance is statically indeterminate and leaves one
+    diagonal unloaded).
     """
     r, w, m = d.wheel_radius, d.wheel_width, d.wheel_mass
     i_axle = 0.5 * m * r**2
@@ -256,5 +259,6 @@ def build_urdf(d: CarDimensions) -> str:
 
 
 def write_urdf(path: Path = URDF_PATH, dims: CarDimensions | None = None) -> Path:
+    """Write `build_urdf(dims)` (default dimensions if None) to `path`; the path."""
     path.write_text(build_urdf(dims or CarDimensions()))
     return path

@@ -1,4 +1,9 @@
-"""Read the car's geometry back from its URDF, so everyone uses the URDF's own numbers."""
+"""Read the car's geometry back from its URDF, so everyone uses the URDF's own numbers.
+
+Frame: the base link's (x forward, y left, z up; origin at the centre of the body's
+footprint, at wheel-centre height, midway between the axles). Lengths in metres, angles in
+radians, masses in kilograms.
+"""
 
 from __future__ import annotations
 
@@ -15,9 +20,9 @@ WHEELS = ("front_left", "front_right", "rear_left", "rear_right")  # joint/link 
 class CarGeometry:
     wheelbase: float  # [m] front to rear axle
     track: float  # [m] left to right wheel centre
-    wheel_radius: float  # [m]
-    body_length: float  # [m]
-    body_width: float  # [m]
+    wheel_radius: float  # [m] rolling radius
+    body_length: float  # [m] bumper to bumper
+    body_width: float  # [m] side to side
     front_axle: float  # [m] ahead of the car's centre (base origin)
     rear_axle: float  # [m] behind the car's centre, as a positive distance
     mass: float  # [kg] total

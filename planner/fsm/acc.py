@@ -1,32 +1,35 @@
-"""The ACC / event-driven ACC layer of the DECS paper: its mode FSM and its gaps.
+"""The ACC / event-driven ACC modes of the DECS paper: the mode FSM and its gaps.
 
 States (the paper's Stateflow chart, Fig. 2): ACC_OFF, and inside ACC_ON either ACC_ACTIVE
 {CRUISE, TRAIL, BRAKE, SPEED_LIMIT} or EDACC {OFF_RAMP, PEDESTRIAN, SPEED_BUMP, STOP_SIGN,
-FLAT}, plus two of our own for town junctions, RED_LIGHT and YIELD (their rows are marked *
-in the table, as are the rows the paper's chart has no counterpart for). Inputs
-(`AccInput`): the gap d to the vehicle ahead in the lane and its speed V_l (+inf when there
-is none), the set speed V_s, the posted limit where the car is V_GPS (the
-paper reads it from the map by GPS), the ego speed v and the discrete events.
+FLAT}, plus two modes of our own for town junctions, RED_LIGHT and YIELD. Inputs
+(`AccInput`, speeds [m/s], gaps [m]): the bumper gap d to the vehicle ahead in the lane and
+its speed V_l (+inf when there is none), the set speed V_s, the posted limit V_GPS (the
+paper reads it from the map by GPS; here at the front bumper), the ego speed v and the set
+of discrete events. The events are decided upstream (`planner.events`,
+`planner.junctions`); this module only says which mode holds.
 
-Gaps (the paper gives none; designed here, all in metres, speeds in m/s):
+Gaps (the paper gives none; designed here, `gaps`, parameters `AccParams`):
 
 - d_min(v): the UN R157 minimum following distance, ``max(v t_front, 2 m)`` with
-  ``t_front = 1.0 + v_kph / 100`` s (v_kph taken as at least 10 km/h below 10 km/h);
-- d_des(v) = max(d0 + tau v, d_min(v)): the desired gap, a standstill gap d0 (4 m) plus a
-  time gap tau (1.5 s), never below d_min;
+  ``t_front = 1.0 + v_kph / 100`` s (v_kph taken as at least 10 km/h);
+- d_des(v) = max(d0 + tau v, d_min(v)): the desired gap, a standstill gap d0 plus a time
+  gap tau, never below d_min;
 - d_max(v, V_l) = d_des + max(v^2 - V_l^2, 0) / (2 a_comf) + d_reach: the gap inside which
-  the lead matters. Beyond it, braking at a_comf (1.5 m/s^2) from v to V_l still ends at
-  d_des, with d_reach (10 m) of hysteresis.
+  the lead matters. Beyond it, braking at a_comf from v to V_l still ends at or beyond
+  d_des; d_reach is hysteresis.
 
-Transitions: every row of the paper's Table 2, plus the ones a sound chart needs and the
-table's "sample" leaves out, and our two town modes (marked * below). Events are a set of
-`AccEvent`s, each with its mode (`EVENT_MODE`); they are tried by priority: pedestrian,
-stop sign, red light, give way, speed bump, off-ramp. An event mode stays while its own
-event holds, unless a higher one takes over; when it is over the car cruises (the chart's
-default ACC_ACTIVE state), and the next tick's rows settle the mode. For the state the car
-is in, the rows that leave it are tried in this order and the first that holds is taken
-(Table 2's conditions overlap: out of BRAKE with the lead beyond d_max, Trail's row also
-holds, so Cruise and SpeedLimit are tried first). `TABLE` is this table, as data:
+Transitions (`TABLE`, as data): every row of the paper's Table 2, plus the rows a sound
+chart needs that the table's "sample" leaves out, and the town modes' rows; rows and parts
+of rows the paper has no counterpart for are marked *. For the state the car is in, the rows
+that leave it are tried in this order and the first that holds is taken. The events
+(`AccEvent`, each with its mode, `EVENT_MODE`) thus take priority in this order: flat tyre,
+pedestrian, stop sign, red light, give way, speed bump, off-ramp. An event mode holds while
+its own event does, unless a row leaves it for another event's mode (only where the table
+has one: a stop sign does not interrupt a speed bump); when its event is over the car
+cruises (the chart's default ACC_ACTIVE state) and the next tick's rows settle the mode.
+Table 2's conditions overlap: out of BRAKE with the lead beyond d_max, Trail's row also
+holds, so Cruise and SpeedLimit are tried first.
 
 1. acc_off -> cruise: ACC switched on (the chart's default state)
 2. any ACC_ON but flat -> acc_off: ACC switched off *
@@ -59,8 +62,7 @@ holds, so Cruise and SpeedLimit are tried first). `TABLE` is this table, as data
 25. cruise, trail -> speed_limit: V_GPS < V_s and (d >= d_max or (V_GPS <= V_l and d >
     d_min)) (Trail *)
 
-FLAT has no row out: the car stops on the shoulder ("Simulation Stops"). The events are
-decided upstream (perception and the map); this module only says which mode holds.
+FLAT has no row out: the car stops on the shoulder ("Simulation Stops").
 """
 
 from __future__ import annotations
@@ -128,10 +130,10 @@ class AccParams:
 
 @dataclass(frozen=True, slots=True)
 class AccInput:
-    acc_on: bool  # the driver's ACC switch (with a set speed)
+    acc_on: bool  # the driver's ACC switch (on: a set speed > 0)
     v: float  # [m/s] ego speed
     v_s: float  # [m/s] set speed
-    v_gps: float  # [m/s] posted limit where the car is
+    v_gps: float  # [m/s] posted limit in force at the front bumper
     d: float = math.inf  # [m] gap to the vehicle ahead in the lane (+inf: none)
     v_l: float = math.inf  # [m/s] its speed over ground (+inf: none)
     events: frozenset[AccEvent] = NO_EVENTS  # the events that hold now
@@ -139,9 +141,9 @@ class AccInput:
 
 @dataclass(frozen=True, slots=True)
 class Gaps:
-    d_min: float  # [m]
-    d_des: float  # [m]
-    d_max: float  # [m]
+    d_min: float  # [m] UN R157 minimum following distance
+    d_des: float  # [m] desired gap
+    d_max: float  # [m] gap inside which the lead matters
 
 
 def r157_min_gap(v: float) -> float:

@@ -3,24 +3,24 @@
 States (the paper's Fig. 3a): STOP, EMERGENCY_STOP, ACCELERATION, DECELERATION and
 SPEED_KEEPING. The paper names them and says the changes follow the recognised objects,
 lights and signs; it gives no conditions, so these are designed here. Inputs
-(`ControlInput`): the ego speed v, the planner's target speed v_target and feed-forward
-acceleration a_target after the ACC layer, the deceleration a_required needed to avoid the
-vehicle ahead and the time to collision ttc with it (both computed upstream, see
-`required_deceleration` and `time_to_collision`). Speeds in m/s, accelerations in m/s^2.
+(`ControlInput`, speeds [m/s], accelerations [m/s^2]): the ego speed v, the planner's target
+speed v_target and feed-forward acceleration a_target after the ACC layer, the deceleration
+a_required needed to avoid the vehicle ahead and the time to collision ttc [s] with it (both
+computed upstream: `required_deceleration`, `time_to_collision`).
 
 Terms (the thresholds are `ControlParams`):
 
 - moving: v >= v_stopped; stopped otherwise. A stopped car has no emergency.
-- threat: a_required >= a_emergency_enter (the ACC's hard braking covers up to 5 m/s^2) or
-  ttc < ttc_emergency. It is over when a_required < a_emergency_exit and the gap no longer
-  closes (ttc infinite): once braking hard the car closes more slowly, so a finite TTC or a
+- threat: a_required >= a_emergency_enter (more than the ACC's BRAKE mode plans) or
+  ttc < ttc_emergency. It is over when a_required < a_emergency_exit and the gap does not
+  close (ttc infinite): braking hard, the car closes more slowly, so a finite TTC or a
   falling a_required says the braking works, not that the threat is gone (AEB practice,
   and ICCAS: the car "stops the same when the deceleration exceeds a threshold"). The
   gap between the two thresholds keeps EMERGENCY_STOP from chattering.
 - slow down (D): v - v_target > speed_band or a_target < -accel_band.
 - speed up (A): (v_target - v > speed_band or a_target > accel_band), not D and no threat.
   Slowing down wins when the speed error and the plan's acceleration disagree (a target
-  above the speed but a braking feed-forward, or the reverse): without it ACCELERATION and
+  above the speed but a braking feed-forward, or the reverse): otherwise ACCELERATION and
   DECELERATION would swap every tick. A threat keeps a stopped car (below v_stopped, so no
   emergency) from starting into it; a moving car under a threat is in EMERGENCY_STOP first.
 - on target: |v_target - v| <= keep_band and |a_target| <= accel_band (keep_band is

@@ -1,7 +1,9 @@
 """Where the lateral reference comes from: the camera's lane, or the map when it is lost.
 
-An enum FSM with its transition table as data (`TABLE`); for the state it is in, the rows
-that leave it are tried in this order and the first that holds is taken:
+Inputs (`LaneSourceInput`): the time t [s], the confidence [-] of the latest lane estimate,
+the time [s] the state was entered and whether the car is near a town junction. Transitions
+(`TABLE`, as data): for the state it is in, the rows that leave it are tried in this order
+and the first that holds is taken:
 
 1. junction -> camera: past the junction, confidence >= `acquire`
 2. junction -> acquiring: past the junction, no good estimate yet
@@ -10,16 +12,18 @@ that leave it are tried in this order and the first that holds is taken:
 4. camera -> map_hold: confidence < `lose` (hysteresis: `lose` < `acquire`)
 5. acquiring, map_hold, stop_in_lane -> camera: confidence >= `acquire` (a good lane
    estimate)
-6. acquiring -> map_hold: no good estimate `acquire_time` after the start
+6. acquiring -> map_hold: no good estimate for `acquire_time`
 7. map_hold -> stop_in_lane: lost for `stop_after` seconds
 
-MAP is the state of a stack built without a camera (GNSS + odometry on the HD map only):
-it never changes. ACQUIRING follows the map lane at the planned speed (the camera's first
-estimate arrives one sensor period after the start). MAP_HOLD follows the map lane with the
-localisation estimate (GNSS + odometry) and slows to `hold_speed`; STOP_IN_LANE brings the
-car to a stop in its lane. JUNCTION follows the map's path through a town junction at the
-planned speed: its lines end at the junction's mouth, and the path turns where none are
-painted. Every change carries a reason for the log.
+What each state follows (`planner.planner`): MAP is the state of a stack built without a
+camera (GNSS + odometry on the HD map only); no row leaves it. ACQUIRING follows the map
+lane at the planned speed (the camera's first estimate arrives one sensor period after the
+start). CAMERA follows the camera's lane where it agrees with the map's. MAP_HOLD follows
+the map lane placed by the localisation estimate (GNSS + odometry) and slows to
+`hold_speed`; STOP_IN_LANE brings the car to a stop in its lane. JUNCTION follows the map's
+path through a town junction at the planned speed: the painted lines end at the junction's
+mouth, and the path turns where none are painted. Every change carries a reason for the
+log.
 """
 
 from __future__ import annotations
@@ -43,8 +47,8 @@ class LaneSource(enum.Enum):
 class LaneSourceParams:
     acquire: float = 0.5  # [-] confidence to take (or take back) the camera's lane
     lose: float = 0.3  # [-] confidence below which the camera's lane is lost
-    acquire_time: float = 1.0  # [s] from the start, to find the lane before holding
-    stop_after: float = 5.0  # [s] lost this long: stop in lane
+    acquire_time: float = 1.0  # [s] ACQUIRING this long without a lane: hold on the map
+    stop_after: float = 5.0  # [s] MAP_HOLD this long: stop in lane
     hold_speed: float = 20.0 / 3.6  # [m/s] speed while holding the lane on the map
 
 
@@ -52,7 +56,7 @@ class LaneSourceParams:
 class LaneSourceInput:
     t: float  # [s] now
     confidence: float  # [-] of the latest lane estimate (0 when there is none)
-    since: float  # [s] time of the last change of state (the start, for ACQUIRING)
+    since: float  # [s] when the state was entered (the first tick, for the initial one)
     junction: bool = False  # the car is near a town junction (`Planner.near_junction`)
 
 
@@ -106,7 +110,7 @@ TABLE: Table[LaneSource, LaneSourceInput, LaneSourceParams] = Table(LaneSource, 
     Row(_SEEKING, L.CAMERA, _found, "confidence >= `acquire` (a good lane estimate)",
         lambda x, p: f"lane found (confidence {x.confidence:.2f})"),
     Row(frozenset({L.ACQUIRING}), L.MAP_HOLD, _nothing_found,
-        "no good estimate `acquire_time` after the start",
+        "no good estimate for `acquire_time`",
         lambda x, p: f"no lane found in {p.acquire_time:.1f} s"),
     Row(frozenset({L.MAP_HOLD}), L.STOP_IN_LANE, _lost_too_long,
         "lost for `stop_after` seconds",

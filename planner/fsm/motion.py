@@ -4,14 +4,18 @@ States: LANE_KEEP, LANE_CHANGE_LEFT, LANE_CHANGE_RIGHT, TURN_RIGHT, TURN_LEFT, U
 turns are entered from the route's command at a town junction (`planner.motion_layer`).
 
 Inputs (`MotionInput`) are decided upstream from the tracks and the map
-(`planner.lane_occupancy`): whether a slower vehicle blocks the lane ahead, whether the lanes
-to the left and right are free ("according to the presence or absence of obstacles in the
-side", ICCAS 2020), the lane the route needs, and the progress of the manoeuvre in hand.
+(`planner.lane_occupancy`, `planner.motion_layer`): whether a slower vehicle blocks the lane
+ahead, whether the lanes to the left and right are free ("according to the presence or
+absence of obstacles in the side", ICCAS 2020), the lanes the route needs the car to move,
+the route's turn at a junction, a flat tyre's pull-over, and the progress of the manoeuvre
+in hand.
 
-A lane change is *committed* once the car's centre has crossed into the target lane: before
-that, a target lane that stops being free aborts the change (back to LANE_KEEP in the origin
-lane: an abort, a change to LANE_KEEP before the change is done); after it, finishing is
-the safer way out.
+A lane change is *committed* once the car's centre is inside the target lane: before that,
+a target lane that stops being free aborts the change (a change to LANE_KEEP before the
+change is done, back to the origin lane); after it, finishing is the safer way out.
+
+Transitions (`TABLE`, as data). For the state the car is in, the rows that leave it are
+tried in this order and the first that holds is taken:
 
 1. lane_keep -> lane_change_right: a flat tyre: pull over (right lane, then shoulder), once
    `route_keep_time` has passed and the lane to the right is free
@@ -29,11 +33,10 @@ the safer way out.
     free, not yet committed
 11. turn_right, turn_left, u_turn -> lane_keep: the turn is done (in the exit lane)
 
-For the state the car is in, the rows that leave it are tried in this order (`TABLE`, as
-data) and the first that holds is taken. A flat tyre comes first and stops everything else:
-the car moves right lane by lane (`right_free` then means the next lane, or the paved shoulder from
-lane 0) and stays on the shoulder. Out of LANE_KEEP, route needs come before overtaking, and
-overtaking waits `keep_time` after the last change (no weaving); a route lane change waits
+A flat tyre comes first and stops everything else out of LANE_KEEP: the car moves right
+lane by lane (`right_free` then means the next lane, or the paved shoulder from lane 0) and
+stays on the shoulder. Then the route's turns, then its lane needs, then overtaking.
+Overtaking waits `keep_time` after the last change (no weaving); a route lane change waits
 `route_keep_time` only.
 """
 
@@ -82,7 +85,7 @@ class MotionInput:
     blocked: bool = False  # a slower vehicle blocks the lane ahead (debounced upstream)
     left_free: bool = False  # a lane to the left exists and is free by the tracks
     right_free: bool = False  # a lane to the right exists and is free by the tracks
-    route_lane: int = 0  # lanes the route needs to move: > 0 left, < 0 right, 0 none
+    route_lane: int = 0  # [lanes] the route needs the car to move: > 0 left, < 0 right
     target_free: bool = True  # the target lane of the change in hand is still free
     committed: bool = False  # the car's centre is in the target lane of the change
     change_done: bool = False  # the lane change's path is finished
