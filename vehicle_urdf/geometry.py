@@ -27,6 +27,9 @@ class CarGeometry:
     rear_axle: float  # [m] behind the car's centre, as a positive distance
     mass: float  # [kg] total
     max_steer: float  # [rad] road-wheel hinge limit
+    tyre_width: float  # [m] a tyre's tread, across
+    ground_clearance: float  # [m] ground to the underbody, at the nominal wheel radius
+    body_height: float  # [m] ground to the roof, at the nominal wheel radius
     tyre_stiffness: float = 300_000.0  # [N/m] vertical contact stiffness of one tyre
     tyre_damping: float = 20_000.0  # [N s/m] vertical contact damping of one tyre
     flat_radius: float = 0.31  # [m] rolling radius of a flat tyre (its rim link's sphere)
@@ -63,6 +66,9 @@ def read_geometry(path: Path = URDF_PATH) -> CarGeometry:
     rl = _xyz(joints["rear_left_wheel_joint"].find("origin"))
     cylinder = links["front_left_wheel"].find("visual/geometry/cylinder")
     body = links["base_link"].find("visual[@name='lower_body']/geometry/box")
+    body_origin = links["base_link"].find("visual[@name='lower_body']/origin")
+    cabin = links["base_link"].find("visual[@name='cabin']/geometry/box")
+    cabin_origin = links["base_link"].find("visual[@name='cabin']/origin")
     limit = joints["front_left_steer_joint"].find("limit")
     stiffness = links["front_left_wheel"].find("contact/stiffness")
     damping = links["front_left_wheel"].find("contact/damping")
@@ -70,21 +76,27 @@ def read_geometry(path: Path = URDF_PATH) -> CarGeometry:
     flat_sphere = None if rim is None else rim.find("collision/geometry/sphere")
     flat_stiffness = None if rim is None else rim.find("contact/stiffness")
     flat_damping = None if rim is None else rim.find("contact/damping")
-    if (cylinder is None or body is None or limit is None or stiffness is None or damping is None
-            or flat_sphere is None or flat_stiffness is None or flat_damping is None):
+    if (cylinder is None or body is None or cabin is None or limit is None or stiffness is None
+            or damping is None or flat_sphere is None or flat_stiffness is None
+            or flat_damping is None):
         raise ValueError(f"{path}: not an avsim car URDF")
-    length, width, _ = (float(v) for v in body.attrib["size"].split())
+    length, width, lower_height = (float(v) for v in body.attrib["size"].split())
+    cabin_height = float(cabin.attrib["size"].split()[2])
+    radius = float(cylinder.attrib["radius"])  # the base origin is at the wheels' centres
     mass = sum(float(m.attrib["value"]) for m in root.iter("mass"))
     return CarGeometry(
         wheelbase=fl[0] - rl[0],
         track=fl[1] - fr[1],
-        wheel_radius=float(cylinder.attrib["radius"]),
+        wheel_radius=radius,
         body_length=length,
         body_width=width,
         front_axle=fl[0],
         rear_axle=-rl[0],
         mass=mass,
         max_steer=float(limit.attrib["upper"]),
+        tyre_width=float(cylinder.attrib["length"]),
+        ground_clearance=_xyz(body_origin)[2] - lower_height / 2 + radius,
+        body_height=_xyz(cabin_origin)[2] + cabin_height / 2 + radius,
         tyre_stiffness=float(stiffness.attrib["value"]),
         tyre_damping=float(damping.attrib["value"]),
         flat_radius=float(flat_sphere.attrib["radius"]),

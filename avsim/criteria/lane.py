@@ -23,7 +23,6 @@ from avsim.scenario.fields import FormatModel, PosFloat
 from world.hdmap import RoadMap
 
 LINE_HALF_WIDTH = 0.075  # [m] half a painted lane line: a tyre touching paint is out
-TYRE_HALF_WIDTH = 0.105  # [m] half the tyre's tread (the URDF's wheel width)
 
 
 class TyresInLane(Criterion):
@@ -170,16 +169,16 @@ class LaneChangeSetting(FormatModel):
 
 
 def _lane_change(setting: LaneChangeSetting, run: RunInputs) -> list[Criterion]:
-    return [LaneChangeDuration(run.road, TYRE_HALF_WIDTH, setting.max_duration),
+    return [LaneChangeDuration(run.road, run.car.tyre_width / 2, setting.max_duration),
             LaneChangeLateralAccel(setting.max_lateral_accel, run.rate)]
 
 
 TYRES_IN_LANE: Declaration[None] = Declaration(
-    build=lambda _, run: [TyresInLane(run.road, TYRE_HALF_WIDTH)], needs=frozenset({Need.MAP}),
-    always=True)
+    build=lambda _, run: [TyresInLane(run.road, run.car.tyre_width / 2)],
+    needs=frozenset({Need.MAP, Need.CAR}), always=True)
 
 LANE_CHANGE: Declaration[LaneChangeSetting] = Declaration(
-    build=_lane_change, needs=frozenset({Need.MAP, Need.RATE}), key="lane_change",
+    build=_lane_change, needs=frozenset({Need.MAP, Need.CAR, Need.RATE}), key="lane_change",
     setting=LaneChangeSetting,
     doc="`{max_duration, max_lateral_accel}`: bounds on each lane change; at least one must "
     "happen. Default: off.", example={"max_duration": 5.0, "max_lateral_accel": 1.0})

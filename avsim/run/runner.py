@@ -326,9 +326,10 @@ class Runner:
         r = g.wheel_radius
         wheels = [[g.front_axle, g.track / 2, 0.0], [g.front_axle, -g.track / 2, 0.0],
                   [-g.rear_axle, g.track / 2, 0.0], [-g.rear_axle, -g.track / 2, 0.0]]
-        rec.log_ego_body(body_half_size=(g.body_length / 2, g.body_width / 2, 0.55),
-                         body_center=(0.0, 0.0, 0.55 + 0.16 - r), wheel_centers=wheels,
-                         wheel_radius=r, wheel_half_width=0.105)
+        half_height = (g.body_height - g.ground_clearance) / 2  # the body as one box
+        rec.log_ego_body(body_half_size=(g.body_length / 2, g.body_width / 2, half_height),
+                         body_center=(0.0, 0.0, g.ground_clearance + half_height - r),
+                         wheel_centers=wheels, wheel_radius=r, wheel_half_width=g.tyre_width / 2)
         lanes = [np.column_stack([lane.position(np.linspace(0, w.road.length, 400), 0.0),
                                   np.full(400, 0.02)]) for lane in w.road.lanes]
         rec.log_static_lines("/world/map/lanes", lanes, (90, 160, 255), 0.03)

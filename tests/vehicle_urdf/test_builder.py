@@ -21,6 +21,10 @@ def test_geometry_read_back_from_the_urdf() -> None:
     assert g.mass == pytest.approx(1500.0, rel=0.02)
     assert g.front_axle == pytest.approx(1.35)
     assert 1.3 <= g.track <= 1.6
+    d = CarDimensions()  # the sizes the committed URDF is built from
+    assert g.tyre_width == pytest.approx(d.wheel_width)
+    assert g.ground_clearance == pytest.approx(d.ground_clearance)
+    assert g.body_height == pytest.approx(d.body_height)
 
 
 def test_builder_follows_its_dimensions() -> None:

@@ -16,12 +16,13 @@ from avsim.criteria.lane import (
     TyresInLane,
 )
 from tests.roads import W, make_map, seg
+from tests.vehicle import CAR
 from world.actors.actor_set import ActorPoses
 from world.hdmap import RoadMap
 from world.spec import ActorType
 
 ROAD = make_map(seg(1000.0))  # lane 0 centred on offset 0, lane 1 on W; 50 km/h
-TYRE = 0.105  # [m] tyre half width (the runner's)
+TYRE = CAR.tyre_width / 2  # [m] tyre half width (the URDF car's)
 TRACK = 0.8  # [m] half the track: tyres at offset +-TRACK from the ego's centre
 EGO_LENGTH = 4.8
 CAR_HALF = np.array([2.3, 0.9, 0.75])
