@@ -14,7 +14,6 @@ from control.stanley import (
     StanleyParams,
     StanleyPid,
     front_axle_error,
-    wrap_angle,
 )
 from control.vehicle_controller import VehicleController, VehicleControllerParams
 
@@ -35,5 +34,4 @@ __all__ = [
     "front_axle_error",
     "longitudinal_force",
     "wheel_torques",
-    "wrap_angle",
 ]

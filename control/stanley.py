@@ -60,23 +60,17 @@ from numpy.typing import NDArray
 
 from control.pid import Pid, PidParams
 from planner.messages import ReferencePath
+from world.frames import wrap_angle
 
 __all__ = [
     "FrontAxleError",
     "StanleyParams",
     "StanleyPid",
     "front_axle_error",
-    "wrap_angle",
 ]
 
 SEARCH_BEHIND = 5  # [-] segments searched behind the hint (the car may be re-localised back)
 SEARCH_AHEAD = 100  # [-] segments searched ahead of the hint
-
-
-def wrap_angle(angle: float) -> float:
-    """Wrap an angle [rad] to (-pi, pi]."""
-    wrapped = math.remainder(angle, math.tau)
-    return math.pi if wrapped == -math.pi else wrapped
 
 
 @dataclass(frozen=True, slots=True)

@@ -37,7 +37,7 @@ from filterpy.kalman import ExtendedKalmanFilter
 from numpy.typing import NDArray
 
 from perception.messages import EgoState
-from world.frames import GnssFix, Odometry
+from world.frames import GnssFix, Odometry, wrap_angle
 
 FloatArray = NDArray[np.float64]
 
@@ -67,12 +67,6 @@ class LocalizerParams:
     heading_walk: float = 0.001  # [rad/sqrt(s)] heading random walk (gyro/heading slip)
     init_speed_sigma: float = 1.0  # [m/s] initial speed uncertainty (no odometry before fix)
     init_yaw_rate_sigma: float = 0.1  # [rad/s] initial yaw-rate uncertainty, as above
-
-
-def wrap_angle(a: float) -> float:
-    """[rad] ``a`` wrapped to (-pi, pi]."""
-    w = math.remainder(a, 2.0 * math.pi)  # in [-pi, pi]
-    return math.pi if w == -math.pi else w
 
 
 def motion(x: FloatArray, dt: float) -> tuple[FloatArray, FloatArray]:

@@ -54,6 +54,7 @@ from numpy.typing import NDArray
 from scipy.optimize import linear_sum_assignment
 
 from perception.messages import Detection, EgoState, ObjectClass, Track
+from world.frames import wrap_angle
 
 FloatArray = NDArray[np.float64]
 
@@ -95,12 +96,6 @@ def transition(dt: float) -> FloatArray:
     f = np.eye(DIM_X)
     f[0, 2] = f[1, 3] = dt
     return f
-
-
-def wrap_angle(a: float) -> float:
-    """[rad] ``a`` wrapped to (-pi, pi]."""
-    w = math.remainder(a, 2.0 * math.pi)
-    return math.pi if w == -math.pi else w
 
 
 @dataclass(frozen=True, slots=True)

@@ -39,7 +39,7 @@ import numpy as np
 from perception.messages import EgoState, ObjectClass, SignDetection, Track
 from planner.fsm.acc import NO_EVENTS, AccEvent
 from planner.limits import A_COMF
-from world.frames import VehicleInfo
+from world.frames import VehicleInfo, kph
 from world.hdmap import Crosswalk, RoadMap, SpeedBump, StopSign, Zone
 
 
@@ -57,7 +57,7 @@ class EventParams:
     crossing_stop: float = 1.0  # [m] stop this much (+ the law's margin) before a crosswalk
     bump_margin: float = 1.0  # [m] pass speed from this before a bump to this past it (the
     #   speed_bumps criterion's reach)
-    bump_undershoot: float = 0.5 / 3.6  # [m/s] aim this far below the pass speed
+    bump_undershoot: float = kph(0.5)  # [m/s] aim this far below the pass speed
     sign_match: float = 5.0  # [m] a seen sign this near a stop line (along) is its sign
 
 

@@ -44,6 +44,7 @@ from numpy.typing import ArrayLike
 
 from planner.messages import ReferencePath
 from planner.route import path_stations
+from world.frames import wrap_angle
 from world.hdmap import FloatArray, Lane
 
 T_STEP = 0.05  # [s] grid of the duration search
@@ -91,11 +92,6 @@ def plan_duration(dr: float, slope: float, speed: float, params: LaneChangeParam
         if peak_lateral_accel(dr, slope, speed, length) <= params.a_lat_design:
             return duration
     return params.t_cap
-
-
-def wrap_angle(angle: float) -> float:
-    """[rad] ``angle`` wrapped to (-pi, pi]."""
-    return math.pi - (math.pi - angle) % (2.0 * math.pi)
 
 
 @dataclass(frozen=True, slots=True)

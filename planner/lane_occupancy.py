@@ -31,7 +31,7 @@ import numpy as np
 
 from perception.messages import Track
 from planner.fsm.acc import AccParams, gaps, r157_min_gap
-from world.frames import VehicleInfo
+from world.frames import VehicleInfo, kph
 from world.hdmap import RoadMap
 
 
@@ -42,7 +42,7 @@ class OccupancyParams:
     rear_reaction: float = 0.4  # [s] t_B, UN R157
     rear_decel: float = 3.0  # [m/s^2] a_rear, UN R157
     rear_time_gap: float = 1.0  # [s] t_G, UN R157
-    block_margin: float = 10.0 / 3.6  # [m/s] slower than wanted by this blocks the lane
+    block_margin: float = kph(10.0)  # [m/s] slower than wanted by this blocks the lane
 
 
 @dataclass(frozen=True, slots=True)

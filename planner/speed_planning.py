@@ -46,10 +46,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from planner.limits import A_COMF
-from world.frames import VehicleInfo
+from world.frames import VehicleInfo, kph
 from world.hdmap import FloatArray, IntArray, Lane, RoadMap
 
-KPH = 1.0 / 3.6  # [m/s per km/h]
 
 class Binding(enum.Enum):
     """Which constraint sets the target speed."""
@@ -69,7 +68,7 @@ _AHEAD = (Binding.LIMIT_AHEAD, Binding.CURVE_AHEAD)
 class SpeedPlanningParams:
     a_comf: float = A_COMF  # [m/s^2] comfortable deceleration towards constraints ahead
     a_lat_max: float = 3.0  # [m/s^2] lateral acceleration allowed in curves
-    limit_margin: float = 0.3 * KPH  # [m/s] target below a posted limit: room for ripple
+    limit_margin: float = kph(0.3)  # [m/s] target below a posted limit: room for ripple
     brake_margin: float = 3.0  # [m] the braking curve reaches v_c this far before d = 0
     sample_spacing: float = 0.5  # [m] station step of the curvature samples (map-fixed grid)
     min_curvature: float = 1e-6  # [1/m] below this |kappa| the lane is straight (no limit)

@@ -36,7 +36,7 @@ class Rule:
 RULES = (
     Rule("perception", ("perception", *STATIC_WORLD), no_pybullet=True),
     Rule("planner", ("planner", "perception.messages", *STATIC_WORLD), no_pybullet=True),
-    Rule("control", ("control", "planner.messages"), no_pybullet=True),
+    Rule("control", ("control", "planner.messages", "world.frames"), no_pybullet=True),
     Rule("world", ("world", "vehicle_urdf"), no_pybullet=False),
     Rule("vehicle_urdf", ("vehicle_urdf",), no_pybullet=False),
 )

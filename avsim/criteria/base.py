@@ -25,7 +25,6 @@ from numpy.typing import NDArray
 if TYPE_CHECKING:
     from world.actors.actor_set import ActorPoses
 
-KPH = 1 / 3.6  # [m/s] per km/h
 SPEED_TOLERANCE_KPH = 1.0  # [km/h] the speed_limit rule's tolerance
 DECEL_WINDOW = 0.2  # [s] moving average of the max_decel criterion
 

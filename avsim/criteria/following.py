@@ -12,7 +12,6 @@ import numpy as np
 from pydantic import AfterValidator, BeforeValidator, Field
 
 from avsim.criteria.base import (
-    KPH,
     SPEED_TOLERANCE_KPH,
     Criterion,
     CriterionResult,
@@ -22,6 +21,7 @@ from avsim.criteria.base import (
 from avsim.criteria.declaration import Declaration
 from avsim.scenario.fields import NonNegFloat, PosFloat, problem
 from planner.fsm.acc import r157_min_gap
+from world.frames import kph
 from world.hdmap import RoadMap
 
 R157 = "r157"  # the min_gap setting for UN R157's d_min(v)
@@ -156,11 +156,11 @@ class TimeToResume(Criterion):
     def update(self, sample: TruthSample) -> None:
         self._t = sample.t
         want = min(self.set_speed, float(self.road.speed_limit_at(sample.front_station)))
-        slow = sample.speed < want - SPEED_TOLERANCE_KPH * KPH
+        slow = sample.speed < want - kph(SPEED_TOLERANCE_KPH)
         a = sample.actors
         reach = 3.0 * want + 10.0
         blocking = a is not None and any(
-            g <= reach and a.speeds[a.ids.index(name)] < want - SPEED_TOLERANCE_KPH * KPH
+            g <= reach and a.speeds[a.ids.index(name)] < want - kph(SPEED_TOLERANCE_KPH)
             for name, g, _ in vehicles_ahead(sample, self.road, self.ego_length).values())
         if self._clear_at is not None and (not slow or blocking):
             self._close(sample)

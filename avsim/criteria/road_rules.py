@@ -10,7 +10,6 @@ from collections.abc import Sequence
 import numpy as np
 
 from avsim.criteria.base import (
-    KPH,
     SPEED_TOLERANCE_KPH,
     Criterion,
     CriterionResult,
@@ -18,6 +17,7 @@ from avsim.criteria.base import (
     TruthSample,
 )
 from avsim.criteria.declaration import Declaration
+from world.frames import to_kph
 from world.hdmap import Crosswalk, RoadMap, SpeedBump, StopSign
 from world.spec import ActorType, TrafficLightSpec
 
@@ -206,11 +206,11 @@ class SpeedBumps(Criterion):
         for lo, hi, pass_speed in self.bumps:
             if not any(lo <= x <= hi for x in axles):
                 continue
-            excess = (sample.speed - pass_speed) / KPH
+            excess = to_kph(sample.speed - pass_speed)
             self.worst = excess if self.worst is None else max(self.worst, excess)
             if excess > SPEED_TOLERANCE_KPH:
-                self._fail(sample, f"speed {sample.speed / KPH:.1f} km/h over the bump "
-                                   f"{pass_speed / KPH:.0f} km/h by {excess:.1f} km/h")
+                self._fail(sample, f"speed {to_kph(sample.speed):.1f} km/h over the bump "
+                                   f"{to_kph(pass_speed):.0f} km/h by {excess:.1f} km/h")
 
     def result(self) -> CriterionResult:
         value = 0.0 if self.worst is None else self.worst

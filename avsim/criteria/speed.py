@@ -8,7 +8,6 @@ from collections import deque
 
 from avsim.criteria.base import (
     DECEL_WINDOW,
-    KPH,
     SPEED_TOLERANCE_KPH,
     Criterion,
     CriterionResult,
@@ -17,6 +16,7 @@ from avsim.criteria.base import (
 )
 from avsim.criteria.declaration import Declaration
 from avsim.scenario.fields import PosFloat
+from world.frames import to_kph
 from world.hdmap import RoadMap
 
 
@@ -33,11 +33,11 @@ class SpeedLimit(Criterion):
 
     def update(self, sample: TruthSample) -> None:
         limit = float(self.road.speed_limit_at(sample.front_station))
-        excess = (sample.speed - limit) / KPH
+        excess = to_kph(sample.speed - limit)
         self.excess = max(self.excess, excess)
         if excess > SPEED_TOLERANCE_KPH:
-            self._fail(sample, f"speed {sample.speed / KPH:.1f} km/h over the limit "
-                               f"{limit / KPH:.0f} km/h by {excess:.1f} km/h")
+            self._fail(sample, f"speed {to_kph(sample.speed):.1f} km/h over the limit "
+                               f"{to_kph(limit):.0f} km/h by {excess:.1f} km/h")
 
     def result(self) -> CriterionResult:
         return CriterionResult(self.name, self.excess <= SPEED_TOLERANCE_KPH, self.excess,

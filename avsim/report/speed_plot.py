@@ -36,12 +36,12 @@ from numpy.typing import NDArray
 
 from planner.fsm.acc import AccMode
 from planner.messages import SpeedSource
+from world.frames import MPS_PER_KPH
 from world.map.road import build_road_map
 
 if TYPE_CHECKING:
     from avsim.run.runner import RunResult
 
-KPH = 3.6  # [km/h per m/s]
 SIZE = (16.0, 7.0)  # [in] at DPI: 1600 x 700 px
 DPI = 100
 BAND_ALPHA = 0.3
@@ -167,10 +167,10 @@ def speed_profile_figure(result: RunResult) -> Figure:
     t = log.array("t")
     limit = log.array("speed_limit")
     series = {
-        "ego": log.array("speed") * KPH,
-        "lead": lead_speed(result) * KPH,
-        "limit": np.where(np.isfinite(limit), limit, math.nan) * KPH,
-        "set": np.full(len(t), result.scenario.driver.set_speed * KPH),
+        "ego": log.array("speed") / MPS_PER_KPH,
+        "lead": lead_speed(result) / MPS_PER_KPH,
+        "limit": np.where(np.isfinite(limit), limit, math.nan) / MPS_PER_KPH,
+        "set": np.full(len(t), result.scenario.driver.set_speed / MPS_PER_KPH),
     }
     for key, values in series.items():
         label, colour, style, width = LINES[key]

@@ -30,6 +30,7 @@ from scipy.optimize import linear_sum_assignment
 
 from perception.messages import Detection, LaneEstimate, ObjectClass, Track
 from world.actors.actor_set import ActorPoses
+from world.frames import wrap_angle
 from world.sensors.lidar import LidarTruth
 from world.spec import ActorType
 
@@ -54,10 +55,6 @@ class ScoringParams:
     detection_range: float = 50.0  # [m]
     match_distance: float = 2.0  # [m]
     min_returns: int = 10  # [-] LiDAR returns on a car for it to count as seen
-
-
-def _wrap(a: float) -> float:
-    return math.remainder(a, 2.0 * math.pi)
 
 
 def _rms(x: list[float]) -> float:
@@ -104,7 +101,7 @@ class PerceptionScore:
             return
         if filtered is not None:
             self.offset_err.append(filtered.offset - truth.lane_offset)
-            self.heading_err.append(_wrap(filtered.heading_error - truth.lane_heading_error))
+            self.heading_err.append(wrap_angle(filtered.heading_error - truth.lane_heading_error))
         if raw is not None and raw.confidence > 0.0:
             self.raw_offset_err.append(raw.offset - truth.lane_offset)
 

@@ -29,7 +29,7 @@ from avsim.run.scoring import CaptureTruth, PerceptionScore
 from avsim.run.stack import PerceptionOutput, Stack
 from perception.messages import Detection
 from world.core.rates import CONTROL_RATE
-from world.frames import CameraFrame, Frame, LidarScan
+from world.frames import CameraFrame, Frame, LidarScan, wrap_angle
 from world.sensors.lidar import LidarTruth
 from world.sensors.pipeline import Capture, InlineSensing, ProcessSensing, Sensing
 from world.sensors.schedule import Due, SensorSchedule
@@ -130,8 +130,8 @@ class SensorLoop:
             values["lane_confidence"] = out.lane.confidence
             if truth.lane_offset is not None:
                 values["lane_offset_error"] = out.lane.offset - truth.lane_offset
-                values["lane_heading_error"] = math.remainder(
-                    out.lane.heading_error - truth.lane_heading_error, 2.0 * math.pi)
+                values["lane_heading_error"] = wrap_angle(
+                    out.lane.heading_error - truth.lane_heading_error)
         if out.tracks is not None:
             values["tracks"] = float(len(out.tracks))
         if values:
@@ -149,7 +149,7 @@ class SensorLoop:
         if lane is not None:
             heading = float(w.road.lane(lane).heading_at(s))
             heading += math.pi if lane < 0 else 0.0
-            heading_error = math.remainder(truth.yaw - heading, 2.0 * math.pi)
+            heading_error = wrap_angle(truth.yaw - heading)
         return CaptureTruth(t=w.t, ego_xy=np.array(xy), ego_yaw=truth.yaw,
                             lane_offset=None if lane is None else r,
                             lane_heading_error=heading_error, actors=w.actors.poses)

@@ -40,9 +40,9 @@ from avsim.scenario.model import (
 )
 from avsim.scenario.scenario import DriverSettings, Scenario
 from world import frames, hdmap, spec
+from world.frames import MPS_PER_KPH
 from world.map.town import TownError, TownLayout, compile_route
 
-MPS_PER_KPH = 1000.0 / 3600.0  # [m/s] per [km/h]
 TOWN_START_S = 5.0  # [m] default station of a car on its town route (past the start mouth)
 
 

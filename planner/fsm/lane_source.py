@@ -32,6 +32,7 @@ import enum
 from dataclasses import dataclass
 
 from planner.fsm.machine import Row, Table, Transition, next_state, render
+from world.frames import kph
 
 
 class LaneSource(enum.Enum):
@@ -49,7 +50,7 @@ class LaneSourceParams:
     lose: float = 0.3  # [-] confidence below which the camera's lane is lost
     acquire_time: float = 1.0  # [s] ACQUIRING this long without a lane: hold on the map
     stop_after: float = 5.0  # [s] MAP_HOLD this long: stop in lane
-    hold_speed: float = 20.0 / 3.6  # [m/s] speed while holding the lane on the map
+    hold_speed: float = kph(20.0)  # [m/s] speed while holding the lane on the map
 
 
 @dataclass(frozen=True, slots=True)

@@ -1,5 +1,5 @@
-"""control/ imports only planner.messages (plus numpy and the standard library), and is clean
-under ruff and mypy --strict."""
+"""control/ imports only planner.messages and the shared conventions of world.frames (plus
+numpy and the standard library), and is clean under ruff and mypy --strict."""
 
 from __future__ import annotations
 
@@ -13,7 +13,7 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
 CONTROL = ROOT / "control"
-ALLOWED_FIRST_PARTY = {"control", "planner.messages"}
+ALLOWED_FIRST_PARTY = {"control", "planner.messages", "world.frames"}
 ALLOWED_THIRD_PARTY = {"numpy"}
 
 
@@ -28,7 +28,7 @@ def imported_modules(path: Path) -> set[str]:
 
 
 @pytest.mark.parametrize("path", sorted(CONTROL.glob("*.py")), ids=lambda p: p.name)
-def test_control_imports_only_planner_messages(path: Path) -> None:
+def test_control_imports_only_the_plan_and_the_conventions(path: Path) -> None:
     for module in imported_modules(path):
         top = module.split(".")[0]
         if top in sys.stdlib_module_names or top in ALLOWED_THIRD_PARTY:

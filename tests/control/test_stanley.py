@@ -8,10 +8,11 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from control.stanley import FrontAxleError, StanleyPid, front_axle_error, wrap_angle
+from control.stanley import FrontAxleError, StanleyPid, front_axle_error
 from planner.messages import ReferencePath
 from tests.control.paths import straight, straight_then_arc
 from tests.vehicle import stanley_params
+from world.frames import wrap_angle
 
 L = 2.7  # [m] wheelbase
 DT = 0.05  # [s]

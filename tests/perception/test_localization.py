@@ -13,9 +13,8 @@ from perception.localization import (
     LocalizerParams,
     NotInitialisedError,
     motion,
-    wrap_angle,
 )
-from world.frames import GnssFix, Odometry
+from world.frames import GnssFix, Odometry, wrap_angle
 
 DEG = math.pi / 180.0
 ODO_RATE = 40.0  # [Hz]

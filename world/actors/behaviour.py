@@ -25,6 +25,7 @@ import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
+from world.frames import wrap_angle
 from world.spec import (
     ActionSpec,
     AfterTrigger,
@@ -152,10 +153,9 @@ class NpcMotion:
             return
         course = math.atan2(self.lateral_speed, self.direction * self.speed)  # route frame
         wanted = course if self.direction > 0 else course - math.pi  # from its lane's direction
-        error = math.remainder(wanted - self._facing, 2.0 * math.pi)
+        error = wrap_angle(wanted - self._facing)
         limit = PEDESTRIAN_TURN_RATE * dt
-        self._facing = math.remainder(self._facing + max(-limit, min(limit, error)),
-                                      2.0 * math.pi)
+        self._facing = wrap_angle(self._facing + max(-limit, min(limit, error)))
 
     def _step_speed(self, t: float, dt: float) -> None:
         error = self._target_speed - self._planned

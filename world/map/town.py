@@ -47,6 +47,7 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
 
+from world.frames import wrap_angle
 from world.hdmap import Control, Junction, LightHead, Manoeuvre, StopSign, Zone
 from world.spec import FeatureSpec, RoadSpec, SegmentSpec, TownSpec, TrafficLightSpec
 
@@ -166,7 +167,7 @@ class TownLayout:
         corner = self.half_width + self.corner_radius * (1.0 - math.sqrt(0.5))
         corner += LIGHT_BEHIND_KERB * math.sqrt(0.5)
         x, y = self.point(j, heading, corner, corner)
-        head = LightHead(x, y, LIGHT_HEIGHT, _wrap(HEADINGS[heading] + math.pi))
+        head = LightHead(x, y, LIGHT_HEIGHT, wrap_angle(HEADINGS[heading] + math.pi))
         red = t.cycle - t.green - t.yellow
         return TrafficLightSpec(0.0, t.green, t.yellow, red, offset % t.cycle, head)
 
@@ -184,7 +185,7 @@ class TownLayout:
                 sign = None
                 if control is Control.STOP_SIGNS:
                     pole = self.point(j, heading, back, self.half_width + SIGN_CLEARANCE)
-                    sign = (pole, _wrap(HEADINGS[heading] + math.pi))
+                    sign = (pole, wrap_angle(HEADINGS[heading] + math.pi))
                 light = self.signal(j, heading) if control is Control.TRAFFIC_LIGHTS else None
                 out.append(Approach(j, heading, line, sign, light))
         return out
@@ -309,6 +310,3 @@ def _controls(layout: TownLayout, junction: Junction, heading: str) -> list[Feat
         return [replace(layout.signal(junction.index, heading), s=junction.s_stop)]
     return []
 
-
-def _wrap(angle: float) -> float:
-    return math.atan2(math.sin(angle), math.cos(angle))

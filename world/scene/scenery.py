@@ -17,12 +17,12 @@ import cv2
 import numpy as np
 from numpy.typing import NDArray
 
+from world.frames import to_kph, wrap_angle
 from world.hdmap import RoadMap, StopSign
 from world.spec import BuildingsSpec
 
 FloatArray = NDArray[np.float64]
 
-MPS_TO_KPH = 3.6  # [km/h per m/s]
 
 # -- buildings ----------------------------------------------------------------------------
 FRONTAGE_RANGE = (10.0, 30.0)  # [m] along the road
@@ -112,11 +112,6 @@ def _rotation(yaw: float) -> FloatArray:
     return np.array([[c, -s], [s, c]])
 
 
-def _wrap(angle: float) -> float:
-    """[rad] angle wrapped to (-pi, pi]."""
-    return math.pi - (math.pi - angle) % (2.0 * math.pi)
-
-
 # -- buildings ----------------------------------------------------------------------------
 
 
@@ -186,7 +181,7 @@ def _place(
         box = BuildingBox(
             (float(x), float(y), 0.5 * height),
             (0.5 * frontage, 0.5 * depth, 0.5 * height),
-            _wrap(heading),
+            wrap_angle(heading),
             rgb,
         )
         intrusion = road_intrusion(road_map, _outline(box), setback, side)
@@ -248,7 +243,7 @@ def roadside_pose(road_map: RoadMap, s: float) -> tuple[tuple[float, float], flo
     right, _ = road_map.paved_edges(s)
     x, y = road_map.position(s, float(right) - SIGN_CLEARANCE)
     heading = float(road_map.heading_at(s))
-    return (float(x), float(y)), _wrap(heading + math.pi)
+    return (float(x), float(y)), wrap_angle(heading + math.pi)
 
 
 def layout_speed_limit_signs(road_map: RoadMap) -> list[SignPlacement]:
@@ -260,7 +255,7 @@ def layout_speed_limit_signs(road_map: RoadMap) -> list[SignPlacement]:
         signs.append(
             SignPlacement(
                 s=posting.s,
-                kph=round(posting.limit * MPS_TO_KPH),
+                kph=round(to_kph(posting.limit)),
                 limit=posting.limit,
                 pole_xy=pole_xy,
                 yaw=yaw,

@@ -7,14 +7,13 @@ Noise is drawn from the sensor's own seeded generator, so a run is reproducible.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from world.core.rates import GNSS, Rate
 from world.ego.body import EgoTruth
-from world.frames import GnssFix
+from world.frames import GnssFix, wrap_angle
 from world.sensors.sensor import Reading
 from world.spec import GnssSpec
 
@@ -46,7 +45,7 @@ class GnssSensor:
             t=t,
             x=float(truth.position[0] + self.spec.bias[0] + self.spec.sigma * noise[0]),
             y=float(truth.position[1] + self.spec.bias[1] + self.spec.sigma * noise[1]),
-            heading=math.atan2(math.sin(heading), math.cos(heading)),
+            heading=wrap_angle(heading),
             sigma=self.spec.sigma,
             heading_sigma=self.spec.heading_sigma,
         )

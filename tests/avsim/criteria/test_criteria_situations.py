@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from avsim.criteria.base import KPH, CriterionResult, TruthSample
+from avsim.criteria.base import CriterionResult, TruthSample
 from avsim.criteria.following import StandstillGap, TimeToResume
 from avsim.criteria.lane import (
     LINE_HALF_WIDTH,
@@ -18,6 +18,7 @@ from avsim.criteria.lane import (
 from tests.roads import W, make_map, seg
 from tests.vehicle import CAR
 from world.actors.actor_set import ActorPoses
+from world.frames import MPS_PER_KPH as KPH
 from world.hdmap import RoadMap
 from world.spec import ActorType
 
