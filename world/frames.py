@@ -5,8 +5,9 @@ may import it without reaching into the simulator.
 
 Frames:
 - map: ENU-like, x east, y north, z up, yaw counter-clockwise from +x;
-- vehicle: the car's footprint frame, origin on the ground below the car's centre (the base
-  link origin), x forward, y left, z up; it moves with the body (pitch and roll included);
+- vehicle: the car's footprint frame, origin on the ground below the car's centre (below the
+  base link origin, which is at wheel-centre height), x forward, y left, z up; it moves with
+  the body (pitch and roll included);
 - sensor: a sensor's own frame, placed on the vehicle by its `SensorMount`; x along the
   sensor's axis (a camera's optical axis), y left, z up.
 
@@ -146,14 +147,14 @@ class CameraInfo:
     images at ``u = cx - fx Y / X``, ``v = cy - fy Z / X``.
     """
 
-    name: str  # "front", "left", "right"
+    name: str  # the camera's place on the car: "front", "left", "right"
     width: int  # [px]
     height: int  # [px]
     fov_x: float  # [rad] horizontal field of view
-    mount: SensorMount
+    mount: SensorMount  # its frame on the car
     rate: float  # [Hz] frames per second
-    near: float = 0.1  # [m] clipping distance of the renderer
-    far: float = 250.0  # [m]
+    near: float = 0.1  # [m] the renderer's near clipping distance
+    far: float = 250.0  # [m] the renderer's far clipping distance
 
     @property
     def fx(self) -> float:
@@ -162,6 +163,7 @@ class CameraInfo:
 
     @property
     def fy(self) -> float:
+        """[px] vertical focal length, = fx."""
         return self.fx
 
     @property
@@ -171,6 +173,7 @@ class CameraInfo:
 
     @property
     def cy(self) -> float:
+        """[px] principal point, the image centre."""
         return 0.5 * self.height
 
     @property
@@ -198,18 +201,20 @@ class LidarInfo:
 
     elevations: tuple[float, ...]  # [rad] per channel (ring), ascending
     azimuth_steps: int  # [-] columns per revolution
-    max_range: float  # [m]
+    max_range: float  # [m] farthest return
     rate: float  # [Hz] revolutions per second
-    mount: SensorMount
+    mount: SensorMount  # its frame on the car
     range_sigma: float = 0.02  # [m] range noise, 1-sigma
     dropout: float = 0.0  # [-] fraction of returns lost
 
     @property
     def channels(self) -> int:
+        """[-] beams (rings) per column."""
         return len(self.elevations)
 
     @property
     def rays(self) -> int:
+        """[-] rays per revolution, channels * azimuth_steps."""
         return self.channels * self.azimuth_steps
 
 
