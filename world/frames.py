@@ -99,7 +99,7 @@ class Odometry:
 
     t: float  # [s] sim time of the measurement
     wheel_speeds: tuple[float, float, float, float]  # [rad/s] FL, FR, RL, RR spin rates
-    wheel_radius: float  # [m] nominal rolling radius the car was built with
+    wheel_radius: float  # [m] the car's nominal rolling radius
     yaw_rate: float  # [rad/s] gyro z, counter-clockwise positive
     steering_angle: float  # [rad] measured road-wheel angle (bicycle equivalent), left +
     accelerator_pedal: float = 0.0  # [-] 0..1, the driver's accelerator pedal position sensor
