@@ -9,10 +9,9 @@ their lane's centre like any actor; their speed is a walking speed along the lan
 
 Each actor follows a line: in a town, its own route road; on a road with an exit, an actor
 that starts before the fork keeps the road the route leaves (`RoadMap.through_line`); any
-other, the route. Bodies are placed with one
-scalar map lookup per moving actor; `poses` (all of them, for criteria, scoring and the
-recording) is one vectorised map call, when asked, with every station and offset taken on
-the ego's route.
+other, the route. Bodies are placed with one scalar map lookup per moving actor; `poses`
+(all of them, for criteria, scoring and the recording) is one vectorised map call, when
+asked, with every station and offset taken on the ego's route.
 """
 
 from __future__ import annotations

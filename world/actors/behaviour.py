@@ -2,11 +2,11 @@
 
 Pure (no PyBullet): `NpcMotion` holds one actor's state along the route (station, lateral
 offset from the reference line, speed, lateral speed) and its pending actions; `step()`
-advances it by dt. Positions and headings never jump: the scripted speed changes at the
-action's acceleration, and lateral moves follow a trapezoidal lateral-speed profile (ramps
-of `LATERAL_ACCEL`, cruise at the action's lateral speed). A town driver's `cap`
-(`world.actors.town_traffic`) may lower the speed at once; the speed comes back up at
-`CAP_ACCEL` when it lifts.
+advances it by dt. Scripted motion is smooth: the speed changes at the action's
+acceleration, and lateral moves follow a trapezoidal lateral-speed profile (ramps of
+`LATERAL_ACCEL`, cruise at the action's lateral speed), so positions and headings never
+jump. A town driver's `cap` (`world.actors.town_traffic`) may lower the speed at once; the
+speed comes back up at `CAP_ACCEL` when it lifts.
 
 Actions (scenario format): `speed` (to a speed at an acceleration), `lane_change` (to a
 lane's centre at a lateral speed), `walk` (across the road to an offset from the actor's
