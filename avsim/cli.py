@@ -27,13 +27,14 @@ if TYPE_CHECKING:
     from avsim.batch.jobs import RunJob, RunOutcome
     from avsim.run.runner import Runner, RunResult
 
-PROFILES = ("fast", "default", "paper", "none")
-SENSING = ("auto", "inline", "process")
-EXIT_FAILED, EXIT_BAD_INPUT = 1, 2
+PROFILES = ("fast", "default", "paper", "none")  # sensor profiles (`world.sensors.setup`)
+SENSING = ("auto", "inline", "process")  # where the cameras render
+EXIT_FAILED, EXIT_BAD_INPUT = 1, 2  # exit statuses (module doc)
 PLOT_NEXT_TO_RECORDING = "\0next-to-recording"  # `--plot` given without a file name
 
 
 def _bad_input(message: str) -> NoReturn:
+    """Print `message` as one error line on stderr and exit with `EXIT_BAD_INPUT`."""
     click.echo(f"avsim: error: {message}", err=True)
     sys.exit(EXIT_BAD_INPUT)
 
@@ -109,6 +110,7 @@ def run(scenario: str, out: Path | None, json_path: Path | None, profile: str, s
 
 
 def _run_with_progress(runner: Runner, duration: float, show: bool) -> RunResult:
+    """Run, with a progress bar in sim seconds on stderr when `show` and it is a terminal."""
     console = Console(stderr=True)
     if not show or not console.is_terminal:
         return runner.run()
@@ -120,6 +122,7 @@ def _run_with_progress(runner: Runner, duration: float, show: bool) -> RunResult
 
 
 def _print_verdict(payload: dict[str, object]) -> None:
+    """The result file's verdict as a table of criteria, then the run's times and files."""
     console = Console()
     table = Table(title=f"{payload['scenario']}: {'PASS' if payload['passed'] else 'FAIL'}")
     for column in ("criterion", "verdict", "value", "threshold", "unit"):
@@ -171,6 +174,7 @@ _batch_options = [
 
 
 def batch_options(f: Callable[..., None]) -> Callable[..., None]:
+    """Decorate a batch command with the options suite and sweep share."""
     for option in reversed(_batch_options):
         f = option(f)
     return f
@@ -235,6 +239,7 @@ def sweep(scenario: str, sets: tuple[str, ...], out: Path | None, metric: str,
 
 def _execute(planned: Sequence[RunJob], executor: str, jobs: int | None,
              address: str | None) -> list[RunOutcome]:
+    """Run the planned jobs on the chosen executor (`--jobs` default: this machine's cores)."""
     from avsim.batch import suite as batch
     from avsim.batch.executors import ExecutorError, LocalExecutor, RayExecutor
 
@@ -248,6 +253,7 @@ def _execute(planned: Sequence[RunJob], executor: str, jobs: int | None,
 
 
 def _report(outcomes: Sequence[RunOutcome], out: Path, title: str, snapshots: bool) -> None:
+    """Snapshots of the failed runs (if asked), junit.xml and summary.md; the table printed."""
     from avsim.batch import suite as batch
     from avsim.report.suite import summary_table
 
@@ -260,6 +266,7 @@ def _report(outcomes: Sequence[RunOutcome], out: Path, title: str, snapshots: bo
 
 def _sweep_report(outcomes: Sequence[RunOutcome], out: Path, swept: list[str],
                   params: list[str], metric: str, name: str) -> None:
+    """sweep.csv and sweep.md over every parameter; heatmap.png when two keys were swept."""
     from avsim.report.sweep import heat_map, sweep_csv, sweep_markdown, sweep_rows
 
     metrics = sorted({metric, "min_gap", "max_decel", "collisions"})

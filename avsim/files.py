@@ -7,7 +7,7 @@ import os
 import tempfile
 from pathlib import Path
 
-FILE_MODE = 0o644  # what a plain `open` would make (mkstemp makes 0o600)
+FILE_MODE = 0o644  # [-] permission bits, as a plain `open` makes them (mkstemp: 0o600)
 
 
 def write_atomic(path: Path, data: str | bytes) -> None:

@@ -5,8 +5,9 @@ may import it without reaching into the simulator.
 
 Frames:
 - map: ENU-like, x east, y north, z up, yaw counter-clockwise from +x;
-- vehicle: the car's footprint frame, origin on the ground below the car's centre (the base
-  link origin), x forward, y left, z up; it moves with the body (pitch and roll included);
+- vehicle: the car's footprint frame, origin on the ground below the car's centre (below the
+  base link origin, which is at wheel-centre height), x forward, y left, z up; it moves with
+  the body (pitch and roll included);
 - sensor: a sensor's own frame, placed on the vehicle by its `SensorMount`; x along the
   sensor's axis (a camera's optical axis), y left, z up.
 
@@ -99,7 +100,7 @@ class Odometry:
 
     t: float  # [s] sim time of the measurement
     wheel_speeds: tuple[float, float, float, float]  # [rad/s] FL, FR, RL, RR spin rates
-    wheel_radius: float  # [m] nominal rolling radius the car was built with
+    wheel_radius: float  # [m] the car's nominal rolling radius
     yaw_rate: float  # [rad/s] gyro z, counter-clockwise positive
     steering_angle: float  # [rad] measured road-wheel angle (bicycle equivalent), left +
     accelerator_pedal: float = 0.0  # [-] 0..1, the driver's accelerator pedal position sensor
@@ -147,13 +148,13 @@ class CameraInfo:
     images at ``u = cx - fx Y / X``, ``v = cy - fy Z / X``.
     """
 
-    name: str  # "front", "left", "right"
+    name: str  # the camera's place on the car: "front", "left", "right"
     width: int  # [px]
     height: int  # [px]
     fov_x: float  # [rad] horizontal field of view
-    mount: SensorMount
-    near: float = 0.1  # [m] clipping distance of the renderer
-    far: float = 250.0  # [m]
+    mount: SensorMount  # its frame on the car
+    near: float = 0.1  # [m] the renderer's near clipping distance
+    far: float = 250.0  # [m] the renderer's far clipping distance
 
     @property
     def fx(self) -> float:
@@ -162,6 +163,7 @@ class CameraInfo:
 
     @property
     def fy(self) -> float:
+        """[px] vertical focal length, = fx."""
         return self.fx
 
     @property
@@ -171,6 +173,7 @@ class CameraInfo:
 
     @property
     def cy(self) -> float:
+        """[px] principal point, the image centre."""
         return 0.5 * self.height
 
     @property
@@ -198,17 +201,19 @@ class LidarInfo:
 
     elevations: tuple[float, ...]  # [rad] per channel (ring), ascending
     azimuth_steps: int  # [-] columns per revolution
-    max_range: float  # [m]
-    mount: SensorMount
+    max_range: float  # [m] farthest return
+    mount: SensorMount  # its frame on the car
     range_sigma: float = 0.02  # [m] range noise, 1-sigma
     dropout: float = 0.0  # [-] fraction of returns lost
 
     @property
     def channels(self) -> int:
+        """[-] beams (rings) per column."""
         return len(self.elevations)
 
     @property
     def rays(self) -> int:
+        """[-] rays per revolution, channels * azimuth_steps."""
         return self.channels * self.azimuth_steps
 
 

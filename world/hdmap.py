@@ -4,15 +4,16 @@ What the stack may know of the road, and nothing more: lane geometry, speed limi
 lines, crosswalks, speed bumps, junctions and where the traffic lights' heads stand; no
 signal timing and no actor (those stay in the world: `world.spec`, `world.map.signals`).
 A map kind builds it: a route road (`world.map.road`), a town route (`world.map.town`).
-Other modules (planner, road mesh builder, actors, criteria) code against this API.
+The planner, the road mesh builder, the actors and the criteria code against this API.
 
-Geometry: the route's reference line is the centre line of lane 0 (the rightmost lane of the
-ego's direction), a chain of straight and constant-curvature arc pieces laid end to end from
-an origin pose (a road's: the origin, heading +x; a town route starts where its start
-junction is). Every lane shares the route's station `s` (metres along the
-reference line); a lane is the reference line shifted sideways by the lane's `offset_at(s)`.
-Lateral `r` is metres from the lane's centre, left of the route direction positive (for
-oncoming lanes too: their travel `direction` is -1 but s and r stay in route coordinates).
+Geometry (map frame, `world.frames`; metres, radians): the route's reference line is the
+centre line of lane 0 (the rightmost lane of the ego's direction), a chain of straight and
+constant-curvature arc pieces laid end to end from an origin pose (a road's: its `origin`; a
+town route's: its start junction's mouth). Every lane shares the route's station `s`
+(metres along the reference line); a lane is the reference line shifted sideways by the
+lane's `offset_at(s)`. Lateral `r` is metres from the lane's centre, left of the route
+direction positive (for oncoming lanes too: their travel `direction` is -1 but s and r stay
+in route coordinates).
 
 Across, on a segment with `lanes` ego lanes of width w and `oncoming_lanes` oncoming lanes
 (offsets from the reference line, left +):
@@ -63,6 +64,8 @@ class Zone(enum.Enum):
 
 
 class Side(enum.Enum):
+    """A side of the road, seen in the route direction."""
+
     RIGHT = "right"
     LEFT = "left"
 
@@ -166,7 +169,7 @@ class Piece:
 
     s0: float  # [m] station at its start
     length: float  # [m]
-    curvature: float  # [1/m] signed, 0 for straight
+    curvature: float  # [1/m] signed, left +, 0 for straight
     x0: float  # [m] map frame start point
     y0: float  # [m]
     heading0: float  # [rad] heading at its start
@@ -176,10 +179,10 @@ class Piece:
 class CrossSection:
     """The road's layout across, on one segment."""
 
-    lanes: int
-    oncoming_lanes: int
-    lane_width: float  # [m]
-    shoulder: float  # [m]
+    lanes: int  # [-] ego-direction lanes
+    oncoming_lanes: int  # [-] lanes against the route direction
+    lane_width: float  # [m] every lane's width
+    shoulder: float  # [m] paved right shoulder's width, 0 for none
     zone: Zone
 
     @property
@@ -206,7 +209,7 @@ class CrossSection:
 
 @dataclass(frozen=True, slots=True)
 class Exit:
-    """Where the route leaves the road it was on by an exit on the right: the route goes on
+    """Where the route leaves its road by an exit on the right: the route goes on
     into the exit segment (a ramp: its own lanes and limit), the road goes on straight from
     the fork as scenery, with its lanes and its traffic (`RoadMap.through_line`).
 
@@ -284,10 +287,12 @@ class ReferenceLine:
         return np.searchsorted(self.inner_bounds, s, side="right")
 
     def heading(self, s: FloatArray) -> FloatArray:
+        """[rad] heading at stations s: h0 + k (s - s0) of the piece, not wrapped."""
         i = self.piece_index(s)
         return self.h0[i] + self.k[i] * (s - self.s0[i])
 
     def curvature(self, s: FloatArray) -> FloatArray:
+        """[1/m] signed curvature at stations s (left +)."""
         return self.k[self.piece_index(s)]
 
     def pose(self, s: FloatArray, d: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
@@ -310,7 +315,7 @@ class ReferenceLine:
 
     def pose_one(self, s: float, d: float) -> tuple[float, float, float]:
         """(x, y, heading) at one station s and offset d: `pose` for a single point in plain
-        floats (a few microseconds, where numpy's per-call cost would dominate)."""
+        floats, where numpy's per-call overhead would dominate."""
         s0, h0, k, straight, inv_k, cx, cy, cos_h0, sin_h0 = self._scalar[
             bisect.bisect_right(self._bounds_list, s)]
         t = s - s0
@@ -364,7 +369,9 @@ class ReferenceLine:
 
 
 def piece_end(piece: Piece) -> tuple[FloatArray, float]:
-    """([m] end point (2,), [rad] end heading) of a piece."""
+    """([m] end point (2,), [rad] end heading) of a piece, in closed form: with theta = k L,
+    along = L sin(theta) / theta and side = L (1 - cos(theta)) / theta in the start frame,
+    written with sinc so that a straight (theta = 0) takes no branch."""
     k, t, h0 = piece.curvature, piece.length, piece.heading0
     theta = k * t
     along = t * float(np.sinc(theta / np.pi))
@@ -447,7 +454,7 @@ class Lane:
 
 
 class RoadMap:
-    """The HD map of one `road` scenario."""
+    """The HD map of one route: a road's or a town route's."""
 
     pieces: tuple[Piece, ...]
     length: float  # [m] route length (end station)
@@ -471,9 +478,9 @@ class RoadMap:
         exit_pieces: tuple[int, ...] = (),
         junctions: tuple[Junction, ...] = (),
     ) -> None:
-        """A map kind's builder makes it (`world.map.road.build_road_map`): this takes the
-        already laid pieces, one section per piece, and the indices of the pieces that leave
-        the road before them by an exit (right)."""
+        """A map kind's builder makes it (`world.map.road.build_road_map`) from the laid
+        pieces, one section per piece, and `exit_pieces`: the indices of the pieces that
+        begin with an exit on the right (the route leaves its road at their start)."""
         self.pieces = pieces
         self.junctions = tuple(sorted(junctions, key=lambda j: j.s_stop))
         self.sections = sections

@@ -45,13 +45,14 @@ class SegmentSpec:
 
     length: float  # [m] along the reference line, > 0
     curvature: float  # [1/m] signed, > 0 turns left, 0 for a straight
-    lanes: int  # driving lanes in the ego's direction, >= 1; lane 0 is the rightmost
-    oncoming_lanes: int  # lanes in the other direction, left of the yellow centre line
-    lane_width: float  # [m]
-    shoulder: float  # [m] paved right shoulder
+    lanes: int  # [-] driving lanes in the ego's direction, >= 1; lane 0 is the rightmost
+    oncoming_lanes: int  # [-] lanes in the other direction, left of the yellow centre line
+    lane_width: float  # [m] every lane's width
+    shoulder: float  # [m] paved right shoulder's width, 0 for none
     speed_limit: float | None = None  # [m/s] posted at the segment's start; None: unchanged
     zone: Zone | None = None  # scenery style; None: as the segment before (highway at start)
-    exit: Side | None = None  # this segment leaves the previous road by an exit (issue D)
+    exit: Side | None = None  # the route leaves the road here by an exit on this side (right
+    #   only: `world.map.road`); the road goes on straight as scenery
 
 
 @dataclass(frozen=True, slots=True)
@@ -70,6 +71,7 @@ class TrafficLightSpec:
 
     @property
     def cycle(self) -> float:
+        """[s] green + yellow + red."""
         return self.green + self.yellow + self.red
 
 
@@ -78,17 +80,22 @@ FeatureSpec = SpeedLimitSign | StopSign | Crosswalk | SpeedBump | TrafficLightSp
 
 @dataclass(frozen=True, slots=True)
 class BuildingsSpec:
+    """Buildings beside a road (`world.scene.scenery`)."""
+
     density: float  # [-] 0..1, fraction of the roadside frontage that is built up
     setback: float  # [m] from the road's outer edge to the building front
 
 
 @dataclass(frozen=True, slots=True)
 class RoadSpec:
-    segments: tuple[SegmentSpec, ...]
+    """A route road (`world.map.road`), or a town route compiled into one (`world.map.town`)."""
+
+    segments: tuple[SegmentSpec, ...]  # in route order
     speed_limit: float  # [m/s] posted at s = 0
-    features: tuple[FeatureSpec, ...] = ()
-    buildings: BuildingsSpec | None = None
-    origin: tuple[float, float, float] = (0.0, 0.0, 0.0)  # [m, m, rad] the line's start pose
+    features: tuple[FeatureSpec, ...] = ()  # signs, crosswalks, bumps, lights, by station
+    buildings: BuildingsSpec | None = None  # None: no buildings
+    origin: tuple[float, float, float] = (0.0, 0.0, 0.0)  # [m, m, rad] map-frame (x, y, heading)
+    #   of the reference line's start
     junctions: tuple[Junction, ...] = ()  # a town route's junctions, by station
 
 
@@ -103,6 +110,7 @@ class LightTiming:
 
     @property
     def cycle(self) -> float:
+        """[s] both directions' green, yellow and all-red."""
         return 2.0 * (self.green + self.yellow + self.all_red)
 
 
@@ -111,12 +119,12 @@ class TownSpec:
     """A grid town (map kind 2): streets along x = ix * block and y = iy * block, junction
     (ix, iy) at their crossing, ix in 0..blocks_x, iy in 0..blocks_y (`world.map.town`)."""
 
-    blocks_x: int
-    blocks_y: int
+    blocks_x: int  # [-] blocks along x
+    blocks_y: int  # [-] blocks along y
     block: float  # [m] junction spacing
-    lanes: int  # per direction
-    lane_width: float  # [m]
-    speed_limit: float  # [m/s]
+    lanes: int  # [-] per direction
+    lane_width: float  # [m] every lane's width
+    speed_limit: float  # [m/s] on every street
     junctions: str  # "stop_signs" | "traffic_lights" | "mixed" (lights where ix + iy is even)
     lights: LightTiming = field(default_factory=LightTiming)
 
@@ -128,22 +136,30 @@ class TownSpec:
 
 @dataclass(frozen=True, slots=True)
 class TimeTrigger:
+    """Holds from sim time `time` on."""
+
     time: float  # [s] simulated time
 
 
 @dataclass(frozen=True, slots=True)
 class EgoStationTrigger:
+    """Holds once the ego's centre has reached station `s`."""
+
     s: float  # [m] the ego's centre station reached
 
 
 @dataclass(frozen=True, slots=True)
 class GapTrigger:
-    gap: float  # [m] bumper-to-bumper distance actor -> ego along the route falls to <= gap
+    """Holds once an actor's gap to the ego has fallen to `gap` (actors only)."""
+
+    gap: float  # [m] bumper-to-bumper distance from the actor to the ego along the route
 
 
 @dataclass(frozen=True, slots=True)
 class AfterTrigger:
-    index: int  # an earlier action of the same actor (or event list)
+    """Holds `delay` after item `index` of the same list ended."""
+
+    index: int  # [-] an earlier action of the same actor (or event of the ego's list)
     delay: float  # [s] after that action ended
 
 
@@ -152,25 +168,25 @@ Trigger = TimeTrigger | EgoStationTrigger | GapTrigger | AfterTrigger
 
 @dataclass(frozen=True, slots=True)
 class SpeedAction:
-    speed: float  # [m/s] target
+    speed: float  # [m/s] target speed
     accel: float  # [m/s^2] magnitude used to reach it (> 0)
 
 
 @dataclass(frozen=True, slots=True)
 class LaneChangeAction:
-    to_lane: int
+    to_lane: int  # [-] lane index on the actor's route
     lateral_speed: float  # [m/s] > 0
 
 
 @dataclass(frozen=True, slots=True)
 class WalkAction:
     to_offset: float  # [m] lateral offset from the actor's lane centre to walk to
-    speed: float  # [m/s]
+    speed: float  # [m/s] walking speed across
 
 
 @dataclass(frozen=True, slots=True)
 class StopAction:
-    decel: float = 6.0  # [m/s^2]
+    decel: float = 6.0  # [m/s^2] braking to rest
 
 
 Action = SpeedAction | LaneChangeAction | WalkAction | StopAction
@@ -178,6 +194,8 @@ Action = SpeedAction | LaneChangeAction | WalkAction | StopAction
 
 @dataclass(frozen=True, slots=True)
 class ActionSpec:
+    """An actor's action and the trigger that fires it (`world.actors.behaviour`)."""
+
     trigger: Trigger
     action: Action
 
@@ -191,24 +209,30 @@ class ActorType(enum.Enum):
 
 @dataclass(frozen=True, slots=True)
 class ActorSpec:
-    id: str
+    """A scripted actor (`world.actors`) and where it starts."""
+
+    id: str  # unique in the scenario
     type: ActorType
     lane: int  # lane index on the route (pedestrians: the lane their offset is measured from)
     s: float  # [m] station of the actor's centre
     offset: float  # [m] lateral, left positive, from the lane centre
     speed: float  # [m/s] initial speed
-    actions: tuple[ActionSpec, ...] = ()
+    actions: tuple[ActionSpec, ...] = ()  # in the scenario's order (`after` indexes them)
     road: RoadSpec | None = None  # in a town: the actor's own route (lane, s, offset on it)
 
 
 @dataclass(frozen=True, slots=True)
 class AcceleratorOverride:
-    pedal: float  # [-] 0..1
-    duration: float  # [s]
+    """The accelerator pedal held (`world.ego.events`)."""
+
+    pedal: float  # [-] 0..1, pedal position
+    duration: float  # [s] held for
 
 
 @dataclass(frozen=True, slots=True)
 class FlatTire:
+    """A punctured tyre (`world.ego.body`)."""
+
     wheel: Wheel
 
 
@@ -217,6 +241,8 @@ EgoEvent = AcceleratorOverride | FlatTire
 
 @dataclass(frozen=True, slots=True)
 class EventSpec:
+    """An event that happens to the ego car and the trigger that fires it."""
+
     trigger: Trigger
     event: EgoEvent
 
@@ -231,7 +257,7 @@ class EgoSpec:
     """The ego car's body at the start (where the driver wants to go is not the world's:
     `avsim.scenario.scenario.DriverSettings`)."""
 
-    lane: int
+    lane: int  # [-] starting lane index on the route
     s: float  # [m] station of the car's centre
     speed: float  # [m/s] initial speed
     max_speed: float  # [m/s] vehicle limit
@@ -239,6 +265,8 @@ class EgoSpec:
 
 @dataclass(frozen=True, slots=True)
 class GnssSpec:
+    """The GNSS receiver's noise (`world.sensors`)."""
+
     sigma: float = 0.05  # [m] 1-sigma horizontal position noise
     heading_sigma: float = 0.0034906585  # [rad] 1-sigma heading noise (0.2 deg)
     bias: tuple[float, float] = (0.0, 0.0)  # [m] constant (x, y) offset
@@ -246,12 +274,16 @@ class GnssSpec:
 
 @dataclass(frozen=True, slots=True)
 class LidarNoiseSpec:
-    range_sigma: float = 0.02  # [m]
+    """The LiDAR's noise (`world.sensors`)."""
+
+    range_sigma: float = 0.02  # [m] range noise, 1-sigma
     dropout: float = 0.0  # [-] fraction of rays lost
 
 
 @dataclass(frozen=True, slots=True)
 class SensorsSpec:
+    """The sensors' noise (`world.sensors`)."""
+
     gnss: GnssSpec = field(default_factory=GnssSpec)
     lidar: LidarNoiseSpec = field(default_factory=LidarNoiseSpec)
 

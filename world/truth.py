@@ -1,4 +1,10 @@
-"""Ground-truth queries: for criteria, perception scoring and the recording, never the stack."""
+"""Ground-truth queries: for criteria, perception scoring and the recording, never the stack.
+
+Points are in the map frame [m]; the car's points are its base link origin (the centre) and
+points offset from it along the body's forward and left axes in the map plane (the body's
+yaw only), by the URDF's geometry: front axle `front_axle` ahead, rear axle `rear_axle`
+behind, tyres `track / 2` each side.
+"""
 
 from __future__ import annotations
 
@@ -14,7 +20,7 @@ from world.hdmap import ReferenceLine
 
 
 def body_axes(truth: EgoTruth) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Unit forward and left vectors (2,) of the car in the map plane."""
+    """Unit forward and left vectors (2,) of the car in the map plane, from its yaw."""
     c, s = np.cos(truth.yaw), np.sin(truth.yaw)
     return np.array([c, s]), np.array([-s, c])
 
@@ -28,6 +34,7 @@ def tyre_patches(truth: EgoTruth, g: CarGeometry) -> NDArray[np.float64]:
 
 
 def front_axle_point(truth: EgoTruth, g: CarGeometry) -> NDArray[np.float64]:
+    """[m] (2,) map-frame centre of the front axle."""
     fwd, _ = body_axes(truth)
     return np.asarray(truth.position[:2] + g.front_axle * fwd)
 
@@ -38,7 +45,7 @@ class RouteTruth:
     with their stations and offsets from the reference line (left +), from one projection."""
 
     points: NDArray[np.float64]  # [m] (6, 2) map frame: centre, front axle, FL, FR, RL, RR
-    stations: NDArray[np.float64]  # [m] (6,)
+    stations: NDArray[np.float64]  # [m] (6,) on the route
     offsets: NDArray[np.float64]  # [m] (6,) from the reference line, left +
 
     @property
@@ -48,14 +55,17 @@ class RouteTruth:
 
     @property
     def tyres(self) -> NDArray[np.float64]:
+        """[m] (4, 2) the tyre patches, FL, FR, RL, RR."""
         return self.points[2:]
 
     @property
     def tyre_stations(self) -> NDArray[np.float64]:
+        """[m] (4,) the tyre patches' stations."""
         return self.stations[2:]
 
     @property
     def tyre_offsets(self) -> NDArray[np.float64]:
+        """[m] (4,) the tyre patches' offsets from the reference line, left +."""
         return self.offsets[2:]
 
 

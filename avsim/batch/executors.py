@@ -36,7 +36,7 @@ from avsim.files import write_atomic
 
 POLL = 0.2  # [s] how often the display is refreshed while runs are under way
 PROGRESS_EVERY = 1.0  # [s] of simulated time between a worker's progress messages
-RAY_EXTRA = "pip install 'avsim[ray]'"
+RAY_EXTRA = "pip install 'avsim[ray]'"  # how to get Ray, for the error message
 
 
 class ExecutorError(Exception):
@@ -48,8 +48,8 @@ class Progress:
     """A running job's simulated time, as a worker reports it."""
 
     name: str  # the job's name
-    sim_time: float  # [s]
-    duration: float  # [s]
+    sim_time: float  # [s] simulated so far
+    duration: float  # [s] the scenario's duration
 
 
 class ProgressSink(Protocol):
@@ -61,7 +61,9 @@ class ProgressSink(Protocol):
 
 
 class Executor(Protocol):
-    name: str
+    """Runs a batch's jobs somewhere."""
+
+    name: str  # as `--executor` names it
 
     def run(self, jobs: Sequence[RunJob], sink: ProgressSink | None = None) -> list[RunOutcome]:
         """Run every job; the outcomes in job order."""
@@ -74,6 +76,7 @@ def longest_first(jobs: Sequence[RunJob]) -> list[RunJob]:
 
 
 def _in_job_order(jobs: Sequence[RunJob], outcomes: Sequence[RunOutcome]) -> list[RunOutcome]:
+    """The outcomes sorted back into the order of `jobs`."""
     by_name = {o.job.name: o for o in outcomes}
     return [by_name[j.name] for j in jobs]
 
@@ -94,6 +97,7 @@ class _QueueProgress:
 
 
 def _local_task(job: RunJob, messages: Any) -> RunOutcome:
+    """A worker's task: say the job started (its name on the queue), then run it."""
     messages.put(job.name)  # started
     return run_job(job, progress=_QueueProgress(job.name, messages))
 
@@ -120,6 +124,8 @@ class LocalExecutor:
     task: Callable[[RunJob, Any], RunOutcome] = _local_task  # what a worker runs (tests)
 
     def run(self, jobs: Sequence[RunJob], sink: ProgressSink | None = None) -> list[RunOutcome]:
+        """Run every job, longest first, in rounds of pools (class doc); outcomes in job
+        order."""
         ctx = mp.get_context("spawn")
         outcomes: list[RunOutcome] = []
         todo = longest_first(jobs)
@@ -175,6 +181,8 @@ class LocalExecutor:
 
 def _drain(messages: Any, jobs: dict[str, RunJob], sink: ProgressSink | None,
            started: set[str]) -> None:
+    """Pass the queued messages on to the sink: a job name is a start (also noted in
+    `started`), a `Progress` an advance."""
     while True:
         try:
             message = messages.get_nowait()
@@ -212,6 +220,8 @@ class RayExecutor:
     name: str = "ray"
 
     def run(self, jobs: Sequence[RunJob], sink: ProgressSink | None = None) -> list[RunOutcome]:
+        """Run every job as a Ray task (starting and stopping Ray if it is not running);
+        outcomes in job order."""
         ray = _import_ray()
         address = self.address or os.environ.get("RAY_ADDRESS") or None
         started_here = not ray.is_initialized()
@@ -225,6 +235,7 @@ class RayExecutor:
 
     def _run(self, ray: Any, jobs: Sequence[RunJob],
              sink: ProgressSink | None) -> list[RunOutcome]:
+        """Submit every task, longest first; write each one's files here as it returns."""
         task = ray.remote(num_cpus=1, max_retries=0)(_ray_task)
         order = longest_first(jobs)
         refs = {task.remote(job): job for job in order}
@@ -248,6 +259,7 @@ class RayExecutor:
 
 
 def _import_ray() -> Any:
+    """The `ray` module, or an `ExecutorError` saying how to install it."""
     try:
         import ray
     except ImportError:
@@ -256,6 +268,7 @@ def _import_ray() -> Any:
 
 
 def _ray_init(ray: Any, address: str | None, cpus: int | None) -> None:
+    """Connect to the cluster at `address`, or start a local instance of `cpus` CPUs."""
     # the workers import avsim from wherever this process does (an editable install or a
     # checkout on the cluster's nodes); they do not need the driver's working directory
     options: dict[str, Any] = {"include_dashboard": False, "log_to_driver": False,
@@ -270,5 +283,6 @@ def _ray_init(ray: Any, address: str | None, cpus: int | None) -> None:
 
 
 def _write_files(out_dir: Path, files: dict[str, bytes]) -> None:
+    """Write a task's returned files (name -> bytes) into `out_dir`, each whole."""
     for name, data in files.items():
         write_atomic(out_dir / name, data)

@@ -50,14 +50,17 @@ class RunJob:
 
     @property
     def recording(self) -> Path:
+        """The run's `.rrd`."""
         return self.out_dir / f"{self.name}.rrd"
 
     @property
     def result_file(self) -> Path:
+        """The run's result JSON."""
         return self.out_dir / f"{self.name}.json"
 
     @property
     def plot_file(self) -> Path:
+        """The run's speed-profile PNG."""
         return self.out_dir / f"{self.name}.png"
 
 
@@ -73,6 +76,7 @@ class RunOutcome:
 
     @property
     def passed(self) -> bool:
+        """Whether every criterion passed."""
         return self.status is Status.PASSED
 
     @property
@@ -86,6 +90,7 @@ class RunOutcome:
         return self._number("wall_time")
 
     def _number(self, key: str) -> float:
+        """The result's number at `key`, 0 when absent."""
         value = None if self.result is None else self.result.get(key)
         return float(value) if isinstance(value, (int, float)) else 0.0
 
@@ -151,6 +156,8 @@ def run_job(job: RunJob, into: Path | None = None,
 
 def _simulate(job: RunJob, scenario: Scenario, into: Path,
               progress: ProgressCallback | None) -> dict[str, object]:
+    """Run the loaded scenario into `into`: the recording (renamed whole at the end), the
+    result JSON and the plot; returns the result JSON."""
     from world.core.quiet import quiet_c_output
 
     with quiet_c_output():  # PyBullet's build banner

@@ -5,8 +5,9 @@
 2. An executor (`avsim.batch.executors`) runs them, while a live display shows the batch and
    each run's simulated time.
 3. The reports go into the batch's folder beside the runs' own files: ``junit.xml``,
-   ``summary.md`` (with a snapshot of each failed run at its first failing moment, in
-   ``snapshots/``) and ``results.json`` (every run's result, in job order).
+   ``summary.md`` (with a snapshot of each failed run at its first failing moment, or at
+   its end when it failed only there, in ``snapshots/``) and ``results.json`` (every run's
+   result, in job order).
 """
 
 from __future__ import annotations
@@ -26,7 +27,7 @@ from avsim.batch.jobs import RunJob, RunOutcome, Status
 from avsim.files import write_atomic
 from avsim.scenario.load import bundled_scenarios, load_scenario
 
-SNAPSHOT_DIR = "snapshots"
+SNAPSHOT_DIR = "snapshots"  # the failed runs' pictures, below the batch's folder
 
 
 class BatchError(ValueError):
@@ -71,6 +72,8 @@ def plan(entries: Sequence[tuple[str | None, str, Mapping[str, object]]], out_di
 
 
 def validate_out_dir(out_dir: Path) -> None:
+    """`BatchError` unless `out_dir` is a folder or can be made: its nearest existing
+    ancestor is a directory."""
     if out_dir.exists() and not out_dir.is_dir():
         raise BatchError(f"{out_dir}: --out: not a directory")
     for ancestor in out_dir.absolute().parents:
@@ -87,12 +90,12 @@ def validate_out_dir(out_dir: Path) -> None:
 class LiveDisplay:
     """A bar for the batch and one per run under way (rich), on stderr."""
 
-    total: int
+    total: int  # runs in the batch
     console: Console = field(default_factory=lambda: Console(stderr=True))
-    _bar: RichProgress | None = None
+    _bar: RichProgress | None = None  # None off a terminal: one line per finished run only
     _batch: TaskID | None = None
-    _runs: dict[str, TaskID] = field(default_factory=dict)
-    _failed: int = 0
+    _runs: dict[str, TaskID] = field(default_factory=dict)  # job name -> its bar
+    _failed: int = 0  # runs finished without passing
 
     def __enter__(self) -> LiveDisplay:
         if self.console.is_terminal:
@@ -108,16 +111,19 @@ class LiveDisplay:
             self._bar.stop()
 
     def started(self, job: RunJob) -> None:
+        """A bar for the run."""
         if self._bar is not None:
             self._runs[job.name] = self._bar.add_task(job.name, total=None, detail="starting")
 
     def advanced(self, progress: Progress) -> None:
+        """The run's bar to its simulated time."""
         task = self._runs.get(progress.name)
         if self._bar is not None and task is not None:
             self._bar.update(task, completed=progress.sim_time, total=progress.duration,
                              detail=f"{progress.sim_time:.0f}/{progress.duration:.0f} s sim")
 
     def finished(self, outcome: RunOutcome) -> None:
+        """The run's verdict as a line; its bar goes, the batch's advances."""
         self._failed += not outcome.passed
         verdict = outcome.status.value.upper() if not outcome.passed else "pass"
         line = f"{outcome.job.name}: {verdict}"
@@ -145,7 +151,7 @@ def execute(jobs: Sequence[RunJob], executor: Executor) -> list[RunOutcome]:
 
 def snapshots_of_failures(outcomes: Sequence[RunOutcome], out_dir: Path,
                           console: Console) -> dict[str, Path]:
-    """A PNG of each failed run's recording at its first failing moment (job name -> PNG).
+    """A PNG of each failed run's recording at `RunOutcome.failure_time` (job name -> PNG).
     A snapshot that cannot be made is reported in one line and left out."""
     from avsim.record.snapshot import SnapshotError, render_snapshot
 

@@ -16,8 +16,8 @@ from dataclasses import dataclass
 
 import yaml
 
-PATH_CHARS = set("abcdefghijklmnopqrstuvwxyz0123456789_.")
-OPENING, CLOSING = "[{", "]}"
+PATH_CHARS = set("abcdefghijklmnopqrstuvwxyz0123456789_.")  # of a dotted key path
+OPENING, CLOSING = "[{", "]}"  # YAML flow brackets: no value splits inside them
 
 
 class SweepError(ValueError):
@@ -32,6 +32,7 @@ class Axis:
     values: tuple[object, ...]  # as YAML reads them
 
     def labels(self) -> list[str]:
+        """Each value as written after `--set PATH=`."""
         return [format_value(v) for v in self.values]
 
 

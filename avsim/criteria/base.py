@@ -81,6 +81,7 @@ class Infraction:
     where: tuple[float, float] | None  # [m] map frame (x, y): the ego's centre then
 
     def as_json(self) -> dict[str, object]:
+        """As the result file has it: t [s] and where [m] rounded."""
         where = None if self.where is None else [round(x, 3) + 0.0 for x in self.where]  # no -0
         return {"t": round(self.t, 4), "kind": self.kind, "message": self.message,
                 "where": where}
@@ -88,15 +89,18 @@ class Infraction:
 
 @dataclass(frozen=True, slots=True)
 class CriterionResult:
-    name: str
+    """A criterion's verdict: its measured value against its threshold, in `unit`."""
+
+    name: str  # the criterion's name
     passed: bool
-    value: float
-    threshold: float
-    unit: str
+    value: float  # [unit] the measured value the verdict rests on
+    threshold: float  # [unit]
+    unit: str  # the unit of value and threshold
     first_failure: float | None = None  # [s] sim time it first failed, if it did
     note: str | None = None  # why it failed when the value does not say (nothing happened)
 
     def as_json(self) -> dict[str, object]:
+        """As the result file has it: values rounded, optional keys only when set."""
         out: dict[str, object] = {
             "name": self.name, "passed": self.passed, "value": _round(self.value),
             "threshold": _round(self.threshold), "unit": self.unit,
@@ -109,6 +113,7 @@ class CriterionResult:
 
 
 def _round(x: float) -> float:
+    """x to 4 decimals; infinities and NaN as they are."""
     return round(x, 4) if math.isfinite(x) else x
 
 
@@ -116,19 +121,21 @@ class Criterion:
     """Base of the criteria: a name, a unit, `update` per sample and a `result`; failures
     and infractions through `_fail` and `_infraction`."""
 
-    name = ""
-    unit = ""
+    name = ""  # the result's name
+    unit = ""  # the value's unit
 
     def __init__(self) -> None:
-        self.first_failure: float | None = None  # [s]
+        self.first_failure: float | None = None  # [s] sim time of the first failure
         self.idle = False  # this run gives it nothing to watch (no such feature on the map):
         #   the samples need not carry what only it needs
         self._new: list[Infraction] = []  # not yet taken by the run
 
     def update(self, sample: TruthSample) -> None:
+        """Watch one sample."""
         raise NotImplementedError
 
     def result(self) -> CriterionResult:
+        """The verdict on the samples seen."""
         raise NotImplementedError
 
     def take_infractions(self) -> list[Infraction]:
@@ -166,6 +173,7 @@ class CriteriaSet:
         return [i for c in self.items for i in c.take_infractions()]
 
     def results(self) -> list[CriterionResult]:
+        """Every criterion's result, in the set's order."""
         return [c.result() for c in self.items]
 
     def find(self, kind: type[C]) -> C:
@@ -177,4 +185,5 @@ class CriteriaSet:
 
     @property
     def passed(self) -> bool:
+        """The run's verdict: every criterion passed."""
         return all(r.passed for r in self.results())

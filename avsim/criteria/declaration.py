@@ -49,7 +49,7 @@ class Declaration(Generic[S]):
     inputs. Without `always` they apply only when the file sets `key`, and `build` gets its
     value. With `always` they apply to every run, and `key` (if any) only tunes them:
     `build` gets None when the file leaves the key out (`reach_s` sets where `completes`
-    is reached, by default the route's end less 30 m)."""
+    is reached, by default the route's end less `route.END_MARGIN`)."""
 
     build: Callable[[S, RunInputs], Sequence[Criterion]]
     needs: frozenset[Need]  # what its criteria use: `RunInputs` fields, sample parts

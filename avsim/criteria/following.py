@@ -28,15 +28,15 @@ R157 = "r157"  # the min_gap setting for UN R157's d_min(v)
 
 
 class MinGap(Criterion):
-    """The bumper gap to the vehicle ahead in the ego's lane is never below the threshold
-    (UN R157's d_min(v), or a fixed number of metres) while the ego moves faster than 2 m/s,
-    except for `grace` seconds after that vehicle entered the lane ahead (a cut-in) and while
-    it brakes harder than 3 m/s^2. Value: the smallest gap [m] checked; its threshold at that
-    moment is reported with it (the least margin decides)."""
+    """The bumper gap to the nearest vehicle ahead in the ego's lane is never below the
+    threshold (UN R157's d_min(v), or a fixed number of metres) while the ego moves faster
+    than `MIN_SPEED`, except for `grace` [s] after that vehicle entered the lane ahead (a
+    cut-in) and while it brakes harder than `HARD_BRAKE`. Value: the gap [m] at the least
+    margin (gap - threshold) checked, reported with its threshold at that moment."""
 
     name, unit = "min_gap", "m"
-    MIN_SPEED = 2.0  # [m/s]
-    HARD_BRAKE = 3.0  # [m/s^2]
+    MIN_SPEED = 2.0  # [m/s] the ego slower than this is not judged
+    HARD_BRAKE = 3.0  # [m/s^2] a vehicle ahead braking harder is not held against the ego
 
     def __init__(self, threshold: float | str, road: RoadMap, ego_length: float,
                  grace: float = 10.0) -> None:
@@ -45,11 +45,12 @@ class MinGap(Criterion):
         self.road = road
         self.ego_length = ego_length
         self.grace = grace
-        self.entered: dict[str, float] = {}  # actor id -> time it entered the lane ahead
-        self._started = False
-        self.margin = math.inf
+        self.entered: dict[str, float] = {}  # actor id -> [s] when it entered the lane ahead
+        self._started = False  # a sample has been seen (vehicles ahead then: no cut-in)
+        self.margin = math.inf  # [m] the least gap - threshold so far
         self.gap = math.inf  # [m] at the least margin
-        self.threshold = math.nan if self.fixed is None else self.fixed
+        self.threshold = math.nan if self.fixed is None else self.fixed  # [m] at the least
+        #   margin (r157: NaN until a gap is checked)
 
     def update(self, sample: TruthSample) -> None:
         ahead = vehicles_ahead(sample, self.road, self.ego_length)
@@ -78,7 +79,9 @@ class MinGap(Criterion):
 def vehicles_ahead(sample: TruthSample, road: RoadMap,
                    ego_length: float) -> dict[str, tuple[str, float, float]]:
     """Actor id -> (id, bumper gap [m], acceleration [m/s^2]) of the vehicles whose centre
-    is in the ego's lane band (half a lane width either side of the ego's centre) ahead."""
+    is in the ego's lane band (half lane 0's width either side of the ego's centre offset)
+    and ahead of the ego's centre station; the gap is the stations' difference less both
+    half lengths."""
     a = sample.actors
     if a is None or not len(a.ids):
         return {}
@@ -92,12 +95,12 @@ def vehicles_ahead(sample: TruthSample, road: RoadMap,
     return out
 
 
-VEHICLES = frozenset({"car", "truck"})
+VEHICLES = frozenset({"car", "truck"})  # the actor kinds that count as vehicles ahead
 
 
 class StandstillGap(Criterion):
-    """Each time the ego stands (below 0.1 m/s for 1 s) behind a vehicle in its lane within
-    `reach` metres, the bumper gap is within [low, high]. Value: the standstill gap farthest
+    """Each time the ego stands (below `STOPPED` for `HOLD`) behind a vehicle in its lane
+    within `REACH`, the bumper gap is within [low, high]. Value: the standstill gap farthest
     from the band's middle [m], against the bound on its side; fails if it never stood."""
 
     name, unit = "standstill_gap", "m"
@@ -106,8 +109,8 @@ class StandstillGap(Criterion):
     def __init__(self, low: float, high: float, road: RoadMap, ego_length: float) -> None:
         super().__init__()
         self.low, self.high, self.road, self.ego_length = low, high, road, ego_length
-        self.gaps: list[float] = []
-        self._since: float | None = None
+        self.gaps: list[float] = []  # [m] every standstill gap judged
+        self._since: float | None = None  # [s] since when the ego stands
 
     def update(self, sample: TruthSample) -> None:
         if sample.speed >= self.STOPPED:
@@ -135,11 +138,15 @@ class StandstillGap(Criterion):
 
 
 class TimeToResume(Criterion):
-    """Once the lane ahead clears (no vehicle in it within 3 s at the wanted speed + 10 m
-    that is slower than that speed) while the ego is slower than the wanted speed (the set
-    speed, or the posted limit where lower) less 1 km/h, the ego is back at it within
-    `threshold` seconds. Value: the longest such wait [s] (one still open at the end counts
-    to the end); fails if the lane never cleared with the ego slowed."""
+    """Once the lane ahead clears while the ego is slow, the ego is back at its wanted speed
+    within `threshold` [s].
+
+    The wanted speed is the set speed, or the posted limit where lower; slow is below it
+    less `SPEED_TOLERANCE_KPH`. The lane is blocked by a vehicle ahead in it, within
+    3 s at the wanted speed + 10 m, that is itself slow; it clears when it was blocked and
+    is not. A wait runs from the clearing until the ego is no longer slow or the lane is
+    blocked again. Value: the longest wait [s] (one still open at the end counts to the
+    end); fails if the lane never cleared with the ego slowed."""
 
     name, unit = "time_to_resume", "s"
 
@@ -148,10 +155,10 @@ class TimeToResume(Criterion):
         super().__init__()
         self.threshold, self.set_speed, self.road = threshold, set_speed, road
         self.ego_length = ego_length
-        self.waits: list[float] = []
-        self._clear_at: float | None = None
-        self._was_blocked = False
-        self._t = 0.0
+        self.waits: list[float] = []  # [s] every closed wait
+        self._clear_at: float | None = None  # [s] when the open wait began
+        self._was_blocked = False  # the lane was blocked at the last sample
+        self._t = 0.0  # [s] the last sample's time
 
     def update(self, sample: TruthSample) -> None:
         self._t = sample.t
@@ -169,6 +176,7 @@ class TimeToResume(Criterion):
         self._was_blocked = blocking
 
     def _close(self, sample: TruthSample) -> None:
+        """End the open wait now; an infraction if it was too long."""
         assert self._clear_at is not None
         wait = sample.t - self._clear_at
         self.waits.append(wait)
@@ -188,6 +196,7 @@ class TimeToResume(Criterion):
 
 
 def _r157_or_metres(value: Any) -> Any:
+    """`min_gap`'s value if it is `r157` or a number > 0, else the format's problem."""
     is_number = isinstance(value, int | float) and not isinstance(value, bool)
     if value == R157 or (is_number and value > 0):
         return value
@@ -195,6 +204,7 @@ def _r157_or_metres(value: Any) -> Any:
 
 
 def _low_below_high(value: tuple[float, float]) -> tuple[float, float]:
+    """`standstill_gap`'s band if low < high, else the format's problem."""
     if not value[0] < value[1]:
         raise problem(f"low must be below high, got {list(value)}")
     return value

@@ -1,16 +1,16 @@
 """`max_jerk`: the ego's longitudinal jerk stays within the scenario's threshold; off unless
 the scenario sets it (`criteria: {max_jerk: 10}`, [m/s^3]).
 
-The jerk is the derivative of the ego's true longitudinal acceleration, on a 0.2 s moving
-average. From the samples (t_k [s], v_k [m/s] true forward speed):
+The jerk is the derivative of the ego's true longitudinal acceleration, on a `JERK_WINDOW`
+moving average. From the samples (t_k [s], v_k [m/s] true forward speed):
 
 1. a_k = (v_k - v_(k-1)) / (t_k - t_(k-1)), the acceleration between two samples [m/s^2],
    at the time between them, m_k = (t_k + t_(k-1)) / 2;
 2. j_k = (a_k - a_i) / (m_k - m_i), with a_i the newest acceleration at least
-   `JERK_WINDOW` = 0.2 s before a_k: the mean jerk over 0.2 s, which is the derivative of
-   the acceleration's 0.2 s moving average [m/s^3].
+   `JERK_WINDOW` before a_k: the mean jerk over the window, which is the derivative of the
+   acceleration's moving average over it [m/s^3].
 
-At a steady criteria rate f, a_i is a_(k-N) with N = 0.2 s f (8 at 40 Hz) and
+At a steady criteria rate f, a_i is a_(k-N) with N = JERK_WINDOW f (a whole number) and
 j_k = (a_k - a_(k-N)) f / N; the first is judged at the (N + 2)th sample. The samples' own
 times are used, so an extra sample (the runner samples at each contact onset too) does not
 bend it: under a constant jerk every a_k is the acceleration at m_k exactly, and every j_k
@@ -33,8 +33,8 @@ TIME_TOLERANCE = 1e-9  # [s] in comparing spans of sample times (sums of float s
 
 
 class MaxJerk(Criterion):
-    """The ego's longitudinal jerk (0.2 s moving average) never exceeds the threshold
-    [m/s^3] in magnitude."""
+    """The ego's longitudinal jerk (module doc) never exceeds the threshold [m/s^3] in
+    magnitude."""
 
     name, unit = "max_jerk", "m/s^3"
 

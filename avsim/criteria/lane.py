@@ -40,8 +40,8 @@ class TyresInLane(Criterion):
     def __init__(self, road: RoadMap, tyre_half_width: float) -> None:
         super().__init__()
         self.road = road
-        self.tyre_half_width = tyre_half_width
-        self.margin = math.inf
+        self.tyre_half_width = tyre_half_width  # [m]
+        self.margin = math.inf  # [m] the least margin so far
 
     def update(self, sample: TruthSample) -> None:
         if sample.turning:
@@ -80,11 +80,11 @@ class LaneChangeDuration(Criterion):
     def __init__(self, road: RoadMap, tyre_half_width: float, threshold: float) -> None:
         super().__init__()
         self.road, self.tyre_half_width, self.threshold = road, tyre_half_width, threshold
-        self.durations: list[float] = []
+        self.durations: list[float] = []  # [s] every finished lane change
         self._command: tuple[int, int] | None = None  # (origin, lane) at the last sample
         self._change: tuple[int, int] | None = None  # (origin, target) being watched
         self._left: float | None = None  # [s] a tyre left the origin lane
-        self._t = 0.0
+        self._t = 0.0  # [s] the last sample's time
 
     def update(self, sample: TruthSample) -> None:
         self._t = sample.t
@@ -116,21 +116,22 @@ class LaneChangeDuration(Criterion):
 
 
 class LaneChangeLateralAccel(Criterion):
-    """During each commanded lane change and 1 s after, the lateral acceleration the change
-    adds (speed * yaw rate less speed^2 * the road's curvature, 0.2 s moving average) stays
-    within `threshold`. Value: its peak [m/s^2]; fails if no lane change was made."""
+    """During each commanded lane change and `AFTER` it, the lateral acceleration the change
+    adds (speed * yaw rate less speed^2 * the road's curvature, moving average over
+    `DECEL_WINDOW`) stays within `threshold`. Value: its peak [m/s^2]; fails if no lane
+    change was made."""
 
     name, unit = "lane_change_lateral_accel", "m/s^2"
-    AFTER = 1.0  # [s]
+    AFTER = 1.0  # [s] judged this long after a change ends
 
     def __init__(self, threshold: float, rate: float) -> None:
         super().__init__()
         self.threshold = threshold
         self.window: deque[float] = deque(maxlen=max(1, round(DECEL_WINDOW * rate)))
-        self.peak = 0.0
-        self.changes = 0
-        self._until = -math.inf
-        self._changing = False
+        self.peak = 0.0  # [m/s^2] the largest averaged magnitude judged
+        self.changes = 0  # commanded lane changes so far
+        self._until = -math.inf  # [s] judged up to this time
+        self._changing = False  # a change was commanded at the last sample
 
     def update(self, sample: TruthSample) -> None:
         self.window.append(sample.lateral_accel - sample.speed**2 * sample.road_curvature)
@@ -169,6 +170,7 @@ class LaneChangeSetting(FormatModel):
 
 
 def _lane_change(setting: LaneChangeSetting, run: RunInputs) -> list[Criterion]:
+    """The two criteria of a `lane_change` setting."""
     return [LaneChangeDuration(run.road, run.car.tyre_width / 2, setting.max_duration),
             LaneChangeLateralAccel(setting.max_lateral_accel, run.rate)]
 

@@ -66,6 +66,7 @@ class CriteriaSettings:
         return next((v for k, v in self.items if k == key), None)
 
     def keys(self) -> tuple[str, ...]:
+        """The keys set, sorted."""
         return tuple(k for k, _ in self.items)
 
 

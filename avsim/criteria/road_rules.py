@@ -24,15 +24,15 @@ from world.spec import ActorType, TrafficLightSpec
 
 class StopSigns(Criterion):
     """At each stop line (a `stop_sign` feature's station s) the ego stands, speed below
-    0.1 m/s, for at least 1 s with its front bumper 0 to 4 m before the line (s - 4 <= front
-    bumper station <= s) before the front bumper is ever over it (> s).
+    `STOPPED`, for at least `HOLD` with its front bumper at most `ZONE` before the line
+    (s - ZONE <= front bumper station <= s) before the front bumper is ever over it (> s).
 
     Value: the shortest standstill [s] over the lines judged, each line's being its longest
     unbroken standstill in that zone before the bumper went over (0 if none). A line is
-    judged once the bumper has gone over it or stood for 1 s; a line the run ends before
-    (neither) is not, nor one the bumper was already over at the first sample. Fails at the
-    first line the bumper goes over without the 1 s stop. No line judged (none on the map):
-    value 0, passed."""
+    judged once the bumper has gone over it or stood for `HOLD`; a line the run ends before
+    (neither) is not, nor one the bumper was already over at the first sample. An
+    infraction at each line the bumper goes over without the stop. No line judged (none on
+    the map): value 0, passed."""
 
     name, unit = "stop_signs", "s"
     STOPPED, HOLD, ZONE = 0.1, 1.0, 4.0  # [m/s], [s], [m]
@@ -41,9 +41,9 @@ class StopSigns(Criterion):
         super().__init__()
         self.lines = [f.s for f in road.features if isinstance(f, StopSign)]
         self.longest = [0.0] * len(self.lines)  # [s] per line
-        self.judged = [False] * len(self.lines)
+        self.judged = [False] * len(self.lines)  # per line: gone over, or stood HOLD
         self._watched: list[bool] | None = None  # per line: before it at the first sample
-        self._since: list[float | None] = [None] * len(self.lines)
+        self._since: list[float | None] = [None] * len(self.lines)  # [s] standing since
         self._over = [False] * len(self.lines)  # the bumper has gone over the line
 
     def update(self, sample: TruthSample) -> None:
@@ -87,7 +87,7 @@ class RedLights(Criterion):
     def __init__(self, lights: Sequence[TrafficLightSpec]) -> None:
         super().__init__()
         self.lights = list(lights)
-        self.margin = math.inf
+        self.margin = math.inf  # [s] the least margin to red at a crossing so far
         self._front: float | None = None  # [m] the front bumper's station at the last sample
 
     def update(self, sample: TruthSample) -> None:
@@ -117,27 +117,28 @@ def _margin_to_red(light: TrafficLightSpec, t: float) -> float:
 
 class Crosswalks(Criterion):
     """No part of the ego is on a crosswalk while a pedestrian is on it within the ego's
-    lane or within 1 m of that lane.
+    lane or within `LANE_MARGIN` of that lane.
 
     A crosswalk (a `crosswalk` feature) covers stations [s, s + width] across the paved road.
     The ego covers stations [rear bumper, front bumper]. A pedestrian (an actor of type
     pedestrian) is on it when its footprint (its centre +- the larger of its half length and
     half width, along and across) overlaps the crosswalk, and in the ego's lane when that
-    footprint also overlaps, across, the ego's lane widened by 1 m on each side: the lanes
-    (of the ego's direction) its tyres are in, at the crosswalk's station. Value: the
+    footprint also overlaps, across, the ego's lane widened by `LANE_MARGIN` on each side
+    (within the paved road): the lanes (of the ego's direction) its tyres are in, at the
+    crosswalk's station. Value: the
     deepest overlap [m] of the ego's stations with a crosswalk while a pedestrian was on it
     in the ego's lane (negative: the ego stayed that far off it); 0 if that never happened
     (or the map has no crosswalk)."""
 
     name, unit = "crosswalks", "m"
-    LANE_MARGIN = 1.0  # [m]
+    LANE_MARGIN = 1.0  # [m] the ego's lane band widened by this each side
 
     def __init__(self, road: RoadMap) -> None:
         super().__init__()
         self.road = road
         self.crosswalks = [(f.s, f.s + f.width) for f in road.features
                            if isinstance(f, Crosswalk)]
-        self.worst: float | None = None
+        self.worst: float | None = None  # [m] the deepest overlap so far
         self.idle = not self.crosswalks  # no crosswalk: no pedestrians to watch
 
     def update(self, sample: TruthSample) -> None:
@@ -181,15 +182,15 @@ class Crosswalks(Criterion):
 
 
 class SpeedBumps(Criterion):
-    """The ego's speed is at most the bump's pass speed + 1 km/h while either axle is within
-    1 m of a speed bump (a `speed_bump` feature centred on station s: axle station in
-    [s - length / 2 - 1, s + length / 2 + 1]).
+    """The ego's speed is at most the bump's pass speed + `SPEED_TOLERANCE_KPH` while either
+    axle is within `NEAR` of a speed bump (a `speed_bump` feature centred on station s: axle
+    station in [s - length / 2 - NEAR, s + length / 2 + NEAR]).
 
     Value: the largest excess [km/h] of the speed over the bump's pass speed at those
     moments (negative: slower); 0 if an axle never came near a bump (or the map has none)."""
 
     name, unit = "speed_bumps", "km/h"
-    NEAR = 1.0  # [m]
+    NEAR = 1.0  # [m] an axle this close to a bump's ends is on it
 
     def __init__(self, road: RoadMap, front_axle: float, rear_axle: float) -> None:
         """`front_axle`, `rear_axle`: [m] from the car's centre, both positive (used when
@@ -198,7 +199,7 @@ class SpeedBumps(Criterion):
         self.front_axle, self.rear_axle = front_axle, rear_axle
         self.bumps = [(f.s - 0.5 * f.length - self.NEAR, f.s + 0.5 * f.length + self.NEAR,
                        f.pass_speed) for f in road.features if isinstance(f, SpeedBump)]
-        self.worst: float | None = None
+        self.worst: float | None = None  # [km/h] the largest excess so far
 
     def update(self, sample: TruthSample) -> None:
         axles = sample.axle_stations or (sample.station + self.front_axle,

@@ -19,7 +19,7 @@ END_MARGIN = 30.0  # [m] default station to reach: the route's end less this
 
 
 class Completes(Criterion):
-    """The ego's centre reaches `reach_s` before the end, or it stops (below 0.1 m/s for
+    """The ego's centre reaches `reach_s` before the end, or it stops (below `STOPPED` for
     `STOPPED_FOR`) after a flat tyre, a stop the scenario expects: value = farthest
     station [m] (the note says when the flat tyre's stop completed it)."""
 
@@ -28,10 +28,10 @@ class Completes(Criterion):
 
     def __init__(self, reach_s: float) -> None:
         super().__init__()
-        self.reach_s = reach_s
-        self.farthest = -math.inf
-        self.stopped_flat = False
-        self._since: float | None = None
+        self.reach_s = reach_s  # [m] station to reach
+        self.farthest = -math.inf  # [m] the farthest centre station so far
+        self.stopped_flat = False  # it has stood for STOPPED_FOR with a flat tyre
+        self._since: float | None = None  # [s] since when it stands with a flat tyre
 
     def update(self, sample: TruthSample) -> None:
         self.farthest = max(self.farthest, sample.station)
@@ -43,6 +43,7 @@ class Completes(Criterion):
 
     @property
     def done(self) -> bool:
+        """Whether the route is completed (reached, or stopped on a flat tyre)."""
         return self.farthest >= self.reach_s or self.stopped_flat
 
     def result(self) -> CriterionResult:

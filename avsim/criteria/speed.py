@@ -21,15 +21,15 @@ from world.hdmap import RoadMap
 
 
 class SpeedLimit(Criterion):
-    """Speed never exceeds the posted limit at the front bumper by more than 1 km/h:
-    value = the largest excess [km/h]."""
+    """Speed never exceeds the posted limit at the front bumper's station by more than
+    `SPEED_TOLERANCE_KPH`: value = the largest excess [km/h]."""
 
     name, unit = "speed_limit", "km/h"
 
     def __init__(self, road: RoadMap) -> None:
         super().__init__()
         self.road = road
-        self.excess = -math.inf
+        self.excess = -math.inf  # [km/h] the largest speed over the limit so far
 
     def update(self, sample: TruthSample) -> None:
         limit = float(self.road.speed_limit_at(sample.front_station))
@@ -45,7 +45,9 @@ class SpeedLimit(Criterion):
 
 
 class MaxDecel(Criterion):
-    """The ego's deceleration (0.2 s moving average) never exceeds the threshold [m/s^2]."""
+    """The ego's deceleration over `DECEL_WINDOW` never exceeds the threshold [m/s^2]:
+    with N = round(DECEL_WINDOW rate) (at least 1) and the last N + 1 speeds v,
+    decel = (v_0 - v_N) rate / N, judged once N + 1 samples are in; value = its peak."""
 
     name, unit = "max_decel", "m/s^2"
 
@@ -54,8 +56,8 @@ class MaxDecel(Criterion):
         self.threshold = threshold
         self._speeds: deque[float] = deque(maxlen=max(2, round(DECEL_WINDOW * rate) + 1))
         self._window = (self._speeds.maxlen or 2) - 1
-        self._rate = rate
-        self.peak = 0.0
+        self._rate = rate  # [Hz] the criteria rate
+        self.peak = 0.0  # [m/s^2] the largest deceleration so far
 
     def update(self, sample: TruthSample) -> None:
         self._speeds.append(sample.speed)

@@ -43,11 +43,12 @@ PLAN_PATH = "/world/plan/path"  # LineStrips3D over sim_time: the planned path
 LIDAR = "/world/lidar"  # Points3D over sim_time: the LiDAR scan in the map frame
 TRACKS = "/world/tracks"  # static AnnotationContext: the tracks' class colours
 TRACK_BOXES = "/world/tracks/boxes"  # Boxes3D over sim_time, labels "id <n>", class = kind
-TRACK_VELOCITY = "/world/tracks/velocity"  # Arrows3D over sim_time: 1 s of motion
+TRACK_VELOCITY = "/world/tracks/velocity"  # Arrows3D over sim_time: a horizon of motion
 PERCEPTION = "/world/perception"  # perception outputs in the map frame
 LANE_LINES = "/world/perception/lanes"  # LineStrips3D over sim_time: detected lane lines
 DETECTIONS = "/world/perception/detections"  # Boxes3D over sim_time: raw detections
-INFRACTIONS = "/world/infractions"  # Points3D over sim_time: every infraction so far, where
+INFRACTIONS = "/world/infractions"  # Points3D over sim_time: every infraction so far, at
+#   the place it happened
 METRICS = "/metrics"  # /metrics/<name>: Scalars over sim_time, SeriesLines static
 EVENTS = "/events"  # TextLog over sim_time
 FSM_ROOT = "/fsm"  # /fsm/<machine>: StateChange over sim_time (StateConfiguration static)
@@ -70,6 +71,7 @@ STEERING_METRICS = ("steering", "cross_track_error")  # [rad], [m]
 
 
 def _metric_paths(names: tuple[str, ...]) -> list[str]:
+    """`/metrics/<name>` of each name."""
     return [f"{METRICS}/{name}" for name in names]
 
 

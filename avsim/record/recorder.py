@@ -1,17 +1,16 @@
 """One Rerun `.rrd` per run, written cheaply.
 
-A `rerun` log call costs 20-60 us, too much for every physics or control tick at the
-real-time factors we need. So the time series (ego pose, scalars, actor boxes, planned path)
-are *buffered* in numpy arrays and sent as columns (`RecordingStream.send_columns`) every
+A `rerun` log call costs too much to make on every physics or control tick at the real-time
+factors a run needs. So the time series (ego pose, scalars, actor boxes, planned path) are
+*buffered* in numpy arrays and sent as columns (`RecordingStream.send_columns`) every
 `FLUSH_INTERVAL` of simulated time and at `close()`; so are the perception outputs (tracks,
-detections, lane lines, ~10 Hz). Static things (road meshes, buildings, the ego's body,
-series styles, camera intrinsics and mounts) are logged once. Events, FSM state changes,
-camera images (JPEG, a few Hz) and LiDAR scans (~1 Hz) are few and logged directly.
+detections, lane lines). Static things (road meshes, buildings, the ego's body, series
+styles, camera intrinsics and mounts) are logged once. Events, FSM state changes, camera
+images and LiDAR scans come at low rates and are logged directly.
 
-Size: camera images are JPEG-compressed (`JPEG_QUALITY`, ~27 kB for a 640x480 frame) and a
-LiDAR point costs 12 bytes (16 with a colour), so the caller picks the rates and point counts:
-front 640x480 at 2 Hz, sides 320x240 at 0.5 Hz, 5,000 coloured points at 1 Hz, tracks and
-lanes at 10 Hz and the time series at 20 Hz make ~8.9 MB a simulated minute.
+Size is the caller's to choose, by its rates and point counts: camera images are
+JPEG-compressed (`JPEG_QUALITY`), and a LiDAR point costs 12 bytes (float32 x, y, z; 16 with
+a colour).
 
 All temporal data sits on one duration timeline, `sim_time` [s] (converted to integer
 nanoseconds by rounding, exactly like `RecordingStream.set_time(duration=...)`).
@@ -37,7 +36,7 @@ Entity paths (constants in `avsim.record.blueprint`), map frame z up, SI units:
 | `/world/lidar` | Points3D, map frame | direct |
 | `/world/tracks` | AnnotationContext: track class colours | static |
 | `/world/tracks/boxes` | Boxes3D, labels "id <n>", class = kind, transparent fill | buffered |
-| `/world/tracks/velocity` | Arrows3D from the box centres, 1 s of motion | buffered |
+| `/world/tracks/velocity` | Arrows3D from box centres, `VELOCITY_HORIZON` of motion | buffered |
 | `/world/perception/lanes` | LineStrips3D: detected lane lines | buffered |
 | `/world/perception/detections` | Boxes3D wireframes, class = kind | buffered |
 | `/world/infractions` | Points3D: every infraction so far where it was, label = kind | direct |
@@ -71,7 +70,7 @@ Rgb = tuple[int, int, int]  # [0..255]
 
 FLUSH_INTERVAL = 2.0  # [s] of sim time between sends of the buffered columns
 NANOS_PER_SECOND = 1e9  # [ns/s]
-INITIAL_ROWS = 256  # rows a buffer holds before it first grows (it doubles)
+INITIAL_ROWS = 256  # [-] rows a buffer holds before it first grows (it doubles)
 
 # -- the chase camera: rigidly attached to the car, looking forward and down ----------------
 CHASE_OFFSET = (-12.0, 0.0, 5.0)  # [m] car frame: behind and above the car origin
@@ -106,9 +105,9 @@ SERIES_PALETTE: tuple[Rgb, ...] = (  # for metrics not in SERIES_STYLES, in orde
     (188, 189, 34),
     (23, 190, 207),
 )
-EGO_BODY_RGB: Rgb = (230, 230, 235)
-EGO_WHEEL_RGB: Rgb = (30, 30, 30)
-PATH_RGB: Rgb = (0, 220, 120)
+EGO_BODY_RGB: Rgb = (230, 230, 235)  # [0..255]
+EGO_WHEEL_RGB: Rgb = (30, 30, 30)  # [0..255]
+PATH_RGB: Rgb = (0, 220, 120)  # [0..255] the planned path
 PATH_RADIUS = 0.08  # [m] line half-width of the planned path
 TRACK_CLASSES: dict[str, tuple[int, Rgb]] = {  # kind -> (class id as ACTOR_CLASSES, colour)
     "other": (0, (255, 255, 255)),
@@ -127,9 +126,9 @@ RIDE_HEIGHT = 0.33  # [m] default height of the base link (`/world/ego`) over th
 IMAGE_PLANE_DISTANCE = 0.5  # [m] distance of a camera's image plane in the 3D views
 TEXT_LOG_LEVELS = frozenset({"TRACE", "DEBUG", "INFO", "WARN", "ERROR", "CRITICAL"})
 INFRACTION_HEIGHT = 2.5  # [m] of an infraction's marker over the ground: above the car's
-#   roof (1.4 m), which would hide a marker at the car's centre
-INFRACTION_RADIUS = 0.5  # [m]
-INFRACTION_RGB = (230, 30, 30)
+#   roof, which would hide a marker at the car's centre
+INFRACTION_RADIUS = 0.5  # [m] an infraction marker's radius
+INFRACTION_RGB = (230, 30, 30)  # [0..255]
 
 
 class MeshLike(Protocol):
@@ -152,8 +151,8 @@ class MeshLike(Protocol):
 def _time_column(times: FloatArray) -> rr.TimeColumn:
     """`sim_time` column for times [s], rounded to [ns] as `set_time(duration=t)` does.
 
-    (`rr.TimeColumn(duration=float_array)` truncates instead of rounding, which would put a
-    buffered sample 1 ns away from a directly logged one for about 2 % of 40 Hz ticks.)
+    (`rr.TimeColumn(duration=float_array)` truncates instead of rounding, which would put
+    some buffered samples 1 ns away from a directly logged one at the same tick.)
     """
     nanos = np.round(times * NANOS_PER_SECOND).astype(np.int64)
     return rr.TimeColumn(bp.TIMELINE, duration=nanos.astype("timedelta64[ns]"))
@@ -171,6 +170,7 @@ class _RowBuffer:
         return self._n
 
     def append(self, t: float, row: npt.ArrayLike) -> None:
+        """One row (width,) at time t [s]; the arrays double when full."""
         if self._n == len(self._times):
             self._times = np.concatenate([self._times, np.empty_like(self._times)])
             self._rows = np.concatenate([self._rows, np.empty_like(self._rows)])
@@ -194,7 +194,7 @@ class _BoxBuffer:
     half_sizes: list[FloatArray] = field(default_factory=list)  # each (n, 3) [m]
     quaternions: list[FloatArray] = field(default_factory=list)  # each (n, 4) xyzw
     labels: list[str] = field(default_factory=list)  # empty if the boxes have none
-    class_ids: list[int] = field(default_factory=list)
+    class_ids: list[int] = field(default_factory=list)  # one per box, as the classes' map
     vectors: list[FloatArray] = field(default_factory=list)  # each (n, 3) [m]; tracks only
 
     def append(
@@ -245,7 +245,7 @@ class _CameraSetup(NamedTuple):
     width: int  # [px]
     height: int  # [px]
     mount_xyz: tuple[float, float, float] | None  # [m] vehicle frame, z from the ground
-    mount_rpy: tuple[float, float, float]  # [rad]
+    mount_rpy: tuple[float, float, float]  # [rad] roll, pitch, yaw (as `SensorMount`)
     ride_height: float  # [m] base link origin above the ground
 
 
@@ -373,6 +373,7 @@ class Recorder:
 
     @property
     def closed(self) -> bool:
+        """Whether `close()` has been called."""
         return self._closed
 
     def close(self) -> None:
@@ -616,7 +617,7 @@ class Recorder:
         half_sizes (N, 3) [m]; velocities (N, 2) or (N, 3) [m/s] over ground, map frame;
         kinds (N,) coloured by `TRACK_CLASSES` (class ids as `ACTOR_CLASSES`; unknown kinds
         are "other"). Buffered; sent as Boxes3D columns at `/world/tracks/boxes` and as
-        Arrows3D from the centres, `VELOCITY_HORIZON` (1 s) of motion long, at
+        Arrows3D from the centres, `VELOCITY_HORIZON` of motion long, at
         `/world/tracks/velocity`.
         """
         self._check_open()
@@ -737,7 +738,7 @@ class Recorder:
     ) -> None:
         """A LiDAR scan at sim time t [s]: points_world (N, 3) [m] in the map frame, optional
         colors (N, 3) uint8 RGB, point radius [m]. Points3D at `/world/lidar`, logged
-        directly (float32 positions, ~12 bytes a point before compression)."""
+        directly (float32 positions: 12 bytes a point before compression)."""
         self._check_open()
         points = _rows(points_world, 3, "points_world").astype(np.float32)
         rgb = None
@@ -809,11 +810,13 @@ class Recorder:
 
     # -- internals --------------------------------------------------------------------------------
     def _check_open(self) -> None:
+        """RuntimeError once closed."""
         if self._closed:
             raise RuntimeError(f"Recorder for {self.path} is closed")
 
     @staticmethod
     def _fsm_entity(machine: str) -> str:
+        """`/fsm/<machine>`, or ValueError unless `machine` is one entity path part."""
         if not machine or "/" in machine:
             raise ValueError(f"FSM machine name {machine!r}: one non-empty entity path part")
         return f"{bp.FSM_ROOT}/{machine}"
@@ -843,17 +846,21 @@ class Recorder:
         )
 
     def _log_series_style(self, name: str) -> None:
+        """A metric's static SeriesLines: its `SERIES_STYLES` label and colour, else its name
+        in the next `SERIES_PALETTE` colour."""
         n_custom = sum(1 for known in self._scalars if known not in SERIES_STYLES)
         default = (name, SERIES_PALETTE[(n_custom - 1) % len(SERIES_PALETTE)])
         label, rgb = SERIES_STYLES.get(name, default)
         self._rec.log(f"{bp.METRICS}/{name}", rr.SeriesLines(names=label, colors=rgb), static=True)
 
     def _maybe_flush(self, t: float) -> None:
+        """Send the buffers once t [s] reaches the next multiple of the flush interval."""
         if t >= self._next_flush:
             self._flush_buffers()
             self._next_flush = (math.floor(t / self._flush_interval) + 1) * self._flush_interval
 
     def _flush_buffers(self) -> None:
+        """Send every buffer's columns, emptying it."""
         self._rec.flush()  # the batched log calls first, then the columns: a fixed order
         self._flush_pose()
         self._flush_scalars()

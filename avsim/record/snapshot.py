@@ -46,10 +46,10 @@ from avsim.record.blueprint import TIMELINE
 
 NS_PER_S = 1_000_000_000  # [ns/s]
 POLL_PERIOD = 0.1  # [s] between two polls of the viewer while it starts or loads
-STABLE_SHOTS = 3  # consecutive identical screenshots that count as "everything drawn"
+STABLE_SHOTS = 3  # [-] consecutive identical screenshots that count as "everything drawn"
 # [s] after launch before a screenshot may count as settled: the viewer's start-up toast
-# ("Listening for gRPC connections ...") stays ~1.7 s of wall-clock time, during which
-# consecutive frames are identical.
+# ("Listening for gRPC connections ...") stays for a while of wall-clock time, during which
+# consecutive frames are identical; this is beyond it.
 TOAST_TIME = 3.0
 QUIT_TIMEOUT = 5.0  # [s] the viewer gets to exit after SIGTERM, before SIGKILL
 HOST = "127.0.0.1"  # the viewer listens on loopback only
@@ -78,9 +78,9 @@ class SnapshotError(Exception):
 def recording_time_range(recording: Path) -> tuple[float, float]:
     """The first and last `sim_time` of the first recording in an `.rrd` file, [s].
 
-    Reads every chunk on the `sim_time` timeline (`RrdReader(...).stream()`, about 0.2 s for a
-    14 MB file). Raises `SnapshotError` if the file is missing, is not a readable `.rrd`, or
-    holds no `sim_time` data.
+    Reads every chunk on the `sim_time` timeline (`RrdReader(...).stream()`). Raises
+    `SnapshotError` if the file is missing, is not a readable `.rrd`, or holds no `sim_time`
+    data.
     """
     start_ns, end_ns = _time_range_ns(recording)
     return start_ns / NS_PER_S, end_ns / NS_PER_S
@@ -97,12 +97,12 @@ def render_snapshot(
 ) -> None:
     """Render `recording`'s default blueprint at `sim_time` = `at` [s] to the PNG `out`.
 
-    The PNG is `width` x `height` [px] (the viewer's window, at one pixel per point). `timeout`
-    [s] bounds the whole run: viewer start, load and settling; a single viewer call may
-    block up to 15 s more. Creates `out`'s folder if needed; an existing `out` is replaced only
-    by a complete PNG. Raises `SnapshotError` for a missing or broken file, `at` outside the
-    recording's `sim_time` range, a viewer that cannot start (no Vulkan) or does not settle in
-    time. The viewer process is ended in every case.
+    The PNG is `width` x `height` [px] (the viewer's window, at one pixel per point).
+    `timeout` [s] bounds the whole run: viewer start, load and settling; a single viewer call
+    may block up to 15 s more (the client's own limit). Creates `out`'s folder if needed; an
+    existing `out` is replaced only by a complete PNG. Raises `SnapshotError` for a missing or
+    broken file, `at` outside the recording's `sim_time` range, a viewer that cannot start (no
+    Vulkan) or does not settle in time. The viewer process is ended in every case.
     """
     start_ns, end_ns = _time_range_ns(recording)
     at_ns = round(at * NS_PER_S) if math.isfinite(at) else end_ns + 1
@@ -260,7 +260,7 @@ def _capture(viewer: _Viewer, recording: Path, at_ns: int, deadline: float) -> b
 
 
 def _connect(viewer: _Viewer, deadline: float) -> ViewerClient:
-    """A client for `viewer`, once it answers (it starts listening ~0.1 s after launch)."""
+    """A client for `viewer`, once it answers (it listens shortly after launch)."""
     while True:
         try:
             client = ViewerClient.connect(viewer.url)
@@ -274,7 +274,7 @@ def _settled_screenshot(viewer: _Viewer, client: ViewerClient, deadline: float) 
     """Screenshots until `STABLE_SHOTS` in a row, all `TOAST_TIME` after launch, are identical.
 
     Each screenshot also makes the headless viewer draw a frame, which is what moves loading
-    and camera animations on; so keep taking them (~0.4 s each at 1600x900 on two cores).
+    and camera animations on; so keep taking them, with no sleep between.
     """
     last = b""
     repeats = 0  # identical screenshots in a row, counted from TOAST_TIME on
@@ -295,6 +295,7 @@ def _wait_or_fail(viewer: _Viewer, deadline: float, what: str) -> None:
 
 
 def _check_alive(viewer: _Viewer, deadline: float, what: str) -> None:
+    """`SnapshotError` if the viewer has exited or the deadline passed (waiting for `what`)."""
     if viewer.process.poll() is not None:
         raise viewer.failure()
     if time.monotonic() > deadline:
@@ -314,9 +315,11 @@ def _check_size(png: bytes, width: int, height: int) -> None:
 
 
 def _first_line(err: BaseException | None) -> str:
+    """The first line of `err`'s message, else its type's name."""
     lines = str(err).strip().splitlines() if err is not None else []
     return lines[0] if lines else type(err).__name__
 
 
 def _last(lines: list[str]) -> str:
+    """The last of `lines`, stripped, or a placeholder for none."""
     return lines[-1].strip() if lines else "no panic message"

@@ -13,7 +13,7 @@ of the ego's and its centre is within half a lane width of the ego's centre, sid
 ego's offset from the reference line is rebuilt from the log as the kept lane's centre
 (`lane * lane_width`, the HD map's layout) plus the cross-track error; so during a lane change
 the band moves with the car. The lead's speed is its station's rate of change (a central
-difference over the control ticks), scaled by (1 - curvature * offset) to the speed along its
+difference over the log's ticks), scaled by (1 - curvature * offset) to the speed along its
 own path on arcs; NaN (a gap in the line) where there is no lead.
 
 Pure: no PyBullet, no pyplot (a bare `Figure` on the Agg canvas, so no display is needed).
@@ -43,8 +43,8 @@ if TYPE_CHECKING:
     from avsim.run.runner import RunResult
 
 SIZE = (16.0, 7.0)  # [in] at DPI: 1600 x 700 px
-DPI = 100
-BAND_ALPHA = 0.3
+DPI = 100  # [px/in]
+BAND_ALPHA = 0.3  # [-] opacity of the mode and source bands
 VEHICLES = frozenset({"car", "truck"})  # actor types that can be a lead
 # one colour per ACC / event mode, by `AccMode` value (legend order: AccMode's)
 MODE_COLOURS: dict[str, str] = {
@@ -131,6 +131,7 @@ def lead_speed(result: RunResult) -> FloatArray:
 
 
 def _title(result: RunResult) -> str:
+    """The scenario's name and situation, and its verdict with the failed criteria."""
     failed = [c.name for c in result.criteria if not c.passed]
     verdict = "PASS" if not failed else "FAIL (" + ", ".join(failed) + ")"
     return f"{result.scenario.name} ({result.scenario.situation}): {verdict}"
@@ -197,7 +198,7 @@ def speed_profile_figure(result: RunResult) -> Figure:
 
 
 def plot_speed_profile(result: RunResult, path: Path) -> Path:
-    """Write the run's speed profile as a PNG of 1600 x 700 px to `path` (its directory is
+    """Write the run's speed profile as a PNG of `SIZE` at `DPI` to `path` (its directory is
     made; the file appears whole, through a temporary file beside it). Returns `path`."""
     fig = speed_profile_figure(result)
     path.parent.mkdir(parents=True, exist_ok=True)

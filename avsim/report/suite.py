@@ -32,14 +32,14 @@ from rich.text import Text
 from avsim.batch.jobs import RunOutcome, Status
 
 DASH = "—"  # a value that is absent (None) or not a number
-DECIMALS = 3  # numbers are shown to 3 decimals, trailing zeros dropped
+DECIMALS = 3  # numbers are shown to this many decimals, trailing zeros dropped
 VERDICTS: dict[Status, tuple[str, str]] = {  # status -> (word, rich style)
     Status.PASSED: ("PASS", "bold green"),
     Status.FAILED: ("FAIL", "bold red"),
     Status.BAD_INPUT: ("BAD INPUT", "bold yellow"),
     Status.ERROR: ("ERROR", "bold magenta"),
 }
-_NO_SNAPSHOTS: Mapping[str, Path] = MappingProxyType({})
+_NO_SNAPSHOTS: Mapping[str, Path] = MappingProxyType({})  # an immutable empty default
 _MD_SPECIAL = re.compile(r"([\\`*_{}\[\]<>|])")  # escaped in free text of a table cell
 # characters XML 1.0 cannot hold, even escaped (control codes in a crash's message, say)
 _NOT_XML = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\ud800-\udfff\ufffe\uffff]")
@@ -49,7 +49,7 @@ _NOT_XML = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\ud800-\udfff\ufffe\uffff]")
 
 
 def format_value(x: object) -> str:
-    """A number to 3 decimals without trailing zeros (`18.2`, `0.333`, `0`); `inf`, `-inf`;
+    """A number to `DECIMALS` without trailing zeros (`18.2`, `0.333`, `0`); `inf`, `-inf`;
     `—` for None and NaN; booleans and text as they are."""
     if x is None:
         return DASH
@@ -79,6 +79,7 @@ def _sim_time(outcome: RunOutcome) -> float:
 
 
 def _failed_names(outcome: RunOutcome) -> list[str]:
+    """The names of the run's failed criteria."""
     return [str(c["name"]) for c in outcome.criteria() if not c["passed"]]
 
 
@@ -93,6 +94,7 @@ def _counts(outcomes: Sequence[RunOutcome]) -> tuple[int, int, int]:
 
 
 def _failure_message(criterion: Mapping[str, object]) -> str:
+    """`value V unit (threshold T)` of a criterion."""
     unit = str(criterion.get("unit", "")).strip()
     value = format_value(criterion.get("value"))
     value = f"{value} {unit}" if unit else value
@@ -100,6 +102,7 @@ def _failure_message(criterion: Mapping[str, object]) -> str:
 
 
 def _failure_text(criterion: Mapping[str, object]) -> str:
+    """A failed criterion's message, its first failure time [s] and its note, a line each."""
     lines = [f"{criterion['name']}: {_failure_message(criterion)}"]
     if isinstance(t := criterion.get("first_failure"), (int, float)):
         lines.append(f"first failure at {format_value(t)} s")
@@ -115,6 +118,7 @@ def _xml_safe(text: str) -> str:
 
 
 def _sanitize(root: ET.Element) -> None:
+    """Make every text and attribute below `root` XML-safe (`_xml_safe`), in place."""
     for element in root.iter():
         if element.text is not None:
             element.text = _xml_safe(element.text)
@@ -141,6 +145,7 @@ def _properties(outcome: RunOutcome) -> dict[str, str]:
 
 def _criterion_case(suite: ET.Element, outcome: RunOutcome,
                     criterion: Mapping[str, object], time: float) -> None:
+    """Append a criterion's `<testcase>` (with its `<failure>` if it failed); `time` [s]."""
     case = ET.SubElement(suite, "testcase", classname=f"avsim.{outcome.job.name}",
                          name=str(criterion["name"]), time=_seconds(time))
     if not criterion["passed"]:
@@ -150,6 +155,7 @@ def _criterion_case(suite: ET.Element, outcome: RunOutcome,
 
 
 def _error_case(suite: ET.Element, outcome: RunOutcome) -> None:
+    """Append the `<testcase name="run">` with the `<error>` of a run that did not finish."""
     case = ET.SubElement(suite, "testcase", classname=f"avsim.{outcome.job.name}",
                          name="run", time=_seconds(outcome.wall_time))
     message = outcome.error or f"the run did not finish ({outcome.status.value})"
@@ -230,10 +236,12 @@ def _link(label: str, path: Path, out_dir: Path) -> str:
 
 
 def _verdict(outcome: RunOutcome) -> str:
+    """The run's verdict word (`VERDICTS`)."""
     return VERDICTS[outcome.status][0]
 
 
 def _header(outcomes: Sequence[RunOutcome], title: str) -> list[str]:
+    """The title and a line of counts and total sim and wall times [s]."""
     passed, failed, errors = _counts(outcomes)
     sim = sum(_sim_time(o) for o in outcomes)
     wall = sum(o.wall_time for o in outcomes)
@@ -246,6 +254,7 @@ def _header(outcomes: Sequence[RunOutcome], title: str) -> list[str]:
 
 
 def _run_row(outcome: RunOutcome, out_dir: Path) -> str:
+    """A run's row of the runs table: verdict, times [s], links to its files."""
     job = outcome.job
     if outcome.result is None:
         files = [DASH, DASH]
@@ -260,6 +269,7 @@ def _run_row(outcome: RunOutcome, out_dir: Path) -> str:
 
 
 def _runs_table(outcomes: Sequence[RunOutcome], out_dir: Path) -> list[str]:
+    """The table of runs, a row each."""
     lines = ["| run | verdict | sim time [s] | wall time [s] | recording | result | "
              "speed profile |",
              "|---|---|--:|--:|---|---|---|"]
@@ -268,6 +278,7 @@ def _runs_table(outcomes: Sequence[RunOutcome], out_dir: Path) -> list[str]:
 
 
 def _criterion_row(c: Mapping[str, object]) -> str:
+    """A criterion's row of a run's section."""
     cells = [_md_code(c["name"]), "pass" if c["passed"] else "**FAIL**",
              format_value(c.get("value")), format_value(c.get("threshold")),
              _md_text(c.get("unit", "")), format_value(c.get("first_failure")),
@@ -276,6 +287,7 @@ def _criterion_row(c: Mapping[str, object]) -> str:
 
 
 def _run_section(outcome: RunOutcome) -> list[str]:
+    """A run's section: its facts, then its criteria table (or its error line)."""
     job = outcome.job
     lines = [f"## {job.name}: {_verdict(outcome)}", ""]
     props = _properties(outcome)
@@ -292,6 +304,7 @@ def _run_section(outcome: RunOutcome) -> list[str]:
 
 def _snapshots(outcomes: Sequence[RunOutcome], out_dir: Path,
                snapshots: Mapping[str, Path]) -> list[str]:
+    """The snapshot section: each failed run's picture, titled with its first failure."""
     shown = [o for o in outcomes if o.status is Status.FAILED and o.job.name in snapshots]
     if not shown:
         return []

@@ -32,16 +32,16 @@ from avsim.batch.jobs import RunOutcome, Status
 from avsim.files import write_atomic
 from avsim.report.suite import format_value
 
-RUN, PASSED, STATUS, FAILED, ERROR = "run", "passed", "status", "failed", "error"
+RUN, PASSED, STATUS, FAILED, ERROR = "run", "passed", "status", "failed", "error"  # columns
 SIZE = (10.0, 7.0)  # [in] at DPI: 1000 x 700 px
-DPI = 100
-CMAP = "viridis"
+DPI = 100  # [px/in]
+CMAP = "viridis"  # the metric's colour map
 NO_VALUE_COLOUR = "#bdbdbd"  # grey: a cell whose metric is NaN / inf, or that has no run
 FAIL_COLOUR = "#d50000"  # the frame of a failed run's cell
 FAIL_FRAME_WIDTH = 3.0  # [pt]
 FAIL_FRAME_INSET = 0.04  # [cell] so that neighbouring frames do not merge
 CONTACT_METRIC = "collisions"  # > 0: the ego touched something (`no_collision` failed)
-DARK_CELL = 0.5  # relative luminance below which a cell's annotation is white
+DARK_CELL = 0.5  # [-] relative luminance below which a cell's annotation is white
 LARGE_GRID = 8  # [cells] along an axis beyond which annotations get smaller
 
 FloatArray = NDArray[np.float64]
@@ -94,6 +94,7 @@ def sweep_csv(rows: Sequence[Mapping[str, object]]) -> str:
 
 
 def _md_cell(key: str, value: object) -> str:
+    """A row's value as a Markdown table cell (a verdict in words)."""
     if key == PASSED:
         return "pass" if value else "**FAIL**"
     text = format_value(value) if value is not None else ""
@@ -101,7 +102,7 @@ def _md_cell(key: str, value: object) -> str:
 
 
 def sweep_markdown(rows: Sequence[Mapping[str, object]]) -> str:
-    """The rows as a Markdown table (numbers to 3 decimals, NaN as "—"); "" if none."""
+    """The rows as a Markdown table (numbers as `format_value`, NaN as "—"); "" if none."""
     if not rows:
         return ""
     keys = list(rows[0])
@@ -125,6 +126,7 @@ class HeatGrid:
 
 
 def _value_key(value: object) -> str:
+    """A key under which equal override values meet."""
     return repr(value)  # values may be unhashable (lists); 20 and "20" stay distinct
 
 
@@ -178,6 +180,7 @@ def heat_grid(outcomes: Sequence[RunOutcome], x_param: str, y_param: str,
 
 
 def _norm(values: FloatArray) -> Normalize:
+    """The colour scale over the finite values (0..1 when there are none)."""
     finite = values[np.isfinite(values)]
     if not finite.size:
         return Normalize(0.0, 1.0)
@@ -185,6 +188,7 @@ def _norm(values: FloatArray) -> Normalize:
 
 
 def _annotation(outcome: RunOutcome | None, value: float) -> str:
+    """A cell's text: its value, marked "✗" (and "contact") for a failed run."""
     if outcome is None:
         return "no run"
     if outcome.result is None:
@@ -197,6 +201,7 @@ def _annotation(outcome: RunOutcome | None, value: float) -> str:
 
 
 def _text_colour(cmap: Colormap, norm: Normalize, value: float) -> str:
+    """Black on a light cell, white on a dark one (Rec. 601 luma against `DARK_CELL`)."""
     if not math.isfinite(value):
         return "black"
     r, g, b, _ = cmap(float(norm(value)))
@@ -247,9 +252,9 @@ def heat_map_figure(outcomes: Sequence[RunOutcome], x_param: str, y_param: str, 
 
 def heat_map(outcomes: Sequence[RunOutcome], x_param: str, y_param: str, metric: str,
              out: Path, *, title: str) -> None:
-    """Write a 1000 x 700 px PNG of `metric` over the swept keys `x_param` x `y_param`.
+    """Write a PNG (`SIZE` at `DPI`) of `metric` over the swept keys `x_param` x `y_param`.
 
-    Each cell is one run, coloured by the metric and annotated with its value (3 decimals);
+    Each cell is one run, coloured by the metric and annotated with its value (`format_value`);
     failed runs are framed in red and marked "✗" ("✗ contact" if `collisions` > 0); cells
     with no finite value (a run that did not finish, an absent metric, inf) are grey. Axes
     keep the values' order of appearance in the runs (numbers or strings). `out` appears

@@ -71,6 +71,7 @@ def _segment_at(segments: Sequence[spec.SegmentSpec], s: float) -> spec.SegmentS
 
 
 def _check_station(key: str, s: float, length: float) -> None:
+    """Station s [m] is not beyond the route's end, `length` [m]."""
     if s > length:
         raise LocatedError(
             key, f"station {fmt(s)} m is beyond the end of the route ({fmt(length)} m)"
@@ -117,6 +118,8 @@ def _check_exits(road: RoadModel) -> None:
 
 
 def _check_ego(model: ScenarioModel, segments: Sequence[spec.SegmentSpec]) -> None:
+    """On a road: the ego has a station on the route and a lane there, no town keys, and
+    its speeds within its `max_speed_kph`."""
     ego = model.ego
     for town_key in ("start", "route"):
         if getattr(ego, town_key) is not None:
@@ -135,6 +138,7 @@ def _check_ego(model: ScenarioModel, segments: Sequence[spec.SegmentSpec]) -> No
 
 
 def _check_actors(model: ScenarioModel, segments: Sequence[spec.SegmentSpec]) -> None:
+    """On a road: unique actor ids, and each actor's checks in the file's order."""
     first_seen: dict[str, int] = {}
     for index, actor in enumerate(model.actors):
         key = f"actors.{index}"
@@ -147,6 +151,9 @@ def _check_actors(model: ScenarioModel, segments: Sequence[spec.SegmentSpec]) ->
 
 
 def _check_actor(key: str, actor: ActorModel, segments: Sequence[spec.SegmentSpec]) -> None:
+    """One actor on a road: no town keys, a station on the route and a lane there (oncoming
+    allowed), an obstacle stands still, its triggers and lane changes are sound, its speed
+    actions' accelerations have the right sign."""
     for town_key in ("start", "route"):
         if getattr(actor, town_key) is not None:
             raise LocatedError(
@@ -216,8 +223,9 @@ def speed_accels(key: str, actor: ActorModel) -> dict[int, float]:
     """[m/s^2] the signed acceleration of each speed action, by action index.
 
     The speed before an action is taken as the target of the speed / stop action before it
-    in the list (the actor's initial speed for the first): it picks the default (+2 when
-    speeding up, -3 when slowing) and a given accel must have the matching sign."""
+    in the list (the actor's initial speed for the first): it picks the default
+    (`DEFAULT_SPEED_UP` when speeding up, `DEFAULT_SLOW_DOWN` when slowing) and a given accel
+    must have the matching sign."""
     accels: dict[int, float] = {}
     speed_kph = actor.speed_kph
     for index, action in enumerate(actor.actions):
@@ -254,6 +262,7 @@ def _check_town_car(key: str, lane: int | None, s: float | None, road: spec.Road
 
 
 def _check_town_ids(model: ScenarioModel) -> None:
+    """In a town: unique actor ids."""
     first_seen: dict[str, int] = {}
     for index, actor in enumerate(model.actors):
         if actor.id in first_seen:

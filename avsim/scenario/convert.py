@@ -57,10 +57,12 @@ def convert(model: ScenarioModel) -> Scenario:
 
 
 def _kph(value: float) -> float:
+    """[m/s] of a speed in km/h."""
     return value * MPS_PER_KPH
 
 
 def _segment_spec(segment: SegmentModel, road: RoadModel) -> spec.SegmentSpec:
+    """A segment in SI: an arc's curvature and length, the road's defaults for its layout."""
     if segment.arc is not None:
         angle = math.radians(segment.arc.angle_deg)
         length = segment.arc.radius * abs(angle)
@@ -82,6 +84,7 @@ def _segment_spec(segment: SegmentModel, road: RoadModel) -> spec.SegmentSpec:
 
 
 def _feature_spec(feature: FeatureModel) -> spec.FeatureSpec:
+    """A road feature in SI (a traffic light with its signal plan)."""
     if isinstance(feature, SpeedLimitFeature):
         return hdmap.SpeedLimitSign(s=feature.s, limit=_kph(feature.kph))
     if isinstance(feature, StopSignFeature):
@@ -106,6 +109,7 @@ def _feature_spec(feature: FeatureModel) -> spec.FeatureSpec:
 
 
 def _road_spec(road: RoadModel) -> spec.RoadSpec:
+    """The route road of a file's `road`."""
     buildings = road.buildings
     return spec.RoadSpec(
         segments=tuple(_segment_spec(segment, road) for segment in road.segments),
@@ -118,6 +122,7 @@ def _road_spec(road: RoadModel) -> spec.RoadSpec:
 
 
 def _trigger_spec(trigger: TriggerModel) -> spec.Trigger:
+    """The trigger of the file's one trigger key."""
     kind = trigger.kind
     if kind == "time":
         return spec.TimeTrigger(time=float(given_or(trigger.time, 0.0)))
@@ -130,6 +135,8 @@ def _trigger_spec(trigger: TriggerModel) -> spec.Trigger:
 
 
 def _action_spec(action: ActionModel, accel: float | None) -> spec.Action:
+    """An action in SI; `accel` [m/s^2] is a speed action's signed acceleration
+    (`speed_accels`), of which the spec keeps the magnitude."""
     if action.speed is not None:
         magnitude = abs(given_or(accel, DEFAULT_SPEED_UP))
         return spec.SpeedAction(speed=_kph(action.speed.kph), accel=magnitude)
@@ -144,6 +151,7 @@ def _action_spec(action: ActionModel, accel: float | None) -> spec.Action:
 
 
 def _actor_spec(index: int, actor: ActorModel) -> spec.ActorSpec:
+    """An actor in SI with its actions (`index`: its place in the file, for errors)."""
     accels = speed_accels(f"actors.{index}", actor)
     actions = tuple(
         spec.ActionSpec(
@@ -163,6 +171,7 @@ def _actor_spec(index: int, actor: ActorModel) -> spec.ActorSpec:
 
 
 def _event_spec(event: EventModel) -> spec.EventSpec:
+    """An ego event and its trigger."""
     trigger = _trigger_spec(event.trigger)
     if event.accelerator_override is not None:
         override = event.accelerator_override
@@ -174,6 +183,7 @@ def _event_spec(event: EventModel) -> spec.EventSpec:
 
 
 def _sensors_spec(model: ScenarioModel) -> spec.SensorsSpec:
+    """The sensors' noise, the defaults where the file gives none."""
     gnss, lidar = model.sensors.gnss, model.sensors.lidar
     return spec.SensorsSpec(
         gnss=spec.GnssSpec()
@@ -192,6 +202,7 @@ def _sensors_spec(model: ScenarioModel) -> spec.SensorsSpec:
 def _scenario(model: ScenarioModel, road_spec: spec.RoadSpec,
               actors: tuple[spec.ActorSpec, ...],
               town: spec.TownSpec | None = None) -> Scenario:
+    """The scenario of a checked model, its route road and its actors."""
     ego = model.ego
     world = spec.WorldSpec(
         road=road_spec,
@@ -243,6 +254,7 @@ def _convert_town(model: ScenarioModel) -> Scenario:
 
 def _town_route(layout: TownLayout, key: str, start: tuple[int, int, str] | None,
                 route: Sequence[str] | None) -> spec.RoadSpec:
+    """The route road of a car in the town (`key` names it in errors)."""
     if start is None:
         raise LocatedError(f"{key}.start", "required key missing in a town ([ix, iy, heading])")
     turns = tuple(hdmap.Manoeuvre(turn) for turn in (route or ()))

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import math
 
-FILE_KEY = "(file)"
+FILE_KEY = "(file)"  # the key of a problem with the file as a whole
 
 KeyPath = tuple[str | int, ...]  # a path into the file: mapping keys and list indices
 

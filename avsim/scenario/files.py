@@ -17,8 +17,8 @@ import yaml
 
 from avsim.scenario.errors import FILE_KEY, LocatedError, show
 
-REPO_ROOT = Path(__file__).resolve().parents[2]
-SCENARIO_DIR = REPO_ROOT / "scenarios"
+REPO_ROOT = Path(__file__).resolve().parents[2]  # the repository this package sits in
+SCENARIO_DIR = REPO_ROOT / "scenarios"  # the bundled scenarios
 
 
 def bundled_scenarios() -> list[Path]:
@@ -60,6 +60,7 @@ class _StrictLoader(yaml.SafeLoader):
     """A safe YAML loader that refuses duplicate keys instead of keeping the last one."""
 
     def construct_mapping(self, node: yaml.MappingNode, deep: bool = False) -> dict[Hashable, Any]:
+        """The mapping, or a `LocatedError` at the line of a key's second occurrence."""
         seen: dict[Hashable, yaml.Node] = {}
         for key_node, _ in node.value:
             if key_node.tag == _MERGE_TAG:  # `<<: *anchor`; its keys may be overridden

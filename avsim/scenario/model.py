@@ -214,7 +214,7 @@ class SpeedBumpFeature(FormatModel):
 
 
 class TrafficLightFeature(FormatModel):
-    """A traffic light with a stop line; a fixed green-yellow-red cycle. Not supported yet."""
+    """A traffic light with a stop line; a fixed green-yellow-red cycle."""
 
     type: Literal["traffic_light"] = Field(description="Feature type `traffic_light`.")
     s: NonNegFloat = Field(description="[m] station of the stop line; required, on the route.")
@@ -377,7 +377,8 @@ class LaneChangeActionModel(FormatModel):
 
 class WalkActionModel(FormatModel):
     """Walk across the road to a lateral offset from the actor's lane centre, at a walking
-    speed (reached and left at 1.5 m/s^2), facing the walking direction; then stand."""
+    speed (reached and left at `world.actors.behaviour.LATERAL_ACCEL`), facing the walking
+    direction; then stand."""
 
     to_offset: float = Field(
         description="[m] lateral offset from the actor's lane centre to walk to, left "
@@ -449,8 +450,7 @@ class FlatTireModel(FormatModel):
 
 class EventModel(FormatModel):
     """Something that happens to the ego car: a `trigger` (not `gap`: there is no actor)
-    and exactly one event key. `accelerator_override` is simulated; `flat_tire` is not
-    supported yet."""
+    and exactly one event key, `accelerator_override` or `flat_tire`."""
 
     model_config = ConfigDict(json_schema_extra=_one_of(EVENT_KINDS))
 
@@ -557,7 +557,7 @@ class ActorModel(FormatModel):
 
 
 class GnssModel(FormatModel):
-    """GNSS / odometry noise."""
+    """GNSS / odometry noise; keys left out take their defaults."""
 
     sigma: NonNegFloat = Field(
         default=0.05, description="[m] 1-sigma horizontal position noise, >= 0. Default 0.05."
@@ -572,7 +572,8 @@ class GnssModel(FormatModel):
 
 
 class LidarModel(FormatModel):
-    """LiDAR noise (the beam layout comes from `--profile`)."""
+    """LiDAR noise (the beam layout comes from `--profile`); keys left out take their
+    defaults."""
 
     range_sigma: NonNegFloat = Field(
         default=0.02, description="[m] 1-sigma range noise, >= 0. Default 0.02."
@@ -583,7 +584,8 @@ class LidarModel(FormatModel):
 
 
 class SensorsModel(FormatModel):
-    """Sensor noise; keys left out come from the run's `--profile`."""
+    """Sensor noise; keys left out take their defaults (`--profile` chooses the sensors,
+    not their noise)."""
 
     gnss: GnssModel | None = Field(
         default=None, description="GNSS noise `{sigma, heading_sigma_deg, bias}`."

@@ -27,6 +27,7 @@ def apply_overrides(raw: dict[str, Any], overrides: Mapping[str, object]) -> dic
 
 
 def _set_path(data: dict[str, Any], path: str, value: object) -> None:
+    """Set the dotted `path` of `data` to `value` in place (module doc)."""
     parts = path.split(".")
     if not all(parts):
         raise LocatedError(path or "(override)", "override path is empty or has an empty part")
@@ -58,6 +59,7 @@ def _child(node: object, part: str, where: str, path: str) -> object:
 
 
 def _index(node: list[Any], part: str, path: str) -> int:
+    """`part` as an index of the list `node`, or a `LocatedError` at `path`."""
     if not part.isdigit() or int(part) >= len(node):
         raise LocatedError(path, f"cannot set: {part!r} is not an index of a list of {len(node)}")
     return int(part)

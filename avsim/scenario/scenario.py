@@ -34,8 +34,8 @@ class Scenario:
     description: str  # one line for humans
     situation: str  # which driving situation it exercises (the file's `situation`)
     duration: float  # [s] simulated time limit
-    world: WorldSpec
-    driver: DriverSettings
+    world: WorldSpec  # what the world is built from
+    driver: DriverSettings  # what the driver asks of the stack
     criteria: CriteriaSettings = field(default_factory=CriteriaSettings)
 
     @property

@@ -92,6 +92,7 @@ def _translate(error: ErrorDetails, raw: dict[str, Any]) -> tuple[str, str]:
 
 
 def _message(error: ErrorDetails, loc: KeyPath) -> str:
+    """A pydantic error of a built-in type as a short message (`must be > 0, got -5`)."""
     kind = error["type"]
     context = error.get("ctx") or {}
     got = show(error.get("input"))
@@ -155,7 +156,7 @@ def _file_path(loc: Sequence[str | int], raw: object) -> KeyPath:
     return tuple(kept)
 
 
-_ABSENT = object()
+_ABSENT = object()  # `_item`'s answer for a key or index the file does not have
 
 
 def _item(node: object, part: str | int) -> object:

@@ -1,13 +1,17 @@
 """NPC bodies in the physics world, moved along the route by their scripted behaviour.
 
-NPCs are kinematic: static (mass 0) boxes placed at `world.core.rates.ACTOR_RATE` from their
-`NpcMotion` in route coordinates. The ego collides with them like with a wall, and contact
-queries see them. (Only the ego must drive through its joints; NPCs are scripted traffic.)
-Pedestrians are boxes too (0.5 m deep, 0.6 m wide, 1.75 m tall), placed by station and
-offset from their lane's centre like any actor; `speed_kph` is a walking speed along the
-lane, the `walk` action moves them across the road, facing where they walk.
-Bodies are placed with one scalar map lookup per moving actor; `poses` (all of them, for
-criteria, scoring and the recording) is one vectorised map call, when asked.
+NPCs are kinematic: static (mass 0) boxes of `SIZES`, placed at `ACTOR_RATE`
+(`world.core.rates`) from their `NpcMotion` in route coordinates. The ego collides with them
+like with a wall, and contact queries see them. (Only the ego must drive through its joints;
+NPCs are scripted traffic.) Pedestrians are boxes too, placed by station and offset from
+their lane's centre like any actor; their speed is a walking speed along the lane, and the
+`walk` action moves them across the road, facing where they walk.
+
+Each actor follows a line: in a town, its own route road; on a road with an exit, an actor
+that starts before the fork keeps the road the route leaves (`RoadMap.through_line`); any
+other, the route. Bodies are placed with one scalar map lookup per moving actor; `poses`
+(all of them, for criteria, scoring and the recording) is one vectorised map call, when
+asked, with every station and offset taken on the ego's route.
 """
 
 from __future__ import annotations
@@ -30,18 +34,20 @@ from world.spec import ActorSpec, ActorType
 
 @dataclass(frozen=True, slots=True)
 class BoxSize:
+    """An actor's box."""
+
     length: float  # [m]
     width: float  # [m]
     height: float  # [m]
 
 
 SIZES = {
-    ActorType.CAR: BoxSize(4.6, 1.8, 1.5),
+    ActorType.CAR: BoxSize(4.6, 1.8, 1.5),  # [m] length, width, height
     ActorType.TRUCK: BoxSize(9.0, 2.5, 3.4),
     ActorType.OBSTACLE: BoxSize(1.0, 1.0, 1.0),  # a crate / barrier block
     ActorType.PEDESTRIAN: BoxSize(0.5, 0.6, 1.75),
 }
-COLOURS = {
+COLOURS = {  # [-] RGBA
     ActorType.CAR: (0.85, 0.20, 0.15, 1.0),
     ActorType.TRUCK: (0.90, 0.65, 0.10, 1.0),
     ActorType.OBSTACLE: (0.95, 0.45, 0.05, 1.0),
@@ -58,8 +64,8 @@ class ActorPoses:
     centres: NDArray[np.float64]  # [m] (N, 3) map frame
     yaws: NDArray[np.float64]  # [rad] (N,)
     half_sizes: NDArray[np.float64]  # [m] (N, 3) length, width, height halves
-    stations: NDArray[np.float64]  # [m] (N,) route station of each centre
-    offsets: NDArray[np.float64]  # [m] (N,) lateral offset from the reference line
+    stations: NDArray[np.float64]  # [m] (N,) station of each centre on the ego's route
+    offsets: NDArray[np.float64]  # [m] (N,) lateral offset from the route's reference line
     # [m/s] (N,) vehicles: along their lane; pedestrians: walking speed over ground (a
     # crossing's lateral motion included)
     speeds: NDArray[np.float64]
@@ -101,6 +107,7 @@ class ActorSet:
         self._dt = 1.0  # [s] the last step
         self._ids = tuple(a.id for a in specs)
         self._kinds = tuple(a.type for a in specs)
+        # [rad] an oncoming actor's body faces against the route
         self._flip_list = [math.pi if m.direction < 0 else 0.0 for m in self.motions]
         self._flip = np.array(self._flip_list)
         self._heights = self.half_sizes[:, 2].tolist()  # [m] box centre above the ground
@@ -118,6 +125,7 @@ class ActorSet:
         self._place(force=True)
 
     def _make_body(self, kind: ActorType) -> int:
+        """A static box of `kind`'s size and colour, below the ground until placed."""
         size = SIZES[kind]
         half = [size.length / 2, size.width / 2, size.height / 2]
         shape = self._c.createCollisionShape(pybullet.GEOM_BOX, halfExtents=half)

@@ -2,16 +2,19 @@
 
 Pure (no PyBullet): `NpcMotion` holds one actor's state along the route (station, lateral
 offset from the reference line, speed, lateral speed) and its pending actions; `step()`
-advances it by dt. Motion is smooth by construction: speed changes at a bounded
-acceleration, lateral moves follow a trapezoidal lateral-speed profile (bounded lateral
-acceleration), so positions and headings never jump.
+advances it by dt. Scripted motion is smooth: the speed changes at the action's
+acceleration, and lateral moves follow a trapezoidal lateral-speed profile (ramps of
+`LATERAL_ACCEL`, cruise at the action's lateral speed), so positions and headings never
+jump. A town driver's `cap` (`world.actors.town_traffic`) may lower the speed at once; the
+speed comes back up at `CAP_ACCEL` when it lifts.
 
 Actions (scenario format): `speed` (to a speed at an acceleration), `lane_change` (to a
 lane's centre at a lateral speed), `walk` (across the road to an offset from the actor's
 lane centre, at a walking speed: the same trapezoidal lateral move), `stop` (brake to rest).
 Triggers: `time`, `ego_s`, `gap` (bumper-to-bumper distance to the ego along the route),
 `after` (an earlier action ended, plus a delay). Each action fires once, when its trigger
-first holds.
+first holds; it ends when it reaches its target, or when a later action of the same kind
+(longitudinal: speed, stop; lateral: lane change, walk) replaces it.
 
 Headings: a vehicle's body points along its velocity while it moves faster than 0.1 m/s
 (along its lane at rest). A pedestrian faces where it walks, also straight across the road
@@ -51,6 +54,8 @@ LaneOffset = Callable[[int, float], float]
 
 @dataclass(frozen=True, slots=True)
 class TriggerContext:
+    """What triggers are judged on, at one step."""
+
     t: float  # [s] sim time
     ego_s: float  # [m] the ego's centre station
     gap: float  # [m] bumper-to-bumper distance between this actor and the ego along the route
@@ -88,8 +93,8 @@ class NpcMotion:
         self.speed = speed  # [m/s] along its lane's direction of travel
         self.lateral_speed = 0.0  # [m/s] d(offset)/dt
         self.direction = direction  # +1 with the route, -1 against
-        self.lane = lane
-        self.pedestrian = pedestrian
+        self.lane = lane  # the lane `walk` offsets are measured from
+        self.pedestrian = pedestrian  # faces where it walks
         self._facing = 0.0  # [rad] a pedestrian's heading relative to its lane's direction
         self.actions = actions
         self.fired_at: list[float | None] = [None] * len(actions)  # [s]
@@ -98,10 +103,10 @@ class NpcMotion:
         self._planned = speed  # [m/s] the scripted speed (actions alone)
         self.cap: float | None = None  # [m/s] a town driver's limit (`world.actors.town_traffic`)
         self._accel = 0.0  # [m/s^2] magnitude towards the target speed
-        self._speed_action: int | None = None
+        self._speed_action: int | None = None  # index of the running longitudinal action
         self._target_offset = offset  # [m]
         self._lateral_max = 0.0  # [m/s] cruise lateral speed of the running lateral move
-        self._lateral_action: int | None = None
+        self._lateral_action: int | None = None  # index of the running lateral action
 
     # -- triggers --------------------------------------------------------------------------
 
@@ -158,6 +163,8 @@ class NpcMotion:
         self._facing = wrap_angle(self._facing + max(-limit, min(limit, error)))
 
     def _step_speed(self, t: float, dt: float) -> None:
+        """The scripted speed one step towards its target at the action's acceleration
+        (the action ends on it), then the cap."""
         error = self._target_speed - self._planned
         change = self._accel * dt
         if abs(error) <= change:
@@ -173,6 +180,8 @@ class NpcMotion:
             self.speed = max(0.0, min(self._planned, self.cap, self.speed + CAP_ACCEL * dt))
 
     def _step_lateral(self, t: float, dt: float) -> None:
+        """The lateral speed one step along the trapezoidal profile to the target offset
+        (the action ends on arrival, within `ARRIVED`)."""
         if self._lateral_action is None:
             self.lateral_speed = 0.0
             return
@@ -209,6 +218,7 @@ class NpcMotion:
 
 
 def _same_kind(a: object, b: object) -> bool:
+    """Whether actions a and b are both longitudinal or both lateral."""
     longitudinal = (SpeedAction, StopAction)
     lateral = (LaneChangeAction, WalkAction)
     return (isinstance(a, longitudinal) and isinstance(b, longitudinal)) or (

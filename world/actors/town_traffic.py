@@ -3,24 +3,23 @@
 An NPC in a town drives its route road (`world.map.town.compile_route`) at its scripted speed
 (`NpcMotion`), capped each step by `TownDriver.speed_cap`, the least of:
 
-- **signals**: a red light ahead, or a yellow one it can stop for at ``STOP_DECEL``
-  (2.5 m/s^2), makes it stop with its front bumper ``STOP_MARGIN`` before the line, along
-  the braking curve ``v = sqrt(2 b d)``;
-- **stop signs**: it stops at the line, stands ``STOP_DWELL`` (1.5 s), then goes on once no
-  other vehicle is inside the junction's box;
-- **turns**: ``v = sqrt(TURN_LATERAL_ACCEL / curvature)`` (2.0 m/s^2) on a turn's arc,
-  braked for ahead of it;
+- **signals**: a red light ahead, or a yellow one it can stop for at ``STOP_DECEL``, makes
+  it stop with its front bumper ``STOP_MARGIN`` before the line, along the braking curve
+  ``v = sqrt(2 b d)``, b = ``STOP_DECEL``, d the distance left;
+- **stop signs**: it stops at the line (slower than ``STOP_SPEED``), stands ``STOP_DWELL``,
+  then goes on once no other vehicle's centre is inside the junction's box;
+- **turns**: ``v = sqrt(TURN_LATERAL_ACCEL / curvature)`` on a turn's arc, braked for ahead
+  of it by the braking curve;
 - **the vehicle ahead**: any vehicle (other NPCs, the ego) whose centre is on its route
-  ahead, within its lane (``FOLLOW_LANE_HALF`` of the lane centre), is kept at a standstill
-  gap of ``FOLLOW_GAP`` plus ``FOLLOW_HEADWAY`` seconds of speed, again by the braking
-  curve.
+  ahead, within its lane (``FOLLOW_LANE_HALF`` of the reference line), is kept at a
+  standstill gap of ``FOLLOW_GAP`` plus ``FOLLOW_HEADWAY`` seconds of speed, again by the
+  braking curve;
+- **the route's end** (the next junction's stop line): it stops there and stays.
 
-At its route's end (the next junction's stop line) it stops and stays.
-
-The cap only lowers the speed; `NpcMotion` speeds up again at its ``CAP_ACCEL`` when it
-lifts.
-These are scripted drivers on ground truth (the world's own NPCs), not a stack: they read
-the light's lamp from its timing and other cars' true poses.
+Lines, turns and vehicles count within ``LOOK_AHEAD``. The cap only lowers the speed;
+`NpcMotion` speeds up again at its ``CAP_ACCEL`` when it lifts. These are scripted drivers
+on ground truth (the world's own NPCs), not a stack: they read the light's lamp from its
+timing and other cars' true poses.
 """
 
 from __future__ import annotations
@@ -40,11 +39,11 @@ STOP_DECEL = 2.5  # [m/s^2] the braking curve to a stop line or a car ahead
 STOP_MARGIN = 0.5  # [m] front bumper short of the stop line
 STOP_DWELL = 1.5  # [s] standing at a stop sign
 STOP_SPEED = 0.3  # [m/s] below this at the line counts as stopped
-TURN_LATERAL_ACCEL = 2.0  # [m/s^2]
+TURN_LATERAL_ACCEL = 2.0  # [m/s^2] on a turn's arc
 FOLLOW_GAP = 4.0  # [m] bumper to bumper at a standstill
-FOLLOW_HEADWAY = 1.2  # [s]
+FOLLOW_HEADWAY = 1.2  # [s] of its own speed, added to the standstill gap
 FOLLOW_LANE_HALF = 1.5  # [m] how far off its lane's centre a vehicle counts as ahead
-LOOK_AHEAD = 60.0  # [m]
+LOOK_AHEAD = 60.0  # [m] how far ahead lines, turns and vehicles count
 
 
 FloatArray = NDArray[np.float64]
@@ -52,11 +51,13 @@ FloatArray = NDArray[np.float64]
 
 @dataclass(slots=True)
 class _StopLine:
+    """A stop line on the NPC's route and what the NPC knows of it."""
+
     s: float  # [m] station of the line on the NPC's route
     light: TrafficLightSpec | None  # its signal plan; None: a stop sign
-    box: tuple[float, float, float]  # (x, y, half width) of the junction's box
+    box: tuple[float, float, float]  # [m] (x, y, half width) of the junction's box
     stood_since: float | None = None  # [s] when it came to a stop at a stop sign
-    passed: bool = False
+    passed: bool = False  # the front bumper is over the line
 
 
 class TownDriver:
@@ -65,6 +66,7 @@ class TownDriver:
 
     def __init__(self, road: RoadMap, signals: Sequence[TrafficLightSpec],
                  half_length: float) -> None:
+        """`half_length` [m]: the NPC's centre to its front bumper."""
         self.road = road
         self.half_length = half_length
         boxes = {j.s_stop: (j.x, j.y, j.half_width) for j in road.junctions}
@@ -88,6 +90,7 @@ class TownDriver:
         return min(cap, self._follow_cap(s, speed, others, other_half_lengths))
 
     def _line_cap(self, t: float, front: float, speed: float, others: FloatArray) -> float:
+        """[m/s] the braking speed to the first line ahead it must stop at (signals, signs)."""
         cap = math.inf
         for line in self._lines:
             if line.passed:
@@ -104,9 +107,11 @@ class TownDriver:
 
     def _must_stop(self, line: _StopLine, t: float, distance: float, speed: float,
                    others: FloatArray) -> bool:
+        """Whether it must stop at `line`, `distance` [m] ahead of the front bumper's stop."""
         if line.light is not None:
             colour = light_colour(line.light, t)
-            if colour is LightColour.YELLOW:  # stop if it can at STOP_DECEL, else go
+            # yellow: stop if it can at STOP_DECEL (with 1 m^2/s^2 of slack), else go
+            if colour is LightColour.YELLOW:
                 return speed * speed <= 2.0 * STOP_DECEL * max(distance, 0.0) + 1.0
             return colour is LightColour.RED
         if line.stood_since is None:
@@ -116,6 +121,7 @@ class TownDriver:
         return t - line.stood_since < STOP_DWELL or _box_occupied(line.box, others)
 
     def _turn_cap(self, s: float) -> float:
+        """[m/s] the lowest turn speed ahead, each braked for from its arc's start."""
         cap = math.inf
         for s0, s1, curvature in self._arcs:
             if s > s1 or s0 - s > LOOK_AHEAD:
@@ -126,6 +132,7 @@ class TownDriver:
 
     def _follow_cap(self, s: float, speed: float, others: FloatArray,
                     other_half_lengths: FloatArray) -> float:
+        """[m/s] the braking speed to the following distance behind the nearest vehicle."""
         if len(others) == 0:
             return math.inf
         stations, offsets = self.road.local_coordinates(others)
@@ -143,6 +150,7 @@ def _braking_speed(distance: float) -> float:
 
 
 def _box_occupied(box: tuple[float, float, float], others: FloatArray) -> bool:
+    """Whether any centre of `others` (N, 2) [m] is inside the square `box`."""
     x, y, half = box
     if len(others) == 0 or half == 0.0:
         return False

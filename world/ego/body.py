@@ -5,27 +5,29 @@ split of a bicycle angle), the wheel joints get drive torque and a brake. Nothin
 the body's pose or velocity after spawn.
 
 Actuator model (per wheel): one joint velocity motor, set when the command changes (at the
-control rate) and held by Bullet between commands, so the ego costs no Python per step:
-- driving (drive torque above the resistances): target spin +MAX_WHEEL_SPIN with the net
-  torque as the motor's force limit, i.e. a constant forward torque (all-wheel drive, a
-  quarter each, so the 5 m/s^2 the ICCAS car is allowed stays well inside the tyres' grip);
-- otherwise: target spin 0 with brake + rolling resistance + aerodynamic drag (less any
-  drive torque) as the force limit. A velocity motor with a force limit is a Coulomb
-  friction torque: it opposes the wheel's spin up to the limit and holds the car at rest.
-  Drag `0.5 rho CdA v^2` is taken at the speed of the command and acts through the wheels
-  (for a rolling car the longitudinal effect is the same as at the body);
-- a top-speed governor: no drive torque at or above the vehicle's maximum speed.
-Bullet's default link damping (0.04, applied as m v (k + k |v|), about 4 kN at 8 m/s) is
-switched off: drag and rolling resistance are modelled explicitly instead.
+control rate) and held by Bullet between commands, so the ego costs no Python per step.
+The net torque is ``drive - brake - c m g r - 0.5 rho CdA v^2 r`` (rolling resistance and
+drag at the wheel radius r), a quarter per wheel (all-wheel drive, so that `max_accel` stays
+well inside the tyres' grip):
+- net torque forward: target spin +MAX_WHEEL_SPIN with the net torque as the motor's force
+  limit, i.e. a constant forward torque;
+- otherwise: target spin 0 with brake + rolling resistance + drag, less any drive torque
+  (the net torque's magnitude), as the force limit. A velocity motor with a force limit is
+  a Coulomb friction torque: it opposes the wheel's spin up to the limit and holds the car
+  at rest. Drag is taken at the speed of the command and acts through the wheels (for a
+  rolling car the longitudinal effect is the same as at the body);
+- a top-speed governor: no drive torque at or above `EgoParams.max_speed`.
+Bullet's default link damping (a force m v (k + k |v|), large at road speeds) is switched
+off: drag and rolling resistance are modelled explicitly instead.
 
 Flat tyre (`puncture`, advanced by `update_tyres` at the world's trigger checks). Each wheel
 rolls on its tyre's sphere (the rolling radius); inside it, fixed to the wheel, a smaller
 sphere of the flat rolling radius (the URDF's `<corner>_rim` link: the rim on the folded
-carcass) whose contact is made inert at spawn (stiffness ~0, no friction) so an intact car
-never feels it. A collision shape cannot change at run time, so a puncture moves the
+carcass) whose contact is made inert at spawn (`INERT_CONTACT`, no friction) so an intact
+car never feels it. A collision shape cannot change at run time, so a puncture moves the
 wheel's contact from one sphere to the other, over `EgoParams.deflation_time`:
 1. the first `DEFLATE_TYRE_SHARE` of it, the tyre's contact stiffness falls geometrically to
-   `TYRE_END_STIFFNESS` of its value: the corner sinks until the rim is ~1 mm off the road;
+   `TYRE_END_STIFFNESS` of its value: the corner sinks until the rim is just off the road;
 2. then the tyre stops colliding and the rim's contact takes the load, its stiffness falling
    geometrically from `RIM_START_STIFFNESS` times the flat tyre's to the flat tyre's (URDF):
    the corner sinks on. From here the wheel rolls on the flat radius: it spins
@@ -33,13 +35,12 @@ wheel's contact from one sphere to the other, over `EgoParams.deflation_time`:
 The flat wheel also gets a rolling-resistance torque `deflated * (c_flat - c) * N * r_flat`
 (N its contact's normal force, read when its motor is set): its joint motor's torque is
 less that much, so the car needs more drive to hold its speed. That drag is also a yaw
-moment toward the flat side (~190 N m at 50 km/h), but it does not turn the car: Bullet's
-tyre contacts take no slip angle (sideways they hold rigidly up to mu N), so with the
-steering held straight the car keeps its heading. A pull would need tyre compliance, which
-the simulator does not model for any tyre.
-The body has no suspension (the tyres' compliance is all of it), so a corner cannot drop
-much before the diagonal wheel unloads: the flat corner settles ~2 cm lower (its load and
-the diagonal one's fall to ~45 %), not by the tyre's whole sidewall.
+moment toward the flat side, but it does not turn the car: Bullet's tyre contacts take no
+slip angle (sideways they hold rigidly up to mu N), so with the steering held straight the
+car keeps its heading. A pull would need tyre compliance, which the simulator does not
+model for any tyre. The body has no suspension (the tyres' compliance is all of it), so a
+corner cannot drop much before the diagonal wheel unloads: the flat corner settles by a
+fraction of the tyre's sidewall, not by all of it.
 """
 
 from __future__ import annotations
@@ -59,21 +60,24 @@ from world.frames import VehicleInfo
 AIR_DENSITY = 1.2  # [kg/m^3]
 STEER_TORQUE = 4000.0  # [N m] steering hinge servo force limit
 STEER_RATE = 1.2  # [rad/s] steering hinge servo speed limit (actuator, not the controller's)
-MAX_WHEEL_SPIN = 200.0  # [rad/s] joint velocity cap (Bullet's default 100 rad/s is 33 m/s)
+MAX_WHEEL_SPIN = 200.0  # [rad/s] joint velocity cap (Bullet's default would cap the car's
+#   speed below the vehicle limits)
 INERT_CONTACT = 1e-3  # [N/m], [N s/m] a rim's contact stiffness and damping while its tyre is
-#   inflated: it carries nothing (~1e-5 N at 1 cm), and it has no friction
+#   inflated: it carries next to nothing, and it has no friction
 LARGE_THRESHOLD = 1e18  # [m] Bullet's default contact processing threshold (BT_LARGE_FLOAT)
 DEFLATE_TYRE_SHARE = 0.25  # [-] share of the deflation time in which the tyre's sphere sinks
 TYRE_END_STIFFNESS = 0.35  # [-] the tyre's contact stiffness when the rim takes over, of its
-#   own: the corner has sunk until the rim (0.02 m inside the tyre) is ~1 mm off the road
-#   (measured: the corner lags the falling stiffness; at rest it would sink further)
+#   own: the corner has sunk until the rim (wheel_radius - flat_radius inside the tyre) is
+#   just off the road (the corner lags the falling stiffness; at rest it would sink further)
 RIM_START_STIFFNESS = 10.0  # [-] the rim's contact stiffness when it takes over, of the flat
-#   tyre's: it takes the load within ~1 mm, then softens to the flat tyre's
+#   tyre's: stiff, so it takes the load without a drop, then softens to the flat tyre's
 
 
 @dataclass(frozen=True, slots=True)
 class EgoParams:
-    max_speed: float = 15.0  # [m/s] vehicle limit (the ICCAS car: 15 m/s)
+    """The ego car's parameters beyond the URDF's geometry."""
+
+    max_speed: float = 15.0  # [m/s] vehicle limit (the ICCAS car's)
     max_accel: float = 5.0  # [m/s^2] the drive torque is capped to give this on the flat
     rolling_resistance: float = 0.012  # [-] coefficient, F = c m g
     drag_area: float = 0.7  # [m^2] Cd * A
@@ -88,10 +92,10 @@ class EgoTruth:
     position: NDArray[np.float64]  # [m] (3,) map frame, the base link origin (car centre)
     quaternion: NDArray[np.float64]  # (4,) x, y, z, w, map frame
     rotation: NDArray[np.float64]  # (3, 3) body -> map frame
-    yaw: float  # [rad]
+    yaw: float  # [rad] map frame, counter-clockwise from +x
     velocity: NDArray[np.float64]  # [m/s] (3,) map frame, at the centre of mass
-    speed: float  # [m/s] forward (body x) component
-    yaw_rate: float  # [rad/s]
+    speed: float  # [m/s] forward (body x) component of `velocity`
+    yaw_rate: float  # [rad/s] about the map's z, counter-clockwise +
     wheel_spin: NDArray[np.float64]  # [rad/s] (4,) FL, FR, RL, RR
     steering_angle: float  # [rad] bicycle-equivalent road-wheel angle from the hinges
 
@@ -122,6 +126,8 @@ class EgoBody:
         speed: float,
         params: EgoParams,
     ) -> None:
+        """Spawn the car at (x, y) [m] in the map frame, heading `yaw` [rad], its base link
+        origin at wheel-radius height, rolling forward at `speed` [m/s]."""
         self._c = client
         self.params = params
         self.geometry: CarGeometry = read_geometry(URDF_PATH)
@@ -145,8 +151,8 @@ class EgoBody:
         self.rim_links = [self.links[f"{w}_rim"] for w in WHEELS]
         self._rim_friction = [float(client.getDynamicsInfo(self.body, rim)[1])
                               for rim in self.rim_links]
-        for rim in self.rim_links:  # inert until its tyre goes flat, and the contacts Bullet
-            # finds before it touches (2 cm off the road) not solved: ~15 % of a step
+        for rim in self.rim_links:  # inert until its tyre goes flat; the contacts Bullet
+            # finds before the rim touches are not processed (they would cost every step)
             client.changeDynamics(self.body, rim, contactStiffness=INERT_CONTACT,
                                   contactDamping=INERT_CONTACT, lateralFriction=0.0,
                                   contactProcessingThreshold=0.0)

@@ -10,35 +10,34 @@ line between neighbouring junctions (right-hand traffic, `lanes` each way, no sh
 A street is ``2 hw`` wide, ``hw = lanes * lane_width``; lane 0 (the kerb lane) of a
 direction is centred ``a = hw - lane_width / 2`` right of the street's centre line. The
 junction box is the square where two streets cross, ``hw`` each side of the centre. Its
-kerb corners are rounded with radius ``KERB_RADIUS`` (6 m), tangent to both street edges,
-so that they end ``mouth = hw + KERB_RADIUS`` from the centre. Markings run between mouths;
-inside, nothing is painted.
+kerb corners are rounded with radius ``KERB_RADIUS``, tangent to both street edges, so that
+they end ``mouth = hw + KERB_RADIUS`` from the centre. Markings run between mouths; inside,
+nothing is painted.
 
 **Turn paths** (lane 0 to lane 0, between the mouths, where a route's `Zone.JUNCTION`
 pieces start and end):
 
-- right: a quarter circle of ``RIGHT_TURN_RADIUS`` (6 m) from ``a + RIGHT_TURN_RADIUS``
-  before the centre (straight before and after it, from and to the mouths). A kerb corner
-  concentric with it, lane_width / 2 inside, would leave the rear wheels no room: the car
-  steers its front axle onto the path, and its rear axle runs ~0.65 m inside it on a 6 m
-  turn (sqrt(R^2 - L^2)), plus the tracking error (0.28 m at the front axle, measured).
-  The kerb radius equal to the path's leaves 2.47 m from the path to the kerb at the
-  corner's middle, (sqrt 2 - 1) lane_width / 2 more than concentric;
-- left: a quarter circle of radius ``a + mouth`` (11.25 m for one 3.5 m lane), through
-  the box;
-- U-turn: straight to the centre, then a half circle of radius ``a`` back into the
-  opposite lane 0; the street allows it when ``a >= U_TURN_MIN_RADIUS`` (5 m; the car's
-  tightest circle is 3.6 m at its 0.65 rad steering limit), i.e. from two 3.5 m lanes a
-  direction;
+- right: a quarter circle of radius ``R = RIGHT_TURN_RADIUS`` from ``a + R`` before the
+  centre, straight before and after it. The kerb corner has the path's radius: one
+  concentric with the path (``lane_width / 2`` inside) would leave the rear wheels no room,
+  as the front axle follows the path and the rear axle runs inside it, on radius
+  ``sqrt(R^2 - L^2)`` (L the wheelbase), plus the tracking error. The equal radius leaves
+  ``sqrt(2) lane_width / 2`` from the path to the kerb at the corner's middle;
+- left: a quarter circle of radius ``a + mouth`` through the box;
+- U-turn: straight to the centre, a half circle of radius ``a`` into the opposite lane 0,
+  straight back to the mouth; the street allows it when ``a >= U_TURN_MIN_RADIUS`` (a
+  margin over the car's tightest turning circle at its steering limit);
 - straight: through the box.
 
 **Control.** A junction where three or four streets meet has stop signs on every approach
 or traffic lights (`TownSpec.junctions`; `mixed`: lights where ix + iy is even). A corner of
 the town (two streets) is a bend, uncontrolled. Each approach has a stop line
-``STOP_SETBACK`` before its mouth, a stop sign on its right at the line, or a light on the
-far right corner of the junction facing it. The east-west approaches of a junction share a
-signal plan, the north-south ones get theirs while the others are red (`LightTiming`); the
-plans of neighbouring junctions are offset (`LIGHT_OFFSET_X`, `LIGHT_OFFSET_Y`).
+``STOP_SETBACK`` before its mouth, and either a stop sign on its right at the line
+(``SIGN_CLEARANCE`` beyond the kerb) or a light on the far right corner of the junction
+facing it (``LIGHT_BEHIND_KERB`` behind the rounded kerb, ``LIGHT_HEIGHT`` high). The
+east-west approaches of a junction share a signal plan; the north-south ones get theirs
+half a cycle later, while the others are red (`LightTiming`); the plans of neighbouring
+junctions are offset by ``ix LIGHT_OFFSET_X + iy LIGHT_OFFSET_Y`` (modulo the cycle).
 """
 
 from __future__ import annotations
@@ -62,6 +61,7 @@ LIGHT_OFFSET_X = 10.0  # [s] signal plan offset per junction along x ...
 LIGHT_OFFSET_Y = 17.0  # [s] ... and along y
 MIN_STREET = 10.0  # [m] of marked street a block must leave between two mouths
 
+# compass directions: [rad] map-frame heading, grid step, and turns
 HEADINGS = {"east": 0.0, "north": 0.5 * math.pi, "west": math.pi, "south": -0.5 * math.pi}
 STEPS = {"east": (1, 0), "north": (0, 1), "west": (-1, 0), "south": (0, -1)}
 LEFT_OF = {"east": "north", "north": "west", "west": "south", "south": "east"}
@@ -84,8 +84,8 @@ class TownError(ValueError):
 class Approach:
     """The end of one street at one controlled junction, for the traffic heading in."""
 
-    junction: Index
-    heading: str  # the direction of travel into the junction
+    junction: Index  # (ix, iy)
+    heading: str  # the direction of travel into the junction, a key of `HEADINGS`
     stop_line: tuple[float, float]  # [m] centre of the stop line (across the lanes heading in)
     stop_sign: tuple[tuple[float, float], float] | None  # ([m] pole foot, [rad] plate yaw)
     light: TrafficLightSpec | None  # its signal plan and head; `s` is 0 (not on a route)
@@ -119,19 +119,24 @@ class TownLayout:
 
     @property
     def left_turn_radius(self) -> float:
+        """[m] a + mouth, the left turn's lane-centre radius."""
         return self.kerb_lane + self.mouth
 
     @property
     def u_turn_allowed(self) -> bool:
+        """Whether lane 0 is far enough from the centre line for a U-turn (a half circle)."""
         return self.kerb_lane >= U_TURN_MIN_RADIUS
 
     def centre(self, j: Index) -> tuple[float, float]:
+        """[m] map-frame centre of junction j."""
         return (j[0] * self.spec.block, j[1] * self.spec.block)
 
     def exists(self, j: Index) -> bool:
+        """Whether junction j is in the grid."""
         return 0 <= j[0] <= self.spec.blocks_x and 0 <= j[1] <= self.spec.blocks_y
 
     def junctions(self) -> list[Index]:
+        """Every junction of the grid."""
         return [(ix, iy) for ix in range(self.spec.blocks_x + 1)
                 for iy in range(self.spec.blocks_y + 1)]
 
@@ -140,6 +145,8 @@ class TownLayout:
         return tuple(h for h, (dx, dy) in STEPS.items() if self.exists((j[0] + dx, j[1] + dy)))
 
     def control(self, j: Index) -> Control:
+        """How junction j is controlled: none at a bend (fewer than three arms), else as the
+        spec says (`mixed` by the parity of ix + iy)."""
         if len(self.arms(j)) < 3:
             return Control.NONE
         kind = self.spec.junctions
@@ -212,6 +219,7 @@ class _Builder:
     s: float = 0.0
 
     def street(self, length: float) -> None:
+        """A straight street piece [m] with every lane both ways."""
         n = self.layout.spec.lanes
         self._add(length, 0.0, n, n, Zone.CITY)
 
@@ -222,10 +230,12 @@ class _Builder:
         self._add(length, 0.0, n, n if through else 0, Zone.JUNCTION)
 
     def arc(self, radius: float, angle: float) -> None:
+        """An arc of lane 0 only: `radius` [m], `angle` [rad] > 0 turns left."""
         self._add(radius * abs(angle), math.copysign(1.0 / radius, angle), 1, 0, Zone.JUNCTION)
 
     def _add(self, length: float, curvature: float, lanes: int, oncoming: int,
              zone: Zone) -> None:
+        # a zero-length piece (a right turn's lead-in on a wide street) is left out
         if length <= 1e-9:
             return
         w = self.layout.spec.lane_width
@@ -235,9 +245,14 @@ class _Builder:
 
 def compile_route(layout: TownLayout, start: tuple[int, int, str],
                   route: Sequence[Manoeuvre], key: str) -> RoadSpec:
-    """The route road of a car that starts past the mouth of junction `start[:2]`, heading
-    `start[2]`, and does `route[k]` at the k-th junction it meets; it ends at the stop line
-    of the junction after the last. `key` (`ego`, `actors.3`) names it in errors."""
+    """The route road of a car that starts in lane 0 at the mouth of junction `start[:2]`,
+    heading `start[2]`, and does `route[k]` at the k-th junction it meets.
+
+    Steps, per manoeuvre: check the junction has the street it leaves by; lay the street to
+    the junction's mouth, then its turn path (`_lay_turn`); record the `Junction` and put
+    its control (stop sign or light, at the stop line) among the features. The route ends
+    with a street to the stop line of the junction after the last. `key` (`ego`,
+    `actors.3`) names the route in errors (`TownError`)."""
     j, heading = (start[0], start[1]), start[2]
     if not layout.exists(j):
         raise TownError(f"{key}.start", f"no junction {j} in this town")

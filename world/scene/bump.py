@@ -25,7 +25,7 @@ FloatArray = NDArray[np.float64]
 
 BUMP_SEGMENTS = 16  # [-] straight pieces of the profile along the route
 VISUAL_LIFT = 0.008  # [m] the visual surface above the collision surface (as the road marks)
-STRIPE_WIDTH = 0.5  # [m] across the road, alternately yellow and white
+STRIPE_WIDTH = 0.5  # [m] a stripe's width across the road, alternately yellow and white
 STRIPE_TEXELS = 4  # [px] per stripe across the texture
 YELLOW_RGB = (235, 190, 20)  # [0..255]
 WHITE_RGB = (235, 235, 230)  # [0..255]

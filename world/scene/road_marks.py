@@ -8,9 +8,9 @@ each quad is split along the route every `MARK_STEP` metres at most, so they ben
 
 Across, offsets d are from the route's reference line (left +):
 
-- stop line: from `STOP_LINE_WIDTH` long stations [s, s + STOP_LINE_WIDTH] (its near edge is
-  the stop line's station s), across the ego-direction lanes, from lane 0's right edge to
-  the centre line (the left edge of the ego's lanes);
+- stop line: stations [s, s + STOP_LINE_WIDTH] (its near edge on the stop line's station
+  s), across the ego-direction lanes, from lane 0's right edge to the centre line (the left
+  edge of the ego's lanes);
 - crosswalk: stations [s, s + width], bars `ZEBRA_BAR` wide with `ZEBRA_GAP` between them,
   running along the route, across the whole paved road (shoulder included); as many bars as
   fit, the pattern centred on the paved width.
@@ -28,10 +28,10 @@ from world.scene.road_mesh import TexturedMesh
 
 FloatArray = NDArray[np.float64]
 
-MARK_Z = 0.008  # [m] decal height above the ground (road surface: 0.005 m)
+MARK_Z = 0.008  # [m] decal height above the ground, over `road_mesh.SURFACE_Z`
 MARK_STEP = 1.0  # [m] largest station spacing of a mark's quads
-STOP_LINE_WIDTH = 0.3  # [m] along the route
-ZEBRA_BAR = 0.5  # [m] across the road
+STOP_LINE_WIDTH = 0.3  # [m] a stop line's extent along the route
+ZEBRA_BAR = 0.5  # [m] a zebra bar's width, across the road
 ZEBRA_GAP = 0.5  # [m] across the road, between bars
 PAINT_RGB = (232, 232, 226)  # [0..255] as the road's white lines (`road_mesh.WHITE_RGB`)
 PAINT_TEXELS = 4  # [px] side of the plain paint texture

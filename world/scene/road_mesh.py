@@ -1,7 +1,8 @@
 """The road surface as textured triangle meshes, with the lane markings painted in the texture.
 
 Pure data (numpy, no PyBullet): the world builder turns each `TexturedMesh` into a visual
-shape. The texture of a cross-section is one dash period of the paved road:
+shape. The surface lies flat `SURFACE_Z` above the ground, in the map frame. The texture of
+a cross-section is one dash period of the paved road:
 
 - across (u, texture columns): u = 0 at the right paved edge (the shoulder's outer edge),
   u = 1 at the left paved edge (the outermost lane's left edge);
@@ -46,13 +47,13 @@ SHOULDER_RGB = (74.0, 72.0, 68.0)  # [0..255] a lighter, older paved shoulder
 WHITE_RGB = (232.0, 232.0, 226.0)  # [0..255]
 YELLOW_RGB = (228.0, 176.0, 32.0)  # [0..255]
 ASPHALT_NOISE = 5.0  # [0..255] 1-sigma per-texel brightness noise
-TEXTURE_SEED = 20240  # fixed: the same cross-section always gives the same texture
+TEXTURE_SEED = 20240  # [-] fixed: the same cross-section always gives the same texture
 
 # -- tessellation -------------------------------------------------------------------------
 SURFACE_Z = 0.005  # [m] just above the ground plane
 MAX_STEP = 2.0  # [m] station spacing of the strip
 MAX_CHORD_ERROR = 0.02  # [m] at the outermost paved edge on arcs
-MAX_MESH_VERTICES = 4000  # per mesh (PyBullet's mesh size limit)
+MAX_MESH_VERTICES = 4000  # [-] per mesh (PyBullet's mesh size limit)
 STATION_TOL = 1e-6  # [m] a period boundary this close to a segment's end is not split at
 
 TextureKey = tuple[int, int, float, float]  # lanes, oncoming lanes, lane width, shoulder
@@ -76,11 +77,12 @@ class Marking:
 
     centre: float  # [m] from the right paved edge (u = centre / paved width)
     width: float  # [m]
-    dashed: bool
+    dashed: bool  # painted on v in [0, DASH_LENGTH / DASH_PERIOD) only
     rgb: tuple[float, float, float]  # [0..255]
 
 
 def texture_key(section: CrossSection) -> TextureKey:
+    """What a cross-section's texture depends on (not its zone)."""
     return (section.lanes, section.oncoming_lanes, section.lane_width, section.shoulder)
 
 
@@ -179,6 +181,7 @@ class _MeshBuffer:
     meshes: list[TexturedMesh] = field(default_factory=list)
 
     def add(self, xy: FloatArray, uv: FloatArray) -> None:
+        """Collect one strip, first flushing if it would overfill the mesh."""
         if self.count + len(xy) > MAX_MESH_VERTICES:
             self.flush()
         self.xy.append(xy)

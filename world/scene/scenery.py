@@ -27,12 +27,12 @@ FloatArray = NDArray[np.float64]
 # -- buildings ----------------------------------------------------------------------------
 FRONTAGE_RANGE = (10.0, 30.0)  # [m] along the road
 DEPTH_RANGE = (8.0, 20.0)  # [m] away from the road
-HEIGHT_RANGE = (6.0, 30.0)  # [m]
+HEIGHT_RANGE = (6.0, 30.0)  # [m] roof above the ground
 MIN_BUILDING_GAP = 1.0  # [m] least gap drawn between neighbours along one side
 GAP_JITTER = (0.5, 1.5)  # [-] factor on the mean gap, so the rhythm is not regular
 FOOTPRINT_STEP = 0.5  # [m] spacing of the footprint outline samples checked against the road
-SHIFT_ITERATIONS = 4  # attempts to move a building out of the setback on an inner curve
-SHIFT_MARGIN = 0.01  # [m] extra shift beyond the measured intrusion
+SHIFT_ITERATIONS = 4  # [-] attempts to move a building out of the setback on an inner curve
+SHIFT_MARGIN = 0.01  # [m] extra shift beyond the intrusion found
 FACADE_RGB = (
     (0.62, 0.60, 0.56),  # concrete
     (0.72, 0.66, 0.55),  # sandstone
@@ -45,11 +45,11 @@ FACADE_JITTER = 0.05  # [-] 1-sigma per-channel colour variation
 # -- speed-limit signs --------------------------------------------------------------------
 SIGN_CLEARANCE = 0.5  # [m] from the right paved edge to the pole
 SIGN_PLATE_HEIGHT = 2.0  # [m] plate centre above the ground
-SIGN_PLATE_DIAMETER = 0.75  # [m]
+SIGN_PLATE_DIAMETER = 0.75  # [m] the round plate's
 SIGN_RING_FRACTION = 0.12  # [-] red ring width / plate diameter (Vienna convention ~1/8)
 SIGN_TEXT_WIDTH = 0.70  # [-] of the white disc's diameter, for the widest (3-digit) number
 SIGN_TEXT_HEIGHT = 0.48  # [-] of the white disc's diameter
-SIGN_SUPERSAMPLE = 4  # drawn this much larger, then area-averaged down (anti-aliasing)
+SIGN_SUPERSAMPLE = 4  # [-] drawn this much larger, then area-averaged down (anti-aliasing)
 # -- stop signs (Vienna convention octagon: red, white border, white STOP) ------------------
 STOP_PLATE_WIDTH = 0.75  # [m] across the flats (same size class as the round signs)
 STOP_BORDER_FRACTION = 0.04  # [-] white border width / width across the flats
@@ -84,11 +84,11 @@ class SignPlacement:
 
     s: float  # [m] station of the posting
     kph: int  # the number on the plate [km/h]
-    limit: float  # [m/s]
+    limit: float  # [m/s] the posted limit
     pole_xy: tuple[float, float]  # [m] map frame, foot of the pole
     yaw: float  # [rad] direction the plate's front (its normal) faces: route heading + pi
     plate_height: float = SIGN_PLATE_HEIGHT  # [m] plate centre above the ground
-    plate_diameter: float = SIGN_PLATE_DIAMETER  # [m]
+    plate_diameter: float = SIGN_PLATE_DIAMETER  # [m] the round plate's
 
 
 @dataclass(frozen=True, slots=True)
@@ -108,6 +108,7 @@ class StopSignPlacement:
 
 
 def _rotation(yaw: float) -> FloatArray:
+    """(2, 2) rotation by `yaw` [rad], counter-clockwise."""
     c, s = math.cos(yaw), math.sin(yaw)
     return np.array([[c, -s], [s, c]])
 
@@ -192,6 +193,7 @@ def _place(
 
 
 def _facade(rng: np.random.Generator) -> tuple[float, float, float]:
+    """[-] 0..1 RGB: one of `FACADE_RGB`, jittered by `FACADE_JITTER` per channel."""
     base = np.asarray(FACADE_RGB[int(rng.integers(len(FACADE_RGB)))])
     r, g, b = np.clip(base + rng.normal(0.0, FACADE_JITTER, 3), 0.0, 1.0)
     return float(r), float(g), float(b)

@@ -16,42 +16,35 @@ Everything is in the map (= town) frame; junction (ix, iy) stands at (ix, iy) * 
   and are merged into meshes of at most `MAX_MESH_VERTICES`.
 - **Junctions**: plain asphalt (`ASPHALT_RGB` with the road's texel noise), no markings,
   at the road's `SURFACE_Z`: the box, the arms' ends up to the mouths, and the rounded kerb
-  corners where two streets meet (radius `layout.corner_radius`, centred on the right-turn
-  path's centre, `mouth` from the junction's centre on both axes). Where a street has no
-  continuation, the kerb runs on straight (T-junctions) or meets the other at a square
-  corner (the town's corners). One triangle fan from the centre per junction (the outline
-  is star-shaped from it); it meets the street strips edge to edge at the mouths.
+  corners where two streets meet (radius `layout.corner_radius`, centred `mouth` from the
+  junction's centre on both axes). Where a street has no continuation, the kerb runs on
+  straight (T-junctions) or meets the other at a square corner (the town's corners). One
+  triangle fan from the centre per junction (the outline is star-shaped from it); it meets
+  the street strips edge to edge at the mouths.
 - **Stop lines**: a white `STOP_LINE_WIDTH` band across the lanes heading in (centre line to
   kerb) on every approach of `layout.approaches()`, its near edge on the approach's stop
   line (`STOP_SETBACK` before the mouth), `MARK_Z` high like the road's marks.
-- **Pavements**: every block is one kerbed slab `KERB_HEIGHT` (0.12 m) high, its outline the
-  kerb (a rounded rectangle, convex): a `SIDEWALK_WIDTH` (3 m) concrete ring along the kerb
-  and around the corners (its inner edge a concentric arc of radius `corner_radius - 3 m`),
-  the block's interior in `GROUND_RGB` (the ground plane's colour). Outside the town, four
-  concrete strips `SIDEWALK_WIDTH` wide run along the outer kerbs (square corners). Each
-  slab is one static body whose mesh (top and kerb faces) is also its collision shape, one
-  per block plus four: the LiDAR's ray culling (`world.sensors.ray_culling`) works by bounding
-  boxes, and one body for all kerbs would have a box holding the car, sending every
-  downward ray to Bullet. 0.12 m is below the LiDAR detector's 0.2 m ground clearance:
-  sidewalks and kerbs stay ground for perception. Concrete `CONCRETE_RGB` renders at
-  lightness ~107 (OpenCV HLS), below the lane finder's white gate (130) and far from the
-  paint's ~230; the sidewalk is 3 m wide, far wider than its ridge filter's 12 px.
+- **Pavements**: every block is one kerbed slab `KERB_HEIGHT` high, its outline the kerb (a
+  rounded rectangle, convex): a `SIDEWALK_WIDTH` concrete ring along the kerb and around
+  the corners (its inner edge the kerb moved `SIDEWALK_WIDTH` into the block: concentric
+  arcs), the block's interior in `GROUND_RGB` (the ground plane's colour). Outside the town,
+  four concrete strips `SIDEWALK_WIDTH` wide run along the outer kerbs (square corners).
+  Each slab is one static body whose mesh (top and kerb faces) is also its collision shape,
+  one per block plus four: the LiDAR's ray culling (`world.sensors.ray_culling`) works by
+  bounding boxes, and one body for all kerbs would have a box holding the car, sending
+  every downward ray to Bullet. Perception must not see the pavements: `KERB_HEIGHT` is
+  below the LiDAR detector's ground clearance, so kerbs stay ground; `CONCRETE_RGB` is
+  darker than the lane finder's white gate and far from the paint, and the sidewalk is far
+  wider than a painted ridge.
 - **Buildings**: a few axis-aligned `BuildingBox`es on each side of every block, their
-  fronts `BUILDING_SETBACK` (4 m) behind the sidewalk, walked along the side like
+  fronts `BUILDING_SETBACK` behind the sidewalk, walked along the side like
   `scenery.layout_buildings` (frontage, depth, height, facade, then a gap for
   `BUILDING_DENSITY`), dropped when they would leave the block's building zone or come
-  within `MIN_BUILDING_GAP` of another; deterministic for the rng's state. Frontages are
-  at least 12.5 m: a facade seen whole is longer than any object the LiDAR detector keeps.
+  within `MIN_BUILDING_GAP` of another; deterministic for the rng's state. Frontages
+  (`BUILDING_FRONTAGE`) are longer than any object the LiDAR detector keeps, so a facade
+  seen whole is not taken for one.
 - **Stop signs**: a `StopSignPlacement` at every approach's `stop_sign` (its `s` is 0: not
   on a route).
-
-Sizes (3 x 3 blocks of 90 m, one 3.5 m lane a direction, stop signs): 24 streets in one
-mesh (2,160 vertices, 1,824 triangles), 16 junctions in one (512, 496), 40 stop lines in
-one (160, 80), 13 slabs (9 blocks of 365 vertices and 260 triangles, 4 strips of 21 and
-12), ~55 buildings, 40 stop signs; built in ~50 ms. Measured in a `World` (2 slow cores,
-EGL): the world builds in ~0.5 s with sensors (a road scenario: ~0.45 s), a 1,800-column
-LiDAR scan takes ~45 ms on a street (buildings on every side send most rays to Bullet;
-a road: ~35 ms), and the slabs add nothing measurable to a physics step.
 """
 
 from __future__ import annotations
@@ -91,14 +84,15 @@ IntArray = NDArray[np.int32]
 Index = tuple[int, int]
 
 SIDEWALK_WIDTH = 3.0  # [m] concrete from the kerb into the block
-KERB_HEIGHT = 0.12  # [m] the sidewalk's top above the street (LiDAR ground clearance: 0.2 m)
+KERB_HEIGHT = 0.12  # [m] the sidewalk's top above the street (below the LiDAR detector's
+#   `DetectorParams.ground_clearance`)
 CONCRETE_RGB = (112, 110, 104)  # [0..255] sidewalk and kerb faces
 GROUND_RGB = (84, 115, 64)  # [0..255] a block's interior: the ground plane's grass
-CORNER_SEGMENTS = 12  # chords per rounded kerb corner (R 4.25 m: 9 mm chord error)
+CORNER_SEGMENTS = 12  # [-] chords per rounded kerb corner
 JUNCTION_TEXEL = 0.1  # [m/px] the junction asphalt's texture
 BUILDING_SETBACK = 4.0  # [m] from the sidewalk's inner edge to a building's front
-BUILDING_FRONTAGE = (12.5, 30.0)  # [m] over 12 m: a facade seen whole is no object to the
-#   LiDAR detector (`DetectorParams.max_length`)
+BUILDING_FRONTAGE = (12.5, 30.0)  # [m] (min, max), the least over the LiDAR detector's
+#   `DetectorParams.max_length`: a facade seen whole is no object to it
 BUILDING_DENSITY = 0.7  # [-] built-up fraction of a block side's frontage
 START_JITTER = 5.0  # [m] the first building of a side starts up to this far from its corner
 PAVEMENT_TEXELS = 8  # [px] per colour in the pavement's two-colour texture
@@ -112,9 +106,9 @@ class Pavement:
     """A kerbed slab standing on the ground: a block's sidewalk and interior, or an outer
     sidewalk strip. Its collision is the prism of `outline` from z = 0 to `height`."""
 
-    name: str
+    name: str  # the body's name: town_block_<bx>_<by>, town_edge_<side>
     outline: FloatArray  # (K, 2) [m] map frame, the kerb: a convex polygon, counter-clockwise
-    height: float  # [m]
+    height: float  # [m] its top above the ground
     mesh: TexturedMesh  # the top and the kerb faces (map frame)
 
     @property
@@ -130,10 +124,10 @@ class TownScene:
 
     streets: tuple[TexturedMesh, ...]  # street strips with their markings
     junctions: tuple[TexturedMesh, ...]  # plain asphalt
-    stop_lines: tuple[TexturedMesh, ...]
+    stop_lines: tuple[TexturedMesh, ...]  # white bands
     pavements: tuple[Pavement, ...]  # blocks (row by row from the south-west), then 4 strips
-    buildings: tuple[BuildingBox, ...]
-    stop_signs: tuple[StopSignPlacement, ...]
+    buildings: tuple[BuildingBox, ...]  # block by block, as `layout_town_buildings`
+    stop_signs: tuple[StopSignPlacement, ...]  # in `approaches()` order
 
     @property
     def surfaces(self) -> tuple[TexturedMesh, ...]:
@@ -253,8 +247,8 @@ def _merge(name: str, parts: list[Part], texture: NDArray[np.uint8],
 def build_streets(layout: TownLayout) -> list[TexturedMesh]:
     """Every street's strip with its markings (`build_road_surface` of `street_road`),
     merged. The streets of one heading differ only by where they start: the first one's
-    strip is built, the others are it moved (the same vertices as building each, at a
-    tenth of the cost: the texture is made once)."""
+    strip is built, the others are it moved (the same vertices as building each, and the
+    texture is made once)."""
     parts: list[Part] = []
     texture: NDArray[np.uint8] | None = None
     first: dict[str, tuple[FloatArray, list[TexturedMesh]]] = {}
@@ -388,6 +382,7 @@ def pavement(name: str, outline: FloatArray, inner: FloatArray | None = None,
 
 
 def _rectangle(x0: float, y0: float, x1: float, y1: float) -> FloatArray:
+    """(4, 2) [m] the corners of an axis-aligned rectangle, counter-clockwise."""
     return np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]])
 
 
@@ -421,6 +416,7 @@ def building_zone(layout: TownLayout, block: Index) -> tuple[float, float, float
 
 
 def _aabb(box: BuildingBox) -> FloatArray:
+    """[m] (4,) x0, y0, x1, y1 of the box's footprint."""
     corners = box.footprint()
     return np.concatenate([corners.min(axis=0), corners.max(axis=0)])
 

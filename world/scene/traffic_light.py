@@ -14,16 +14,16 @@ the colour changes. PyBullet has no emissive material: a lit lamp is as bright a
 renderer's default light makes a bright surface (`perception.lights` documents the rendered
 HSV: saturation, not brightness, is what sets a lamp apart from a red car).
 
-Why meshes: the EGL renderer's depth buffer is coarse. Measured with this camera (near plane
-0.1 m): a face 0.02 m in front of another is lost behind it from ~20 m, 0.05 m from ~40 m,
-0.24 m from ~45 m (it depends on how the two depths round). A lamp on the front of a box
-housing therefore vanishes at 20-45 m. Both renderers cull back faces of meshes (measured),
-so the housing is a single-sided OBJ mesh, a closed box with three round holes in its front
-face, and each lamp a single-sided disc filling its hole: seen from the front nothing lies
-behind a lamp but the housing's back face, which faces away and is culled; seen from behind
-the back face hides the lamps, whose discs are culled. The meshes go through Wavefront OBJ
-files (the EGL plugin drops meshes given as vertex arrays), written into ``folder`` once
-(every light there shares them; a temporary directory the body keeps when none is given).
+Why meshes: the EGL renderer's depth buffer is coarse, so a face centimetres in front of
+another is lost behind it from a few tens of metres away, and a lamp on the front of a box
+housing would vanish at the distances the camera must see it from. Both renderers cull back
+faces of meshes, so the housing is a single-sided OBJ mesh, a closed box with three round
+holes in its front face, and each lamp a single-sided disc filling its hole: seen from the
+front nothing lies behind a lamp but the housing's back face, which faces away and is
+culled; seen from behind the back face hides the lamps, whose discs are culled. The meshes
+go through Wavefront OBJ files (the EGL plugin drops meshes given as vertex arrays), written
+into ``folder`` once (every light there shares them; a temporary directory the body keeps
+when none is given).
 """
 
 from __future__ import annotations
@@ -42,19 +42,19 @@ from pybullet_utils.bullet_client import BulletClient
 from world.hdmap import LightColour, LightHead
 
 HOUSING_DEPTH = 0.25  # [m] along the facing
-HOUSING_WIDTH = 0.35  # [m]
-HOUSING_HEIGHT = 1.0  # [m]
-LAMP_DIAMETER = 0.22  # [m]
+HOUSING_WIDTH = 0.35  # [m] across the facing
+HOUSING_HEIGHT = 1.0  # [m] top to bottom
+LAMP_DIAMETER = 0.22  # [m] a lamp disc's
 LAMP_SPACING = 0.30  # [m] centre to centre, vertically
 LAMP_SEGMENTS = 24  # [-] sides of a lamp's polygon
 VISOR_DEPTH = 0.15  # [m] how far a visor reaches out over its lamp
-VISOR_THICKNESS = 0.02  # [m]
+VISOR_THICKNESS = 0.02  # [m] a visor's plate
 VISOR_GAP = 0.01  # [m] between a lamp's top and its visor
-POLE_RADIUS = 0.06  # [m]
+POLE_RADIUS = 0.06  # [m] the pole's cylinder
 
 HOUSING_RGBA = (0.07, 0.07, 0.07, 1.0)  # [-] matt black
 POLE_RGBA = (0.6, 0.6, 0.62, 1.0)  # [-] galvanised steel (as sign poles)
-LIT_RGBA = {
+LIT_RGBA = {  # [-] a lit lamp's colour
     LightColour.RED: (1.0, 0.04, 0.0, 1.0),
     LightColour.YELLOW: (1.0, 0.72, 0.0, 1.0),
     LightColour.GREEN: (0.0, 1.0, 0.45, 1.0),
@@ -82,6 +82,7 @@ class TrafficLightBody:
 
     def __init__(self, client: BulletClient, body: int, lamps: Mapping[LightColour, int],
                  keep: tempfile.TemporaryDirectory[str] | None = None) -> None:
+        """`keep`: the temporary directory of the mesh files, kept alive with the body."""
         self._c = client
         self.body = body  # the pole and housing: static, with collision (an obstacle)
         self.lamps = dict(lamps)  # visual-only lamp bodies
