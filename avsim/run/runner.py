@@ -11,7 +11,9 @@ Rates (the table `world.core.rates`; each divides the physics rate):
 The criteria are the scenario's set (`avsim.criteria.registry`); a sample carries the NPCs'
 true poses only when one of them needs them. After each sample the runner keeps the
 infractions the criteria report (the result's `infractions`), and the recording logs each at
-its sim time; the verdicts are logged at the end.
+its sim time; the verdicts are logged at the end. The recording has a state lane per machine
+of the plan (`planner.messages.MACHINES`), each from the state the first plan started in,
+and the plan's `speed_source` as a lane of its own (what set the speed, tick by tick).
 
 Each control tick decides on one snapshot (the sensor frames of this tick), then the
 command is held on the joints for the control period's physics steps.

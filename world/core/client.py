@@ -2,9 +2,8 @@
 
 Everything static or kinematic (ground, road meshes, buildings, signs, NPC boxes) is made with
 ``useMaximalCoordinates=True``: a plain static rigid body costs nothing per step, while a
-mass-0 multibody still goes through the articulated-body pass every step (measured: 80
-buildings as multibodies add 20 us to a 41 us car step; as rigid bodies, nothing). Only the
-ego is a multibody (its joints).
+mass-0 multibody still goes through the articulated-body pass every step. Only the ego is a
+multibody (its joints).
 
 Two worlds can live in one process: nothing here touches the module-global pybullet
 connection; every call goes through the `BulletClient` passed around explicitly.
@@ -32,8 +31,7 @@ def make_client() -> BulletClient:
     # Pyramid friction, not the cone: Bullet picks the first friction direction along the
     # contact's slip velocity, so a sliding tyre still gets |F| <= mu N along its slip; only
     # combined (braking while cornering) grip near the limit can reach sqrt(2) mu N. The cone
-    # costs 2x per step once the car's axes leave the world's (measured: 165 vs 86 us/step
-    # at 30 deg yaw, same speed to 0.01 %), which is most of the real-time budget.
+    # doubles the cost of a step once the car's axes leave the world's, for the same speeds.
     client.setPhysicsEngineParameter(deterministicOverlappingPairs=1, enableConeFriction=0)
     return client
 

@@ -1,7 +1,8 @@
 """Odometry: with GNSS (`world.sensors.gnss`), the only pose information the stack gets.
 
-Wheel spin rates (encoders, 0.5 % scale noise), gyro yaw rate (0.002 rad/s noise), the
-steering encoder and the accelerator pedal sensor (exact: a position the world's ego events
+Wheel spin rates (encoders, with a relative scale noise), gyro yaw rate, the steering
+encoder (each with white noise: `WHEEL_SPEED_NOISE`, `GYRO_NOISE`, `STEERING_NOISE`) and the
+accelerator pedal sensor (exact: a position the world's ego events
 hold, `world.ego.events`), sampled together at the odometry rate
 (`world.core.rates.ODOMETRY`), delivered at once. Noise is drawn from the sensor's own seeded
 generator, so a run is reproducible.
