@@ -49,6 +49,7 @@ from world.core.rates import (
     PHYSICS_RATE,
     RECORD_RATE,
 )
+from world.core.stopwatch import Stopwatch
 from world.sensors.setup import Profile, sensor_setup
 from world.spec import FlatTire
 from world.truth import touching
@@ -108,6 +109,8 @@ class RunResult:
     infractions: tuple[Infraction, ...] = ()  # every infraction, in time order
     profile: str | None = None  # the sensor profile (None: map + GNSS only)
     renderer: str | None = None  # "egl" or "tiny" when cameras rendered
+    stage_times: dict[str, float] = field(default_factory=dict)  # [s] wall time per stage
+    #   (`world.core.stopwatch`: where the run's time went; not part of the result file)
 
     @property
     def passed(self) -> bool:
@@ -132,7 +135,8 @@ class Runner:
         w = self.world
         self.car = w.ego.geometry
         front = self.setup.camera("front") if self.setup is not None else None
-        self.stack = Stack(w.road, spec.ego, scenario.driver, self.car, front)
+        self.watch = Stopwatch()  # where the run's wall time goes, stage by stage
+        self.stack = Stack(w.road, spec.ego, scenario.driver, self.car, front, self.watch)
         self.log = TrajectoryLog()
         names = {b: "building or sign" for b in w.scene.obstacle_bodies}
         names.update({b: "kerb" for b in w.scene.kerb_bodies})
@@ -145,7 +149,8 @@ class Runner:
         self.collisions = self.criteria.find(NoCollision)  # its count is a metric
         self.infractions: list[Infraction] = []
         self.recorder = Recorder(recording, recording_name=scenario.name) if recording else None
-        self.sensors = SensorLoop(w, self.setup, self.stack, mode, self.recorder, frame_hook)
+        self.sensors = SensorLoop(w, self.setup, self.stack, mode, self.recorder, frame_hook,
+                                  self.watch)
         self.state_changes: list[StateChange] = []
         self._touching: frozenset[int] = frozenset()
         self._last: StackOutput | None = None
@@ -156,9 +161,10 @@ class Runner:
 
     def run(self, progress: ProgressCallback | None = None) -> RunResult:
         start = time.perf_counter()
-        w = self.world
+        w, watch = self.world, self.watch
         if self.recorder is not None:
-            self._record_static()
+            with watch("recording"):
+                self._record_static()
         steps = round(self.scenario.duration * PHYSICS_RATE)
         done_at: float | None = None
         try:
@@ -167,9 +173,11 @@ class Runner:
             while w.clock.step < steps:
                 self._tick()
                 for _ in range(min(CONTROL_RATE.every, steps - w.clock.step)):
-                    w.step()
+                    with watch("physics"):
+                        w.step()
                     if w.clock.step % CONTACT_RATE.every == 0:
-                        self._watch(w.clock.step)
+                        with watch("criteria"):
+                            self._watch(w.clock.step)
                 if done_at is None and self.completes.done:
                     done_at = w.t
                 if done_at is not None and w.t >= done_at + SETTLE_AFTER_DONE:
@@ -179,8 +187,9 @@ class Runner:
         finally:
             self.sensors.close()
             if self.recorder is not None:
-                self._record_criteria()
-                self.recorder.close()
+                with watch("recording"):
+                    self._record_criteria()
+                    self.recorder.close()
             sim_time = w.t
             w.close()
         renderer = self.sensors.sensing.renderer
@@ -191,30 +200,43 @@ class Runner:
             state_changes=tuple(self.state_changes), infractions=tuple(self.infractions),
             profile=self.setup.profile.value if self.setup is not None else None,
             renderer=renderer.value if renderer is not None else None,
+            stage_times=dict(watch.seconds),
         )
 
     def _tick(self) -> None:
         """A control tick: the sensors' frames due now reach the stack, then decide and
         apply."""
-        w = self.world
+        w, watch = self.world, self.watch
         self.sensors.tick()
         out = self.stack.tick(w.t, CONTROL_RATE.period)
         cmd = out.command
         w.ego.apply(cmd.steering_angle, cmd.drive_torque, cmd.brake_torque)
-        if self._last is None and self.recorder is not None:
-            self._record_machines(out.plan)
         previous, self._last = self._last, out
-        self._lane, self._origin_lane = out.plan.lane, out.plan.origin_lane
-        self._turning = out.plan.motion in TURNS
-        self._log_tick(out)
+        with watch("runner"):
+            self._lane, self._origin_lane = out.plan.lane, out.plan.origin_lane
+            self._turning = out.plan.motion in TURNS
+            self._log_tick(out)
+            self.state_changes.extend(out.plan.changes)
+        if self.recorder is not None:
+            with watch("recording"):
+                self._record_plan(out, previous)
+
+    def _record_plan(self, out: StackOutput, previous: StackOutput | None) -> None:
+        """The tick's plan in the recording: the machines' lanes (their initial states at
+        the first tick), the tick's series at the recording rate, each state change and the
+        speed source when it changes."""
+        rec, w = self.recorder, self.world
+        assert rec is not None
+        if previous is None:
+            self._record_machines(out.plan)
+        if RECORD_RATE.fires(w.clock.step):
+            self._record_tick(out)
         for change in out.plan.changes:
-            self.state_changes.append(change)
-            if self.recorder is not None:
-                self.recorder.log_state(change.t, change.machine, change.target, change.reason)
+            rec.log_state(change.t, change.machine, change.target, change.reason)
         source = out.plan.speed_source
-        if self.recorder is not None and previous is not None and \
-                previous.plan.speed_source is not source:  # an attribution, not a state change
-            self.recorder.log_state(w.t, "speed_source", source.value, text=False)
+        if previous is not None and previous.plan.speed_source is not source:
+            rec.log_state(w.t, "speed_source", source.value, text=False)  # an attribution,
+            #   not a state change
 
     def _log_tick(self, out: StackOutput) -> None:
         w, log = self.world, self.log
@@ -245,8 +267,6 @@ class Runner:
         log.pedal.append(w.accelerator_pedal)
         log.actor_station.append(np.array([m.s for m in w.actors.motions]))
         log.actor_offset.append(np.array([m.offset for m in w.actors.motions]))
-        if self.recorder is not None and RECORD_RATE.fires(w.clock.step):
-            self._record_tick(out)
 
     def _watch(self, step: int) -> None:
         """Criteria: contact onsets at the contact rate, the rest at the criteria rate."""

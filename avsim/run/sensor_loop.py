@@ -29,6 +29,7 @@ from avsim.run.scoring import CaptureTruth, PerceptionScore
 from avsim.run.stack import PerceptionOutput, Stack
 from perception.messages import Detection
 from world.core.rates import CONTROL_RATE
+from world.core.stopwatch import Stopwatch
 from world.frames import CameraFrame, Frame, LidarScan, wrap_angle
 from world.sensors.lidar import LidarTruth
 from world.sensors.pipeline import Capture, InlineSensing, ProcessSensing, Sensing
@@ -57,14 +58,17 @@ class SensorLoop:
     one run: every sensor of the car (`setup`'s cameras and LiDAR, if any; GNSS, odometry)."""
 
     def __init__(self, world: World, setup: SensorSetup | None, stack: Stack, mode: str,
-                 recorder: Recorder | None = None, frame_hook: FrameHook | None = None) -> None:
+                 recorder: Recorder | None = None, frame_hook: FrameHook | None = None,
+                 watch: Stopwatch | None = None) -> None:
         """`mode`: 'inline' or 'process' (`world.sensors.pipeline`; without cameras there is
-        nothing to render elsewhere, and every sensor captures inline)."""
+        nothing to render elsewhere, and every sensor captures inline); `watch`: times the
+        captures, the passing of frames, the scoring and the recording."""
         self.world, self.setup, self.stack = world, setup, stack
         self.schedule = SensorSchedule(sensor_timings(setup), CONTROL_RATE)
-        self.sensing: Sensing = (ProcessSensing(world, setup)
+        self.watch = watch if watch is not None else Stopwatch()
+        self.sensing: Sensing = (ProcessSensing(world, setup, self.watch)
                                  if mode == "process" and setup is not None and setup.cameras
-                                 else InlineSensing(world))
+                                 else InlineSensing(world, self.watch))
         self.mode = mode
         self.recorder = recorder
         self.frame_hook = frame_hook
@@ -81,7 +85,8 @@ class SensorLoop:
         dues = self.schedule.due(step)
         late = [due for due in dues if due.deliver > step]
         if late:
-            truth = self._capture_truth()
+            with self.watch("scoring"):
+                truth = self._capture_truth()
             self._truth.update((due, truth) for due in late)
         for due in dues:
             self.sensing.submit(due)
@@ -107,12 +112,14 @@ class SensorLoop:
             if out is None:
                 continue
             self.last = out
-            if truth is None:  # delivered at once: the truth is the present's
-                truth = self._capture_truth()
-            self._score(capture, out, truth)
+            with self.watch("scoring"):
+                if truth is None:  # delivered at once: the truth is the present's
+                    truth = self._capture_truth()
+                self._score(capture, out, truth)
             if self.recorder is not None:
-                self._record(capture, out)
-                self._record_scores(out, truth)
+                with self.watch("recording"):
+                    self._record(capture, out)
+                    self._record_scores(out, truth)
 
     def _score(self, capture: Capture, out: PerceptionOutput, truth: CaptureTruth) -> None:
         if out.lane_raw is not None:  # a frame of the stack's lane camera was perceived

@@ -43,6 +43,7 @@ from planner.messages import Plan
 from planner.motion_layer import MotionLayerParams
 from planner.planner import Planner, PlannerParams
 from vehicle_urdf import CarGeometry
+from world.core.stopwatch import Stopwatch
 from world.ego.body import vehicle_info
 from world.frames import CameraFrame, CameraInfo, Frame, GnssFix, LidarScan, Odometry
 from world.hdmap import RoadMap
@@ -73,9 +74,11 @@ class Stack:
     """Localizer, lane and object perception, lane-keeping planner, vehicle controller."""
 
     def __init__(self, road: RoadMap, ego: EgoSpec, driver: DriverSettings, car: CarGeometry,
-                 front_camera: CameraInfo | None = None) -> None:
+                 front_camera: CameraInfo | None = None, watch: Stopwatch | None = None) -> None:
         """`ego`: the car's start and limits; `driver`: what the driver asks of the stack;
-        `front_camera`: the camera the lane is found in; None for a map-only stack."""
+        `front_camera`: the camera the lane is found in; None for a map-only stack; `watch`:
+        times each stage (localisation, each perception stage, planner, control)."""
+        self.watch = watch if watch is not None else Stopwatch()
         self.localizer = Localizer()
         vehicle = vehicle_info(car)
         self.planner = Planner(
@@ -127,12 +130,15 @@ class Stack:
         return self.on_sensors(t, tuple(cameras), scan)
 
     def on_gnss(self, fix: GnssFix) -> None:
-        self.localizer.on_gnss(fix)
+        with self.watch("localisation"):
+            self.localizer.on_gnss(fix)
 
     def on_odometry(self, odo: Odometry) -> None:
-        self.localizer.on_odometry(odo)
+        with self.watch("localisation"):
+            self.localizer.on_odometry(odo)
         self._pedal = odo.accelerator_pedal
-        self.flat_detector.update(odo)
+        with self.watch("perception flat tyre"):
+            self.flat_detector.update(odo)
 
     def on_sensors(self, t: float, frames: tuple[CameraFrame, ...],
                    scan: LidarScan | None) -> PerceptionOutput | None:
@@ -142,34 +148,45 @@ class Stack:
         if pose is None:
             return None
         front = next((f for f in frames if f.info.name == "front"), None)
+        watch = self.watch
         lane_raw = lane = None
         if front is not None and self.lane_detector is not None:
             prior = self._view.estimate if self._view is not None else None
-            lane_raw = self.lane_detector.detect(front, prior)
-            lane = self.lane_filter.update(lane_raw, pose.speed, pose.yaw_rate)
+            with watch("perception lanes"):
+                lane_raw = self.lane_detector.detect(front, prior)
+            with watch("perception lane filter"):
+                lane = self.lane_filter.update(lane_raw, pose.speed, pose.yaw_rate)
             self._view = LaneView(lane, pose)
         if front is not None and self.sign_detector is not None:
-            self._signs = SignView(tuple(self.sign_detector.detect(front)), pose)
+            with watch("perception signs"):
+                self._signs = SignView(tuple(self.sign_detector.detect(front)), pose)
         if front is not None and self.light_detector is not None:
-            self._lights = self.light_detector.detect(front, pose)
+            with watch("perception lights"):
+                self._lights = self.light_detector.detect(front, pose)
         detections = tracks = None
         if scan is not None:
-            detections = self.object_detector.detect(scan)
-            tracks = self.tracker.update(t, pose, detections)
+            with watch("perception objects"):
+                detections = self.object_detector.detect(scan)
+            with watch("perception tracking"):
+                tracks = self.tracker.update(t, pose, detections)
             self._tracks = tracks
         return PerceptionOutput(t, pose, lane_raw, lane, detections, tracks)
 
     def tick(self, t: float, dt: float) -> StackOutput:
         """Plan and control on the estimate now and the latest perception; a frame's signs
         and lights go to the planner once, at the tick after their delivery."""
-        ego = self.localizer.estimate(t)
+        with self.watch("localisation"):
+            ego = self.localizer.estimate(t)
         self._remember(ego)
-        plan = self.planner.update(PlannerInput(
-            ego=ego, lane=self._view, tracks=self._tracks, signs=self._signs,
-            lights=self._lights, pedal=self._pedal,
-            flat_tyre=self.flat_detector.state is not None))
+        with self.watch("planner"):
+            plan = self.planner.update(PlannerInput(
+                ego=ego, lane=self._view, tracks=self._tracks, signs=self._signs,
+                lights=self._lights, pedal=self._pedal,
+                flat_tyre=self.flat_detector.state is not None))
         self._signs, self._lights = None, ()
-        return StackOutput(plan, self.controller.update(plan, dt))
+        with self.watch("control"):
+            command = self.controller.update(plan, dt)
+        return StackOutput(plan, command)
 
     def _remember(self, ego: EgoState) -> None:
         self._times.append(ego.t)

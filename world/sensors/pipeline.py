@@ -14,18 +14,25 @@ its own motion estimate). Two interchangeable pipelines give bitwise the same da
   is a physics query; GNSS, odometry) in the simulated world's own rig. Rendering runs on the
   second core while the main process casts the LiDAR, steps physics and runs the stack; the
   main process waits for the frames only when they are due.
+
+Given a `Stopwatch`, a pipeline times each capture in its process ("sensor <name>") and, for
+the worker, the passing of data: "ipc send" (the snapshot and request out), "ipc wait"
+(blocked on the worker), "ipc receive" (the frames in) and the worker's own stages
+("worker pose", "worker sensor <name>", "worker ipc send").
 """
 
 from __future__ import annotations
 
 import multiprocessing as mp
+import time
 import traceback
 from collections import deque
 from dataclasses import dataclass
 from multiprocessing.connection import Connection
-from typing import Protocol
+from typing import Any, Protocol
 
 from world.core.rendering import Renderer
+from world.core.stopwatch import Stopwatch
 from world.frames import Frame
 from world.sensors import worker as sensing_worker
 from world.sensors.lidar import LidarSensor
@@ -83,15 +90,16 @@ def _check_now(world: World, due: Due) -> None:
 class InlineSensing:
     """Captures every sensor in the simulated world's own rig."""
 
-    def __init__(self, world: World) -> None:
+    def __init__(self, world: World, watch: Stopwatch | None = None) -> None:
         self._world = world
+        self._watch = watch
         self.renderer: Renderer | None = world.renderer
         self._pending: list[tuple[int, Capture]] = []  # (delivery step, capture)
 
     def submit(self, due: Due) -> None:
         w = self._world
         _check_now(w, due)
-        readings = w.rig.capture(due.sensors, due.t, w.ego_truth)
+        readings = w.rig.capture(due.sensors, due.t, w.ego_truth, self._watch)
         self._pending.append((due.deliver, Capture(due, readings)))
 
     def collect(self, step: int) -> tuple[Capture, ...]:
@@ -118,10 +126,12 @@ class ProcessSensing:
     `World(spec, setup, cameras=False)`) in a worker process on a mirror of `world`, the
     others in `world`."""
 
-    def __init__(self, world: World, setup: SensorSetup) -> None:
+    def __init__(self, world: World, setup: SensorSetup,
+                 watch: Stopwatch | None = None) -> None:
         if world.renderer is not None:
             raise ValueError("ProcessSensing needs a World built without cameras")
         self._world = world
+        self._watch = watch
         for sensor in world.rig:
             if isinstance(sensor, LidarSensor):
                 sensor.lidar.threads = 1  # the other core renders: no oversubscription
@@ -140,10 +150,12 @@ class ProcessSensing:
         _check_now(w, due)
         pending = _Pending(due, tuple(n for n in due.sensors if n not in w.rig))
         if pending.remote:  # first, so that the worker renders while this process casts
+            start = time.perf_counter()
             self._conn.send(("capture", due.t, w.snapshot(), pending.remote))
+            self._time("ipc send", start)
             self._awaiting.append(pending)
         pending.local = w.rig.capture([n for n in due.sensors if n in w.rig], due.t,
-                                      w.ego_truth)
+                                      w.ego_truth, self._watch)
         self._pending.append(pending)
 
     def collect(self, step: int) -> tuple[Capture, ...]:
@@ -155,8 +167,14 @@ class ProcessSensing:
         """The capture of `pending`, its worker's readings received (the worker answers in
         the order it was asked)."""
         while pending.remote and pending.received is None:
-            readings = self._receive()
-            assert isinstance(readings, tuple)
+            start = time.perf_counter()
+            self._conn.poll(None)
+            self._time("ipc wait", start)
+            start = time.perf_counter()
+            readings, seconds = self._receive()
+            self._time("ipc receive", start)
+            if self._watch is not None:
+                self._watch.add_all(seconds, prefix="worker ")
             self._awaiting.popleft().received = readings
         by_name = {r.sensor: r for r in (*pending.local, *(pending.received or ()))}
         due = pending.due
@@ -176,7 +194,11 @@ class ProcessSensing:
                 self._proc.kill()
         self._conn.close()
 
-    def _receive(self) -> object:
+    def _time(self, stage: str, start: float) -> None:
+        if self._watch is not None:
+            self._watch.add(stage, time.perf_counter() - start)
+
+    def _receive(self) -> Any:
         try:
             kind, payload = self._conn.recv()
         except EOFError as e:
@@ -193,13 +215,21 @@ def serve(conn: Connection, spec: WorldSpec, setup: SensorSetup) -> None:
         world = World(spec, setup, lidar=False)
         assert world.renderer is not None
         conn.send(("ready", world.renderer.value))
+        sent = 0.0  # [s]
         while True:
             message = conn.recv()
             if message[0] == "close":
                 break
             _, t, snapshot, names = message
-            world.apply_snapshot(snapshot)
-            conn.send(("data", world.rig.capture(names, t, world.ego_truth)))
+            watch = Stopwatch()
+            if sent:  # the previous answer's send (this one's is in the next answer)
+                watch.add("ipc send", sent)
+            with watch("pose"):
+                world.apply_snapshot(snapshot)
+            readings = world.rig.capture(names, t, world.ego_truth, watch)
+            start = time.perf_counter()
+            conn.send(("data", (readings, watch.seconds)))
+            sent = time.perf_counter() - start
         world.close()
     except Exception:  # report any failure to the main process, which raises it
         conn.send(("error", traceback.format_exc()))

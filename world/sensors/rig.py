@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Iterator, Sequence
 
+from world.core.stopwatch import Stopwatch
 from world.ego.body import EgoTruth
 from world.sensors.sensor import Reading, Sensor
 
@@ -40,6 +41,14 @@ class SensorRig:
             raise KeyError(f"no sensor {name!r} in this rig ({', '.join(self._sensors)})") \
                 from None
 
-    def capture(self, names: Sequence[str], t: float, ego: EgoTruth) -> tuple[Reading, ...]:
-        """The readings of the sensors `names` (in that order) at time `t` [s]."""
-        return tuple(self.sensor(name).capture(t, ego) for name in names)
+    def capture(self, names: Sequence[str], t: float, ego: EgoTruth,
+                watch: Stopwatch | None = None) -> tuple[Reading, ...]:
+        """The readings of the sensors `names` (in that order) at time `t` [s]; each
+        capture timed as the stage "sensor <name>" of `watch`, if given."""
+        if watch is None:
+            return tuple(self.sensor(name).capture(t, ego) for name in names)
+        readings = []
+        for name in names:
+            with watch(f"sensor {name}"):
+                readings.append(self.sensor(name).capture(t, ego))
+        return tuple(readings)
