@@ -49,6 +49,7 @@ bench: $(STAMP)
 	$(BIN)/python -m bench.bench_rtf
 	$(BIN)/python -m bench.bench_components
 	$(BIN)/python -m bench.bench_sensing
+	$(BIN)/python -m bench.bench_stages
 	$(BIN)/python -m bench.bench_batch
 
 clean:

@@ -5,9 +5,10 @@ simulated time:
 
 - floor: the world with the profile's sensors, the stack's own joint commands of the full
   run replayed at the control rate (same path), physics and the sensors (GNSS and odometry
-  included) at their rates and nothing else. Two floors: `inline` (one process, serial)
-  and `process` (cameras rendered in the worker process, the rest in the main one: the
-  pipeline the runner uses);
+  included) at the rates a recorded run captures them (`avsim.run.sensor_loop.frames_read`:
+  the side cameras only for the recording) and nothing else. Two floors: `inline` (one
+  process, serial) and `process` (cameras rendered in the worker process, the rest in the
+  main one: the pipeline the runner uses);
 - full stack: the closed loop with perception, planner, control and scoring, no recording;
 - full stack + recording.
 
@@ -31,11 +32,12 @@ from pathlib import Path
 from typing import Any
 
 from avsim.run.runner import Runner, RunResult
+from avsim.run.sensor_loop import frames_read
 from avsim.scenario.load import load_scenario
-from world.core.rates import CONTROL_RATE, PHYSICS_RATE
+from world.core.rates import CAR_SENSORS, CONTROL_RATE, PHYSICS_RATE
 from world.sensors.pipeline import InlineSensing, ProcessSensing, Sensing
 from world.sensors.schedule import SensorSchedule
-from world.sensors.setup import Profile, sensor_setup, sensor_timings
+from world.sensors.setup import LIDAR, Profile, SensorSetup, sensor_setup, sensor_timings
 from world.world import World
 
 SCENARIO = "normal_driving"
@@ -82,7 +84,9 @@ def floor_rtf(profile: Profile, run: RunResult, mode: str) -> float:
     setup = sensor_setup(profile)
     world = World(run.scenario.world, setup, cameras=mode == "inline")
     sensing: Sensing = InlineSensing(world) if mode == "inline" else ProcessSensing(world, setup)
-    schedule = SensorSchedule(sensor_timings(setup), CONTROL_RATE)
+    timings = sensor_timings(setup)
+    schedule = SensorSchedule(timings, CONTROL_RATE, frames_read(timings, run_reads(setup),
+                                                                 recording=True))
     log = run.log
     try:
         start = time.perf_counter()
@@ -102,6 +106,11 @@ def floor_rtf(profile: Profile, run: RunResult, mode: str) -> float:
         sensing.close()
         world.close()
     return len(log.steering) * CONTROL_RATE.every / PHYSICS_RATE / wall
+
+
+def run_reads(setup: SensorSetup) -> frozenset[str]:
+    """The sensors the stack reads in full: the front camera, the LiDAR, GNSS, odometry."""
+    return frozenset({setup.cameras[0].name, LIDAR, *CAR_SENSORS})
 
 
 def bench(profile: Profile, seconds: float) -> dict[str, float]:

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import math
 import os
-from collections.abc import Callable
+from collections.abc import Callable, Collection, Iterable
 
 import numpy as np
 
@@ -28,7 +28,7 @@ from avsim.record.recorder import Recorder
 from avsim.run.scoring import CaptureTruth, PerceptionScore
 from avsim.run.stack import PerceptionOutput, Stack
 from perception.messages import Detection
-from world.core.rates import CONTROL_RATE
+from world.core.rates import CONTROL_RATE, SensorTiming
 from world.core.stopwatch import Stopwatch
 from world.frames import CameraFrame, Frame, LidarScan, wrap_angle
 from world.sensors.lidar import LidarTruth
@@ -53,6 +53,15 @@ def sensing_mode(requested: str) -> str:
     return requested
 
 
+def frames_read(timings: Iterable[tuple[str, SensorTiming]], reads: Collection[str],
+                recording: bool) -> dict[str, int]:
+    """Per sensor, every how many of its frames somebody reads (`SensorSchedule`'s `keep`):
+    all of those of the sensors the stack `reads`, the recording's `record_every` of the
+    others (a side camera renders only what the recording keeps), none without a recording."""
+    return {name: 1 if name in reads else timing.record_every if recording else 0
+            for name, timing in timings}
+
+
 class SensorLoop:
     """Sensing pipeline + delivery to the stack + perception scoring + sensor recording for
     one run: every sensor of the car (`setup`'s cameras and LiDAR, if any; GNSS, odometry)."""
@@ -64,7 +73,9 @@ class SensorLoop:
         nothing to render elsewhere, and every sensor captures inline); `watch`: times the
         captures, the passing of frames, the scoring and the recording."""
         self.world, self.setup, self.stack = world, setup, stack
-        self.schedule = SensorSchedule(sensor_timings(setup), CONTROL_RATE)
+        timings = sensor_timings(setup)
+        self.schedule = SensorSchedule(timings, CONTROL_RATE,
+                                       frames_read(timings, stack.reads, recorder is not None))
         self.watch = watch if watch is not None else Stopwatch()
         self.sensing: Sensing = (ProcessSensing(world, setup, self.watch)
                                  if mode == "process" and setup is not None and setup.cameras

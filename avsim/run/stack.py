@@ -43,10 +43,12 @@ from planner.messages import Plan
 from planner.motion_layer import MotionLayerParams
 from planner.planner import Planner, PlannerParams
 from vehicle_urdf import CarGeometry
+from world.core.rates import CAR_SENSORS
 from world.core.stopwatch import Stopwatch
 from world.ego.body import vehicle_info
 from world.frames import CameraFrame, CameraInfo, Frame, GnssFix, LidarScan, Odometry
 from world.hdmap import RoadMap
+from world.sensors.setup import LIDAR
 from world.spec import EgoSpec
 
 POSE_HISTORY = 2.0  # [s] own pose estimates kept for interpreting late sensor data
@@ -79,6 +81,9 @@ class Stack:
         `front_camera`: the camera the lane is found in; None for a map-only stack; `watch`:
         times each stage (localisation, each perception stage, planner, control)."""
         self.watch = watch if watch is not None else Stopwatch()
+        self.reads = frozenset({*CAR_SENSORS, LIDAR}
+                               | ({front_camera.name} if front_camera is not None else set()))
+        #   the sensors whose frames it uses (it ignores the side cameras')
         self.localizer = Localizer()
         vehicle = vehicle_info(car)
         self.planner = Planner(

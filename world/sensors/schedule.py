@@ -7,11 +7,16 @@ rate fires, and its capture is delivered `latency` later. The sensors due at one
 the same latency form one `Due`: they are captured together and reach the stack together.
 The schedule is consulted on the steps of a `tick` rate (the control rate), so every sensor's
 period and latency must be whole numbers of the tick's period (checked).
+
+A sensor nobody reads at its full rate captures less: `keep` gives, per sensor, every how
+many of its rate's firings it captures (the first one included; 0: never). The sensor loop
+asks the full rate of what the stack reads, the recording's `record_every` of what only the
+recording shows, and nothing of the rest.
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 
 from world.core.rates import PHYSICS_RATE, Rate, SensorTiming
@@ -34,12 +39,19 @@ class Due:
 class SensorSchedule:
     """The sensors' rates and latencies as physics-step counters."""
 
-    def __init__(self, sensors: Iterable[tuple[str, SensorTiming]], tick: Rate) -> None:
+    def __init__(self, sensors: Iterable[tuple[str, SensorTiming]], tick: Rate,
+                 keep: Mapping[str, int] | None = None) -> None:
         """`sensors`: (name, timing) in the order captures list them; `tick`: the rate at
-        whose steps `due` is asked."""
+        whose steps `due` is asked; `keep`: per sensor, capture every n-th firing of its rate
+        (0: never; a sensor not in it: every firing)."""
         entries = tuple(sensors)
         self.timings = dict(entries)
         self.tick = tick
+        self.keep = {name: (keep or {}).get(name, 1) for name in self.timings}
+        if keep is not None and (unknown := set(keep) - set(self.timings)):
+            raise ValueError(f"keep names sensors not in the schedule: {sorted(unknown)}")
+        if any(n < 0 for n in self.keep.values()):
+            raise ValueError(f"keep must be >= 0 for every sensor: {self.keep}")
         if len(entries) != len(self.timings):
             raise ValueError(f"sensor names must be unique: {[n for n, _ in entries]}")
         for name, timing in self.timings.items():
@@ -58,7 +70,11 @@ class SensorSchedule:
         fire, in the order of their first sensor in the schedule."""
         groups: dict[int, list[str]] = {}
         for name, timing in self.timings.items():
-            if timing.rate.fires(step):
+            if timing.rate.fires(step) and self._kept(name, step // timing.rate.every):
                 groups.setdefault(timing.latency_steps, []).append(name)
         return tuple(Due(step, step + latency, tuple(names))
                      for latency, names in groups.items())
+
+    def _kept(self, name: str, firing: int) -> bool:
+        n = self.keep[name]
+        return n > 0 and firing % n == 0

@@ -10,7 +10,10 @@ Profiles (`--profile`):
 
 The rates (and when frames reach the stack, and which the recording keeps) are the rates
 table's (`world.core.rates.PROFILE_SENSORS`); GNSS and odometry are on every car, with or
-without a profile (`world.core.rates.CAR_SENSORS`).
+without a profile (`world.core.rates.CAR_SENSORS`). A run captures a sensor's frames only as
+often as somebody reads them (`avsim.run.sensor_loop.frames_read`): the stack reads the
+front camera and the LiDAR, so the side cameras render only the frames the recording keeps
+(`paper`: every 4th, 2.5 Hz), and not at all without a recording.
 
 Cameras have an 80 deg horizontal field of view. The LiDAR is VLP-16-like: channels from
 -15 to +15 deg every 2 deg, 360 deg, 100 m. Mounts come from the URDF's sensor links (the

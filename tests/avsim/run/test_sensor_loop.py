@@ -23,9 +23,12 @@ KIND = {CameraFrame: "camera", LidarScan: "lidar", GnssFix: "gnss", Odometry: "o
 
 
 class FakeStack:
-    """Writes down what it is handed; 'perceives' camera and LiDAR deliveries."""
+    """Writes down what it is handed; 'perceives' camera and LiDAR deliveries. It reads
+    the front camera, the LiDAR, GNSS and odometry (as the stack does), or `reads`."""
 
-    def __init__(self) -> None:
+    def __init__(self, reads: frozenset[str] = frozenset({"front", "lidar", "gnss",
+                                                           "odometry"})) -> None:
+        self.reads = reads
         self.calls: list[tuple[int, float, tuple[str, ...]]] = []  # (step, t, frame kinds)
         self.brightest: list[int] = []  # the brightest pixel of each camera frame
         self.step = 0
@@ -58,11 +61,9 @@ def black(frame: CameraFrame) -> CameraFrame:
     return CameraFrame(frame.t, frame.info, np.zeros_like(frame.rgb))
 
 
-@pytest.fixture(scope="module")
-def loop() -> tuple[FakeStack, FakeRecorder]:
+def drive(stack: FakeStack, recorder: FakeRecorder | None) -> None:
     """1.1 s of normal_driving's first instants with the `default` profile, inline."""
     world = World(load_scenario("normal_driving").world, sensor_setup(Profile.DEFAULT))
-    stack, recorder = FakeStack(), FakeRecorder()
     sensors = SensorLoop(world, sensor_setup(Profile.DEFAULT), stack, "inline",  # type: ignore[arg-type]
                          recorder, black)  # type: ignore[arg-type]
     try:
@@ -74,6 +75,12 @@ def loop() -> tuple[FakeStack, FakeRecorder]:
     finally:
         sensors.close()
         world.close()
+
+
+@pytest.fixture(scope="module")
+def loop() -> tuple[FakeStack, FakeRecorder]:
+    stack, recorder = FakeStack(), FakeRecorder()
+    drive(stack, recorder)
     return stack, recorder
 
 
@@ -94,7 +101,8 @@ def test_calls_into_the_stack_within_a_tick(loop: tuple[FakeStack, FakeRecorder]
     ]
     assert stack.calls[:6] == expected_first[:6]
     assert set(expected_first) <= rows
-    assert (144, 0.5, cameras_lidar) in rows  # the sides at 2 Hz
+    assert (144, 0.5, ("camera", "lidar")) in rows  # the sides at 2 Hz, but captured only
+    #   for the recording (every 4th: t = 0, 2, ...): the stack does not read them
     ticks = round(1.1 * PHYSICS_RATE) // CONTROL_RATE.every + 1
     assert [s for s, _, k in stack.calls if k[-1] == "odometry"] == \
         [CONTROL_RATE.every * i for i in range(ticks)]  # odometry at every tick, once
@@ -116,3 +124,20 @@ def test_the_hook_alters_the_stacks_frames_only(loop: tuple[FakeStack, FakeRecor
     stack, recorder = loop
     assert stack.brightest and set(stack.brightest) == {0}
     assert all(brightest > 100 for _, _, brightest in recorder.images)
+
+
+@pytest.mark.parametrize(("reads", "cameras"), [
+    (frozenset({"front", "lidar", "gnss", "odometry"}), {("camera",)}),
+    (frozenset({"front", "left", "lidar", "gnss", "odometry"}),
+     {("camera",), ("camera", "camera")}),
+])
+def test_without_a_recording_a_camera_renders_only_if_the_stack_reads_it(
+        reads: frozenset[str], cameras: set[tuple[str, ...]]) -> None:
+    stack = FakeStack(reads)
+    drive(stack, None)
+    delivered = [tuple(k for k in kinds if k == "camera") for _, _, kinds in stack.calls
+                 if "lidar" in kinds]
+    assert len(delivered) == 11  # t = 0 .. 1.0 s at 10 Hz
+    assert set(delivered) == cameras
+    if len(cameras) == 2:  # the left camera at its 2 Hz: t = 0, 0.5 and 1.0 s
+        assert delivered.count(("camera", "camera")) == 3

@@ -120,3 +120,26 @@ def test_rates_and_latencies_that_do_not_fit_are_rejected() -> None:
                            ("lidar", front)], CONTROL_RATE)
     assert fast.due(12) == (Due(12, 24, ("front",)),)
     assert fast.due(24) == (Due(24, 36, ("front",)), Due(24, 48, ("lidar",)))
+
+
+def test_keep_thins_a_sensors_captures_and_zero_silences_it() -> None:
+    setup = sensor_setup(Profile.PAPER)
+    thinned = SensorSchedule(sensor_timings(setup), CONTROL_RATE,
+                             keep={"left": 4, "right": 0})
+    full = SensorSchedule(sensor_timings(setup), CONTROL_RATE)
+    steps = range(0, 2 * PHYSICS_RATE, CONTROL_RATE.every)
+
+    def captures(s: SensorSchedule, name: str) -> list[int]:
+        return [step for step in steps for due in s.due(step) if name in due.sensors]
+
+    assert captures(full, "left") == list(range(0, 2 * PHYSICS_RATE, 24))  # 10 Hz
+    assert captures(thinned, "left") == [0, 96, 192, 288, 384]  # every 4th: 2.5 Hz
+    assert captures(thinned, "right") == []
+    for name in ("front", "lidar", "gnss", "odometry"):
+        assert captures(thinned, name) == captures(full, name)
+
+
+@pytest.mark.parametrize("keep", [{"rear": 1}, {"left": -1}])
+def test_a_bad_keep_is_rejected(keep: dict[str, int]) -> None:
+    with pytest.raises(ValueError, match="keep"):
+        SensorSchedule(sensor_timings(sensor_setup(Profile.DEFAULT)), CONTROL_RATE, keep)
