@@ -1,6 +1,6 @@
 """Make the heavy native dependencies importable on a fresh machine.
 
-Open3D's libusb dependency is handled in `perception.open3d_loader` (the one place that
+Open3D's libusb dependency is handled in `world.frames.import_open3d` (the one place that
 imports Open3D); `check()` imports every native dependency once, for `make setup`.
 """
 
@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import importlib
 
-from perception.open3d_loader import import_open3d
+from world.frames import import_open3d
 
 
 def check() -> None:

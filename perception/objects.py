@@ -66,7 +66,7 @@ The yaw is the length axis's heading, wrapped to (-pi/2, pi/2] (front and back a
 apart). Limits: a distant pedestrian hit by one ring only, below ``pedestrian_min_height``,
 comes out as OTHER, and one with fewer than ``min_points`` returns is not seen at all.
 
-Open3D is imported lazily, on the first scan, by `perception.open3d_loader`.
+Open3D is imported lazily, on the first scan, by `world.frames.import_open3d`.
 """
 
 from __future__ import annotations
@@ -78,8 +78,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from perception.messages import Detection, ObjectClass
-from perception.open3d_loader import import_open3d
-from world.frames import LidarScan
+from world.frames import LidarScan, import_open3d
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]

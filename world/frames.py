@@ -14,20 +14,32 @@ Frames:
 Conventions every stage shares (the stack may import this module): SI units inside, with
 the one speed conversion named (`MPS_PER_KPH`, `kph`, `to_kph`); angles in radians,
 headings and yaws wrapped to (-pi, pi] by `wrap_angle`.
+
+It also holds the one Open3D importer (`import_open3d`, at the end): both the world (the
+LiDAR's Embree ray caster) and perception (clustering the scans) use Open3D, and this is the
+one module of ours both may import. Open3D 0.20 links against `libusb-1.0.so.0`, which a fresh
+Debian machine lacks; the pinned `libusb-package` wheel carries a copy whose SONAME is
+`libusb-1.0.so.0`, and loading it globally before Open3D satisfies the dynamic linker (a
+system libusb, when present, is used instead). Nothing heavy is imported until it is called.
 """
 
 from __future__ import annotations
 
+import ctypes
 import enum
+import functools
+import importlib
 import math
 from dataclasses import dataclass
+from types import ModuleType
 from typing import TypeAlias
 
 import numpy as np
 from numpy.typing import NDArray
 
 __all__ = ["MPS_PER_KPH", "CameraFrame", "CameraInfo", "GnssFix", "LidarInfo", "LidarScan",
-           "Odometry", "SensorMount", "VehicleInfo", "Wheel", "kph", "to_kph", "wrap_angle"]
+           "Odometry", "SensorMount", "VehicleInfo", "Wheel", "import_open3d", "kph", "to_kph",
+           "wrap_angle"]
 
 MPS_PER_KPH = 1.0 / 3.6  # [m/s per km/h]
 
@@ -234,3 +246,30 @@ class LidarScan:
 
 # What a sensor hands to the stack: one capture of one sensor (`world.sensors.sensor.Sensor`).
 Frame: TypeAlias = CameraFrame | LidarScan | GnssFix | Odometry
+
+
+# ---- Open3D, shared by the world and perception ----------------------------------------------
+
+
+def preload_libusb() -> None:
+    """Load a libusb-1.0 into the process so that Open3D's dependency resolves."""
+    try:
+        ctypes.CDLL("libusb-1.0.so.0", mode=ctypes.RTLD_GLOBAL)
+        return
+    except OSError:
+        pass
+    import libusb_package
+
+    path = libusb_package.get_library_path()
+    if path is None:
+        raise ImportError("no libusb-1.0 found (install libusb-1.0-0 or libusb-package)")
+    ctypes.CDLL(str(path), mode=ctypes.RTLD_GLOBAL)
+
+
+@functools.cache
+def import_open3d() -> ModuleType:
+    """The open3d module, imported once, with its log quiet below errors."""
+    preload_libusb()
+    o3d = importlib.import_module("open3d")
+    o3d.utility.set_verbosity_level(o3d.utility.VerbosityLevel.Error)
+    return o3d

@@ -31,6 +31,7 @@ from world.map.road import build_road_map, light_head
 from world.map.signals import light_colour, route_signals
 from world.map.town import TownLayout
 from world.scene.bump import BumpPlacement, build_speed_bumps, hull_vertices
+from world.scene.collision import Box, CollisionShapes, ConvexHull, Cylinder, Part, TriangleMesh
 from world.scene.road_marks import build_road_marks
 from world.scene.road_mesh import (
     THROUGH_LENGTH,
@@ -119,6 +120,7 @@ class World:
         self.signals = route_signals(spec.road, self.road)  # the route's lights (truth)
         self._tmp = tempfile.TemporaryDirectory(prefix="avsim-textures-")
         self._light_bodies: list[TrafficLightBody] = []
+        self.shapes = CollisionShapes()  # every body's collision shape, for the LiDAR
         self.scene = self._build_scene(np.random.default_rng(seeds[0]))
         self._light_lamps()
         lane = self.road.lane(spec.ego.lane)
@@ -130,7 +132,7 @@ class World:
         )
         for link in range(-1, self.client.getNumJoints(self.ego.body)):
             self.client.setCollisionFilterGroupMask(self.ego.body, link, EGO_RAY_GROUP, 0xFFFF)
-        self.actors = ActorSet(self.client, self.road, spec.actors)
+        self.actors = ActorSet(self.client, self.road, spec.actors, self.shapes)
         self._events = EgoEvents(spec.events)
         self.rig = self._build_rig(sensors, lidar, seeds)
         self._truth: EgoTruth | None = None
@@ -154,7 +156,7 @@ class World:
         if setup is not None and lidar:
             caster = Lidar(self.client, setup.lidar, np.random.default_rng(seeds[3]),
                            self.actors.bodies, self.scene.ground,
-                           sorted(self.scene.static_bodies))
+                           sorted(self.scene.static_bodies), self.shapes)
             sensors.append(LidarSensor(caster, setup.timing(LIDAR), ride_height))
         events = self._events
         sensors += [GnssSensor(self.spec.sensors.gnss, np.random.default_rng(seeds[1])),
@@ -211,7 +213,8 @@ class World:
         """The traffic lights' bodies (pole and housing: obstacles), lamps lit by
         `_light_lamps`."""
         self._light_bodies = [add_traffic_light(self.client, light_head(self.road, f),
-                                                Path(self._tmp.name)) for f in lights]
+                                                Path(self._tmp.name), self.shapes)
+                              for f in lights]
         return {b.body for b in self._light_bodies}
 
     def _light_lamps(self) -> None:
@@ -235,8 +238,7 @@ class World:
                for s in signs):
             raise ValueError("stop signs of different sizes cannot share one plate")
         top = first.plate_height + first.corner_radius
-        shape = c.createCollisionShape(pybullet.GEOM_CYLINDER, radius=SIGN_POLE_RADIUS,
-                                       height=top)
+        shape = self.shapes.create(c, Part(Cylinder(SIGN_POLE_RADIUS, top)))
         pole = c.createVisualShape(pybullet.GEOM_CYLINDER, radius=SIGN_POLE_RADIUS,
                                    length=top, rgbaColor=list(POLE_RGBA))
         vertices, indices, uvs, normals = _plate_mesh(
@@ -248,8 +250,8 @@ class World:
         poles = set()
         for sign in signs:
             quat = c.getQuaternionFromEuler([0.0, 0.0, sign.yaw])
-            poles.add(int(c.createMultiBody(0.0, shape, pole, [*sign.pole_xy, top / 2],
-                                            useMaximalCoordinates=True)))
+            poles.add(self.shapes.placed(int(c.createMultiBody(
+                0.0, shape, pole, [*sign.pole_xy, top / 2], useMaximalCoordinates=True)), shape))
             c.createMultiBody(0.0, -1, plate, [*sign.pole_xy, 0.0], quat,
                               useMaximalCoordinates=True)
         return poles
@@ -263,12 +265,11 @@ class World:
         mesh = slab.mesh
         centre = np.array([*slab.centre, 0.0])
         local = mesh.vertices - centre
-        shape = c.createCollisionShape(pybullet.GEOM_MESH, vertices=local.tolist(),
-                                       indices=mesh.indices.reshape(-1).tolist())
+        shape = self.shapes.create(c, Part(TriangleMesh(local, mesh.indices.reshape(-1, 3))))
         visual = self._mesh_visual(mesh.name, local, mesh.indices, mesh.uvs, mesh.normals,
                                    mesh.texture)
-        body = int(c.createMultiBody(0.0, shape, visual, centre.tolist(),
-                                     useMaximalCoordinates=True))
+        body = self.shapes.placed(int(c.createMultiBody(0.0, shape, visual, centre.tolist(),
+                                                        useMaximalCoordinates=True)), shape)
         c.changeDynamics(body, -1, lateralFriction=GROUND_FRICTION)
         return body
 
@@ -313,23 +314,22 @@ class World:
 
     def _add_building(self, b: BuildingBox) -> int:
         c = self.client
-        shape = c.createCollisionShape(pybullet.GEOM_BOX, halfExtents=list(b.half_extents))
+        shape = self.shapes.create(c, Part(Box(b.half_extents)))
         visual = c.createVisualShape(
             pybullet.GEOM_BOX, halfExtents=list(b.half_extents), rgbaColor=[*b.rgb, 1.0]
         )
         quat = c.getQuaternionFromEuler([0.0, 0.0, b.yaw])
-        return int(c.createMultiBody(0.0, shape, visual, list(b.centre), quat,
-                                     useMaximalCoordinates=True))
+        return self.shapes.placed(int(c.createMultiBody(0.0, shape, visual, list(b.centre),
+                                                        quat, useMaximalCoordinates=True)), shape)
 
     def _add_pole(self, xy: tuple[float, float], top: float) -> int:
         """A sign pole standing on the ground up to `top` [m], with collision."""
         c = self.client
-        shape = c.createCollisionShape(pybullet.GEOM_CYLINDER, radius=SIGN_POLE_RADIUS,
-                                       height=top)
+        shape = self.shapes.create(c, Part(Cylinder(SIGN_POLE_RADIUS, top)))
         visual = c.createVisualShape(pybullet.GEOM_CYLINDER, radius=SIGN_POLE_RADIUS,
                                      length=top, rgbaColor=list(POLE_RGBA))
-        return int(c.createMultiBody(0.0, shape, visual, [*xy, top / 2],
-                                     useMaximalCoordinates=True))
+        return self.shapes.placed(int(c.createMultiBody(0.0, shape, visual, [*xy, top / 2],
+                                                        useMaximalCoordinates=True)), shape)
 
     def _add_sign(self, sign: SignPlacement) -> int:
         """A pole (with collision) and a round textured plate facing the traffic."""
@@ -360,16 +360,15 @@ class World:
         the body's frame (a body without a visual shape makes the EGL plugin try to draw
         the collision mesh from a file, and warn)."""
         c = self.client
-        shape = c.createCollisionShape(pybullet.GEOM_MESH,
-                                       vertices=hull_vertices(bump).tolist())
+        shape = self.shapes.create(c, Part(ConvexHull(hull_vertices(bump))))
         cos, sin = math.cos(bump.yaw), math.sin(bump.yaw)
         rotation = np.array([[cos, -sin, 0.0], [sin, cos, 0.0], [0.0, 0.0, 1.0]])
         local = (mesh.vertices - np.array([*bump.centre, 0.0])) @ rotation
         visual = self._mesh_visual(mesh.name, local, mesh.indices, mesh.uvs,
                                    mesh.normals @ rotation, mesh.texture)
         quat = c.getQuaternionFromEuler([0.0, 0.0, bump.yaw])
-        body = int(c.createMultiBody(0.0, shape, visual, [*bump.centre, 0.0], quat,
-                                     useMaximalCoordinates=True))
+        body = self.shapes.placed(int(c.createMultiBody(
+            0.0, shape, visual, [*bump.centre, 0.0], quat, useMaximalCoordinates=True)), shape)
         c.changeDynamics(body, -1, lateralFriction=GROUND_FRICTION)
         return body
 

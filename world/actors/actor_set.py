@@ -29,6 +29,7 @@ from world.actors.town_traffic import TownDriver
 from world.hdmap import RoadMap
 from world.map.road import build_road_map
 from world.map.signals import route_signals
+from world.scene.collision import Box, CollisionShapes, Part
 from world.spec import ActorSpec, ActorType
 
 
@@ -75,8 +76,11 @@ class ActorPoses:
 class ActorSet:
     """All scripted actors of a world."""
 
-    def __init__(self, client: BulletClient, road: RoadMap, specs: tuple[ActorSpec, ...]) -> None:
+    def __init__(self, client: BulletClient, road: RoadMap, specs: tuple[ActorSpec, ...],
+                 shapes: CollisionShapes | None = None) -> None:
+        """`shapes` keeps the bodies' collision boxes (a book of its own when None)."""
         self._c = client
+        self._shapes = CollisionShapes() if shapes is None else shapes
         self._reset_pose = client.resetBasePositionAndOrientation  # bound once: hot path
         self._road = road
         self.specs = specs
@@ -127,13 +131,13 @@ class ActorSet:
     def _make_body(self, kind: ActorType) -> int:
         """A static box of `kind`'s size and colour, below the ground until placed."""
         size = SIZES[kind]
-        half = [size.length / 2, size.width / 2, size.height / 2]
-        shape = self._c.createCollisionShape(pybullet.GEOM_BOX, halfExtents=half)
+        half = (size.length / 2, size.width / 2, size.height / 2)
+        shape = self._shapes.create(self._c, Part(Box(half)))
         visual = self._c.createVisualShape(
-            pybullet.GEOM_BOX, halfExtents=half, rgbaColor=list(COLOURS[kind])
+            pybullet.GEOM_BOX, halfExtents=list(half), rgbaColor=list(COLOURS[kind])
         )
-        return int(self._c.createMultiBody(0.0, shape, visual, [0.0, 0.0, -10.0],
-                                         useMaximalCoordinates=True))
+        return self._shapes.placed(int(self._c.createMultiBody(
+            0.0, shape, visual, [0.0, 0.0, -10.0], useMaximalCoordinates=True)), shape)
 
     def lane_offset(self, lane: int, s: float) -> float:
         """[m] offset of a route lane's centre at s (the actors on the route's road)."""

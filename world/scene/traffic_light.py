@@ -40,6 +40,8 @@ from numpy.typing import NDArray
 from pybullet_utils.bullet_client import BulletClient
 
 from world.hdmap import LightColour, LightHead
+from world.scene import collision
+from world.scene.collision import CollisionShapes, Cylinder, Part
 
 HOUSING_DEPTH = 0.25  # [m] along the facing
 HOUSING_WIDTH = 0.35  # [m] across the facing
@@ -100,11 +102,12 @@ class TrafficLightBody:
         self.colour = colour
 
 
-def add_traffic_light(client: BulletClient, head: LightHead,
-                      folder: Path | None = None) -> TrafficLightBody:
+def add_traffic_light(client: BulletClient, head: LightHead, folder: Path | None = None,
+                      shapes: CollisionShapes | None = None) -> TrafficLightBody:
     """Build a traffic light at `head` in `client`, all lamps dark. The mesh files go into
     `folder` (which must outlive the client's use of them; the world's own temporary
-    directory), or a temporary directory that the returned body keeps."""
+    directory), or a temporary directory that the returned body keeps. `shapes` keeps the
+    collision shape's description (a book of its own when None)."""
     if head.z <= 0.5 * HOUSING_HEIGHT:
         raise ValueError(f"a light head {head.z} m high leaves no room for its pole")
     keep = None
@@ -117,22 +120,22 @@ def add_traffic_light(client: BulletClient, head: LightHead,
         write_obj(housing, *housing_mesh())
     if not disc.exists():
         write_obj(disc, *disc_mesh(0.5 * LAMP_DIAMETER, LAMP_SEGMENTS))
-    body = _add_pole_and_housing(client, head, housing)
+    body = _add_pole_and_housing(client, head, housing,
+                                 CollisionShapes() if shapes is None else shapes)
     lamps = {colour: _add_lamp(client, head, colour, disc) for colour in LightColour}
     return TrafficLightBody(client, body, lamps, keep)
 
 
-def _add_pole_and_housing(client: BulletClient, head: LightHead, housing: Path) -> int:
+def _add_pole_and_housing(client: BulletClient, head: LightHead, housing: Path,
+                          shapes: CollisionShapes) -> int:
     """One static body at the head, yawed to its facing (body x = the lamps' normal): for
     collision a box and the pole below it; for the eye the housing mesh, the visors and
     the pole."""
     pole_length = head.z - 0.5 * HOUSING_HEIGHT
-    pole_centre = [0.0, 0.0, -0.5 * HOUSING_HEIGHT - 0.5 * pole_length]
-    housing_half = [0.5 * HOUSING_DEPTH, 0.5 * HOUSING_WIDTH, 0.5 * HOUSING_HEIGHT]
-    shape = client.createCollisionShapeArray(
-        [pybullet.GEOM_BOX, pybullet.GEOM_CYLINDER],
-        halfExtents=[housing_half, [0.0, 0.0, 0.0]], radii=[0.0, POLE_RADIUS],
-        lengths=[0.0, pole_length], collisionFramePositions=[[0.0, 0.0, 0.0], pole_centre])
+    pole_centre = (0.0, 0.0, -0.5 * HOUSING_HEIGHT - 0.5 * pole_length)
+    housing_half = (0.5 * HOUSING_DEPTH, 0.5 * HOUSING_WIDTH, 0.5 * HOUSING_HEIGHT)
+    shape = shapes.create(client, Part(collision.Box(housing_half)),
+                          Part(Cylinder(POLE_RADIUS, pole_length), pole_centre))
     visors = visor_boxes()
     n = len(visors)
     visual = client.createVisualShapeArray(
@@ -140,12 +143,13 @@ def _add_pole_and_housing(client: BulletClient, head: LightHead, housing: Path) 
         fileNames=[str(housing), ""] + [""] * n,
         halfExtents=[[0.0, 0.0, 0.0]] * 2 + [list(half) for _, half in visors],
         radii=[0.0, POLE_RADIUS] + [0.0] * n, lengths=[0.0, pole_length] + [0.0] * n,
-        visualFramePositions=[[0.0, 0.0, 0.0], pole_centre]
+        visualFramePositions=[[0.0, 0.0, 0.0], list(pole_centre)]
         + [list(centre) for centre, _ in visors],
         rgbaColors=[list(HOUSING_RGBA), list(POLE_RGBA)] + [list(HOUSING_RGBA)] * n)
     quat = client.getQuaternionFromEuler([0.0, 0.0, head.facing])
-    return int(client.createMultiBody(0.0, shape, visual, [head.x, head.y, head.z], quat,
-                                      useMaximalCoordinates=True))
+    return shapes.placed(int(client.createMultiBody(0.0, shape, visual,
+                                                    [head.x, head.y, head.z], quat,
+                                                    useMaximalCoordinates=True)), shape)
 
 
 def _add_lamp(client: BulletClient, head: LightHead, colour: LightColour, disc: Path) -> int:

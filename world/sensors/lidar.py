@@ -2,14 +2,14 @@
 
 Each revolution is cast at one instant (no motion skew) from the sensor's true pose: one ray
 per (channel, column), channel elevations from `LidarInfo`, columns evenly spaced over 360
-deg from the sensor's forward axis, counter-clockwise. Rays go to `max_range` in batches of at
-most 16,383 (`rayTestBatch`'s limit; 16,384 silently drops a ray), as (N, 3) numpy arrays,
-on all cores (``numThreads=0``; 1 when another process renders the cameras on the other
-core, see `world.sensors.pipeline`). The ego's own body is in a collision group the rays skip
-(a real roof sensor's self-returns are cropped by its driver the same way).
+deg from the sensor's forward axis, counter-clockwise, each to `max_range`. The ego's own
+body is never hit (a real roof sensor's self-returns are cropped by its driver the same way).
 
-Rays that can only meet the flat ground are solved in closed form and only the others are
-cast (`world.sensors.ray_culling`): the same returns at a fraction of the cost.
+Two ray casters give the same returns up to float32 rounding and the tessellation of
+cylinders (`RayBackend`): Embree through Open3D (`world.sensors.embree_caster`, the default:
+static triangles, actor boxes and the ground plane, each the nearest of three), and Bullet's
+own `rayTestBatch` (`world.sensors.bullet_caster`, after culling the rays that can only meet
+the ground).
 
 Returns: range = hit fraction x max range, plus Gaussian range noise (``range_sigma``), and a
 ``dropout`` fraction of returns lost, both from the world's seeded generator. Points are in
@@ -22,10 +22,9 @@ perception scoring and the recording; never given to the stack).
 
 from __future__ import annotations
 
+import enum
 import math
 from dataclasses import dataclass
-from operator import itemgetter
-from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -34,13 +33,21 @@ from pybullet_utils.bullet_client import BulletClient
 from world.core.rates import Rate, SensorTiming
 from world.ego.body import EgoTruth
 from world.frames import LidarInfo, LidarScan
-from world.sensors.ray_culling import Box, ground_distance, rays_to_cast
+from world.scene.collision import CollisionShapes
+from world.sensors.bullet_caster import EGO_RAY_GROUP, RAY_MASK, BulletCaster
+from world.sensors.embree_caster import EmbreeCaster
 from world.sensors.sensor import Reading, vehicle_pose
 from world.sensors.setup import LIDAR
 
-MAX_BATCH = 16_383  # rays per rayTestBatch call
-EGO_RAY_GROUP = 0x40  # collision group of the ego's links; the rays' mask leaves it out
-RAY_MASK = 0xFFFF & ~EGO_RAY_GROUP
+__all__ = ["EGO_RAY_GROUP", "RAY_MASK", "Lidar", "LidarSensor", "LidarTruth", "RayBackend",
+           "beam_directions"]
+
+
+class RayBackend(enum.Enum):
+    """Which engine casts the rays."""
+
+    EMBREE = "embree"  # Open3D's Embree scene + closed-form boxes and ground
+    BULLET = "bullet"  # Bullet's rayTestBatch after the ground culling
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -67,23 +74,35 @@ class Lidar:
     """Casts one `LidarInfo` in one client."""
 
     def __init__(self, client: BulletClient, info: LidarInfo, rng: np.random.Generator,
-                 actor_bodies: list[int], ground: int, static_bodies: list[int]) -> None:
+                 actor_bodies: list[int], ground: int, static_bodies: list[int],
+                 shapes: CollisionShapes, backend: RayBackend = RayBackend.EMBREE) -> None:
         """`actor_bodies`: the scenario actors' body ids, in scenario order (ground truth,
-        and moving boxes for the ray culling); `ground`: the ground plane's body;
-        `static_bodies`: every other body with collision that never moves (ego excluded)."""
+        and moving bodies); `ground`: the ground plane's body; `static_bodies`: every other
+        body with collision that never moves (ego excluded); `shapes`: their collision
+        shapes (the Embree caster's geometry)."""
         self.info = info
-        self._ground = ground
-        self._actors = list(actor_bodies)
-        self._static_boxes = [_aabb(client, b) for b in static_bodies]
         self._actor_of = np.full(max([*actor_bodies, 0]) + 1, -1, dtype=np.int16)
         self._actor_of[actor_bodies] = np.arange(len(actor_bodies), dtype=np.int16)
-        self._c = client
         self._rng = rng
         self._dirs, self._ring, self._column = beam_directions(info)
         m = info.mount
         self._mount_xyz = np.array([m.x, m.y, m.z])
         self._mount_rot = m.rotation()
-        self.threads = 0  # rayTestBatch threads: 0 = Bullet's choice (all cores)
+        self.backend = backend
+        self.caster: EmbreeCaster | BulletCaster = (
+            EmbreeCaster(client, shapes, info.max_range, actor_bodies, ground, static_bodies)
+            if backend is RayBackend.EMBREE else
+            BulletCaster(client, info.max_range, info.azimuth_steps, actor_bodies, ground,
+                         static_bodies))
+
+    @property
+    def threads(self) -> int:
+        """Threads the caster casts on (0: its library's choice, all cores)."""
+        return self.caster.threads
+
+    @threads.setter
+    def threads(self, threads: int) -> None:
+        self.caster.threads = threads
 
     def scan(self, t: float, vehicle_origin: NDArray[np.float64],
              vehicle_rotation: NDArray[np.float64]) -> tuple[LidarScan, LidarTruth]:
@@ -111,30 +130,8 @@ class Lidar:
 
     def _cast(self, origin: NDArray[np.float64], directions: NDArray[np.float64],
               heading: float) -> tuple[NDArray[np.int32], NDArray[np.float64]]:
-        """(body hit or -1, hit fraction of the max range) per ray: the flat ground in
-        closed form where nothing else can be met (`world.sensors.ray_culling`), Bullet for the
-        rest."""
-        info = self.info
-        ground = ground_distance(origin, directions, info.max_range)
-        reach = np.minimum(ground, info.max_range)
-        boxes = self._static_boxes + [_aabb(self._c, b) for b in self._actors]
-        shape = (info.channels, info.azimuth_steps)
-        need = rays_to_cast(origin, directions.reshape(*shape, 3), reach.reshape(shape),
-                            boxes, heading, info.azimuth_steps).reshape(-1)
-        body = np.where(np.isfinite(ground), self._ground, -1).astype(np.int32)
-        fraction = np.where(np.isfinite(ground), ground / info.max_range, 1.0)
-        idx = np.flatnonzero(need)
-        if len(idx):
-            ends = origin + directions[idx] * info.max_range
-            starts = np.broadcast_to(origin, ends.shape)
-            results: list[tuple[Any, ...]] = []
-            for i in range(0, len(idx), MAX_BATCH):
-                results += self._c.rayTestBatch(starts[i:i + MAX_BATCH], ends[i:i + MAX_BATCH],
-                                                numThreads=self.threads,
-                                                collisionFilterMask=RAY_MASK)
-            body[idx] = np.array(list(map(itemgetter(0), results)), dtype=np.int32)
-            fraction[idx] = np.array(list(map(itemgetter(2), results)), dtype=np.float64)
-        return body, fraction
+        """(body hit or -1, hit fraction of the max range) per ray, by the backend."""
+        return self.caster.cast(origin, directions, heading)
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -158,8 +155,3 @@ class LidarSensor:
     def capture(self, t: float, ego: EgoTruth) -> Reading:
         scan, truth = self.lidar.scan(t, *vehicle_pose(ego, self.ride_height))
         return Reading(self.name, scan, truth)
-
-
-def _aabb(client: BulletClient, body: int) -> Box:
-    lo, hi = client.getAABB(body)
-    return np.array(lo), np.array(hi)

@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from avsim.scenario.load import load_scenario
+from world.sensors.bullet_caster import BulletCaster
 from world.sensors.lidar import RAY_MASK, Lidar, beam_directions
 from world.sensors.sensor import vehicle_pose
 from world.sensors.setup import Profile, sensor_setup
@@ -67,8 +68,12 @@ def test_car_ahead_ground_and_truth(world: World) -> None:
 
 
 def test_culled_cast_equals_casting_every_ray(world: World) -> None:
-    """At several poses along the route, buildings, signs and the parked car in view."""
+    """At several poses along the route, buildings, signs and the parked car in view (the
+    Bullet backend, whose culling this is)."""
     lidar = world.rig.sensor("lidar").lidar  # type: ignore[attr-defined]
+    caster = BulletCaster(world.client, lidar.info.max_range, lidar.info.azimuth_steps,
+                          world.actors.bodies, world.scene.ground,
+                          sorted(world.scene.static_bodies))
     for _ in range(4):
         for _ in range(240):
             world.ego.apply(0.0, 1500.0 * 2.0 * 0.33, 0.0)
@@ -77,7 +82,7 @@ def test_culled_cast_equals_casting_every_ray(world: World) -> None:
         r = rotation @ lidar._mount_rot
         o = origin + rotation @ lidar._mount_xyz
         dirs = lidar._dirs @ r.T
-        body, fraction = lidar._cast(o, dirs, math.atan2(r[1, 0], r[0, 0]))
+        body, fraction = caster.cast(o, dirs, math.atan2(r[1, 0], r[0, 0]))
         ends = o + dirs * lidar.info.max_range
         full = []
         for i in range(0, len(ends), 16_383):
