@@ -55,7 +55,7 @@ from world.scene.town_scene import Pavement, build_town_scene
 from world.scene.traffic_light import TrafficLightBody, add_traffic_light
 from world.sensors.camera import Camera, CameraSensor
 from world.sensors.gnss import GnssSensor
-from world.sensors.lidar import EGO_RAY_GROUP, Lidar, LidarSensor
+from world.sensors.lidar import EGO_RAY_GROUP, Lidar, LidarSensor, RayBackend
 from world.sensors.odometry import OdometrySensor
 from world.sensors.rig import SensorRig
 from world.sensors.sensor import Sensor
@@ -106,9 +106,11 @@ class World:
     """One scenario's world in its own physics client."""
 
     def __init__(self, spec: WorldSpec, sensors: SensorSetup | None = None, *,
-                 cameras: bool = True, lidar: bool = True) -> None:
+                 cameras: bool = True, lidar: bool = True,
+                 lidar_backend: RayBackend = RayBackend.EMBREE) -> None:
         """`sensors`: the profile's cameras (the renderer is attached before anything else,
-        as EGL requires) and / or LiDAR join the rig's GNSS and odometry in this client."""
+        as EGL requires) and / or LiDAR join the rig's GNSS and odometry in this client;
+        `lidar_backend`: what casts the LiDAR's rays (`world.sensors.lidar.RayBackend`)."""
         self.spec = spec
         seeds = np.random.SeedSequence(spec.seed).spawn(4)
         self.client = make_client()
@@ -134,7 +136,7 @@ class World:
             self.client.setCollisionFilterGroupMask(self.ego.body, link, EGO_RAY_GROUP, 0xFFFF)
         self.actors = ActorSet(self.client, self.road, spec.actors, self.shapes)
         self._events = EgoEvents(spec.events)
-        self.rig = self._build_rig(sensors, lidar, seeds)
+        self.rig = self._build_rig(sensors, lidar, seeds, lidar_backend)
         self._truth: EgoTruth | None = None
         self._route: RouteTruth | None = None
         self.ego_s = self.ego_route.station
@@ -143,7 +145,7 @@ class World:
     # -- building ----------------------------------------------------------------------------
 
     def _build_rig(self, setup: SensorSetup | None, lidar: bool,
-                   seeds: list[np.random.SeedSequence]) -> SensorRig:
+                   seeds: list[np.random.SeedSequence], backend: RayBackend) -> SensorRig:
         """The car's sensors in this client: the profile's cameras (with a renderer) and
         LiDAR (with `lidar`), GNSS and odometry; each draws its noise from its own child of
         the scenario's seed (LiDAR 3, GNSS 1, odometry 2)."""
@@ -156,7 +158,7 @@ class World:
         if setup is not None and lidar:
             caster = Lidar(self.client, setup.lidar, np.random.default_rng(seeds[3]),
                            self.actors.bodies, self.scene.ground,
-                           sorted(self.scene.static_bodies), self.shapes)
+                           sorted(self.scene.static_bodies), self.shapes, backend)
             sensors.append(LidarSensor(caster, setup.timing(LIDAR), ride_height))
         events = self._events
         sensors += [GnssSensor(self.spec.sensors.gnss, np.random.default_rng(seeds[1])),

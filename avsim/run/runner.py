@@ -50,6 +50,7 @@ from world.core.rates import (
     RECORD_RATE,
 )
 from world.core.stopwatch import Stopwatch
+from world.sensors.lidar import RayBackend
 from world.sensors.setup import Profile, sensor_setup
 from world.spec import FlatTire
 from world.truth import touching
@@ -122,16 +123,19 @@ class Runner:
 
     def __init__(self, scenario: Scenario, recording: Path | None = None,
                  profile: Profile | None = Profile.DEFAULT, sensing: str = "auto",
-                 frame_hook: FrameHook | None = None) -> None:
+                 frame_hook: FrameHook | None = None,
+                 lidar_backend: RayBackend = RayBackend.EMBREE) -> None:
         """`profile`: the sensor set-up (None: no cameras or LiDAR, the stack drives on
         GNSS + odometry and the map); `sensing`: where cameras render ('auto', 'inline' or
         'process', see `world.sensors.pipeline`); `frame_hook`: alters the camera frames the stack
-        gets (fault injection in tests)."""
+        gets (fault injection in tests); `lidar_backend`: what casts the LiDAR's rays (Embree,
+        or Bullet's own ray test to compare with)."""
         self.scenario = scenario
         spec = scenario.world
         self.setup = sensor_setup(profile, spec.sensors.lidar) if profile is not None else None
         mode = sensing_mode(sensing)
-        self.world = World(spec, self.setup, cameras=mode == "inline")
+        self.world = World(spec, self.setup, cameras=mode == "inline",
+                           lidar_backend=lidar_backend)
         w = self.world
         self.car = w.ego.geometry
         front = self.setup.camera("front") if self.setup is not None else None
