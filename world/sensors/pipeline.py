@@ -13,7 +13,8 @@ its own motion estimate). Two interchangeable pipelines give bitwise the same da
   same scenario, posed from a `WorldSnapshot` at each capture), the rest (LiDAR: ray casting
   is a physics query; GNSS, odometry) in the simulated world's own rig. Rendering runs on the
   second core while the main process casts the LiDAR, steps physics and runs the stack; the
-  main process waits for the frames only when they are due.
+  main process waits for the frames only when they are due. The images come back through
+  shared memory (`world.sensors.frame_slots`), the rest of each answer through the pipe.
 
 Given a `Stopwatch`, a pipeline times each capture in its process ("sensor <name>") and, for
 the worker, the passing of data: "ipc send" (the snapshot and request out), "ipc wait"
@@ -24,17 +25,21 @@ the worker, the passing of data: "ipc send" (the snapshot and request out), "ipc
 from __future__ import annotations
 
 import multiprocessing as mp
+import os
+import tempfile
 import time
 import traceback
 from collections import deque
 from dataclasses import dataclass
 from multiprocessing.connection import Connection
+from pathlib import Path
 from typing import Any, Protocol
 
 from world.core.rendering import Renderer
 from world.core.stopwatch import Stopwatch
 from world.frames import Frame
 from world.sensors import worker as sensing_worker
+from world.sensors.frame_slots import SLOTS, FrameSlots, shared_dir
 from world.sensors.lidar import LidarSensor
 from world.sensors.schedule import Due
 from world.sensors.sensor import Reading
@@ -135,25 +140,34 @@ class ProcessSensing:
         for sensor in world.rig:
             if isinstance(sensor, LidarSensor):
                 sensor.lidar.threads = 1  # the other core renders: no oversubscription
+        fd, name = tempfile.mkstemp(prefix="avsim-frames-", dir=shared_dir())
+        os.close(fd)
+        self._slots = FrameSlots(Path(name), setup.cameras, create=True)
         ctx = mp.get_context("spawn")  # a fresh interpreter: no inherited physics or GL state
         self._conn, child = ctx.Pipe()
-        self._proc = ctx.Process(target=sensing_worker.main, args=(child, world.spec, setup),
+        self._proc = ctx.Process(target=sensing_worker.main,
+                                 args=(child, world.spec, setup, self._slots.path),
                                  name="avsim-sensing", daemon=True)
         self._proc.start()
         child.close()
         self.renderer: Renderer | None = Renderer(self._receive())
         self._pending: list[_Pending] = []  # in submission order
         self._awaiting: deque[_Pending] = deque()  # sent to the worker, unanswered, in order
+        self._sent = 0  # requests sent to the worker
+        self._answered = 0  # answers received from it
 
     def submit(self, due: Due) -> None:
         w = self._world
         _check_now(w, due)
         pending = _Pending(due, tuple(n for n in due.sensors if n not in w.rig))
         if pending.remote:  # first, so that the worker renders while this process casts
+            while len(self._awaiting) >= SLOTS:  # free the image slot this request takes
+                self._answer_oldest()
             start = time.perf_counter()
             self._conn.send(("capture", due.t, w.snapshot(), pending.remote))
             self._time("ipc send", start)
             self._awaiting.append(pending)
+            self._sent += 1
         pending.local = w.rig.capture([n for n in due.sensors if n in w.rig], due.t,
                                       w.ego_truth, self._watch)
         self._pending.append(pending)
@@ -167,18 +181,26 @@ class ProcessSensing:
         """The capture of `pending`, its worker's readings received (the worker answers in
         the order it was asked)."""
         while pending.remote and pending.received is None:
-            start = time.perf_counter()
-            self._conn.poll(None)
-            self._time("ipc wait", start)
-            start = time.perf_counter()
-            readings, seconds = self._receive()
-            self._time("ipc receive", start)
-            if self._watch is not None:
-                self._watch.add_all(seconds, prefix="worker ")
-            self._awaiting.popleft().received = readings
+            self._answer_oldest()
         by_name = {r.sensor: r for r in (*pending.local, *(pending.received or ()))}
         due = pending.due
         return Capture(due, tuple(by_name[name] for name in due.sensors))
+
+    def _answer_oldest(self) -> None:
+        """Receive the worker's answer to the oldest unanswered request, its images copied
+        out of their slots."""
+        start = time.perf_counter()
+        self._conn.poll(None)
+        self._time("ipc wait", start)
+        start = time.perf_counter()
+        readings, seconds = self._receive()
+        request, self._answered = self._answered, self._answered + 1
+        slots = self._slots
+        self._awaiting.popleft().received = tuple(
+            slots.take(request, r) if r.sensor in slots else r for r in readings)
+        self._time("ipc receive", start)
+        if self._watch is not None:
+            self._watch.add_all(seconds, prefix="worker ")
 
     def close(self) -> None:
         if self._proc.is_alive():
@@ -193,6 +215,8 @@ class ProcessSensing:
             if self._proc.is_alive():
                 self._proc.kill()
         self._conn.close()
+        self._slots.close()
+        self._slots.path.unlink(missing_ok=True)
 
     def _time(self, stage: str, start: float) -> None:
         if self._watch is not None:
@@ -208,14 +232,16 @@ class ProcessSensing:
         return payload
 
 
-def serve(conn: Connection, spec: WorldSpec, setup: SensorSetup) -> None:
+def serve(conn: Connection, spec: WorldSpec, setup: SensorSetup, slots_file: Path) -> None:
     """The worker: build the mirror world (cameras, no LiDAR), then capture on request until
-    told to close."""
+    told to close; the images go into `slots_file`'s slots (`FrameSlots`)."""
     try:
         world = World(spec, setup, lidar=False)
         assert world.renderer is not None
+        slots = FrameSlots(slots_file, setup.cameras, create=False)
         conn.send(("ready", world.renderer.value))
         sent = 0.0  # [s]
+        request = 0
         while True:
             message = conn.recv()
             if message[0] == "close":
@@ -228,8 +254,12 @@ def serve(conn: Connection, spec: WorldSpec, setup: SensorSetup) -> None:
                 world.apply_snapshot(snapshot)
             readings = world.rig.capture(names, t, world.ego_truth, watch)
             start = time.perf_counter()
+            readings = tuple(slots.put(request, r) if r.sensor in slots else r
+                             for r in readings)
             conn.send(("data", (readings, watch.seconds)))
             sent = time.perf_counter() - start
+            request += 1
+        slots.close()
         world.close()
     except Exception:  # report any failure to the main process, which raises it
         conn.send(("error", traceback.format_exc()))

@@ -15,6 +15,9 @@ often as somebody reads them (`avsim.run.sensor_loop.frames_read`): the stack re
 front camera and the LiDAR, so the side cameras render only the frames the recording keeps
 (`paper`: every 4th, 2.5 Hz), and not at all without a recording.
 
+With the EGL renderer, `paper`'s 1280x960 images are drawn at 1024x768, the plugin's fixed
+surface, and scaled up nearest-neighbour by Bullet (TinyRenderer draws them at full size).
+
 Cameras have an 80 deg horizontal field of view. The LiDAR is VLP-16-like: channels from
 -15 to +15 deg every 2 deg, 360 deg, 100 m. Mounts come from the URDF's sensor links (the
 vehicle frame's origin is on the ground, the base link's origin `CarGeometry.ride_height`

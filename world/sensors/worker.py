@@ -12,10 +12,10 @@ from multiprocessing.connection import Connection
 from typing import Any
 
 
-def main(conn: Connection, spec: Any, setup: Any) -> None:
+def main(conn: Connection, spec: Any, setup: Any, slots_file: Any) -> None:
     devnull = os.open(os.devnull, os.O_WRONLY)
     os.dup2(devnull, 1)
     os.dup2(devnull, 2)
     from world.sensors.pipeline import serve
 
-    serve(conn, spec, setup)
+    serve(conn, spec, setup, slots_file)

@@ -5,6 +5,8 @@ surface as errors, not hangs."""
 from __future__ import annotations
 
 import itertools
+import time
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -12,6 +14,7 @@ import pytest
 from avsim.scenario.load import load_scenario
 from world.core.rates import CONTROL_RATE, FRAME_LATENCY, PHYSICS_RATE
 from world.frames import CameraFrame, GnssFix, LidarScan, Odometry
+from world.sensors.frame_slots import SLOTS
 from world.sensors.lidar import LidarTruth
 from world.sensors.pipeline import Capture, InlineSensing, ProcessSensing, SensingError
 from world.sensors.schedule import SensorSchedule
@@ -143,3 +146,52 @@ def test_process_sensing_needs_a_world_without_cameras() -> None:
             ProcessSensing(world, setup)
     finally:
         world.close()
+
+
+def held_captures(mode: str, captures: int) -> list[Capture]:
+    """`captures` front-camera captures, one every control tick, none collected until the
+    last was submitted: more requests unanswered than the worker has image slots."""
+    spec = load_scenario("normal_driving").world
+    setup = sensor_setup(Profile.FAST)
+    world = World(spec, setup, cameras=mode == "inline", lidar=False)
+    sensing = InlineSensing(world) if mode == "inline" else ProcessSensing(world, setup)
+    schedule = SensorSchedule(sensor_timings(setup), CONTROL_RATE)
+    front = next(due for due in schedule.due(0) if "front" in due.sensors)
+    try:
+        world.ego.apply(0.0, 1500.0 * 2.0 * 0.33, 0.0)
+        for _ in range(captures):
+            for _ in range(CONTROL_RATE.every):
+                world.step()
+            step = world.clock.step
+            sensing.submit(replace(front, step=step, deliver=step + LATE, sensors=("front",)))
+        time.sleep(2.0)  # let the worker answer all it was sent before any is read
+        return list(sensing.collect(world.clock.step + LATE))
+    finally:
+        sensing.close()
+        world.close()
+
+
+def test_frames_survive_more_requests_in_flight_than_image_slots() -> None:
+    captures = 3 * SLOTS + 1
+    inline, process = held_captures("inline", captures), held_captures("process", captures)
+    assert len(inline) == len(process) == captures
+    for a, b in zip(inline, process, strict=True):
+        assert a.due == b.due
+        assert_same(a.readings[0].frame, b.readings[0].frame)
+    # the car moved: the images differ from one capture to the next (a reused slot would
+    # show up as two equal images or one from another capture)
+    images = [c.readings[0].frame for c in process]
+    assert all(isinstance(f, CameraFrame) for f in images)
+    assert not any(np.array_equal(f.rgb, g.rgb)  # type: ignore[union-attr]
+                   for f, g in itertools.pairwise(images))
+
+
+def test_the_image_slot_file_is_removed_on_close() -> None:
+    setup = sensor_setup(Profile.FAST)
+    world = World(load_scenario("normal_driving").world, setup, cameras=False, lidar=False)
+    sensing = ProcessSensing(world, setup)
+    path = sensing._slots.path
+    assert path.exists()
+    sensing.close()
+    world.close()
+    assert not path.exists()
