@@ -9,8 +9,7 @@ time of one simulated second (1000 / RTF), "untimed" being the rest of the loop.
 
 Rows starting with "worker" ran in the render worker, beside the main process: they overlap
 the main rows, and the main process waits for them in "ipc wait" only when they are late.
-"worker ipc send" includes the worker's wait for the main process to take the frames off the
-pipe (it takes them when they are due), so it is not all work.
+"worker ipc send" is the images into shared memory and the rest of the answer into the pipe.
 
 `make bench` runs it; `--json FILE` also writes the figures; `--profiles default paper` for
 some; `--sensing inline` to time every capture in the main process.

@@ -63,6 +63,8 @@ class EmbreeCaster:
         for geometry, body in body_of:
             self._body_of[geometry] = body
         self._tensor = o3d.core.Tensor
+        self._rays = np.empty((0, 6), np.float32)  # origin and direction per ray: the cast's
+        #   input, filled in place each scan (Open3D copies it into its tensor)
         self.threads = 0  # Embree cast threads: 0 = Open3D's choice (all cores)
         self._cast_static(np.array([[0, 0, 0, 1, 0, 0]], np.float32))  # commits (builds BVH)
 
@@ -74,7 +76,9 @@ class EmbreeCaster:
         max_range = self._max_range
         t_best = ground_distance(origin, directions, max_range)
         body = np.where(np.isfinite(t_best), self._ground, -1).astype(np.int32)
-        rays = np.empty((len(directions), 6), np.float32)
+        if len(self._rays) != len(directions):  # allocated once per beam layout
+            self._rays = np.empty((len(directions), 6), np.float32)
+        rays = self._rays
         rays[:, :3] = origin - self.origin
         rays[:, 3:] = directions
         t_static, geometry = self._cast_static(rays)
