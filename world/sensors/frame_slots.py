@@ -8,7 +8,7 @@ request. The worker writes request j's image into slot ``j % SLOTS`` and sends o
 frame's metadata; the main process copies the image out as soon as it receives the answer.
 The main process never has more than `SLOTS` requests unanswered
 (`world.sensors.pipeline.ProcessSensing`), so a slot is written again only after its last
-image was copied out.
+image was copied out. The file is unlinked as soon as both have mapped it.
 """
 
 from __future__ import annotations

@@ -150,11 +150,13 @@ class ProcessSensing:
                                  name="avsim-sensing", daemon=True)
         self._proc.start()
         child.close()
-        self.renderer: Renderer | None = Renderer(self._receive())
+        try:
+            self.renderer: Renderer | None = Renderer(self._receive())
+        finally:  # both processes have it mapped now (or the worker failed): nothing can
+            self._slots.path.unlink()  # be left behind in shared memory, even on a crash
         self._pending: list[_Pending] = []  # in submission order
         self._awaiting: deque[_Pending] = deque()  # sent to the worker, unanswered, in order
-        self._sent = 0  # requests sent to the worker
-        self._answered = 0  # answers received from it
+        self._answered = 0  # answers received from the worker
 
     def submit(self, due: Due) -> None:
         w = self._world
@@ -167,7 +169,6 @@ class ProcessSensing:
             self._conn.send(("capture", due.t, w.snapshot(), pending.remote))
             self._time("ipc send", start)
             self._awaiting.append(pending)
-            self._sent += 1
         pending.local = w.rig.capture([n for n in due.sensors if n in w.rig], due.t,
                                       w.ego_truth, self._watch)
         self._pending.append(pending)
@@ -216,7 +217,6 @@ class ProcessSensing:
                 self._proc.kill()
         self._conn.close()
         self._slots.close()
-        self._slots.path.unlink(missing_ok=True)
 
     def _time(self, stage: str, start: float) -> None:
         if self._watch is not None:
