@@ -44,6 +44,11 @@ FOLLOW_GAP = 4.0  # [m] bumper to bumper at a standstill
 FOLLOW_HEADWAY = 1.2  # [s] of its own speed, added to the standstill gap
 FOLLOW_LANE_HALF = 1.5  # [m] how far off its lane's centre a vehicle counts as ahead
 LOOK_AHEAD = 60.0  # [m] how far ahead lines, turns and vehicles count
+FOLLOW_REACH = LOOK_AHEAD + FOLLOW_LANE_HALF + 20.0  # [m] a vehicle farther than this from
+#   the route's point at the NPC's station cannot be ahead within LOOK_AHEAD and within
+#   FOLLOW_LANE_HALF of the line (the route between two stations is no shorter than the
+#   straight line between them; 20 m spare for projections clipped at a piece's end), so
+#   it is not projected at all: the same answer without the cost
 
 
 FloatArray = NDArray[np.float64]
@@ -133,8 +138,11 @@ class TownDriver:
     def _follow_cap(self, s: float, speed: float, others: FloatArray,
                     other_half_lengths: FloatArray) -> float:
         """[m/s] the braking speed to the following distance behind the nearest vehicle."""
-        if len(others) == 0:
+        x, y, _ = self.road.line.pose_one(s, 0.0)
+        near = np.hypot(others[:, 0] - x, others[:, 1] - y) < FOLLOW_REACH
+        if not near.any():
             return math.inf
+        others, other_half_lengths = others[near], other_half_lengths[near]
         stations, offsets = self.road.local_coordinates(others)
         ahead = (stations > s) & (stations - s < LOOK_AHEAD) & (np.abs(offsets) < FOLLOW_LANE_HALF)
         if not ahead.any():
