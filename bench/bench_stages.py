@@ -11,6 +11,10 @@ Rows starting with "worker" ran in the render worker, beside the main process: t
 the main rows, and the main process waits for them in "ipc wait" only when they are late.
 "worker ipc send" is the images into shared memory and the rest of the answer into the pipe.
 
+The machines are shared and noisy (about +-10 % from run to run), so each profile runs
+`--repeat` times, round robin, and the table shows the fastest run, with the slowest run's
+real-time factor in the last row.
+
 `make bench` runs it; `--json FILE` also writes the figures; `--profiles default paper` for
 some; `--sensing inline` to time every capture in the main process.
 """
@@ -50,6 +54,12 @@ def stage_times(profile: str, seconds: float, sensing: str) -> dict[str, float]:
     return out
 
 
+def best(runs: list[dict[str, float]]) -> dict[str, float]:
+    """The fastest run's figures, with the slowest run's real-time factor beside them."""
+    fastest = min(runs, key=lambda r: r["wall"])
+    return fastest | {"rtf slowest run": min(r["rtf"] for r in runs)}
+
+
 def _order(stage: str) -> tuple[int, str]:
     groups = ("physics", "sensor", "ipc", "worker", "localisation", "perception", "planner",
               "control", "criteria", "scoring", "runner", "recording", "untimed", "wall",
@@ -72,11 +82,16 @@ def main() -> None:
     parser.add_argument("--seconds", type=float, default=20.0)
     parser.add_argument("--profiles", nargs="+", default=list(PROFILES), choices=PROFILES)
     parser.add_argument("--sensing", default="auto", choices=("auto", "inline", "process"))
+    parser.add_argument("--repeat", type=int, default=3)
     parser.add_argument("--json", type=Path, default=None)
     args = parser.parse_args()
-    figures = {p: stage_times(p, args.seconds, args.sensing) for p in args.profiles}
+    runs: dict[str, list[dict[str, float]]] = {p: [] for p in args.profiles}
+    for _ in range(args.repeat):  # round robin: a slow spell of the machine hits them all
+        for profile in args.profiles:
+            runs[profile].append(stage_times(profile, args.seconds, args.sensing))
+    figures = {p: best(r) for p, r in runs.items()}
     print(f"{SCENARIO}, {args.seconds:.0f} s simulated per run, full stack + recording, "
-          f"sensing {args.sensing}")
+          f"sensing {args.sensing}; the fastest of {args.repeat} runs per profile")
     print(table(figures))
     if args.json:
         args.json.write_text(json.dumps(figures, indent=2) + "\n")
