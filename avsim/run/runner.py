@@ -51,6 +51,7 @@ from world.core.rates import (
 )
 from world.core.stopwatch import Stopwatch
 from world.sensors.lidar import RayBackend
+from world.sensors.pipeline import SensingWorker
 from world.sensors.setup import Profile, sensor_setup
 from world.spec import FlatTire
 from world.truth import touching
@@ -134,6 +135,20 @@ class Runner:
         spec = scenario.world
         self.setup = sensor_setup(profile, spec.sensors.lidar) if profile is not None else None
         mode = sensing_mode(sensing)
+        # the sensing worker builds its mirror world while this process builds its own
+        worker = SensingWorker(spec, self.setup) \
+            if mode == "process" and self.setup is not None and self.setup.cameras else None
+        try:
+            self._build(scenario, recording, mode, frame_hook, lidar_backend, worker)
+        except BaseException:
+            if worker is not None:
+                worker.close()
+            raise
+
+    def _build(self, scenario: Scenario, recording: Path | None, mode: str,
+               frame_hook: FrameHook | None, lidar_backend: RayBackend,
+               worker: SensingWorker | None) -> None:
+        spec = scenario.world
         self.world = World(spec, self.setup, cameras=mode == "inline",
                            lidar_backend=lidar_backend)
         w = self.world
@@ -154,7 +169,7 @@ class Runner:
         self.infractions: list[Infraction] = []
         self.recorder = Recorder(recording, recording_name=scenario.name) if recording else None
         self.sensors = SensorLoop(w, self.setup, self.stack, mode, self.recorder, frame_hook,
-                                  self.watch)
+                                  self.watch, worker)
         self.state_changes: list[StateChange] = []
         self._touching: frozenset[int] = frozenset()
         self._last: StackOutput | None = None

@@ -32,7 +32,13 @@ from world.core.rates import CONTROL_RATE, SensorTiming
 from world.core.stopwatch import Stopwatch
 from world.frames import CameraFrame, Frame, LidarScan, wrap_angle
 from world.sensors.lidar import LidarTruth
-from world.sensors.pipeline import Capture, InlineSensing, ProcessSensing, Sensing
+from world.sensors.pipeline import (
+    Capture,
+    InlineSensing,
+    ProcessSensing,
+    Sensing,
+    SensingWorker,
+)
 from world.sensors.schedule import Due, SensorSchedule
 from world.sensors.setup import SensorSetup, sensor_timings
 from world.world import World
@@ -68,16 +74,17 @@ class SensorLoop:
 
     def __init__(self, world: World, setup: SensorSetup | None, stack: Stack, mode: str,
                  recorder: Recorder | None = None, frame_hook: FrameHook | None = None,
-                 watch: Stopwatch | None = None) -> None:
+                 watch: Stopwatch | None = None, worker: SensingWorker | None = None) -> None:
         """`mode`: 'inline' or 'process' (`world.sensors.pipeline`; without cameras there is
         nothing to render elsewhere, and every sensor captures inline); `watch`: times the
-        captures, the passing of frames, the scoring and the recording."""
+        captures, the passing of frames, the scoring and the recording; `worker`: the
+        sensing worker for 'process', started early (else it starts here)."""
         self.world, self.setup, self.stack = world, setup, stack
         timings = sensor_timings(setup)
         self.schedule = SensorSchedule(timings, CONTROL_RATE,
                                        frames_read(timings, stack.reads, recorder is not None))
         self.watch = watch if watch is not None else Stopwatch()
-        self.sensing: Sensing = (ProcessSensing(world, setup, self.watch)
+        self.sensing: Sensing = (ProcessSensing(world, setup, self.watch, worker)
                                  if mode == "process" and setup is not None and setup.cameras
                                  else InlineSensing(world, self.watch))
         self.mode = mode

@@ -15,6 +15,8 @@ its own motion estimate). Two interchangeable pipelines give bitwise the same da
   second core while the main process casts the LiDAR, steps physics and runs the stack; the
   main process waits for the frames only when they are due. The images come back through
   shared memory (`world.sensors.frame_slots`), the rest of each answer through the pipe.
+  The worker (`SensingWorker`) can be started before the simulated world is built, so that
+  the two worlds are built side by side (the runner does).
 
 Given a `Stopwatch`, a pipeline times each capture in its process ("sensor <name>") and, for
 the worker, the passing of data: "ipc send" (the snapshot and request out), "ipc wait"
@@ -126,34 +128,90 @@ class _Pending:
     received: tuple[Reading, ...] | None = None
 
 
+class SensingWorker:
+    """The worker process of a `ProcessSensing`, started on its own: it builds its mirror of
+    the scenario's world while the main process builds the simulated one (about 2 s and 1 s
+    here, side by side instead of one after the other)."""
+
+    def __init__(self, spec: WorldSpec, setup: SensorSetup) -> None:
+        self.spec = spec
+        fd, name = tempfile.mkstemp(prefix="avsim-frames-", dir=shared_dir())
+        os.close(fd)
+        self.slots = FrameSlots(Path(name), setup.cameras, create=True)
+        ctx = mp.get_context("spawn")  # a fresh interpreter: no inherited physics or GL state
+        self._conn, child = ctx.Pipe()
+        self._proc = ctx.Process(target=sensing_worker.main,
+                                 args=(child, spec, setup, self.slots.path),
+                                 name="avsim-sensing", daemon=True)
+        self._proc.start()
+        child.close()
+        self._renderer: Renderer | None = None
+
+    @property
+    def renderer(self) -> Renderer:
+        """The worker's renderer, once its world is built (waits for it the first time)."""
+        if self._renderer is None:
+            try:
+                self._renderer = Renderer(self.receive())
+            finally:  # both processes have it mapped now (or the worker failed): nothing
+                self.slots.path.unlink(missing_ok=True)  # is left in shared memory
+        return self._renderer
+
+    def send(self, message: tuple[Any, ...]) -> None:
+        self._conn.send(message)
+
+    def poll(self) -> None:
+        """Block until the worker has answered."""
+        self._conn.poll(None)
+
+    def receive(self) -> Any:
+        try:
+            kind, payload = self._conn.recv()
+        except EOFError as e:
+            raise SensingError(f"sensing worker exited (code {self._proc.exitcode})") from e
+        if kind == "error":
+            raise SensingError(f"sensing worker failed:\n{payload}")
+        return payload
+
+    def close(self, unanswered: int = 0) -> None:
+        """Take the `unanswered` answers still due off the pipe, stop the worker, drop the
+        slots."""
+        if self._proc.is_alive():
+            try:
+                if self._renderer is None:
+                    self.renderer  # noqa: B018 (its "ready" comes first)
+                for _ in range(unanswered):
+                    self.receive()
+                self._conn.send(("close",))
+            except (OSError, EOFError, SensingError):
+                pass
+            self._proc.join(timeout=10)
+            if self._proc.is_alive():
+                self._proc.kill()
+        self._conn.close()
+        self.slots.close()
+        self.slots.path.unlink(missing_ok=True)
+
+
 class ProcessSensing:
     """The sensors `world`'s rig lacks (its cameras: `world` must be built without them,
     `World(spec, setup, cameras=False)`) in a worker process on a mirror of `world`, the
     others in `world`."""
 
-    def __init__(self, world: World, setup: SensorSetup,
-                 watch: Stopwatch | None = None) -> None:
+    def __init__(self, world: World, setup: SensorSetup, watch: Stopwatch | None = None,
+                 worker: SensingWorker | None = None) -> None:
+        """`worker`: one started earlier for `world`'s scenario (else one starts now)."""
         if world.renderer is not None:
             raise ValueError("ProcessSensing needs a World built without cameras")
+        if worker is not None and worker.spec is not world.spec:
+            raise ValueError("the sensing worker was started for another world")
         self._world = world
         self._watch = watch
         for sensor in world.rig:
             if isinstance(sensor, LidarSensor):
                 sensor.lidar.threads = 1  # the other core renders: no oversubscription
-        fd, name = tempfile.mkstemp(prefix="avsim-frames-", dir=shared_dir())
-        os.close(fd)
-        self._slots = FrameSlots(Path(name), setup.cameras, create=True)
-        ctx = mp.get_context("spawn")  # a fresh interpreter: no inherited physics or GL state
-        self._conn, child = ctx.Pipe()
-        self._proc = ctx.Process(target=sensing_worker.main,
-                                 args=(child, world.spec, setup, self._slots.path),
-                                 name="avsim-sensing", daemon=True)
-        self._proc.start()
-        child.close()
-        try:
-            self.renderer: Renderer | None = Renderer(self._receive())
-        finally:  # both processes have it mapped now (or the worker failed): nothing can
-            self._slots.path.unlink()  # be left behind in shared memory, even on a crash
+        self._worker = worker if worker is not None else SensingWorker(world.spec, setup)
+        self.renderer: Renderer | None = self._worker.renderer
         self._pending: list[_Pending] = []  # in submission order
         self._awaiting: deque[_Pending] = deque()  # sent to the worker, unanswered, in order
         self._answered = 0  # answers received from the worker
@@ -166,7 +224,7 @@ class ProcessSensing:
             while len(self._awaiting) >= SLOTS:  # free the image slot this request takes
                 self._answer_oldest()
             start = time.perf_counter()
-            self._conn.send(("capture", due.t, w.snapshot(), pending.remote))
+            self._worker.send(("capture", due.t, w.snapshot(), pending.remote))
             self._time("ipc send", start)
             self._awaiting.append(pending)
         pending.local = w.rig.capture([n for n in due.sensors if n in w.rig], due.t,
@@ -191,12 +249,12 @@ class ProcessSensing:
         """Receive the worker's answer to the oldest unanswered request, its images copied
         out of their slots."""
         start = time.perf_counter()
-        self._conn.poll(None)
+        self._worker.poll()
         self._time("ipc wait", start)
         start = time.perf_counter()
-        readings, seconds = self._receive()
+        readings, seconds = self._worker.receive()
         request, self._answered = self._answered, self._answered + 1
-        slots = self._slots
+        slots = self._worker.slots
         self._awaiting.popleft().received = tuple(
             slots.take(request, r) if r.sensor in slots else r for r in readings)
         self._time("ipc receive", start)
@@ -204,32 +262,12 @@ class ProcessSensing:
             self._watch.add_all(seconds, prefix="worker ")
 
     def close(self) -> None:
-        if self._proc.is_alive():
-            try:
-                while self._awaiting:
-                    self._awaiting.popleft()
-                    self._receive()
-                self._conn.send(("close",))
-            except (OSError, EOFError, SensingError):
-                pass
-            self._proc.join(timeout=10)
-            if self._proc.is_alive():
-                self._proc.kill()
-        self._conn.close()
-        self._slots.close()
+        self._worker.close(unanswered=len(self._awaiting))
+        self._awaiting.clear()
 
     def _time(self, stage: str, start: float) -> None:
         if self._watch is not None:
             self._watch.add(stage, time.perf_counter() - start)
-
-    def _receive(self) -> Any:
-        try:
-            kind, payload = self._conn.recv()
-        except EOFError as e:
-            raise SensingError(f"sensing worker exited (code {self._proc.exitcode})") from e
-        if kind == "error":
-            raise SensingError(f"sensing worker failed:\n{payload}")
-        return payload
 
 
 def serve(conn: Connection, spec: WorldSpec, setup: SensorSetup, slots_file: Path) -> None:

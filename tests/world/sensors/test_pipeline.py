@@ -16,7 +16,13 @@ from world.core.rates import CONTROL_RATE, FRAME_LATENCY, PHYSICS_RATE
 from world.frames import CameraFrame, GnssFix, LidarScan, Odometry
 from world.sensors.frame_slots import SLOTS, shared_dir
 from world.sensors.lidar import LidarTruth
-from world.sensors.pipeline import Capture, InlineSensing, ProcessSensing, SensingError
+from world.sensors.pipeline import (
+    Capture,
+    InlineSensing,
+    ProcessSensing,
+    SensingError,
+    SensingWorker,
+)
 from world.sensors.schedule import SensorSchedule
 from world.sensors.setup import Profile, sensor_setup, sensor_timings
 from world.world import World
@@ -186,16 +192,19 @@ def test_frames_survive_more_requests_in_flight_than_image_slots() -> None:
                    for f, g in itertools.pairwise(images))
 
 
-def test_the_image_slot_file_is_gone_once_both_processes_mapped_it() -> None:
-    """Nothing is left in shared memory, whatever happens to the processes later."""
+def test_a_worker_started_first_serves_its_world_and_leaves_no_file() -> None:
+    """A `SensingWorker` starts before the world is built; its image slot file is gone once
+    both processes have mapped it, so nothing is left in shared memory whatever happens."""
     setup = sensor_setup(Profile.FAST)
-    world = World(load_scenario("normal_driving").world, setup, cameras=False, lidar=False)
-    sensing = ProcessSensing(world, setup)
+    spec = load_scenario("normal_driving").world
+    worker = SensingWorker(spec, setup)
+    path = worker.slots.path
+    assert path.parent == shared_dir() and path.name.startswith("avsim-frames-")
+    assert path.exists()  # until the worker says it is ready
+    world = World(spec, setup, cameras=False, lidar=False)
+    sensing = ProcessSensing(world, setup, worker=worker)
     try:
-        path = sensing._slots.path
-        assert path.parent == shared_dir() and path.name.startswith("avsim-frames-")
         assert not path.exists()
-        # and the images still pass: one front frame, captured and delivered
         due = next(d for d in SensorSchedule(sensor_timings(setup), CONTROL_RATE).due(0)
                    if "front" in d.sensors)
         sensing.submit(replace(due, sensors=("front",)))
@@ -203,6 +212,12 @@ def test_the_image_slot_file_is_gone_once_both_processes_mapped_it() -> None:
         frame = capture.readings[0].frame
         assert isinstance(frame, CameraFrame) and frame.rgb.shape == (480, 640, 3)
         assert frame.rgb.std() > 10.0  # a picture, not an empty slot
+        other = World(load_scenario("traffic_jam").world, setup, cameras=False, lidar=False)
+        try:  # the worker mirrors another scenario's world: refused
+            with pytest.raises(ValueError, match="another world"):
+                ProcessSensing(other, setup, worker=worker)
+        finally:
+            other.close()
     finally:
         sensing.close()
         world.close()
