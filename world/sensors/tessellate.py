@@ -19,7 +19,6 @@ import math
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.spatial import ConvexHull as Qhull
 
 from world.scene.collision import Box, ConvexHull, Cylinder, Part, Shape, TriangleMesh
 
@@ -44,6 +43,10 @@ def shape_triangles(shape: Shape) -> Triangles:
     if isinstance(shape, Cylinder):
         return cylinder_triangles(shape.radius, shape.height, CYLINDER_SIDES)
     if isinstance(shape, ConvexHull):
+        # imported here: scipy.spatial takes 0.65 s to import, and the sensing worker (no
+        # LiDAR) and most scenes (no hulls) never need it
+        from scipy.spatial import ConvexHull as Qhull
+
         points = np.asarray(shape.points, dtype=np.float64)
         return points, np.asarray(Qhull(points).simplices, dtype=np.int64)
     if isinstance(shape, TriangleMesh):
