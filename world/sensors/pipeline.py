@@ -128,6 +128,19 @@ class _Pending:
     received: tuple[Reading, ...] | None = None
 
 
+LIGHT_RENDERING = 10e6  # [px/s] below this the worker renders on one llvmpipe thread
+
+
+def render_threads(setup: SensorSetup) -> int:
+    """llvmpipe threads for the worker (0: Mesa's choice, every core). Where its cameras are
+    light (`fast`, `default`: 3-4 Mpx/s) the main process is the bottleneck, and a second
+    render thread only takes its core: one thread made `default` 6 % faster (three
+    interleaved pairs). Where they are heavy (`paper`: 37 Mpx/s) the worker is the
+    bottleneck, and two threads were 2-3 % faster (five pairs of six)."""
+    pixels = sum(c.width * c.height * setup.timing(c.name).rate.hz for c in setup.cameras)
+    return 1 if pixels < LIGHT_RENDERING else 0
+
+
 class SensingWorker:
     """The worker process of a `ProcessSensing`, started on its own: it builds its mirror of
     the scenario's world while the main process builds the simulated one (about 2 s and 1 s
@@ -141,7 +154,8 @@ class SensingWorker:
         ctx = mp.get_context("spawn")  # a fresh interpreter: no inherited physics or GL state
         self._conn, child = ctx.Pipe()
         self._proc = ctx.Process(target=sensing_worker.main,
-                                 args=(child, spec, setup, self.slots.path),
+                                 args=(child, spec, setup, self.slots.path,
+                                       render_threads(setup)),
                                  name="avsim-sensing", daemon=True)
         self._proc.start()
         child.close()

@@ -22,6 +22,7 @@ from world.sensors.pipeline import (
     ProcessSensing,
     SensingError,
     SensingWorker,
+    render_threads,
 )
 from world.sensors.schedule import SensorSchedule
 from world.sensors.setup import Profile, sensor_setup, sensor_timings
@@ -221,3 +222,11 @@ def test_a_worker_started_first_serves_its_world_and_leaves_no_file() -> None:
     finally:
         sensing.close()
         world.close()
+
+
+@pytest.mark.parametrize(("profile", "threads"), [
+    (Profile.FAST, 1), (Profile.DEFAULT, 1), (Profile.PAPER, 0)])
+def test_light_cameras_render_on_one_thread(profile: Profile, threads: int) -> None:
+    """The worker renders on one llvmpipe thread where the main process is the bottleneck
+    (640x480 front), on every core where the worker is (three 1280x960 cameras)."""
+    assert render_threads(sensor_setup(profile)) == threads
