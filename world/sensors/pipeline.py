@@ -191,14 +191,15 @@ class SensingWorker:
         """Take the `unanswered` answers still due off the pipe, stop the worker, drop the
         slots."""
         if self._proc.is_alive():
-            try:
-                if self._renderer is None:
-                    self.renderer  # noqa: B018 (its "ready" comes first)
-                for _ in range(unanswered):
-                    self.receive()
-                self._conn.send(("close",))
-            except (OSError, EOFError, SensingError):
-                pass
+            if self._renderer is None:  # never asked for anything (still building its
+                self._proc.kill()  # world, perhaps): nothing of it to wait for
+            else:
+                try:
+                    for _ in range(unanswered):
+                        self.receive()
+                    self._conn.send(("close",))
+                except (OSError, EOFError, SensingError):
+                    pass
             self._proc.join(timeout=10)
             if self._proc.is_alive():
                 self._proc.kill()
