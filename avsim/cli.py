@@ -19,7 +19,7 @@ from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.table import Table
 
 from avsim.files import write_atomic
-from avsim.run.result import result_json
+from avsim.run.result import dumps, result_json
 from avsim.scenario.load import ScenarioError, bundled_scenarios, load_scenario
 from avsim.scenario.schema import scenario_json_schema
 
@@ -100,7 +100,7 @@ def run(scenario: str, out: Path | None, json_path: Path | None, profile: str, s
     result = _run_with_progress(runner, loaded.duration, not no_progress)
     partial.replace(out)
     payload = result_json(result, scenario, out, profile)
-    write_atomic(json_path, json.dumps(payload, indent=2) + "\n")
+    write_atomic(json_path, dumps(payload))
     if plot_path is not None:
         from avsim.report.speed_plot import plot_speed_profile
 
@@ -130,8 +130,11 @@ def _print_verdict(payload: dict[str, object]) -> None:
     criteria = payload["criteria"]
     assert isinstance(criteria, list)
     for c in criteria:
-        table.add_row(c["name"], "pass" if c["passed"] else "[red]FAIL[/red]",
-                      f"{c['value']:.3f}", f"{c['threshold']}", c["unit"])
+        verdict = ("n/a" if c["passed"] is None else "pass" if c["passed"]
+                   else "[red]FAIL[/red]")
+        value = "-" if c["value"] is None else f"{c['value']:.3f}"
+        threshold = "-" if c["threshold"] is None else f"{c['threshold']}"
+        table.add_row(c["name"], verdict, value, threshold, c["unit"])
     console.print(table)
     renderer = f", cameras by {payload['renderer']}" if payload.get("renderer") else ""
     console.print(f"sim {payload['sim_time']:.1f} s in {payload['wall_time']:.1f} s wall "

@@ -18,3 +18,4 @@ class VehicleCommand:
     drive_torque: float  # [N m] total at the driven wheels, >= 0
     brake_torque: float  # [N m] total over all wheels, >= 0
     accel_request: float  # [m/s^2] longitudinal acceleration behind the torques (for logging)
+    hazard_lights: bool = False  # the hazard lights flash

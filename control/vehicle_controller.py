@@ -22,7 +22,7 @@ from control.actuation import VehicleParams, wheel_torques
 from control.command import VehicleCommand
 from control.longitudinal import SpeedController, SpeedParams
 from control.stanley import FrontAxleError, StanleyParams, StanleyPid, front_axle_error
-from planner.messages import ControlState, Plan, ReferencePath
+from planner.messages import ControlState, HazardLights, Plan, ReferencePath
 
 __all__ = ["VehicleController", "VehicleControllerParams"]
 
@@ -92,4 +92,5 @@ class VehicleController:
             drive_torque=torques.drive,
             brake_torque=torques.brake,
             accel_request=speed_cmd.accel,
+            hazard_lights=plan.hazard is HazardLights.ON,
         )

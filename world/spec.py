@@ -198,6 +198,7 @@ class ActionSpec:
 
     trigger: Trigger
     action: Action
+    optional: bool = False  # the run may end without it having fired
 
 
 class ActorType(enum.Enum):
@@ -245,6 +246,7 @@ class EventSpec:
 
     trigger: Trigger
     event: EgoEvent
+    optional: bool = False  # the run may end without it having fired
 
 
 # ---------------------------------------------------------------------------------------

@@ -8,7 +8,9 @@ behind, tyres `track / 2` each side.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
@@ -16,7 +18,11 @@ from pybullet_utils.bullet_client import BulletClient
 
 from vehicle_urdf import CarGeometry
 from world.ego.body import EgoTruth
-from world.hdmap import ReferenceLine
+from world.hdmap import ReferenceLine, RoadMap
+from world.spec import ActorType
+
+if TYPE_CHECKING:
+    from world.actors.actor_set import ActorPoses
 
 
 def body_axes(truth: EgoTruth) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -82,3 +88,55 @@ def route_truth(truth: EgoTruth, g: CarGeometry, line: ReferenceLine) -> RouteTr
 def touching(client: BulletClient, body: int, ignore: int) -> set[int]:
     """Bodies in contact with `body` now, other than `ignore` (the ground)."""
     return {int(c[2]) for c in client.getContactPoints(bodyA=body) if c[2] != ignore}
+
+
+VEHICLES = frozenset({ActorType.CAR, ActorType.TRUCK})  # the actor kinds that can be ahead
+ALONG = math.cos(math.radians(45.0))  # a vehicle heading within 45 deg of its lane's
+#   direction travels along it (crossing or oncoming traffic does not)
+
+
+@dataclass(frozen=True, slots=True)
+class VehicleAhead:
+    """A vehicle ahead of the ego in its lane (`vehicles_ahead`)."""
+
+    id: str  # the actor's id
+    index: int  # its index in the poses
+    gap: float  # [m] bumper to bumper along the route
+    speed: float  # [m/s] along its lane
+    accel: float  # [m/s^2] rate of change of its speed, signed
+
+
+def ego_lane_edges(road: RoadMap, station: float, offset: float) -> tuple[float, float]:
+    """([m] right, [m] left) offsets from the reference line of the edges of the lane the
+    ego's centre (at `station`, `offset`) is in: the band of lane width that holds it, of
+    the route's lanes as they lie at that station."""
+    c0 = float(road.lane(0).offset_at(station))
+    w = float(road.lane(0).width_at(station))
+    band = math.floor((offset - c0 + 0.5 * w) / w)
+    return c0 + (band - 0.5) * w, c0 + (band + 0.5) * w
+
+
+def vehicles_ahead(road: RoadMap, poses: ActorPoses, station: float, offset: float,
+                   ego_length: float) -> tuple[VehicleAhead, ...]:
+    """The vehicles (cars, trucks) ahead of the ego in its lane, nearest first, from the
+    truth and the map: their footprint (the box, turned by its heading relative to the
+    route) overlaps, across, the lane the ego's centre is in (`ego_lane_edges`), their
+    centre is ahead of the ego's along its route, and they travel along the lane (heading
+    within 45 deg of it). In a town as on a road, every actor's station and offset are on
+    the ego's route (`ActorPoses`). The gap is the stations' difference less the ego's half
+    length and the vehicle's half extent along the route."""
+    if not len(poses.ids):
+        return ()
+    lo, hi = ego_lane_edges(road, station, offset)
+    rel = poses.yaws - np.asarray(road.heading_at(poses.stations))
+    cos, sin = np.abs(np.cos(rel)), np.abs(np.sin(rel))
+    half_l, half_w = poses.half_sizes[:, 0], poses.half_sizes[:, 1]
+    across = half_w * cos + half_l * sin  # [m] the footprint's half extent across
+    along = half_l * cos + half_w * sin
+    candidates = ((poses.offsets + across > lo) & (poses.offsets - across < hi)
+                  & (poses.stations > station) & (np.cos(rel) > ALONG))
+    gaps = poses.stations - station - along - 0.5 * ego_length
+    out = [VehicleAhead(poses.ids[i], int(i), float(gaps[i]), float(poses.speeds[i]),
+                        float(poses.accels[i]))
+           for i in np.flatnonzero(candidates) if poses.kinds[i] in VEHICLES]
+    return tuple(sorted(out, key=lambda v: v.gap))

@@ -141,6 +141,8 @@ class World:
         self._route: RouteTruth | None = None
         self.ego_s = self.ego_route.station
         self.started_actions: list[tuple[str, int]] = []  # (actor id, action) at the last check
+        self.action_fired_at: dict[tuple[str, int], float] = {}  # [s] (actor id, action) ->
+        #   when it fired
 
     # -- building ----------------------------------------------------------------------------
 
@@ -436,6 +438,8 @@ class World:
             self.started_actions = self.actors.fire_triggers(
                 self.clock.t, self.ego_s, self.ego.geometry.body_length
             )
+            for started in self.started_actions:
+                self.action_fired_at.setdefault(started, self.clock.t)
             self._events.update(self.clock.t, self.ego_s)
             for wheel in self._events.started_flats:
                 self.ego.puncture(wheel.value, self.clock.t)

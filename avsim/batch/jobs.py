@@ -9,7 +9,6 @@ outcome. A job never raises: bad input and crashes come back as outcomes with a 
 
 from __future__ import annotations
 
-import json
 import math
 import time
 import traceback
@@ -116,7 +115,7 @@ class RunOutcome:
     def first_failure(self) -> float | None:
         """[s] the earliest time a criterion failed, if one did and said when."""
         times = [float(t) for c in self.criteria()
-                 if not c["passed"] and isinstance(t := c.get("first_failure"), (int, float))]
+                 if c["passed"] is False and isinstance(t := c.get("first_failure"), (int, float))]
         return min(times) if times else None
 
     def failure_time(self) -> float | None:
@@ -162,7 +161,7 @@ def _simulate(job: RunJob, scenario: Scenario, into: Path,
 
     with quiet_c_output():  # PyBullet's build banner
         from avsim.report.speed_plot import plot_speed_profile
-        from avsim.run.result import result_json
+        from avsim.run.result import dumps, result_json
         from avsim.run.runner import Runner
         from world.sensors.setup import Profile
 
@@ -173,7 +172,7 @@ def _simulate(job: RunJob, scenario: Scenario, into: Path,
     result = Runner(scenario, partial, profile, job.sensing).run(progress)
     partial.replace(recording)
     payload = result_json(result, job.scenario, job.recording, job.profile)
-    write_atomic(into / job.result_file.name, json.dumps(payload, indent=2) + "\n")
+    write_atomic(into / job.result_file.name, dumps(payload))
     if job.plot:
         plot_speed_profile(result, into / job.plot_file.name)
     return payload

@@ -12,7 +12,6 @@
 
 from __future__ import annotations
 
-import json
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -25,6 +24,7 @@ from rich.progress import Progress as RichProgress
 from avsim.batch.executors import Executor, Progress
 from avsim.batch.jobs import RunJob, RunOutcome, Status
 from avsim.files import write_atomic
+from avsim.run.result import dumps
 from avsim.scenario.load import bundled_scenarios, load_scenario
 
 SNAPSHOT_DIR = "snapshots"  # the failed runs' pictures, below the batch's folder
@@ -178,7 +178,7 @@ def write_reports(outcomes: Sequence[RunOutcome], out_dir: Path, title: str,
     write_atomic(out_dir / "junit.xml", junit_xml(outcomes, title))
     write_atomic(out_dir / "summary.md",
                  summary_markdown(outcomes, title=title, out_dir=out_dir, snapshots=snapshots))
-    write_atomic(out_dir / "results.json", json.dumps(results_json(outcomes), indent=2) + "\n")
+    write_atomic(out_dir / "results.json", dumps(results_json(outcomes)))
 
 
 def results_json(outcomes: Sequence[RunOutcome]) -> list[dict[str, object]]:

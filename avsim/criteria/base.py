@@ -27,6 +27,8 @@ if TYPE_CHECKING:
 
 SPEED_TOLERANCE_KPH = 1.0  # [km/h] the speed_limit rule's tolerance
 DECEL_WINDOW = 0.2  # [s] moving average of the max_decel criterion
+MAX_LANE_CHANGE = 8.0  # [s] a lane change's bound for `tyres_in_lane` when the scenario
+#   sets no `lane_change` (then its `max_duration`)
 
 
 class Need(enum.Enum):
@@ -41,6 +43,8 @@ class Need(enum.Enum):
     SET_SPEED = "set_speed"  # [m/s] the driver's set speed
     BODIES = "bodies"  # what each body the ego may touch is (body id -> name)
     ACTORS = "actors"  # the NPCs' true poses in every sample (costly: only when needed)
+    LANE_CHANGE = "lane_change_max"  # [s] how long a lane change may take
+    STORY = "story"  # the scenario's required actions and events (`story_label`s)
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -58,12 +62,12 @@ class TruthSample:
     offset: float = 0.0  # [m] ego centre offset from the reference line, left +
     actors: ActorPoses | None = None  # every NPC now; None unless a criterion needs them
     #   (`Need.ACTORS`)
-    lane: int = 0  # the lane the stack keeps, or moves into (its plan's command)
-    origin_lane: int = 0  # the lane a commanded lane change leaves (== lane otherwise)
-    turning: bool = False  # the stack's motion FSM is in a commanded turn (a town junction)
     lateral_accel: float = 0.0  # [m/s^2] speed * yaw rate, left +
     road_curvature: float = 0.0  # [1/m] the route's curvature at the ego's station
     flat: bool = False  # a flat tyre event has happened to the ego
+    hazard_lights: bool = False  # the ego's hazard lights are flashing (its lamps' state)
+    fired: frozenset[str] = frozenset()  # the scripted actions and events fired so far
+    #   (`avsim.criteria.story.story_label`)
     rear_station: float | None = None  # [m] rear bumper station; None: as far behind the
     #   centre as the front bumper is ahead of it (the body is centred on the car's centre)
     axle_stations: tuple[float, float] | None = None  # [m] (front, rear) axle stations;
@@ -87,23 +91,64 @@ class Infraction:
                 "where": where}
 
 
+class Verdict(enum.Enum):
+    """A criterion's verdict. `NOT_APPLICABLE`: its situation never happened in the run (no
+    stop line on the route, no pedestrian on a crosswalk); it neither passes nor fails the
+    run. A criterion the scenario asked for by name fails instead (its note says what never
+    happened)."""
+
+    PASS = "pass"
+    FAIL = "fail"
+    NOT_APPLICABLE = "not_applicable"
+
+
 @dataclass(frozen=True, slots=True)
 class CriterionResult:
-    """A criterion's verdict: its measured value against its threshold, in `unit`."""
+    """A criterion's verdict: its measured value against its threshold, in `unit`.
+
+    `passed` is None when the criterion is not applicable (its value is then None too, and
+    `note` says what never happened). Values and thresholds are finite or None: a run's
+    result is strict JSON."""
 
     name: str  # the criterion's name
-    passed: bool
-    value: float  # [unit] the measured value the verdict rests on
-    threshold: float  # [unit]
+    passed: bool | None  # None: not applicable
+    value: float | None  # [unit] the measured value the verdict rests on; None: none
+    threshold: float | None  # [unit]; None: none (a limit that depends on what was met)
     unit: str  # the unit of value and threshold
     first_failure: float | None = None  # [s] sim time it first failed, if it did
-    note: str | None = None  # why it failed when the value does not say (nothing happened)
+    note: str | None = None  # why it failed when the value does not say, or what never
+    #   happened (not applicable)
+
+    def __post_init__(self) -> None:
+        for what, x in (("value", self.value), ("threshold", self.threshold)):
+            if x is not None and not math.isfinite(x):
+                raise ValueError(f"criterion {self.name}: {what} {x} is not finite")
+        if self.passed is None and (self.value is not None or self.note is None):
+            raise ValueError(f"criterion {self.name}: not applicable needs no value and a note")
+
+    @classmethod
+    def not_applicable(cls, name: str, threshold: float | None, unit: str,
+                       note: str) -> CriterionResult:
+        """The result of a criterion whose situation never happened: `note` says what."""
+        return cls(name, None, None, threshold, unit, None, note)
+
+    @property
+    def verdict(self) -> Verdict:
+        if self.passed is None:
+            return Verdict.NOT_APPLICABLE
+        return Verdict.PASS if self.passed else Verdict.FAIL
+
+    @property
+    def failed(self) -> bool:
+        """It failed (a criterion not applicable did not)."""
+        return self.passed is False
 
     def as_json(self) -> dict[str, object]:
         """As the result file has it: values rounded, optional keys only when set."""
         out: dict[str, object] = {
-            "name": self.name, "passed": self.passed, "value": _round(self.value),
-            "threshold": _round(self.threshold), "unit": self.unit,
+            "name": self.name, "verdict": self.verdict.value, "passed": self.passed,
+            "value": _round(self.value), "threshold": _round(self.threshold),
+            "unit": self.unit,
         }
         if self.first_failure is not None:
             out["first_failure"] = round(self.first_failure, 3)
@@ -112,9 +157,9 @@ class CriterionResult:
         return out
 
 
-def _round(x: float) -> float:
-    """x to 4 decimals; infinities and NaN as they are."""
-    return round(x, 4) if math.isfinite(x) else x
+def _round(x: float | None) -> float | None:
+    """x to 4 decimals (no -0.0); None as it is."""
+    return None if x is None else round(x, 4) + 0.0
 
 
 class Criterion:
@@ -143,16 +188,16 @@ class Criterion:
         new, self._new = self._new, []
         return new
 
-    def _fail(self, sample: TruthSample, message: str) -> None:
-        """It fails now; its first failure is an infraction, later ones (the same
-        condition going on, or again) are not."""
+    def _fail(self, sample: TruthSample, message: str, at: float | None = None) -> None:
+        """It fails now (`at`: it is known now that it failed then, [s]); its first failure
+        is an infraction, later ones (the same condition going on, or again) are not."""
         if self.first_failure is None:
-            self._infraction(sample, message)
+            self._infraction(sample, message, at)
 
-    def _infraction(self, sample: TruthSample, message: str) -> None:
+    def _infraction(self, sample: TruthSample, message: str, at: float | None = None) -> None:
         """An infraction now (it fails too): for an event that breaks the rule each time."""
         if self.first_failure is None:
-            self.first_failure = sample.t
+            self.first_failure = sample.t if at is None else at
         self._new.append(Infraction(sample.t, self.name, message, sample.xy))
 
 
@@ -185,5 +230,5 @@ class CriteriaSet:
 
     @property
     def passed(self) -> bool:
-        """The run's verdict: every criterion passed."""
-        return all(r.passed for r in self.results())
+        """The run's verdict: no criterion failed (one not applicable does not fail it)."""
+        return not any(r.failed for r in self.results())

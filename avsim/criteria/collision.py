@@ -37,7 +37,7 @@ class NoCollision(Criterion):
     def result(self) -> CriterionResult:
         note = "; ".join(f"{what} at {t:.2f} s" for t, what in self._contacts[:5])
         return CriterionResult(self.name, self.count == 0, self.count, 0, self.unit,
-                               self.first_failure, note=note)
+                               self.first_failure, note=note or None)
 
 
 NO_COLLISION: Declaration[None] = Declaration(

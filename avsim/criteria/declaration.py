@@ -19,7 +19,7 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any, Generic, TypeVar
 
-from avsim.criteria.base import Criterion, Need
+from avsim.criteria.base import MAX_LANE_CHANGE, Criterion, Need
 from vehicle_urdf import CarGeometry
 from world.hdmap import RoadMap
 from world.spec import TrafficLightSpec
@@ -39,6 +39,10 @@ class RunInputs:
     signals: tuple[TrafficLightSpec, ...]  # the route's signal plans (ground truth)
     set_speed: float  # [m/s] the driver's set speed
     bodies: Mapping[int, str]  # body id -> what it is, for each body the ego may touch
+    lane_change_max: float = MAX_LANE_CHANGE  # [s] how long a lane change may take (the
+    #   scenario's `lane_change.max_duration`)
+    story: tuple[str, ...] = ()  # the actions and events that must fire
+    #   (`avsim.criteria.story.story_label`)
 
 
 @dataclass(frozen=True, slots=True)
@@ -60,10 +64,14 @@ class Declaration(Generic[S]):
     doc: str = ""  # the setting's description: unit, bounds, default
     example: object = None  # a valid setting as a file writes it (the JSON Schema's example)
     on_route: bool = False  # the setting is a station [m] that must lie on the ego's route
+    switch: str | None = None  # a key whose `false` turns these always-on criteria off
+    #   (`completes: false`); None: they cannot be turned off
 
     def __post_init__(self) -> None:
         if self.key is None and not (self.always and self.setting is None):
             raise ValueError("a declaration without a key always applies and has no setting")
+        if self.switch is not None and not self.always:
+            raise ValueError(f"criteria switch {self.switch!r}: only always-on criteria")
         if self.key is not None and (self.setting is None or not self.doc
                                      or self.example is None):
             raise ValueError(f"criteria key {self.key!r} needs a setting type, a doc and an "

@@ -8,7 +8,6 @@ from __future__ import annotations
 import math
 from typing import Annotated, Any, Literal
 
-import numpy as np
 from pydantic import AfterValidator, BeforeValidator, Field
 
 from avsim.criteria.base import (
@@ -23,6 +22,7 @@ from avsim.scenario.fields import NonNegFloat, PosFloat, problem
 from planner.fsm.acc import r157_min_gap
 from world.frames import kph
 from world.hdmap import RoadMap
+from world.truth import VehicleAhead, vehicles_ahead
 
 R157 = "r157"  # the min_gap setting for UN R157's d_min(v)
 
@@ -48,22 +48,24 @@ class MinGap(Criterion):
         self.entered: dict[str, float] = {}  # actor id -> [s] when it entered the lane ahead
         self._started = False  # a sample has been seen (vehicles ahead then: no cut-in)
         self.margin = math.inf  # [m] the least gap - threshold so far
-        self.gap = math.inf  # [m] at the least margin
-        self.threshold = math.nan if self.fixed is None else self.fixed  # [m] at the least
-        #   margin (r157: NaN until a gap is checked)
+        self.gap: float | None = None  # [m] at the least margin; None: no gap checked
+        self.threshold = self.fixed  # [m] at the least margin (r157: None until a gap is
+        #   checked)
 
     def update(self, sample: TruthSample) -> None:
-        ahead = vehicles_ahead(sample, self.road, self.ego_length)
+        ahead = ahead_of(sample, self.road, self.ego_length)
+        names = {v.id for v in ahead}
         for name in list(self.entered):
-            if name not in ahead:
+            if name not in names:
                 del self.entered[name]
-        for name in ahead:  # a vehicle ahead from the start has not cut in: no grace
+        for name in names:  # a vehicle ahead from the start has not cut in: no grace
             self.entered.setdefault(name, sample.t if self._started else -math.inf)
         self._started = True
         if not ahead or sample.speed <= self.MIN_SPEED:
             return
-        name, gap, accel = min(ahead.values(), key=lambda a: a[1])
-        if sample.t - self.entered[name] < self.grace or accel < -self.HARD_BRAKE:
+        lead = ahead[0]
+        name, gap = lead.id, lead.gap
+        if sample.t - self.entered[name] < self.grace or lead.accel < -self.HARD_BRAKE:
             return
         d_min = self.fixed if self.fixed is not None else r157_min_gap(sample.speed)
         if gap - d_min < self.margin:
@@ -72,30 +74,21 @@ class MinGap(Criterion):
             self._fail(sample, f"gap {gap:.1f} m to {name} under {d_min:.1f} m")
 
     def result(self) -> CriterionResult:
+        if self.gap is None:  # asked for by name: it fails
+            return CriterionResult(self.name, False, None, self.threshold, self.unit, None,
+                                   "no vehicle ahead in the ego's lane was ever judged (the "
+                                   "ego faster than 2 m/s, no cut-in grace)")
         return CriterionResult(self.name, self.first_failure is None, self.gap,
                                self.threshold, self.unit, self.first_failure)
 
 
-def vehicles_ahead(sample: TruthSample, road: RoadMap,
-                   ego_length: float) -> dict[str, tuple[str, float, float]]:
-    """Actor id -> (id, bumper gap [m], acceleration [m/s^2]) of the vehicles whose centre
-    is in the ego's lane band (half lane 0's width either side of the ego's centre offset)
-    and ahead of the ego's centre station; the gap is the stations' difference less both
-    half lengths."""
-    a = sample.actors
-    if a is None or not len(a.ids):
-        return {}
-    width = float(road.lane(0).width_at(sample.station))
-    lateral = np.abs(a.offsets - sample.offset) < 0.5 * width
-    gap = a.stations - sample.station - (2.0 * a.half_sizes[:, 0] + ego_length) / 2
-    out = {}
-    for i in np.flatnonzero(lateral & (a.stations > sample.station)):
-        if a.kinds[i].value in VEHICLES:
-            out[a.ids[i]] = (a.ids[i], float(gap[i]), float(a.accels[i]))
-    return out
-
-
-VEHICLES = frozenset({"car", "truck"})  # the actor kinds that count as vehicles ahead
+def ahead_of(sample: TruthSample, road: RoadMap,
+             ego_length: float) -> tuple[VehicleAhead, ...]:
+    """The vehicles ahead of the ego in its lane at `sample`, nearest first
+    (`world.truth.vehicles_ahead`: from the truth and the map)."""
+    if sample.actors is None:
+        return ()
+    return vehicles_ahead(road, sample.actors, sample.station, sample.offset, ego_length)
 
 
 class StandstillGap(Criterion):
@@ -117,8 +110,8 @@ class StandstillGap(Criterion):
             self._since = None
             return
         self._since = sample.t if self._since is None else self._since
-        ahead = vehicles_ahead(sample, self.road, self.ego_length)
-        gap = min((g for _, g, _ in ahead.values()), default=math.inf)
+        ahead = ahead_of(sample, self.road, self.ego_length)
+        gap = ahead[0].gap if ahead else math.inf
         if sample.t - self._since < self.HOLD or gap > self.REACH:
             return
         self.gaps.append(gap)
@@ -128,7 +121,7 @@ class StandstillGap(Criterion):
 
     def result(self) -> CriterionResult:
         if not self.gaps:
-            return CriterionResult(self.name, False, 0.0, self.low, self.unit, None,
+            return CriterionResult(self.name, False, None, self.low, self.unit, None,
                                    "the ego never stood behind a vehicle")
         mid = 0.5 * (self.low + self.high)
         worst = max(self.gaps, key=lambda g: abs(g - mid))
@@ -164,11 +157,9 @@ class TimeToResume(Criterion):
         self._t = sample.t
         want = min(self.set_speed, float(self.road.speed_limit_at(sample.front_station)))
         slow = sample.speed < want - kph(SPEED_TOLERANCE_KPH)
-        a = sample.actors
         reach = 3.0 * want + 10.0
-        blocking = a is not None and any(
-            g <= reach and a.speeds[a.ids.index(name)] < want - kph(SPEED_TOLERANCE_KPH)
-            for name, g, _ in vehicles_ahead(sample, self.road, self.ego_length).values())
+        blocking = any(v.gap <= reach and v.speed < want - kph(SPEED_TOLERANCE_KPH)
+                       for v in ahead_of(sample, self.road, self.ego_length))
         if self._clear_at is not None and (not slow or blocking):
             self._close(sample)
         if self._clear_at is None and slow and not blocking and self._was_blocked:
@@ -188,7 +179,7 @@ class TimeToResume(Criterion):
     def result(self) -> CriterionResult:
         waits = self.waits + ([self._t - self._clear_at] if self._clear_at is not None else [])
         if not waits:
-            return CriterionResult(self.name, False, 0.0, self.threshold, self.unit, None,
+            return CriterionResult(self.name, False, None, self.threshold, self.unit, None,
                                    "the lane ahead never cleared with the ego slowed")
         value = max(waits)
         return CriterionResult(self.name, value <= self.threshold, value, self.threshold,

@@ -24,8 +24,9 @@ from avsim.criteria.following import MIN_GAP, RESUME_WITHIN, STANDSTILL_GAP
 from avsim.criteria.jerk import MAX_JERK
 from avsim.criteria.lane import LANE_CHANGE, TYRES_IN_LANE
 from avsim.criteria.road_rules import CROSSWALKS, RED_LIGHTS, SPEED_BUMPS, STOP_SIGNS
-from avsim.criteria.route import COMPLETES
+from avsim.criteria.route import COMPLETES, MINIMUM_RISK_STOP
 from avsim.criteria.speed import MAX_DECEL, SPEED_LIMIT
+from avsim.criteria.story import STORY
 
 DECLARATIONS: tuple[Declaration[Any], ...] = (
     # always
@@ -36,7 +37,9 @@ DECLARATIONS: tuple[Declaration[Any], ...] = (
     RED_LIGHTS,
     CROSSWALKS,
     SPEED_BUMPS,
-    COMPLETES,  # `reach_s`
+    COMPLETES,  # `reach_s`; `completes: false` turns it off
+    MINIMUM_RISK_STOP,
+    STORY,
     # when the scenario sets their key
     MAX_DECEL,  # `max_decel`
     MIN_GAP,  # `min_gap`
@@ -75,15 +78,30 @@ def keyed() -> tuple[Declaration[Any], ...]:
     return tuple(d for d in DECLARATIONS if d.key is not None)
 
 
+def switches() -> tuple[Declaration[Any], ...]:
+    """The declarations of always-on criteria a scenario can turn off (`completes: false`),
+    in registry order."""
+    return tuple(d for d in DECLARATIONS if d.switch is not None)
+
+
+def setting_keys() -> tuple[str, ...]:
+    """Every key a scenario's `criteria:` section may set: the declarations' keys, then
+    their switches."""
+    return (tuple(str(d.key) for d in keyed())
+            + tuple(str(d.switch) for d in switches()))
+
+
 def build_criteria(settings: CriteriaSettings, run: RunInputs) -> CriteriaSet:
     """The run's criteria, in registry order, and what their samples must carry: the needs
     of their declarations, but not those of a criterion this run leaves idle."""
-    unknown = set(settings.keys()) - {d.key for d in keyed()}
+    unknown = set(settings.keys()) - set(setting_keys())
     if unknown:
         raise ValueError(f"no criteria declare the keys {sorted(unknown)}")
     items: list[Criterion] = []
     needs: set[Need] = set()
     for d in DECLARATIONS:
+        if d.switch is not None and settings.get(d.switch) is False:
+            continue
         setting = None if d.key is None else settings.get(d.key)
         if setting is None and not d.always:
             continue

@@ -31,8 +31,8 @@ class StopSigns(Criterion):
     unbroken standstill in that zone before the bumper went over (0 if none). A line is
     judged once the bumper has gone over it or stood for `HOLD`; a line the run ends before
     (neither) is not, nor one the bumper was already over at the first sample. An
-    infraction at each line the bumper goes over without the stop. No line judged (none on
-    the map): value 0, passed."""
+    infraction at each line the bumper goes over without the stop. No line judged: not
+    applicable."""
 
     name, unit = "stop_signs", "s"
     STOPPED, HOLD, ZONE = 0.1, 1.0, 4.0  # [m/s], [s], [m]
@@ -69,7 +69,11 @@ class StopSigns(Criterion):
 
     def result(self) -> CriterionResult:
         judged = [d for d, j in zip(self.longest, self.judged, strict=True) if j]
-        return CriterionResult(self.name, self.first_failure is None, min(judged, default=0.0),
+        if not judged:
+            return CriterionResult.not_applicable(
+                self.name, self.HOLD, self.unit, "the ego met no stop line" if self.lines
+                else "no stop line on the route")
+        return CriterionResult(self.name, self.first_failure is None, min(judged),
                                self.HOLD, self.unit, self.first_failure)
 
 
@@ -79,8 +83,8 @@ class RedLights(Criterion):
 
     Value: the least margin [s] to red over the lines crossed: at each crossing, the time
     left until the light turns red, or minus the time it has been red (fails). No line
-    crossed: value +inf, passed. The lights' signal plans are the world's (the truth), not
-    the stack's map, which has none."""
+    crossed: not applicable. The lights' signal plans are the world's (the truth), not the
+    stack's map, which has none."""
 
     name, unit = "red_lights", "s"
 
@@ -104,6 +108,10 @@ class RedLights(Criterion):
                                              f"{-margin:.1f} s into red")
 
     def result(self) -> CriterionResult:
+        if math.isinf(self.margin):
+            return CriterionResult.not_applicable(
+                self.name, 0.0, self.unit, "the ego crossed no traffic light's stop line"
+                if self.lights else "no traffic light on the route")
         return CriterionResult(self.name, self.first_failure is None, self.margin, 0.0,
                                self.unit, self.first_failure)
 
@@ -127,8 +135,8 @@ class Crosswalks(Criterion):
     (within the paved road): the lanes (of the ego's direction) its tyres are in, at the
     crosswalk's station. Value: the
     deepest overlap [m] of the ego's stations with a crosswalk while a pedestrian was on it
-    in the ego's lane (negative: the ego stayed that far off it); 0 if that never happened
-    (or the map has no crosswalk)."""
+    in the ego's lane (negative: the ego stayed that far off it). Not applicable when no
+    pedestrian was ever on a crosswalk in the ego's lane."""
 
     name, unit = "crosswalks", "m"
     LANE_MARGIN = 1.0  # [m] the ego's lane band widened by this each side
@@ -176,9 +184,12 @@ class Crosswalks(Criterion):
         return float(lo) - 0.5 * w, float(hi) + 0.5 * w
 
     def result(self) -> CriterionResult:
-        value = 0.0 if self.worst is None else self.worst
-        return CriterionResult(self.name, self.first_failure is None, value, 0.0, self.unit,
-                               self.first_failure)
+        if self.worst is None:
+            return CriterionResult.not_applicable(
+                self.name, 0.0, self.unit, "no pedestrian was on a crosswalk in the ego's "
+                "lane" if self.crosswalks else "no crosswalk on the route")
+        return CriterionResult(self.name, self.first_failure is None, self.worst, 0.0,
+                               self.unit, self.first_failure)
 
 
 class SpeedBumps(Criterion):
@@ -187,7 +198,7 @@ class SpeedBumps(Criterion):
     station in [s - length / 2 - NEAR, s + length / 2 + NEAR]).
 
     Value: the largest excess [km/h] of the speed over the bump's pass speed at those
-    moments (negative: slower); 0 if an axle never came near a bump (or the map has none)."""
+    moments (negative: slower). Not applicable when no axle came near a bump."""
 
     name, unit = "speed_bumps", "km/h"
     NEAR = 1.0  # [m] an axle this close to a bump's ends is on it
@@ -214,8 +225,11 @@ class SpeedBumps(Criterion):
                                    f"{to_kph(pass_speed):.0f} km/h by {excess:.1f} km/h")
 
     def result(self) -> CriterionResult:
-        value = 0.0 if self.worst is None else self.worst
-        return CriterionResult(self.name, self.first_failure is None, value,
+        if self.worst is None:
+            return CriterionResult.not_applicable(
+                self.name, SPEED_TOLERANCE_KPH, self.unit, "no axle came near a speed bump"
+                if self.bumps else "no speed bump on the route")
+        return CriterionResult(self.name, self.first_failure is None, self.worst,
                                SPEED_TOLERANCE_KPH, self.unit, self.first_failure)
 
 

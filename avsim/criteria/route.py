@@ -1,60 +1,160 @@
-"""`completes`: the ego gets where the route goes (or stops as a flat tyre demands). It
-always applies; the scenario's `reach_s` sets the station to reach (default: the route's
-end less `END_MARGIN`)."""
+"""The route: the ego gets where it goes (`completes`), or after a flat tyre comes to a
+minimum-risk stop (`minimum_risk_stop`). Both always apply; the scenario's `reach_s` sets
+the station to reach (default: the route's end less `END_MARGIN`), and `completes: false`
+turns route completion off (a test of a behaviour that need not get anywhere)."""
 
 from __future__ import annotations
 
 import math
+from collections import deque
 
 from avsim.criteria.base import (
+    DECEL_WINDOW,
     Criterion,
     CriterionResult,
     Need,
     TruthSample,
 )
 from avsim.criteria.declaration import Declaration
+from avsim.criteria.lane import footprint
 from avsim.scenario.fields import PosFloat
+from world.hdmap import SHOULDER, RoadMap
 
 END_MARGIN = 30.0  # [m] default station to reach: the route's end less this
+MRM_DECEL = 4.0  # [m/s^2] the most a minimum-risk manoeuvre may brake (UN R157 5.5.3.4.1)
+STOPPED, STOPPED_FOR = 0.1, 2.0  # [m/s], [s] the ego stands: below this speed for this long
 
 
-class Completes(Criterion):
-    """The ego's centre reaches `reach_s` before the end, or it stops (below `STOPPED` for
-    `STOPPED_FOR`) after a flat tyre, a stop the scenario expects: value = farthest
-    station [m] (the note says when the flat tyre's stop completed it)."""
+class StopAfterFlat:
+    """The watch of a minimum-risk stop after a flat tyre (truth and map): from the flat
+    on, the deceleration's peak (`DECEL_WINDOW` moving average over the samples), and the
+    first standstill (below `STOPPED` for `STOPPED_FOR`): where it stands and whether the
+    hazard lights flash then."""
 
-    name, unit = "completes", "m"
-    STOPPED, STOPPED_FOR = 0.1, 2.0  # [m/s], [s]
+    def __init__(self, road: RoadMap, half_tread: float, rate: float) -> None:
+        self.road, self.half_tread = road, half_tread
+        self.flat_at: float | None = None  # [s] the flat tyre happened (first sample with it)
+        self.peak = 0.0  # [m/s^2] the largest deceleration since the flat
+        self.stop: tuple[float, str | None] | None = None  # ([s] the standstill's start, what
+        #   is wrong with it: None when it is a minimum-risk stop)
+        self._speeds: deque[float] = deque(maxlen=max(2, round(DECEL_WINDOW * rate) + 1))
+        self._rate = rate
+        self._since: float | None = None  # [s] standing since
 
-    def __init__(self, reach_s: float) -> None:
-        super().__init__()
-        self.reach_s = reach_s  # [m] station to reach
-        self.farthest = -math.inf  # [m] the farthest centre station so far
-        self.stopped_flat = False  # it has stood for STOPPED_FOR with a flat tyre
-        self._since: float | None = None  # [s] since when it stands with a flat tyre
-
-    def update(self, sample: TruthSample) -> None:
-        self.farthest = max(self.farthest, sample.station)
-        if not sample.flat or sample.speed >= self.STOPPED:
+    def update(self, sample: TruthSample) -> float | None:
+        """Watch `sample`; the deceleration [m/s^2] over the window ending now, once the flat
+        has happened and the window is full (else None)."""
+        self._speeds.append(sample.speed)
+        if not sample.flat or self.stop is not None:
+            return None
+        if self.flat_at is None:
+            self.flat_at = sample.t
+        if sample.speed >= STOPPED:
             self._since = None
-            return
-        self._since = sample.t if self._since is None else self._since
-        self.stopped_flat |= sample.t - self._since >= self.STOPPED_FOR
+        else:
+            self._since = sample.t if self._since is None else self._since
+            if sample.t - self._since >= STOPPED_FOR:
+                self.stop = (self._since, self._wrong(sample))
+        if len(self._speeds) < (self._speeds.maxlen or 2):
+            return None
+        decel = (self._speeds[0] - self._speeds[-1]) * self._rate / (len(self._speeds) - 1)
+        self.peak = max(self.peak, decel)
+        return decel
+
+    def _wrong(self, sample: TruthSample) -> str | None:
+        """What keeps the standstill at `sample` from being a minimum-risk stop, or None."""
+        place = footprint(self.road, sample, self.half_tread)
+        shoulder = self.road.cross_section_at(sample.station).shoulder > 0.0
+        if shoulder and place.lane != SHOULDER:
+            return "stood off the shoulder, which the road has there"
+        if not shoulder and (place.lane is None or place.lane < 0):
+            return "stood outside a lane (the road has no shoulder there)"
+        if not sample.hazard_lights:
+            return "stood without hazard lights"
+        return None
 
     @property
     def done(self) -> bool:
-        """Whether the route is completed (reached, or stopped on a flat tyre)."""
-        return self.farthest >= self.reach_s or self.stopped_flat
+        """A minimum-risk stop was made."""
+        return self.stop is not None and self.stop[1] is None
+
+
+class MinimumRiskStop(Criterion):
+    """After a flat tyre the ego comes to a minimum-risk stop: it stands (below `STOPPED`
+    for `STOPPED_FOR`) with every tyre on the paved shoulder where the road has one there,
+    else wholly inside a lane of its direction, with its hazard lights flashing, and never
+    decelerates harder than `MRM_DECEL` on the way (0.2 s average; UN R157's bound for a
+    minimum-risk manoeuvre). Value: the peak deceleration [m/s^2] from the flat to the
+    stop. Not applicable without a flat tyre."""
+
+    name, unit = "minimum_risk_stop", "m/s^2"
+
+    def __init__(self, road: RoadMap, half_tread: float, rate: float) -> None:
+        super().__init__()
+        self.watch = StopAfterFlat(road, half_tread, rate)
+
+    def update(self, sample: TruthSample) -> None:
+        stopped = self.watch.stop is not None
+        decel = self.watch.update(sample)
+        if decel is not None and decel > MRM_DECEL:
+            self._fail(sample, f"deceleration {decel:.2f} m/s^2 after the flat tyre, over "
+                               f"{MRM_DECEL:g} m/s^2")
+        stop = self.watch.stop
+        if not stopped and stop is not None and stop[1] is not None:
+            self._fail(sample, f"after the flat tyre it {stop[1]}", at=stop[0])
 
     def result(self) -> CriterionResult:
-        note = "stopped after a flat tyre" if self.stopped_flat else None
+        w = self.watch
+        if w.flat_at is None:
+            return CriterionResult.not_applicable(self.name, MRM_DECEL, self.unit,
+                                                  "no flat tyre")
+        note = ("no standstill after the flat tyre" if w.stop is None
+                else None if w.stop[1] is None else f"it {w.stop[1]}")
+        return CriterionResult(self.name, self.first_failure is None and w.done, w.peak,
+                               MRM_DECEL, self.unit, self.first_failure, note)
+
+
+class Completes(Criterion):
+    """The ego's centre reaches `reach_s` before the end, or after a flat tyre it makes a
+    minimum-risk stop (`StopAfterFlat`, what `minimum_risk_stop` judges). Value: the
+    farthest centre station [m] (the note says when the stop completed it)."""
+
+    name, unit = "completes", "m"
+
+    def __init__(self, reach_s: float, road: RoadMap, half_tread: float, rate: float) -> None:
+        super().__init__()
+        self.reach_s = reach_s  # [m] station to reach
+        self.farthest = -math.inf  # [m] the farthest centre station so far
+        self.stop = StopAfterFlat(road, half_tread, rate)
+
+    def update(self, sample: TruthSample) -> None:
+        self.farthest = max(self.farthest, sample.station)
+        self.stop.update(sample)
+
+    @property
+    def done(self) -> bool:
+        """Whether the route is completed (reached, or a minimum-risk stop made)."""
+        return self.farthest >= self.reach_s or self.stop.done
+
+    def result(self) -> CriterionResult:
+        if math.isinf(self.farthest):
+            return CriterionResult.not_applicable(self.name, self.reach_s, self.unit,
+                                                  "the run had no sample")
+        note = ("a minimum-risk stop after a flat tyre" if self.stop.done
+                and self.farthest < self.reach_s else None)
         return CriterionResult(self.name, self.done, self.farthest, self.reach_s, self.unit,
                                note=note)
 
 
 COMPLETES: Declaration[float | None] = Declaration(
-    build=lambda reach_s, run: [Completes(reach_s if reach_s is not None
-                                          else run.road.length - END_MARGIN)],
-    needs=frozenset({Need.MAP}), key="reach_s", always=True, on_route=True, setting=PosFloat,
+    build=lambda reach_s, run: [Completes(
+        reach_s if reach_s is not None else run.road.length - END_MARGIN, run.road,
+        run.car.tyre_width / 2, run.rate)],
+    needs=frozenset({Need.MAP, Need.CAR, Need.RATE}), key="reach_s", always=True,
+    on_route=True, setting=PosFloat, switch="completes",
     doc="[m] station the ego must reach, > 0, on the route. Default: the end of the route "
     "less 30 m.", example=300.0)
+
+MINIMUM_RISK_STOP: Declaration[None] = Declaration(
+    build=lambda _, run: [MinimumRiskStop(run.road, run.car.tyre_width / 2, run.rate)],
+    needs=frozenset({Need.MAP, Need.CAR, Need.RATE}), always=True)

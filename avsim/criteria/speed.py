@@ -22,7 +22,8 @@ from world.hdmap import RoadMap
 
 class SpeedLimit(Criterion):
     """Speed never exceeds the posted limit at the front bumper's station by more than
-    `SPEED_TOLERANCE_KPH`: value = the largest excess [km/h]."""
+    `SPEED_TOLERANCE_KPH`: value = the largest excess [km/h] of the speed over the limit
+    (negative: it stayed that far under it)."""
 
     name, unit = "speed_limit", "km/h"
 
@@ -40,6 +41,9 @@ class SpeedLimit(Criterion):
                                f"{to_kph(limit):.0f} km/h by {excess:.1f} km/h")
 
     def result(self) -> CriterionResult:
+        if math.isinf(self.excess):
+            return CriterionResult.not_applicable(self.name, SPEED_TOLERANCE_KPH, self.unit,
+                                                  "the run had no sample")
         return CriterionResult(self.name, self.excess <= SPEED_TOLERANCE_KPH, self.excess,
                                SPEED_TOLERANCE_KPH, self.unit, self.first_failure)
 

@@ -7,14 +7,11 @@ strip of bands says which constraint set the plan's speed at each tick
 (`planner.messages.SpeedSource`: set speed, limit, curve, following, event, pedal, degraded
 lane, emergency).
 
-The lead vehicle at a tick is the nearest car or truck ahead of the ego in its lane, from the
-ground truth in the run's log, by the `min_gap` criterion's rule: its centre station is ahead
-of the ego's and its centre is within half a lane width of the ego's centre, sideways. The
-ego's offset from the reference line is rebuilt from the log as the kept lane's centre
-(`lane * lane_width`, the HD map's layout) plus the cross-track error; so during a lane change
-the band moves with the car. The lead's speed is its station's rate of change (a central
-difference over the log's ticks), scaled by (1 - curvature * offset) to the speed along its
-own path on arcs; NaN (a gap in the line) where there is no lead.
+The lead vehicle at a tick is the nearest car or truck ahead of the ego in its lane, as the
+run's log has it from the truth and the map by the `min_gap` criterion's rule
+(`world.truth.vehicles_ahead`: its footprint in the lane the ego's centre is in, ahead along
+the ego's route, travelling along the lane; in a town as on a road); a gap in the line where
+there is none.
 
 Pure: no PyBullet, no pyplot (a bare `Figure` on the Agg canvas, so no display is needed).
 """
@@ -37,7 +34,6 @@ from numpy.typing import NDArray
 from planner.fsm.acc import AccMode
 from planner.messages import SpeedSource
 from world.frames import MPS_PER_KPH
-from world.map.road import build_road_map
 
 if TYPE_CHECKING:
     from avsim.run.runner import RunResult
@@ -103,36 +99,14 @@ def mode_runs(t: Sequence[float],
 
 
 def lead_speed(result: RunResult) -> FloatArray:
-    """[m/s] per tick: the speed of the nearest car or truck ahead in the ego's lane (truth),
-    NaN where there is none (see the module's doc for the rule)."""
-    log, world = result.log, result.scenario.world
-    n = len(log.t)
-    vehicles = np.array([a.type.value in VEHICLES for a in world.actors], dtype=bool)
-    if n < 2 or not vehicles.any() or len(log.actor_station) != n:
-        return np.full(n, math.nan)
-    t = log.array("t")
-    stations = np.vstack(log.actor_station).astype(np.float64)  # (T, N)
-    offsets = np.vstack(log.actor_offset).astype(np.float64)
-    road = build_road_map(world.road)
-    ego_s = log.array("station")
-    width = np.asarray(road.lane(0).width_at(ego_s), dtype=np.float64)
-    ego_offset = np.asarray(log.lane, dtype=np.float64) * width + log.array("cross_track")
-    speeds = np.gradient(stations, t, axis=0)
-    curvature = np.asarray(road.curvature_at(stations.ravel()), dtype=np.float64)
-    speeds *= 1.0 - curvature.reshape(stations.shape) * offsets
-    candidate = (
-        vehicles[None, :]
-        & (stations > ego_s[:, None])
-        & (np.abs(offsets - ego_offset[:, None]) < 0.5 * width[:, None])
-    )
-    nearest = np.argmin(np.where(candidate, stations, np.inf), axis=1)
-    lead = speeds[np.arange(n), nearest]
-    return np.where(candidate.any(axis=1), lead, math.nan)
+    """[m/s] per tick: the speed of the vehicle ahead in the ego's lane (the run's log, from
+    the truth and the map), NaN where there is none."""
+    return result.log.array("lead_speed")
 
 
 def _title(result: RunResult) -> str:
     """The scenario's name and situation, and its verdict with the failed criteria."""
-    failed = [c.name for c in result.criteria if not c.passed]
+    failed = [c.name for c in result.criteria if c.failed]
     verdict = "PASS" if not failed else "FAIL (" + ", ".join(failed) + ")"
     return f"{result.scenario.name} ({result.scenario.situation}): {verdict}"
 

@@ -80,7 +80,12 @@ def _sim_time(outcome: RunOutcome) -> float:
 
 def _failed_names(outcome: RunOutcome) -> list[str]:
     """The names of the run's failed criteria."""
-    return [str(c["name"]) for c in outcome.criteria() if not c["passed"]]
+    return [str(c["name"]) for c in outcome.criteria() if c["passed"] is False]
+
+
+def _skipped_names(outcome: RunOutcome) -> list[str]:
+    """The names of the run's criteria that were not applicable."""
+    return [str(c["name"]) for c in outcome.criteria() if c["passed"] is None]
 
 
 def _counts(outcomes: Sequence[RunOutcome]) -> tuple[int, int, int]:
@@ -144,11 +149,20 @@ def _properties(outcome: RunOutcome) -> dict[str, str]:
 
 
 def _criterion_case(suite: ET.Element, outcome: RunOutcome,
-                    criterion: Mapping[str, object], time: float) -> None:
-    """Append a criterion's `<testcase>` (with its `<failure>` if it failed); `time` [s]."""
+                    criterion: Mapping[str, object]) -> None:
+    """Append a criterion's `<testcase>`: with its `<failure>` if it failed (and its first
+    failure's sim time as a property), `<skipped>` if it was not applicable. No time: the
+    criteria are judged together over the whole run, which the suite's time is."""
     case = ET.SubElement(suite, "testcase", classname=f"avsim.{outcome.job.name}",
-                         name=str(criterion["name"]), time=_seconds(time))
-    if not criterion["passed"]:
+                         name=str(criterion["name"]))
+    first = criterion.get("first_failure")
+    if first is not None:
+        properties = ET.SubElement(case, "properties")
+        ET.SubElement(properties, "property", name="first_failure_sim_time",
+                      value=f"{first}")
+    if criterion["passed"] is None:
+        ET.SubElement(case, "skipped", message=str(criterion.get("note") or "not applicable"))
+    elif not criterion["passed"]:
         failure = ET.SubElement(case, "failure", message=_failure_message(criterion),
                                 type="criterion")
         failure.text = _failure_text(criterion)
@@ -176,13 +190,13 @@ def _testsuite(parent: ET.Element, outcome: RunOutcome) -> tuple[int, int, int]:
         ET.SubElement(suite, "testcase", classname=f"avsim.{outcome.job.name}", name="run",
                       time=_seconds(outcome.wall_time))
     for criterion in criteria:
-        # the run's time split evenly, so that a suite's time is the sum of its cases'
-        _criterion_case(suite, outcome, criterion, outcome.wall_time / len(criteria))
+        _criterion_case(suite, outcome, criterion)
     tests = max(len(criteria), 1)
     failures = len(_failed_names(outcome))
     errors = int(outcome.result is None)
     suite.attrib.update(tests=str(tests), failures=str(failures), errors=str(errors),
-                        skipped="0", time=_seconds(outcome.wall_time))
+                        skipped=str(len(_skipped_names(outcome))),
+                        time=_seconds(outcome.wall_time))
     return tests, failures, errors
 
 
@@ -279,7 +293,8 @@ def _runs_table(outcomes: Sequence[RunOutcome], out_dir: Path) -> list[str]:
 
 def _criterion_row(c: Mapping[str, object]) -> str:
     """A criterion's row of a run's section."""
-    cells = [_md_code(c["name"]), "pass" if c["passed"] else "**FAIL**",
+    verdict = "n/a" if c["passed"] is None else "pass" if c["passed"] else "**FAIL**"
+    cells = [_md_code(c["name"]), verdict,
              format_value(c.get("value")), format_value(c.get("threshold")),
              _md_text(c.get("unit", "")), format_value(c.get("first_failure")),
              _md_text(c["note"]) if c.get("note") else ""]

@@ -67,7 +67,7 @@ def sweep_rows(outcomes: Sequence[RunOutcome], params: Sequence[str],
         row[PASSED] = outcome.passed
         row[STATUS] = outcome.status.value
         row.update({m: outcome.metric(m) for m in metrics})
-        row[FAILED] = " ".join(str(c["name"]) for c in outcome.criteria() if not c["passed"])
+        row[FAILED] = " ".join(str(c["name"]) for c in outcome.criteria() if c["passed"] is False)
         row[ERROR] = outcome.error or ""
         rows.append(row)
     return rows

@@ -1,7 +1,9 @@
-"""The result file (`--json`) of a run, as SCENARIO_FORMAT.md specifies it."""
+"""The result file (`--json`) of a run, as SCENARIO_FORMAT.md specifies it: strict JSON,
+every number finite or null (`dumps` refuses anything else)."""
 
 from __future__ import annotations
 
+import json
 import math
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -29,6 +31,13 @@ def result_json(result: RunResult, file: str | Path, recording: Path, profile: s
         "wall_time": round(result.wall_time, 3),
         "criteria": [c.as_json() for c in result.criteria],
         "infractions": [i.as_json() for i in result.infractions],
+        "story": [
+            ({"actor": e.actor, "action": e.index} if e.actor is not None
+             else {"event": e.index}) | {"kind": e.kind, "optional": e.optional,
+                                        "fired_at": None if e.fired_at is None
+                                        else round(e.fired_at, 4)}
+            for e in result.story
+        ],
         "metrics": {k: _clean(v) for k, v in result.metrics.items()},
         "state_changes": [
             {"t": round(c.t, 4), "machine": c.machine, "from": c.source, "to": c.target,
@@ -37,3 +46,9 @@ def result_json(result: RunResult, file: str | Path, recording: Path, profile: s
         ],
         "recording": str(recording),
     }
+
+
+def dumps(payload: object) -> str:
+    """`payload` as the result files write it: indented strict JSON (a NaN or an infinity
+    is a bug here: ValueError), with a final newline."""
+    return json.dumps(payload, indent=2, allow_nan=False) + "\n"

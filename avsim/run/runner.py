@@ -30,16 +30,24 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from avsim.criteria.base import CriterionResult, Infraction, Need, TruthSample
+from avsim.criteria.base import (
+    MAX_LANE_CHANGE,
+    CriterionResult,
+    Infraction,
+    Need,
+    TruthSample,
+    Verdict,
+)
 from avsim.criteria.collision import NoCollision
 from avsim.criteria.declaration import RunInputs
+from avsim.criteria.lane import TyresInLane
 from avsim.criteria.registry import build_criteria
 from avsim.criteria.route import Completes
+from avsim.criteria.story import story_label
 from avsim.record.recorder import Recorder
 from avsim.run.sensor_loop import FrameHook, SensorLoop, sensing_mode
 from avsim.run.stack import Stack, StackOutput
 from avsim.scenario.scenario import Scenario
-from planner.fsm.motion import TURNS
 from planner.messages import MACHINES, AccMode, HazardLights, Motion, Plan, SpeedSource, StateChange
 from world.core.rates import (
     ACTOR_RECORD_RATE,
@@ -54,12 +62,14 @@ from world.sensors.lidar import RayBackend
 from world.sensors.pipeline import SensingWorker
 from world.sensors.setup import Profile, sensor_setup
 from world.spec import FlatTire
-from world.truth import touching
+from world.truth import ego_lane_edges, touching, vehicles_ahead
 from world.world import World
 
-SETTLE_AFTER_DONE = 1.0  # [s] the run goes on this long after `completes` is reached
+SETTLE_AFTER_DONE = 1.0  # [s] the run goes on this long after it may end: `completes`
+#   reached and every required action and event fired
 
 ProgressCallback = Callable[[float, float], None]  # (sim time, duration) [s]
+VERDICT_WORDS = {Verdict.PASS: "pass", Verdict.FAIL: "FAIL", Verdict.NOT_APPLICABLE: "n/a"}
 
 
 @dataclass
@@ -73,7 +83,11 @@ class TrajectoryLog:
     speed: list[float] = field(default_factory=list)  # [m/s] true forward speed
     station: list[float] = field(default_factory=list)  # [m] true centre station
     cross_track: list[float] = field(default_factory=list)  # [m] true centre offset from
-    #   the centre of the lane kept, left +
+    #   the centre of the lane the stack keeps (its plan's), left +
+    lane_error: list[float] = field(default_factory=list)  # [m] true centre offset from the
+    #   centre of the lane it is in (the truth and the map: `world.truth.ego_lane_edges`)
+    crossing: list[bool] = field(default_factory=list)  # its tyres are on or over a lane
+    #   line (a lane change, from the truth: `avsim.criteria.lane.LaneChanges`)
     front_axle_error: list[float] = field(default_factory=list)  # [m] true, at front axle
     target_speed: list[float] = field(default_factory=list)  # [m/s]
     speed_limit: list[float] = field(default_factory=list)  # [m/s] at the front bumper
@@ -90,9 +104,13 @@ class TrajectoryLog:
     pedal: list[float] = field(default_factory=list)  # [-] the driver's accelerator pedal
     actor_station: list[NDArray[np.float64]] = field(default_factory=list)  # [m] (N,) true,
     #   along the road each drives on (the route; past an exit's fork, the road the route
-    #   left for traffic that kept it: `RoadMap.through_line`)
+    #   left for traffic that kept it; in a town, each actor's own route): not comparable
+    #   with the ego's station off the route (the lead is `lead_gap`, `lead_speed`)
     actor_offset: list[NDArray[np.float64]] = field(default_factory=list)  # [m] (N,) true,
     #   from that road's reference line, left +
+    lead_gap: list[float] = field(default_factory=list)  # [m] bumper gap to the vehicle
+    #   ahead in the ego's lane (truth and map: `world.truth.vehicles_ahead`), NaN: none
+    lead_speed: list[float] = field(default_factory=list)  # [m/s] its speed, NaN: none
 
     def array(self, name: str) -> NDArray[np.float64]:
         return np.asarray(getattr(self, name), dtype=np.float64)
@@ -113,10 +131,28 @@ class RunResult:
     renderer: str | None = None  # "egl" or "tiny" when cameras rendered
     stage_times: dict[str, float] = field(default_factory=dict)  # [s] wall time per stage
     #   (`world.core.stopwatch`: where the run's time went; not part of the result file)
+    story: tuple[StoryEntry, ...] = ()  # each scripted action and event, and when it fired
 
     @property
     def passed(self) -> bool:
-        return all(c.passed for c in self.criteria)
+        """No criterion failed (one not applicable does not fail the run)."""
+        return not any(c.failed for c in self.criteria)
+
+
+@dataclass(frozen=True, slots=True)
+class StoryEntry:
+    """A scripted action of an actor (`actor` its id, `index` in its actions) or an ego
+    event (`actor` None, `index` in the scenario's events), and when it fired."""
+
+    actor: str | None
+    index: int
+    kind: str  # the action's or event's kind (`speed`, `lane_change`, `flat_tire`, ...)
+    optional: bool  # the run may end without it
+    fired_at: float | None  # [s] None: it never fired
+
+    @property
+    def label(self) -> str:
+        return story_label(self.actor, self.index)
 
 
 class Runner:
@@ -161,11 +197,19 @@ class Runner:
         names.update({b: "kerb" for b in w.scene.kerb_bodies})
         names.update({b: f"actor {a.id}" for b, a in zip(w.actors.bodies, spec.actors,
                                                           strict=True)})
+        lane_change = scenario.criteria.get("lane_change")
+        self.story = _story(scenario)
         self.criteria = build_criteria(scenario.criteria, RunInputs(
             road=w.road, car=self.car, rate=CRITERIA_RATE.hz, signals=w.signals,
-            set_speed=scenario.driver.set_speed, bodies=names))
-        self.completes = self.criteria.find(Completes)  # reached: the run may end
+            set_speed=scenario.driver.set_speed, bodies=names,
+            lane_change_max=getattr(lane_change, "max_duration", MAX_LANE_CHANGE),
+            story=tuple(e.label for e in self.story if not e.optional)))
+        self.completes = next((c for c in self.criteria.items if isinstance(c, Completes)),
+                              None)  # reached (and the story played out): the run may end;
+        #   None (`completes: false`): it runs to its duration
         self.collisions = self.criteria.find(NoCollision)  # its count is a metric
+        self.lanes = self.criteria.find(TyresInLane).lanes  # the truth's lane changes
+        self._fired: frozenset[str] = frozenset()  # the story's labels fired so far
         self.infractions: list[Infraction] = []
         self.recorder = Recorder(recording, recording_name=scenario.name) if recording else None
         self.sensors = SensorLoop(w, self.setup, self.stack, mode, self.recorder, frame_hook,
@@ -173,8 +217,6 @@ class Runner:
         self.state_changes: list[StateChange] = []
         self._touching: frozenset[int] = frozenset()
         self._last: StackOutput | None = None
-        self._lane = self._origin_lane = spec.ego.lane  # the stack's lane command
-        self._turning = False  # the stack's motion FSM is in a turn
 
     # -- the loop ------------------------------------------------------------------------------
 
@@ -197,7 +239,7 @@ class Runner:
                     if w.clock.step % CONTACT_RATE.every == 0:
                         with watch("criteria"):
                             self._watch(w.clock.step)
-                if done_at is None and self.completes.done:
+                if done_at is None and self._may_end():
                     done_at = w.t
                 if done_at is not None and w.t >= done_at + SETTLE_AFTER_DONE:
                     break
@@ -219,8 +261,31 @@ class Runner:
             state_changes=tuple(self.state_changes), infractions=tuple(self.infractions),
             profile=self.setup.profile.value if self.setup is not None else None,
             renderer=renderer.value if renderer is not None else None,
-            stage_times=dict(watch.seconds),
+            stage_times=dict(watch.seconds), story=self._story_now(),
         )
+
+    def _may_end(self) -> bool:
+        """`completes` is reached and every required action and event has fired."""
+        return (self.completes is not None and self.completes.done
+                and all(e.optional or e.label in self._fired for e in self.story))
+
+    def _story_now(self) -> tuple[StoryEntry, ...]:
+        """The story with the times its actions and events fired."""
+        w = self.world
+        return tuple(StoryEntry(
+            e.actor, e.index, e.kind, e.optional,
+            w.action_fired_at.get((e.actor, e.index)) if e.actor is not None
+            else w.event_fired_at[e.index]) for e in self.story)
+
+    def _update_fired(self) -> None:
+        """The labels of the actions and events fired so far (a new set only on a change)."""
+        w = self.world
+        count = len(w.action_fired_at) + sum(t is not None for t in w.event_fired_at)
+        if count != len(self._fired):
+            self._fired = frozenset(
+                [story_label(a, i) for a, i in w.action_fired_at]
+                + [story_label(None, i) for i, t in enumerate(w.event_fired_at)
+                   if t is not None])
 
     def _tick(self) -> None:
         """A control tick: the sensors' frames due now reach the stack, then decide and
@@ -230,10 +295,9 @@ class Runner:
         out = self.stack.tick(w.t, CONTROL_RATE.period)
         cmd = out.command
         w.ego.apply(cmd.steering_angle, cmd.drive_torque, cmd.brake_torque)
+        w.ego.set_hazard_lights(cmd.hazard_lights)
         previous, self._last = self._last, out
         with watch("runner"):
-            self._lane, self._origin_lane = out.plan.lane, out.plan.origin_lane
-            self._turning = out.plan.motion in TURNS
             self._log_tick(out)
             self.state_changes.extend(out.plan.changes)
         if self.recorder is not None:
@@ -263,6 +327,9 @@ class Runner:
         s = route.station
         lane = self.world.road.lane(out.plan.lane)
         r, r_fa = (route.offsets[:2] - lane.offset_at(route.stations[:2])).tolist()
+        lo, hi = ego_lane_edges(w.road, s, float(route.offsets[0]))
+        ahead = vehicles_ahead(w.road, w.actors.poses, s, float(route.offsets[0]),
+                               self.car.body_length) if w.actors.bodies else ()
         log.t.append(w.t)
         log.x.append(float(truth.position[0]))
         log.y.append(float(truth.position[1]))
@@ -284,8 +351,12 @@ class Runner:
         log.lane.append(out.plan.lane)
         log.changing.append(out.plan.lane != out.plan.origin_lane)
         log.pedal.append(w.accelerator_pedal)
+        log.lane_error.append(float(route.offsets[0]) - 0.5 * (lo + hi))
+        log.crossing.append(self.lanes.crossing is not None)
         log.actor_station.append(np.array([m.s for m in w.actors.motions]))
         log.actor_offset.append(np.array([m.offset for m in w.actors.motions]))
+        log.lead_gap.append(ahead[0].gap if ahead else math.nan)
+        log.lead_speed.append(ahead[0].speed if ahead else math.nan)
 
     def _watch(self, step: int) -> None:
         """Criteria: contact onsets at the contact rate, the rest at the criteria rate."""
@@ -303,19 +374,19 @@ class Runner:
         w = self.world
         truth, route = w.ego_truth, w.ego_route
         actors = w.actors.poses if Need.ACTORS in self.criteria.needs else None
+        self._update_fired()
         infractions = self.criteria.update(TruthSample(
             t=w.t, speed=truth.speed, station=route.station,
             front_station=route.station + self.car.front_overhang,
             tyres=route.tyres, tyre_stations=route.tyre_stations,
             tyre_offsets=route.tyre_offsets, touching=self._touching,
             offset=float(route.offsets[0]), actors=actors,
-            lane=self._lane, origin_lane=self._origin_lane, turning=self._turning,
             lateral_accel=truth.speed * truth.yaw_rate,
             road_curvature=float(w.road.curvature_at(route.station)),
             rear_station=route.station - self.car.body_length / 2,
             axle_stations=(float(route.stations[1]),
                            float(np.mean(route.stations[4:6]))),
-            flat=self._flat_fired(),
+            flat=self._flat_fired(), hazard_lights=w.ego.hazard_lights, fired=self._fired,
             xy=(float(truth.position[0]), float(truth.position[1])),
         ))
         self.infractions += infractions
@@ -332,8 +403,8 @@ class Runner:
     # -- results -------------------------------------------------------------------------------
 
     def _metrics(self) -> dict[str, float]:
-        keeping = ~np.asarray(self.log.changing, dtype=bool)  # lane changes are not errors
-        xte = self.log.array("cross_track")[keeping]
+        keeping = ~np.asarray(self.log.crossing, dtype=bool)  # lane changes are not errors
+        xte = self.log.array("lane_error")[keeping]
         speed = self.log.array("speed")
         dt = CONTROL_RATE.period
         decel = -np.diff(speed) / dt if len(speed) > 1 else np.zeros(1)
@@ -411,8 +482,25 @@ class Runner:
             scores = ", ".join(f"{k} {v:.3f}" for k, v in self.sensors.metrics().items())
             rec.log_event(self.world.t, f"perception against the truth: {scores}", "INFO")
         for r in self.criteria.results():
-            level = "INFO" if r.passed else "ERROR"
+            level = "ERROR" if r.failed else "INFO"
             t = r.first_failure if r.first_failure is not None else self.world.t
-            rec.log_event(t, f"criterion {r.name}: {'pass' if r.passed else 'FAIL'} "
-                             f"(value {r.value:.3f} {r.unit}, threshold {r.threshold} {r.unit})",
-                          level)
+            value = "none" if r.value is None else f"{r.value:.3f} {r.unit}"
+            note = f"; {r.note}" if r.note else ""
+            rec.log_event(t, f"criterion {r.name}: {VERDICT_WORDS[r.verdict]} (value {value}, "
+                             f"threshold {r.threshold} {r.unit}{note})", level)
+
+
+def _story(scenario: Scenario) -> tuple[StoryEntry, ...]:
+    """The scenario's scripted actions (actor by actor) and ego events, none fired yet."""
+    spec = scenario.world
+    actions = [StoryEntry(a.id, i, _kind(x.action), x.optional, None)
+               for a in spec.actors for i, x in enumerate(a.actions)]
+    events = [StoryEntry(None, i, _kind(e.event), e.optional, None)
+              for i, e in enumerate(spec.events)]
+    return tuple(actions + events)
+
+
+def _kind(thing: object) -> str:
+    """A spec's kind as the file names it: `LaneChangeAction` -> `lane_change`."""
+    name = type(thing).__name__.removesuffix("Action")
+    return "".join(f"_{c.lower()}" if c.isupper() else c for c in name).lstrip("_")

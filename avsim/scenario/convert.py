@@ -14,7 +14,7 @@ import math
 from collections.abc import Sequence
 from dataclasses import replace
 
-from avsim.criteria.registry import CriteriaSettings, keyed
+from avsim.criteria.registry import CriteriaSettings, setting_keys
 from avsim.scenario.checks import (
     DEFAULT_SPEED_UP,
     check_road,
@@ -155,7 +155,8 @@ def _actor_spec(index: int, actor: ActorModel) -> spec.ActorSpec:
     accels = speed_accels(f"actors.{index}", actor)
     actions = tuple(
         spec.ActionSpec(
-            trigger=_trigger_spec(action.trigger), action=_action_spec(action, accels.get(number))
+            trigger=_trigger_spec(action.trigger), action=_action_spec(action, accels.get(number)),
+            optional=action.optional,
         )
         for number, action in enumerate(actor.actions)
     )
@@ -176,10 +177,12 @@ def _event_spec(event: EventModel) -> spec.EventSpec:
     if event.accelerator_override is not None:
         override = event.accelerator_override
         return spec.EventSpec(
-            trigger, spec.AcceleratorOverride(pedal=override.pedal, duration=override.duration)
+            trigger, spec.AcceleratorOverride(pedal=override.pedal, duration=override.duration),
+            event.optional,
         )
     assert event.flat_tire is not None
-    return spec.EventSpec(trigger, spec.FlatTire(wheel=frames.Wheel(event.flat_tire.wheel)))
+    return spec.EventSpec(trigger, spec.FlatTire(wheel=frames.Wheel(event.flat_tire.wheel)),
+                          event.optional)
 
 
 def _sensors_spec(model: ScenarioModel) -> spec.SensorsSpec:
@@ -225,8 +228,8 @@ def _scenario(model: ScenarioModel, road_spec: spec.RoadSpec,
         duration=float(model.duration),
         world=world,
         driver=DriverSettings(set_speed=_kph(ego.set_speed_kph), overtake=ego.overtake),
-        criteria=CriteriaSettings.of({str(d.key): getattr(model.criteria, str(d.key))
-                                      for d in keyed()}),
+        criteria=CriteriaSettings.of({key: getattr(model.criteria, key)
+                                      for key in setting_keys()}),
     )
 
 

@@ -22,9 +22,17 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Annotated, Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, create_model, field_validator, model_validator
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    StrictBool,
+    create_model,
+    field_validator,
+    model_validator,
+)
 
-from avsim.criteria.registry import keyed
+from avsim.criteria.registry import keyed, setting_keys, switches
 from avsim.scenario.fields import (
     FormatModel,
     Fraction,
@@ -413,11 +421,16 @@ class ActionModel(FormatModel):
     stop: StopActionModel | None = Field(
         default=None, description="Brake to a stop: `{}` (optional `decel`)."
     )
+    optional: StrictBool = Field(
+        default=False, description="true: the run may end without it having fired; else it "
+        "must fire before the run ends early, and one that never fires fails `story`. "
+        "Default false.")
 
     @model_validator(mode="before")
     @classmethod
     def _known_kind(cls, data: Any) -> Any:
-        data = _reject_unknown_kind(data, {"trigger", *ACTION_KINDS}, ACTION_KINDS, "action")
+        data = _reject_unknown_kind(data, {"trigger", "optional", *ACTION_KINDS}, ACTION_KINDS,
+                                    "action")
         return _empty_for_null(data, ACTION_KINDS)
 
     @model_validator(mode="after")
@@ -459,11 +472,16 @@ class EventModel(FormatModel):
         default=None, description="Hold the accelerator: `{pedal, duration}`."
     )
     flat_tire: FlatTireModel | None = Field(default=None, description="A flat tyre: `{wheel}`.")
+    optional: StrictBool = Field(
+        default=False, description="true: the run may end without it having fired; else it "
+        "must fire before the run ends early, and one that never fires fails `story`. "
+        "Default false.")
 
     @model_validator(mode="before")
     @classmethod
     def _known_kind(cls, data: Any) -> Any:
-        data = _reject_unknown_kind(data, {"trigger", *EVENT_KINDS}, EVENT_KINDS, "event")
+        data = _reject_unknown_kind(data, {"trigger", "optional", *EVENT_KINDS}, EVENT_KINDS,
+                                    "event")
         return _empty_for_null(data, EVENT_KINDS)
 
     @model_validator(mode="after")
@@ -602,6 +620,12 @@ def _criteria_model() -> type[FormatModel]:
         str(d.key): (d.setting | None,
                      Field(default=None, description=d.doc, examples=[d.example]))
         for d in keyed()
+    } | {
+        str(d.switch): (StrictBool | None, Field(
+            default=None, examples=[False],
+            description=f"false turns the always-on `{d.switch}` off; true (the default) "
+            "keeps it."))
+        for d in switches()
     }
     return create_model("CriteriaModel", __base__=FormatModel, __module__=__name__,
                         __doc__="Optional criteria; the default criteria always apply.",
@@ -658,7 +682,7 @@ class ScenarioModel(FormatModel):
     criteria: CriteriaModel = Field(
         default_factory=CriteriaModel,
         description="Criteria to add or tune, by key: "
-        + ", ".join(str(d.key) for d in keyed())
+        + ", ".join(setting_keys())
         + ". The default criteria always apply. Default: none added.",
     )
 

@@ -36,7 +36,7 @@ def _lead(r: RunResult) -> tuple[np.ndarray, np.ndarray]:
 
 
 def test_every_criterion_passes(result: RunResult) -> None:
-    assert all(c.passed for c in result.criteria), result.criteria
+    assert not any(c.failed for c in result.criteria), result.criteria
     c = {r.name: r for r in result.criteria}
     assert c["stop_signs"].value >= 1.0
     assert c["crosswalks"].value < 0.0  # never on the crossing while the pedestrian was
@@ -116,6 +116,11 @@ def test_the_flat_tyre_pull_over(result: RunResult) -> None:
     assert log.lane[-1] == SHOULDER and v[-1] < 0.1 and log.hazard[-1]
     assert abs(log.cross_track[-1]) < 0.5  # on the shoulder's middle
     assert result.state_changes[-1].t - fired < 30.0
+    # the verdict judges it from the truth: on the shoulder, hazard lights, <= 4 m/s^2
+    c = {r.name: r for r in result.criteria}
+    mrm = c["minimum_risk_stop"]
+    assert mrm.passed and mrm.value is not None and mrm.value <= 4.0, mrm
+    assert c["completes"].passed
 
 
 def test_the_mode_sequence_is_the_papers(result: RunResult) -> None:

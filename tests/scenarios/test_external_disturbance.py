@@ -34,7 +34,7 @@ def _pressed(r: RunResult) -> np.ndarray:
 
 
 def test_the_pedal_raised_the_speed_to_the_limit_and_no_further(alone: RunResult) -> None:
-    assert all(c.passed for c in alone.criteria), alone.criteria
+    assert not any(c.failed for c in alone.criteria), alone.criteria
     t, v = alone.log.array("t"), alone.log.array("speed")
     pressed = _pressed(alone)
     held = t[pressed]
@@ -49,7 +49,7 @@ def test_the_pedal_raised_the_speed_to_the_limit_and_no_further(alone: RunResult
 
 
 def test_following_the_pedal_closes_up_but_never_below_d_min(following: RunResult) -> None:
-    assert all(c.passed for c in following.criteria), following.criteria
+    assert not any(c.failed for c in following.criteria), following.criteria
     log = following.log
     v = log.array("speed")
     k = [a.id for a in following.scenario.world.actors].index("lead")

@@ -25,7 +25,7 @@ def result(run_scenario: Callable[..., RunResult]) -> RunResult:
 
 
 def test_every_criterion_passes(result: RunResult) -> None:
-    failed = [c for c in result.criteria if not c.passed]
+    failed = [c for c in result.criteria if c.failed]
     assert not failed, failed
     names = {c.name for c in result.criteria}
     assert {"no_collision", "tyres_in_lane", "speed_limit", "completes"} <= names

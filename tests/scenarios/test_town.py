@@ -67,7 +67,7 @@ def _states(r: RunResult, machine: str) -> list[str]:
 
 
 def test_town_route_passes_every_criterion(route: RunResult) -> None:
-    assert all(c.passed for c in route.criteria), route.criteria
+    assert not any(c.failed for c in route.criteria), route.criteria
     c = {r.name: r for r in route.criteria}
     assert c["stop_signs"].value >= 1.0  # the all-way stop was judged: it stood there
     assert 0.0 < c["red_lights"].value < np.inf  # lights were crossed, none on red
@@ -139,7 +139,7 @@ def test_npcs_keep_to_lights_and_stop_signs(route: RunResult) -> None:
 
 
 def test_with_an_oncoming_car_close_the_left_turn_waits(close_car: RunResult) -> None:
-    assert all(c.passed for c in close_car.criteria), close_car.criteria
+    assert not any(c.failed for c in close_car.criteria), close_car.criteria
     j = build_road_map(close_car.scenario.world.road).junctions[0]
     t = close_car.log.array("t")
     inside = _in_box(_actor_xy(close_car, "oncoming"), j)
@@ -157,7 +157,7 @@ def test_with_an_oncoming_car_close_the_left_turn_waits(close_car: RunResult) ->
 
 def test_with_the_oncoming_car_far_the_left_turn_goes_at_once(far_car: RunResult,
                                                               close_car: RunResult) -> None:
-    assert all(c.passed for c in far_car.criteria), far_car.criteria
+    assert not any(c.failed for c in far_car.criteria), far_car.criteria
     j = build_road_map(far_car.scenario.world.road).junctions[0]
     t = far_car.log.array("t")
     xy = _actor_xy(far_car, "oncoming")

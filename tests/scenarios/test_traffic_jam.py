@@ -49,7 +49,7 @@ def test_stop_and_go_twice(result: RunResult) -> None:
 
 
 def test_verdict_and_back_to_set_speed(result: RunResult) -> None:
-    assert all(c.passed for c in result.criteria), result.criteria
+    assert not any(c.failed for c in result.criteria), result.criteria
     c = {r.name: r for r in result.criteria}
     assert c["min_gap"].value >= c["min_gap"].threshold  # d_min while moving
     assert c["max_decel"].value <= 1.5  # the jam is taken gently

@@ -174,6 +174,7 @@ class EgoBody:
         self.drive_torque = 0.0  # [N m] last applied, total
         self.brake_torque = 0.0  # [N m] last applied, total
         self.steer_command = 0.0  # [rad] last commanded bicycle angle
+        self.hazard_lights = False  # the hazard lights flash (their switch, as commanded)
         self._net_torque = 0.0  # [N m] total wheel torque of the last command, + forward
         self._spawn_speed(yaw, speed)
         self.apply(0.0, 0.0, 0.0)
@@ -225,6 +226,10 @@ class EgoBody:
         )
 
     # -- flat tyres ---------------------------------------------------------------------------
+
+    def set_hazard_lights(self, on: bool) -> None:
+        """Switch the hazard lights on or off (held until the next call)."""
+        self.hazard_lights = bool(on)
 
     def puncture(self, wheel: str, t: float) -> None:
         """The tyre of `wheel` (a `vehicle_urdf.WHEELS` name) is punctured at sim time `t`

@@ -113,7 +113,7 @@ def test_the_junit_file_parses_with_a_case_per_criterion(
         cases = {c.name: c for c in suite}
         assert set(cases) == {c["name"] for c in result["criteria"]}
         failed = {n for n, c in cases.items() if any(isinstance(r, Failure) for r in c.result)}
-        assert failed == {c["name"] for c in result["criteria"] if not c["passed"]}
+        assert failed == {c["name"] for c in result["criteria"] if c["passed"] is False}
         assert suite.tests == len(cases) and suite.failures == len(failed)
         assert not any(isinstance(r, Error) for c in suite for r in c.result)
     assert suites["too_far"].failures == 1 and suites["follow"].failures == 0

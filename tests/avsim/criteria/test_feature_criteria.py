@@ -150,14 +150,16 @@ def test_lines_not_reached_or_already_passed_are_not_judged() -> None:
     c = StopSigns(road(StopSign(30.0), StopSign(STOP_S)))
     drive(c, lambda t: (50.0 + 2.0 * t, 2.0), 10.0)  # front from 52.4 to 72.4 m
     r = c.result()
-    assert r.passed and r.value == 0.0 and c.judged == [False, False]
+    assert r.passed is None and r.value is None and c.judged == [False, False]
+    assert r.verdict.value == "not_applicable" and r.note == "the ego met no stop line"
 
 
-def test_no_stop_line_passes_with_value_zero() -> None:
+def test_no_stop_line_is_not_applicable() -> None:
     c = StopSigns(road())
     drive(c, lambda t: (10.0 + 10.0 * t, 10.0), 20.0)
     r = c.result()
-    assert r.passed and r.value == 0.0 and r.first_failure is None
+    assert r.passed is None and r.value is None and r.first_failure is None
+    assert r.note == "no stop line on the route" and not r.failed
 
 
 # -- crosswalks ----------------------------------------------------------------------------
@@ -203,30 +205,34 @@ def test_entering_an_occupied_crosswalk_fails() -> None:
 ])
 def test_which_pedestrians_count(where: tuple[float, float], conflict: bool) -> None:
     r = crosswalk_run(where).result()
-    assert r.passed is not conflict
-    assert (r.value > 0.0) is conflict
+    assert r.failed is conflict
+    assert (r.value is not None and r.value > 0.0) is conflict
+    if not conflict:  # nobody on the crosswalk in the ego's lane: nothing to judge
+        assert r.passed is None and r.value is None
 
 
 def test_the_lane_is_where_the_tyres_are() -> None:
     """In lane 1, a pedestrian in lane 0 more than 1 m from lane 1 does not count, one in
     lane 1 does; straddling both lanes, both count."""
     far = (ZEBRA_S + 2.0, -1.0)
-    assert crosswalk_run(far, offset=W).result().passed
-    assert not crosswalk_run((ZEBRA_S + 2.0, W), offset=W).result().passed
-    assert not crosswalk_run(far, offset=W / 2).result().passed
+    assert crosswalk_run(far, offset=W).result().passed is None  # not in its lane
+    assert crosswalk_run((ZEBRA_S + 2.0, W), offset=W).result().failed
+    assert crosswalk_run(far, offset=W / 2).result().failed
 
 
 def test_other_actors_on_the_crosswalk_do_not_count() -> None:
     r = crosswalk_run((ZEBRA_S + 2.0, 0.0), kinds=[ActorType.CAR]).result()
-    assert r.passed and r.value == 0.0
+    assert r.passed is None and r.value is None
+    assert r.note == "no pedestrian was on a crosswalk in the ego's lane"
 
 
-def test_no_crosswalk_passes_with_value_zero() -> None:
+def test_no_crosswalk_is_not_applicable() -> None:
     c = Crosswalks(road(StopSign(STOP_S)))
     assert c.idle  # no crosswalk: the samples need not carry the actors
     drive(c, lambda t: (120.0 + 5.0 * t, 5.0), 12.0, actors=walkers((ZEBRA_S, 0.0)))
     r = c.result()
-    assert r.passed and r.value == 0.0 and r.first_failure is None
+    assert r.passed is None and r.value is None and r.first_failure is None
+    assert r.note == "no crosswalk on the route"
 
 
 # -- speed_bumps ---------------------------------------------------------------------------
@@ -285,11 +291,12 @@ def test_the_samples_axle_stations_are_used() -> None:
     assert not c.result().passed
     c = SpeedBumps(road(BUMP), FRONT_AXLE, REAR_AXLE)
     c.update(sample(0.0, 30 * KPH, BUMP_S, axles=(150.0, 147.3)))
-    assert c.result().passed and c.result().value == 0.0
+    assert c.result().passed is None and c.result().note == "no axle came near a speed bump"
 
 
-def test_no_bump_passes_with_value_zero() -> None:
+def test_no_bump_is_not_applicable() -> None:
     c = SpeedBumps(road(StopSign(STOP_S)), FRONT_AXLE, REAR_AXLE)
     c.update(sample(0.0, 30 * KPH, BUMP_S))
     r = c.result()
-    assert r.passed and r.value == 0.0 and r.first_failure is None
+    assert r.passed is None and r.value is None and r.first_failure is None
+    assert r.note == "no speed bump on the route"

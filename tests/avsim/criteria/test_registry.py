@@ -17,7 +17,13 @@ from pydantic import BaseModel
 
 from avsim.criteria.base import Criterion, Need, TruthSample
 from avsim.criteria.declaration import Declaration, RunInputs
-from avsim.criteria.registry import DECLARATIONS, CriteriaSettings, build_criteria, keyed
+from avsim.criteria.registry import (
+    DECLARATIONS,
+    CriteriaSettings,
+    build_criteria,
+    keyed,
+    setting_keys,
+)
 from avsim.scenario.load import ScenarioError, load_scenario
 from avsim.scenario.model import CriteriaModel
 from avsim.scenario.schema import scenario_json_schema
@@ -43,7 +49,7 @@ def run_inputs(road: Any = ROAD) -> RunInputs:
 
 
 ALWAYS = ["no_collision", "tyres_in_lane", "speed_limit", "stop_signs", "red_lights",
-          "crosswalks", "speed_bumps", "completes"]
+          "crosswalks", "speed_bumps", "completes", "minimum_risk_stop", "story"]
 
 
 def scenario_file(tmp_path: Path, criteria: object) -> Path:
@@ -169,14 +175,16 @@ def test_the_schema_lists_every_key_with_its_doc_and_example() -> None:
 
     schema = scenario_json_schema()
     section = schema["$defs"]["CriteriaModel"]
-    assert list(section["properties"]) == [d.key for d in keyed()]
+    assert list(section["properties"]) == list(setting_keys())
+    assert setting_keys()[-1] == "completes"  # the one switch: `completes: false`
+    assert section["properties"]["completes"]["anyOf"][0] == {"type": "boolean"}
     assert section["additionalProperties"] is False
     for d in keyed():
         field = section["properties"][d.key]
         assert field["description"] == d.doc
         assert field["examples"] == [d.example]
     top = schema["properties"]["criteria"]["description"]
-    assert all(str(d.key) in top for d in keyed())
+    assert all(key in top for key in setting_keys())
     validator = jsonschema.Draft202012Validator(schema)
     file = yaml.safe_load(scenario_file_text({d.key: d.example for d in keyed()}))
     validator.validate(file)
@@ -191,6 +199,7 @@ def scenario_file_text(criteria: object) -> str:
 
 def test_the_docs_name_every_key_and_every_field_of_a_setting() -> None:
     doc = DOC.read_text(encoding="utf-8")
+    assert "| `completes` |" in doc
     for d in keyed():
         assert f"| `{d.key}` |" in doc, f"no row for criteria key {d.key} in {DOC.name}"
         if isinstance(d.setting, type) and issubclass(d.setting, BaseModel):
@@ -225,7 +234,7 @@ def poses(station: float) -> ActorPoses:
 def samples(with_actors: bool) -> list[TruthSample]:
     """40 s at 40 Hz along the featured road, through its stop line, crosswalk, bump and
     light: 10 m/s, slowing to a stand and on again, touching a body for a moment, a lane
-    change commanded in between; the NPCs' poses in each, or (without) a stand-in that
+    change to lane 1 in between; the NPCs' poses in each, or (without) a stand-in that
     fails when used."""
     out = []
     station = 250.0
@@ -234,13 +243,14 @@ def samples(with_actors: bool) -> list[TruthSample]:
         speed = 10.0 if k < 400 or k > 600 else max(0.0, 10.0 - 0.1 * (k - 400))
         station += speed / RATE
         changing = 800 <= k < 900
+        d = 3.5 * min(1.0, max(0.0, (k - 800) / 100))  # lane 0's centre to lane 1's
         out.append(TruthSample(
             t=t, speed=speed, station=station, front_station=station + 2.4,
             tyres=np.zeros((4, 2)), tyre_stations=station + np.array([1.35, 1.35, -1.35, -1.35]),
-            tyre_offsets=np.array([0.8, -0.8, 0.8, -0.8]),
+            tyre_offsets=d + np.array([0.8, -0.8, 0.8, -0.8]), offset=d,
             touching=frozenset({BODY}) if 100 <= k < 110 else frozenset(),
             actors=poses(station) if with_actors else Withheld(Need.ACTORS),  # type: ignore[arg-type]
-            lane=1 if changing else 0, origin_lane=0, lateral_accel=0.1 * changing,
+            lateral_accel=0.1 * changing,
             xy=(station, 0.0)))
     return out
 
@@ -281,3 +291,11 @@ def test_the_samples_carry_the_actors_only_when_a_criterion_needs_them(
         road: Any, settings: dict[str, object], actors: bool) -> None:
     needs = build_criteria(CriteriaSettings.of(settings), run_inputs(road)).needs
     assert (Need.ACTORS in needs) is actors
+
+
+def test_completes_false_turns_route_completion_off(tmp_path: Path) -> None:
+    settings = load_scenario(scenario_file(tmp_path, {"completes": False})).criteria
+    assert "completes" not in names(settings)
+    assert names(CriteriaSettings.of({"completes": True})) == ALWAYS
+    with pytest.raises(ScenarioError, match="completes"):
+        load_scenario(scenario_file(tmp_path, {"completes": "no"}))

@@ -9,7 +9,6 @@ wiring is checked with the simulator replaced by a stand-in that returns that ru
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from pathlib import Path
 
@@ -26,7 +25,6 @@ from avsim.run.runner import RunResult, TrajectoryLog
 from avsim.scenario.load import load_scenario
 from planner.fsm.acc import AccMode
 from planner.messages import SpeedSource
-from world.spec import ActorSpec, ActorType
 
 REPO = Path(__file__).parents[3]
 TRAFFIC_JAM = REPO / "scenarios" / "traffic_jam.yaml"
@@ -63,9 +61,9 @@ def synthetic_result(passed: bool = True) -> RunResult:
         log.speed_limit.append(50 / 3.6)
         log.acc_mode.append(_mode_at(t))
         log.speed_source.append(SOURCES[_mode_at(t)])
-        lead_offset = 0.0 if t < LEAD_LEAVES else LANE_WIDTH
-        log.actor_station.append(np.array([lead_s, beside_s]))
-        log.actor_offset.append(np.array([lead_offset, LANE_WIDTH]))
+        ahead = t < LEAD_LEAVES  # then it moves to lane 1: no vehicle ahead
+        log.lead_gap.append(lead_s - ego_s - 4.8 if ahead else math.nan)
+        log.lead_speed.append(lead_v if ahead else math.nan)
         ego_s += ego_v * dt
         lead_s = ego_s + 30.0 if t < 1 else lead_s + lead_v * dt
         beside_s += 15.0 * dt
@@ -75,36 +73,16 @@ def synthetic_result(passed: bool = True) -> RunResult:
                      sim_time=DURATION, wall_time=1.0, log=log, recording=None)
 
 
-def test_lead_speed_is_the_nearest_vehicle_ahead_in_the_lane() -> None:
+def test_lead_speed_is_the_runs_vehicle_ahead_from_the_truth() -> None:
+    """The plot draws the log's lead (`world.truth.vehicles_ahead`, tested there): a gap in
+    the line where there is none."""
     result = synthetic_result()
     t = result.log.array("t")
     lead = plot.lead_speed(result)
     assert lead.shape == t.shape
-    steady_fast = (t > 2) & (t < 29.9)
-    steady_slow = (t > 30.1) & (t < LEAD_LEAVES - 0.1)
-    np.testing.assert_allclose(lead[steady_fast], 10.0, atol=1e-6)
-    np.testing.assert_allclose(lead[steady_slow], 5.0, atol=1e-6)
-    # once the lead is in lane 1 there is none: the car there (15 m/s) never counts
+    np.testing.assert_allclose(lead[t < 30], 10.0)
+    np.testing.assert_allclose(lead[(t >= 30) & (t < LEAD_LEAVES)], 5.0)
     assert np.isnan(lead[t >= LEAD_LEAVES]).all()
-    assert not np.any(np.isclose(lead, 15.0))
-
-
-def test_lead_speed_without_vehicles_is_all_nan() -> None:
-    result = synthetic_result()
-    world = result.scenario.world
-
-    def with_actors(*actors: ActorSpec) -> RunResult:
-        scenario = dataclasses.replace(result.scenario,
-                                       world=dataclasses.replace(world, actors=actors))
-        return dataclasses.replace(result, scenario=scenario)
-
-    alone = with_actors()
-    assert np.isnan(plot.lead_speed(alone)).all()
-    # a pedestrian or an obstacle is never a lead
-    walker = dataclasses.replace(world.actors[0], type=ActorType.PEDESTRIAN)
-    box = dataclasses.replace(world.actors[1], type=ActorType.OBSTACLE)
-    others = with_actors(walker, box)
-    assert np.isnan(plot.lead_speed(others)).all()
 
 
 def test_mode_runs_cover_the_run_without_gaps() -> None:

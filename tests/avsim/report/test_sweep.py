@@ -62,7 +62,8 @@ def _outcome(gap: object, speed: object, tmp: Path, extra: dict[str, object] | N
     ]
     result: dict[str, object] = {
         "scenario": "cut_in", "file": "cut_in.yaml", "seed": 1, "profile": "none",
-        "passed": all(c["passed"] for c in criteria), "sim_time": 20.0, "wall_time": 1.0,
+        "passed": all(c["passed"] is not False for c in criteria), "sim_time": 20.0,
+        "wall_time": 1.0,
         "criteria": criteria, "metrics": {"collisions": float(contact), "max_decel": None},
         "state_changes": [], "recording": "x.rrd"}
     status = Status.PASSED if result["passed"] else Status.FAILED
