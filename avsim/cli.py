@@ -21,6 +21,7 @@ from rich.table import Table
 from avsim.files import write_atomic
 from avsim.run.result import dumps, result_json
 from avsim.scenario.load import ScenarioError, bundled_scenarios, load_scenario
+from avsim.scenario.profile_fit import check_profile
 from avsim.scenario.schema import scenario_json_schema
 
 if TYPE_CHECKING:
@@ -71,14 +72,26 @@ def main() -> None:
               help="Also write the speed profile (ego, lead, limit and set speed over time, "
                    "ACC / event mode as bands; the DECS paper's Fig. 3) as a 1600x700 PNG. "
                    "Without a value: next to the recording, <name>.png")
+@click.option("--set", "sets", multiple=True, metavar="PATH=VALUE",
+              help="Set a key of the file before validation, as sweep does (one value).")
 @click.option("--no-progress", is_flag=True, help="No progress bar.")
 def run(scenario: str, out: Path | None, json_path: Path | None, profile: str, sensing: str,
-        seed: int | None, plot: str | None, no_progress: bool) -> None:
+        seed: int | None, sets: tuple[str, ...], plot: str | None, no_progress: bool) -> None:
     """Run SCENARIO (a file or a bundled name) and judge it."""
-    overrides = {"seed": seed} if seed is not None else None
+    from avsim.batch.sweep import SweepError, parse_set
+
+    overrides: dict[str, object] = {}
     try:
+        for text in sets:
+            axis = parse_set(text)
+            if len(axis.values) != 1:
+                raise SweepError(f"--set {text}: run takes one value (sweep takes several)")
+            overrides[axis.path] = axis.values[0]
+        if seed is not None:
+            overrides["seed"] = seed
         loaded = load_scenario(scenario, overrides)
-    except ScenarioError as exc:
+        check_profile(loaded, profile, scenario)
+    except (ScenarioError, SweepError) as exc:
         _bad_input(str(exc))
     out = out if out is not None else Path("runs") / f"{loaded.name}.rrd"
     json_path = json_path if json_path is not None else out.with_suffix(".json")

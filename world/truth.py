@@ -14,15 +14,17 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
-from pybullet_utils.bullet_client import BulletClient
 
 from vehicle_urdf import CarGeometry
-from world.ego.body import EgoTruth
 from world.hdmap import ReferenceLine, RoadMap
 from world.spec import ActorType
 
-if TYPE_CHECKING:
+if TYPE_CHECKING:  # types only: the criteria import this module, the loader them, and no
+    #   scenario file is read with PyBullet loaded
+    from pybullet_utils.bullet_client import BulletClient
+
     from world.actors.actor_set import ActorPoses
+    from world.ego.body import EgoTruth
 
 
 def body_axes(truth: EgoTruth) -> tuple[NDArray[np.float64], NDArray[np.float64]]:

@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING
 
 from avsim.files import write_atomic
 from avsim.scenario.load import ScenarioError, load_scenario
+from avsim.scenario.profile_fit import check_profile
 
 if TYPE_CHECKING:
     from avsim.scenario.scenario import Scenario
@@ -140,6 +141,7 @@ def run_job(job: RunJob, into: Path | None = None,
     start = time.perf_counter()
     try:
         scenario = load_scenario(job.scenario, dict(job.overrides))
+        check_profile(scenario, job.profile, job.scenario)
     except ScenarioError as exc:
         return RunOutcome(job, Status.BAD_INPUT, error=str(exc),
                           wall_time=time.perf_counter() - start)

@@ -26,6 +26,7 @@ from avsim.batch.jobs import RunJob, RunOutcome, Status
 from avsim.files import write_atomic
 from avsim.run.result import dumps
 from avsim.scenario.load import bundled_scenarios, load_scenario
+from avsim.scenario.profile_fit import check_profile
 
 SNAPSHOT_DIR = "snapshots"  # the failed runs' pictures, below the batch's folder
 
@@ -61,6 +62,7 @@ def plan(entries: Sequence[tuple[str | None, str, Mapping[str, object]]], out_di
     names: dict[str, str] = {}
     for name, scenario, overrides in entries:
         loaded = load_scenario(scenario, dict(overrides))
+        check_profile(loaded, profile, scenario)
         job_name = name or loaded.name
         if job_name in names:
             raise BatchError(f"{scenario}: name: {job_name!r} is also the name of "

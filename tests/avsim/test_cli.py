@@ -92,6 +92,16 @@ def _inputs(directory: Path) -> dict[str, Case]:
     cases["out_is_a_directory"] = Case(
         ("run", "normal_driving", "--out", "tmp", "--json", "tmp/x.json", "--no-progress"),
         "tmp", "--out")
+    cases["run_set_two_values"] = Case(
+        (*_run_args("normal_driving"), "--set", "actors.0.speed_kph=20,30"), "--set",
+        "actors.0.speed_kph")
+    cases["run_set_bad_path"] = Case((*_run_args("normal_driving"), "--set",
+                                      "actors.7.speed_kph=20"), "normal_driving", "actors.7")
+    cases["run_set_bad_value"] = Case((*_run_args("normal_driving"), "--set", "duration=-3"),
+                                      "normal_driving", "duration")
+    # a profile that cannot run the scenario honestly: no camera to read its lights
+    cases["lights_without_a_camera"] = Case(
+        (*_run_args("traffic_light"), "--profile", "none"), "traffic_light", "road.features")
     a_file = directory / "a_file.txt"
     a_file.write_text("not a directory\n", encoding="utf-8")
     below_file = str(a_file / "sub" / "x.rrd")
@@ -126,7 +136,8 @@ OTHER: dict[str, Case] = {
 
 BAD_CASE_NAMES = [f"fixture_{stem}" for stem in SUBPROCESS_FIXTURES] + [
     "missing_file", "missing_bundled_name", "empty_file", "only_comments", "unknown_key",
-    "out_is_a_directory", "out_below_a_file",
+    "out_is_a_directory", "out_below_a_file", "run_set_two_values", "run_set_bad_path",
+    "run_set_bad_value", "lights_without_a_camera",
 ]
 
 
@@ -256,3 +267,27 @@ def test_unknown_profile_is_a_usage_error(outcomes: dict[str, Outcome]) -> None:
     assert "--profile" in out.stderr and "bogus" in out.stderr
     assert out.stdout == ""
     assert [p.name for p in out.cwd.iterdir()] == ["tmp"]
+
+
+def strict_json(text: str) -> object:
+    """`text` parsed as strict JSON: NaN and the infinities (Python's extension) refused."""
+    def refuse(constant: str) -> object:
+        raise ValueError(f"not strict JSON: {constant}")
+    return json.loads(text, parse_constant=refuse)
+
+
+def test_run_set_overrides_a_key_and_the_result_is_strict_json(tmp_path: Path) -> None:
+    proc = subprocess.run(
+        [sys.executable, "-m", "avsim.cli", "run", "normal_driving", "--profile", "none",
+         "--set", "duration=2.5", "--set", "ego.set_speed_kph=30", "--out",
+         str(tmp_path / "x.rrd"), "--no-progress"],
+        cwd=tmp_path, capture_output=True, text=True, timeout=120, check=False)
+    assert proc.returncode == 1, proc.stderr  # stopped at 2.5 s: not completed
+    result = strict_json((tmp_path / "x.json").read_text(encoding="utf-8"))
+    assert isinstance(result, dict) and result["sim_time"] == 2.5
+    verdicts = {c["name"]: c["verdict"] for c in result["criteria"]}
+    assert verdicts["completes"] == "fail" and verdicts["stop_signs"] == "not_applicable"
+    assert all(c["value"] is None for c in result["criteria"]
+               if c["verdict"] == "not_applicable")
+    with pytest.raises(ValueError, match="not strict JSON"):
+        strict_json('{"value": Infinity}')

@@ -6,10 +6,13 @@ change meant to keep behaviour shows that it does, to the last bit. A change mea
 behaviour rewrites them with `make golden` (which sets ``AVSIM_GOLDEN=write``), and its
 commit says which behaviour changed and why.
 
-What is compared: every criterion (all fields), every metric, every state change of the
-machines the golden file lists, the simulated time and a SHA-256 of the ego's trajectory
-(`TRAJECTORY`, as float64 bytes). Wall time is not kept. Keys and state machines a later
-change adds are not in the older golden files, and are set aside.
+What is compared: every criterion (all fields), every metric, the story, every state change
+of the machines the golden file lists, the simulated time and a SHA-256 of the ego's
+trajectory (`TRAJECTORY`, as float64 bytes). Wall time is not kept. Keys and state machines
+a later change adds are not in the older golden files, and are set aside.
+
+Every run checked here also has its result file (`avsim.run.result`) parsed by a strict
+JSON parser: no NaN, no infinities.
 """
 
 from __future__ import annotations
@@ -23,6 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
+from avsim.run.result import dumps, result_json
 from avsim.run.runner import RunResult
 
 GOLDEN_DIR = Path(__file__).resolve().parent / "golden"
@@ -46,6 +50,7 @@ def record(result: RunResult) -> dict[str, object]:
         "sim_time": result.sim_time,
         "criteria": [dataclasses.asdict(c) for c in result.criteria],
         "metrics": dict(result.metrics),
+        "story": [dataclasses.asdict(e) for e in result.story],
         "machines": sorted({c["machine"] for c in changes}),
         "state_changes": changes,
         "trajectory_sha256": digest.hexdigest(),
@@ -56,6 +61,8 @@ def check(result: RunResult, label: str) -> None:
     """Assert that `result` equals the golden file `label`.json (or write it, with
     ``AVSIM_GOLDEN=write``)."""
     path = GOLDEN_DIR / f"{label}.json"
+    strict_json(dumps(result_json(result, f"{label}.yaml", Path(f"{label}.rrd"),
+                                  result.profile or "none")))
     now = record(result)
     if WRITE:
         GOLDEN_DIR.mkdir(exist_ok=True)
@@ -99,3 +106,10 @@ def _same(a: object, b: object) -> bool:
     if isinstance(a, float) and isinstance(b, float | int) and not isinstance(b, bool):
         return a == b or (math.isnan(a) and math.isnan(float(b)))
     return a == b
+
+
+def strict_json(text: str) -> object:
+    """`text` parsed as strict JSON: NaN and the infinities (Python's extension) refused."""
+    def refuse(constant: str) -> object:
+        raise AssertionError(f"the result file is not strict JSON: {constant}")
+    return json.loads(text, parse_constant=refuse)

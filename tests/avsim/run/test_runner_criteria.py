@@ -100,7 +100,7 @@ def test_the_samples_carry_the_npc_poses_only_when_a_criterion_needs_them(
     result = runner.run()
     assert len(seen) == 20  # 0.5 s at 40 Hz
     assert set(seen) == {sampled}
-    assert [c.name for c in result.criteria][:8] == [
+    assert [c.name for c in result.criteria][:10] == [
         "no_collision", "tyres_in_lane", "speed_limit", "stop_signs", "red_lights",
-        "crosswalks", "speed_bumps", "completes"]
-    assert [c.name for c in result.criteria][8:] == list(criteria)
+        "crosswalks", "speed_bumps", "completes", "minimum_risk_stop", "story"]
+    assert [c.name for c in result.criteria][10:] == list(criteria)
