@@ -9,6 +9,8 @@ truth in the run's log."""
 
 from __future__ import annotations
 
+import dataclasses
+import math
 from collections.abc import Callable
 from pathlib import Path
 
@@ -31,9 +33,9 @@ def scenario(tmp_path: Path, name: str, *, speed_kph: float, limit_kph: float = 
              features: list[dict[str, object]] | None = None,
              actors: list[dict[str, object]] | None = None,
              criteria: dict[str, object] | None = None, duration: float = 12.0,
-             events: list[dict[str, object]] | None = None) -> Path:
+             events: list[dict[str, object]] | None = None, lanes: int = 1) -> Path:
     text = {"format": "avsim/1", "name": name, "duration": duration,
-            "road": {"lanes": 1, "shoulder": 2.5, "speed_limit_kph": limit_kph,
+            "road": {"lanes": lanes, "shoulder": 2.5, "speed_limit_kph": limit_kph,
                      "segments": [{"straight": 400}], "features": features or []},
             "events": events or [],
             "ego": {"s": 10, "speed_kph": speed_kph, "set_speed_kph": speed_kph,
@@ -44,16 +46,20 @@ def scenario(tmp_path: Path, name: str, *, speed_kph: float, limit_kph: float = 
     return path
 
 
-def reckless(path: Path, driver: Driver) -> RunResult:
-    """Run `path` without sensors, the stack's commands replaced by `driver`'s torques and a
-    straight wheel."""
+def reckless(path: Path, driver: Driver, steer: Callable[[float], float] = lambda t: 0.0,
+             declare: tuple[int, int] | None = None) -> RunResult:
+    """Run `path` without sensors, the stack's commands replaced by `driver`'s torques and
+    `steer`'s wheel angle [rad]; with `declare` (lane, origin lane) its plan claims that
+    lane change all along."""
     runner = Runner(load_scenario(path), None, profile=None)
     stack_tick = runner.stack.tick
 
     def tick(t: float, dt: float) -> StackOutput:
         out = stack_tick(t, dt)
+        plan = out.plan if declare is None else dataclasses.replace(
+            out.plan, lane=declare[0], origin_lane=declare[1])
         drive, brake = driver(t)
-        return StackOutput(out.plan, VehicleCommand(0.0, drive, brake, 0.0))
+        return StackOutput(plan, VehicleCommand(steer(t), drive, brake, 0.0))
 
     runner.stack.tick = tick  # type: ignore[method-assign]
     return runner.run()
@@ -129,3 +135,21 @@ def test_a_panic_stop_in_lane_after_a_flat_tyre_is_no_minimum_risk_stop(tmp_path
     assert mrm.note == "it stood off the shoulder, which the road has there"
     completes = next(c for c in result.criteria if c.name == "completes")
     assert completes.passed is False  # the stop does not count as completion
+
+
+def test_a_stack_that_declares_a_lane_change_but_weaves_fails_tyres_in_lane(
+        tmp_path: Path) -> None:
+    """Its plan says "lane 1 from lane 0" the whole run; the car swerves over the line and
+    back. The criterion judges the tyres, not the claim."""
+    path = scenario(tmp_path, "weave", speed_kph=40, lanes=2, duration=8)
+
+    def swerve(t: float) -> float:  # one period of cos from 1 to 4 s: out by ~1.2 m and back
+        return 0.055 * math.cos(2.0 * math.pi * (t - 1.0) / 3.0) if 1.0 < t < 4.0 else 0.0
+
+    result = reckless(path, lambda t: (350.0, 0.0), steer=swerve, declare=(1, 0))
+    assert all(lane == 1 for lane in result.log.lane)  # the claim, all along
+    lateral = result.log.array("lane_error")
+    assert lateral.max() > 0.9 and abs(lateral[-1]) < 0.9  # over the line (tyres) and back
+    tyres = next(c for c in result.criteria if c.name == "tyres_in_lane")
+    assert tyres.passed is False and tyres.value is not None and tyres.value < 0.0
+    assert any("no lane change" in i.message for i in result.infractions)
