@@ -507,6 +507,9 @@ class RoadMap:
         shoulder = np.array([c.shoulder for c in sections])
         self.shoulder = Lane(SHOULDER, self.line, -0.5 * (w + shoulder), shoulder > 0.0,
                              shoulder)
+        self.section_lanes: IntArray = n_ego  # [-] per segment: `CrossSection.lanes`
+        self.section_widths: FloatArray = w  # [m] per segment: `CrossSection.lane_width`
+        self.section_shoulders: FloatArray = shoulder  # [m] per segment: the shoulder's width
         self._limit_s: FloatArray = np.array([p.s for p in speed_limits])
         self._limit_v: FloatArray = np.array([p.limit for p in speed_limits])
 

@@ -61,9 +61,7 @@ def footprint(road: RoadMap, sample: TruthSample, half_tread: float) -> Footprin
     """The footprint of `sample`'s tyres on `road` (`half_tread`: [m] a tyre's half width)."""
     s, y = sample.tyre_stations, sample.tyre_offsets
     seg = road.line.segment_index(s)
-    sections = [road.sections[int(i)] for i in seg]
-    w = np.array([c.lane_width for c in sections])
-    n = np.array([c.lanes for c in sections])
+    w, n = road.section_widths[seg], road.section_lanes[seg]
     c0 = np.asarray(road.lane(0).offset_at(s), dtype=np.float64)
     top = c0 + (n - 0.5) * w  # the leftmost lane's left edge
     bottom = c0 - 0.5 * w  # lane 0's right edge
@@ -71,7 +69,7 @@ def footprint(road: RoadMap, sample: TruthSample, half_tread: float) -> Footprin
     if junction:
         margins = np.minimum(y - half_tread - bottom, top - (y + half_tread))
         return Footprint(None, float(margins.min()), (math.inf, math.inf), True)
-    shoulder = np.array([c.shoulder for c in sections]) if sample.flat else np.zeros(4)
+    shoulder = road.section_shoulders[seg] if sample.flat else np.zeros(4)
     low = np.where(shoulder > 0.0, bottom - shoulder, bottom + LINE_HALF_WIDTH)
     margins = np.minimum(y - half_tread - low, top - LINE_HALF_WIDTH - (y + half_tread))
     band = np.floor((y - c0 + 0.5 * w) / w)  # the lane whose edges hold the patch centre
