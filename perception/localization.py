@@ -1,30 +1,46 @@
-"""The car's own pose estimate: an EKF fusing GNSS fixes with wheel odometry and the gyro.
+"""The car's own pose estimate: an EKF fusing GNSS fixes, wheel odometry and the gyro, and
+the camera's lane on the HD map (map matching).
 
-State (map frame, car centre): ``[x, y, heading, speed, yaw_rate]`` in ``[m, m, rad, m/s,
-rad/s]``, heading counter-clockwise from +x, wrapped to (-pi, pi].
+State (map frame, car centre): ``[x, y, heading, speed, yaw_rate, bias_x, bias_y]`` in
+``[m, m, rad, m/s, rad/s, m, m]``, heading counter-clockwise from +x, wrapped to (-pi, pi];
+``bias_*`` is the GNSS receiver's slowly wandering error (a fix measures position + bias).
 
 Steps:
 
-1. The first GNSS fix initialises the state (speed and yaw rate from the latest odometry
-   sample, if one came before it, else zero with ``init_*_sigma``). Odometry before that is
-   only remembered.
+1. The first valid GNSS fix initialises the state (speed and yaw rate from the latest
+   odometry sample, if one came before it, else zero with ``init_*_sigma``; the bias zero
+   with the receiver's stated sigma, so that position + bias is known to the white noise).
+   Odometry before that is only remembered.
 2. Predict to every sample's time with a unicycle model evaluated at the midpoint heading
    (``x += v dt cos(psi + w dt / 2)``, ...): it matches the exact constant-turn-rate (CTRV)
    chord up to a relative length error of ``(w dt)^2 / 24``, negligible at odometry rates,
    and its Jacobian has no ``w -> 0`` singularity. Process noise: white longitudinal and yaw
    acceleration (``accel_sigma``, ``yaw_accel_sigma``) plus a random walk on position and
-   heading (``position_walk``, ``heading_walk``: slip, tyre radius error).
+   heading (``position_walk``, ``heading_walk``: slip, tyre radius error). The bias is a
+   first-order Gauss-Markov process (``gnss_bias_tau``) of 1-sigma the receiver's stated
+   accuracy.
 3. Update at every odometry sample with its speed (mean rear wheel spin x nominal radius)
-   and the gyro yaw rate, and at every GNSS fix with its position and heading (the noise the
-   larger of the fix's own sigma and ``gnss_sigma`` / ``gnss_heading_sigma``); the heading
-   innovation is wrapped to (-pi, pi].
+   and the gyro yaw rate, and at every valid GNSS fix with position + bias and heading (the
+   white noise ``gnss_white`` x the fix's stated sigma, at least ``gnss_sigma``; the heading
+   noise the larger of the fix's own and ``gnss_heading_sigma``); an invalid fix (an
+   outage) is skipped. The heading innovation is wrapped to (-pi, pi].
+4. Map matching (`on_lane`): a confident camera lane estimate gives the car's lateral
+   offset from a lane centre and its heading relative to the lane. The lane is the HD map's
+   ego-direction lane that puts the car nearest the estimate (before the first match: the
+   lane the car starts in, since a GNSS bias may exceed half a lane). The pseudo-measurement
+   is the estimate projected onto that lane (its station kept) with the camera's lateral
+   offset and heading in place of its own; the innovation is taken against the pose the
+   stack had at the frame's time (the frame arrives late) and applied now. It is gated by
+   its Mahalanobis distance (``lane_gate``), so a reading that would put the car in another
+   place than the estimate allows (a wrong lane, a misdetection) is rejected.
 
-A constant GNSS bias is NOT observable here: odometry measures only speed and yaw rate, never
-absolute position, so the estimate follows the biased fixes (offset by the bias). Removing it
-needs another absolute reference (map matching of camera lane lines, landmarks).
+So the camera pins the lateral position and heading while it sees the lane; the station
+along the route comes from the odometry (the map's stations of the dead-reckoned pose), and
+GNSS only bounds the drift through the bias's mean reversion. Without the camera, a GNSS
+bias cannot be separated from the position: the estimate follows the biased fixes.
 
 The filter's update step is filterpy's `ExtendedKalmanFilter.update` (Joseph form) with our
-own Jacobians; the prediction is done here because the model is non-linear.
+own Jacobians; the prediction and the gated map-matching update are done here.
 """
 
 from __future__ import annotations
@@ -36,17 +52,19 @@ import numpy as np
 from filterpy.kalman import ExtendedKalmanFilter
 from numpy.typing import NDArray
 
-from perception.messages import EgoState
+from perception.messages import EgoState, LaneEstimate
 from world.frames import GnssFix, Odometry, wrap_angle
+from world.hdmap import Lane, RoadMap
 
 FloatArray = NDArray[np.float64]
 
-DIM_X = 5
-IX, IY, IPSI, IV, IW = range(DIM_X)
+DIM_X = 7
+IX, IY, IPSI, IV, IW, IBX, IBY = range(DIM_X)
 DEG = math.pi / 180.0  # [rad/deg]
 
-_H_GNSS = np.eye(DIM_X)[[IX, IY, IPSI]]  # (3, 5) x, y, heading
-_H_ODO = np.eye(DIM_X)[[IV, IW]]  # (2, 5) speed, yaw rate
+_H_GNSS = np.eye(DIM_X)[[IX, IY, IPSI]] + np.eye(DIM_X)[[IBX, IBY, IPSI]] * [[1], [1], [0]]
+#   (3, 7): position + bias, heading
+_H_ODO = np.eye(DIM_X)[[IV, IW]]  # (2, 7) speed, yaw rate
 
 
 class NotInitialisedError(RuntimeError):
@@ -57,8 +75,10 @@ class NotInitialisedError(RuntimeError):
 class LocalizerParams:
     """Measurement and process noise (1-sigma) of the localization EKF."""
 
-    gnss_sigma: float = 0.05  # [m] position noise floor; the fix's own larger sigma wins
-    gnss_heading_sigma: float = 0.2 * DEG  # [rad] heading noise floor, as above
+    gnss_sigma: float = 0.05  # [m] white position noise floor of a fix
+    gnss_white: float = 0.25  # [-] the white part of a fix's stated sigma (the rest wanders)
+    gnss_heading_sigma: float = 0.2 * DEG  # [rad] heading noise floor; the fix's larger wins
+    gnss_bias_tau: float = 60.0  # [s] correlation time assumed for the GNSS bias
     wheel_speed_sigma: float = 0.05  # [m/s] odometry speed noise
     gyro_sigma: float = 0.005  # [rad/s] gyro yaw-rate noise
     accel_sigma: float = 3.0  # [m/s^2] white longitudinal acceleration (process)
@@ -67,10 +87,27 @@ class LocalizerParams:
     heading_walk: float = 0.001  # [rad/sqrt(s)] heading random walk (gyro/heading slip)
     init_speed_sigma: float = 1.0  # [m/s] initial speed uncertainty (no odometry before fix)
     init_yaw_rate_sigma: float = 0.1  # [rad/s] initial yaw-rate uncertainty, as above
+    lane_offset_sigma: float = 0.15  # [m] camera lane offset noise (its frames' errors are
+    #   correlated: about 4 x the 0.04 m RMS error measured on normal_driving)
+    lane_heading_sigma: float = 1.0 * DEG  # [rad] camera heading-to-lane noise (0.66 deg RMS)
+    lane_confidence: float = 0.5  # [-] a lane estimate this confident is a measurement
+    lane_gate: float = 13.8  # [-] Mahalanobis distance^2 gate (chi^2, 2 dof, 99.9 %)
+
+
+@dataclass(frozen=True, slots=True)
+class LaneMatch:
+    """What one map-matching update did."""
+
+    lane: int  # the map lane the camera's lane was matched with
+    innovation: tuple[float, float]  # [m, rad] lateral offset, heading: camera minus pose
+    distance2: float  # [-] its squared Mahalanobis distance
+    accepted: bool  # within the gate, applied
+    correction: tuple[float, float, float]  # [m, m, rad] x, y, heading added to the state
 
 
 def motion(x: FloatArray, dt: float) -> tuple[FloatArray, FloatArray]:
-    """Propagate state ``x`` (5,) by ``dt`` [s]; return (x', F) with F the (5, 5) Jacobian."""
+    """Propagate state ``x`` by ``dt`` [s]; return (x', F) with F its Jacobian. The pose
+    moves, the rest (and any bias states after the first five) stays."""
     psi, v, w = x[IPSI], x[IV], x[IW]
     a = psi + 0.5 * w * dt  # [rad] midpoint heading
     c, s = math.cos(a), math.sin(a)
@@ -78,7 +115,7 @@ def motion(x: FloatArray, dt: float) -> tuple[FloatArray, FloatArray]:
     out[IX] += v * dt * c
     out[IY] += v * dt * s
     out[IPSI] = wrap_angle(psi + w * dt)
-    f = np.eye(DIM_X)
+    f = np.eye(len(x))
     f[IX, IPSI] = -v * dt * s
     f[IX, IV] = dt * c
     f[IX, IW] = -0.5 * v * dt * dt * s
@@ -90,18 +127,16 @@ def motion(x: FloatArray, dt: float) -> tuple[FloatArray, FloatArray]:
 
 
 def process_noise(x: FloatArray, dt: float, p: LocalizerParams) -> FloatArray:
-    """(5, 5) discrete process noise for a step of ``dt`` [s] from state ``x``."""
+    """(7, 7) discrete process noise of the pose and motion for a step of ``dt`` [s] from
+    state ``x`` (the bias's is added by the filter, which knows its sigma)."""
     a = x[IPSI] + 0.5 * x[IW] * dt
     half_dt2 = 0.5 * dt * dt
-    g = np.array(
-        [
-            [half_dt2 * math.cos(a), 0.0],
-            [half_dt2 * math.sin(a), 0.0],
-            [0.0, half_dt2],
-            [dt, 0.0],
-            [0.0, dt],
-        ]
-    )
+    g = np.zeros((DIM_X, 2))
+    g[IX, 0] = half_dt2 * math.cos(a)
+    g[IY, 0] = half_dt2 * math.sin(a)
+    g[IPSI, 1] = half_dt2
+    g[IV, 0] = dt
+    g[IW, 1] = dt
     q: FloatArray = (g * [p.accel_sigma**2, p.yaw_accel_sigma**2]) @ g.T
     q[IX, IX] += p.position_walk**2 * dt
     q[IY, IY] += p.position_walk**2 * dt
@@ -125,7 +160,7 @@ def _h_gnss(_x: FloatArray) -> FloatArray:
 
 
 def _hx_gnss(x: FloatArray) -> FloatArray:
-    return x[[IX, IY, IPSI]]
+    return np.array([x[IX] + x[IBX], x[IY] + x[IBY], x[IPSI]])
 
 
 def _h_odo(_x: FloatArray) -> FloatArray:
@@ -137,23 +172,29 @@ def _hx_odo(x: FloatArray) -> FloatArray:
 
 
 class Localizer:
-    """EKF pose estimate from `GnssFix` and `Odometry` samples; see the module docstring."""
+    """EKF pose estimate from `GnssFix` and `Odometry` samples and, given the HD map, the
+    camera's lane (`on_lane`); see the module docstring."""
 
-    def __init__(self, params: LocalizerParams | None = None) -> None:
+    def __init__(self, params: LocalizerParams | None = None, road: RoadMap | None = None,
+                 start_lane: int = 0) -> None:
+        """`road`: the HD map the camera's lane is matched on (None: no map matching);
+        `start_lane`: the ego-direction lane the car starts in."""
         self.params = params if params is not None else LocalizerParams()
         p = self.params
+        self.road = road
+        self.start_lane = start_lane
         self._r_odo = np.diag([p.wheel_speed_sigma**2, p.gyro_sigma**2])  # (2, 2) constant
-        self._ekf = ExtendedKalmanFilter(dim_x=DIM_X, dim_z=3)
-        self._t = 0.0  # [s] time the filter state refers to
-        self._initialised = False
-        self._last_odo: Odometry | None = None
+        self._r_lane = np.diag([p.lane_offset_sigma**2, p.lane_heading_sigma**2])
+        self.reset()
 
     def reset(self) -> None:
         """Forget everything; the next GNSS fix initialises again."""
         self._ekf = ExtendedKalmanFilter(dim_x=DIM_X, dim_z=3)
-        self._t = 0.0
+        self._t = 0.0  # [s] time the filter state refers to
         self._initialised = False
-        self._last_odo = None
+        self._last_odo: Odometry | None = None
+        self._bias_sigma = 0.0  # [m] 1-sigma of the GNSS bias (the receiver's stated)
+        self.matched = False  # a camera lane has been matched on the map since the start
 
     @property
     def initialised(self) -> bool:
@@ -161,12 +202,13 @@ class Localizer:
 
     @property
     def state(self) -> FloatArray:
-        """(5,) copy of ``[x, y, heading, speed, yaw_rate]`` at the last sample's time."""
+        """(7,) copy of ``[x, y, heading, speed, yaw_rate, bias_x, bias_y]`` at the last
+        sample's time."""
         return np.array(self._ekf.x, dtype=np.float64)
 
     @property
     def covariance(self) -> FloatArray:
-        """(5, 5) copy of the state covariance, same order and units as `state`."""
+        """(7, 7) copy of the state covariance, same order and units as `state`."""
         return np.array(self._ekf.P, dtype=np.float64)
 
     def on_odometry(self, odo: Odometry) -> None:
@@ -178,22 +220,82 @@ class Localizer:
         self._ekf.update(np.array([odo.speed, odo.yaw_rate]), _h_odo, _hx_odo, R=self._r_odo)
 
     def on_gnss(self, fix: GnssFix) -> None:
-        """Initialise from the first fix; later, predict to ``fix.t`` and update with it.
+        """Initialise from the first valid fix; later, predict to ``fix.t`` and update with
+        it. A fix flagged invalid (an outage) carries nothing and is skipped.
 
         A fix older than the filter time is applied at the filter time (no retrodiction): a
         fix d [s] late is off by speed x d, so the sensor model must stamp fixes on time.
         """
+        if not fix.valid:
+            return
         if not self._initialised:
             self._initialise(fix)
             return
+        self._bias_sigma = fix.sigma
         self._predict_to(fix.t)
-        p = self.params
-        sigma = max(p.gnss_sigma, fix.sigma)
-        heading_sigma = max(p.gnss_heading_sigma, fix.heading_sigma)
+        sigma = self._white_sigma(fix)
+        heading_sigma = max(self.params.gnss_heading_sigma, fix.heading_sigma)
         r = np.diag([sigma**2, sigma**2, heading_sigma**2])
         z = np.array([fix.x, fix.y, fix.heading])
         self._ekf.update(z, _h_gnss, _hx_gnss, R=r, residual=_gnss_residual)
         self._ekf.x[IPSI] = wrap_angle(float(self._ekf.x[IPSI]))
+
+    def on_lane(self, lane: LaneEstimate, pose: EgoState) -> LaneMatch | None:
+        """Map matching: correct the lateral position and heading with the camera's lane
+        estimate ``lane``, taken when the stack's pose estimate was ``pose`` (module doc,
+        step 4). None when there is nothing to match (no map, no fix yet, not confident,
+        no ego-direction lane there); else what was done."""
+        p = self.params
+        if self.road is None or not self._initialised or lane.confidence < p.lane_confidence:
+            return None
+        found = self._match(lane, pose)
+        if found is None:
+            return None
+        index, map_lane, s = found
+        _, r = map_lane.local_coordinates(np.array([pose.x, pose.y]))
+        theta = float(map_lane.heading_at(s))
+        nu = np.array([lane.offset - float(r),
+                       wrap_angle(lane.heading_error - wrap_angle(pose.heading - theta))])
+        now_theta = float(map_lane.heading_at(
+            map_lane.local_coordinates(self.state[[IX, IY]])[0]))
+        h = np.zeros((2, DIM_X))
+        h[0, IX], h[0, IY] = -math.sin(now_theta), math.cos(now_theta)
+        h[1, IPSI] = 1.0
+        cov = self._ekf.P
+        s_mat = h @ cov @ h.T + self._r_lane
+        d2 = float(nu @ np.linalg.solve(s_mat, nu))
+        innovation = (float(nu[0]), float(nu[1]))
+        if d2 > p.lane_gate:
+            return LaneMatch(index, innovation, d2, False, (0.0, 0.0, 0.0))
+        gain = cov @ h.T @ np.linalg.inv(s_mat)
+        dx = gain @ nu
+        i_kh = np.eye(DIM_X) - gain @ h
+        self._ekf.P = i_kh @ cov @ i_kh.T + gain @ self._r_lane @ gain.T
+        self._ekf.x = self._ekf.x + dx
+        self._ekf.x[IPSI] = wrap_angle(float(self._ekf.x[IPSI]))
+        self.matched = True
+        return LaneMatch(index, innovation, d2, True,
+                         (float(dx[IX]), float(dx[IY]), float(dx[IPSI])))
+
+    def _match(self, lane: LaneEstimate, pose: EgoState) -> tuple[int, Lane, float] | None:
+        """(index, lane, station at the pose) of the ego-direction lane whose centre plus
+        the camera's offset is nearest the pose (the start lane before the first match)."""
+        assert self.road is not None
+        road = self.road
+        xy = np.array([pose.x, pose.y])
+        s_arr, d_arr = road.local_coordinates(xy)
+        s, d = float(s_arr), float(d_arr)
+        if self.matched:
+            candidates = [i for i in range(len(road.lanes))
+                          if bool(road.lanes[i].exists_at(s))]
+        else:
+            candidates = [self.start_lane] if 0 <= self.start_lane < len(road.lanes) \
+                and bool(road.lanes[self.start_lane].exists_at(s)) else []
+        if not candidates:
+            return None
+        best = min(candidates,
+                   key=lambda i: abs(float(road.lanes[i].offset_at(s)) + lane.offset - d))
+        return best, road.lanes[best], s
 
     def estimate(self, t: float) -> EgoState:
         """The estimate extrapolated (not committed) to time ``t`` [s].
@@ -221,16 +323,27 @@ class Localizer:
             position_sigma=math.sqrt(max(pos_var, 0.0)),
         )
 
+    def _white_sigma(self, fix: GnssFix) -> float:
+        """[m] the white noise assumed of a fix: a part of its stated sigma, at least the
+        floor."""
+        return max(self.params.gnss_sigma, self.params.gnss_white * fix.sigma)
+
     def _initialise(self, fix: GnssFix) -> None:
         p = self.params
         odo = self._last_odo
         speed, yaw_rate = (odo.speed, odo.yaw_rate) if odo is not None else (0.0, 0.0)
         speed_sigma = p.wheel_speed_sigma if odo is not None else p.init_speed_sigma
         yaw_sigma = p.gyro_sigma if odo is not None else p.init_yaw_rate_sigma
-        sigma = max(p.gnss_sigma, fix.sigma)
+        white = self._white_sigma(fix)
         heading_sigma = max(p.gnss_heading_sigma, fix.heading_sigma)
-        self._ekf.x = np.array([fix.x, fix.y, wrap_angle(fix.heading), speed, yaw_rate])
-        self._ekf.P = np.diag([sigma**2, sigma**2, heading_sigma**2, speed_sigma**2, yaw_sigma**2])
+        self._bias_sigma = fix.sigma
+        b2 = fix.sigma**2
+        self._ekf.x = np.array([fix.x, fix.y, wrap_angle(fix.heading), speed, yaw_rate, 0.0,
+                                0.0])
+        cov = np.diag([b2 + white**2, b2 + white**2, heading_sigma**2, speed_sigma**2,
+                       yaw_sigma**2, b2, b2])
+        cov[IX, IBX] = cov[IBX, IX] = cov[IY, IBY] = cov[IBY, IY] = -b2  # x + b: the fix
+        self._ekf.P = cov
         self._t = fix.t
         self._initialised = True
 
@@ -240,6 +353,12 @@ class Localizer:
             return
         x0 = self.state
         x, f = motion(x0, dt)
+        decay = math.exp(-dt / self.params.gnss_bias_tau)
+        x[[IBX, IBY]] *= decay
+        f[IBX, IBX] = f[IBY, IBY] = decay
+        q = process_noise(x0, dt, self.params)
+        q[IBX, IBX] += self._bias_sigma**2 * (1.0 - decay * decay)
+        q[IBY, IBY] += self._bias_sigma**2 * (1.0 - decay * decay)
         self._ekf.x = x
-        self._ekf.P = f @ self._ekf.P @ f.T + process_noise(x0, dt, self.params)
+        self._ekf.P = f @ self._ekf.P @ f.T + q
         self._t = t

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import bisect
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from avsim.scenario.scenario import DriverSettings
 from control.actuation import VehicleParams
@@ -25,7 +25,7 @@ from control.vehicle_controller import VehicleController, VehicleControllerParam
 from perception.flat_tyre import FlatTyreDetector
 from perception.lanes import LaneDetector, LaneFilter
 from perception.lights import TrafficLightDetector
-from perception.localization import Localizer
+from perception.localization import LaneMatch, Localizer
 from perception.messages import (
     Detection,
     EgoState,
@@ -46,7 +46,15 @@ from vehicle_urdf import CarGeometry
 from world.core.rates import CAR_SENSORS
 from world.core.stopwatch import Stopwatch
 from world.ego.body import vehicle_info
-from world.frames import CameraFrame, CameraInfo, Frame, GnssFix, LidarScan, Odometry
+from world.frames import (
+    CameraFrame,
+    CameraInfo,
+    Frame,
+    GnssFix,
+    LidarScan,
+    Odometry,
+    wrap_angle,
+)
 from world.hdmap import RoadMap
 from world.sensors.setup import LIDAR
 from world.spec import EgoSpec
@@ -72,6 +80,15 @@ class PerceptionOutput:
     tracks: tuple[Track, ...] | None
 
 
+def _corrected(pose: EgoState, match: LaneMatch | None) -> EgoState:
+    """The pose at a camera frame's time, moved by the map-matching correction that frame
+    made (the frame's lane is placed in the map with it, as the car's pose now is)."""
+    if match is None or not match.accepted:
+        return pose
+    dx, dy, dpsi = match.correction
+    return replace(pose, x=pose.x + dx, y=pose.y + dy, heading=wrap_angle(pose.heading + dpsi))
+
+
 class Stack:
     """Localizer, lane and object perception, lane-keeping planner, vehicle controller."""
 
@@ -84,7 +101,8 @@ class Stack:
         self.reads = frozenset({*CAR_SENSORS, LIDAR}
                                | ({front_camera.name} if front_camera is not None else set()))
         #   the sensors whose frames it uses (it ignores the side cameras')
-        self.localizer = Localizer()
+        self.localizer = Localizer(road=road, start_lane=ego.lane)
+        #   the camera's lane corrects the pose across the lane (map matching)
         vehicle = vehicle_info(car)
         self.planner = Planner(
             road, PlannerParams(set_speed=driver.set_speed, max_speed=ego.max_speed,
@@ -161,7 +179,9 @@ class Stack:
                 lane_raw = self.lane_detector.detect(front, prior)
             with watch("perception lane filter"):
                 lane = self.lane_filter.update(lane_raw, pose.speed, pose.yaw_rate)
-            self._view = LaneView(lane, pose)
+            with watch("localisation"):
+                match = self.localizer.on_lane(lane, pose)
+            self._view = LaneView(lane, _corrected(pose, match))
         if front is not None and self.sign_detector is not None:
             with watch("perception signs"):
                 self._signs = SignView(tuple(self.sign_detector.detect(front)), pose)
