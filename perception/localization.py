@@ -9,7 +9,7 @@ Steps:
 
 1. The first valid GNSS fix initialises the state (speed and yaw rate from the latest
    odometry sample, if one came before it, else zero with ``init_*_sigma``; the bias zero
-   with the receiver's stated sigma, so that position + bias is known to the white noise).
+   with its assumed sigma (step 2), so that position + bias is known to the white noise).
    Odometry before that is only remembered.
 2. Predict to every sample's time with a unicycle model evaluated at the midpoint heading
    (``x += v dt cos(psi + w dt / 2)``, ...): it matches the exact constant-turn-rate (CTRV)
@@ -18,7 +18,9 @@ Steps:
    acceleration (``accel_sigma``, ``yaw_accel_sigma``) plus a random walk on position and
    heading (``position_walk``, ``heading_walk``: slip, tyre radius error). The bias is a
    first-order Gauss-Markov process (``gnss_bias_tau``) of 1-sigma the receiver's stated
-   accuracy.
+   accuracy, with a map at least ``gnss_bias_floor``: a receiver that states 5 cm may still
+   be off by an offset it does not know of, and the camera's lane must be able to correct
+   that.
 3. Update at every odometry sample with its speed (mean rear wheel spin x nominal radius)
    and the gyro yaw rate, and at every valid GNSS fix with position + bias and heading (the
    white noise ``gnss_white`` x the fix's stated sigma, at least ``gnss_sigma``; the heading
@@ -79,6 +81,9 @@ class LocalizerParams:
     gnss_white: float = 0.25  # [-] the white part of a fix's stated sigma (the rest wanders)
     gnss_heading_sigma: float = 0.2 * DEG  # [rad] heading noise floor; the fix's larger wins
     gnss_bias_tau: float = 60.0  # [s] correlation time assumed for the GNSS bias
+    gnss_bias_floor: float = 1.0  # [m] 1-sigma of the bias assumed of any receiver, however
+    #   accurate it says it is (an offset it does not know of: lever arm, datum, a constant
+    #   error); the camera's lane may move the position across the lane this far
     wheel_speed_sigma: float = 0.05  # [m/s] odometry speed noise
     gyro_sigma: float = 0.005  # [rad/s] gyro yaw-rate noise
     accel_sigma: float = 3.0  # [m/s^2] white longitudinal acceleration (process)
@@ -231,7 +236,7 @@ class Localizer:
         if not self._initialised:
             self._initialise(fix)
             return
-        self._bias_sigma = fix.sigma
+        self._bias_sigma = self._bias_sigma_of(fix)
         self._predict_to(fix.t)
         sigma = self._white_sigma(fix)
         heading_sigma = max(self.params.gnss_heading_sigma, fix.heading_sigma)
@@ -323,6 +328,12 @@ class Localizer:
             position_sigma=math.sqrt(max(pos_var, 0.0)),
         )
 
+    def _bias_sigma_of(self, fix: GnssFix) -> float:
+        """[m] 1-sigma of the bias assumed of a fix: its stated sigma, at least the floor
+        when the camera's lane can be matched on a map (else nothing could correct it)."""
+        floor = self.params.gnss_bias_floor if self.road is not None else 0.0
+        return max(floor, fix.sigma)
+
     def _white_sigma(self, fix: GnssFix) -> float:
         """[m] the white noise assumed of a fix: a part of its stated sigma, at least the
         floor."""
@@ -336,8 +347,8 @@ class Localizer:
         yaw_sigma = p.gyro_sigma if odo is not None else p.init_yaw_rate_sigma
         white = self._white_sigma(fix)
         heading_sigma = max(p.gnss_heading_sigma, fix.heading_sigma)
-        self._bias_sigma = fix.sigma
-        b2 = fix.sigma**2
+        self._bias_sigma = self._bias_sigma_of(fix)
+        b2 = self._bias_sigma**2
         self._ekf.x = np.array([fix.x, fix.y, wrap_angle(fix.heading), speed, yaw_rate, 0.0,
                                 0.0])
         cov = np.diag([b2 + white**2, b2 + white**2, heading_sigma**2, speed_sigma**2,

@@ -20,7 +20,9 @@ Positions are in the map frame, stations [m] along the route's reference line, s
    (`planner.camera_lane`) when the source is CAMERA (the camera sees the lane kept: its
    offset agrees with the map's within ``camera_agree`` at the frame's pose, which the
    camera's lane itself corrects across the lane) and the lane is not the shoulder, else
-   the map lane; the lane source is updated once the lane kept is known;
+   the map lane (ACQUIRING at the start, before the camera's lane has corrected the pose
+   across the lane: the line parallel to the lane through the car, holding its offset); the
+   lane source is updated once the lane kept is known;
 4. the lead vehicle (`planner.lead`: in the path's lane, or along the map lane through a
    junction, or in the lanes a lane change occupies);
 5. the speed, a chain of `planner.speed.PlannedSpeed`s, each link keeping what it was given
@@ -116,6 +118,7 @@ class Planner:
         self.source = Machine("lane_source",
                               LaneSource.ACQUIRING if p.camera else LaneSource.MAP)
         self._start: float | None = None  # [s] time of the first tick
+        self._lane_seen = False  # the camera's lane has been the path (the pose is matched)
         self._cap = math.inf  # [m/s] the ramped speed cap of the degraded modes
         self._last_t: float | None = None
         self._keep(p.lane)
@@ -142,14 +145,14 @@ class Planner:
         s, r = self.lane.local_coordinates(np.array([ego.x, ego.y]))
         return float(np.asarray(s)), float(np.asarray(r))
 
-    def path_for(self, ego: EgoState, station: float) -> ReferencePath:
-        """The lane kept's centre from ``path_behind`` behind the car's centre at `station`
-        [m] to max(``path_ahead_min``, ``path_ahead_time`` * speed) ahead."""
+    def path_for(self, ego: EgoState, station: float, offset: float = 0.0) -> ReferencePath:
+        """The lane kept's centre (or the line `offset` [m] left of it) from ``path_behind``
+        behind the car's centre at `station` [m] to max(``path_ahead_min``,
+        ``path_ahead_time`` * speed) ahead."""
         p = self.params
         ahead = max(p.path_ahead_min, p.path_ahead_time * max(ego.speed, 0.0))
-        return lane_path(
-            self.lane, station, p.path_behind, ahead, p.path_spacing, length=self.road.length
-        )
+        return lane_path(self.lane, station, p.path_behind, ahead, p.path_spacing,
+                         length=self.road.length, offset=offset)
 
     def speed_for(self, station: float, set_speed: float | None = None) -> SpeedTarget:
         """The map's speed target for the car's centre at ``station`` [m] (at ``set_speed``
@@ -243,6 +246,11 @@ class Planner:
         if self.source.state is LaneSource.CAMERA and view is not None and \
                 self.lane_index != SHOULDER:
             return LateralChoice(self._camera_path(view), camera=True)
+        if self.source.state is LaneSource.ACQUIRING and not self._lane_seen:
+            # the pose has GNSS's error across the lane until the camera's lane corrects it
+            # (`perception.localization`): hold the offset the car has, parallel to the lane
+            return LateralChoice(self.path_for(ego, station, self.localise(ego)[1]),
+                                 camera=False)
         return LateralChoice(self.path_for(ego, station), camera=False)
 
     def _other_lane(self, view: LaneView | None, manoeuvre: Manoeuvre) -> bool:
@@ -261,8 +269,10 @@ class Planner:
         confidence = view.estimate.confidence if view is not None else 0.0
         since = max(self.source.since, self._start)  # ACQUIRING counts from the start
         x = LaneSourceInput(t, confidence, since, junction, other_lane)
-        return self.source.apply(t, lane_source.transition(self.source.state, x,
-                                                           self.params.source))
+        changes = self.source.apply(t, lane_source.transition(self.source.state, x,
+                                                              self.params.source))
+        self._lane_seen = self._lane_seen or self.source.state is LaneSource.CAMERA
+        return changes
 
     def _camera_path(self, view: LaneView) -> ReferencePath:
         p = self.params

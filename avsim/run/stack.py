@@ -101,7 +101,8 @@ class Stack:
         self.reads = frozenset({*CAR_SENSORS, LIDAR}
                                | ({front_camera.name} if front_camera is not None else set()))
         #   the sensors whose frames it uses (it ignores the side cameras')
-        self.localizer = Localizer(road=road, start_lane=ego.lane)
+        self.localizer = Localizer(road=road if front_camera is not None else None,
+                                   start_lane=ego.lane)
         #   the camera's lane corrects the pose across the lane (map matching)
         vehicle = vehicle_info(car)
         self.planner = Planner(

@@ -24,8 +24,9 @@ STATED_SIGMA = 1.24  # [m] a consumer receiver's stated accuracy
 
 
 def drive(road: RoadMap, duration: float, bias: tuple[float, float], *, camera: bool = True,
-          lane: int = 0, start_lane: int = 0, seed: int = 0,
-          s0: float = 20.0) -> tuple[Localizer, np.ndarray, np.ndarray]:
+          lane: int = 0, start_lane: int = 0, seed: int = 0, s0: float = 20.0,
+          stated: float = STATED_SIGMA,
+          noise: float = 0.3) -> tuple[Localizer, np.ndarray, np.ndarray]:
     """Drive the centre of `lane` at SPEED with a constant GNSS `bias`; the camera (if any)
     sees the lane with 4 cm / 0.5 deg noise. Returns the localiser, the times and the
     estimate's lateral errors [m] (left +, across the lane) at each tick."""
@@ -45,10 +46,9 @@ def drive(road: RoadMap, duration: float, bias: tuple[float, float], *, camera: 
                                  yaw_rate + rng.normal(0.0, 0.005), 0.0))
         if k % GNSS_EVERY:
             continue
-        loc.on_gnss(GnssFix(t, float(xy[0]) + bias[0] + rng.normal(0.0, 0.3),
-                            float(xy[1]) + bias[1] + rng.normal(0.0, 0.3),
-                            wrap_angle(heading + rng.normal(0.0, 0.005)), STATED_SIGMA,
-                            0.005))
+        loc.on_gnss(GnssFix(t, float(xy[0]) + bias[0] + rng.normal(0.0, noise),
+                            float(xy[1]) + bias[1] + rng.normal(0.0, noise),
+                            wrap_angle(heading + rng.normal(0.0, 0.005)), stated, 0.005))
         late = k - round(CAMERA_DELAY * ODO_RATE)
         if camera and late in poses:
             loc.on_lane(estimate(t - CAMERA_DELAY, rng.normal(0.0, 0.04),
@@ -76,6 +76,14 @@ def test_biased_gnss_with_the_camera_converges_across_the_lane(
     """Straight (+x), then a left arc: the camera's lane takes the GNSS bias out across the
     lane within 2 s and keeps it out through the curve."""
     _, t, err = drive(ROAD, 40.0, bias)
+    settled = t >= 2.0
+    assert float(np.sqrt(np.mean(err[settled] ** 2))) < 0.05
+    assert float(np.max(np.abs(err[settled]))) < 0.15
+
+
+def test_a_receiver_that_understates_its_error_is_corrected_too() -> None:
+    """5 cm stated (RTK grade) but 1.5 m off sideways: the issue's failing case."""
+    _, t, err = drive(ROAD, 20.0, (0.0, 1.5), stated=0.05, noise=0.05)
     settled = t >= 2.0
     assert float(np.sqrt(np.mean(err[settled] ** 2))) < 0.05
     assert float(np.max(np.abs(err[settled]))) < 0.15
