@@ -22,9 +22,9 @@ and the first that holds is taken:
 
 What each state follows (`planner.planner`): MAP is the state of a stack built without a
 camera (GNSS + odometry on the HD map only); no row leaves it. ACQUIRING follows the map
-lane at the planned speed (at the start, before the camera's lane has corrected the pose
-across the lane, the line through the car parallel to it) (the camera's first estimate arrives one sensor period after the
-start, and after a lane change the camera may still see the lane left for a moment).
+lane at the planned speed: the camera's first estimate arrives one sensor period after the
+start (until it has corrected the pose across the lane, the line through the car parallel
+to the lane), and after a lane change the camera may still see the lane left for a moment.
 CAMERA follows the camera's lane, the lane kept. MAP_HOLD follows
 the map lane placed by the localisation estimate (GNSS + odometry) and slows to
 `hold_speed`; STOP_IN_LANE brings the car to a stop in its lane. JUNCTION follows the map's
