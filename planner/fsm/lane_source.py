@@ -25,9 +25,9 @@ camera (GNSS + odometry on the HD map only); no row leaves it. ACQUIRING follows
 lane at the planned speed: the camera's first estimate arrives one sensor period after the
 start (until it has corrected the pose across the lane, the line through the car parallel
 to the lane), and after a lane change the camera may still see the lane left for a moment.
-CAMERA follows the camera's lane, the lane kept. MAP_HOLD follows
-the map lane placed by the localisation estimate (GNSS + odometry) and slows to
-`hold_speed`; STOP_IN_LANE brings the car to a stop in its lane. JUNCTION follows the map's
+CAMERA follows the camera's lane, the lane kept. MAP_HOLD follows the map lane placed by
+the localisation estimate (odometry, GNSS and the camera's lane as long as it was seen) and
+slows to `hold_speed`; STOP_IN_LANE brings the car to a stop in its lane. JUNCTION follows the map's
 path through a town junction at the planned speed: the painted lines end at the junction's
 mouth, and the path turns where none are painted. Every change carries a reason for the
 log.
