@@ -35,10 +35,14 @@ Steps:
    stack had at the frame's time (the frame arrives late) and applied now. It is gated by
    its Mahalanobis distance (``lane_gate``), so a reading that would put the car in another
    place than the estimate allows (a wrong lane, a misdetection) is rejected.
+5. Along the route (`on_line_end`): at a town junction the painted lines end at its mouth;
+   where the camera sees them end, the car's station is the mouth's less that distance
+   (gated likewise). Roads without junctions have no such update.
 
 So the camera pins the lateral position and heading while it sees the lane; the station
-along the route comes from the odometry (the map's stations of the dead-reckoned pose), and
-GNSS only bounds the drift through the bias's mean reversion. Without the camera, a GNSS
+along the route comes from the odometry (the map's stations of the dead-reckoned pose) and,
+before a town junction, from where its lines end; GNSS only bounds the drift through the
+bias's mean reversion. Without the camera, a GNSS
 bias cannot be separated from the position: the estimate follows the biased fixes.
 
 The filter's update step is filterpy's `ExtendedKalmanFilter.update` (Joseph form) with our
@@ -97,14 +101,19 @@ class LocalizerParams:
     lane_heading_sigma: float = 1.0 * DEG  # [rad] camera heading-to-lane noise (0.66 deg RMS)
     lane_confidence: float = 0.5  # [-] a lane estimate this confident is a measurement
     lane_gate: float = 13.8  # [-] Mahalanobis distance^2 gate (chi^2, 2 dof, 99.9 %)
+    line_end_sigma: float = 1.0  # [m] where the camera sees the painted lines end
+    line_end_range: tuple[float, float] = (10.0, 28.0)  # [m] ahead of the car's centre where
+    #   a line end is believed: well inside the bird's-eye view (5 .. 35 m), not cut by it
+    line_end_gate: float = 10.8  # [-] Mahalanobis distance^2 gate (chi^2, 1 dof, 99.9 %)
 
 
 @dataclass(frozen=True, slots=True)
 class LaneMatch:
     """What one map-matching update did."""
 
-    lane: int  # the map lane the camera's lane was matched with
+    lane: int  # the map lane the camera's lane was matched with (-1: along the route)
     innovation: tuple[float, float]  # [m, rad] lateral offset, heading: camera minus pose
+    #   (along the route: [m] station, 0)
     distance2: float  # [-] its squared Mahalanobis distance
     accepted: bool  # within the gate, applied
     correction: tuple[float, float, float]  # [m, m, rad] x, y, heading added to the state
@@ -266,20 +275,57 @@ class Localizer:
         h = np.zeros((2, DIM_X))
         h[0, IX], h[0, IY] = -math.sin(now_theta), math.cos(now_theta)
         h[1, IPSI] = 1.0
+        match = self._gated_update(h, nu, self._r_lane, p.lane_gate, index)
+        self.matched = self.matched or match.accepted
+        return match
+
+    def on_line_end(self, lane: LaneEstimate, pose: EgoState) -> LaneMatch | None:
+        """Along the route: at a town junction the painted lines end at its mouth
+        (`world.hdmap.Junction.s_enter`). Where the map has a mouth within
+        ``line_end_range`` ahead of ``pose`` (the pose at the frame's time) and the farthest
+        painted line of ``lane`` ends within that range too, the car's station is the
+        mouth's less that distance: an update of the position along the lane, gated like
+        the lateral one (``line_end_gate``). None when there is nothing to match; else what
+        was done (``innovation``: [m] along the route, 0)."""
+        p = self.params
+        road = self.road
+        if road is None or not road.junctions or not self._initialised \
+                or lane.confidence < p.lane_confidence:
+            return None
+        ends = [b.x_max for b in (lane.left, lane.right) if b is not None]
+        lo, hi = p.line_end_range
+        if not ends or not lo <= max(ends) <= hi:
+            return None
+        x_end = max(ends)  # [m] the farthest line: a car ahead hides the nearer ends
+        s = float(road.local_coordinates(np.array([pose.x, pose.y]))[0])
+        mouths = [j.s_enter - s for j in road.junctions if lo - 5.0 <= j.s_enter - s <= hi + 5.0]
+        if not mouths:
+            return None
+        ahead = min(mouths, key=lambda d: abs(d - x_end))
+        nu = ahead - x_end  # [m] the station measured less the pose's
+        theta = float(road.heading_at(float(road.local_coordinates(self.state[[IX, IY]])[0])))
+        h = np.zeros((1, DIM_X))
+        h[0, IX], h[0, IY] = math.cos(theta), math.sin(theta)
+        r = np.array([[p.line_end_sigma**2]])
+        return self._gated_update(h, np.array([nu]), r, p.line_end_gate, -1)
+
+    def _gated_update(self, h: FloatArray, nu: FloatArray, r: FloatArray, gate: float,
+                      lane: int) -> LaneMatch:
+        """Update with innovation ``nu`` (m,) of a measurement (m, 7) ``h``, noise ``r``,
+        unless its squared Mahalanobis distance exceeds ``gate``."""
         cov = self._ekf.P
-        s_mat = h @ cov @ h.T + self._r_lane
+        s_mat = h @ cov @ h.T + r
         d2 = float(nu @ np.linalg.solve(s_mat, nu))
-        innovation = (float(nu[0]), float(nu[1]))
-        if d2 > p.lane_gate:
-            return LaneMatch(index, innovation, d2, False, (0.0, 0.0, 0.0))
+        innovation = (float(nu[0]), float(nu[1]) if len(nu) > 1 else 0.0)
+        if d2 > gate:
+            return LaneMatch(lane, innovation, d2, False, (0.0, 0.0, 0.0))
         gain = cov @ h.T @ np.linalg.inv(s_mat)
         dx = gain @ nu
         i_kh = np.eye(DIM_X) - gain @ h
-        self._ekf.P = i_kh @ cov @ i_kh.T + gain @ self._r_lane @ gain.T
+        self._ekf.P = i_kh @ cov @ i_kh.T + gain @ r @ gain.T
         self._ekf.x = self._ekf.x + dx
         self._ekf.x[IPSI] = wrap_angle(float(self._ekf.x[IPSI]))
-        self.matched = True
-        return LaneMatch(index, innovation, d2, True,
+        return LaneMatch(lane, innovation, d2, True,
                          (float(dx[IX]), float(dx[IY]), float(dx[IPSI])))
 
     def _match(self, lane: LaneEstimate, pose: EgoState) -> tuple[int, Lane, float] | None:

@@ -182,6 +182,7 @@ class Stack:
                 lane = self.lane_filter.update(lane_raw, pose.speed, pose.yaw_rate)
             with watch("localisation"):
                 match = self.localizer.on_lane(lane, pose)
+                self.localizer.on_line_end(lane, pose)
             self._view = LaneView(lane, _corrected(pose, match))
         if front is not None and self.sign_detector is not None:
             with watch("perception signs"):

@@ -5,12 +5,13 @@ gated out."""
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
 
 from perception.localization import Localizer
-from perception.messages import EgoState, LaneEstimate
+from perception.messages import EgoState, LaneBoundary, LaneEstimate
 from tests.roads import W, arc, make_map, seg
 from world.frames import GnssFix, Odometry, wrap_angle
 from world.hdmap import RoadMap
@@ -134,3 +135,42 @@ def test_an_unconfident_estimate_or_an_outage_changes_nothing() -> None:
     loc.on_gnss(GnssFix(t[-1], math.nan, math.nan, math.nan, STATED_SIGMA, 0.005,
                         valid=False))
     assert np.array_equal(loc.state, before)
+
+
+def test_where_the_lines_end_at_a_town_junction_fixes_the_station() -> None:
+    """A 2.5 m GNSS bias along the street: the camera's lane pins the lateral position but
+    not the station, until the painted lines end at the junction's mouth within view."""
+    from avsim.scenario.load import load_scenario
+    from world.map.road import build_road_map
+
+    road = build_road_map(load_scenario("town_left_turn").world.road)
+    mouth = road.junctions[0].s_enter  # [m] 71: the lines of the approach end there
+    rng = np.random.default_rng(1)
+    loc = Localizer(road=road)
+    lane = road.lane(0)
+    along: list[tuple[float, float]] = []
+    for k in range(round(4.0 * ODO_RATE) + 1):  # from s = 20 to 68 at 12 m/s
+        t = k / ODO_RATE
+        s = 20.0 + SPEED * t
+        xy = lane.position(s, 0.0)
+        spin = SPEED / WHEEL_RADIUS
+        loc.on_odometry(Odometry(t, (spin, spin, spin, spin), WHEEL_RADIUS, 0.0, 0.0))
+        if k % GNSS_EVERY:
+            continue
+        loc.on_gnss(GnssFix(t, float(xy[0]) + 2.5 + rng.normal(0.0, 0.3),
+                            float(xy[1]) + rng.normal(0.0, 0.3), rng.normal(0.0, 0.005),
+                            STATED_SIGMA, 0.005))
+        pose = loc.estimate(t)
+        end = min(mouth - s, 34.0)  # [m] where the lines end, or the view does
+        line = LaneBoundary((1.75, 0.0, 0.0), 5.0, end + rng.normal(0.0, 0.2), 400)
+        seen = replace(estimate(t, rng.normal(0.0, 0.04)), left=line,
+                       right=replace(line, coefficients=(-1.75, 0.0, 0.0)))
+        loc.on_lane(seen, pose)
+        loc.on_line_end(seen, pose)
+        est = loc.estimate(t)
+        along.append((mouth - s, est.x - float(xy[0])))  # the street heads +x
+    errors = dict(along)
+    far = [e for d, e in along if d > 30.0]
+    assert min(far) > 1.5  # the bias along the street: nothing sees it yet
+    near = [e for d, e in along if d < 12.0]
+    assert max(abs(e) for e in near) < 0.5, errors
