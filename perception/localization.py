@@ -35,14 +35,15 @@ Steps:
    stack had at the frame's time (the frame arrives late) and applied now. It is gated by
    its Mahalanobis distance (``lane_gate``), so a reading that would put the car in another
    place than the estimate allows (a wrong lane, a misdetection) is rejected.
-5. Along the route (`on_line_end`): at a town junction the painted lines end at its mouth;
-   where the camera sees them end, the car's station is the mouth's less that distance
-   (gated likewise). Roads without junctions have no such update.
+5. Along the route: at a town junction the painted lines end at its mouth (`on_line_end`),
+   and before a stop sign or a town junction a stop line is painted across the lane
+   (`on_stop_line`, seen by `perception.stop_lines`); where the camera sees either, the car's
+   station is the map's less that distance (gated likewise).
 
 So the camera pins the lateral position and heading while it sees the lane; the station
 along the route comes from the odometry (the map's stations of the dead-reckoned pose) and,
-before a town junction, from where its lines end; GNSS only bounds the drift through the
-bias's mean reversion. Without the camera, a GNSS
+where the map has them, from stop lines and the ends of the lines at a town junction; GNSS
+only bounds the drift through the bias's mean reversion. Without the camera, a GNSS
 bias cannot be separated from the position: the estimate follows the biased fixes.
 
 The filter's update step is filterpy's `ExtendedKalmanFilter.update` (Joseph form) with our
@@ -60,7 +61,7 @@ from numpy.typing import NDArray
 
 from perception.messages import EgoState, LaneEstimate
 from world.frames import GnssFix, Odometry, wrap_angle
-from world.hdmap import Lane, RoadMap
+from world.hdmap import Lane, RoadMap, StopSign
 
 FloatArray = NDArray[np.float64]
 
@@ -104,7 +105,10 @@ class LocalizerParams:
     line_end_sigma: float = 1.0  # [m] where the camera sees the painted lines end
     line_end_range: tuple[float, float] = (10.0, 28.0)  # [m] ahead of the car's centre where
     #   a line end is believed: well inside the bird's-eye view (5 .. 35 m), not cut by it
-    line_end_gate: float = 10.8  # [-] Mahalanobis distance^2 gate (chi^2, 1 dof, 99.9 %)
+    line_end_gate: float = 10.8  # [-] Mahalanobis distance^2 gate (chi^2, 1 dof, 99.9 %),
+    #   also of a stop line's
+    stop_line_sigma: float = 0.3  # [m] where the camera sees a stop line's near edge
+    stop_line_window: float = 2.0  # [m] a stop line seen is the map's nearest within 3 x this
 
 
 @dataclass(frozen=True, slots=True)
@@ -302,12 +306,45 @@ class Localizer:
         if not mouths:
             return None
         ahead = min(mouths, key=lambda d: abs(d - x_end))
-        nu = ahead - x_end  # [m] the station measured less the pose's
+        return self._along(ahead - x_end, p.line_end_sigma)
+
+    def stop_lines_ahead(self, pose: EgoState, near: float, far: float) -> list[float]:
+        """[m] distances from ``pose`` to the map's painted stop lines (a stop sign's, a town
+        junction's) between ``near`` and ``far`` ahead along the route."""
+        if self.road is None:
+            return []
+        road = self.road
+        s = float(road.local_coordinates(np.array([pose.x, pose.y]))[0])
+        lines = {f.s for f in road.features if isinstance(f, StopSign)}
+        lines |= {j.s_stop for j in road.junctions}
+        return sorted(d for d in (line - s for line in lines) if near <= d <= far)
+
+    def on_stop_line(self, distance: float, pose: EgoState) -> LaneMatch | None:
+        """Along the route: the camera saw the near edge of a stop line ``distance`` [m]
+        ahead of the car's centre when the pose estimate was ``pose``; the nearest of the
+        map's stop lines there gives the car's station (gated like the other updates). None
+        when the map has no stop line near there."""
+        p = self.params
+        if not self._initialised:
+            return None
+        reach = 3.0 * p.stop_line_window
+        lines = self.stop_lines_ahead(pose, distance - reach, distance + reach)
+        if not lines:
+            return None
+        ahead = min(lines, key=lambda d: abs(d - distance))
+        return self._along(ahead - distance, p.stop_line_sigma)
+
+    def _along(self, nu: float, sigma: float) -> LaneMatch:
+        """A gated update of the position along the route by ``nu`` [m] (a measured station
+        less the pose's) of noise ``sigma`` [m]."""
+        p = self.params
+        assert self.road is not None
+        road = self.road
         theta = float(road.heading_at(float(road.local_coordinates(self.state[[IX, IY]])[0])))
         h = np.zeros((1, DIM_X))
         h[0, IX], h[0, IY] = math.cos(theta), math.sin(theta)
-        r = np.array([[p.line_end_sigma**2]])
-        return self._gated_update(h, np.array([nu]), r, p.line_end_gate, -1)
+        return self._gated_update(h, np.array([nu]), np.array([[sigma**2]]), p.line_end_gate,
+                                  -1)
 
     def _gated_update(self, h: FloatArray, nu: FloatArray, r: FloatArray, gate: float,
                       lane: int) -> LaneMatch:

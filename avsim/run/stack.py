@@ -38,6 +38,7 @@ from perception.messages import (
 )
 from perception.objects import ObjectDetector
 from perception.signs import StopSignDetector
+from perception.stop_lines import StopLineDetector
 from perception.tracking import MultiObjectTracker
 from planner.messages import Plan
 from planner.motion_layer import MotionLayerParams
@@ -118,6 +119,8 @@ class Stack:
         self.controller = VehicleController(VehicleControllerParams(
             lateral=lateral, vehicle=VehicleParams(mass=car.mass, wheel_radius=car.wheel_radius)))
         self.lane_detector = LaneDetector(front_camera) if front_camera is not None else None
+        self.stop_line_detector = StopLineDetector(front_camera) \
+            if front_camera is not None else None
         self.sign_detector = StopSignDetector(front_camera) if front_camera is not None \
             else None
         self.light_detector = TrafficLightDetector(front_camera, road, vehicle) \
@@ -183,6 +186,7 @@ class Stack:
             with watch("localisation"):
                 match = self.localizer.on_lane(lane, pose)
                 self.localizer.on_line_end(lane, pose)
+            self._stop_line(front, lane, pose)
             self._view = LaneView(lane, _corrected(pose, match))
         if front is not None and self.sign_detector is not None:
             with watch("perception signs"):
@@ -198,6 +202,22 @@ class Stack:
                 tracks = self.tracker.update(t, pose, detections)
             self._tracks = tracks
         return PerceptionOutput(t, pose, lane_raw, lane, detections, tracks)
+
+    def _stop_line(self, front: CameraFrame, lane: LaneEstimate, pose: EgoState) -> None:
+        """Look for a stop line where the map has one ahead, and place the car along the
+        route by it (`perception.stop_lines`, `Localizer.on_stop_line`)."""
+        detector = self.stop_line_detector
+        if detector is None or lane.confidence < self.localizer.params.lane_confidence:
+            return
+        p = detector.params
+        margin = self.localizer.params.stop_line_window
+        if not self.localizer.stop_lines_ahead(pose, p.min_x - margin, p.max_x + margin):
+            return
+        with self.watch("perception stop lines"):
+            distance = detector.detect(front, lane)
+        if distance is not None:
+            with self.watch("localisation"):
+                self.localizer.on_stop_line(distance, pose)
 
     def tick(self, t: float, dt: float) -> StackOutput:
         """Plan and control on the estimate now and the latest perception; a frame's signs
