@@ -36,7 +36,7 @@ class StopLineParams:
     min_depth: float = 0.15  # [m] a stop line is 0.3 m along the lane
     max_depth: float = 0.6  # [m]
     min_x: float = 6.0  # [m] nearest forward distance looked at (the view starts at 5 m)
-    max_x: float = 25.0  # [m] farthest (the band thins with depth)
+    max_x: float = 17.0  # [m] farthest: beyond, a 0.3 m bar is too thin in a 640 x 480 frame
 
 
 class StopLineDetector:

@@ -174,3 +174,40 @@ def test_where_the_lines_end_at_a_town_junction_fixes_the_station() -> None:
     assert min(far) > 1.5  # the bias along the street: nothing sees it yet
     near = [e for d, e in along if d < 12.0]
     assert max(abs(e) for e in near) < 0.5, errors
+
+
+def test_a_stop_line_seen_fixes_the_station() -> None:
+    """A 2 m GNSS bias along the road, a stop line at s = 150 m: once the camera sees its
+    near edge (6 to 17 m ahead) the station is the map's less that distance."""
+    from world.hdmap import StopSign
+
+    stop = 150.0
+    road = make_map(seg(400.0), features=(StopSign(stop),))
+    rng = np.random.default_rng(2)
+    loc = Localizer(road=road)
+    lane = road.lane(0)
+    along: list[tuple[float, float, bool]] = []
+    for k in range(round(10.0 * ODO_RATE) + 1):  # from s = 30 to 150 at 12 m/s
+        t = k / ODO_RATE
+        s = 30.0 + SPEED * t
+        xy = lane.position(s, 0.0)
+        spin = SPEED / WHEEL_RADIUS
+        loc.on_odometry(Odometry(t, (spin, spin, spin, spin), WHEEL_RADIUS, 0.0, 0.0))
+        if k % GNSS_EVERY:
+            continue
+        loc.on_gnss(GnssFix(t, float(xy[0]) + 2.0 + rng.normal(0.0, 0.3),
+                            float(xy[1]) + rng.normal(0.0, 0.3), rng.normal(0.0, 0.005),
+                            STATED_SIGMA, 0.005))
+        pose = loc.estimate(t)
+        loc.on_lane(estimate(t, rng.normal(0.0, 0.04)), pose)
+        match = None
+        if 6.0 <= stop - s <= 17.0:
+            match = loc.on_stop_line(stop - s + rng.normal(0.0, 0.05), pose)
+            assert match is not None
+        along.append((stop - s, loc.estimate(t).x - float(xy[0]),
+                      match is not None and match.accepted))
+    assert min(e for d, e, _ in along if d > 20.0) > 1.2  # the bias: nothing sees it yet
+    assert all(ok for d, _, ok in along if 6.0 <= d <= 17.0)
+    assert max(abs(e) for d, e, _ in along if 0.0 <= d < 12.0) < 0.3
+    back = replace(loc.estimate(t), x=100.0)  # 50 m before the line: none 3 m ahead
+    assert loc.on_stop_line(3.0, back) is None
