@@ -38,7 +38,8 @@ Steps:
 5. Along the route: at a town junction the painted lines end at its mouth (`on_line_end`),
    and before a stop sign or a town junction a stop line is painted across the lane
    (`on_stop_line`, seen by `perception.stop_lines`); where the camera sees either, the car's
-   station is the map's less that distance (gated likewise).
+   station is the map's less that distance (gated likewise; a stop line, unambiguous within
+   its window, first raises the variance along the route to its innovation's square).
 
 So the camera pins the lateral position and heading while it sees the lane; the station
 along the route comes from the odometry (the map's stations of the dead-reckoned pose) and,
@@ -332,19 +333,32 @@ class Localizer:
         if not lines:
             return None
         ahead = min(lines, key=lambda d: abs(d - distance))
-        return self._along(ahead - distance, p.stop_line_sigma)
+        nu = ahead - distance
+        # the map's stop lines are tens of metres apart, so the one within the window is the
+        # one seen whatever the filter's own variance along the route says (the lateral
+        # updates in curves make it overconfident): the variance along the route is raised
+        # to the innovation's square first, so that the gate below passes and the update
+        # moves the station by most of it
+        h = self._along_row()
+        p_along = float((h @ self._ekf.P @ h.T)[0, 0])
+        if nu * nu > p_along:
+            self._ekf.P = self._ekf.P + (nu * nu - p_along) * (h.T @ h)
+        return self._along(nu, p.stop_line_sigma)
 
     def _along(self, nu: float, sigma: float) -> LaneMatch:
         """A gated update of the position along the route by ``nu`` [m] (a measured station
         less the pose's) of noise ``sigma`` [m]."""
-        p = self.params
+        return self._gated_update(self._along_row(), np.array([nu]), np.array([[sigma**2]]),
+                                  self.params.line_end_gate, -1)
+
+    def _along_row(self) -> FloatArray:
+        """(1, 7) the position's component along the route at the estimate."""
         assert self.road is not None
         road = self.road
         theta = float(road.heading_at(float(road.local_coordinates(self.state[[IX, IY]])[0])))
         h = np.zeros((1, DIM_X))
         h[0, IX], h[0, IY] = math.cos(theta), math.sin(theta)
-        return self._gated_update(h, np.array([nu]), np.array([[sigma**2]]), p.line_end_gate,
-                                  -1)
+        return h
 
     def _gated_update(self, h: FloatArray, nu: FloatArray, r: FloatArray, gate: float,
                       lane: int) -> LaneMatch:
