@@ -1,30 +1,54 @@
-"""The car's own pose estimate: an EKF fusing GNSS fixes with wheel odometry and the gyro.
+"""The car's own pose estimate: an EKF fusing GNSS fixes, wheel odometry and the gyro, and
+the camera's lane on the HD map (map matching).
 
-State (map frame, car centre): ``[x, y, heading, speed, yaw_rate]`` in ``[m, m, rad, m/s,
-rad/s]``, heading counter-clockwise from +x, wrapped to (-pi, pi].
+State (map frame, car centre): ``[x, y, heading, speed, yaw_rate, bias_x, bias_y]`` in
+``[m, m, rad, m/s, rad/s, m, m]``, heading counter-clockwise from +x, wrapped to (-pi, pi];
+``bias_*`` is the GNSS receiver's slowly wandering error (a fix measures position + bias).
 
 Steps:
 
-1. The first GNSS fix initialises the state (speed and yaw rate from the latest odometry
-   sample, if one came before it, else zero with ``init_*_sigma``). Odometry before that is
-   only remembered.
+1. The first valid GNSS fix initialises the state (speed and yaw rate from the latest
+   odometry sample, if one came before it, else zero with ``init_*_sigma``; the bias zero
+   with its assumed sigma (step 2), so that position + bias is known to the white noise).
+   Odometry before that is only remembered.
 2. Predict to every sample's time with a unicycle model evaluated at the midpoint heading
    (``x += v dt cos(psi + w dt / 2)``, ...): it matches the exact constant-turn-rate (CTRV)
    chord up to a relative length error of ``(w dt)^2 / 24``, negligible at odometry rates,
    and its Jacobian has no ``w -> 0`` singularity. Process noise: white longitudinal and yaw
    acceleration (``accel_sigma``, ``yaw_accel_sigma``) plus a random walk on position and
-   heading (``position_walk``, ``heading_walk``: slip, tyre radius error).
+   heading (``position_walk``, ``heading_walk``: slip, tyre radius error). The bias is a
+   first-order Gauss-Markov process (``gnss_bias_tau``) of 1-sigma the receiver's stated
+   accuracy, with a map at least ``gnss_bias_floor``: a receiver that states 5 cm may still
+   be off by an offset it does not know of, and the camera's lane must be able to correct
+   that.
 3. Update at every odometry sample with its speed (mean rear wheel spin x nominal radius)
-   and the gyro yaw rate, and at every GNSS fix with its position and heading (the noise the
-   larger of the fix's own sigma and ``gnss_sigma`` / ``gnss_heading_sigma``); the heading
-   innovation is wrapped to (-pi, pi].
+   and the gyro yaw rate, and at every valid GNSS fix with position + bias and heading (the
+   white noise ``gnss_white`` x the fix's stated sigma, at least ``gnss_sigma``; the heading
+   noise the larger of the fix's own and ``gnss_heading_sigma``); an invalid fix (an
+   outage) is skipped. The heading innovation is wrapped to (-pi, pi].
+4. Map matching (`on_lane`): a confident camera lane estimate gives the car's lateral
+   offset from a lane centre and its heading relative to the lane. The lane is the HD map's
+   ego-direction lane that puts the car nearest the estimate (before the first match: the
+   lane the car starts in, since a GNSS bias may exceed half a lane). The pseudo-measurement
+   is the estimate projected onto that lane (its station kept) with the camera's lateral
+   offset and heading in place of its own; the innovation is taken against the pose the
+   stack had at the frame's time (the frame arrives late) and applied now. It is gated by
+   its Mahalanobis distance (``lane_gate``), so a reading that would put the car in another
+   place than the estimate allows (a wrong lane, a misdetection) is rejected.
+5. Along the route: at a town junction the painted lines end at its mouth (`on_line_end`),
+   and before a stop sign or a town junction a stop line is painted across the lane
+   (`on_stop_line`, seen by `perception.stop_lines`); where the camera sees either, the car's
+   station is the map's less that distance (gated likewise; a stop line, unambiguous within
+   its window, first raises the variance along the route to its innovation's square).
 
-A constant GNSS bias is NOT observable here: odometry measures only speed and yaw rate, never
-absolute position, so the estimate follows the biased fixes (offset by the bias). Removing it
-needs another absolute reference (map matching of camera lane lines, landmarks).
+So the camera pins the lateral position and heading while it sees the lane; the station
+along the route comes from the odometry (the map's stations of the dead-reckoned pose) and,
+where the map has them, from stop lines and the ends of the lines at a town junction; GNSS
+only bounds the drift through the bias's mean reversion. Without the camera, a GNSS
+bias cannot be separated from the position: the estimate follows the biased fixes.
 
 The filter's update step is filterpy's `ExtendedKalmanFilter.update` (Joseph form) with our
-own Jacobians; the prediction is done here because the model is non-linear.
+own Jacobians; the prediction and the gated map-matching update are done here.
 """
 
 from __future__ import annotations
@@ -36,17 +60,19 @@ import numpy as np
 from filterpy.kalman import ExtendedKalmanFilter
 from numpy.typing import NDArray
 
-from perception.messages import EgoState
+from perception.messages import EgoState, LaneEstimate
 from world.frames import GnssFix, Odometry, wrap_angle
+from world.hdmap import Lane, RoadMap, StopSign
 
 FloatArray = NDArray[np.float64]
 
-DIM_X = 5
-IX, IY, IPSI, IV, IW = range(DIM_X)
+DIM_X = 7
+IX, IY, IPSI, IV, IW, IBX, IBY = range(DIM_X)
 DEG = math.pi / 180.0  # [rad/deg]
 
-_H_GNSS = np.eye(DIM_X)[[IX, IY, IPSI]]  # (3, 5) x, y, heading
-_H_ODO = np.eye(DIM_X)[[IV, IW]]  # (2, 5) speed, yaw rate
+_H_GNSS = np.eye(DIM_X)[[IX, IY, IPSI]] + np.eye(DIM_X)[[IBX, IBY, IPSI]] * [[1], [1], [0]]
+#   (3, 7): position + bias, heading
+_H_ODO = np.eye(DIM_X)[[IV, IW]]  # (2, 7) speed, yaw rate
 
 
 class NotInitialisedError(RuntimeError):
@@ -57,8 +83,13 @@ class NotInitialisedError(RuntimeError):
 class LocalizerParams:
     """Measurement and process noise (1-sigma) of the localization EKF."""
 
-    gnss_sigma: float = 0.05  # [m] position noise floor; the fix's own larger sigma wins
-    gnss_heading_sigma: float = 0.2 * DEG  # [rad] heading noise floor, as above
+    gnss_sigma: float = 0.05  # [m] white position noise floor of a fix
+    gnss_white: float = 0.25  # [-] the white part of a fix's stated sigma (the rest wanders)
+    gnss_heading_sigma: float = 0.2 * DEG  # [rad] heading noise floor; the fix's larger wins
+    gnss_bias_tau: float = 60.0  # [s] correlation time assumed for the GNSS bias
+    gnss_bias_floor: float = 1.0  # [m] 1-sigma of the bias assumed of any receiver, however
+    #   accurate it says it is (an offset it does not know of: lever arm, datum, a constant
+    #   error); the camera's lane may move the position across the lane this far
     wheel_speed_sigma: float = 0.05  # [m/s] odometry speed noise
     gyro_sigma: float = 0.005  # [rad/s] gyro yaw-rate noise
     accel_sigma: float = 3.0  # [m/s^2] white longitudinal acceleration (process)
@@ -67,10 +98,35 @@ class LocalizerParams:
     heading_walk: float = 0.001  # [rad/sqrt(s)] heading random walk (gyro/heading slip)
     init_speed_sigma: float = 1.0  # [m/s] initial speed uncertainty (no odometry before fix)
     init_yaw_rate_sigma: float = 0.1  # [rad/s] initial yaw-rate uncertainty, as above
+    lane_offset_sigma: float = 0.15  # [m] camera lane offset noise (its frames' errors are
+    #   correlated: about 4 x the 0.04 m RMS error measured on normal_driving)
+    lane_heading_sigma: float = 1.0 * DEG  # [rad] camera heading-to-lane noise (0.66 deg RMS)
+    lane_confidence: float = 0.5  # [-] a lane estimate this confident is a measurement
+    lane_gate: float = 13.8  # [-] Mahalanobis distance^2 gate (chi^2, 2 dof, 99.9 %)
+    line_end_sigma: float = 1.0  # [m] where the camera sees the painted lines end
+    line_end_range: tuple[float, float] = (10.0, 28.0)  # [m] ahead of the car's centre where
+    #   a line end is believed: well inside the bird's-eye view (5 .. 35 m), not cut by it
+    line_end_gate: float = 10.8  # [-] Mahalanobis distance^2 gate (chi^2, 1 dof, 99.9 %),
+    #   also of a stop line's
+    stop_line_sigma: float = 0.3  # [m] where the camera sees a stop line's near edge
+    stop_line_window: float = 2.0  # [m] a stop line seen is the map's nearest within 3 x this
+
+
+@dataclass(frozen=True, slots=True)
+class LaneMatch:
+    """What one map-matching update did."""
+
+    lane: int  # the map lane the camera's lane was matched with (-1: along the route)
+    innovation: tuple[float, float]  # [m, rad] lateral offset, heading: camera minus pose
+    #   (along the route: [m] station, 0)
+    distance2: float  # [-] its squared Mahalanobis distance
+    accepted: bool  # within the gate, applied
+    correction: tuple[float, float, float]  # [m, m, rad] x, y, heading added to the state
 
 
 def motion(x: FloatArray, dt: float) -> tuple[FloatArray, FloatArray]:
-    """Propagate state ``x`` (5,) by ``dt`` [s]; return (x', F) with F the (5, 5) Jacobian."""
+    """Propagate state ``x`` by ``dt`` [s]; return (x', F) with F its Jacobian. The pose
+    moves, the rest (and any bias states after the first five) stays."""
     psi, v, w = x[IPSI], x[IV], x[IW]
     a = psi + 0.5 * w * dt  # [rad] midpoint heading
     c, s = math.cos(a), math.sin(a)
@@ -78,7 +134,7 @@ def motion(x: FloatArray, dt: float) -> tuple[FloatArray, FloatArray]:
     out[IX] += v * dt * c
     out[IY] += v * dt * s
     out[IPSI] = wrap_angle(psi + w * dt)
-    f = np.eye(DIM_X)
+    f = np.eye(len(x))
     f[IX, IPSI] = -v * dt * s
     f[IX, IV] = dt * c
     f[IX, IW] = -0.5 * v * dt * dt * s
@@ -90,18 +146,16 @@ def motion(x: FloatArray, dt: float) -> tuple[FloatArray, FloatArray]:
 
 
 def process_noise(x: FloatArray, dt: float, p: LocalizerParams) -> FloatArray:
-    """(5, 5) discrete process noise for a step of ``dt`` [s] from state ``x``."""
+    """(7, 7) discrete process noise of the pose and motion for a step of ``dt`` [s] from
+    state ``x`` (the bias's is added by the filter, which knows its sigma)."""
     a = x[IPSI] + 0.5 * x[IW] * dt
     half_dt2 = 0.5 * dt * dt
-    g = np.array(
-        [
-            [half_dt2 * math.cos(a), 0.0],
-            [half_dt2 * math.sin(a), 0.0],
-            [0.0, half_dt2],
-            [dt, 0.0],
-            [0.0, dt],
-        ]
-    )
+    g = np.zeros((DIM_X, 2))
+    g[IX, 0] = half_dt2 * math.cos(a)
+    g[IY, 0] = half_dt2 * math.sin(a)
+    g[IPSI, 1] = half_dt2
+    g[IV, 0] = dt
+    g[IW, 1] = dt
     q: FloatArray = (g * [p.accel_sigma**2, p.yaw_accel_sigma**2]) @ g.T
     q[IX, IX] += p.position_walk**2 * dt
     q[IY, IY] += p.position_walk**2 * dt
@@ -125,7 +179,7 @@ def _h_gnss(_x: FloatArray) -> FloatArray:
 
 
 def _hx_gnss(x: FloatArray) -> FloatArray:
-    return x[[IX, IY, IPSI]]
+    return np.array([x[IX] + x[IBX], x[IY] + x[IBY], x[IPSI]])
 
 
 def _h_odo(_x: FloatArray) -> FloatArray:
@@ -137,23 +191,29 @@ def _hx_odo(x: FloatArray) -> FloatArray:
 
 
 class Localizer:
-    """EKF pose estimate from `GnssFix` and `Odometry` samples; see the module docstring."""
+    """EKF pose estimate from `GnssFix` and `Odometry` samples and, given the HD map, the
+    camera's lane (`on_lane`); see the module docstring."""
 
-    def __init__(self, params: LocalizerParams | None = None) -> None:
+    def __init__(self, params: LocalizerParams | None = None, road: RoadMap | None = None,
+                 start_lane: int = 0) -> None:
+        """`road`: the HD map the camera's lane is matched on (None: no map matching);
+        `start_lane`: the ego-direction lane the car starts in."""
         self.params = params if params is not None else LocalizerParams()
         p = self.params
+        self.road = road
+        self.start_lane = start_lane
         self._r_odo = np.diag([p.wheel_speed_sigma**2, p.gyro_sigma**2])  # (2, 2) constant
-        self._ekf = ExtendedKalmanFilter(dim_x=DIM_X, dim_z=3)
-        self._t = 0.0  # [s] time the filter state refers to
-        self._initialised = False
-        self._last_odo: Odometry | None = None
+        self._r_lane = np.diag([p.lane_offset_sigma**2, p.lane_heading_sigma**2])
+        self.reset()
 
     def reset(self) -> None:
         """Forget everything; the next GNSS fix initialises again."""
         self._ekf = ExtendedKalmanFilter(dim_x=DIM_X, dim_z=3)
-        self._t = 0.0
+        self._t = 0.0  # [s] time the filter state refers to
         self._initialised = False
-        self._last_odo = None
+        self._last_odo: Odometry | None = None
+        self._bias_sigma = 0.0  # [m] 1-sigma of the GNSS bias (the receiver's stated)
+        self.matched = False  # a camera lane has been matched on the map since the start
 
     @property
     def initialised(self) -> bool:
@@ -161,12 +221,13 @@ class Localizer:
 
     @property
     def state(self) -> FloatArray:
-        """(5,) copy of ``[x, y, heading, speed, yaw_rate]`` at the last sample's time."""
+        """(7,) copy of ``[x, y, heading, speed, yaw_rate, bias_x, bias_y]`` at the last
+        sample's time."""
         return np.array(self._ekf.x, dtype=np.float64)
 
     @property
     def covariance(self) -> FloatArray:
-        """(5, 5) copy of the state covariance, same order and units as `state`."""
+        """(7, 7) copy of the state covariance, same order and units as `state`."""
         return np.array(self._ekf.P, dtype=np.float64)
 
     def on_odometry(self, odo: Odometry) -> None:
@@ -178,22 +239,165 @@ class Localizer:
         self._ekf.update(np.array([odo.speed, odo.yaw_rate]), _h_odo, _hx_odo, R=self._r_odo)
 
     def on_gnss(self, fix: GnssFix) -> None:
-        """Initialise from the first fix; later, predict to ``fix.t`` and update with it.
+        """Initialise from the first valid fix; later, predict to ``fix.t`` and update with
+        it. A fix flagged invalid (an outage) carries nothing and is skipped.
 
         A fix older than the filter time is applied at the filter time (no retrodiction): a
         fix d [s] late is off by speed x d, so the sensor model must stamp fixes on time.
         """
+        if not fix.valid:
+            return
         if not self._initialised:
             self._initialise(fix)
             return
+        self._bias_sigma = self._bias_sigma_of(fix)
         self._predict_to(fix.t)
-        p = self.params
-        sigma = max(p.gnss_sigma, fix.sigma)
-        heading_sigma = max(p.gnss_heading_sigma, fix.heading_sigma)
+        sigma = self._white_sigma(fix)
+        heading_sigma = max(self.params.gnss_heading_sigma, fix.heading_sigma)
         r = np.diag([sigma**2, sigma**2, heading_sigma**2])
         z = np.array([fix.x, fix.y, fix.heading])
         self._ekf.update(z, _h_gnss, _hx_gnss, R=r, residual=_gnss_residual)
         self._ekf.x[IPSI] = wrap_angle(float(self._ekf.x[IPSI]))
+
+    def on_lane(self, lane: LaneEstimate, pose: EgoState) -> LaneMatch | None:
+        """Map matching: correct the lateral position and heading with the camera's lane
+        estimate ``lane``, taken when the stack's pose estimate was ``pose`` (module doc,
+        step 4). None when there is nothing to match (no map, no fix yet, not confident,
+        no ego-direction lane there); else what was done."""
+        p = self.params
+        if self.road is None or not self._initialised or lane.confidence < p.lane_confidence:
+            return None
+        found = self._match(lane, pose)
+        if found is None:
+            return None
+        index, map_lane, s = found
+        _, r = map_lane.local_coordinates(np.array([pose.x, pose.y]))
+        theta = float(map_lane.heading_at(s))
+        nu = np.array([lane.offset - float(r),
+                       wrap_angle(lane.heading_error - wrap_angle(pose.heading - theta))])
+        now_theta = float(map_lane.heading_at(
+            map_lane.local_coordinates(self.state[[IX, IY]])[0]))
+        h = np.zeros((2, DIM_X))
+        h[0, IX], h[0, IY] = -math.sin(now_theta), math.cos(now_theta)
+        h[1, IPSI] = 1.0
+        match = self._gated_update(h, nu, self._r_lane, p.lane_gate, index)
+        self.matched = self.matched or match.accepted
+        return match
+
+    def on_line_end(self, lane: LaneEstimate, pose: EgoState) -> LaneMatch | None:
+        """Along the route: at a town junction the painted lines end at its mouth
+        (`world.hdmap.Junction.s_enter`). Where the map has a mouth within
+        ``line_end_range`` ahead of ``pose`` (the pose at the frame's time) and the farthest
+        painted line of ``lane`` ends within that range too, the car's station is the
+        mouth's less that distance: an update of the position along the lane, gated like
+        the lateral one (``line_end_gate``). None when there is nothing to match; else what
+        was done (``innovation``: [m] along the route, 0)."""
+        p = self.params
+        road = self.road
+        if road is None or not road.junctions or not self._initialised \
+                or lane.confidence < p.lane_confidence:
+            return None
+        ends = [b.x_max for b in (lane.left, lane.right) if b is not None]
+        lo, hi = p.line_end_range
+        if not ends or not lo <= max(ends) <= hi:
+            return None
+        x_end = max(ends)  # [m] the farthest line: a car ahead hides the nearer ends
+        s = float(road.local_coordinates(np.array([pose.x, pose.y]))[0])
+        mouths = [j.s_enter - s for j in road.junctions if lo - 5.0 <= j.s_enter - s <= hi + 5.0]
+        if not mouths:
+            return None
+        ahead = min(mouths, key=lambda d: abs(d - x_end))
+        return self._along(ahead - x_end, p.line_end_sigma)
+
+    def stop_lines_ahead(self, pose: EgoState, near: float, far: float) -> list[float]:
+        """[m] distances from ``pose`` to the map's painted stop lines (a stop sign's, a town
+        junction's) between ``near`` and ``far`` ahead along the route."""
+        if self.road is None:
+            return []
+        road = self.road
+        s = float(road.local_coordinates(np.array([pose.x, pose.y]))[0])
+        lines = {f.s for f in road.features if isinstance(f, StopSign)}
+        lines |= {j.s_stop for j in road.junctions}
+        return sorted(d for d in (line - s for line in lines) if near <= d <= far)
+
+    def on_stop_line(self, distance: float, pose: EgoState) -> LaneMatch | None:
+        """Along the route: the camera saw the near edge of a stop line ``distance`` [m]
+        ahead of the car's centre when the pose estimate was ``pose``; the nearest of the
+        map's stop lines there gives the car's station (gated like the other updates). None
+        when the map has no stop line near there."""
+        p = self.params
+        if not self._initialised:
+            return None
+        reach = 3.0 * p.stop_line_window
+        lines = self.stop_lines_ahead(pose, distance - reach, distance + reach)
+        if not lines:
+            return None
+        ahead = min(lines, key=lambda d: abs(d - distance))
+        nu = ahead - distance
+        # the map's stop lines are tens of metres apart, so the one within the window is the
+        # one seen whatever the filter's own variance along the route says (the lateral
+        # updates in curves make it overconfident): the variance along the route is raised
+        # to the innovation's square first, so that the gate below passes and the update
+        # moves the station by most of it
+        h = self._along_row()
+        p_along = float((h @ self._ekf.P @ h.T)[0, 0])
+        if nu * nu > p_along:
+            self._ekf.P = self._ekf.P + (nu * nu - p_along) * (h.T @ h)
+        return self._along(nu, p.stop_line_sigma)
+
+    def _along(self, nu: float, sigma: float) -> LaneMatch:
+        """A gated update of the position along the route by ``nu`` [m] (a measured station
+        less the pose's) of noise ``sigma`` [m]."""
+        return self._gated_update(self._along_row(), np.array([nu]), np.array([[sigma**2]]),
+                                  self.params.line_end_gate, -1)
+
+    def _along_row(self) -> FloatArray:
+        """(1, 7) the position's component along the route at the estimate."""
+        assert self.road is not None
+        road = self.road
+        theta = float(road.heading_at(float(road.local_coordinates(self.state[[IX, IY]])[0])))
+        h = np.zeros((1, DIM_X))
+        h[0, IX], h[0, IY] = math.cos(theta), math.sin(theta)
+        return h
+
+    def _gated_update(self, h: FloatArray, nu: FloatArray, r: FloatArray, gate: float,
+                      lane: int) -> LaneMatch:
+        """Update with innovation ``nu`` (m,) of a measurement (m, 7) ``h``, noise ``r``,
+        unless its squared Mahalanobis distance exceeds ``gate``."""
+        cov = self._ekf.P
+        s_mat = h @ cov @ h.T + r
+        d2 = float(nu @ np.linalg.solve(s_mat, nu))
+        innovation = (float(nu[0]), float(nu[1]) if len(nu) > 1 else 0.0)
+        if d2 > gate:
+            return LaneMatch(lane, innovation, d2, False, (0.0, 0.0, 0.0))
+        gain = cov @ h.T @ np.linalg.inv(s_mat)
+        dx = gain @ nu
+        i_kh = np.eye(DIM_X) - gain @ h
+        self._ekf.P = i_kh @ cov @ i_kh.T + gain @ r @ gain.T
+        self._ekf.x = self._ekf.x + dx
+        self._ekf.x[IPSI] = wrap_angle(float(self._ekf.x[IPSI]))
+        return LaneMatch(lane, innovation, d2, True,
+                         (float(dx[IX]), float(dx[IY]), float(dx[IPSI])))
+
+    def _match(self, lane: LaneEstimate, pose: EgoState) -> tuple[int, Lane, float] | None:
+        """(index, lane, station at the pose) of the ego-direction lane whose centre plus
+        the camera's offset is nearest the pose (the start lane before the first match)."""
+        assert self.road is not None
+        road = self.road
+        xy = np.array([pose.x, pose.y])
+        s_arr, d_arr = road.local_coordinates(xy)
+        s, d = float(s_arr), float(d_arr)
+        if self.matched:
+            candidates = [i for i in range(len(road.lanes))
+                          if bool(road.lanes[i].exists_at(s))]
+        else:
+            candidates = [self.start_lane] if 0 <= self.start_lane < len(road.lanes) \
+                and bool(road.lanes[self.start_lane].exists_at(s)) else []
+        if not candidates:
+            return None
+        best = min(candidates,
+                   key=lambda i: abs(float(road.lanes[i].offset_at(s)) + lane.offset - d))
+        return best, road.lanes[best], s
 
     def estimate(self, t: float) -> EgoState:
         """The estimate extrapolated (not committed) to time ``t`` [s].
@@ -221,16 +425,33 @@ class Localizer:
             position_sigma=math.sqrt(max(pos_var, 0.0)),
         )
 
+    def _bias_sigma_of(self, fix: GnssFix) -> float:
+        """[m] 1-sigma of the bias assumed of a fix: its stated sigma, at least the floor
+        when the camera's lane can be matched on a map (else nothing could correct it)."""
+        floor = self.params.gnss_bias_floor if self.road is not None else 0.0
+        return max(floor, fix.sigma)
+
+    def _white_sigma(self, fix: GnssFix) -> float:
+        """[m] the white noise assumed of a fix: a part of its stated sigma, at least the
+        floor."""
+        return max(self.params.gnss_sigma, self.params.gnss_white * fix.sigma)
+
     def _initialise(self, fix: GnssFix) -> None:
         p = self.params
         odo = self._last_odo
         speed, yaw_rate = (odo.speed, odo.yaw_rate) if odo is not None else (0.0, 0.0)
         speed_sigma = p.wheel_speed_sigma if odo is not None else p.init_speed_sigma
         yaw_sigma = p.gyro_sigma if odo is not None else p.init_yaw_rate_sigma
-        sigma = max(p.gnss_sigma, fix.sigma)
+        white = self._white_sigma(fix)
         heading_sigma = max(p.gnss_heading_sigma, fix.heading_sigma)
-        self._ekf.x = np.array([fix.x, fix.y, wrap_angle(fix.heading), speed, yaw_rate])
-        self._ekf.P = np.diag([sigma**2, sigma**2, heading_sigma**2, speed_sigma**2, yaw_sigma**2])
+        self._bias_sigma = self._bias_sigma_of(fix)
+        b2 = self._bias_sigma**2
+        self._ekf.x = np.array([fix.x, fix.y, wrap_angle(fix.heading), speed, yaw_rate, 0.0,
+                                0.0])
+        cov = np.diag([b2 + white**2, b2 + white**2, heading_sigma**2, speed_sigma**2,
+                       yaw_sigma**2, b2, b2])
+        cov[IX, IBX] = cov[IBX, IX] = cov[IY, IBY] = cov[IBY, IY] = -b2  # x + b: the fix
+        self._ekf.P = cov
         self._t = fix.t
         self._initialised = True
 
@@ -240,6 +461,12 @@ class Localizer:
             return
         x0 = self.state
         x, f = motion(x0, dt)
+        decay = math.exp(-dt / self.params.gnss_bias_tau)
+        x[[IBX, IBY]] *= decay
+        f[IBX, IBX] = f[IBY, IBY] = decay
+        q = process_noise(x0, dt, self.params)
+        q[IBX, IBX] += self._bias_sigma**2 * (1.0 - decay * decay)
+        q[IBY, IBY] += self._bias_sigma**2 * (1.0 - decay * decay)
         self._ekf.x = x
-        self._ekf.P = f @ self._ekf.P @ f.T + process_noise(x0, dt, self.params)
+        self._ekf.P = f @ self._ekf.P @ f.T + q
         self._t = t

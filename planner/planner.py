@@ -11,14 +11,18 @@ Positions are in the map frame, stations [m] along the route's reference line, s
    (`planner.events`, `planner.junctions`);
 2. the car is placed on the lane kept (station, lateral offset); the lane-source FSM
    (`planner.fsm.lane_source`) says where the lateral reference comes from: the camera's
-   lane, or the map lane (`planner.route.lane_path`, placed by the GNSS + odometry
-   estimate) while the camera's is acquired or lost, or near a town junction;
+   lane, or the map lane (`planner.route.lane_path`, placed by the pose estimate) while the
+   camera's is acquired, lost or another lane than the one kept, or near a town junction;
 3. the motion FSM (`planner.motion_layer`) keeps the lane, changes lanes from the lane
    occupancy of the tracks, turns at a junction or pulls over; a lane change (or its
    abort) makes its target lane the lane kept and its Hermite path
    (`planner.lane_change_path`) the path. Otherwise the path is the camera's lane
-   (`planner.camera_lane`) when the source is CAMERA, the lane is not the shoulder and the
-   camera's offset agrees with the map's within ``camera_agree``, else the map lane;
+   (`planner.camera_lane`) when the source is CAMERA (the camera sees the lane kept: its
+   offset agrees with the map's within ``camera_agree`` at the frame's pose, which the
+   camera's lane itself corrects across the lane) and the lane is not the shoulder, else
+   the map lane (ACQUIRING at the start, before the camera's lane has corrected the pose
+   across the lane: the line parallel to the lane through the car, holding its offset); the
+   lane source is updated once the lane kept is known;
 4. the lead vehicle (`planner.lead`: in the path's lane, or along the map lane through a
    junction, or in the lanes a lane change occupies);
 5. the speed, a chain of `planner.speed.PlannedSpeed`s, each link keeping what it was given
@@ -114,6 +118,7 @@ class Planner:
         self.source = Machine("lane_source",
                               LaneSource.ACQUIRING if p.camera else LaneSource.MAP)
         self._start: float | None = None  # [s] time of the first tick
+        self._lane_seen = False  # the camera's lane has been the path (the pose is matched)
         self._cap = math.inf  # [m/s] the ramped speed cap of the degraded modes
         self._last_t: float | None = None
         self._keep(p.lane)
@@ -140,14 +145,14 @@ class Planner:
         s, r = self.lane.local_coordinates(np.array([ego.x, ego.y]))
         return float(np.asarray(s)), float(np.asarray(r))
 
-    def path_for(self, ego: EgoState, station: float) -> ReferencePath:
-        """The lane kept's centre from ``path_behind`` behind the car's centre at `station`
-        [m] to max(``path_ahead_min``, ``path_ahead_time`` * speed) ahead."""
+    def path_for(self, ego: EgoState, station: float, offset: float = 0.0) -> ReferencePath:
+        """The lane kept's centre (or the line `offset` [m] left of it) from ``path_behind``
+        behind the car's centre at `station` [m] to max(``path_ahead_min``,
+        ``path_ahead_time`` * speed) ahead."""
         p = self.params
         ahead = max(p.path_ahead_min, p.path_ahead_time * max(ego.speed, 0.0))
-        return lane_path(
-            self.lane, station, p.path_behind, ahead, p.path_spacing, length=self.road.length
-        )
+        return lane_path(self.lane, station, p.path_behind, ahead, p.path_spacing,
+                         length=self.road.length, offset=offset)
 
     def speed_for(self, station: float, set_speed: float | None = None) -> SpeedTarget:
         """The map's speed target for the car's centre at ``station`` [m] (at ``set_speed``
@@ -167,7 +172,6 @@ class Planner:
         if inp.lights:
             self.junctions.see_lights(inp.lights)
         station, lateral = self.localise(ego)
-        changes = self._update_source(ego.t, view, self.near_junction(station))
         target = self.speed_for(station)
         want = min(self.params.set_speed, target.limit_at_front)
         manoeuvre, motion_changes = self.motion.update(ego, want, tracks,
@@ -176,6 +180,8 @@ class Planner:
             self._keep(manoeuvre.lane)
             station, lateral = self.localise(ego)
             target = self.speed_for(station)
+        changes = self._update_source(ego.t, view, self.near_junction(station),
+                                      self._other_lane(view, manoeuvre))
         lateral_choice = self._path(ego, station, view, manoeuvre)
         lead = self._lead(view, tracks, ego, manoeuvre, lateral_choice.camera)
         planned = PlannedSpeed(SpeedRef(target.speed, target.accel),
@@ -235,23 +241,38 @@ class Planner:
             return LateralChoice(manoeuvre.path.reference_path(
                 self.lane, station, p.path_behind, ahead, p.path_spacing, self.road.length),
                 camera=False)
-        # the camera's lane lies between painted lines: not the shoulder (no outer line)
+        # the camera's lane lies between painted lines: not the shoulder (no outer line);
+        # in CAMERA it is the lane kept (`_other_lane`, the lane source's input)
         if self.source.state is LaneSource.CAMERA and view is not None and \
                 self.lane_index != SHOULDER:
-            _, r = self.localise(view.pose)
-            if abs(view.estimate.offset - r) <= p.camera_agree:
-                return LateralChoice(self._camera_path(view), camera=True)
+            return LateralChoice(self._camera_path(view), camera=True)
+        if self.source.state is LaneSource.ACQUIRING and not self._lane_seen:
+            # the pose has GNSS's error across the lane until the camera's lane corrects it
+            # (`perception.localization`): hold the offset the car has, parallel to the lane
+            return LateralChoice(self.path_for(ego, station, self.localise(ego)[1]),
+                                 camera=False)
         return LateralChoice(self.path_for(ego, station), camera=False)
 
-    def _update_source(self, t: float, view: LaneView | None,
-                       junction: bool) -> tuple[StateChange, ...]:
+    def _other_lane(self, view: LaneView | None, manoeuvre: Manoeuvre) -> bool:
+        """Whether the camera's lane is not the lane kept: its offset is more than
+        ``camera_agree`` from the map's lane kept at the frame's pose (not judged during a
+        lane change's path, nor on the shoulder, which has no painted lane)."""
+        if view is None or manoeuvre.path is not None or self.lane_index == SHOULDER:
+            return False
+        _, r = self.localise(view.pose)
+        return abs(view.estimate.offset - r) > self.params.camera_agree
+
+    def _update_source(self, t: float, view: LaneView | None, junction: bool,
+                       other_lane: bool) -> tuple[StateChange, ...]:
         if self._start is None:
             self._start = t
         confidence = view.estimate.confidence if view is not None else 0.0
         since = max(self.source.since, self._start)  # ACQUIRING counts from the start
-        x = LaneSourceInput(t, confidence, since, junction)
-        return self.source.apply(t, lane_source.transition(self.source.state, x,
-                                                           self.params.source))
+        x = LaneSourceInput(t, confidence, since, junction, other_lane)
+        changes = self.source.apply(t, lane_source.transition(self.source.state, x,
+                                                              self.params.source))
+        self._lane_seen = self._lane_seen or self.source.state is LaneSource.CAMERA
+        return changes
 
     def _camera_path(self, view: LaneView) -> ReferencePath:
         p = self.params

@@ -51,17 +51,20 @@ def lane_path(
     spacing: float,
     *,
     length: float,
+    offset: float = 0.0,
 ) -> ReferencePath:
-    """The centre line (r = 0) of ``lane`` from ``s - behind`` to ``s + ahead``.
+    """The centre line (r = 0) of ``lane``, or the line ``offset`` [m] left of it, from
+    ``s - behind`` to ``s + ahead``.
 
     ``s``, ``behind``, ``ahead``, ``spacing`` [m] are stations / station distances along the
     route's reference line; on an offset lane in a curve the points are about ``spacing``
     apart (scaled by ``1 - k * offset``). ``length`` [m] is the route length
     (`RoadMap.length`): lanes end at the route end, so the window is clamped to [0, length].
-    Headings [rad] and signed curvatures [1/m] come from the map, not from differencing.
+    Headings [rad] and signed curvatures [1/m] come from the map, not from differencing
+    (the centre line's curvature, also for an offset line).
     """
     stations = path_stations(s, behind, ahead, spacing, length)
-    xy = np.asarray(lane.position(stations, np.zeros_like(stations)), dtype=np.float64)
+    xy = np.asarray(lane.position(stations, np.full_like(stations, offset)), dtype=np.float64)
     heading = np.asarray(lane.heading_at(stations), dtype=np.float64)
     curvature = np.asarray(lane.curvature_at(stations), dtype=np.float64)
     return ReferencePath(xy=xy.reshape(-1, 2), heading=heading, curvature=curvature)

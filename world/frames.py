@@ -94,14 +94,18 @@ class VehicleInfo:
 
 @dataclass(frozen=True, slots=True)
 class GnssFix:
-    """A GNSS position and heading fix, with the sensor's noise and bias already in it."""
+    """A GNSS position and heading fix, with the sensor's noise and bias already in it.
+
+    In an outage the receiver still reports each epoch, flagged ``valid=False`` (NMEA's
+    status V, "no fix"): its position and heading are then NaN and mean nothing."""
 
     t: float  # [s] sim time of the measurement
     x: float  # [m] map frame, at the car's centre (base link origin)
     y: float  # [m] map frame
     heading: float  # [rad] yaw of the car's body, counter-clockwise from +x, in (-pi, pi]
-    sigma: float  # [m] the receiver's stated 1-sigma horizontal accuracy
+    sigma: float  # [m] the receiver's stated 1-sigma horizontal accuracy, per axis
     heading_sigma: float  # [rad] the receiver's stated 1-sigma heading accuracy
+    valid: bool = True  # False: no fix this epoch (an outage)
 
 
 @dataclass(frozen=True, slots=True)

@@ -15,6 +15,7 @@ its start. Lateral offsets `r` are metres, left positive, from the centre of the
 from __future__ import annotations
 
 import enum
+import math
 from dataclasses import dataclass, field
 
 from world.frames import Wheel
@@ -267,11 +268,52 @@ class EgoSpec:
 
 @dataclass(frozen=True, slots=True)
 class GnssSpec:
-    """The GNSS receiver's noise (`world.sensors`)."""
+    """The GNSS receiver's errors (`world.sensors.gnss`); the defaults are the `consumer`
+    preset (`GNSS_PRESETS`).
 
-    sigma: float = 0.05  # [m] 1-sigma horizontal position noise
-    heading_sigma: float = 0.0034906585  # [rad] 1-sigma heading noise (0.2 deg)
-    bias: tuple[float, float] = (0.0, 0.0)  # [m] constant (x, y) offset
+    Position error per axis (x, y of the map frame) = ``bias`` + a wandering bias (a
+    first-order Gauss-Markov process of stationary 1-sigma ``bias_sigma`` and correlation
+    time ``bias_tau``) + white noise ``sigma``. Heading error = white noise of 1-sigma
+    ``heading_sigma``, and, with ``velocity_sigma`` > 0, of ``atan(velocity_sigma / speed)``
+    on top (a single-antenna receiver's heading is its course over ground, from its velocity:
+    none at a standstill). Outages start at ``dropout_rate`` per second and last
+    ``dropout_duration`` seconds on average (both exponential); a fix in an outage is
+    flagged invalid (`world.frames.GnssFix.valid`).
+    """
+
+    sigma: float = 0.3  # [m] 1-sigma white position noise per axis
+    heading_sigma: float = 0.0052359878  # [rad] 1-sigma heading noise floor (0.3 deg)
+    bias: tuple[float, float] = (0.0, 0.0)  # [m] constant (x, y) offset (the bias's mean)
+    bias_sigma: float = 1.2  # [m] stationary 1-sigma of the wandering bias, per axis
+    bias_tau: float = 60.0  # [s] the wandering bias's correlation time
+    velocity_sigma: float = 0.15  # [m/s] 1-sigma velocity noise (heading from motion); 0: none
+    dropout_rate: float = 1.0 / 300.0  # [1/s] outages started per second of fix
+    dropout_duration: float = 2.0  # [s] mean length of an outage
+
+    @property
+    def stated_sigma(self) -> float:
+        """[m] the 1-sigma horizontal accuracy per axis the receiver states with each fix
+        (like u-blox's hAcc): its white noise and wandering bias together. A constant
+        ``bias`` is an error it does not know of."""
+        return math.hypot(self.sigma, self.bias_sigma)
+
+
+GNSS_PRESETS: dict[str, GnssSpec] = {
+    # RTK (e.g. u-blox ZED-F9P with corrections: 0.01 m + 1 ppm CEP in its data sheet; 5 cm
+    # 1-sigma for a moving car with float fixes and multipath; dual-antenna heading 0.2 deg).
+    # Exactly what a `gnss:` block meant before the presets (white noise, no wander).
+    "rtk": GnssSpec(sigma=0.05, heading_sigma=0.0034906585, bias_sigma=0.0, velocity_sigma=0.0,
+                    dropout_rate=0.0),
+    # consumer single-frequency / dual-frequency receiver without corrections (u-blox
+    # NEO-M8: 2.5 m CEP autonomous, 2.0 m CEP with SBAS; ZED-F9P: 1.5 m CEP PVT; both:
+    # velocity 0.05 m/s, heading 0.3 deg at 30 m/s, 50 %). 1.2 m wandering bias + 0.3 m noise
+    # per axis is 1.24 m 1-sigma, 1.46 m CEP (CEP = 1.1774 sigma for a circular Gaussian).
+    "consumer": GnssSpec(),
+    # the same receiver in a street canyon / under trees: multipath, fewer satellites
+    # (several metres CEP, frequent outages)
+    "degraded": GnssSpec(sigma=0.8, heading_sigma=0.0174532925, bias_sigma=3.0, bias_tau=30.0,
+                         velocity_sigma=0.3, dropout_rate=1.0 / 30.0, dropout_duration=3.0),
+}
 
 
 @dataclass(frozen=True, slots=True)
@@ -286,7 +328,7 @@ class LidarNoiseSpec:
 class SensorsSpec:
     """The sensors' noise (`world.sensors`)."""
 
-    gnss: GnssSpec = field(default_factory=GnssSpec)
+    gnss: GnssSpec = field(default_factory=GnssSpec)  # the `consumer` preset
     lidar: LidarNoiseSpec = field(default_factory=LidarNoiseSpec)
 
 

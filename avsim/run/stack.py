@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import bisect
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from avsim.scenario.scenario import DriverSettings
 from control.actuation import VehicleParams
@@ -25,7 +25,7 @@ from control.vehicle_controller import VehicleController, VehicleControllerParam
 from perception.flat_tyre import FlatTyreDetector
 from perception.lanes import LaneDetector, LaneFilter
 from perception.lights import TrafficLightDetector
-from perception.localization import Localizer
+from perception.localization import LaneMatch, Localizer
 from perception.messages import (
     Detection,
     EgoState,
@@ -38,6 +38,7 @@ from perception.messages import (
 )
 from perception.objects import ObjectDetector
 from perception.signs import StopSignDetector
+from perception.stop_lines import StopLineDetector
 from perception.tracking import MultiObjectTracker
 from planner.messages import Plan
 from planner.motion_layer import MotionLayerParams
@@ -46,7 +47,15 @@ from vehicle_urdf import CarGeometry
 from world.core.rates import CAR_SENSORS
 from world.core.stopwatch import Stopwatch
 from world.ego.body import vehicle_info
-from world.frames import CameraFrame, CameraInfo, Frame, GnssFix, LidarScan, Odometry
+from world.frames import (
+    CameraFrame,
+    CameraInfo,
+    Frame,
+    GnssFix,
+    LidarScan,
+    Odometry,
+    wrap_angle,
+)
 from world.hdmap import RoadMap
 from world.sensors.setup import LIDAR
 from world.spec import EgoSpec
@@ -72,6 +81,15 @@ class PerceptionOutput:
     tracks: tuple[Track, ...] | None
 
 
+def _corrected(pose: EgoState, match: LaneMatch | None) -> EgoState:
+    """The pose at a camera frame's time, moved by the map-matching correction that frame
+    made (the frame's lane is placed in the map with it, as the car's pose now is)."""
+    if match is None or not match.accepted:
+        return pose
+    dx, dy, dpsi = match.correction
+    return replace(pose, x=pose.x + dx, y=pose.y + dy, heading=wrap_angle(pose.heading + dpsi))
+
+
 class Stack:
     """Localizer, lane and object perception, lane-keeping planner, vehicle controller."""
 
@@ -84,7 +102,9 @@ class Stack:
         self.reads = frozenset({*CAR_SENSORS, LIDAR}
                                | ({front_camera.name} if front_camera is not None else set()))
         #   the sensors whose frames it uses (it ignores the side cameras')
-        self.localizer = Localizer()
+        self.localizer = Localizer(road=road if front_camera is not None else None,
+                                   start_lane=ego.lane)
+        #   the camera's lane corrects the pose across the lane (map matching)
         vehicle = vehicle_info(car)
         self.planner = Planner(
             road, PlannerParams(set_speed=driver.set_speed, max_speed=ego.max_speed,
@@ -99,6 +119,8 @@ class Stack:
         self.controller = VehicleController(VehicleControllerParams(
             lateral=lateral, vehicle=VehicleParams(mass=car.mass, wheel_radius=car.wheel_radius)))
         self.lane_detector = LaneDetector(front_camera) if front_camera is not None else None
+        self.stop_line_detector = StopLineDetector(front_camera) \
+            if front_camera is not None else None
         self.sign_detector = StopSignDetector(front_camera) if front_camera is not None \
             else None
         self.light_detector = TrafficLightDetector(front_camera, road, vehicle) \
@@ -161,7 +183,11 @@ class Stack:
                 lane_raw = self.lane_detector.detect(front, prior)
             with watch("perception lane filter"):
                 lane = self.lane_filter.update(lane_raw, pose.speed, pose.yaw_rate)
-            self._view = LaneView(lane, pose)
+            with watch("localisation"):
+                match = self.localizer.on_lane(lane, pose)
+                self.localizer.on_line_end(lane, pose)
+            self._stop_line(front, lane, pose)
+            self._view = LaneView(lane, _corrected(pose, match))
         if front is not None and self.sign_detector is not None:
             with watch("perception signs"):
                 self._signs = SignView(tuple(self.sign_detector.detect(front)), pose)
@@ -176,6 +202,22 @@ class Stack:
                 tracks = self.tracker.update(t, pose, detections)
             self._tracks = tracks
         return PerceptionOutput(t, pose, lane_raw, lane, detections, tracks)
+
+    def _stop_line(self, front: CameraFrame, lane: LaneEstimate, pose: EgoState) -> None:
+        """Look for a stop line where the map has one ahead, and place the car along the
+        route by it (`perception.stop_lines`, `Localizer.on_stop_line`)."""
+        detector = self.stop_line_detector
+        if detector is None or lane.confidence < self.localizer.params.lane_confidence:
+            return
+        p = detector.params
+        margin = self.localizer.params.stop_line_window
+        if not self.localizer.stop_lines_ahead(pose, p.min_x - margin, p.max_x + margin):
+            return
+        with self.watch("perception stop lines"):
+            distance = detector.detect(front, lane)
+        if distance is not None:
+            with self.watch("localisation"):
+                self.localizer.on_stop_line(distance, pose)
 
     def tick(self, t: float, dt: float) -> StackOutput:
         """Plan and control on the estimate now and the latest perception; a frame's signs

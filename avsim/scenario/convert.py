@@ -13,6 +13,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import replace
+from typing import Any
 
 from avsim.criteria.registry import CriteriaSettings, setting_keys
 from avsim.scenario.checks import (
@@ -29,6 +30,7 @@ from avsim.scenario.model import (
     CrosswalkFeature,
     EventModel,
     FeatureModel,
+    GnssModel,
     RoadModel,
     ScenarioModel,
     SegmentModel,
@@ -185,17 +187,31 @@ def _event_spec(event: EventModel) -> spec.EventSpec:
                           event.optional)
 
 
+def _gnss_spec(gnss: GnssModel | None) -> spec.GnssSpec:
+    """The GNSS receiver: the `consumer` preset without a `gnss:` block; else the block's
+    preset (`rtk` if it names none) with the knobs it gives in place of the preset's."""
+    if gnss is None:
+        return spec.GNSS_PRESETS["consumer"]
+    base = spec.GNSS_PRESETS[gnss.preset or "rtk"]
+    knobs: dict[str, Any] = {
+        "sigma": gnss.sigma,
+        "heading_sigma": None if gnss.heading_sigma_deg is None
+        else math.radians(gnss.heading_sigma_deg),
+        "bias": None if gnss.bias is None else (float(gnss.bias[0]), float(gnss.bias[1])),
+        "bias_sigma": gnss.bias_sigma,
+        "bias_tau": gnss.bias_tau,
+        "velocity_sigma": gnss.velocity_sigma,
+        "dropout_rate": gnss.dropout_rate,
+        "dropout_duration": gnss.dropout_duration,
+    }
+    return replace(base, **{k: v for k, v in knobs.items() if v is not None})
+
+
 def _sensors_spec(model: ScenarioModel) -> spec.SensorsSpec:
     """The sensors' noise, the defaults where the file gives none."""
-    gnss, lidar = model.sensors.gnss, model.sensors.lidar
+    lidar = model.sensors.lidar
     return spec.SensorsSpec(
-        gnss=spec.GnssSpec()
-        if gnss is None
-        else spec.GnssSpec(
-            sigma=gnss.sigma,
-            heading_sigma=math.radians(gnss.heading_sigma_deg),
-            bias=(float(gnss.bias[0]), float(gnss.bias[1])),
-        ),
+        gnss=_gnss_spec(model.sensors.gnss),
         lidar=spec.LidarNoiseSpec()
         if lidar is None
         else spec.LidarNoiseSpec(range_sigma=lidar.range_sigma, dropout=lidar.dropout),

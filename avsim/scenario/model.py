@@ -574,19 +574,57 @@ class ActorModel(FormatModel):
     )
 
 
-class GnssModel(FormatModel):
-    """GNSS / odometry noise; keys left out take their defaults."""
+GnssPreset = Literal["rtk", "consumer", "degraded"]
+MAX_GNSS_BIAS = 50.0  # [m] the largest GNSS bias (constant or wandering 1-sigma) a file may set
 
-    sigma: NonNegFloat = Field(
-        default=0.05, description="[m] 1-sigma horizontal position noise, >= 0. Default 0.05."
+
+class GnssModel(FormatModel):
+    """The GNSS receiver: a preset and / or its knobs. Knobs override the preset's values;
+    knobs without a preset start from `rtk` (what a `gnss:` block meant before presets);
+    no `gnss:` block at all is the `consumer` preset."""
+
+    preset: GnssPreset | None = Field(
+        default=None,
+        description="Named receiver: `rtk` (5 cm white noise, no bias), `consumer` (a "
+        "wandering bias of 1.2 m 1-sigma per axis, 60 s correlation time, 0.3 m noise, "
+        "heading from motion, outages) or `degraded` (3 m, 30 s, 0.8 m, frequent "
+        "outages). Default: `rtk` when knobs are given, else `consumer`.",
     )
-    heading_sigma_deg: NonNegFloat = Field(
-        default=0.2, description="[deg] 1-sigma heading noise, >= 0. Default 0.2."
+    sigma: NonNegFloat | None = Field(
+        default=None, description="[m] 1-sigma white position noise per axis, >= 0. "
+        "Default: the preset's (rtk 0.05, consumer 0.3, degraded 0.8)."
+    )
+    heading_sigma_deg: NonNegFloat | None = Field(
+        default=None, description="[deg] 1-sigma heading noise, >= 0. Default: the "
+        "preset's (rtk 0.2, consumer 0.3, degraded 1.0)."
     )
     bias: Annotated[
-        tuple[Annotated[float, Field(strict=True)], Annotated[float, Field(strict=True)]],
+        tuple[Annotated[float, Field(strict=True, ge=-MAX_GNSS_BIAS, le=MAX_GNSS_BIAS)],
+              Annotated[float, Field(strict=True, ge=-MAX_GNSS_BIAS, le=MAX_GNSS_BIAS)]],
         Field(strict=False),
-    ] = Field(default=(0.0, 0.0), description="[m] constant (x, y) offset. Default [0, 0].")
+    ] | None = Field(default=None, description="[m] constant (x, y) offset, each within "
+                     "+-50. Default [0, 0].")
+    bias_sigma: Annotated[float, Field(ge=0, le=MAX_GNSS_BIAS)] | None = Field(
+        default=None, description="[m] stationary 1-sigma of the wandering (Gauss-Markov) "
+        "bias per axis, 0..50. Default: the preset's (rtk 0, consumer 1.2, degraded 3)."
+    )
+    bias_tau: PosFloat | None = Field(
+        default=None, description="[s] correlation time of the wandering bias, > 0. "
+        "Default: the preset's (60, degraded 30)."
+    )
+    velocity_sigma: NonNegFloat | None = Field(
+        default=None, description="[m/s] 1-sigma velocity noise; > 0: the heading is the "
+        "course over ground, noisier at low speed, none at a standstill. Default: the "
+        "preset's (rtk 0, consumer 0.15, degraded 0.3)."
+    )
+    dropout_rate: NonNegFloat | None = Field(
+        default=None, description="[1/s] outages started per second, >= 0. Default: the "
+        "preset's (rtk 0, consumer 1/300, degraded 1/30)."
+    )
+    dropout_duration: PosFloat | None = Field(
+        default=None, description="[s] mean length of an outage, > 0. Default: the "
+        "preset's (2, degraded 3)."
+    )
 
 
 class LidarModel(FormatModel):
@@ -606,7 +644,9 @@ class SensorsModel(FormatModel):
     not their noise)."""
 
     gnss: GnssModel | None = Field(
-        default=None, description="GNSS noise `{sigma, heading_sigma_deg, bias}`."
+        default=None, description="GNSS receiver `{preset, sigma, heading_sigma_deg, bias, "
+        "bias_sigma, bias_tau, velocity_sigma, dropout_rate, dropout_duration}`; default: "
+        "the `consumer` preset."
     )
     lidar: LidarModel | None = Field(
         default=None, description="LiDAR noise `{range_sigma, dropout}`."

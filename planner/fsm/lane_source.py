@@ -1,26 +1,33 @@
 """Where the lateral reference comes from: the camera's lane, or the map when it is lost.
 
 Inputs (`LaneSourceInput`): the time t [s], the confidence [-] of the latest lane estimate,
-the time [s] the state was entered and whether the car is near a town junction. Transitions
+the time [s] the state was entered, whether the car is near a town junction and whether the
+camera's lane is another than the lane kept (its offset more than `camera_agree` from the
+map's lane kept at the frame's pose: a lane change just ended and the camera still sees the
+lane left, or a misdetection; with the pose corrected by the camera's lane on the map,
+`perception.localization`, a GNSS bias no longer makes them disagree). Transitions
 (`TABLE`, as data): for the state it is in, the rows that leave it are tried in this order
 and the first that holds is taken:
 
-1. junction -> camera: past the junction, confidence >= `acquire`
+1. junction -> camera: past the junction, confidence >= `acquire` of the lane kept
 2. junction -> acquiring: past the junction, no good estimate yet
 3. acquiring, camera, map_hold, stop_in_lane -> junction: near a town junction (no lines
    inside; the map's turn path)
 4. camera -> map_hold: confidence < `lose` (hysteresis: `lose` < `acquire`)
-5. acquiring, map_hold, stop_in_lane -> camera: confidence >= `acquire` (a good lane
-   estimate)
-6. acquiring -> map_hold: no good estimate for `acquire_time`
-7. map_hold -> stop_in_lane: lost for `stop_after` seconds
+5. camera -> acquiring: the camera's lane is not the lane kept
+6. acquiring, map_hold, stop_in_lane -> camera: confidence >= `acquire` (a good lane
+   estimate) of the lane kept
+7. acquiring -> map_hold: no good estimate of the lane kept for `acquire_time`
+8. map_hold -> stop_in_lane: lost for `stop_after` seconds
 
 What each state follows (`planner.planner`): MAP is the state of a stack built without a
 camera (GNSS + odometry on the HD map only); no row leaves it. ACQUIRING follows the map
-lane at the planned speed (the camera's first estimate arrives one sensor period after the
-start). CAMERA follows the camera's lane where it agrees with the map's. MAP_HOLD follows
-the map lane placed by the localisation estimate (GNSS + odometry) and slows to
-`hold_speed`; STOP_IN_LANE brings the car to a stop in its lane. JUNCTION follows the map's
+lane at the planned speed: the camera's first estimate arrives one sensor period after the
+start (until it has corrected the pose across the lane, the line through the car parallel
+to the lane), and after a lane change the camera may still see the lane left for a moment.
+CAMERA follows the camera's lane, the lane kept. MAP_HOLD follows the map lane placed by
+the localisation estimate (odometry, GNSS and the camera's lane as long as it was seen) and
+slows to `hold_speed`; STOP_IN_LANE brings the car to a stop in its lane. JUNCTION follows the map's
 path through a town junction at the planned speed: the painted lines end at the junction's
 mouth, and the path turns where none are painted. Every change carries a reason for the
 log.
@@ -59,6 +66,7 @@ class LaneSourceInput:
     confidence: float  # [-] of the latest lane estimate (0 when there is none)
     since: float  # [s] when the state was entered (the first tick, for the initial one)
     junction: bool = False  # the car is near a town junction (`Planner.near_junction`)
+    other_lane: bool = False  # the camera's lane is not the lane kept (module doc)
 
 
 def _good(x: LaneSourceInput, p: LaneSourceParams) -> bool:
@@ -66,7 +74,7 @@ def _good(x: LaneSourceInput, p: LaneSourceParams) -> bool:
 
 
 def _past_found(_s: LaneSource, x: LaneSourceInput, p: LaneSourceParams) -> bool:
-    return not x.junction and _good(x, p)
+    return not x.junction and _good(x, p) and not x.other_lane
 
 
 def _past(_s: LaneSource, x: LaneSourceInput, _p: LaneSourceParams) -> bool:
@@ -82,7 +90,11 @@ def _lost(_s: LaneSource, x: LaneSourceInput, p: LaneSourceParams) -> bool:
 
 
 def _found(_s: LaneSource, x: LaneSourceInput, p: LaneSourceParams) -> bool:
-    return _good(x, p)
+    return _good(x, p) and not x.other_lane
+
+
+def _other_lane(_s: LaneSource, x: LaneSourceInput, _p: LaneSourceParams) -> bool:
+    return x.other_lane
 
 
 def _nothing_found(_s: LaneSource, x: LaneSourceInput, p: LaneSourceParams) -> bool:
@@ -98,7 +110,7 @@ _SEEKING = frozenset({L.ACQUIRING, L.MAP_HOLD, L.STOP_IN_LANE})  # looking for t
 
 TABLE: Table[LaneSource, LaneSourceInput, LaneSourceParams] = Table(LaneSource, (
     Row(frozenset({L.JUNCTION}), L.CAMERA, _past_found,
-        "past the junction, confidence >= `acquire`",
+        "past the junction, confidence >= `acquire` of the lane kept",
         lambda x, p: f"past the junction, lane found (confidence {x.confidence:.2f})"),
     Row(frozenset({L.JUNCTION}), L.ACQUIRING, _past, "past the junction, no good estimate yet",
         "past the junction: looking for the lane"),
@@ -108,10 +120,14 @@ TABLE: Table[LaneSource, LaneSourceInput, LaneSourceParams] = Table(LaneSource, 
     Row(frozenset({L.CAMERA}), L.MAP_HOLD, _lost,
         "confidence < `lose` (hysteresis: `lose` < `acquire`)",
         lambda x, p: f"lane confidence {x.confidence:.2f} < {p.lose}: holding on the map"),
-    Row(_SEEKING, L.CAMERA, _found, "confidence >= `acquire` (a good lane estimate)",
+    Row(frozenset({L.CAMERA}), L.ACQUIRING, _other_lane,
+        "the camera's lane is not the lane kept",
+        "the camera sees another lane than the one kept: the map's lane"),
+    Row(_SEEKING, L.CAMERA, _found,
+        "confidence >= `acquire` (a good lane estimate) of the lane kept",
         lambda x, p: f"lane found (confidence {x.confidence:.2f})"),
     Row(frozenset({L.ACQUIRING}), L.MAP_HOLD, _nothing_found,
-        "no good estimate for `acquire_time`",
+        "no good estimate of the lane kept for `acquire_time`",
         lambda x, p: f"no lane found in {p.acquire_time:.1f} s"),
     Row(frozenset({L.MAP_HOLD}), L.STOP_IN_LANE, _lost_too_long,
         "lost for `stop_after` seconds",

@@ -136,7 +136,9 @@ def test_speed_and_yaw_rate_estimated() -> None:
     assert est.speed == pytest.approx(SPEED, abs=0.01)
     assert est.yaw_rate == pytest.approx(SPEED / RADIUS, abs=0.002)
     assert est.steering_angle == 0.1
-    assert 0.0 < est.position_sigma < 0.05
+    # no camera: the position is known no better than the receiver's stated 5 cm (its bias
+    # and its position cannot be told apart)
+    assert 0.04 < est.position_sigma < 0.06
 
 
 def test_not_initialised_until_first_fix_and_reset() -> None:

@@ -192,6 +192,10 @@ BAD: dict[str, tuple[str, str]] = {
     "town_block_too_short": ("town.block", "must be at least 29 m with 1 lane(s) of 3.5 m"),
     "town_actor_without_start": ("actors.0.start", "required key missing in a town"),
     "bad_lidar_dropout": ("sensors.lidar.dropout", "must be <= 1, got 1.5"),
+    "bad_gnss_preset": ("sensors.gnss.preset",
+                        "must be one of rtk, consumer, degraded, got 'consumr'"),
+    "bad_gnss_bias": ("sensors.gnss.bias.1", "must be <= 50, got 51"),
+    "bad_gnss_sigma": ("sensors.gnss.sigma", "must be >= 0, got -0.1"),
 }
 
 

@@ -42,6 +42,17 @@ TABLE_CASES = [
     (S.MAP, 100.0, 0.0, 0.0, None),
 ]
 
+# (state, confidence, the camera's lane is another than the lane kept) -> next state
+OTHER_LANE_TABLE = [
+    (S.CAMERA, 0.9, True, S.ACQUIRING),  # the path is the map's: the source says so
+    (S.CAMERA, P.lose - 0.01, True, S.MAP_HOLD),  # lost first
+    (S.ACQUIRING, 0.9, True, None),  # a good estimate, but of another lane
+    (S.MAP_HOLD, 0.9, True, None),
+    (S.STOP_IN_LANE, 0.9, True, None),
+    (S.JUNCTION, 0.9, True, S.ACQUIRING),
+    (S.MAP, 0.9, True, None),
+]
+
 
 # (state, confidence, near a junction) -> next state
 JUNCTION_TABLE = [
@@ -73,11 +84,19 @@ def test_junction_table(state: LaneSource, confidence: float, junction: bool,
     assert (change.to if change else None) is expected
 
 
+@pytest.mark.parametrize(("state", "confidence", "other", "expected"), OTHER_LANE_TABLE)
+def test_other_lane_table(state: LaneSource, confidence: float, other: bool,
+                          expected: LaneSource | None) -> None:
+    change = transition(state, LaneSourceInput(100.0, confidence, 99.5, other_lane=other), P)
+    assert (change.to if change else None) is expected
+
+
 def test_every_state_and_edge_of_the_table_is_covered() -> None:
     edges = {(row[0], row[4]) for row in TABLE_CASES if row[4] is not None}
     edges |= {(row[0], row[3]) for row in JUNCTION_TABLE if row[3] is not None}
+    edges |= {(row[0], row[3]) for row in OTHER_LANE_TABLE if row[3] is not None}
     assert edges == {(S.ACQUIRING, S.CAMERA), (S.ACQUIRING, S.MAP_HOLD),
-                     (S.CAMERA, S.MAP_HOLD), (S.MAP_HOLD, S.CAMERA),
+                     (S.CAMERA, S.MAP_HOLD), (S.CAMERA, S.ACQUIRING), (S.MAP_HOLD, S.CAMERA),
                      (S.MAP_HOLD, S.STOP_IN_LANE), (S.STOP_IN_LANE, S.CAMERA),
                      *((s, S.JUNCTION) for s in (S.CAMERA, S.MAP_HOLD, S.STOP_IN_LANE,
                                                  S.ACQUIRING)),
@@ -90,6 +109,8 @@ def test_the_cases_walk_every_row_of_the_data() -> None:
              for state, t, confidence, since, expected in TABLE_CASES]
     cases += [(state, LaneSourceInput(100.0, confidence, 99.0, junction), expected)
               for state, confidence, junction, expected in JUNCTION_TABLE]
+    cases += [(state, LaneSourceInput(100.0, confidence, 99.5, other_lane=other), expected)
+              for state, confidence, other, expected in OTHER_LANE_TABLE]
     assert unwalked_rows(TABLE, cases, lambda _: P) == []
 
 
