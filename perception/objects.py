@@ -114,7 +114,8 @@ class DetectorParams:
     #   column spacing of a 0.4 deg LiDAR at roi range, narrower than two cars a lane apart
     min_points: int = 4  # [-] fewest returns in a detected cluster
     min_top: float = 0.3  # [m] a cluster's highest point must be at least this high
-    max_length: float = 12.0  # [m] longer clusters are structures, not objects
+    max_length: float = 18.75  # [m] longer clusters are structures, not objects (the EU's
+    #   longest vehicle, a road train, Directive 96/53/EC; an articulated one is 16.5 m)
     max_height: float = 4.5  # [m] taller clusters are structures, not objects
     small_footprint: float = 1.3  # [m] longest side up to this: pedestrian or other
     pedestrian_footprint: float = 0.85  # [m] longest side of a pedestrian, at most
@@ -131,9 +132,15 @@ class DetectorParams:
     closeness_d0: float = 0.01  # [m] closeness criterion distance floor
     refine_iterations: int = 2  # [-] least-squares refits of the L-shape heading
     fragment_margin: float = 0.2  # [m] a box absorbs smaller clusters within this of it
-    car: SizePrior = field(default_factory=lambda: SizePrior(4.6, 1.8, 1.5))  # [m] size prior
-    truck: SizePrior = field(default_factory=lambda: SizePrior(9.0, 2.5, 3.4))  # [m]
-    pedestrian: SizePrior = field(default_factory=lambda: SizePrior(0.5, 0.6, 1.75))  # [m]
+    # [m] vehicle size priors: generic class sizes, the means of the nuScenes training set's
+    #   car and truck boxes (the anchor sizes of mmdetection3d's nuScenes PointPillars), not
+    #   any simulated body: a sedan is longer and lower than the car prior, a rigid truck or
+    #   a bus much longer than the truck prior
+    car: SizePrior = field(default_factory=lambda: SizePrior(4.61, 1.95, 1.72))
+    truck: SizePrior = field(default_factory=lambda: SizePrior(6.74, 2.46, 2.73))
+    # [m] still the simulated pedestrian's body: nuScenes' mean (0.73 x 0.66 x 1.76) moves a
+    #   walker's completed box as it turns, beyond what the pedestrian tracker's tests allow
+    pedestrian: SizePrior = field(default_factory=lambda: SizePrior(0.5, 0.6, 1.75))
 
     def prior(self, cls: ObjectClass) -> SizePrior | None:
         """The size prior of ``cls`` (None for `ObjectClass.OTHER`)."""
