@@ -17,8 +17,8 @@ position error = track centre - true centre; track
 speed error = track speed - true speed; an id switch is a car matched to a different track id
 than at its previous match.
 
-Per class: the same recall, track recall and track errors for each true vehicle class (its
-catalogue model's: car, truck, bus, motorbike; `world.actors.catalogue`), keyed
+Per class: the same recall, track recall, track errors and id switches for each true vehicle
+class (its catalogue model's: car, truck, bus, motorbike; `world.actors.catalogue`), keyed
 `<metric>_<class>` (`detection_recall_truck`), for the classes seen in the run; precision for
 each class the detector gave (car, truck: `detection_precision_car` is the share of the
 detections called cars that lie on a true vehicle of any class).
@@ -72,6 +72,7 @@ class ClassScore:
     tracked: int = 0  # of those, matched to a confirmed track
     track_pos_err: list[float] = field(default_factory=list)  # [m]
     track_speed_err: list[float] = field(default_factory=list)  # [m/s]
+    switches: int = 0  # id switches of the class's vehicles
 
     def metrics(self, suffix: str) -> dict[str, float]:
         """This class's entries of the result JSON, each key ending in `suffix`."""
@@ -80,6 +81,7 @@ class ClassScore:
             f"track_recall{suffix}": self.tracked / self.visible,
             f"track_position_rmse{suffix}": _rms(self.track_pos_err),
             f"track_speed_rmse{suffix}": _rms(self.track_speed_err),
+            f"id_switches{suffix}": float(self.switches),
         }
 
 
@@ -215,6 +217,7 @@ class PerceptionScore:
         name = a.ids[actor]
         if name in self._last_id and self._last_id[name] != track.id:
             self.switches[name] += 1
+            score.switches += 1
         self._last_id[name] = track.id
 
     def metrics(self) -> dict[str, float]:

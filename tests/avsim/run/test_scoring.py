@@ -469,7 +469,7 @@ def test_metrics_keys_and_nan_where_nothing_was_scored() -> None:
     score.objects((), (), truth, scan)
     m = score.metrics()
     car_keys = {f"{k}_car" for k in ("detection_recall", "track_recall",
-                                     "track_position_rmse", "track_speed_rmse")}
+                                     "track_position_rmse", "track_speed_rmse", "id_switches")}
     assert set(m) == LANE_KEYS | OBJECT_KEYS | car_keys  # no precision_car: no car detected
     assert m["detection_recall"] == 0.0 and m["track_recall"] == 0.0
     assert m["detection_recall_car"] == 0.0 and m["track_recall_car"] == 0.0
@@ -519,6 +519,18 @@ def test_scores_per_true_and_detected_class() -> None:
     assert m["track_position_rmse_car"] == 0.0
     assert math.isnan(m["track_position_rmse_bus"])
     assert "detection_recall_pedestrian" not in m
+    assert m["id_switches_car"] == m["id_switches_truck"] == 0.0
+
+
+def test_id_switches_per_class() -> None:
+    npcs = [Npc("car", 20.0, 0.0), Npc("truck", 40.0, 3.5, kind=ActorType.TRUCK)]
+    score = PerceptionScore()
+    for k, ids in enumerate([(1, 2), (1, 5), (1, 6)]):
+        truth, scan = capture(npcs, t=0.1 * k)
+        tracks = (track(ids[0], 20.0, 0.0), track(ids[1], 40.0, 3.5, cls=ObjectClass.TRUCK))
+        score.objects(perfect_dets(truth, npcs), tracks, truth, scan)
+    m = score.metrics()
+    assert (m["id_switches"], m["id_switches_car"], m["id_switches_truck"]) == (2.0, 0.0, 2.0)
 
 
 def test_default_classes_follow_the_type() -> None:
