@@ -94,6 +94,18 @@ def test_car_beside_or_in_an_adjacent_lane(detector: ObjectDetector, x: float, y
     assert_box(found[0], box, ObjectClass.CAR)
 
 
+@pytest.mark.parametrize(("x", "y"), [(3.0, 3.5), (-3.0, -3.5), (0.0, 3.5), (5.0, -3.5)])
+def test_car_close_beside_whose_roof_is_seen(detector: ObjectDetector, x: float,
+                                             y: float) -> None:
+    """Close beside the car, the LiDAR sees the other car's roof from above: its heading is
+    fitted below the roof, so the box is not tilted, not too wide and not taken for a truck."""
+    box = on_ground(x, y, CAR, 3.0 * DEG)
+    found = detect(detector, [box])
+    assert len(found) == 1, found
+    assert_box(found[0], box, ObjectClass.CAR)
+    assert found[0].width == pytest.approx(detector.params.car.width, abs=0.1)
+
+
 @pytest.mark.parametrize(("x", "y", "yaw_deg"), [(15.0, 3.0, 30.0), (25.0, -6.0, -30.0),
                                                  (-10.0, 8.0, 60.0), (40.0, 10.0, 60.0)])
 def test_car_at_an_angle(detector: ObjectDetector, x: float, y: float, yaw_deg: float) -> None:
