@@ -32,7 +32,10 @@ named below are fields of `DetectorParams`.
    keeps the edge its points are closer to (norm of the distance vector), and the score is
    sum 1 / max(min(d1, d2), ``closeness_d0``). It is searched every ``coarse_step``, then
    every ``fine_step`` within one coarse step of the best, on at most ``fit_max_points``
-   points (an even stride). The criterion chases the extreme (noisiest) points, so the
+   points (an even stride). The points within ``roof_band`` of the cluster's highest point
+   are left out of the heading fit (unless fewer than ``min_points`` would remain): a roof
+   seen from above, close by, fills the rectangle's interior and tilts the refit below.
+   The criterion chases the extreme (noisiest) points, so the
    heading is then refitted ``refine_iterations`` times by least squares: each point goes to
    the nearer of the two kept edges, and the two perpendicular lines minimising the summed
    squared distances have the normal n = the eigenvector of the smallest eigenvalue of S_1 -
@@ -114,7 +117,8 @@ class DetectorParams:
     #   column spacing of a 0.4 deg LiDAR at roi range, narrower than two cars a lane apart
     min_points: int = 4  # [-] fewest returns in a detected cluster
     min_top: float = 0.3  # [m] a cluster's highest point must be at least this high
-    max_length: float = 12.0  # [m] longer clusters are structures, not objects
+    max_length: float = 18.75  # [m] longer clusters are structures, not objects (the EU's
+    #   longest vehicle, a road train, Directive 96/53/EC; an articulated one is 16.5 m)
     max_height: float = 4.5  # [m] taller clusters are structures, not objects
     small_footprint: float = 1.3  # [m] longest side up to this: pedestrian or other
     pedestrian_footprint: float = 0.85  # [m] longest side of a pedestrian, at most
@@ -130,10 +134,18 @@ class DetectorParams:
     fit_max_points: int = 400  # [-] points used in the heading search, at most
     closeness_d0: float = 0.01  # [m] closeness criterion distance floor
     refine_iterations: int = 2  # [-] least-squares refits of the L-shape heading
+    roof_band: float = 0.15  # [m] points this close below a cluster's top are left out of
+    #   the heading fit (a roof seen from above fills the footprint and tilts the refit)
     fragment_margin: float = 0.2  # [m] a box absorbs smaller clusters within this of it
-    car: SizePrior = field(default_factory=lambda: SizePrior(4.6, 1.8, 1.5))  # [m] size prior
-    truck: SizePrior = field(default_factory=lambda: SizePrior(9.0, 2.5, 3.4))  # [m]
-    pedestrian: SizePrior = field(default_factory=lambda: SizePrior(0.5, 0.6, 1.75))  # [m]
+    # [m] vehicle size priors: generic class sizes, the means of the nuScenes training set's
+    #   car and truck boxes (the anchor sizes of mmdetection3d's nuScenes PointPillars), not
+    #   any simulated body: a sedan is longer and lower than the car prior, a rigid truck or
+    #   a bus much longer than the truck prior
+    car: SizePrior = field(default_factory=lambda: SizePrior(4.61, 1.95, 1.72))
+    truck: SizePrior = field(default_factory=lambda: SizePrior(6.74, 2.46, 2.73))
+    # [m] still the simulated pedestrian's body: nuScenes' mean (0.73 x 0.66 x 1.76) moves a
+    #   walker's completed box as it turns, beyond what the pedestrian tracker's tests allow
+    pedestrian: SizePrior = field(default_factory=lambda: SizePrior(0.5, 0.6, 1.75))
 
     def prior(self, cls: ObjectClass) -> SizePrior | None:
         """The size prior of ``cls`` (None for `ObjectClass.OTHER`)."""
@@ -364,9 +376,11 @@ class Footprint:
         return out
 
 
-def footprint(xy: FloatArray, sensor_xy: tuple[float, float], p: DetectorParams) -> Footprint:
-    """L-shape fit of (N, 2) vehicle-frame points [m] seen from ``sensor_xy`` [m]."""
-    theta = l_shape_heading(xy, p)
+def footprint(xy: FloatArray, sensor_xy: tuple[float, float], p: DetectorParams,
+              fit: FloatArray | None = None) -> Footprint:
+    """L-shape fit of (N, 2) vehicle-frame points [m] seen from ``sensor_xy`` [m]; the heading
+    is fitted to the points ``fit`` (default: all of them), the extents span all."""
+    theta = l_shape_heading(xy if fit is None else fit, p)
     c, s = math.cos(theta), math.sin(theta)
     axes = np.array([[c, s], [-s, c]])
     proj = xy @ axes.T
@@ -429,10 +443,16 @@ def wrap_half_pi(a: float) -> float:
 
 
 def box_from_points(xy: FloatArray, top: float, sensor_xy: tuple[float, float],
-                    p: DetectorParams) -> Detection | None:
+                    p: DetectorParams, heights: FloatArray | None = None) -> Detection | None:
     """The completed box of one cluster: (N, 2) vehicle-frame points [m], highest point
-    ``top`` [m] above the ground, sensor position [m]; None if it is not an object."""
-    fp = footprint(xy, sensor_xy, p)
+    ``top`` [m] above the ground, sensor position [m], the points' (N,) heights [m] above
+    the ground (given: the heading is fitted below the roof band); None if it is not an
+    object."""
+    fit = None
+    if heights is not None:
+        below = heights < top - p.roof_band
+        fit = xy[below] if below.sum() >= p.min_points else None
+    fp = footprint(xy, sensor_xy, p, fit)
     ext = fp.extents
     longer_first = ext[0] >= ext[1]
     hyps = [hypothesis(fp, cls, axis1_length, p)
@@ -505,7 +525,7 @@ class ObjectDetector:
         sensor = (scan.info.mount.x, scan.info.mount.y)
         found: list[tuple[Detection, FloatArray]] = []
         for idx in gated_clusters(cluster_labels(xy, p), xy, heights, p):
-            det = box_from_points(xy[idx], float(heights[idx].max()), sensor, p)
+            det = box_from_points(xy[idx], float(heights[idx].max()), sensor, p, heights[idx])
             if det is not None:
                 found.append((det, xy[idx]))
         kept = suppress_fragments(found, p.fragment_margin)

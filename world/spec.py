@@ -18,6 +18,7 @@ import enum
 import math
 from dataclasses import dataclass, field
 
+from world.actors.catalogue import VehicleModel
 from world.frames import Wheel
 from world.hdmap import (
     Crosswalk,
@@ -221,6 +222,8 @@ class ActorSpec:
     speed: float  # [m/s] initial speed
     actions: tuple[ActionSpec, ...] = ()  # in the scenario's order (`after` indexes them)
     road: RoadSpec | None = None  # in a town: the actor's own route (lane, s, offset on it)
+    model: VehicleModel | None = None  # a vehicle's body (`world.actors.catalogue`); None:
+    #   its type's default model (a car or truck), or no vehicle (pedestrian, obstacle)
 
 
 @dataclass(frozen=True, slots=True)

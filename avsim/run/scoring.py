@@ -16,6 +16,12 @@ vehicle detections within range that match a true vehicle in range (seen or not)
 position error = track centre - true centre; track
 speed error = track speed - true speed; an id switch is a car matched to a different track id
 than at its previous match.
+
+Per class: the same recall, track recall, track errors and id switches for each true vehicle
+class (its catalogue model's: car, truck, bus, motorbike; `world.actors.catalogue`), keyed
+`<metric>_<class>` (`detection_recall_truck`), for the classes seen in the run; precision for
+each class the detector gave (car, truck: `detection_precision_car` is the share of the
+detections called cars that lie on a true vehicle of any class).
 """
 
 from __future__ import annotations
@@ -57,6 +63,28 @@ class ScoringParams:
     min_returns: int = 10  # [-] LiDAR returns on a car for it to count as seen
 
 
+@dataclass
+class ClassScore:
+    """The object scores of one true vehicle class over a run."""
+
+    visible: int = 0  # visible true vehicles of the class in range, summed over scans
+    detected: int = 0  # of those, matched to a detection
+    tracked: int = 0  # of those, matched to a confirmed track
+    track_pos_err: list[float] = field(default_factory=list)  # [m]
+    track_speed_err: list[float] = field(default_factory=list)  # [m/s]
+    switches: int = 0  # id switches of the class's vehicles
+
+    def metrics(self, suffix: str) -> dict[str, float]:
+        """This class's entries of the result JSON, each key ending in `suffix`."""
+        return {
+            f"detection_recall{suffix}": self.detected / self.visible,
+            f"track_recall{suffix}": self.tracked / self.visible,
+            f"track_position_rmse{suffix}": _rms(self.track_pos_err),
+            f"track_speed_rmse{suffix}": _rms(self.track_speed_err),
+            f"id_switches{suffix}": float(self.switches),
+        }
+
+
 def _rms(x: list[float]) -> float:
     return math.sqrt(float(np.mean(np.square(x)))) if x else math.nan
 
@@ -91,6 +119,9 @@ class PerceptionScore:
     track_pos_err: list[float] = field(default_factory=list)  # [m]
     track_speed_err: list[float] = field(default_factory=list)  # [m/s]
     switches: dict[str, int] = field(default_factory=lambda: defaultdict(int))
+    by_class: dict[str, ClassScore] = field(default_factory=dict)  # by true class
+    detections_by_class: dict[str, int] = field(default_factory=dict)  # by detected class
+    true_detections_by_class: dict[str, int] = field(default_factory=dict)
     _last_id: dict[str, int] = field(default_factory=dict)
     _first_t: float = math.inf
     _last_t: float = -math.inf
@@ -112,13 +143,26 @@ class PerceptionScore:
         idx = self._visible_vehicles(truth, scan)
         true_xy = truth.actors.centres[idx, :2]
         self.visible += len(idx)
-        det_xy = self._detections_in_map(detections, truth)
+        classes = [self._class_score(truth, int(i)) for i in idx]
+        for score in classes:
+            score.visible += 1
+        det_xy, det_cls = self._detections_in_map(detections, truth)
         near = np.linalg.norm(det_xy - truth.ego_xy, axis=1) <= p.detection_range \
             if len(det_xy) else np.zeros(0, bool)
+        near_cls = [c for c, n in zip(det_cls, near.tolist(), strict=True) if n]
         self.detections += int(near.sum())
-        self.detected += len(_match(true_xy, det_xy[near], p.match_distance))
+        found = _match(true_xy, det_xy[near], p.match_distance)
+        self.detected += len(found)
+        for i, _ in found:
+            classes[i].detected += 1
         all_xy = truth.actors.centres[self._vehicles_in_range(truth), :2]
-        self.true_detections += len(_match(all_xy, det_xy[near], p.match_distance))
+        true_found = _match(all_xy, det_xy[near], p.match_distance)
+        self.true_detections += len(true_found)
+        for c in near_cls:
+            self.detections_by_class[c] = self.detections_by_class.get(c, 0) + 1
+        for _, j in true_found:
+            c = near_cls[j]
+            self.true_detections_by_class[c] = self.true_detections_by_class.get(c, 0) + 1
         vehicle_tracks = [tr for tr in tracks if tr.cls in VEHICLE_CLASSES]
         trk_xy = np.array([[tr.x, tr.y] for tr in vehicle_tracks]).reshape(-1, 2)
         for i, j in _match(true_xy, trk_xy, p.match_distance):
@@ -141,26 +185,39 @@ class PerceptionScore:
         hits = np.bincount(scan.actor[scan.actor >= 0], minlength=n)[:n]
         return np.flatnonzero(self._in_range(truth) & (hits >= self.params.min_returns))
 
+    def _class_score(self, truth: CaptureTruth, actor: int) -> ClassScore:
+        """The per-class score of a true vehicle's class (made when first seen)."""
+        cls = truth.actors.truth_class(actor)
+        assert cls is not None  # a vehicle
+        return self.by_class.setdefault(cls.value, ClassScore())
+
     @staticmethod
     def _detections_in_map(detections: tuple[Detection, ...],
-                           truth: CaptureTruth) -> NDArray[np.float64]:
+                           truth: CaptureTruth) -> tuple[NDArray[np.float64], list[str]]:
+        """(N, 2) [m] map-frame centres of the vehicle-class detections, and their classes."""
         vehicle = [d for d in detections if d.cls in VEHICLE_CLASSES]
         if not vehicle:
-            return np.zeros((0, 2))
+            return np.zeros((0, 2)), []
         xy = np.array([[d.x, d.y] for d in vehicle])
         c, s = math.cos(truth.ego_yaw), math.sin(truth.ego_yaw)
         out: NDArray[np.float64] = truth.ego_xy + xy @ np.array([[c, s], [-s, c]])
-        return out
+        return out, [d.cls.value for d in vehicle]
 
     def _score_track(self, actor: int, track: Track, truth: CaptureTruth) -> None:
         a = truth.actors
         self.tracked += 1
-        self.track_pos_err.append(math.hypot(track.x - a.centres[actor, 0],
-                                             track.y - a.centres[actor, 1]))
-        self.track_speed_err.append(track.speed - abs(float(a.speeds[actor])))
+        pos_err = math.hypot(track.x - a.centres[actor, 0], track.y - a.centres[actor, 1])
+        speed_err = track.speed - abs(float(a.speeds[actor]))
+        self.track_pos_err.append(pos_err)
+        self.track_speed_err.append(speed_err)
+        score = self._class_score(truth, actor)
+        score.tracked += 1
+        score.track_pos_err.append(pos_err)
+        score.track_speed_err.append(speed_err)
         name = a.ids[actor]
         if name in self._last_id and self._last_id[name] != track.id:
             self.switches[name] += 1
+            score.switches += 1
         self._last_id[name] = track.id
 
     def metrics(self) -> dict[str, float]:
@@ -185,4 +242,9 @@ class PerceptionScore:
                 "id_switches": float(sum(self.switches.values())),
                 "max_id_switches_per_car_per_100s": per_100s,
             }
+        for name in sorted(self.by_class):
+            out |= self.by_class[name].metrics(f"_{name}")
+        for name in sorted(self.detections_by_class):
+            out[f"detection_precision_{name}"] = (self.true_detections_by_class.get(name, 0)
+                                                  / self.detections_by_class[name])
         return out

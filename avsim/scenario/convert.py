@@ -42,6 +42,7 @@ from avsim.scenario.model import (
 )
 from avsim.scenario.scenario import DriverSettings, Scenario
 from world import frames, hdmap, spec
+from world.actors.catalogue import CATALOGUE, DEFAULT_MODEL, VehicleModel
 from world.frames import MPS_PER_KPH
 from world.map.town import TownError, TownLayout, compile_route
 
@@ -170,7 +171,16 @@ def _actor_spec(index: int, actor: ActorModel) -> spec.ActorSpec:
         offset=actor.offset,
         speed=_kph(actor.speed_kph),
         actions=actions,
+        model=_vehicle_model(actor),
     )
+
+
+def _vehicle_model(actor: ActorModel) -> VehicleModel | None:
+    """A vehicle's catalogue model: its own, else its type's default; None: not a vehicle."""
+    if actor.model is not None:
+        return CATALOGUE[actor.model]
+    default = DEFAULT_MODEL.get(actor.type)
+    return None if default is None else CATALOGUE[default]
 
 
 def _event_spec(event: EventModel) -> spec.EventSpec:

@@ -42,6 +42,7 @@ from avsim.scenario.fields import (
     PosInt,
     problem,
 )
+from world.actors.catalogue import CATALOGUE, TYPE_CLASSES
 
 FORMAT = "avsim/1"
 NAME_PATTERN = r"^[a-z0-9_]+$"
@@ -60,6 +61,9 @@ Situation = Literal[
 ZoneName = Literal["highway", "ramp", "city"]
 SideName = Literal["right", "left"]
 ActorTypeName = Literal["car", "truck", "pedestrian", "obstacle"]
+VehicleModelName = Literal[  # `world.actors.catalogue.CATALOGUE`'s names (a test keeps them equal)
+    "small_car", "sedan", "suv", "van", "bus", "rigid_truck", "semi_trailer", "motorbike"
+]
 Junctions = Literal["stop_signs", "traffic_lights", "mixed"]
 Heading = Literal["east", "north", "west", "south"]
 Turn = Literal["straight", "left", "right", "u_turn"]
@@ -546,6 +550,12 @@ class ActorModel(FormatModel):
         description="car | truck | pedestrian | obstacle (a static box); required. "
         "A pedestrian is a 0.5 x 0.6 x 1.75 m body; its speed_kph is a walking speed."
     )
+    model: VehicleModelName | None = Field(
+        default=None,
+        description="(car, truck) the body from the vehicle catalogue, real dimensions: "
+        "small_car | sedan | suv | van | motorbike (type car), bus | rigid_truck | "
+        "semi_trailer (type truck). Default: sedan for a car, rigid_truck for a truck.",
+    )
     lane: int | None = Field(
         default=None,
         description="(road) lane index: 0 = rightmost of the ego's direction; -1, -2, ... "
@@ -572,6 +582,21 @@ class ActorModel(FormatModel):
         description="Scripted actions, each fires once when its trigger first holds. "
         "Default none: the actor keeps its lane and speed.",
     )
+
+    @model_validator(mode="after")
+    def _model_fits_type(self) -> ActorModel:
+        """A catalogue model only on a vehicle, and of a class its type takes."""
+        if self.model is None:
+            return self
+        classes = TYPE_CLASSES.get(self.type)
+        if classes is None:
+            raise problem(f"only a car or truck takes a model (this is a {self.type})",
+                          key="model")
+        model = CATALOGUE[self.model]
+        if model.cls not in classes:
+            fits = next(t for t, c in TYPE_CLASSES.items() if model.cls in c)
+            raise problem(f"a {self.model} needs type: {fits}, not {self.type}", key="model")
+        return self
 
 
 GnssPreset = Literal["rtk", "consumer", "degraded"]

@@ -64,6 +64,7 @@ def _run_args(scenario: str) -> tuple[str, ...]:
 SUBPROCESS_FIXTURES = (
     "bad_yaml_syntax", "duplicate_key", "not_a_mapping", "unknown_nested_key", "wrong_type",
     "actor_lane_out_of_range", "after_forward", "town_route_leaves_town",
+    "unknown_vehicle_model",
 )
 
 

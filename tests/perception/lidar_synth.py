@@ -20,6 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from world.actors.catalogue import CATALOGUE
 from world.frames import LidarInfo, LidarScan, SensorMount
 from world.sensors.lidar import beam_directions
 
@@ -28,9 +29,11 @@ FloatArray = NDArray[np.float64]
 LIDAR_ELEVATIONS = tuple(math.radians(e) for e in range(-15, 16, 2))  # [rad] VLP-16-like
 LIDAR_MOUNT = SensorMount(0.0, 0.0, 1.57)  # [m] roof, as in world.sensor_setup
 
-# (length, width, height) [m] of the simulator's actors
-CAR = (4.6, 1.8, 1.5)
-TRUCK = (9.0, 2.5, 3.4)
+# (length, width, height) [m] of the simulator's actors: the default car and truck of the
+# vehicle catalogue (a sedan, a rigid truck), which the detector's generic priors do not equal
+CAR = (CATALOGUE["sedan"].length, CATALOGUE["sedan"].width, CATALOGUE["sedan"].height)
+TRUCK = (CATALOGUE["rigid_truck"].length, CATALOGUE["rigid_truck"].width,
+         CATALOGUE["rigid_truck"].height)
 PEDESTRIAN = (0.5, 0.6, 1.75)
 OBSTACLE = (1.0, 1.0, 1.0)
 

@@ -13,6 +13,7 @@ from perception.objects import (
     ObjectDetector,
     fit_ground,
     grow_interval,
+    inside_box,
     wrap_half_pi,
 )
 from tests.perception.lidar_synth import (
@@ -27,6 +28,7 @@ from tests.perception.lidar_synth import (
     lidar_info,
     on_ground,
 )
+from world.actors.catalogue import CATALOGUE
 from world.frames import LidarScan, SensorMount
 
 DEG = math.pi / 180.0
@@ -57,6 +59,14 @@ def assert_box(det: Detection, box: Box, cls: ObjectClass, check_yaw: bool = Tru
     assert -math.pi / 2 < det.yaw <= math.pi / 2
 
 
+def assert_rear_in_place(det: Detection, box: Box) -> None:
+    """A vehicle ahead (yaw 0) seen from behind: its rear face is where the truth's is, and
+    the box is across the truth's centre line."""
+    assert det.x - 0.5 * det.length == pytest.approx(box.x - 0.5 * box.length, abs=0.1), det
+    assert det.y == pytest.approx(box.y, abs=POSITION_TOL), det
+    assert yaw_error(det.yaw, box.yaw) <= YAW_TOL, det
+
+
 @pytest.mark.parametrize("distance", [10.0, 30.0, 50.0])
 @pytest.mark.parametrize("columns", [1800, 900])
 def test_car_ahead_is_completed_from_its_rear(detector: ObjectDetector, distance: float,
@@ -66,8 +76,13 @@ def test_car_ahead_is_completed_from_its_rear(detector: ObjectDetector, distance
     assert len(found) == 1, found
     det = found[0]
     assert_box(det, box, ObjectClass.CAR)
-    assert (det.length, det.width, det.height) == pytest.approx(CAR, abs=0.05)
-    assert det.z == pytest.approx(0.75, abs=0.05)
+    # a rear says nothing of a car's length (nor, from below, of its roof): the generic
+    # prior's box, grown away from the sensor, so that the rear face stays where it was seen
+    prior = detector.params.car
+    assert (det.length, det.width, det.height) == pytest.approx(
+        (prior.length, max(prior.width, CAR[1]), prior.height), abs=0.05)
+    assert_rear_in_place(det, box)
+    assert det.z == pytest.approx(0.5 * prior.height, abs=0.05)
     assert det.points >= 4
 
 
@@ -79,6 +94,18 @@ def test_car_beside_or_in_an_adjacent_lane(detector: ObjectDetector, x: float, y
     assert_box(found[0], box, ObjectClass.CAR)
 
 
+@pytest.mark.parametrize(("x", "y"), [(3.0, 3.5), (-3.0, -3.5), (0.0, 3.5), (5.0, -3.5)])
+def test_car_close_beside_whose_roof_is_seen(detector: ObjectDetector, x: float,
+                                             y: float) -> None:
+    """Close beside the car, the LiDAR sees the other car's roof from above: its heading is
+    fitted below the roof, so the box is not tilted, not too wide and not taken for a truck."""
+    box = on_ground(x, y, CAR, 3.0 * DEG)
+    found = detect(detector, [box])
+    assert len(found) == 1, found
+    assert_box(found[0], box, ObjectClass.CAR)
+    assert found[0].width == pytest.approx(detector.params.car.width, abs=0.1)
+
+
 @pytest.mark.parametrize(("x", "y", "yaw_deg"), [(15.0, 3.0, 30.0), (25.0, -6.0, -30.0),
                                                  (-10.0, 8.0, 60.0), (40.0, 10.0, 60.0)])
 def test_car_at_an_angle(detector: ObjectDetector, x: float, y: float, yaw_deg: float) -> None:
@@ -88,14 +115,34 @@ def test_car_at_an_angle(detector: ObjectDetector, x: float, y: float, yaw_deg: 
     assert_box(found[0], box, ObjectClass.CAR)
 
 
-@pytest.mark.parametrize(("x", "y", "yaw_deg"), [(20.0, 0.0, 0.0), (40.0, -3.5, 0.0),
-                                                 (12.0, -6.0, 20.0)])
-def test_truck(detector: ObjectDetector, x: float, y: float, yaw_deg: float) -> None:
-    box = on_ground(x, y, TRUCK, yaw_deg * DEG)
+@pytest.mark.parametrize(("x", "y"), [(20.0, 0.0), (40.0, -3.5)])
+def test_truck_ahead(detector: ObjectDetector, x: float, y: float) -> None:
+    """Seen from behind (its side at grazing incidence at most): the rear face in place and
+    the generic truck prior's length (a rigid truck is longer: the box's centre is short)."""
+    box = on_ground(x, y, TRUCK)
     found = detect(detector, [box])
     assert len(found) == 1, found  # its side, seen at grazing incidence, is not a second one
+    assert found[0].cls is ObjectClass.TRUCK
+    assert_rear_in_place(found[0], box)
+    assert found[0].length == pytest.approx(detector.params.truck.length, abs=0.05)
+
+
+@pytest.mark.parametrize(("model", "x", "y", "yaw_deg"), [
+    ("rigid_truck", 12.0, -6.0, 20.0), ("bus", 10.0, 6.0, -10.0),
+    ("semi_trailer", 4.0, -7.0, 0.0),
+    pytest.param("semi_trailer", 14.0, 8.0, 15.0, marks=pytest.mark.xfail(
+        strict=True, reason="known limit: the far end of a 16.5 m side seen at an angle "
+        "breaks into fragments beyond the fitted box (15.1 m), which are kept as two OTHERs"))])
+def test_truck_seen_along_its_side_has_its_length(detector: ObjectDetector, model: str,
+                                                  x: float, y: float, yaw_deg: float) -> None:
+    """Beside the car, the side is seen whole: the box has the vehicle's real length, longer
+    than the prior (a semi-trailer's 16.5 m too: not taken for a structure)."""
+    m = CATALOGUE[model]
+    box = on_ground(x, y, (m.length, m.width, m.height), yaw_deg * DEG)
+    found = detect(detector, [box])
+    assert len(found) == 1, found
     assert_box(found[0], box, ObjectClass.TRUCK)
-    assert (found[0].length, found[0].width) == pytest.approx(TRUCK[:2], abs=0.05)
+    assert found[0].length == pytest.approx(m.length, abs=0.15)
 
 
 @pytest.mark.parametrize(("x", "y"), [(12.0, 2.0), (8.0, -5.5), (-6.0, 4.0), (20.0, 6.0)])
@@ -189,13 +236,19 @@ def test_street_scene(detector: ObjectDetector) -> None:
     buildings += [on_ground(x + 10.0, -19.0, (16.0, 12.0, 9.0)) for x in range(-70, 80, 25)]
     truth = [*vehicles, pedestrian, *poles]
     found = detect(detector, [*truth, *buildings], ground=Ground(pitch=0.7 * DEG))
+    truck = vehicles[3]  # seen from behind: its box is the truck prior's, the rear in place
     for det in found:  # no phantom: each detection is on a real object
-        assert min(math.hypot(det.x - b.x, det.y - b.y) for b in truth) < 0.5, det
+        on_truck = bool(inside_box(np.array([[truck.x, truck.y]]), det, 0.0)[0])
+        assert on_truck or min(math.hypot(det.x - b.x, det.y - b.y) for b in truth) < 0.5, det
     for box, cls in [*((v, ObjectClass.CAR) for v in vehicles if v.length == CAR[0]),
-                     (vehicles[3], ObjectClass.TRUCK), (pedestrian, ObjectClass.PEDESTRIAN)]:
+                     (pedestrian, ObjectClass.PEDESTRIAN)]:
         near = [d for d in found if math.hypot(d.x - box.x, d.y - box.y) < 1.0]
         assert len(near) == 1, (box, near)
         assert_box(near[0], box, cls, check_yaw=cls is not ObjectClass.PEDESTRIAN)
+    covering = [d for d in found if inside_box(np.array([[truck.x, truck.y]]), d, 0.0)[0]]
+    assert len(covering) == 1, covering
+    assert covering[0].cls is ObjectClass.TRUCK
+    assert_rear_in_place(covering[0], truck)
 
 
 def test_mount_offset_and_tilt_are_undone(detector: ObjectDetector) -> None:

@@ -12,6 +12,9 @@ import pytest
 from avsim.run.runner import RunResult
 from planner.fsm.acc import AccParams, gaps
 from tests.scenarios import golden
+from world.actors.catalogue import CATALOGUE, DEFAULT_MODEL
+
+NPC_CAR_LENGTH = CATALOGUE[DEFAULT_MODEL["car"]].length  # [m] a `type: car` actor's body
 
 pytestmark = pytest.mark.slow
 KPH = 1 / 3.6
@@ -53,7 +56,7 @@ def test_following_the_pedal_closes_up_but_never_below_d_min(following: RunResul
     log = following.log
     v = log.array("speed")
     k = [a.id for a in following.scenario.world.actors].index("lead")
-    gap = np.array(log.actor_station)[:, k] - log.array("station") - (4.6 + 4.8) / 2
+    gap = np.array(log.actor_station)[:, k] - log.array("station") - (NPC_CAR_LENGTH + 4.8) / 2
     pressed = _pressed(following)
     start = int(np.argmax(pressed))
     d_des = gaps(v[start], v[start], AccParams()).d_des

@@ -11,6 +11,9 @@ import pytest
 
 from avsim.run.runner import RunResult
 from tests.scenarios import golden
+from world.actors.catalogue import CATALOGUE, DEFAULT_MODEL
+
+NPC_CAR_LENGTH = CATALOGUE[DEFAULT_MODEL["car"]].length  # [m] a `type: car` actor's body
 
 pytestmark = pytest.mark.slow
 KPH = 1 / 3.6
@@ -28,7 +31,7 @@ def _lead(result: RunResult) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.nda
     t = log.array("t")
     k = [a.id for a in result.scenario.world.actors].index("lead")
     lead_s = np.array(log.actor_station)[:, k]
-    gap = lead_s - log.array("station") - (4.6 + 4.8) / 2
+    gap = lead_s - log.array("station") - (NPC_CAR_LENGTH + 4.8) / 2
     return t, lead_s, np.gradient(lead_s, t), gap
 
 

@@ -19,7 +19,7 @@ from world.map.signals import light_colour
 from world.spec import TrafficLightSpec
 
 pytestmark = pytest.mark.slow
-FRONT = 2.4  # [m] the ego's centre -> front bumper (and an NPC car's: 4.6 m long)
+FRONT = 2.4  # [m] the ego's centre -> front bumper
 
 
 @pytest.fixture(scope="module")
@@ -118,8 +118,8 @@ def test_npcs_keep_to_lights_and_stop_signs(route: RunResult) -> None:
     t = route.log.array("t")
     met_red = stood = 0
     for k, actor in enumerate(route.scenario.world.actors):
-        assert actor.road is not None
-        front = np.array(route.log.actor_station)[:, k] + 2.3
+        assert actor.road is not None and actor.model is not None
+        front = np.array(route.log.actor_station)[:, k] + 0.5 * actor.model.length
         v = np.gradient(front, t)
         for f in actor.road.features:  # the spec's: the lights with their signal plans
             if front[0] > f.s or not np.any(front > f.s):

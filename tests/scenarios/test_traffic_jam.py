@@ -11,6 +11,9 @@ import pytest
 
 from avsim.run.runner import RunResult
 from tests.scenarios import golden
+from world.actors.catalogue import CATALOGUE, DEFAULT_MODEL
+
+NPC_CAR_LENGTH = CATALOGUE[DEFAULT_MODEL["car"]].length  # [m] a `type: car` actor's body
 
 pytestmark = pytest.mark.slow
 KPH = 1 / 3.6
@@ -34,7 +37,7 @@ def test_stop_and_go_twice(result: RunResult) -> None:
     k = [a.id for a in result.scenario.world.actors].index("lead")
     lead_s = np.array(log.actor_station)[:, k]
     lead_v = np.gradient(lead_s, t)
-    gap = lead_s - s - (4.6 + 4.8) / 2
+    gap = lead_s - s - (NPC_CAR_LENGTH + 4.8) / 2
     stops = [(a, b) for a, b in _intervals(lead_v < 0.05, t) if b - a >= 9.0]
     assert len(stops) == 2, stops  # the lead stopped twice, ~10 s each
     for a, b in stops:

@@ -1,9 +1,11 @@
 """NPC bodies in the physics world, moved along the route by their scripted behaviour.
 
-NPCs are kinematic: static (mass 0) boxes of `SIZES`, placed at `ACTOR_RATE`
+NPCs are kinematic: static (mass 0) boxes, placed at `ACTOR_RATE`
 (`world.core.rates`) from their `NpcMotion` in route coordinates. The ego collides with them
 like with a wall, and contact queries see them. (Only the ego must drive through its joints;
-NPCs are scripted traffic.) Pedestrians are boxes too, placed by station and offset from
+NPCs are scripted traffic.) A vehicle's box is its catalogue model's (`world.actors.catalogue`:
+the actor's `model`, else its type's default); a pedestrian's and an obstacle's are `SIZES`.
+Pedestrians are boxes too, placed by station and offset from
 their lane's centre like any actor; their speed is a walking speed along the lane, and the
 `walk` action moves them across the road, facing where they walk.
 
@@ -25,6 +27,7 @@ from numpy.typing import NDArray
 from pybullet_utils.bullet_client import BulletClient
 
 from world.actors.behaviour import NpcMotion, TriggerContext
+from world.actors.catalogue import CATALOGUE, DEFAULT_MODEL, VehicleClass, VehicleModel
 from world.actors.town_traffic import TownDriver
 from world.hdmap import RoadMap
 from world.map.road import build_road_map
@@ -42,12 +45,29 @@ class BoxSize:
     height: float  # [m]
 
 
-SIZES = {
-    ActorType.CAR: BoxSize(4.6, 1.8, 1.5),  # [m] length, width, height
-    ActorType.TRUCK: BoxSize(9.0, 2.5, 3.4),
-    ActorType.OBSTACLE: BoxSize(1.0, 1.0, 1.0),  # a crate / barrier block
+SIZES = {  # the bodies that are not vehicles (those are catalogue models)
+    ActorType.OBSTACLE: BoxSize(1.0, 1.0, 1.0),  # [m] length, width, height: a crate / block
     ActorType.PEDESTRIAN: BoxSize(0.5, 0.6, 1.75),
 }
+VEHICLES = (ActorType.CAR, ActorType.TRUCK)
+
+
+def vehicle_of(spec: ActorSpec) -> VehicleModel | None:
+    """The catalogue model of a vehicle actor (its own, else its type's default); None for a
+    pedestrian or an obstacle."""
+    if spec.type not in VEHICLES:
+        return None
+    return spec.model if spec.model is not None else CATALOGUE[DEFAULT_MODEL[spec.type.value]]
+
+
+def body_size(spec: ActorSpec) -> BoxSize:
+    """[m] the box of an actor's body."""
+    model = vehicle_of(spec)
+    if model is None:
+        return SIZES[spec.type]
+    return BoxSize(model.length, model.width, model.height)
+
+
 COLOURS = {  # [-] RGBA
     ActorType.CAR: (0.85, 0.20, 0.15, 1.0),
     ActorType.TRUCK: (0.90, 0.65, 0.10, 1.0),
@@ -71,6 +91,16 @@ class ActorPoses:
     # crossing's lateral motion included)
     speeds: NDArray[np.float64]
     accels: NDArray[np.float64]  # [m/s^2] (N,) rate of change of `speeds`, signed
+    # each vehicle's catalogue class, None for a pedestrian or an obstacle; () (poses made
+    # by hand in tests): as the type's default model, see `truth_class`
+    classes: tuple[VehicleClass | None, ...] = ()
+
+    def truth_class(self, i: int) -> VehicleClass | None:
+        """The catalogue class of actor `i` (None: not a vehicle)."""
+        if self.classes:
+            return self.classes[i]
+        kind = self.kinds[i]
+        return CATALOGUE[DEFAULT_MODEL[kind.value]].cls if kind in VEHICLES else None
 
 
 class ActorSet:
@@ -88,7 +118,6 @@ class ActorSet:
         self._maps = [road if a.road is None else build_road_map(a.road) for a in specs]
         self._own = np.array([a.road is not None for a in specs], dtype=bool)
         self.motions: list[NpcMotion] = []
-        self.bodies: list[int] = []
         for spec, own_map in zip(specs, self._maps, strict=True):
             lane = own_map.lane(spec.lane)
             offset = float(lane.offset_at(spec.s)) + spec.offset
@@ -96,21 +125,24 @@ class ActorSet:
                 NpcMotion(spec.s, offset, spec.speed, lane.direction, spec.actions,
                           lane=spec.lane, pedestrian=spec.type is ActorType.PEDESTRIAN)
             )
-            self.bodies.append(self._make_body(spec.type))
-        self.lengths = np.array([SIZES[a.type].length for a in specs])
+        sizes = [body_size(a) for a in specs]
+        self.bodies = [self._make_body(a.type, size)
+                       for a, size in zip(specs, sizes, strict=True)]
+        self.lengths = np.array([size.length for size in sizes])
         self.half_sizes = np.array(
-            [[SIZES[a.type].length / 2, SIZES[a.type].width / 2, SIZES[a.type].height / 2]
-             for a in specs]
+            [[size.length / 2, size.width / 2, size.height / 2] for size in sizes]
         ).reshape(-1, 3)
         self._drivers = [
-            TownDriver(own_map, route_signals(a.road, own_map), SIZES[a.type].length / 2)
-            if a.road is not None and a.type in (ActorType.CAR, ActorType.TRUCK) else None
-            for a, own_map in zip(specs, self._maps, strict=True)
+            TownDriver(own_map, route_signals(a.road, own_map), size.length / 2)
+            if a.road is not None and a.type in VEHICLES else None
+            for a, own_map, size in zip(specs, self._maps, sizes, strict=True)
         ]
         self._last_speed = self._speeds()  # [m/s] before the last step
         self._dt = 1.0  # [s] the last step
         self._ids = tuple(a.id for a in specs)
         self._kinds = tuple(a.type for a in specs)
+        self._classes = tuple(m.cls if (m := vehicle_of(a)) is not None else None
+                              for a in specs)
         # [rad] an oncoming actor's body faces against the route
         self._flip_list = [math.pi if m.direction < 0 else 0.0 for m in self.motions]
         self._flip = np.array(self._flip_list)
@@ -128,9 +160,8 @@ class ActorSet:
         self._poses: ActorPoses | None = None
         self._place(force=True)
 
-    def _make_body(self, kind: ActorType) -> int:
-        """A static box of `kind`'s size and colour, below the ground until placed."""
-        size = SIZES[kind]
+    def _make_body(self, kind: ActorType, size: BoxSize) -> int:
+        """A static box of `size` in `kind`'s colour, below the ground until placed."""
         half = (size.length / 2, size.width / 2, size.height / 2)
         shape = self._shapes.create(self._c, Part(Box(half)))
         visual = self._c.createVisualShape(
@@ -187,7 +218,7 @@ class ActorSet:
         """Each town driver's speed cap from its rules and the other vehicles' centres."""
         if not self._own.any():
             return
-        vehicles = np.array([k in (ActorType.CAR, ActorType.TRUCK) for k in self._kinds])
+        vehicles = np.array([k in VEHICLES for k in self._kinds])
         xy, half = self._xy[vehicles], self.half_sizes[vehicles, 0]
         if ego is not None:
             xy = np.vstack([xy, [ego[:2]]])
@@ -240,6 +271,7 @@ class ActorSet:
         return ActorPoses(
             ids=self._ids,
             kinds=self._kinds,
+            classes=self._classes,
             centres=centres,
             yaws=yaws,
             half_sizes=self.half_sizes,

@@ -17,6 +17,7 @@ import pytest
 from avsim.run.scoring import CaptureTruth, PerceptionScore, ScoringParams
 from perception.messages import Detection, LaneEstimate, ObjectClass, Track
 from world.actors.actor_set import ActorPoses
+from world.actors.catalogue import VehicleClass
 from world.sensors.lidar import LidarTruth
 from world.spec import ActorType
 
@@ -40,6 +41,7 @@ class Npc:
     speed: float = 10.0  # [m/s]
     yaw: float = 0.0  # [rad]
     returns: int = SEEN  # LiDAR returns on it in the scan
+    cls: VehicleClass | None = None  # its catalogue class; None: its type's default model's
 
 
 def poses(npcs: list[Npc]) -> ActorPoses:
@@ -54,6 +56,8 @@ def poses(npcs: list[Npc]) -> ActorPoses:
         offsets=np.zeros(n),
         speeds=np.array([a.speed for a in npcs], dtype=np.float64),
         accels=np.zeros(n),
+        classes=(tuple(a.cls for a in npcs) if any(a.cls is not None for a in npcs)
+                 else ()),
     )
 
 
@@ -453,8 +457,8 @@ def test_metrics_keys_and_nan_where_nothing_was_scored() -> None:
     truth, scan = capture([Npc("far", 200.0, 0.0)])
     score.objects((det(10.0, 0.0),), (), truth, scan)
     m = score.metrics()
-    assert set(m) == LANE_KEYS | OBJECT_KEYS
-    assert m["detection_precision"] == 0.0
+    assert set(m) == LANE_KEYS | OBJECT_KEYS | {"detection_precision_car"}
+    assert m["detection_precision"] == m["detection_precision_car"] == 0.0
     for key in ("detection_recall", "track_recall", "track_position_rmse",
                 "track_speed_rmse"):
         assert math.isnan(m[key]), key
@@ -464,8 +468,11 @@ def test_metrics_keys_and_nan_where_nothing_was_scored() -> None:
     truth, scan = capture([Npc("a", 20.0, 0.0)])
     score.objects((), (), truth, scan)
     m = score.metrics()
-    assert set(m) == LANE_KEYS | OBJECT_KEYS
+    car_keys = {f"{k}_car" for k in ("detection_recall", "track_recall",
+                                     "track_position_rmse", "track_speed_rmse", "id_switches")}
+    assert set(m) == LANE_KEYS | OBJECT_KEYS | car_keys  # no precision_car: no car detected
     assert m["detection_recall"] == 0.0 and m["track_recall"] == 0.0
+    assert m["detection_recall_car"] == 0.0 and m["track_recall_car"] == 0.0
     assert math.isnan(m["detection_precision"])
     assert math.isnan(m["track_position_rmse"]) and math.isnan(m["track_speed_rmse"])
     assert all(isinstance(v, float) for v in m.values())
@@ -479,3 +486,59 @@ def test_scans_without_any_actor() -> None:
     score.objects((det(12.0, 1.0),), (track(1, 12.0, 1.0),), truth, scan)
     m = score.metrics()
     assert m["detection_precision"] == 0.0 and math.isnan(m["detection_recall"])
+
+
+# -- per class ---------------------------------------------------------------------------------
+
+
+def test_scores_per_true_and_detected_class() -> None:
+    """Recall and track scores by the truth's catalogue class, precision by the detector's
+    class: a car, a rigid truck, a bus and a motorbike; the bus is missed (its box 3 m off,
+    no track), the motorbike called a car, one phantom car."""
+    npcs = [Npc("car", 20.0, 0.0, cls=VehicleClass.CAR),
+            Npc("truck", 40.0, 3.5, kind=ActorType.TRUCK, cls=VehicleClass.TRUCK),
+            Npc("bus", 30.0, -20.0, kind=ActorType.TRUCK, cls=VehicleClass.BUS),
+            Npc("bike", -15.0, 0.0, cls=VehicleClass.MOTORBIKE)]
+    score = PerceptionScore()
+    for k in range(2):
+        truth, scan = capture(npcs, t=0.1 * k)
+        dets = (det_at(truth, 20.0, 0.0), det_at(truth, 40.0, 3.5, ObjectClass.TRUCK),
+                det_at(truth, 33.0, -20.0, ObjectClass.TRUCK), det_at(truth, -15.0, 0.0),
+                det_at(truth, 0.0, 30.0))
+        tracks = (track(1, 20.0, 0.0), track(2, 41.0, 3.5, cls=ObjectClass.TRUCK),
+                  track(3, -15.0, 0.0))
+        score.objects(dets, tracks, truth, scan)
+    m = score.metrics()
+    assert m["detection_recall"] == pytest.approx(3 / 4)
+    for cls, recall in (("car", 1.0), ("truck", 1.0), ("bus", 0.0), ("motorbike", 1.0)):
+        assert m[f"detection_recall_{cls}"] == recall, cls
+        assert m[f"track_recall_{cls}"] == recall, cls
+    assert m["detection_precision_car"] == pytest.approx(2 / 3)  # car, motorbike; phantom
+    assert m["detection_precision_truck"] == pytest.approx(1 / 2)  # truck; bus box off
+    assert m["track_position_rmse_truck"] == pytest.approx(1.0)
+    assert m["track_position_rmse_car"] == 0.0
+    assert math.isnan(m["track_position_rmse_bus"])
+    assert "detection_recall_pedestrian" not in m
+    assert m["id_switches_car"] == m["id_switches_truck"] == 0.0
+
+
+def test_id_switches_per_class() -> None:
+    npcs = [Npc("car", 20.0, 0.0), Npc("truck", 40.0, 3.5, kind=ActorType.TRUCK)]
+    score = PerceptionScore()
+    for k, ids in enumerate([(1, 2), (1, 5), (1, 6)]):
+        truth, scan = capture(npcs, t=0.1 * k)
+        tracks = (track(ids[0], 20.0, 0.0), track(ids[1], 40.0, 3.5, cls=ObjectClass.TRUCK))
+        score.objects(perfect_dets(truth, npcs), tracks, truth, scan)
+    m = score.metrics()
+    assert (m["id_switches"], m["id_switches_car"], m["id_switches_truck"]) == (2.0, 0.0, 2.0)
+
+
+def test_default_classes_follow_the_type() -> None:
+    """Poses without classes: a car actor is a car, a truck actor a truck (their default
+    models' classes)."""
+    npcs = [Npc("a", 10.0, 0.0), Npc("t", 25.0, 3.5, kind=ActorType.TRUCK)]
+    score = PerceptionScore()
+    truth, scan = capture(npcs)
+    score.objects(perfect_dets(truth, npcs[:1]), (), truth, scan)
+    m = score.metrics()
+    assert (m["detection_recall_car"], m["detection_recall_truck"]) == (1.0, 0.0)

@@ -6,7 +6,7 @@ import math
 import pickle
 import re
 from pathlib import Path
-from typing import Any
+from typing import Any, get_args
 
 import jsonschema  # type: ignore[import-untyped]
 import pytest
@@ -30,6 +30,7 @@ from avsim.scenario.scenario import DriverSettings
 from avsim.scenario.schema import scenario_json_schema
 from tests.avsim.texts import MINIMAL
 from world import spec
+from world.actors.catalogue import CATALOGUE, DEFAULT_MODEL
 
 HERE = Path(__file__).parents[1]
 BAD_DIR = HERE / "bad_scenarios"
@@ -196,6 +197,13 @@ BAD: dict[str, tuple[str, str]] = {
                         "must be one of rtk, consumer, degraded, got 'consumr'"),
     "bad_gnss_bias": ("sensors.gnss.bias.1", "must be <= 50, got 51"),
     "bad_gnss_sigma": ("sensors.gnss.sigma", "must be >= 0, got -0.1"),
+    "unknown_vehicle_model": (
+        "actors.0.model",
+        "must be one of small_car, sedan, suv, van, bus, rigid_truck, semi_trailer, "
+        "motorbike, got 'tank'",
+    ),
+    "model_on_pedestrian": ("actors.0.model", "only a car or truck takes a model"),
+    "model_type_mismatch": ("actors.0.model", "a semi_trailer needs type: truck, not car"),
 }
 
 
@@ -272,6 +280,26 @@ def test_minimal_file_and_defaults(tmp_path: Path) -> None:
     assert loaded.criteria == CriteriaSettings()
     assert loaded.world.actors == ()
     assert loaded.world.events == ()
+
+
+def test_vehicle_models_and_their_defaults(tmp_path: Path) -> None:
+    text = MINIMAL + """\
+actors:
+  - {id: semi, type: truck, s: 50, model: semi_trailer}
+  - {id: bike, type: car, s: 60, model: motorbike}
+  - {id: car, type: car, s: 70}
+  - {id: lorry, type: truck, s: 80}
+  - {id: walker, type: pedestrian, s: 90}
+"""
+    actors = load_scenario(_write(tmp_path, text)).world.actors
+    assert [a.model for a in actors] == [CATALOGUE["semi_trailer"], CATALOGUE["motorbike"],
+                                         CATALOGUE[DEFAULT_MODEL["car"]],
+                                         CATALOGUE[DEFAULT_MODEL["truck"]], None]
+    assert (DEFAULT_MODEL["car"], DEFAULT_MODEL["truck"]) == ("sedan", "rigid_truck")
+
+
+def test_format_names_every_catalogue_model() -> None:
+    assert get_args(scenario_model.VehicleModelName) == tuple(CATALOGUE)
 
 
 def test_example_converts(tmp_path: Path) -> None:
