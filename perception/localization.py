@@ -18,9 +18,11 @@ Steps:
    acceleration (``accel_sigma``, ``yaw_accel_sigma``) plus a random walk on position and
    heading (``position_walk``, ``heading_walk``: slip, tyre radius error). The bias is a
    first-order Gauss-Markov process (``gnss_bias_tau``) of 1-sigma the receiver's stated
-   accuracy, with a map at least ``gnss_bias_floor``: a receiver that states 5 cm may still
-   be off by an offset it does not know of, and the camera's lane must be able to correct
-   that.
+   accuracy, with a map at least ``gnss_bias_floor``: a receiver may be off by more than it
+   says, and the camera's lane must be able to correct that. A receiver that states
+   carrier-phase (RTK) accuracy (``rtk_sigma`` or better) is taken at its word: the camera's
+   lane errors would otherwise pass into the bias estimate and move the car's pose where
+   nothing corrects it (through a town junction's turn, out of its corridor by 0.35 m).
 3. Update at every odometry sample with its speed (mean rear wheel spin x nominal radius)
    and the gyro yaw rate, and at every valid GNSS fix with position + bias and heading (the
    white noise ``gnss_white`` x the fix's stated sigma, at least ``gnss_sigma``; the heading
@@ -87,6 +89,8 @@ class LocalizerParams:
     gnss_white: float = 0.25  # [-] the white part of a fix's stated sigma (the rest wanders)
     gnss_heading_sigma: float = 0.2 * DEG  # [rad] heading noise floor; the fix's larger wins
     gnss_bias_tau: float = 60.0  # [s] correlation time assumed for the GNSS bias
+    rtk_sigma: float = 0.1  # [m] a receiver stating this or better has a carrier-phase fix
+    #   (RTK): its accuracy is taken as stated, no floor
     gnss_bias_floor: float = 1.0  # [m] 1-sigma of the bias assumed of any receiver, however
     #   accurate it says it is (an offset it does not know of: lever arm, datum, a constant
     #   error); the camera's lane may move the position across the lane this far
@@ -428,7 +432,8 @@ class Localizer:
     def _bias_sigma_of(self, fix: GnssFix) -> float:
         """[m] 1-sigma of the bias assumed of a fix: its stated sigma, at least the floor
         when the camera's lane can be matched on a map (else nothing could correct it)."""
-        floor = self.params.gnss_bias_floor if self.road is not None else 0.0
+        p = self.params
+        floor = p.gnss_bias_floor if self.road is not None and fix.sigma > p.rtk_sigma else 0.0
         return max(floor, fix.sigma)
 
     def _white_sigma(self, fix: GnssFix) -> float:

