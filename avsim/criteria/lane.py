@@ -123,6 +123,7 @@ class LaneChanges:
         self.crossing: Crossing | None = None  # the crossing under way
         self.changes: list[LaneChange] = []  # every lane change made
         self.place: Footprint | None = None  # at the last sample
+        self._overdue: Crossing | None = None  # the crossing `overdue` last returned
 
     def update(self, sample: TruthSample) -> LaneChange | Crossing | None:
         """Watch `sample` (its footprint is then `place`)."""
@@ -146,6 +147,15 @@ class LaneChanges:
                 self.changes.append(ended)
         self.lane, self.crossing = place.lane, None
         return ended
+
+    def overdue(self, t: float, limit: float) -> Crossing | None:
+        """The crossing under way at `t` [s] once it has lasted over `limit` [s]: returned
+        once, the first time; None otherwise."""
+        crossing = self.crossing
+        if crossing is None or crossing is self._overdue or t - crossing.since <= limit:
+            return None
+        self._overdue = crossing
+        return crossing
 
     def _margin_to(self, lane: int, sample: TruthSample) -> float:
         """[m] the least margin of the tyres inside `lane`'s lines (negative: over)."""
@@ -208,7 +218,6 @@ class TyresInLane(Criterion):
         self.margin = math.inf  # [m] the least margin so far
         self._stay: Stay | None = None  # the lane kept now
         self._left: Stay | None = None  # the lane kept before the crossing under way
-        self._long: Crossing | None = None  # the crossing already failed for its duration
 
     def update(self, sample: TruthSample) -> None:
         ended = self.lanes.update(sample)
@@ -246,10 +255,7 @@ class TyresInLane(Criterion):
         self._left = self._stay = None
 
     def _judge_crossings(self, sample: TruthSample, ended: LaneChange | Crossing | None) -> None:
-        crossing = self.lanes.crossing
-        if (crossing is not None and crossing is not self._long
-                and sample.t - crossing.since > self.max_duration):
-            self._long = crossing
+        if self.lanes.overdue(sample.t, self.max_duration) is not None:
             self._fail(sample, f"a tyre on or over a lane line for over "
                                f"{self.max_duration:g} s")
         if isinstance(ended, Crossing) and ended.origin_margin < 0.0:
@@ -294,16 +300,13 @@ class LaneChangeDuration(Criterion):
         super().__init__()
         self.lanes = LaneChanges(road, half_tread)
         self.threshold = threshold
-        self._failed: Crossing | None = None  # the crossing already failed
         self._t = 0.0  # [s] the last sample's time
 
     def update(self, sample: TruthSample) -> None:
         self._t = sample.t
         self.lanes.update(sample)
-        crossing = self.lanes.crossing
-        if (crossing is not None and crossing is not self._failed
-                and sample.t - crossing.since > self.threshold):
-            self._failed = crossing
+        crossing = self.lanes.overdue(sample.t, self.threshold)
+        if crossing is not None:
             self._fail(sample, f"a lane change from lane {crossing.origin} takes over "
                                f"{self.threshold:g} s")
 

@@ -102,6 +102,8 @@ class TrajectoryLog:
     lane: list[int] = field(default_factory=list)  # the lane the stack keeps (cross_track's)
     changing: list[bool] = field(default_factory=list)  # a commanded lane change in hand
     pedal: list[float] = field(default_factory=list)  # [-] the driver's accelerator pedal
+    pose_error: list[float] = field(default_factory=list)  # [m] the stack's position
+    #   estimate (the plan's) from the true centre
     actor_station: list[NDArray[np.float64]] = field(default_factory=list)  # [m] (N,) true,
     #   along the road each drives on (the route; past an exit's fork, the road the route
     #   left for traffic that kept it; in a town, each actor's own route): not comparable
@@ -351,6 +353,8 @@ class Runner:
         log.lane.append(out.plan.lane)
         log.changing.append(out.plan.lane != out.plan.origin_lane)
         log.pedal.append(w.accelerator_pedal)
+        log.pose_error.append(math.hypot(out.plan.ego.x - float(truth.position[0]),
+                                         out.plan.ego.y - float(truth.position[1])))
         log.lane_error.append(float(route.offsets[0]) - 0.5 * (lo + hi))
         log.crossing.append(self.lanes.crossing is not None)
         log.actor_station.append(np.array([m.s for m in w.actors.motions]))
@@ -417,6 +421,8 @@ class Runner:
                 float(np.max(np.abs(self.log.array("front_axle_error")[keeping])))
             if len(xte) else math.nan,
             "max_decel": float(max(0.0, np.max(smooth))) if len(smooth) else 0.0,
+            "pose_rmse": float(np.sqrt(np.mean(self.log.array("pose_error") ** 2)))
+            if len(speed) else math.nan,
             "max_speed": float(np.max(speed)) if len(speed) else 0.0,
             "distance": float(self.log.station[-1] - self.log.station[0]) if xte.size else 0.0,
             "collisions": float(self.collisions.count),

@@ -41,7 +41,7 @@ def test_the_cut_in_and_out_happened(result: RunResult) -> None:
 
 def test_verdict_and_the_r157_figures(result: RunResult) -> None:
     c = {r.name: r for r in result.criteria}
-    assert all(r.passed for r in result.criteria), result.criteria
+    assert not any(r.failed for r in result.criteria), result.criteria
     assert c["max_decel"].value <= 3.5
     assert c["min_gap"].value >= c["min_gap"].threshold  # d_min kept outside the grace
     modes = [x.target for x in result.state_changes if x.machine == "acc"]

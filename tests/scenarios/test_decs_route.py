@@ -40,7 +40,7 @@ def test_every_criterion_passes(result: RunResult) -> None:
     c = {r.name: r for r in result.criteria}
     assert c["stop_signs"].value >= 1.0
     assert c["crosswalks"].value < 0.0  # never on the crossing while the pedestrian was
-    assert c["completes"].note == "stopped after a flat tyre"
+    assert c["completes"].note == "a minimum-risk stop after a flat tyre"
 
 
 def test_highway_cruise_then_trail_through_60_50_40(result: RunResult) -> None:
