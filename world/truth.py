@@ -102,7 +102,6 @@ class VehicleAhead:
     """A vehicle ahead of the ego in its lane (`vehicles_ahead`)."""
 
     id: str  # the actor's id
-    index: int  # its index in the poses
     gap: float  # [m] bumper to bumper along the route
     speed: float  # [m/s] along its lane
     accel: float  # [m/s^2] rate of change of its speed, signed
@@ -138,7 +137,7 @@ def vehicles_ahead(road: RoadMap, poses: ActorPoses, station: float, offset: flo
     candidates = ((poses.offsets + across > lo) & (poses.offsets - across < hi)
                   & (poses.stations > station) & (np.cos(rel) > ALONG))
     gaps = poses.stations - station - along - 0.5 * ego_length
-    out = [VehicleAhead(poses.ids[i], int(i), float(gaps[i]), float(poses.speeds[i]),
+    out = [VehicleAhead(poses.ids[i], float(gaps[i]), float(poses.speeds[i]),
                         float(poses.accels[i]))
            for i in np.flatnonzero(candidates) if poses.kinds[i] in VEHICLES]
     return tuple(sorted(out, key=lambda v: v.gap))
