@@ -49,10 +49,12 @@ named below are fields of `DetectorParams`.
    TRUCK.
 7. **Box completion**: each candidate class's box is grown to its size prior (``car``,
    ``truck``, ``pedestrian``; never shrunk below what was seen; OTHER: a square of the longer
-   observed side), with either rectangle axis as the length. Each axis grows away from the
-   sensor, so that the faces seen stay where they were seen: if the sensor projects onto the
-   axis outside the observed interval, the interval's end nearer the sensor is kept; if inside
-   (a face seen head-on, both its ends visible), the interval grows symmetrically. The
+   observed side), with either rectangle axis as the length. A pedestrian's rectangle is
+   taken along the line of sight instead of the L-shape fit (see `along_sight`). Each axis
+   grows away from the sensor, so that the faces seen stay where they were seen: if the
+   sensor projects onto the axis outside the observed interval, the interval's end nearer
+   the sensor is kept; if inside (a face seen head-on, both its ends visible), the interval
+   grows symmetrically. The
    hypothesis of least cost = silhouette growth + ``overshoot_weight`` x overshoot (+
    ``truck_bias`` for trucks) wins: the silhouette growth [m] is how far the box sticks out
    sideways beyond the seen points as viewed from the sensor (azimuth growth x mean range; a
@@ -143,9 +145,8 @@ class DetectorParams:
     #   a bus much longer than the truck prior
     car: SizePrior = field(default_factory=lambda: SizePrior(4.61, 1.95, 1.72))
     truck: SizePrior = field(default_factory=lambda: SizePrior(6.74, 2.46, 2.73))
-    # [m] still the simulated pedestrian's body: nuScenes' mean (0.73 x 0.66 x 1.76) moves a
-    #   walker's completed box as it turns, beyond what the pedestrian tracker's tests allow
-    pedestrian: SizePrior = field(default_factory=lambda: SizePrior(0.5, 0.6, 1.75))
+    # [m] nuScenes' mean pedestrian box (not the simulated walker's 0.5 x 0.6 x 1.75)
+    pedestrian: SizePrior = field(default_factory=lambda: SizePrior(0.73, 0.66, 1.76))
 
     def prior(self, cls: ObjectClass) -> SizePrior | None:
         """The size prior of ``cls`` (None for `ObjectClass.OTHER`)."""
@@ -404,6 +405,7 @@ class Hypothesis:
     cls: ObjectClass  # the candidate class whose size prior the box was grown to
     axis1_length: bool  # the first fitted axis is the box's length axis
     bounds: tuple[tuple[float, float], tuple[float, float]]  # [m] (lo, hi) along each axis
+    axes: FloatArray  # (2, 2) [-] the axes of ``bounds`` (the footprint's it was grown from)
 
 
 def silhouette_growth(fp: Footprint, bounds: tuple[tuple[float, float], ...]) -> float:
@@ -433,7 +435,24 @@ def hypothesis(fp: Footprint, cls: ObjectClass, axis1_length: bool,
     overshoot = max(0.0, ext[0] - dims[0]) + max(0.0, ext[1] - dims[1])
     bias = p.truck_bias if cls is ObjectClass.TRUCK else 0.0
     cost = silhouette_growth(fp, bounds) + p.overshoot_weight * overshoot + bias
-    return Hypothesis(cost, cls, axis1_length, bounds)
+    return Hypothesis(cost, cls, axis1_length, bounds, fp.axes)
+
+
+def along_sight(fp: Footprint, xy: FloatArray, prior: SizePrior) -> Footprint:
+    """``fp`` re-expressed on the line of sight and across it: a walker's few returns give
+    no heading (an L-shape fit of them turns with every stride), so a pedestrian's box is
+    taken along the ray and grown away from the sensor from a near face placed by a
+    cylinder model (as in Autoware's shape estimation): a round body of the prior's mean
+    diameter D, whose returns (evenly spread across it, as a scanning LiDAR spreads them)
+    lie on average pi D / 8 in front of its centre. The returns' mean range is used, not the
+    nearest return: range noise on a couple of dozen points moves their minimum by
+    centimetres a scan, which a tracker reads as motion."""
+    proj = xy @ fp.view.T
+    lo, hi = proj.min(axis=0), proj.max(axis=0)
+    diameter = 0.5 * (prior.length + prior.width)
+    lo[0] = proj[:, 0].mean() + (math.pi / 8.0 - 0.5) * diameter
+    return replace(fp, axes=fp.view, lo=(float(lo[0]), float(lo[1])),
+                   hi=(float(hi[0]), float(hi[1])))
 
 
 def wrap_half_pi(a: float) -> float:
@@ -455,18 +474,20 @@ def box_from_points(xy: FloatArray, top: float, sensor_xy: tuple[float, float],
     fp = footprint(xy, sensor_xy, p, fit)
     ext = fp.extents
     longer_first = ext[0] >= ext[1]
-    hyps = [hypothesis(fp, cls, axis1_length, p)
-            for cls in candidate_classes(max(ext), min(ext), top, p)
+    classes = candidate_classes(max(ext), min(ext), top, p)
+    sight = along_sight(fp, xy, p.pedestrian) if ObjectClass.PEDESTRIAN in classes else fp
+    hyps = [hypothesis(sight if cls is ObjectClass.PEDESTRIAN else fp, cls, axis1_length, p)
+            for cls in classes
             for axis1_length in (longer_first, not longer_first)]
     if not hyps:
         return None
     best = min(hyps, key=lambda h: h.cost)  # the first of equals: deterministic
     (lo1, hi1), (lo2, hi2) = best.bounds
-    centre = np.array([0.5 * (lo1 + hi1), 0.5 * (lo2 + hi2)]) @ fp.axes
+    centre = np.array([0.5 * (lo1 + hi1), 0.5 * (lo2 + hi2)]) @ best.axes
     prior = p.prior(best.cls)
     height = max(top, prior.height) if prior is not None else top
     length, width = (hi1 - lo1, hi2 - lo2) if best.axis1_length else (hi2 - lo2, hi1 - lo1)
-    axis = fp.axes[0] if best.axis1_length else fp.axes[1]
+    axis = best.axes[0] if best.axis1_length else best.axes[1]
     return Detection(x=float(centre[0]), y=float(centre[1]), z=0.5 * height, length=length,
                      width=width, height=height,
                      yaw=wrap_half_pi(math.atan2(float(axis[1]), float(axis[0]))),
