@@ -175,6 +175,33 @@ class Piece:
     heading0: float  # [rad] heading at its start
 
 
+class MarkKind(enum.Enum):
+    """How a lane line is painted (OpenDRIVE's roadMark types that a camera tells apart)."""
+
+    SOLID = "solid"
+    BROKEN = "broken"
+    NONE = "none"  # no paint
+
+
+@dataclass(frozen=True, slots=True)
+class LineMark:
+    """One painted lane line."""
+
+    kind: MarkKind
+    width: float  # [m] across
+    yellow: bool = False  # white otherwise
+
+
+@dataclass(frozen=True, slots=True)
+class LinePaint:
+    """The lines of a cross-section as a map file paints them (OpenDRIVE road marks); a
+    section without one is painted by the road's own rules (`world.scene.road_mesh`)."""
+
+    right_edge: LineMark  # lane 0's right edge (the shoulder boundary)
+    lane_lines: tuple[LineMark, ...]  # between ego lanes, right to left (lanes - 1 of them)
+    left_edge: LineMark  # the ego lanes' left edge
+
+
 @dataclass(frozen=True, slots=True)
 class CrossSection:
     """The road's layout across, on one segment."""
@@ -184,6 +211,7 @@ class CrossSection:
     lane_width: float  # [m] every lane's width
     shoulder: float  # [m] paved right shoulder's width, 0 for none
     zone: Zone
+    paint: LinePaint | None = None  # the map file's lines; None: the road's own rules
 
     @property
     def right_edge(self) -> float:

@@ -24,6 +24,7 @@ from world.hdmap import (
     Crosswalk,
     Junction,
     LightHead,
+    LinePaint,
     Side,
     SpeedBump,
     SpeedLimitSign,
@@ -55,6 +56,10 @@ class SegmentSpec:
     zone: Zone | None = None  # scenery style; None: as the segment before (highway at start)
     exit: Side | None = None  # the route leaves the road here by an exit on this side (right
     #   only: `world.map.road`); the road goes on straight as scenery
+    start: tuple[float, float, float] | None = None  # [m, m, rad] the piece's exact start
+    #   pose (x, y, heading) where the map kind knows it (an OpenDRIVE road's arc spline);
+    #   None: laid from the end of the piece before
+    paint: LinePaint | None = None  # the map file's lane lines; None: the road's own rules
 
 
 @dataclass(frozen=True, slots=True)
