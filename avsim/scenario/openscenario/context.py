@@ -1,0 +1,38 @@
+"""What the element readers share: the attribute reader of the current parameter scope, the
+catalogs, and the declared entity names (to check entity references)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+from avsim.scenario.openscenario.attributes import Attributes
+from avsim.scenario.openscenario.catalogs import Catalogs
+from avsim.scenario.openscenario.parameters import Scope, evaluate_declarations
+from avsim.scenario.openscenario.xmlread import Node
+
+
+@dataclass(frozen=True, slots=True)
+class Context:
+    attrs: Attributes
+    catalogs: Catalogs
+    entity_names: frozenset[str] | None  # None while the entities are being read
+
+    def in_scope(self, scope: Scope) -> Context:
+        """This context reading attributes in another scope (a catalog entry's)."""
+        return replace(self, attrs=Attributes(scope))
+
+    def with_declarations(self, node: Node) -> Context:
+        """This context with the ParameterDeclarations under `node` (if any) in scope."""
+        declarations = node.child("ParameterDeclarations")
+        if declarations is None:
+            return self
+        scope = evaluate_declarations(declarations, self.attrs.scope, {}, file=node.file)
+        return self.in_scope(scope)
+
+    def entity_ref(self, node: Node, name: str = "entityRef") -> str:
+        """An entity reference attribute, checked against the declared entities."""
+        entity = self.attrs.text(node, name)
+        if self.entity_names is not None and entity not in self.entity_names:
+            known = ", ".join(sorted(self.entity_names))
+            raise node.error(f"{name}: no entity {entity} (entities: {known})")
+        return entity
