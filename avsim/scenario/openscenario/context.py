@@ -16,18 +16,20 @@ class Context:
     attrs: Attributes
     catalogs: Catalogs
     entity_names: frozenset[str] | None  # None while the entities are being read
+    declared_for: Node | None = None  # the element whose declarations `attrs` already has
 
-    def in_scope(self, scope: Scope) -> Context:
-        """This context reading attributes in another scope (a catalog entry's)."""
-        return replace(self, attrs=Attributes(scope))
+    def in_scope(self, scope: Scope, entry: Node | None = None) -> Context:
+        """This context reading attributes in another scope: a catalog entry's (`entry`,
+        whose ParameterDeclarations the scope already holds, assignments applied)."""
+        return replace(self, attrs=Attributes(scope), declared_for=entry)
 
     def with_declarations(self, node: Node) -> Context:
         """This context with the ParameterDeclarations under `node` (if any) in scope."""
         declarations = node.child("ParameterDeclarations")
-        if declarations is None:
+        if declarations is None or node is self.declared_for:
             return self
         scope = evaluate_declarations(declarations, self.attrs.scope, {}, file=node.file)
-        return self.in_scope(scope)
+        return self.in_scope(scope, node)
 
     def entity_ref(self, node: Node, name: str = "entityRef") -> str:
         """An entity reference attribute, checked against the declared entities."""

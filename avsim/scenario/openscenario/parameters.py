@@ -249,9 +249,11 @@ def _holds(rule: str, value: ParamValue, bound: ParamValue) -> bool:
     }[rule]
 
 
-def _shown(raw: str, bound: ParamValue) -> str:
-    text = to_str(bound)
-    return text if raw == text else f"{text} ({raw})"
+def _shown(raw: str, value: ParamValue, bound: ParamValue) -> str:
+    """The constraint's value as compared (a number without a trailing `.0`), followed by
+    the reference or expression it came from."""
+    text = to_str(bound) if isinstance(value, str) else fmt(to_float(bound))
+    return f"{text} ({raw})" if raw.startswith("$") else text
 
 
 def check_constraints(info: ParameterInfo, value: ParamValue, scope: Scope, where: Node) -> None:
@@ -266,7 +268,7 @@ def check_constraints(info: ParameterInfo, value: ParamValue, scope: Scope, wher
             except ResolveError as exc:
                 raise where.error(f"parameter {info.name}: constraint {vc.rule}: {exc}") from None
             if not ok:
-                failed.append(f"{vc.rule} {_shown(vc.value, bound)}")
+                failed.append(f"{vc.rule} {_shown(vc.value, value, bound)}")
         if not failed:
             return
         broken.append(" and ".join(failed))

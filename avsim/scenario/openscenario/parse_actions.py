@@ -154,7 +154,7 @@ def parse_trajectory(node: Node, ctx: Context) -> Trajectory:
     """A Trajectory element, or a CatalogReference to one (Polyline shapes only)."""
     if node.tag == "CatalogReference":
         entry = ctx.catalogs.resolve(node, ctx.attrs, ("Trajectory",))
-        return parse_trajectory(entry.node, ctx.in_scope(entry.scope))
+        return parse_trajectory(entry.node, ctx.in_scope(entry.scope, entry.node))
     if node.tag != "Trajectory":
         raise unsupported(node)
     ctx = ctx.with_declarations(node)

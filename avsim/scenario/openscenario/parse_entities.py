@@ -97,7 +97,7 @@ def parse_controller(node: Node, ctx: Context) -> Controller:
     """A Controller element, or a CatalogReference to one."""
     if node.tag == "CatalogReference":
         entry = ctx.catalogs.resolve(node, ctx.attrs, ("Controller",))
-        return parse_controller(entry.node, ctx.in_scope(entry.scope))
+        return parse_controller(entry.node, ctx.in_scope(entry.scope, entry.node))
     if node.tag != "Controller":
         raise unsupported(node)
     ctx = ctx.with_declarations(node)
@@ -111,7 +111,7 @@ def parse_object(node: Node, ctx: Context) -> EntityObject:
     """A Vehicle, Pedestrian or MiscObject element, or a CatalogReference to one."""
     if node.tag == "CatalogReference":
         entry = ctx.catalogs.resolve(node, ctx.attrs, OBJECT_KINDS)
-        return parse_object(entry.node, ctx.in_scope(entry.scope))
+        return parse_object(entry.node, ctx.in_scope(entry.scope, entry.node))
     if node.tag == "Vehicle":
         return parse_vehicle(node, ctx)
     if node.tag == "Pedestrian":

@@ -62,7 +62,7 @@ def parse_maneuver(node: Node, ctx: Context) -> Maneuver:
     """A Maneuver element, or a CatalogReference to one."""
     if node.tag == "CatalogReference":
         entry = ctx.catalogs.resolve(node, ctx.attrs, ("Maneuver",))
-        return parse_maneuver(entry.node, ctx.in_scope(entry.scope))
+        return parse_maneuver(entry.node, ctx.in_scope(entry.scope, entry.node))
     ctx = ctx.with_declarations(node)
     return Maneuver(
         name=ctx.attrs.text(node, "name"),
