@@ -161,6 +161,8 @@ class AssignControllerAction:
     controller: Controller
     activate_lateral: bool | None  # 1.1+ attributes; None when not written
     activate_longitudinal: bool | None
+    activate_lighting: bool | None  # 1.2
+    activate_animation: bool | None  # 1.2
 
 
 PrivateAction = (

@@ -30,7 +30,8 @@ CATALOG_LOCATIONS: tuple[str, ...] = (
     "ManeuverCatalog",
     "TrajectoryCatalog",
     "RouteCatalog",
-)
+    "SensorCatalog",
+)  # all accepted and read; entries are used by kind (Vehicle, Controller, ...)
 
 
 @dataclass(frozen=True, slots=True)
@@ -55,6 +56,7 @@ class Catalogs:
         entries: dict[str, dict[str, Node]] = {}
         if locations is None:
             return cls(entries)
+        read: set[Path] = set()  # a directory may serve several kinds; read it once
         for loc in locations.children:
             if loc.tag not in CATALOG_LOCATIONS:
                 raise loc.error(f"not supported yet ({loc.tag})")
@@ -62,6 +64,9 @@ class Catalogs:
             directory = (base_dir / attrs.text(directory_node, "path")).resolve()
             if not directory.is_dir():
                 raise directory_node.error(f"catalog directory not found: {directory}")
+            if directory in read:
+                continue
+            read.add(directory)
             for file in sorted(directory.glob("*.xosc")):
                 _read_catalog_file(file, entries)
         return cls(entries)

@@ -120,7 +120,7 @@ class OffroadCondition:
 @dataclass(frozen=True, slots=True)
 class CollisionCondition:
     """A collision with the entity `entity`, or with any object of type `by_type` (vehicle,
-    pedestrian, miscellaneous); exactly one is set."""
+    pedestrian, miscellaneous, external); exactly one is set."""
 
     entity: str | None
     by_type: str | None

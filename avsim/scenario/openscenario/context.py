@@ -3,6 +3,7 @@ catalogs, and the declared entity names (to check entity references)."""
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, replace
 
 from avsim.scenario.openscenario.attributes import Attributes
@@ -16,6 +17,7 @@ class Context:
     attrs: Attributes
     catalogs: Catalogs
     entity_names: frozenset[str] | None  # None while the entities are being read
+    element_names: Mapping[str, frozenset[str]] | None = None  # storyboard names by type
     declared_for: Node | None = None  # the element whose declarations `attrs` already has
 
     def in_scope(self, scope: Scope, entry: Node | None = None) -> Context:
@@ -38,3 +40,15 @@ class Context:
             known = ", ".join(sorted(self.entity_names))
             raise node.error(f"{name}: no entity {entity} (entities: {known})")
         return entity
+
+    def element_ref(self, node: Node, element_type: str, name: str) -> str:
+        """A storyboard element reference (`CutInAction`, or 1.2's qualified
+        `CutInStory::CutInAct`), checked against the storyboard's elements of that type."""
+        ref = self.attrs.text(node, name)
+        if self.element_names is None:
+            return ref
+        known = self.element_names.get(element_type, frozenset())
+        if ref.split("::")[-1] not in known:
+            listing = ", ".join(sorted(known)) or "none"
+            raise node.error(f"{name}: no {element_type} {ref} (the {element_type}s: {listing})")
+        return ref

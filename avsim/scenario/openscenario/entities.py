@@ -37,10 +37,14 @@ class Vehicle:
     max_speed: float  # [m/s]
     max_accel: float  # [m/s²]
     max_decel: float  # [m/s²] (positive)
+    max_accel_rate: float | None  # [m/s³] (1.2 Performance attribute), None when not given
+    max_decel_rate: float | None  # [m/s³] (1.2)
     front_axle: Axle
     rear_axle: Axle
     additional_axles: tuple[Axle, ...]
     mass: float | None  # [kg] (OpenSCENARIO 1.1+ attribute), None when not given
+    role: str | None  # vehicleRole (1.2): none, ambulance, civil, fire, military, police, ...
+    model: str  # model3d (1.1+), "" when absent
     properties: dict[str, str]  # Property name -> value, as written
 
 
@@ -60,6 +64,7 @@ class MiscObject:
     category: str  # miscObjectCategory: obstacle, pole, tree, barrier, ...
     mass: float  # [kg]
     bbox: BoundingBox
+    model: str  # model3d (1.1+), "" when absent
     properties: dict[str, str]
 
 

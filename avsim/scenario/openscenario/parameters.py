@@ -23,11 +23,12 @@ from avsim.scenario.openscenario.xmlread import Node
 
 ParamValue = int | float | bool | str  # a parameter's value (dateTime kept as its text)
 ParameterType = Literal[
-    "integer", "unsignedInt", "unsignedShort", "double", "string", "boolean", "dateTime"
-]
+    "int", "integer", "unsignedInt", "unsignedShort", "double", "string", "boolean", "dateTime"
+]  # "int" is 1.2's name for 1.0/1.1's "integer"
 Rule = Literal["equalTo", "greaterThan", "lessThan", "greaterOrEqual", "lessOrEqual", "notEqualTo"]
 
 PARAMETER_TYPES: tuple[str, ...] = (
+    "int",
     "integer",
     "unsignedInt",
     "unsignedShort",
@@ -182,7 +183,7 @@ def convert(value: ParamValue, ptype: ParameterType) -> ParamValue:
     """A resolved value as a parameter of type `ptype`; `ResolveError` if it is not one."""
     if ptype == "double":
         return to_float(value)
-    if ptype in ("integer", "unsignedInt", "unsignedShort"):
+    if ptype in ("int", "integer", "unsignedInt", "unsignedShort"):
         number = to_int(value)
         low, high = _INT_RANGE.get(ptype, (-(2**31), 2**31 - 1))
         if not low <= number <= high:

@@ -227,6 +227,8 @@ def _assign_controller(node: Node, ctx: Context) -> PrivateAction:
         controller=parse_controller(inner[0], ctx),
         activate_lateral=a.opt_boolean(node, "activateLateral"),
         activate_longitudinal=a.opt_boolean(node, "activateLongitudinal"),
+        activate_lighting=a.opt_boolean(node, "activateLighting"),
+        activate_animation=a.opt_boolean(node, "activateAnimation"),
     )
 
 

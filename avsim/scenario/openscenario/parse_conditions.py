@@ -69,16 +69,20 @@ def _simulation_time(node: Node, ctx: Context) -> ConditionKind:
 
 def _element_state(node: Node, ctx: Context) -> ConditionKind:
     a = ctx.attrs
+    element_type = a.choice(node, "storyboardElementType", ELEMENT_TYPES)
     return StoryboardElementStateCondition(
-        element_type=a.choice(node, "storyboardElementType", ELEMENT_TYPES),
-        element_ref=a.text(node, "storyboardElementRef"),
+        element_type=element_type,
+        element_ref=ctx.element_ref(node, element_type, "storyboardElementRef"),
         state=a.choice(node, "state", STATES),
     )
 
 
 def _parameter(node: Node, ctx: Context) -> ConditionKind:
     a = ctx.attrs
-    return ParameterCondition(a.text(node, "parameterRef"), a.text(node, "value"), _rule(node, ctx))  # type: ignore[arg-type]
+    parameter = a.text(node, "parameterRef")
+    if a.scope.get(parameter) is None:
+        raise node.error(f"parameterRef: no parameter {parameter}")
+    return ParameterCondition(parameter, a.text(node, "value"), _rule(node, ctx))  # type: ignore[arg-type]
 
 
 def _relative_distance(node: Node, ctx: Context) -> ConditionKind:
@@ -165,7 +169,7 @@ def _collision(node: Node, ctx: Context) -> ConditionKind:
     if target.tag == "EntityRef":
         return CollisionCondition(ctx.entity_ref(target), None)
     if target.tag == "ByType":
-        kinds = ("pedestrian", "vehicle", "miscellaneous")
+        kinds = ("pedestrian", "vehicle", "miscellaneous", "external")
         return CollisionCondition(None, ctx.attrs.choice(target, "type", kinds))
     raise unsupported(target)
 

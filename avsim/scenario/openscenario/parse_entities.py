@@ -57,10 +57,14 @@ def parse_vehicle(node: Node, ctx: Context) -> Vehicle:
         max_speed=a.number(perf, "maxSpeed"),
         max_accel=a.number(perf, "maxAcceleration"),
         max_decel=a.number(perf, "maxDeceleration"),
+        max_accel_rate=a.opt_number(perf, "maxAccelerationRate"),
+        max_decel_rate=a.opt_number(perf, "maxDecelerationRate"),
         front_axle=parse_axle(axles.need("FrontAxle"), ctx),
         rear_axle=parse_axle(axles.need("RearAxle"), ctx),
         additional_axles=tuple(parse_axle(x, ctx) for x in axles.all("AdditionalAxle")),
         mass=a.opt_number(node, "mass"),
+        role=a.opt_text(node, "vehicleRole"),
+        model=a.opt_text(node, "model3d") or "",
         properties=a.properties(node.child("Properties")),
     )
 
@@ -89,6 +93,7 @@ def parse_misc_object(node: Node, ctx: Context) -> MiscObject:
         category=a.text(node, "miscObjectCategory"),
         mass=a.number(node, "mass"),
         bbox=parse_bbox(node.need("BoundingBox"), ctx),
+        model=a.opt_text(node, "model3d") or "",
         properties=a.properties(node.child("Properties")),
     )
 

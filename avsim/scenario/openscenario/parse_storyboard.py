@@ -3,6 +3,8 @@ ManeuverCatalog), Events, Actions, triggers."""
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 from avsim.scenario.openscenario.attributes import unsupported
 from avsim.scenario.openscenario.context import Context
 from avsim.scenario.openscenario.parse_actions import parse_private_action
@@ -105,7 +107,34 @@ def parse_story(node: Node, ctx: Context) -> Story:
     return Story(ctx.attrs.text(node, "name"), tuple(parse_act(x, ctx) for x in node.all("Act")))
 
 
+_ELEMENT_TYPES = {
+    "Story": "story",
+    "Act": "act",
+    "ManeuverGroup": "maneuverGroup",
+    "Maneuver": "maneuver",
+    "Event": "event",
+    "Action": "action",
+}
+
+
+def element_names(node: Node, ctx: Context) -> dict[str, frozenset[str]] | None:
+    """The names of the storyboard's elements by StoryboardElementType, or None when a
+    maneuver comes from a catalog (its names are not checked then)."""
+    names: dict[str, set[str]] = {t: set() for t in _ELEMENT_TYPES.values()}
+    stack = [node]
+    while stack:
+        current = stack.pop()
+        if current.tag == "ManeuverGroup" and current.child("CatalogReference") is not None:
+            return None
+        kind = _ELEMENT_TYPES.get(current.tag)
+        if kind is not None and current.parent is not None and current.parent.tag != "Init":
+            names[kind].add(ctx.attrs.text(current, "name"))
+        stack.extend(current.children)
+    return {kind: frozenset(found) for kind, found in names.items()}
+
+
 def parse_storyboard(node: Node, ctx: Context) -> Storyboard:
+    ctx = replace(ctx, element_names=element_names(node, ctx))
     return Storyboard(
         init=parse_init(node.child("Init"), ctx),
         stories=tuple(parse_story(s, ctx) for s in node.all("Story")),

@@ -131,3 +131,18 @@ def test_undefined_entity_is_malformed() -> None:
     with pytest.raises(ScenarioError) as info:
         parse_xml_bytes(b"<a>\n&x;</a>", "mem.xml")
     assert str(info.value) == "mem.xml: line 2: malformed XML: undefined entity"
+
+
+def test_unknown_storyboard_element_is_named() -> None:
+    assert message("bad_element_ref.xosc") == (
+        "line 86: /OpenSCENARIO/Storyboard/StopTrigger/ConditionGroup/Condition[End]"
+        "/ByValueCondition/StoryboardElementStateCondition: storyboardElementRef: "
+        "no action MainActoin (the actions: MainAction)"
+    )
+
+
+def test_unknown_entity_is_named() -> None:
+    assert message("bad_entity_ref.xosc") == (
+        "line 28: /OpenSCENARIO/Storyboard/Init/Actions/Private: entityRef: "
+        "no entity Egoo (entities: Ego)"
+    )
