@@ -1,0 +1,10 @@
+"""ASAM OpenSCENARIO 1.0-1.2 (XML, .xosc) reading: `load_openscenario(path, overrides)`
+parses a file, resolves its parameters (`$name`, `${...}`, constraint groups) and catalogs,
+and gives the typed model in `model`; `declared_parameters(path)` lists the parameters."""
+
+from __future__ import annotations
+
+from avsim.scenario.openscenario.parameters import ParameterInfo
+from avsim.scenario.openscenario.parse import declared_parameters, load_openscenario
+
+__all__ = ["ParameterInfo", "declared_parameters", "load_openscenario"]
