@@ -229,6 +229,9 @@ class ActorSpec:
     road: RoadSpec | None = None  # in a town: the actor's own route (lane, s, offset on it)
     model: VehicleModel | None = None  # a vehicle's body (`world.actors.catalogue`); None:
     #   its type's default model (a car or truck), or no vehicle (pedestrian, obstacle)
+    size: tuple[float, float, float] | None = None  # [m] length, width, height of a
+    #   pedestrian's or an obstacle's box (a scenario file's bounding box); None: the type's
+    #   (`world.actors.actor_set.SIZES`)
 
 
 @dataclass(frozen=True, slots=True)
