@@ -28,6 +28,9 @@ Value = float | bool  # what an expression gives
 Lookup = Callable[[str], Value]  # a parameter's value by name; raises ExpressionError
 
 
+MAX_DEPTH = 100  # deepest nesting of parentheses, unary minus and `not`
+
+
 class ExpressionError(ValueError):
     """An expression cannot be evaluated: the message says why (one line)."""
 
@@ -149,6 +152,13 @@ class _Evaluator:
         self.tokens = tokenize(text)
         self.i = 0
         self.lookup = lookup
+        self.depth = 0
+
+    def enter(self) -> None:
+        """Counts one more level of nesting; refuses more than MAX_DEPTH."""
+        self.depth += 1
+        if self.depth > MAX_DEPTH:
+            raise ExpressionError(f"nested more than {MAX_DEPTH} deep")
 
     def peek(self) -> Token:
         return self.tokens[self.i]
@@ -176,11 +186,13 @@ class _Evaluator:
         return value
 
     def or_(self) -> Value:
+        self.enter()
         value = self.and_()
         while self.is_word("or"):
             self.take()
             right = self.and_()
             value = _boolean(value, "or") | _boolean(right, "or")
+        self.depth -= 1
         return value
 
     def and_(self) -> Value:
@@ -194,7 +206,10 @@ class _Evaluator:
     def not_(self) -> Value:
         if self.is_word("not"):
             self.take()
-            return not _boolean(self.not_(), "not")
+            self.enter()
+            value = not _boolean(self.not_(), "not")
+            self.depth -= 1
+            return value
         return self.compare()
 
     def compare(self) -> Value:
@@ -233,7 +248,10 @@ class _Evaluator:
         tok = self.peek()
         if tok.kind == "op" and tok.text == "-":
             self.take()
-            return -_number(self.unary(), "unary minus")
+            self.enter()
+            value = -_number(self.unary(), "unary minus")
+            self.depth -= 1
+            return value
         return self.primary()
 
     def primary(self) -> Value:

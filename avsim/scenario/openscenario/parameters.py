@@ -232,6 +232,10 @@ def parse_declarations(node: Node | None) -> tuple[ParameterInfo, ...]:
 
 
 def _holds(rule: str, value: ParamValue, bound: ParamValue) -> bool:
+    if isinstance(value, bool):
+        if rule not in ("equalTo", "notEqualTo"):
+            raise ResolveError(f"{rule} cannot compare booleans")
+        return (value == to_bool(bound)) == (rule == "equalTo")
     if isinstance(value, str):
         left, right = to_str(value), to_str(bound)
         if rule == "equalTo":
@@ -253,7 +257,7 @@ def _holds(rule: str, value: ParamValue, bound: ParamValue) -> bool:
 def _shown(raw: str, value: ParamValue, bound: ParamValue) -> str:
     """The constraint's value as compared (a number without a trailing `.0`), followed by
     the reference or expression it came from."""
-    text = to_str(bound) if isinstance(value, str) else fmt(to_float(bound))
+    text = to_str(bound) if isinstance(value, str | bool) else fmt(to_float(bound))
     return f"{text} ({raw})" if raw.startswith("$") else text
 
 

@@ -55,6 +55,9 @@ def declared_parameters(path: Path) -> tuple[ParameterInfo, ...]:
 
 def _road_network(root: Node, base_dir: Path, attrs: Attributes) -> Path | None:
     network = root.need("RoadNetwork")
+    signals = network.child("TrafficSignals")
+    if signals is not None and signals.children:
+        raise signals.children[0].error(f"not supported yet ({signals.children[0].tag})")
     logic = network.child("LogicFile")
     if logic is None:
         return None

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import pytest
@@ -146,3 +147,71 @@ def test_unknown_entity_is_named() -> None:
         "line 28: /OpenSCENARIO/Storyboard/Init/Actions/Private: entityRef: "
         "no entity Egoo (entities: Ego)"
     )
+
+
+_MINIMAL = (DATA / "minimal.xosc").read_text()
+SPEED_ACTION = _MINIMAL[
+    _MINIMAL.index("<LongitudinalAction>") : _MINIMAL.index("</LongitudinalAction>") + 21
+]
+SIM_TIME = '<SimulationTimeCondition value="1" rule="greaterOrEqual"/>'
+WORLD = '<WorldPosition x="0" y="0" h="0"/>'
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "name"),
+    [
+        (SPEED_ACTION, '<SynchronizeAction masterEntityRef="Ego"/>', "SynchronizeAction"),
+        (
+            SPEED_ACTION,
+            "<LongitudinalAction><SpeedProfileAction followingMode='follow'/></LongitudinalAction>",
+            "SpeedProfileAction",
+        ),
+        (
+            SPEED_ACTION,
+            "<LateralAction><LateralDistanceAction entityRef='Ego' continuous='true' "
+            "freespace='true'/></LateralAction>",
+            "LateralDistanceAction",
+        ),
+        (
+            SPEED_ACTION,
+            "<RoutingAction><AcquirePositionAction><Position>" + WORLD + "</Position>"
+            "</AcquirePositionAction></RoutingAction>",
+            "AcquirePositionAction",
+        ),
+        (
+            SPEED_ACTION,
+            "<ControllerAction><OverrideControllerValueAction/></ControllerAction>",
+            "OverrideControllerValueAction",
+        ),
+        (
+            SPEED_ACTION,
+            "<RoutingAction><FollowTrajectoryAction><TrajectoryRef>"
+            "<Trajectory name='t' closed='false'><Shape><Clothoid curvature='0' length='1'>"
+            "</Clothoid></Shape></Trajectory></TrajectoryRef><TimeReference><None/>"
+            "</TimeReference><TrajectoryFollowingMode followingMode='follow'/>"
+            "</FollowTrajectoryAction></RoutingAction>",
+            "Clothoid",
+        ),
+        (WORLD, '<GeoPosition latitudeDeg="48" longitudeDeg="11"/>', "GeoPosition"),
+        (
+            SIM_TIME,
+            '<TimeOfDayCondition dateTime="2024-01-01T00:00:00" rule="lessThan"/>',
+            "TimeOfDayCondition",
+        ),
+        ("<Private entityRef", "<GlobalAction/><Private entityRef", "GlobalAction"),
+        (
+            "<RoadNetwork>",
+            "<RoadNetwork><TrafficSignals><TrafficSignalController name='c'/></TrafficSignals>",
+            "TrafficSignalController",
+        ),
+    ],
+)
+def test_unsupported_elements_are_named(tmp_path: Path, old: str, new: str, name: str) -> None:
+    text = _MINIMAL
+    assert old in text
+    path = tmp_path / "variant.xosc"
+    path.write_text(text.replace(old, new, 1))
+    with pytest.raises(ScenarioError) as info:
+        load_openscenario(path)
+    assert str(info.value).startswith(f"{path}: line ")
+    assert re.search(rf"/{name}(\[\w+\])?: not supported yet \({name}\)$", str(info.value))

@@ -62,6 +62,11 @@ def test_arithmetic(text: str, expected: float) -> None:
     assert ev(text) == pytest.approx(expected)
 
 
+def test_nesting_up_to_the_limit() -> None:
+    assert ev("(" * 99 + "1" + ")" * 99) == 1.0
+    assert ev("-" * 99 + "1") == -1.0
+
+
 @pytest.mark.parametrize(
     ("text", "expected"),
     [
@@ -100,6 +105,9 @@ def test_booleans(text: str, expected: bool) -> None:
         ("1 # 2", "unexpected character '#' at 2"),
         ("pow(10, 400)", "pow: argument out of range"),
         ("", "expected a value at 0, found the end"),
+        ("(" * 101 + "1" + ")" * 101, "nested more than 100 deep"),
+        ("-" * 101 + "1", "nested more than 100 deep"),
+        ("not " * 101 + "true", "nested more than 100 deep"),
     ],
 )
 def test_errors(text: str, problem: str) -> None:

@@ -143,6 +143,13 @@ def test_string_constraints() -> None:
     )
 
 
+def test_boolean_constraints() -> None:
+    groups = '<ConstraintGroup><ValueConstraint rule="notEqualTo" value="false"/></ConstraintGroup>'
+    body = decl("on", "boolean", "true", groups)
+    assert declarations(body) == {"on": True}
+    assert failure(body, {"on": "0"}).endswith("parameter on = false: breaks notEqualTo false")
+
+
 def test_constraint_referencing_a_later_parameter() -> None:
     groups = '<ConstraintGroup><ValueConstraint rule="lessThan" value="$max"/></ConstraintGroup>'
     body = decl("v", "double", "3", groups) + decl("max", "double", "4")
