@@ -66,6 +66,7 @@ class Director:
         self._follows: dict[str, Follow] = {}  # tag -> a command renewed every check
         self._tag_action: dict[str, str] = {}  # tag -> action id
         self.ended = False
+        self.ended_at: float | None = None  # [s] when the StopTrigger fired
         self._first = True
         self._top = {e.name: getattr(e.object, "max_speed", WALKING_TOP)
                      for e in osc.entities}  # [m/s] each entity's top speed
@@ -88,7 +89,8 @@ class Director:
         for started in result.started:
             self._start(started, snap)
         self._renew(snap)
-        self.ended = result.ended
+        if result.ended and not self.ended:
+            self.ended, self.ended_at = True, snap.time
         return self.ended
 
     def _motion(self, entity: str) -> NpcMotion | None:
