@@ -25,13 +25,14 @@ def _sampled_distance(a: np.ndarray, b: np.ndarray, n: int = 60) -> tuple[float,
     u, v = np.meshgrid(k, k)
 
     def points(r: np.ndarray) -> np.ndarray:
-        return (r[1] + u[..., None] * (r[0] - r[1]) + v[..., None] * (r[2] - r[1])).reshape(-1, 2)
+        grid = r[1] + u[..., None] * (r[0] - r[1]) + v[..., None] * (r[2] - r[1])
+        return np.asarray(grid, dtype=float).reshape(-1, 2)
 
     def inside(p: np.ndarray, r: np.ndarray) -> np.ndarray:
         e1, e2 = r[0] - r[1], r[2] - r[1]
         q = p - r[1]
         a1, a2 = q @ e1 / (e1 @ e1), q @ e2 / (e2 @ e2)
-        return (a1 >= 0) & (a1 <= 1) & (a2 >= 0) & (a2 <= 1)
+        return np.asarray((a1 >= 0) & (a1 <= 1) & (a2 >= 0) & (a2 <= 1), dtype=bool)
 
     pa, pb = points(a), points(b)
     overlap = bool(inside(pa, b).any() or inside(pb, a).any())
