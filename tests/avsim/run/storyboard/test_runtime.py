@@ -139,6 +139,18 @@ def test_an_act_waits_for_its_start_trigger() -> None:
     assert started(step(rt, 2.0)) == [f"{PATH}/E/EA#1"]
 
 
+def test_an_events_trigger_is_evaluated_only_once_its_act_runs() -> None:
+    """A rising edge is first evaluated when the event starts waiting: a condition already
+    true then does not rise (the first evaluation has no previous value)."""
+    fast = condition(SpeedCondition(10.0, "greaterThan"), edge="rising", entities=("Ego",))
+    rt = run(storyboard(event("E", trigger((fast,))), act_start=at_time(2.0)))
+    step(rt, 0.0, speed=5.0)
+    assert step(rt, 1.0, speed=20.0).started == ()  # the act waits: not evaluated
+    assert step(rt, 2.0, speed=20.0).started == ()  # first evaluation: no rise
+    assert step(rt, 2.1, speed=5.0).started == ()
+    assert started(step(rt, 2.2, speed=20.0)) == [f"{PATH}/E/EA#1"]
+
+
 def test_an_acts_stop_trigger_stops_everything_in_it() -> None:
     rt = run(storyboard(event("E1", None), event("E2", at_time(50.0)), act_stop=at_time(1.0)))
     step(rt, 0.0)
