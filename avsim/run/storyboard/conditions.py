@@ -1,14 +1,14 @@
 """Judging one condition at one step (`holds`), and a condition with its triggering
 entities (`judge`). Behaves as esmini's `OSCCondition` where not said otherwise.
 
-Rules: ints and strings compare exactly; floats with equalTo / notEqualTo within 1e-6
-(absolute), the others exactly. Entity conditions are judged per triggering entity; rule
-"any": true when it holds for one of them, "all": for every one (the entities it holds for
-are the ones `selectTriggeringEntities` adds). Distances (`geometry`) are along the ego's
-route: coordinate systems "entity", "lane" and "road" are all taken along the route (the
-route is the lane kept; the entity's own axes are not used), "trajectory" likewise.
-Relative and position distances compare their magnitude. Kind-specific notes are on each
-judge below.
+Rules: `rules.compare` (floats equal within 1e-6 absolute, ints and strings exactly).
+Entity conditions are judged per triggering entity; rule "any": true when it holds for one
+of them, "all": for every one (the entities it holds for are the ones
+`selectTriggeringEntities` adds). Distances (`geometry`) are along the ego's route:
+coordinate systems "entity", "lane", "road" and "trajectory" are all taken along the route
+(the route is the lane kept; an entity's own axes are not used). Relative and position
+distances compare their magnitude. An entity missing from the snapshot: false. Notes
+particular to a kind are on its judge below.
 """
 
 from __future__ import annotations
@@ -19,6 +19,7 @@ from dataclasses import dataclass
 
 from avsim.run.storyboard import geometry as g
 from avsim.run.storyboard.elements import ElementState, TransitionKind, TransitionRecord
+from avsim.run.storyboard.rules import compare, parameter_holds
 from avsim.run.storyboard.snapshot import EntityState, Snapshot
 from avsim.scenario.openscenario.conditions import (
     CollisionCondition,
@@ -32,7 +33,6 @@ from avsim.scenario.openscenario.conditions import (
     RelativeDistanceCondition,
     RelativeDistanceType,
     RelativeSpeedCondition,
-    Rule,
     SimulationTimeCondition,
     SpeedCondition,
     StandStillCondition,
@@ -44,7 +44,6 @@ from avsim.scenario.openscenario.conditions import (
 from avsim.scenario.openscenario.parameters import ParamValue
 from avsim.scenario.openscenario.positions import Position
 
-FLOAT_EQUAL = 1e-6  # [-] absolute tolerance of equalTo / notEqualTo on floats
 STANDING = 0.01  # [m/s] below this an entity stands still (as the snapshot's standing_for)
 Resolved = tuple[float, float, float, float]  # x, y [m] map frame; s, offset [m] route
 Resolver = Callable[[Position, Snapshot], Resolved]
@@ -63,50 +62,6 @@ class ConditionContext:
     log: Sequence[TransitionRecord] = ()  # every transition so far, in order
     since: int = 0  # log[since:] happened since the condition's previous evaluation
     resolve: Resolver = no_resolver  # a position -> (x, y, s, offset)
-
-
-_RULES: dict[str, Callable[[float, float], bool]] = {
-    "greaterThan": lambda a, b: a > b,
-    "lessThan": lambda a, b: a < b,
-    "greaterOrEqual": lambda a, b: a >= b,
-    "lessOrEqual": lambda a, b: a <= b,
-    "equalTo": lambda a, b: a == b,
-    "notEqualTo": lambda a, b: a != b,
-}
-
-
-def compare(a: float | int | str, rule: Rule, b: float | int | str) -> bool:
-    """`a rule b`; floats equal within `FLOAT_EQUAL`, ints and strings exactly."""
-    if isinstance(a, float) or isinstance(b, float):
-        fa, fb = float(a), float(b)
-        if rule == "equalTo":
-            return abs(fa - fb) <= FLOAT_EQUAL
-        if rule == "notEqualTo":
-            return abs(fa - fb) > FLOAT_EQUAL
-    if isinstance(a, str) or isinstance(b, str):
-        sa, sb = str(a), str(b)
-        return bool(_RULES[rule](sa, sb))  # type: ignore[arg-type]
-    return _RULES[rule](a, b)
-
-
-def _as_type(value: ParamValue, text: str) -> float | int | str:
-    if isinstance(value, bool):
-        return int(text.strip().lower() == "true")
-    if isinstance(value, int):
-        return int(text)
-    if isinstance(value, float):
-        return float(text)
-    return text
-
-
-def _parameter(c: ParameterCondition, ctx: ConditionContext) -> bool:
-    """The parameter's value against the written value read as the parameter's type
-    (unknown parameter: false, as esmini)."""
-    if c.parameter not in ctx.parameters:
-        return False
-    value = ctx.parameters[c.parameter]
-    mine = int(value) if isinstance(value, bool) else value
-    return compare(mine, c.rule, _as_type(value, c.value))
 
 
 _STATES = {s.value: s for s in ElementState}
@@ -129,7 +84,7 @@ def _by_value(kind: ConditionKind, snap: Snapshot, ctx: ConditionContext) -> boo
     if isinstance(kind, SimulationTimeCondition):
         return compare(snap.time, kind.rule, kind.value)
     if isinstance(kind, ParameterCondition):
-        return _parameter(kind, ctx)
+        return parameter_holds(kind, ctx.parameters)
     if isinstance(kind, StoryboardElementStateCondition):
         return _element_state(kind, ctx)
     raise TypeError(f"{type(kind).__name__} needs a triggering entity")

@@ -1,8 +1,8 @@
 """The storyboard at run time (`StoryRuntime`): which actions start and stop at each step.
 
-Each `step(snap)` evaluates, in this order (as esmini's `ScenarioEngine::step`):
-1. the storyboard's stop trigger (every step): when it fires every element still in
-   standby or running is stopped and the run has ended;
+Each `step(snap)` evaluates, in this order:
+1. the storyboard's stop trigger (every step; none: never): when it fires every element
+   still in standby or running is stopped and the run has ended;
 2. each story (started at the first step), each of its acts: a standby act's start trigger
    (none: it starts at once) starts it with all its maneuver groups and their maneuvers; a
    running act's stop trigger stops it and everything in it; a re-armed maneuver group
@@ -126,7 +126,8 @@ class StoryRuntime:
 
     def action_done(self, action_id: str, t: float) -> None:
         """The world reports the action reached its goal at `t` [s]: it ends (and what it
-        completes with it). Ignored unless that execution of the action is running."""
+        completes with it). Ignored unless that execution of the action is running. Report
+        before the `step` of the same time, so its conditions see it at that step."""
         path, _, _n = action_id.rpartition("#")
         node = self._actions.get(path)
         if node is None:

@@ -103,7 +103,7 @@ class TriggerWatch:
 
     def triggering_entities(self) -> tuple[str, ...]:
         """The entities the conditions of the groups that fired at the latest update held for
-        at that evaluation (with a delay: those of the evaluation passed on, not kept)."""
+        at the latest evaluation (with a delay: of the latest one, not the delayed one)."""
         names: dict[str, None] = {}
         for group in self.groups:
             if group and all(w.value for w in group):
