@@ -223,20 +223,10 @@ class Runner:
             # on the joints for the period's physics steps (contacts watched at their rate)
             while w.clock.step < steps:
                 self._tick()
-                for _ in range(min(CONTROL_RATE.every, steps - w.clock.step)):
-                    with watch("physics"):
-                        w.step()
-                    if self.director is not None and TRIGGER_RATE.fires(w.clock.step):
-                        with watch("runner"):
-                            self.director.step(self._touching)
-                    if w.clock.step % CONTACT_RATE.every == 0:
-                        with watch("criteria"):
-                            self._watch(w.clock.step)
-                if self.director is not None and self.director.ended:
-                    break  # the file's StopTrigger ends the run
+                self._period(steps)
                 if done_at is None and self._may_end():
                     done_at = w.t
-                if done_at is not None and w.t >= done_at + SETTLE_AFTER_DONE:
+                if self._over(done_at):
                     break
                 if progress is not None and w.clock.step % PHYSICS_RATE == 0:
                     progress(w.t, self.scenario.duration)
@@ -258,6 +248,27 @@ class Runner:
             renderer=renderer.value if renderer is not None else None,
             stage_times=dict(watch.seconds), story=self.story.now(),
         )
+
+    def _period(self, steps: int) -> None:
+        """The physics steps of one control period (at most up to `steps`), with the
+        storyboard's director and the contact watch at their rates."""
+        w, watch = self.world, self.watch
+        for _ in range(min(CONTROL_RATE.every, steps - w.clock.step)):
+            with watch("physics"):
+                w.step()
+            if self.director is not None and TRIGGER_RATE.fires(w.clock.step):
+                with watch("runner"):
+                    self.director.step(self._touching)
+            if w.clock.step % CONTACT_RATE.every == 0:
+                with watch("criteria"):
+                    self._watch(w.clock.step)
+
+    def _over(self, done_at: float | None) -> bool:
+        """The run ends: an OpenSCENARIO file's StopTrigger fired, or it settled after it
+        may end (`done_at`)."""
+        if self.director is not None and self.director.ended:
+            return True
+        return done_at is not None and self.world.t >= done_at + SETTLE_AFTER_DONE
 
     def _may_end(self) -> bool:
         """`completes` is reached and every required action and event has fired."""

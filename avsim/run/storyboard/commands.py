@@ -189,8 +189,8 @@ def _speed_span(d: TransitionDynamics, start: float, target: float) -> float:
         return d.value
     if d.dimension == "distance":
         return speed_span_by_distance(start, target, d.value)
-    if target == start or shape is Shape.STEP:
-        return 0.0
+    if abs(target - start) < SPEED_MATCHED * 1e-3 or shape is Shape.STEP:
+        return 0.0  # nothing to change (to rounding: an entity's speed read back)
     if d.value <= 0.0:
         raise ValueError(f"a speed change at rate {d.value:g} m/s^2 never ends")
     return span_by_rate(shape, target - start, d.value)

@@ -53,6 +53,7 @@ from world.map.opendrive import OpenDriveError, load_opendrive
 from world.map.opendrive.route import OdrRoute, build_route
 from world.map.road import MapError, build_road_map
 
+DEFAULT_CRITERIA = CriteriaSettings.of({"completes": False})  # the StopTrigger ends the run
 MAX_DURATION = 600.0  # [s] a run whose StopTrigger never fires ends here
 EGO_NAMES = ("ego",)  # the car under test's entity name, compared in lower case
 TRUCKS = frozenset({"truck", "bus", "trailer", "semitrailer"})
@@ -97,7 +98,7 @@ def load_xosc(path: Path, overrides: Mapping[str, str] | None = None,
     return Scenario(name=_name(path), description=osc.description, situation="openscenario",
                     duration=MAX_DURATION, world=world,
                     driver=DriverSettings(set_speed=ego_spec.speed),
-                    criteria=criteria if criteria is not None else CriteriaSettings(),
+                    criteria=criteria if criteria is not None else DEFAULT_CRITERIA,
                     story=program)
 
 
