@@ -14,7 +14,8 @@ the same world spec, driver settings and criteria as a YAML file gives, plus the
   before); a speed action with a step sets the starting speed; a longitudinal distance
   action without dynamic constraints places its entity at the distance (as esmini jumps);
   every other Init action starts at t = 0 (`StoryProgram.init_commands`).
-- The run lasts until the StopTrigger fires, at most `MAX_DURATION`.
+- The run lasts until the StopTrigger fires, at most the sidecar's `duration`; the criteria,
+  seed and sensor noise come from the sidecar (`sidecar`).
 """
 
 from __future__ import annotations
@@ -25,7 +26,6 @@ from collections.abc import Mapping
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-from avsim.criteria.registry import CriteriaSettings
 from avsim.scenario.errors import ScenarioError
 from avsim.scenario.openscenario.model import (
     AbsoluteTargetSpeed,
@@ -44,6 +44,7 @@ from avsim.scenario.openscenario.model import (
 from avsim.scenario.openscenario.parse import load_openscenario
 from avsim.scenario.openscenario.program import StoryProgram
 from avsim.scenario.openscenario.resolve import Pose, PositionError, Resolver
+from avsim.scenario.openscenario.sidecar import load_sidecar, sidecar_path, split_overrides
 from avsim.scenario.scenario import DriverSettings, Scenario
 from vehicle_urdf.geometry import read_geometry
 from world import spec
@@ -53,8 +54,6 @@ from world.map.opendrive import OpenDriveError, load_opendrive
 from world.map.opendrive.route import OdrRoute, build_route
 from world.map.road import MapError, build_road_map
 
-DEFAULT_CRITERIA = CriteriaSettings.of({"completes": False})  # the StopTrigger ends the run
-MAX_DURATION = 600.0  # [s] a run whose StopTrigger never fires ends here
 EGO_NAMES = ("ego",)  # the car under test's entity name, compared in lower case
 TRUCKS = frozenset({"truck", "bus", "trailer", "semitrailer"})
 CLASSES = {"truck": VehicleClass.TRUCK, "trailer": VehicleClass.TRUCK,
@@ -70,11 +69,15 @@ class _Placed:
     speed: float = 0.0  # [m/s]
 
 
-def load_xosc(path: Path, overrides: Mapping[str, str] | None = None,
-              criteria: CriteriaSettings | None = None) -> Scenario:
-    """The scenario of the OpenSCENARIO file `path` (module doc); `ScenarioError` (one
-    line) for anything it cannot run."""
-    osc = load_openscenario(path, overrides or {})
+def load_xosc(path: Path, overrides: Mapping[str, object] | None = None,
+              criteria_file: Path | None = None) -> Scenario:
+    """The scenario of the OpenSCENARIO file `path` (module doc) with `overrides` (the
+    file's `parameters.NAME`, the sidecar's keys) and the sidecar `criteria_file` (None:
+    `NAME.criteria.yaml` beside it if there is one); `ScenarioError` (one line) for
+    anything it cannot run."""
+    params, rest = split_overrides(overrides or {})
+    side = load_sidecar(sidecar_path(path, criteria_file), rest)
+    osc = load_openscenario(path, params)
     if osc.road_network is None:
         raise ScenarioError(str(path), "RoadNetwork", "no OpenDRIVE LogicFile: avsim needs "
                             "the road")
@@ -94,11 +97,11 @@ def load_xosc(path: Path, overrides: Mapping[str, str] | None = None,
         actors=tuple((e.name, i) for i, e in enumerate(others)),
         centre_ahead=tuple(ahead.items()), lane_ids=route.layout.lane_ids,
         init_commands=tuple(deferred))
-    world = spec.WorldSpec(road=route.spec, ego=ego_spec, actors=actors)
+    world = spec.WorldSpec(road=route.spec, ego=ego_spec, actors=actors, seed=side.seed,
+                           sensors=side.sensors)
     return Scenario(name=_name(path), description=osc.description, situation="openscenario",
-                    duration=MAX_DURATION, world=world,
-                    driver=DriverSettings(set_speed=ego_spec.speed),
-                    criteria=criteria if criteria is not None else DEFAULT_CRITERIA,
+                    duration=side.duration, world=world,
+                    driver=DriverSettings(set_speed=ego_spec.speed), criteria=side.criteria,
                     story=program)
 
 
