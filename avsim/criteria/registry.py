@@ -108,5 +108,5 @@ def build_criteria(settings: CriteriaSettings, run: RunInputs) -> CriteriaSet:
         built = list(d.build(setting, run))
         items += built
         if not all(c.idle for c in built):
-            needs |= d.needs
+            needs |= d.needs | (d.needs_if_set if setting is not None else frozenset())
     return CriteriaSet(items, frozenset(needs))

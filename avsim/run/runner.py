@@ -193,6 +193,7 @@ class Runner:
         self.criteria = build_criteria(scenario.criteria, RunInputs(
             road=w.road, car=self.car, rate=CRITERIA_RATE.hz, signals=w.signals,
             set_speed=scenario.driver.set_speed, bodies=names,
+            actor_bodies={b: a.id for b, a in zip(w.actors.bodies, spec.actors, strict=True)},
             lane_change_max=getattr(lane_change, "max_duration", MAX_LANE_CHANGE),
             story=tuple(e.label for e in self.story.entries if not e.optional)))
         self.completes = next((c for c in self.criteria.items if isinstance(c, Completes)),
