@@ -82,7 +82,8 @@ def _no_collision(setting: str | None, run: RunInputs) -> list[Criterion]:
 NO_COLLISION: Declaration[str | None] = Declaration(
     build=_no_collision,
     needs=frozenset({Need.BODIES, Need.ACTOR_BODIES}),
-    needs_if_set=frozenset({Need.MAP, Need.CAR, Need.ACTORS}), always=True, key="unavoidable", setting=Literal["r157"],
+    needs_if_set=frozenset({Need.MAP, Need.CAR, Need.ACTORS}), always=True,
+    key="unavoidable", setting=Literal["r157"],
     doc="`r157`: a collision with a vehicle cutting in where UN R157 5.2.5.2 does not "
     "require the ALKS to avoid it is reported, not failed. Default: every collision fails.",
     example=R157)
