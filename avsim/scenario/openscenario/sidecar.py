@@ -1,7 +1,8 @@
 """What avsim adds to an OpenSCENARIO file, which carries no pass/fail criteria: a sidecar
 file of the YAML format's keys.
 
-The sidecar is `NAME.criteria.yaml` beside `NAME.xosc`, or the file `--criteria` names. It
+The sidecar is `NAME.criteria.yaml` beside `NAME.xosc`, or the file `--criteria` names, or a
+bundled set by its name (`--criteria r157`: `sets/r157.criteria.yaml`, UN R157's). It
 may set `criteria` (the YAML format's `criteria:` section, the same keys), `seed`,
 `sensors` and `duration` (the time limit [s] when the StopTrigger does not fire). Left out,
 the defaults apply: the criteria that always apply, with route completion off (the
@@ -58,9 +59,21 @@ class Sidecar:
     file: Path | None  # the sidecar read, None: the defaults
 
 
+SETS = Path(__file__).with_name("sets")  # the bundled criteria sets (`r157`)
+
+
+def bundled_sets() -> tuple[str, ...]:
+    """The names of the bundled criteria sets (`--criteria NAME`)."""
+    return tuple(sorted(p.name.removesuffix(SUFFIX) for p in SETS.glob("*" + SUFFIX)))
+
+
 def sidecar_path(xosc: Path, given: Path | None) -> Path | None:
-    """The sidecar of `xosc`: `given`, else `NAME.criteria.yaml` beside it if it exists."""
+    """The sidecar of `xosc`: `given` (a file, or a bundled set's name), else
+    `NAME.criteria.yaml` beside it if it exists."""
     if given is not None:
+        named = SETS / f"{given}{SUFFIX}"
+        if given.suffix == "" and len(given.parts) == 1 and named.exists():
+            return named
         return given
     beside = xosc.with_name(xosc.stem + SUFFIX)
     return beside if beside.exists() else None
