@@ -114,6 +114,7 @@ class NpcMotion:
         self._lateral_cmd: LateralCommand | None = None
         self._path_cmd: PathCommand | None = None
         self._path_index = 0  # the vertex an untimed path heads for
+        self._path_speed = 0.0  # [m/s] the speed an untimed path is followed at
         self.finished: list[str] = []  # tags of commands that reached their goal, in order
 
     # -- triggers --------------------------------------------------------------------------
@@ -155,6 +156,7 @@ class NpcMotion:
         if isinstance(cmd, PathCommand):
             self._speed_cmd = self._lateral_cmd = None
             self._path_cmd, self._path_index = cmd, 0
+            self._path_speed = self.ground_speed
         elif isinstance(cmd, LateralCommand):
             self._path_cmd, self._lateral_cmd = None, cmd
         else:
@@ -181,10 +183,13 @@ class NpcMotion:
         if self._path_cmd is not None:
             cmd = self._path_cmd
             along, across, done, self._path_index = cmd.velocity(
-                t, self.s, self.offset, self.speed, dt, self._path_index)
+                t, self.s, self.offset, self._path_speed, dt, self._path_index)
             self.speed, self.lateral_speed = along * self.direction, across
-            if done:
+            if done:  # then on along the route at its last segment's speed along it
                 self._path_cmd = None
+                self._planned = self._target_speed = (
+                    cmd.along_speed_at_end(self._path_speed) * self.direction)
+                self._speed_action = None
                 self.finished.append(cmd.tag)
             return True
         if self._speed_cmd is None and self._lateral_cmd is None:

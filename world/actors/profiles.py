@@ -35,6 +35,8 @@ class Shape(enum.Enum):
     CUBIC = "cubic"
 
 
+SPAN_TOL = 1e-9  # [s] or [m] a transition this close to its span's end is done (sums of
+#   steps fall short of it by rounding)
 PEAK_SLOPE = {Shape.STEP: math.inf, Shape.LINEAR: 1.0, Shape.SINUSOIDAL: 0.5 * math.pi,
               Shape.CUBIC: 1.5}  # [-] the largest d(fraction)/du of each shape
 
@@ -63,7 +65,7 @@ class Transition:
 
     def at(self, x: float) -> tuple[float, float, bool]:
         """(value, d value / dx, done) at `x` [s] or [m] into the transition."""
-        if self.span <= 0.0 or self.shape is Shape.STEP or x >= self.span:
+        if self.span <= 0.0 or self.shape is Shape.STEP or x >= self.span - SPAN_TOL:
             return self.target, 0.0, True
         f, slope = fraction(self.shape, x / self.span)
         delta = self.target - self.start
@@ -130,6 +132,16 @@ class PathCommand:
     s: tuple[float, ...]  # [m]
     offset: tuple[float, ...]  # [m]
     times: tuple[float, ...] | None  # [s] simulation time at each vertex, increasing
+
+    def along_speed_at_end(self, speed: float) -> float:
+        """[m/s] the speed along the route of the path's last segment (timed: its own;
+        untimed: `speed` [m/s] along it): what the actor goes on at once the path ends."""
+        ds = self.s[-1] - self.s[-2] if len(self.s) > 1 else 0.0
+        if self.times is not None and len(self.times) > 1:
+            return ds / max(self.times[-1] - self.times[-2], 1e-9)
+        do = self.offset[-1] - self.offset[-2] if len(self.s) > 1 else 0.0
+        length = math.hypot(ds, do)
+        return speed * ds / length if length > 0.0 else 0.0
 
     def velocity(self, t: float, s: float, offset: float, speed: float, dt: float,
                  index: int) -> tuple[float, float, bool, int]:
