@@ -199,7 +199,8 @@ class LinePaint:
 
     right_edge: LineMark  # lane 0's right edge (the shoulder boundary)
     lane_lines: tuple[LineMark, ...]  # between ego lanes, right to left (lanes - 1 of them)
-    left_edge: LineMark  # the ego lanes' left edge
+    left_edge: LineMark  # the ego lanes' left edge (the centre line with oncoming lanes)
+    oncoming: tuple[LineMark, ...] = ()  # each oncoming lane's outer edge, from the centre
 
 
 @dataclass(frozen=True, slots=True)

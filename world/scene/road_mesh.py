@@ -123,8 +123,8 @@ def file_markings(section: CrossSection, paint: LinePaint) -> list[Marking]:
     right to left: each centred on its lane boundary, an edge line kept `EDGE_LINE_INSET`
     plus half its width from a paved edge; unpainted boundaries (`MarkKind.NONE`) left out."""
     w, shoulder, width = section.lane_width, section.shoulder, section.paved_width
-    bounds = [shoulder + i * w for i in range(section.lanes + 1)]
-    marks = [paint.right_edge, *paint.lane_lines, paint.left_edge]
+    bounds = [shoulder + i * w for i in range(section.lanes + 1 + len(paint.oncoming))]
+    marks = [paint.right_edge, *paint.lane_lines, paint.left_edge, *paint.oncoming]
     lines = []
     for centre, mark in zip(bounds, marks, strict=True):
         if mark.kind is MarkKind.NONE:

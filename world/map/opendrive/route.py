@@ -202,7 +202,8 @@ def _layout(odr: OpenDrive, section: LaneSection) -> Layout:
     marks = [_mark(odr, lane) for lane in reversed(drive)]  # outermost first
     inside = right[first - 1] if first > 0 else section.center
     paint = LinePaint(right_edge=marks[0], lane_lines=tuple(marks[1:]),
-                      left_edge=_mark(odr, inside))
+                      left_edge=_mark(odr, inside),
+                      oncoming=tuple(_mark(odr, lane) for lane in oncoming))
     speeds = {lane.speed for lane in drive}
     speed = speeds.pop() if len(speeds) == 1 else None
     return Layout(tuple(lane.id for lane in reversed(drive)),
