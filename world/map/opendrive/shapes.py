@@ -127,6 +127,8 @@ class PolyCurve(LocalCurve):
         elif self.cum[-1] > 0:
             self.scale = self.cum[-1] / length if length > 0 else 1.0
         self.p_end = p_end
+        self.h0 = float(np.arctan2(self.dv[0], self.du[0]))  # [rad] the start tangent's
+        self.c0, self.s0 = np.cos(self.h0), np.sin(self.h0)
 
     def _speed(self, p: FloatArray) -> FloatArray:
         du = np.polynomial.polynomial.polyval(p, self.du)
@@ -158,7 +160,9 @@ class PolyCurve(LocalCurve):
         p = self.param(ds)
         pv = np.polynomial.polynomial.polyval
         u, v = pv(p, self.cu), pv(p, self.cv)
-        h = np.arctan2(pv(p, self.dv), pv(p, self.du))
+        du, dv = pv(p, self.du), pv(p, self.dv)
+        # relative to the start tangent: continuous unless the curve turns half a turn
+        h = self.h0 + np.arctan2(dv * self.c0 - du * self.s0, du * self.c0 + dv * self.s0)
         return np.asarray(u, dtype=float), np.asarray(v, dtype=float), np.asarray(h, dtype=float)
 
     def curvature(self, ds: FloatArray) -> FloatArray:

@@ -77,3 +77,17 @@ def test_curved_records_split_and_mean_curvature() -> None:
         (Geometry(0, 0, 0, 0, 50.0, ParamPoly3(0, 50, 0, 0, 0, 0, 0, 0, "normalized")),)
     )
     assert len(arc_spline(straight)) == 1
+
+
+def test_a_gap_between_records_is_not_split_into_dust() -> None:
+    gap = 5e-3  # [m] the second record starts this far off the first one's end
+    x1, y1 = 100 * np.sinc(0.0), 0.0
+    pv = PlanView(
+        (
+            Geometry(0.0, 0.0, 0.0, 0.0, 100.0, Spiral(0.0, 0.0)),
+            Geometry(100.0, x1, y1 + gap, 0.0, 50.0, Spiral(0.0, 0.01)),
+        )
+    )
+    pieces = arc_spline(pv, 1e-3)
+    assert len(pieces) < 40
+    assert pieces[0].length == 100.0

@@ -206,3 +206,15 @@ def test_project_vectorised_shape() -> None:
     x, y, _ = MIXED.pose(s)
     s2, t2 = MIXED.project(np.stack([x, y], axis=-1))
     assert s2.shape == (3, 4) and np.allclose(s2, s, atol=1e-6) and np.allclose(t2, 0, atol=1e-6)
+
+
+def test_param_poly3_turning_past_a_quarter_keeps_its_heading_continuous() -> None:
+    r = 10.0
+    k = 4 * r / 3
+    p0, p1, p2, p3 = (np.array(p) for p in ([0, 0], [k, 0], [k, 2 * r - 0.2 * k], [0, 2 * r]))
+    b, c, d = 3 * (p1 - p0), 3 * (p0 - 2 * p1 + p2), p3 - p0 + 3 * (p1 - p2)
+    shape = ParamPoly3(0, b[0], c[0], d[0], 0, b[1], c[1], d[1], "normalized")
+    pv = one(shape, 30.0, hdg=2.5)  # starts near +pi: the wrapped heading crosses it
+    _, _, h = pv.pose_unwrapped(np.linspace(0.0, 30.0, 301))
+    assert np.max(np.abs(np.diff(h))) < 0.1
+    assert h[-1] == pytest.approx(2.5 + np.pi - np.arctan(0.2))

@@ -171,6 +171,11 @@ def variant(tmp_path: Path, old: str, new: str) -> Path:
         ('pRange="normalized"', 'pRange="p"', "pRange is not arcLength or normalized ('p')"),
         ('length="220.0', 'length="230.0', "is not the road's length 230.0"),
         ('unit="km/h"', 'unit="kn"', "unit is not m/s, km/h or mph ('kn')"),
+        (
+            '<type name="solid" width="0.15"',
+            '<type name="solid" width="0.3"',
+            "(roadMark type width",
+        ),
         ("<OpenDRIVE>", "<!DOCTYPE x [<!ENTITY a 'b'>]><OpenDRIVE>", "DOCTYPE at line 3 refused"),
     ],
 )
@@ -186,3 +191,9 @@ def test_file_size_limit(tmp_path: Path) -> None:
     with path.open("wb") as f:
         f.truncate(MAX_FILE_BYTES + 1)
     assert f"over the {MAX_FILE_BYTES} limit" in error_of(path)
+
+
+def test_a_newline_in_an_id_keeps_the_message_on_one_line(tmp_path: Path) -> None:
+    path = variant(tmp_path, 'id="1" junction', 'id="a&#10;b" junction')
+    path.write_text(path.read_text().replace('length="10.0">', 'length="ten">', 1))
+    assert "/road[id=a b]/planView/geometry[1]: length is not a number" in error_of(path)
