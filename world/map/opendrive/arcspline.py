@@ -4,8 +4,9 @@ simulator's HD map is made of).
 Each piece starts at an exact sample of the line (position and heading) and turns at its
 mean curvature (its exact heading change over its length), so the chain's headings at the
 piece joints are exact. Lines and arcs are one piece each; spirals, poly3 and paramPoly3
-records are halved until the piece's largest position deviation from the exact line
-(checked at `CHECKS` stations per piece) is below `tolerance`.
+records are halved until the piece's largest position deviation from the exact record
+(checked at `CHECKS` stations per piece) is below `tolerance` (each record is approximated
+on its own, so a gap between records in the file is not split into ever smaller pieces).
 """
 
 from __future__ import annotations
@@ -53,7 +54,8 @@ def piece_deviation(plan_view: PlanView, piece: ArcPiece, checks: int = CHECKS) 
 
 def _piece(plan_view: PlanView, s0: float, s1: float) -> ArcPiece:
     x, y, h = plan_view.pose_unwrapped(np.array([s0, s1]))
-    k = (h[1] - h[0]) / (s1 - s0) if s1 > s0 else 0.0
+    turn = (h[1] - h[0] + np.pi) % (2 * np.pi) - np.pi  # a piece turns less than half a turn
+    k = turn / (s1 - s0) if s1 > s0 else 0.0
     return ArcPiece(s0, s1 - s0, float(k), float(x[0]), float(y[0]), float(h[0]))
 
 
@@ -68,11 +70,12 @@ def arc_spline(plan_view: PlanView, tolerance: float = 1e-3) -> list[ArcPiece]:
             k = 0.0 if isinstance(g.shape, Line) else g.shape.curvature
             pieces.append(ArcPiece(s0, g.length, k, g.x, g.y, g.hdg))
             continue
+        record = PlanView((g,))  # its end evaluated on itself, whatever the next record's start
         stack = [(s0, s1)]
         while stack:
             a, b = stack.pop()
-            piece = _piece(plan_view, a, b)
-            if b - a > MIN_PIECE and piece_deviation(plan_view, piece) > SAFETY * tolerance:
+            piece = _piece(record, a, b)
+            if b - a > MIN_PIECE and piece_deviation(record, piece) > SAFETY * tolerance:
                 mid = 0.5 * (a + b)
                 stack.extend([(mid, b), (a, mid)])  # the first half is popped first
             else:

@@ -18,4 +18,5 @@ class OpenDriveError(ValueError):
         self.line = line  # 1-based line of the element's start tag, None for the whole file
         self.path = path  # the element path, e.g. /OpenDRIVE/road[id=0]/planView/geometry[3]
         where = self.file if line is None else f"{self.file}:{line}"
-        super().__init__(f"{where}: {path}: {self.problem}" if path else f"{where}: {self.problem}")
+        message = f"{where}: {path}: {self.problem}" if path else f"{where}: {self.problem}"
+        super().__init__(" ".join(message.splitlines()))  # one line, whatever an id holds

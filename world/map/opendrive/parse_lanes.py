@@ -48,6 +48,8 @@ def _mark_type(node: Node, mark: RoadMark) -> None:
     """Accept a roadMark's <type> only if it says what the roadMark's attributes say."""
     if node.get("name") != mark.type:
         raise node.unsupported("roadMark type differing from its type attribute")
+    if abs(node.num("width", mark.width) - mark.width) > 1e-9:
+        raise node.unsupported("roadMark type width differing from its roadMark")
     for line in node.only("line")["line"]:
         line.only()
         if abs(line.num("width", mark.width) - mark.width) > 1e-9:
