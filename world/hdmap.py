@@ -391,8 +391,16 @@ class ReferenceLine:
         t_clip = np.clip(t, self.t_lo, self.t_hi)
         # beyond a piece's end: the distance along at the point's own radius
         excess = (t - t_clip) * np.abs(1.0 - self.k * d)
-        best = np.argmin(excess * excess + d * d, axis=1)
+        cost = excess * excess + d * d
         rows = np.arange(xy.shape[0])
+        # a point lies beyond the route's start (end) only if its nearest point on the route
+        # is the start (end): on a route that comes back near itself (a loop nearly closed)
+        # the straight extensions must not claim points beside the route
+        inner = np.argmin(cost[:, 1:-1], axis=1) + 1
+        s_inner = self.s0[inner] + t_clip[rows, inner]
+        cost[:, 0] = np.where(s_inner <= 0.0, cost[:, 0], np.inf)
+        cost[:, -1] = np.where(s_inner >= self.length, cost[:, -1], np.inf)
+        best = np.argmin(cost, axis=1)
         s = self.s0[best] + t_clip[rows, best]
         return s, d[rows, best]
 
