@@ -101,6 +101,8 @@ def load_sidecar(path: Path | None, overrides: Mapping[str, object]) -> Sidecar:
     shown = str(path) if path is not None else "(overrides)"
     try:
         raw: dict[str, Any] = read_raw(path) if path is not None else {}
+        for section in ("criteria", "sensors"):  # overrides may set keys inside them
+            raw.setdefault(section, {})
         raw = apply_overrides(raw, overrides)
         model = validate_as(raw, overrides, SidecarModel)
     except LocatedError as problem:
