@@ -36,6 +36,7 @@ MAX_ROADS = 100_000
 MAX_GEOMETRIES = 100_000  # planView records in the whole file
 REV_MINORS = range(4, 9)  # OpenDRIVE 1.4 .. 1.8
 LENGTH_TOLERANCE = 1e-2  # [m] the road length vs its planView's, at least
+MAX_TURN = 1e4  # [rad] the most an arc or spiral record may turn (a bound on the work)
 FLAT_PROFILES = {
     "elevation": "elevation",
     "superelevation": "superelevation",
@@ -147,9 +148,15 @@ def _geometry(node: Node) -> Geometry:
     length = node.num("length")
     if length < 0:
         raise node.error(f"length is negative ({length})")
-    return Geometry(
-        node.num("s"), node.num("x"), node.num("y"), node.num("hdg"), length, _shape(shapes[0])
-    )
+    shape = _shape(shapes[0])
+    curvature = 0.0
+    if isinstance(shape, Arc):
+        curvature = abs(shape.curvature)
+    elif isinstance(shape, Spiral):
+        curvature = max(abs(shape.curv_start), abs(shape.curv_end))
+    if curvature * length > MAX_TURN:
+        raise shapes[0].error(f"turns more than {MAX_TURN:g} rad")
+    return Geometry(node.num("s"), node.num("x"), node.num("y"), node.num("hdg"), length, shape)
 
 
 def _plan_view(node: Node, road_length: float) -> PlanView:
