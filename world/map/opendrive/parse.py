@@ -29,6 +29,7 @@ from world.map.opendrive.model import (
     Spiral,
 )
 from world.map.opendrive.parse_lanes import lanes, speed
+from world.map.opendrive.shapes import PolyCurve, local_curve
 from world.map.opendrive.xmltree import Node, parse_xml
 
 MAX_FILE_BYTES = 50 * 1024 * 1024  # [byte]
@@ -36,6 +37,7 @@ MAX_ROADS = 100_000
 MAX_GEOMETRIES = 100_000  # planView records in the whole file
 REV_MINORS = range(4, 9)  # OpenDRIVE 1.4 .. 1.8
 LENGTH_TOLERANCE = 1e-2  # [m] the road length vs its planView's, at least
+PARAM_LENGTH_TOLERANCE = 1e-2  # [1] paramPoly3 arc length vs its record's (esmini scales)
 MAX_TURN = 1e4  # [rad] the most an arc or spiral record may turn (a bound on the work)
 FLAT_PROFILES = {
     "elevation": "elevation",
@@ -156,7 +158,13 @@ def _geometry(node: Node) -> Geometry:
         curvature = max(abs(shape.curv_start), abs(shape.curv_end))
     if curvature * length > MAX_TURN:
         raise shapes[0].error(f"turns more than {MAX_TURN:g} rad")
-    return Geometry(node.num("s"), node.num("x"), node.num("y"), node.num("hdg"), length, shape)
+    geom = Geometry(node.num("s"), node.num("x"), node.num("y"), node.num("hdg"), length, shape)
+    curve = local_curve(geom)
+    if isinstance(curve, PolyCurve) and abs(curve.scale - 1.0) > PARAM_LENGTH_TOLERANCE:
+        raise shapes[0].error(
+            f"its arc length {curve.cum[-1]:.6g} m is not the record's length {length:.6g} m"
+        )
+    return geom
 
 
 def _plan_view(node: Node, road_length: float) -> PlanView:
