@@ -1,6 +1,8 @@
 """The OpenDRIVE map kind: an ASAM OpenDRIVE (.xodr, 1.4-1.8) reader with exact
 reference-line geometry (`load_opendrive`, `PlanView`, `arc_spline`, lane borders)."""
 
+from __future__ import annotations
+
 from world.map.opendrive.arcspline import ArcPiece, arc_spline, piece_deviation
 from world.map.opendrive.errors import OpenDriveError
 from world.map.opendrive.geometry import PlanView

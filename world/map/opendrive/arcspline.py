@@ -22,6 +22,7 @@ from world.map.opendrive.shapes import FloatArray
 CHECKS = 65  # stations per piece where its deviation is checked
 MIN_PIECE = 1e-3  # [m] pieces are not split below this length
 SAFETY = 0.8  # the split criterion is SAFETY * tolerance (the deviation between checks)
+MAX_PIECES = 100_000  # per record: a bound on the work for pathological curves
 
 
 class ArcPiece(NamedTuple):
@@ -60,7 +61,8 @@ def _piece(plan_view: PlanView, s0: float, s1: float) -> ArcPiece:
 
 
 def arc_spline(plan_view: PlanView, tolerance: float = 1e-3) -> list[ArcPiece]:
-    """The chain of pieces approximating `plan_view` within `tolerance` [m] (module doc)."""
+    """The chain of pieces approximating `plan_view` within `tolerance` [m] (module doc);
+    ValueError if a record needs more than `MAX_PIECES` pieces."""
     pieces: list[ArcPiece] = []
     for g in plan_view.geometries:
         if g.length <= 0:
@@ -72,6 +74,7 @@ def arc_spline(plan_view: PlanView, tolerance: float = 1e-3) -> list[ArcPiece]:
             continue
         record = PlanView((g,))  # its end evaluated on itself, whatever the next record's start
         stack = [(s0, s1)]
+        count = 0
         while stack:
             a, b = stack.pop()
             piece = _piece(record, a, b)
@@ -80,4 +83,7 @@ def arc_spline(plan_view: PlanView, tolerance: float = 1e-3) -> list[ArcPiece]:
                 stack.extend([(mid, b), (a, mid)])  # the first half is popped first
             else:
                 pieces.append(piece)
+                count += 1
+                if count > MAX_PIECES:
+                    raise ValueError(f"the record at s={g.s} needs over {MAX_PIECES} pieces")
     return pieces

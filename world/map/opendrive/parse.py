@@ -5,7 +5,10 @@ types and speeds, planView records (line, arc, spiral, poly3, paramPoly3), lanes
 `parse_lanes`), flat elevation and lateral profiles (every coefficient 0), empty objects,
 signals and surface; userData anywhere is skipped. Everything else - junctions, objects,
 signals, elevation, superelevation, any other element - is refused as "not supported yet
-(...)" naming the element, as are bad numbers and files beyond the size limits.
+(...)" naming the element, as are bad numbers and files beyond the size limits. Checked on
+the geometry: records ascend in s and add up to the road's length (within 1 cm), a
+paramPoly3's arc length is within 1 % of its record's length, no number is beyond 1e9, no
+arc or spiral record turns more than 1e4 rad.
 """
 
 from __future__ import annotations
@@ -29,6 +32,7 @@ from world.map.opendrive.model import (
     Spiral,
 )
 from world.map.opendrive.parse_lanes import lanes, speed
+from world.map.opendrive.shapes import PolyCurve, local_curve
 from world.map.opendrive.xmltree import Node, parse_xml
 
 MAX_FILE_BYTES = 50 * 1024 * 1024  # [byte]
@@ -36,6 +40,8 @@ MAX_ROADS = 100_000
 MAX_GEOMETRIES = 100_000  # planView records in the whole file
 REV_MINORS = range(4, 9)  # OpenDRIVE 1.4 .. 1.8
 LENGTH_TOLERANCE = 1e-2  # [m] the road length vs its planView's, at least
+PARAM_LENGTH_TOLERANCE = 1e-2  # [1] paramPoly3 arc length vs its record's (esmini scales)
+MAX_TURN = 1e4  # [rad] the most an arc or spiral record may turn (a bound on the work)
 FLAT_PROFILES = {
     "elevation": "elevation",
     "superelevation": "superelevation",
@@ -147,9 +153,21 @@ def _geometry(node: Node) -> Geometry:
     length = node.num("length")
     if length < 0:
         raise node.error(f"length is negative ({length})")
-    return Geometry(
-        node.num("s"), node.num("x"), node.num("y"), node.num("hdg"), length, _shape(shapes[0])
-    )
+    shape = _shape(shapes[0])
+    curvature = 0.0
+    if isinstance(shape, Arc):
+        curvature = abs(shape.curvature)
+    elif isinstance(shape, Spiral):
+        curvature = max(abs(shape.curv_start), abs(shape.curv_end))
+    if curvature * length > MAX_TURN:
+        raise shapes[0].error(f"turns more than {MAX_TURN:g} rad")
+    geom = Geometry(node.num("s"), node.num("x"), node.num("y"), node.num("hdg"), length, shape)
+    curve = local_curve(geom)
+    if isinstance(curve, PolyCurve) and abs(curve.scale - 1.0) > PARAM_LENGTH_TOLERANCE:
+        raise shapes[0].error(
+            f"its arc length {curve.cum[-1]:.6g} m is not the record's length {length:.6g} m"
+        )
+    return geom
 
 
 def _plan_view(node: Node, road_length: float) -> PlanView:

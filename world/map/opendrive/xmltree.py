@@ -16,6 +16,7 @@ from xml.parsers import expat
 from world.map.opendrive.errors import OpenDriveError
 
 MAX_ELEMENTS = 5_000_000  # elements in one file
+MAX_MAGNITUDE = 1e9  # no number in a file is larger (coordinates [m], lengths, coefficients)
 IGNORED = frozenset({"userData"})  # children skipped wherever they appear
 NUMBER = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?")
 # how an unsupported element is named in "not supported yet (...)", where not by its tag
@@ -73,6 +74,8 @@ class Node:
         value = float(raw)
         if not math.isfinite(value):
             raise self.error(f"{name} is not a finite number ({raw!r})")
+        if abs(value) > MAX_MAGNITUDE:
+            raise self.error(f"{name} is beyond the limit of {MAX_MAGNITUDE:g} ({raw!r})")
         return value
 
     def integer(self, name: str, default: int | None = None) -> int:

@@ -165,6 +165,13 @@ def variant(tmp_path: Path, old: str, new: str) -> Path:
         ('<arc curvature="0.02"/>', "<arc/>", "/geometry[3]/arc: missing attribute curvature"),
         ('curvEnd="0.02"', 'curvEnd="nan"', "curvEnd is not a number ('nan')"),
         ('curvEnd="0.02"', 'curvEnd="1e999"', "curvEnd is not a finite number ('1e999')"),
+        (
+            'bU="1" cU="0"',
+            'bU="1" cU="0.1"',
+            "paramPoly3: its arc length 119.985 m is not the record",
+        ),
+        ('y="0.0"', 'y="-2e9"', "y is beyond the limit of 1e+09 ('-2e9')"),
+        ('<arc curvature="0.02"/>', '<arc curvature="2e3"/>', "/arc: turns more than 10000 rad"),
         ('id="-2"', 'id="-3"', "/right: lane ids are [-3, -1], not [-2, -1]"),
         ('id="-2"', 'id="two"', "id is not an integer ('two')"),
         ('<type name="solid"', '<type name="broken"', "(roadMark type differing from its"),
