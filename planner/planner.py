@@ -300,7 +300,7 @@ class Planner:
         if view is not None and camera:
             centre = view.estimate.centre_y
         return select_lead(tracks, centre, ego.heading, self.params.lead,
-                           self.params.vehicle.front_overhang, ego.speed)
+                           self.params.vehicle.front_overhang)
 
     def near_junction(self, station: float) -> bool:
         """Whether the car's centre is near or in a town junction, where the map's path is
