@@ -183,13 +183,20 @@ class MarkKind(enum.Enum):
     NONE = "none"  # no paint
 
 
+class PaintColour(enum.Enum):
+    """A lane line's paint."""
+
+    WHITE = "white"
+    YELLOW = "yellow"
+
+
 @dataclass(frozen=True, slots=True)
 class LineMark:
     """One painted lane line."""
 
     kind: MarkKind
     width: float  # [m] across
-    yellow: bool = False  # white otherwise
+    colour: PaintColour = PaintColour.WHITE
 
 
 @dataclass(frozen=True, slots=True)

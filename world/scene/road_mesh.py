@@ -26,7 +26,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 from numpy.typing import NDArray
 
-from world.hdmap import CrossSection, LineMark, LinePaint, MarkKind, RoadMap
+from world.hdmap import CrossSection, LineMark, LinePaint, MarkKind, PaintColour, RoadMap
 
 FloatArray = NDArray[np.float64]
 ImageRGB = NDArray[np.uint8]
@@ -136,7 +136,7 @@ def file_markings(section: CrossSection, paint: LinePaint) -> list[Marking]:
 
 
 def _rgb(mark: LineMark) -> tuple[float, float, float]:
-    return YELLOW_RGB if mark.yellow else WHITE_RGB
+    return YELLOW_RGB if mark.colour is PaintColour.YELLOW else WHITE_RGB
 
 
 def _coverage(lo: float, hi: float, n: int, extent: float) -> FloatArray:

@@ -36,7 +36,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from world.frames import MPS_PER_KPH
-from world.hdmap import LineMark, LinePaint, MarkKind, Zone
+from world.hdmap import LineMark, LinePaint, MarkKind, PaintColour, Zone
 from world.map.opendrive.arcspline import ArcPiece, arc_spline, piece_points
 from world.map.opendrive.errors import OpenDriveError
 from world.map.opendrive.model import LaneSection, OdrLane, OpenDrive, Road, RoadMark
@@ -222,4 +222,5 @@ def _mark(odr: OpenDrive, lane: OdrLane) -> LineMark:
         raise _refuse(odr, f"lane {lane.id}: road mark type {mark.type!r}")
     if mark.color not in WHITE and mark.color != "yellow":
         raise _refuse(odr, f"lane {lane.id}: road mark colour {mark.color!r}")
-    return LineMark(kind, mark.width, yellow=mark.color == "yellow")
+    colour = PaintColour.YELLOW if mark.color == "yellow" else PaintColour.WHITE
+    return LineMark(kind, mark.width, colour)

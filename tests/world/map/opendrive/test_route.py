@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from world.hdmap import MarkKind, RoadMap
+from world.hdmap import LineMark, MarkKind, PaintColour, RoadMap
 from world.map.opendrive import OpenDriveError, lane_centre_t, load_opendrive
 from world.map.opendrive.route import OdrRoute, build_route
 from world.map.road import build_road_map
@@ -83,7 +83,7 @@ def test_a_two_way_road_paints_its_centre_line_and_oncoming_lanes() -> None:
     section = road_map.sections[0]
     assert (section.lanes, section.oncoming_lanes) == (2, 2)
     assert section.paint is not None
-    assert section.paint.left_edge.yellow and section.paint.left_edge.kind is MarkKind.SOLID
+    assert section.paint.left_edge == LineMark(MarkKind.SOLID, 0.12, PaintColour.YELLOW)
     kinds = [(m.dashed, m.rgb[2] < 100) for m in markings(section)]  # yellow: little blue
     assert kinds == [(False, False), (True, False), (False, True), (True, False),
                      (False, False)]
