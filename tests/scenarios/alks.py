@@ -1,6 +1,7 @@
 """The vendored ASAM/BMW ALKS (UN R157) scenario set as the scenario tests run it: each file
 with its default parameters until its StopTrigger, under the `r157` criteria set, with the
-`fast` sensor profile (camera and LiDAR; the runs are long: two of them are 300 s)."""
+`default` sensor profile: the `fast` one's LiDAR (half the columns) first sees the standing
+pedestrian of 4.2.1 too late to stop for it from 60 km/h."""
 
 from __future__ import annotations
 
@@ -16,7 +17,7 @@ from world.sensors.setup import Profile
 
 ALKS = (Path(__file__).parents[1] / "data" / "alks" / "logical_scenarios"
         / "concrete_scenarios")
-PROFILE = Profile.FAST
+PROFILE = Profile.DEFAULT
 LANE_WIDTH = 3.5  # [m] the ALKS road's
 EGO_LANE = 1  # lane -4, the middle of the three: route lane 1, centre 3.5 m left of lane 0's
 KPH = 1.0 / 3.6

