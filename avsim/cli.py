@@ -310,6 +310,34 @@ def _sweep_report(outcomes: Sequence[RunOutcome], out: Path, swept: list[str],
                       highlight=False)
 
 
+@main.command("convert")
+@click.argument("file", type=click.Path(path_type=Path))
+@click.option("--criteria", "criteria", type=click.Path(path_type=Path), default=None,
+              help="The file's criteria (default: NAME.criteria.yaml beside it).")
+def convert_command(file: Path, criteria: Path | None) -> None:
+    """Print the avsim/1 YAML of an OpenSCENARIO FILE where it fits that format; what does
+    not fit is listed at its top (and counted on stderr)."""
+    import yaml
+
+    from avsim.scenario.openscenario.to_yaml import convert_xosc
+
+    if file.suffix != ".xosc":
+        _bad_input(f"{file}: (file): convert takes an OpenSCENARIO file (.xosc)")
+    try:
+        conversion = convert_xosc(file, criteria)
+    except ScenarioError as exc:
+        _bad_input(str(exc))
+    head = [f"# avsim/1, converted from {file}"]
+    if conversion.misfits:
+        head.append("# does not fit the format (approximated or left out):")
+        head += [f"#   - {m}" for m in conversion.misfits]
+    click.echo("\n".join(head))
+    click.echo(yaml.safe_dump(conversion.document, sort_keys=False), nl=False)
+    if conversion.misfits:
+        click.echo(f"avsim: {len(conversion.misfits)} thing(s) do not fit the avsim/1 format: "
+                   "listed at the top", err=True)
+
+
 @main.command()
 @click.argument("recording", type=click.Path(path_type=Path))
 @click.option("--at", "at", type=float, required=True, help="[s] simulated time.")

@@ -26,6 +26,7 @@ import numpy as np
 
 from avsim.criteria.base import TruthSample
 from world.hdmap import RoadMap
+from world.spec import ActorType
 from world.truth import ego_lane_edges
 
 R157_DECEL = 6.0  # [m/s^2] 5.2.5.2 (c): the deceleration in the TTC bound
@@ -33,6 +34,7 @@ R157_REACTION = 0.35  # [s] 5.2.5.2 (c)
 R157_VISIBLE = 0.72  # [s] 5.2.5.2 (b): the lateral movement visible at least this long
 INTRUSION = 0.225  # [m] into the ego's lane past its edge (module doc)
 MOVING_LATERALLY = 0.1  # [m/s] a lateral speed towards the lane that counts as moving
+VEHICLES = (ActorType.CAR, ActorType.TRUCK)
 
 
 @dataclass(frozen=True, slots=True)
@@ -59,7 +61,8 @@ class CutIn:
 
 
 class CutInWatch:
-    """Every lane intrusion of a vehicle into the ego's lane ahead of it (module doc)."""
+    """Every lane intrusion of a vehicle (a car or truck: not a pedestrian or an obstacle)
+    into the ego's lane ahead of it (module doc)."""
 
     def __init__(self, road: RoadMap, ego_length: float) -> None:
         self.road = road
@@ -80,6 +83,8 @@ class CutInWatch:
         along = (poses.half_sizes[:, 0] * np.abs(np.cos(rel))
                  + poses.half_sizes[:, 1] * np.abs(np.sin(rel)))
         for i, actor in enumerate(poses.ids):
+            if poses.kinds[i] not in VEHICLES:
+                continue  # 5.2.5.2 is about cutting-in vehicles
             offset = float(poses.offsets[i])
             centre = 0.5 * (lo + hi)
             towards = self._lateral_towards(actor, sample.t, offset, centre)

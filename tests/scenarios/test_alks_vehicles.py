@@ -85,8 +85,13 @@ def test_a_cut_in_r157_calls_unavoidable_is_not_failed(runs: dict[str, RunResult
         assert "unavoidable under UN R157 5.2.5.2" in (collision.note or "")
 
 
-@pytest.mark.parametrize(("number", "entity"), [("4_6_1", "TargetBlocking"),
-                                                ("4_6_2", "SideVehicle")])
+@pytest.mark.parametrize(("number", "entity"), [
+    ("4_6_1", "TargetBlocking"),
+    pytest.param("4_6_2", "SideVehicle", marks=pytest.mark.xfail(
+        strict=True, reason="the detector has no motorbike class: the 2.2 m side of the "
+        "motorbike beside the ego is boxed as a truck's rear and grown 6.7 m away from the "
+        "sensor, its centre 2.9 m off: never matched, so never tracked (issue K)")),
+])
 def test_the_detection_range_is_reported(runs: dict[str, RunResult], number: str,
                                          entity: str) -> None:
     result = runs[number]
