@@ -31,6 +31,7 @@ if TYPE_CHECKING:
 PROFILES = ("fast", "default", "paper", "none")  # sensor profiles (`world.sensors.setup`)
 SENSING = ("auto", "inline", "process")  # where the cameras render
 EXIT_FAILED, EXIT_BAD_INPUT = 1, 2  # exit statuses (module doc)
+PARAMETER_PREFIX = "parameters."  # `--param NAME=V` is `--set parameters.NAME=V`
 PLOT_NEXT_TO_RECORDING = "\0next-to-recording"  # `--plot` given without a file name
 
 
@@ -74,22 +75,27 @@ def main() -> None:
                    "Without a value: next to the recording, <name>.png")
 @click.option("--set", "sets", multiple=True, metavar="PATH=VALUE",
               help="Set a key of the file before validation, as sweep does (one value).")
+@click.option("--param", "params", multiple=True, metavar="NAME=VALUE",
+              help="An OpenSCENARIO file's parameter (short for --set parameters.NAME=VALUE).")
+@click.option("--criteria", "criteria", type=click.Path(path_type=Path), default=None,
+              help="An OpenSCENARIO file's criteria (default: NAME.criteria.yaml beside it).")
 @click.option("--no-progress", is_flag=True, help="No progress bar.")
 def run(scenario: str, out: Path | None, json_path: Path | None, profile: str, sensing: str,
-        seed: int | None, sets: tuple[str, ...], plot: str | None, no_progress: bool) -> None:
-    """Run SCENARIO (a file or a bundled name) and judge it."""
+        seed: int | None, sets: tuple[str, ...], plot: str | None, params: tuple[str, ...],
+        criteria: Path | None, no_progress: bool) -> None:
+    """Run SCENARIO (a YAML or OpenSCENARIO file, or a bundled name) and judge it."""
     from avsim.batch.sweep import SweepError, parse_set
 
     overrides: dict[str, object] = {}
     try:
-        for text in sets:
+        for text in sets + tuple(PARAMETER_PREFIX + p for p in params):
             axis = parse_set(text)
             if len(axis.values) != 1:
                 raise SweepError(f"--set {text}: run takes one value (sweep takes several)")
             overrides[axis.path] = axis.values[0]
         if seed is not None:
             overrides["seed"] = seed
-        loaded = load_scenario(scenario, overrides)
+        loaded = load_scenario(scenario, overrides, criteria)
         check_profile(loaded, profile, scenario)
     except (ScenarioError, SweepError) as exc:
         _bad_input(str(exc))
@@ -221,15 +227,18 @@ def suite(paths: tuple[str, ...], out: Path, jobs: int | None, executor: str,
 
 @main.command()
 @click.argument("scenario")
-@click.option("--set", "sets", multiple=True, required=True, metavar="PATH=V1,V2,...",
+@click.option("--set", "sets", multiple=True, metavar="PATH=V1,V2,...",
               help="A key path and its values; several --set make a grid.")
+@click.option("--param", "params", multiple=True, metavar="NAME=V1,V2,...",
+              help="An OpenSCENARIO file's parameter and its values (checked against the "
+              "file's constraint groups); short for --set parameters.NAME=...")
 @click.option("--out", "out", type=click.Path(path_type=Path), default=None,
               help="Folder for the runs and the reports. Default: runs/sweep_<name>")
 @click.option("--metric", default="min_gap", show_default=True,
               help="The heat map's metric (a metric or a criterion of the result).")
 @batch_options
-def sweep(scenario: str, sets: tuple[str, ...], out: Path | None, metric: str,
-          jobs: int | None, executor: str, address: str | None, profile: str,
+def sweep(scenario: str, sets: tuple[str, ...], params: tuple[str, ...], out: Path | None,
+          metric: str, jobs: int | None, executor: str, address: str | None, profile: str,
           snapshots: bool) -> None:
     """Run SCENARIO over the grid of --set values, like a suite; write sweep.csv,
     sweep.md and, over two swept keys, heatmap.png of --metric."""
@@ -237,7 +246,9 @@ def sweep(scenario: str, sets: tuple[str, ...], out: Path | None, metric: str,
     from avsim.batch.sweep import SweepError, grid, parse_set
 
     try:
-        axes = [parse_set(s) for s in sets]
+        axes = [parse_set(s) for s in sets + tuple(PARAMETER_PREFIX + p for p in params)]
+        if not axes:
+            raise SweepError("give at least one --set or --param to sweep")
         runs = grid(axes)
         name = load_scenario(scenario).name
         out = out if out is not None else Path("runs") / f"sweep_{name}"
@@ -297,6 +308,34 @@ def _sweep_report(outcomes: Sequence[RunOutcome], out: Path, swept: list[str],
     else:
         console.print(f"no heat map: it needs two swept keys, {len(swept)} were swept",
                       highlight=False)
+
+
+@main.command("convert")
+@click.argument("file", type=click.Path(path_type=Path))
+@click.option("--criteria", "criteria", type=click.Path(path_type=Path), default=None,
+              help="The file's criteria (default: NAME.criteria.yaml beside it).")
+def convert_command(file: Path, criteria: Path | None) -> None:
+    """Print the avsim/1 YAML of an OpenSCENARIO FILE where it fits that format; what does
+    not fit is listed at its top (and counted on stderr)."""
+    import yaml
+
+    from avsim.scenario.openscenario.to_yaml import convert_xosc
+
+    if file.suffix != ".xosc":
+        _bad_input(f"{file}: (file): convert takes an OpenSCENARIO file (.xosc)")
+    try:
+        conversion = convert_xosc(file, criteria)
+    except ScenarioError as exc:
+        _bad_input(str(exc))
+    head = [f"# avsim/1, converted from {file}"]
+    if conversion.misfits:
+        head.append("# does not fit the format (approximated or left out):")
+        head += [f"#   - {m}" for m in conversion.misfits]
+    click.echo("\n".join(head))
+    click.echo(yaml.safe_dump(conversion.document, sort_keys=False), nl=False)
+    if conversion.misfits:
+        click.echo(f"avsim: {len(conversion.misfits)} thing(s) do not fit the avsim/1 format: "
+                   "listed at the top", err=True)
 
 
 @main.command()

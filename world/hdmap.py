@@ -175,6 +175,41 @@ class Piece:
     heading0: float  # [rad] heading at its start
 
 
+class MarkKind(enum.Enum):
+    """How a lane line is painted (OpenDRIVE's roadMark types that a camera tells apart)."""
+
+    SOLID = "solid"
+    BROKEN = "broken"
+    NONE = "none"  # no paint
+
+
+class PaintColour(enum.Enum):
+    """A lane line's paint."""
+
+    WHITE = "white"
+    YELLOW = "yellow"
+
+
+@dataclass(frozen=True, slots=True)
+class LineMark:
+    """One painted lane line."""
+
+    kind: MarkKind
+    width: float  # [m] across
+    colour: PaintColour = PaintColour.WHITE
+
+
+@dataclass(frozen=True, slots=True)
+class LinePaint:
+    """The lines of a cross-section as a map file paints them (OpenDRIVE road marks); a
+    section without one is painted by the road's own rules (`world.scene.road_mesh`)."""
+
+    right_edge: LineMark  # lane 0's right edge (the shoulder boundary)
+    lane_lines: tuple[LineMark, ...]  # between ego lanes, right to left (lanes - 1 of them)
+    left_edge: LineMark  # the ego lanes' left edge (the centre line with oncoming lanes)
+    oncoming: tuple[LineMark, ...] = ()  # each oncoming lane's outer edge, from the centre
+
+
 @dataclass(frozen=True, slots=True)
 class CrossSection:
     """The road's layout across, on one segment."""
@@ -184,6 +219,7 @@ class CrossSection:
     lane_width: float  # [m] every lane's width
     shoulder: float  # [m] paved right shoulder's width, 0 for none
     zone: Zone
+    paint: LinePaint | None = None  # the map file's lines; None: the road's own rules
 
     @property
     def right_edge(self) -> float:
@@ -362,8 +398,16 @@ class ReferenceLine:
         t_clip = np.clip(t, self.t_lo, self.t_hi)
         # beyond a piece's end: the distance along at the point's own radius
         excess = (t - t_clip) * np.abs(1.0 - self.k * d)
-        best = np.argmin(excess * excess + d * d, axis=1)
+        cost = excess * excess + d * d
         rows = np.arange(xy.shape[0])
+        # a point lies beyond the route's start (end) only if its nearest point on the route
+        # is the start (end): on a route that comes back near itself (a loop nearly closed)
+        # the straight extensions must not claim points beside the route
+        inner = np.argmin(cost[:, 1:-1], axis=1) + 1
+        s_inner = self.s0[inner] + t_clip[rows, inner]
+        cost[:, 0] = np.where(s_inner <= 0.0, cost[:, 0], np.inf)
+        cost[:, -1] = np.where(s_inner >= self.length, cost[:, -1], np.inf)
+        best = np.argmin(cost, axis=1)
         s = self.s0[best] + t_clip[rows, best]
         return s, d[rows, best]
 

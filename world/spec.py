@@ -24,6 +24,7 @@ from world.hdmap import (
     Crosswalk,
     Junction,
     LightHead,
+    LinePaint,
     Side,
     SpeedBump,
     SpeedLimitSign,
@@ -55,6 +56,10 @@ class SegmentSpec:
     zone: Zone | None = None  # scenery style; None: as the segment before (highway at start)
     exit: Side | None = None  # the route leaves the road here by an exit on this side (right
     #   only: `world.map.road`); the road goes on straight as scenery
+    start: tuple[float, float, float] | None = None  # [m, m, rad] the piece's exact start
+    #   pose (x, y, heading) where the map kind knows it (an OpenDRIVE road's arc spline);
+    #   None: laid from the end of the piece before
+    paint: LinePaint | None = None  # the map file's lane lines; None: the road's own rules
 
 
 @dataclass(frozen=True, slots=True)
@@ -224,6 +229,9 @@ class ActorSpec:
     road: RoadSpec | None = None  # in a town: the actor's own route (lane, s, offset on it)
     model: VehicleModel | None = None  # a vehicle's body (`world.actors.catalogue`); None:
     #   its type's default model (a car or truck), or no vehicle (pedestrian, obstacle)
+    size: tuple[float, float, float] | None = None  # [m] length, width, height of a
+    #   pedestrian's or an obstacle's box (a scenario file's bounding box); None: the type's
+    #   (`world.actors.actor_set.SIZES`)
 
 
 @dataclass(frozen=True, slots=True)

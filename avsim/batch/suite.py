@@ -26,6 +26,7 @@ from avsim.batch.jobs import RunJob, RunOutcome, Status
 from avsim.files import write_atomic
 from avsim.run.result import dumps
 from avsim.scenario.load import bundled_scenarios, load_scenario
+from avsim.scenario.openscenario.sidecar import SUFFIX as SIDECAR_SUFFIX
 from avsim.scenario.profile_fit import check_profile
 
 SNAPSHOT_DIR = "snapshots"  # the failed runs' pictures, below the batch's folder
@@ -36,17 +37,20 @@ class BatchError(ValueError):
 
 
 def collect_scenarios(args: Sequence[str]) -> list[str]:
-    """The scenarios a suite runs: each argument a file, a folder (its ``*.yaml``, sorted)
-    or a bundled scenario's name; none: every bundled scenario."""
+    """The scenarios a suite runs: each argument a file, a folder (its ``*.yaml`` and
+    ``*.xosc`` files, sorted; OpenSCENARIO catalogs are not scenarios and are left out) or a
+    bundled scenario's name; none: every bundled scenario."""
     if not args:
         return [str(p) for p in bundled_scenarios()]
     found: list[str] = []
     for arg in args:
         path = Path(arg)
         if path.is_dir():
-            files = sorted(path.glob("*.yaml")) + sorted(path.glob("*.yml"))
+            files = sorted(p for p in path.iterdir()
+                           if p.suffix in {".yaml", ".yml", ".xosc"}
+                           and not p.name.endswith(SIDECAR_SUFFIX))
             if not files:
-                raise BatchError(f"{arg}: no scenario files (*.yaml) in this folder")
+                raise BatchError(f"{arg}: no scenario files (*.yaml, *.xosc) in this folder")
             found += [str(p) for p in files]
         else:
             found.append(arg)  # a file or a bundled name: load_scenario says if neither

@@ -17,6 +17,8 @@ from dataclasses import dataclass
 import yaml
 
 PATH_CHARS = set("abcdefghijklmnopqrstuvwxyz0123456789_.")  # of a dotted key path
+PARAMETERS = "parameters."  # an OpenSCENARIO file's parameter: `parameters.NAME`
+PARAMETER_CHARS = set("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_")
 OPENING, CLOSING = "[{", "]}"  # YAML flow brackets: no value splits inside them
 
 
@@ -42,7 +44,7 @@ def parse_set(text: str) -> Axis:
     path = path.strip()
     if not sep or not path:
         raise SweepError(f"--set {text}: expected PATH=V1,V2,...")
-    if not set(path) <= PATH_CHARS or path.startswith(".") or path.endswith(".") or ".." in path:
+    if not _is_key_path(path):
         raise SweepError(f"--set {text}: {path!r} is not a dotted key path (a.b.0.c)")
     items = split_values(values)
     if not items or any(not item.strip() for item in items):
@@ -56,6 +58,16 @@ def parse_set(text: str) -> Axis:
     if len({format_value(v) for v in parsed}) != len(parsed):
         raise SweepError(f"--set {text}: a value is given twice")
     return Axis(path, tuple(parsed))
+
+
+def _is_key_path(path: str) -> bool:
+    """A dotted key path, or `parameters.NAME` (an OpenSCENARIO parameter's name: letters
+    of either case, digits, _)."""
+    name = path.removeprefix(PARAMETERS)
+    if name != path:
+        return bool(name) and set(name) <= PARAMETER_CHARS
+    return (set(path) <= PATH_CHARS and not path.startswith(".") and not path.endswith(".")
+            and ".." not in path)
 
 
 def split_values(text: str) -> list[str]:

@@ -45,6 +45,7 @@ class Need(enum.Enum):
     ACTORS = "actors"  # the NPCs' true poses in every sample (costly: only when needed)
     LANE_CHANGE = "lane_change_max"  # [s] how long a lane change may take
     STORY = "story"  # the scenario's required actions and events (`story_label`s)
+    ACTOR_BODIES = "actor_bodies"  # which actor each NPC body is (body id -> actor id)
 
 
 @dataclass(frozen=True, slots=True, eq=False)

@@ -16,7 +16,7 @@ change.
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any, Generic, TypeVar
 
 from avsim.criteria.base import MAX_LANE_CHANGE, Criterion, Need
@@ -43,6 +43,8 @@ class RunInputs:
     #   scenario's `lane_change.max_duration`)
     story: tuple[str, ...] = ()  # the actions and events that must fire
     #   (`avsim.criteria.story.story_label`)
+    actor_bodies: Mapping[int, str] = field(default_factory=dict)  # NPC body id -> its
+    #   actor's id
 
 
 @dataclass(frozen=True, slots=True)
@@ -57,6 +59,8 @@ class Declaration(Generic[S]):
 
     build: Callable[[S, RunInputs], Sequence[Criterion]]
     needs: frozenset[Need]  # what its criteria use: `RunInputs` fields, sample parts
+    needs_if_set: frozenset[Need] = frozenset()  # what they use besides when the scenario
+    #   sets the key (an always-on criterion that a setting makes look at more)
     key: str | None = None  # under the file's `criteria:`; None: nothing to set
     always: bool = False  # applies without its key
     setting: Any = None  # the setting's type as pydantic validates it (an annotated type or

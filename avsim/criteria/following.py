@@ -82,6 +82,40 @@ class MinGap(Criterion):
                                self.threshold, self.unit, self.first_failure)
 
 
+class FollowingGap(MinGap):
+    """UN R157 5.2.3.3's minimum following distance d_min(v), where the regulation applies
+    it: while the ego follows a moving vehicle ahead in its lane, as `MinGap` judges it (the
+    same grace after a cut-in and exemption while the vehicle ahead brakes hard), but not
+    behind a vehicle at rest (a blocking target is not a vehicle to follow). Not applicable
+    when the ego followed no vehicle."""
+
+    name = "following_gap"
+    LEAD_MOVING = 2.0  # [m/s] a vehicle ahead slower than this is not followed
+
+    def __init__(self, road: RoadMap, ego_length: float) -> None:
+        super().__init__(R157, road, ego_length)
+
+    def update(self, sample: TruthSample) -> None:
+        ahead = ahead_of(sample, self.road, self.ego_length)
+        if ahead and ahead[0].speed < self.LEAD_MOVING:
+            self._forget_standing(sample, ahead[0].id)
+            return
+        super().update(sample)
+
+    def _forget_standing(self, sample: TruthSample, name: str) -> None:
+        """Behind a standing vehicle: nothing judged (its entry time kept for the grace)."""
+        self.entered.setdefault(name, sample.t if self._started else -math.inf)
+        self._started = True
+
+    def result(self) -> CriterionResult:
+        if self.gap is None:
+            return CriterionResult.not_applicable(
+                self.name, self.threshold, self.unit,
+                "the ego followed no moving vehicle in its lane (UN R157 5.2.3.3 applies "
+                "to following)")
+        return super().result()
+
+
 def ahead_of(sample: TruthSample, road: RoadMap,
              ego_length: float) -> tuple[VehicleAhead, ...]:
     """The vehicles ahead of the ego in its lane at `sample`, nearest first
@@ -210,6 +244,14 @@ MIN_GAP: Declaration[float | str] = Declaration(
     needs=frozenset({Need.MAP, Need.CAR, Need.ACTORS}), key="min_gap", setting=MinGapSetting,
     doc="`r157` (UN R157 d_min(v)) or a number [m] > 0: minimum bumper gap to the vehicle "
     "ahead. Default: off.", example=R157)
+
+FOLLOWING_GAP: Declaration[str] = Declaration(
+    build=lambda _, run: [FollowingGap(run.road, run.car.body_length)],
+    needs=frozenset({Need.MAP, Need.CAR, Need.ACTORS}), key="following_gap",
+    setting=Literal["r157"],
+    doc="`r157`: UN R157 5.2.3.3's minimum following distance d_min(v) while the ego "
+    "follows a moving vehicle in its lane, as `min_gap: r157` judges it; not applicable "
+    "when it follows none. Default: off.", example=R157)
 
 STANDSTILL_GAP: Declaration[tuple[float, float]] = Declaration(
     build=lambda band, run: [StandstillGap(*band, run.road, run.car.body_length)],

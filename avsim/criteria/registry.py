@@ -20,7 +20,7 @@ from typing import Any
 from avsim.criteria.base import CriteriaSet, Criterion, Need
 from avsim.criteria.collision import NO_COLLISION
 from avsim.criteria.declaration import Declaration, RunInputs
-from avsim.criteria.following import MIN_GAP, RESUME_WITHIN, STANDSTILL_GAP
+from avsim.criteria.following import FOLLOWING_GAP, MIN_GAP, RESUME_WITHIN, STANDSTILL_GAP
 from avsim.criteria.jerk import MAX_JERK
 from avsim.criteria.lane import LANE_CHANGE, TYRES_IN_LANE
 from avsim.criteria.road_rules import CROSSWALKS, RED_LIGHTS, SPEED_BUMPS, STOP_SIGNS
@@ -43,6 +43,7 @@ DECLARATIONS: tuple[Declaration[Any], ...] = (
     # when the scenario sets their key
     MAX_DECEL,  # `max_decel`
     MIN_GAP,  # `min_gap`
+    FOLLOWING_GAP,  # `following_gap`
     LANE_CHANGE,  # `lane_change`
     STANDSTILL_GAP,  # `standstill_gap`
     RESUME_WITHIN,  # `resume_within`
@@ -108,5 +109,5 @@ def build_criteria(settings: CriteriaSettings, run: RunInputs) -> CriteriaSet:
         built = list(d.build(setting, run))
         items += built
         if not all(c.idle for c in built):
-            needs |= d.needs
+            needs |= d.needs | (d.needs_if_set if setting is not None else frozenset())
     return CriteriaSet(items, frozenset(needs))

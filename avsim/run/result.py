@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from avsim.run.runner import RunResult
+    from avsim.run.story import StoryEntry
 
 
 def _clean(x: float) -> float | None:
@@ -31,13 +32,7 @@ def result_json(result: RunResult, file: str | Path, recording: Path, profile: s
         "wall_time": round(result.wall_time, 3),
         "criteria": [c.as_json() for c in result.criteria],
         "infractions": [i.as_json() for i in result.infractions],
-        "story": [
-            ({"actor": e.actor, "action": e.index} if e.actor is not None
-             else {"event": e.index}) | {"kind": e.kind, "optional": e.optional,
-                                        "fired_at": None if e.fired_at is None
-                                        else round(e.fired_at, 4)}
-            for e in result.story
-        ],
+        "story": [_story_entry(e) for e in result.story],
         "metrics": {k: _clean(v) for k, v in result.metrics.items()},
         "state_changes": [
             {"t": round(c.t, 4), "machine": c.machine, "from": c.source, "to": c.target,
@@ -52,3 +47,16 @@ def dumps(payload: object) -> str:
     """`payload` as the result files write it: indented strict JSON (a NaN or an infinity
     is a bug here: ValueError), with a final newline."""
     return json.dumps(payload, indent=2, allow_nan=False) + "\n"
+
+
+def _story_entry(e: StoryEntry) -> dict[str, object]:
+    """A story entry in the result: an actor's action, an ego event, or an OpenSCENARIO
+    storyboard element (by name)."""
+    if e.element is not None:
+        where: dict[str, object] = {"element": e.element}
+    elif e.actor is not None:
+        where = {"actor": e.actor, "action": e.index}
+    else:
+        where = {"event": e.index}
+    return where | {"kind": e.kind, "optional": e.optional,
+                    "fired_at": None if e.fired_at is None else round(e.fired_at, 4)}

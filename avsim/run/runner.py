@@ -43,10 +43,11 @@ from avsim.criteria.declaration import RunInputs
 from avsim.criteria.lane import TyresInLane
 from avsim.criteria.registry import build_criteria
 from avsim.criteria.route import Completes
-from avsim.criteria.story import story_label
 from avsim.record.recorder import Recorder
 from avsim.run.sensor_loop import FrameHook, SensorLoop, sensing_mode
 from avsim.run.stack import Stack, StackOutput
+from avsim.run.story import ScriptedStory, StoryboardStory, StoryEntry
+from avsim.run.storyboard.director import Director
 from avsim.scenario.scenario import Scenario
 from planner.messages import MACHINES, AccMode, HazardLights, Motion, Plan, SpeedSource, StateChange
 from world.core.rates import (
@@ -56,6 +57,7 @@ from world.core.rates import (
     CRITERIA_RATE,
     PHYSICS_RATE,
     RECORD_RATE,
+    TRIGGER_RATE,
 )
 from world.core.stopwatch import Stopwatch
 from world.sensors.lidar import RayBackend
@@ -141,22 +143,6 @@ class RunResult:
         return not any(c.failed for c in self.criteria)
 
 
-@dataclass(frozen=True, slots=True)
-class StoryEntry:
-    """A scripted action of an actor (`actor` its id, `index` in its actions) or an ego
-    event (`actor` None, `index` in the scenario's events), and when it fired."""
-
-    actor: str | None
-    index: int
-    kind: str  # the action's or event's kind (`speed`, `lane_change`, `flat_tire`, ...)
-    optional: bool  # the run may end without it
-    fired_at: float | None  # [s] None: it never fired
-
-    @property
-    def label(self) -> str:
-        return story_label(self.actor, self.index)
-
-
 class Runner:
     """Runs one scenario to its end (duration, or `completes` reached) and judges it."""
 
@@ -200,18 +186,21 @@ class Runner:
         names.update({b: f"actor {a.id}" for b, a in zip(w.actors.bodies, spec.actors,
                                                           strict=True)})
         lane_change = scenario.criteria.get("lane_change")
-        self.story = _story(scenario)
+        self.director = Director(scenario.story, w) if scenario.story is not None else None
+        self.story: ScriptedStory | StoryboardStory = (
+            ScriptedStory(scenario, w) if self.director is None
+            else StoryboardStory(self.director))
         self.criteria = build_criteria(scenario.criteria, RunInputs(
             road=w.road, car=self.car, rate=CRITERIA_RATE.hz, signals=w.signals,
             set_speed=scenario.driver.set_speed, bodies=names,
+            actor_bodies={b: a.id for b, a in zip(w.actors.bodies, spec.actors, strict=True)},
             lane_change_max=getattr(lane_change, "max_duration", MAX_LANE_CHANGE),
-            story=tuple(e.label for e in self.story if not e.optional)))
+            story=tuple(e.label for e in self.story.entries if not e.optional)))
         self.completes = next((c for c in self.criteria.items if isinstance(c, Completes)),
                               None)  # reached (and the story played out): the run may end;
         #   None (`completes: false`): it runs to its duration
         self.collisions = self.criteria.find(NoCollision)  # its count is a metric
         self.lanes = self.criteria.find(TyresInLane).lanes  # the truth's lane changes
-        self._fired: frozenset[str] = frozenset()  # the story's labels fired so far
         self.infractions: list[Infraction] = []
         self.recorder = Recorder(recording, recording_name=scenario.name) if recording else None
         self.sensors = SensorLoop(w, self.setup, self.stack, mode, self.recorder, frame_hook,
@@ -235,15 +224,10 @@ class Runner:
             # on the joints for the period's physics steps (contacts watched at their rate)
             while w.clock.step < steps:
                 self._tick()
-                for _ in range(min(CONTROL_RATE.every, steps - w.clock.step)):
-                    with watch("physics"):
-                        w.step()
-                    if w.clock.step % CONTACT_RATE.every == 0:
-                        with watch("criteria"):
-                            self._watch(w.clock.step)
+                self._period(steps)
                 if done_at is None and self._may_end():
                     done_at = w.t
-                if done_at is not None and w.t >= done_at + SETTLE_AFTER_DONE:
+                if self._over(done_at):
                     break
                 if progress is not None and w.clock.step % PHYSICS_RATE == 0:
                     progress(w.t, self.scenario.duration)
@@ -263,31 +247,34 @@ class Runner:
             state_changes=tuple(self.state_changes), infractions=tuple(self.infractions),
             profile=self.setup.profile.value if self.setup is not None else None,
             renderer=renderer.value if renderer is not None else None,
-            stage_times=dict(watch.seconds), story=self._story_now(),
+            stage_times=dict(watch.seconds), story=self.story.now(),
         )
+
+    def _period(self, steps: int) -> None:
+        """The physics steps of one control period (at most up to `steps`), with the
+        storyboard's director and the contact watch at their rates."""
+        w, watch = self.world, self.watch
+        for _ in range(min(CONTROL_RATE.every, steps - w.clock.step)):
+            with watch("physics"):
+                w.step()
+            if self.director is not None and TRIGGER_RATE.fires(w.clock.step):
+                with watch("runner"):
+                    self.director.step(self._touching)
+            if w.clock.step % CONTACT_RATE.every == 0:
+                with watch("criteria"):
+                    self._watch(w.clock.step)
+
+    def _over(self, done_at: float | None) -> bool:
+        """The run ends: an OpenSCENARIO file's StopTrigger fired, or it settled after it
+        may end (`done_at`)."""
+        if self.director is not None and self.director.ended:
+            return True
+        return done_at is not None and self.world.t >= done_at + SETTLE_AFTER_DONE
 
     def _may_end(self) -> bool:
         """`completes` is reached and every required action and event has fired."""
         return (self.completes is not None and self.completes.done
-                and all(e.optional or e.label in self._fired for e in self.story))
-
-    def _story_now(self) -> tuple[StoryEntry, ...]:
-        """The story with the times its actions and events fired."""
-        w = self.world
-        return tuple(StoryEntry(
-            e.actor, e.index, e.kind, e.optional,
-            w.action_fired_at.get((e.actor, e.index)) if e.actor is not None
-            else w.event_fired_at[e.index]) for e in self.story)
-
-    def _update_fired(self) -> None:
-        """The labels of the actions and events fired so far (a new set only on a change)."""
-        w = self.world
-        count = len(w.action_fired_at) + sum(t is not None for t in w.event_fired_at)
-        if count != len(self._fired):
-            self._fired = frozenset(
-                [story_label(a, i) for a, i in w.action_fired_at]
-                + [story_label(None, i) for i, t in enumerate(w.event_fired_at)
-                   if t is not None])
+                and all(e.optional or e.label in self.story.fired for e in self.story.entries))
 
     def _tick(self) -> None:
         """A control tick: the sensors' frames due now reach the stack, then decide and
@@ -378,7 +365,7 @@ class Runner:
         w = self.world
         truth, route = w.ego_truth, w.ego_route
         actors = w.actors.poses if Need.ACTORS in self.criteria.needs else None
-        self._update_fired()
+        self.story.update()
         infractions = self.criteria.update(TruthSample(
             t=w.t, speed=truth.speed, station=route.station,
             front_station=route.station + self.car.front_overhang,
@@ -390,7 +377,7 @@ class Runner:
             rear_station=route.station - self.car.body_length / 2,
             axle_stations=(float(route.stations[1]),
                            float(np.mean(route.stations[4:6]))),
-            flat=self._flat_fired(), hazard_lights=w.ego.hazard_lights, fired=self._fired,
+            flat=self._flat_fired(), hazard_lights=w.ego.hazard_lights, fired=self.story.fired,
             xy=(float(truth.position[0]), float(truth.position[1])),
         ))
         self.infractions += infractions
@@ -495,18 +482,3 @@ class Runner:
             rec.log_event(t, f"criterion {r.name}: {VERDICT_WORDS[r.verdict]} (value {value}, "
                              f"threshold {r.threshold} {r.unit}{note})", level)
 
-
-def _story(scenario: Scenario) -> tuple[StoryEntry, ...]:
-    """The scenario's scripted actions (actor by actor) and ego events, none fired yet."""
-    spec = scenario.world
-    actions = [StoryEntry(a.id, i, _kind(x.action), x.optional, None)
-               for a in spec.actors for i, x in enumerate(a.actions)]
-    events = [StoryEntry(None, i, _kind(e.event), e.optional, None)
-              for i, e in enumerate(spec.events)]
-    return tuple(actions + events)
-
-
-def _kind(thing: object) -> str:
-    """A spec's kind as the file names it: `LaneChangeAction` -> `lane_change`."""
-    name = type(thing).__name__.removesuffix("Action")
-    return "".join(f"_{c.lower()}" if c.isupper() else c for c in name).lstrip("_")

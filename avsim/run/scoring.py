@@ -17,6 +17,11 @@ position error = track centre - true centre; track
 speed error = track speed - true speed; an id switch is a car matched to a different track id
 than at its previous match.
 
+First tracked (every actor, any kind, at any range): the distance [m] from the car's centre
+to the actor's when a confirmed track (any class) first lies within `match_distance` of it,
+`first_tracked_distance_<actor id>` (NaN when never): how far ahead or aside the stack first
+knew of it (the detection-range scenarios of UN R157's ALKS set).
+
 Per class: the same recall, track recall, track errors and id switches for each true vehicle
 class (its catalogue model's: car, truck, bus, motorbike; `world.actors.catalogue`), keyed
 `<metric>_<class>` (`detection_recall_truck`), for the classes seen in the run; precision for
@@ -123,6 +128,8 @@ class PerceptionScore:
     detections_by_class: dict[str, int] = field(default_factory=dict)  # by detected class
     true_detections_by_class: dict[str, int] = field(default_factory=dict)
     _last_id: dict[str, int] = field(default_factory=dict)
+    first_tracked: dict[str, float] = field(default_factory=dict)  # actor id -> [m] range
+    _actor_ids: tuple[str, ...] = ()  # every actor seen in a capture's truth
     _first_t: float = math.inf
     _last_t: float = -math.inf
 
@@ -163,10 +170,26 @@ class PerceptionScore:
         for _, j in true_found:
             c = near_cls[j]
             self.true_detections_by_class[c] = self.true_detections_by_class.get(c, 0) + 1
+        self._first_tracked(tracks, truth)
         vehicle_tracks = [tr for tr in tracks if tr.cls in VEHICLE_CLASSES]
         trk_xy = np.array([[tr.x, tr.y] for tr in vehicle_tracks]).reshape(-1, 2)
         for i, j in _match(true_xy, trk_xy, p.match_distance):
             self._score_track(int(idx[i]), vehicle_tracks[j], truth)
+
+    def _first_tracked(self, tracks: tuple[Track, ...], truth: CaptureTruth) -> None:
+        """Each actor's range when a confirmed track first lies on it (module doc)."""
+        a = truth.actors
+        self._actor_ids = a.ids
+        if not tracks or len(self.first_tracked) == len(a.ids):
+            return
+        trk_xy = np.array([[tr.x, tr.y] for tr in tracks])
+        for i, name in enumerate(a.ids):
+            if name in self.first_tracked:
+                continue
+            near = np.linalg.norm(trk_xy - a.centres[i, :2], axis=1)
+            if near.min() <= self.params.match_distance:
+                self.first_tracked[name] = float(np.linalg.norm(a.centres[i, :2]
+                                                                - truth.ego_xy))
 
     def _in_range(self, truth: CaptureTruth) -> NDArray[np.bool_]:
         a = truth.actors
@@ -247,4 +270,6 @@ class PerceptionScore:
         for name in sorted(self.detections_by_class):
             out[f"detection_precision_{name}"] = (self.true_detections_by_class.get(name, 0)
                                                   / self.detections_by_class[name])
+        for name in self._actor_ids:
+            out[f"first_tracked_distance_{name}"] = self.first_tracked.get(name, math.nan)
         return out

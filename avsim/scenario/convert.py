@@ -34,6 +34,7 @@ from avsim.scenario.model import (
     RoadModel,
     ScenarioModel,
     SegmentModel,
+    SensorsModel,
     SpeedBumpFeature,
     SpeedLimitFeature,
     StopSignFeature,
@@ -217,11 +218,11 @@ def _gnss_spec(gnss: GnssModel | None) -> spec.GnssSpec:
     return replace(base, **{k: v for k, v in knobs.items() if v is not None})
 
 
-def _sensors_spec(model: ScenarioModel) -> spec.SensorsSpec:
+def sensors_spec(sensors: SensorsModel) -> spec.SensorsSpec:
     """The sensors' noise, the defaults where the file gives none."""
-    lidar = model.sensors.lidar
+    lidar = sensors.lidar
     return spec.SensorsSpec(
-        gnss=_gnss_spec(model.sensors.gnss),
+        gnss=_gnss_spec(sensors.gnss),
         lidar=spec.LidarNoiseSpec()
         if lidar is None
         else spec.LidarNoiseSpec(range_sigma=lidar.range_sigma, dropout=lidar.dropout),
@@ -243,7 +244,7 @@ def _scenario(model: ScenarioModel, road_spec: spec.RoadSpec,
         ),
         seed=model.seed,
         actors=actors,
-        sensors=_sensors_spec(model),
+        sensors=sensors_spec(model.sensors),
         events=tuple(_event_spec(event) for event in model.events),
         town=town,
     )

@@ -27,8 +27,8 @@ def bundled_scenarios() -> list[Path]:
 
 
 def scenario_path(path_or_name: str | Path) -> Path:
-    """The file a scenario argument names: a path (anything with a `/`, a `.yaml` / `.yml`
-    suffix, or an existing file), else the bundled `<repo>/scenarios/<name>.yaml`."""
+    """The file a scenario argument names: a path (anything with a `/`, a `.yaml` / `.yml` /
+    `.xosc` suffix, or an existing file), else the bundled `<repo>/scenarios/<name>.yaml`."""
     candidate = Path(path_or_name)
     if looks_like_path(path_or_name) or candidate.exists():
         return candidate
@@ -38,7 +38,7 @@ def scenario_path(path_or_name: str | Path) -> Path:
 def looks_like_path(path_or_name: str | Path) -> bool:
     """Whether a scenario argument is meant as a path (not a bundled scenario's name)."""
     text = str(path_or_name)
-    is_file_name = Path(text).suffix in {".yaml", ".yml"}
+    is_file_name = Path(text).suffix in {".yaml", ".yml", ".xosc"}
     return isinstance(path_or_name, Path) or is_file_name or "/" in text or os.sep in text
 
 

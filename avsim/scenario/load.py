@@ -48,7 +48,8 @@ UNSUPPORTED: dict[str, str] = {
 
 
 def load_scenario(
-    path_or_name: str | Path, overrides: Mapping[str, object] | None = None
+    path_or_name: str | Path, overrides: Mapping[str, object] | None = None,
+    criteria_file: Path | None = None,
 ) -> Scenario:
     """Load, validate and convert a scenario file.
 
@@ -57,9 +58,19 @@ def load_scenario(
     (`actors.0.speed_kph`) to values set into the file's data before validation; values are
     used as given (parse command-line text with `yaml.safe_load` first).
 
+    An OpenSCENARIO file (`.xosc`) loads with its sidecar (`criteria_file`, else
+    `NAME.criteria.yaml` beside it): `avsim.scenario.openscenario.convert.load_xosc`.
+
     Raises `ScenarioError` with a one-line message `<file>: <key.path>: <problem>`.
     """
     path = scenario_path(path_or_name)
+    if path.suffix == ".xosc":
+        from avsim.scenario.openscenario.convert import load_xosc
+
+        return load_xosc(path, overrides, criteria_file)
+    if criteria_file is not None:
+        raise ScenarioError(str(path_or_name), FILE_KEY, "--criteria is for OpenSCENARIO "
+                            "files (a YAML scenario has its own criteria: section)")
     shown = shown_name(path_or_name, path)
     if not looks_like_path(path_or_name) and not path.exists():
         raise ScenarioError(

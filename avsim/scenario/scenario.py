@@ -14,6 +14,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from avsim.criteria.registry import CriteriaSettings
+from avsim.scenario.openscenario.program import StoryProgram
 from world.spec import WorldSpec
 
 
@@ -37,6 +38,8 @@ class Scenario:
     world: WorldSpec  # what the world is built from
     driver: DriverSettings  # what the driver asks of the stack
     criteria: CriteriaSettings = field(default_factory=CriteriaSettings)
+    story: StoryProgram | None = None  # an OpenSCENARIO file's storyboard (its director
+    #   plays it: `avsim.run.storyboard`); None: the world spec's own scripted actions
 
     @property
     def seed(self) -> int:

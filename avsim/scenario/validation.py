@@ -12,7 +12,7 @@ from __future__ import annotations
 import difflib
 import re
 from collections.abc import Mapping, Sequence
-from typing import Any, get_args
+from typing import Any, TypeVar, get_args
 
 from pydantic import BaseModel, ValidationError
 from pydantic_core import ErrorDetails
@@ -49,13 +49,22 @@ _BOUND_KEYS = {
 }
 
 
+M = TypeVar("M", bound=BaseModel)
+
+
 def validate(raw: dict[str, Any], overrides: Mapping[str, object]) -> ScenarioModel:
-    """The validated model, or a `LocatedError` from the first validation error."""
+    """The validated scenario model, or a `LocatedError` from the first validation error."""
+    return validate_as(raw, overrides, ScenarioModel)
+
+
+def validate_as(raw: dict[str, Any], overrides: Mapping[str, object], model: type[M]) -> M:
+    """The validated `model` (the scenario file's, or another file's made of its parts,
+    e.g. an OpenSCENARIO file's criteria), or a `LocatedError` from the first error."""
     try:
-        return ScenarioModel.model_validate(raw)
+        return model.model_validate(raw)
     except ValidationError as exc:
         error = _first_error(exc.errors(include_url=False))
-        key, message = _translate(error, raw)
+        key, message = _translate(error, raw, model)
         if any(key == path or key.startswith(path + ".") for path in overrides):
             message += " (set by an override)"
         raise LocatedError(key, message) from None
@@ -72,7 +81,8 @@ def _first_error(errors: list[ErrorDetails]) -> ErrorDetails:
     return first
 
 
-def _translate(error: ErrorDetails, raw: dict[str, Any]) -> tuple[str, str]:
+def _translate(error: ErrorDetails, raw: dict[str, Any],
+               root: type[BaseModel]) -> tuple[str, str]:
     """A pydantic error as (dotted key path, friendly message)."""
     loc = _file_path(error["loc"], raw)
     context = error.get("ctx") or {}
@@ -88,10 +98,10 @@ def _translate(error: ErrorDetails, raw: dict[str, Any]) -> tuple[str, str]:
             return dotted((*loc, "type")), f"required key missing (the {noun}type)"
         got = context.get("tag")
         return dotted((*loc, "type")), f"unknown {noun}type {got!r} (expected one of {tags})"
-    return dotted(loc), _message(error, loc)
+    return dotted(loc), _message(error, loc, root)
 
 
-def _message(error: ErrorDetails, loc: KeyPath) -> str:
+def _message(error: ErrorDetails, loc: KeyPath, root: type[BaseModel]) -> str:
     """A pydantic error of a built-in type as a short message (`must be > 0, got -5`)."""
     kind = error["type"]
     context = error.get("ctx") or {}
@@ -100,7 +110,7 @@ def _message(error: ErrorDetails, loc: KeyPath) -> str:
         too_few = bool(loc) and isinstance(loc[-1], int)
         return "item missing (too few items)" if too_few else "required key missing"
     if kind == "extra_forbidden":
-        known = sorted(_keys_at(loc[:-1]))
+        known = sorted(_keys_at(loc[:-1], root))
         close = difflib.get_close_matches(str(loc[-1]), known, n=1, cutoff=0.75)
         return f"unknown key (did you mean {close[0]}?)" if close else "unknown key"
     if kind in _EXPECTED:
@@ -122,10 +132,10 @@ def _message(error: ErrorDetails, loc: KeyPath) -> str:
     return text[:1].lower() + text[1:]
 
 
-def _keys_at(parent: KeyPath) -> set[str]:
+def _keys_at(parent: KeyPath, root: type[BaseModel]) -> set[str]:
     """The keys the format allows in the mapping at `parent` (for "did you mean" hints);
     for a feature, those of every feature type."""
-    models: list[type[BaseModel]] = [ScenarioModel]
+    models: list[type[BaseModel]] = [root]
     for part in parent:
         if isinstance(part, int):  # a list item: `_models_in` already unwrapped the list
             continue

@@ -103,12 +103,47 @@ def _inputs(directory: Path) -> dict[str, Case]:
     # a profile that cannot run the scenario honestly: no camera to read its lights
     cases["lights_without_a_camera"] = Case(
         (*_run_args("traffic_light"), "--profile", "none"), "traffic_light", "road.features")
+    cases |= _openscenario_inputs(directory)
     a_file = directory / "a_file.txt"
     a_file.write_text("not a directory\n", encoding="utf-8")
     below_file = str(a_file / "sub" / "x.rrd")
     cases["out_below_a_file"] = Case(
         ("run", "normal_driving", "--out", below_file, "--json", "tmp/x.json", "--no-progress"),
         below_file, "--out")
+    return cases
+
+
+ALKS = HERE.parent / "data" / "alks" / "logical_scenarios" / "concrete_scenarios"
+CUT_IN = ALKS / "alks_scenario_4_4_1_cut_in_no_collision_template.xosc"
+
+
+def _openscenario_inputs(directory: Path) -> dict[str, Case]:
+    """Bad OpenSCENARIO input: each names the file and where in it."""
+    cases = {"xosc_param_breaks_a_constraint": Case(
+        (*_run_args(str(CUT_IN)), "--param", "Ego_InitSpeed_Ve0_kph=70"), str(CUT_IN),
+        "ParameterDeclaration[Ego_InitSpeed_Ve0_kph]")}
+    text = CUT_IN.read_text(encoding="utf-8-sig").replace("./", f"{ALKS}/")
+    bad = {
+        "xosc_malformed": (text.replace("</Entities>", "</Entitie>"), "line"),
+        "xosc_unresolved_reference": (text.replace('value="$CutInVehicle_Model"',
+                                                   'value="$Nope"').replace(
+            'entryName="$CutInVehicle_Model"', 'entryName="$Nope"'), "$Nope"),
+        "xosc_unsupported_action": (text.replace(
+            "<ActivateControllerAction lateral=\"true\" longitudinal=\"true\" />",
+            "<OverrideControllerValueAction/>"), "not supported yet"),
+        "xosc_missing_road": (text.replace("alks_road_straight.xodr", "no_road.xodr"),
+                              "no_road.xodr"),
+    }
+    for name, (content, key) in bad.items():
+        path = directory / f"{name}.xosc"
+        path.write_text(content, encoding="utf-8")
+        cases[name] = Case(_run_args(str(path)), str(path), key)
+    junction = HERE.parent / "world" / "map" / "opendrive" / "data" / "junction.xodr"
+    path = directory / "xosc_road_with_junction.xosc"
+    path.write_text(text.replace(f"{ALKS}/road_networks/alks_road_straight.xodr",
+                                 str(junction)), encoding="utf-8")
+    cases["xosc_road_with_junction"] = Case(_run_args(str(path)), str(junction),
+                                            "not supported yet (junctions)")
     return cases
 
 
@@ -138,7 +173,9 @@ OTHER: dict[str, Case] = {
 BAD_CASE_NAMES = [f"fixture_{stem}" for stem in SUBPROCESS_FIXTURES] + [
     "missing_file", "missing_bundled_name", "empty_file", "only_comments", "unknown_key",
     "out_is_a_directory", "out_below_a_file", "run_set_two_values", "run_set_bad_path",
-    "run_set_bad_value", "lights_without_a_camera",
+    "run_set_bad_value", "lights_without_a_camera", "xosc_param_breaks_a_constraint",
+    "xosc_malformed", "xosc_unresolved_reference", "xosc_unsupported_action",
+    "xosc_missing_road", "xosc_road_with_junction",
 ]
 
 

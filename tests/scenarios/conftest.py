@@ -15,16 +15,20 @@ from world.sensors.setup import Profile
 
 @pytest.fixture(scope="module")
 def run_scenario(tmp_path_factory: pytest.TempPathFactory) -> Callable[..., RunResult]:
-    """`run(name, record=True, profile=Profile.DEFAULT, frame_hook=None, **overrides)`:
-    one run per distinct argument set in this module."""
+    """`run(name, record=True, profile=Profile.DEFAULT, frame_hook=None, criteria=None,
+    **overrides)`: one run per distinct argument set in this module (`name` a bundled
+    scenario or a file; `criteria` an OpenSCENARIO file's criteria set or sidecar)."""
     cache: dict[str, RunResult] = {}
 
     def run(name: str, record: bool = True, profile: Profile | None = Profile.DEFAULT,
-            frame_hook: FrameHook | None = None, **overrides: object) -> RunResult:
-        key = repr((name, record, profile, frame_hook, sorted(overrides.items())))
+            frame_hook: FrameHook | None = None, criteria: str | None = None,
+            **overrides: object) -> RunResult:
+        key = repr((name, record, profile, frame_hook, criteria, sorted(overrides.items())))
         if key not in cache:
-            scenario = load_scenario(name, overrides or None)
-            out: Path | None = tmp_path_factory.mktemp("runs") / f"{name}.rrd" if record else None
+            scenario = load_scenario(name, overrides or None,
+                                     Path(criteria) if criteria is not None else None)
+            out: Path | None = (tmp_path_factory.mktemp("runs") / f"{scenario.name}.rrd"
+                                if record else None)
             cache[key] = Runner(scenario, out, profile=profile, frame_hook=frame_hook).run()
         return cache[key]
 

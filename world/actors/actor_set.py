@@ -64,7 +64,7 @@ def body_size(spec: ActorSpec) -> BoxSize:
     """[m] the box of an actor's body."""
     model = vehicle_of(spec)
     if model is None:
-        return SIZES[spec.type]
+        return SIZES[spec.type] if spec.size is None else BoxSize(*spec.size)
     return BoxSize(model.length, model.width, model.height)
 
 

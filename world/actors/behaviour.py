@@ -28,6 +28,7 @@ import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
+from world.actors.profiles import LateralCommand, PathCommand, SpeedCommand, TrackCommand
 from world.frames import wrap_angle
 from world.spec import (
     ActionSpec,
@@ -48,6 +49,7 @@ PEDESTRIAN_TURN_RATE = math.pi  # [rad/s] a pedestrian turns to face where it wa
 PEDESTRIAN_MOVING = 0.05  # [m/s] a pedestrian slower than this over ground keeps its heading
 CAP_ACCEL = 1.5  # [m/s^2] a capped NPC (a town driver) speeds up again at this
 
+Command = SpeedCommand | TrackCommand | LateralCommand | PathCommand
 LaneOffset = Callable[[int, float], float]
 """(lane index, station) -> lateral offset [m] of that lane's centre from the reference line."""
 
@@ -107,6 +109,13 @@ class NpcMotion:
         self._target_offset = offset  # [m]
         self._lateral_max = 0.0  # [m/s] cruise lateral speed of the running lateral move
         self._lateral_action: int | None = None  # index of the running lateral action
+        # a director's commands (`world.actors.profiles`), over the actions above while set
+        self._speed_cmd: SpeedCommand | TrackCommand | None = None
+        self._lateral_cmd: LateralCommand | None = None
+        self._path_cmd: PathCommand | None = None
+        self._path_index = 0  # the vertex an untimed path heads for
+        self._path_speed = 0.0  # [m/s] the speed an untimed path is followed at
+        self.finished: list[str] = []  # tags of commands that reached their goal, in order
 
     # -- triggers --------------------------------------------------------------------------
 
@@ -139,13 +148,102 @@ class NpcMotion:
             if j != i and running and _same_kind(self.actions[j].action, action):
                 self.ended_at[j] = self.fired_at[i]
 
+    # -- a director's commands ---------------------------------------------------------------
+
+    def command(self, cmd: Command) -> None:
+        """Drive by `cmd` from now on: a speed or track command takes the speed, a lateral
+        command the offset, a path both (each replaces what drove that part before)."""
+        if isinstance(cmd, PathCommand):
+            self._speed_cmd = self._lateral_cmd = None
+            self._path_cmd, self._path_index = cmd, 0
+            self._path_speed = self.ground_speed
+        elif isinstance(cmd, LateralCommand):
+            self._path_cmd, self._lateral_cmd = None, cmd
+        else:
+            self._path_cmd, self._speed_cmd = None, cmd
+
+    def cancel(self, tag: str) -> None:
+        """Stop the command tagged `tag` (if it still runs): the actor holds its speed and
+        offset from here on."""
+        if self._speed_cmd is not None and self._speed_cmd.tag == tag:
+            self._speed_cmd = None
+            self._hold_speed()
+        if self._lateral_cmd is not None and self._lateral_cmd.tag == tag:
+            self._lateral_cmd = None
+        if self._path_cmd is not None and self._path_cmd.tag == tag:
+            self._path_cmd = None
+            self._hold_speed()
+
+    def _hold_speed(self) -> None:
+        self._planned = self._target_speed = self.speed
+        self._speed_action = None
+
+    def _step_commands(self, t: float, dt: float, curvature: float) -> bool:
+        """Step the director's commands; False if none drives the actor."""
+        if self._path_cmd is not None:
+            cmd = self._path_cmd
+            along, across, done, self._path_index = cmd.velocity(
+                t, self.s, self.offset, self._path_speed, dt, self._path_index)
+            self.speed, self.lateral_speed = along * self.direction, across
+            if done:  # then on along the route at its last segment's speed along it
+                self._path_cmd = None
+                self._planned = self._target_speed = (
+                    cmd.along_speed_at_end(self._path_speed) * self.direction)
+                self._speed_action = None
+                self.finished.append(cmd.tag)
+            return True
+        if self._speed_cmd is None and self._lateral_cmd is None:
+            return False
+        if self._speed_cmd is None:
+            self._step_speed(t, dt)
+        else:
+            self._step_speed_cmd(t, dt)
+        if self._lateral_cmd is None:
+            self._step_lateral(t, dt)
+        else:
+            self._step_lateral_cmd(t, dt, curvature)
+        return True
+
+    def _step_speed_cmd(self, t: float, dt: float) -> None:
+        cmd = self._speed_cmd
+        if isinstance(cmd, TrackCommand):
+            change = cmd.target - self.speed
+            change = max(-cmd.max_decel * dt, min(cmd.max_accel * dt, change))
+            self.speed = min(cmd.max_speed, max(0.0, self.speed + change))
+            self._hold_speed()
+            return
+        assert cmd is not None
+        self.speed, _, done = cmd.transition.at(t + dt - cmd.t0)
+        self._hold_speed()
+        if done and not cmd.continuous:
+            self._speed_cmd = None
+            self.finished.append(cmd.tag)
+
+    def _step_lateral_cmd(self, t: float, dt: float, curvature: float) -> None:
+        cmd = self._lateral_cmd
+        assert cmd is not None
+        if cmd.by_distance:
+            scale = max(1.0 - curvature * self.offset, 1e-3)
+            x = abs(self.s + self.direction * self.speed * dt / scale - cmd.s0)
+        else:
+            x = t + dt - cmd.t0
+        offset, _, done = cmd.transition.at(x)
+        self.lateral_speed = (offset - self.offset) / dt
+        if done:
+            self._lateral_cmd = None
+            self._target_offset = offset
+            if cmd.lane is not None:
+                self.lane = cmd.lane
+            self.finished.append(cmd.tag)
+
     # -- motion ------------------------------------------------------------------------------
 
     def step(self, t: float, dt: float, curvature: float) -> None:
         """Advance by dt [s]. `curvature` [1/m] is the reference line's at the actor's station
         (the station rate of a body at lateral offset r is v / (1 - k r))."""
-        self._step_speed(t, dt)
-        self._step_lateral(t, dt)
+        if not self._step_commands(t, dt, curvature):
+            self._step_speed(t, dt)
+            self._step_lateral(t, dt)
         if self.pedestrian:
             self._turn(dt)
         scale = 1.0 - curvature * self.offset

@@ -2,13 +2,15 @@
 lane layout, limits, features and exits) laid out into the HD map (`world.hdmap.RoadMap`).
 
 Steps: each segment becomes a reference-line piece laid from the end of the one before
-(from the spec's `origin` pose), with its cross-section (lanes, oncoming lanes, widths,
-shoulder, zone; a zone carries on until a segment names another); the segments are checked
-(`MapError`); the speed-limit postings are the road's limit at s = 0, each segment's at
-its start and each sign's at its station (of several at one station the last listed wins);
-each feature goes onto the map, a traffic light as its place only: its head where the spec
-puts it, else on a pole `LIGHT_AHEAD` past its stop line, `LIGHT_SIDE` right of the paved
-edge, `LIGHT_HEIGHT` high, facing the route's traffic. The signal plan stays in the spec.
+(from the spec's `origin` pose), or from its own exact `start` pose where the map kind
+gives one (an OpenDRIVE road's arc spline: `world.map.opendrive`), with its cross-section
+(lanes, oncoming lanes, widths, shoulder, zone, the file's paint; a zone carries on until a
+segment names another); the segments are checked (`MapError`); the speed-limit postings
+are the road's limit at s = 0, each segment's at its start and each sign's at its station
+(of several at one station the last listed wins); each feature goes onto the map, a
+traffic light as its place only: its head where the spec puts it, else on a pole
+`LIGHT_AHEAD` past its stop line, `LIGHT_SIDE` right of the paved edge, `LIGHT_HEIGHT` high,
+facing the route's traffic. The signal plan stays in the spec.
 """
 
 from __future__ import annotations
@@ -52,12 +54,14 @@ def build_road_map(spec: RoadSpec) -> RoadMap:
     for i, seg in enumerate(spec.segments):
         zone = seg.zone if seg.zone is not None else zone
         section = CrossSection(
-            seg.lanes, seg.oncoming_lanes, seg.lane_width, seg.shoulder, zone
+            seg.lanes, seg.oncoming_lanes, seg.lane_width, seg.shoulder, zone, seg.paint
         )
         _check_segment(i, seg.length, seg.curvature, section)
         if seg.exit is not None:
             _check_exit(i, seg.exit, sections)
             exits.append(i)
+        if seg.start is not None:
+            xy, heading = np.array(seg.start[:2], dtype=float), float(seg.start[2])
         piece = Piece(
             s, float(seg.length), float(seg.curvature), float(xy[0]), float(xy[1]), heading
         )

@@ -26,7 +26,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 from numpy.typing import NDArray
 
-from world.hdmap import CrossSection, RoadMap
+from world.hdmap import CrossSection, LineMark, LinePaint, MarkKind, PaintColour, RoadMap
 
 FloatArray = NDArray[np.float64]
 ImageRGB = NDArray[np.uint8]
@@ -56,7 +56,8 @@ MAX_CHORD_ERROR = 0.02  # [m] at the outermost paved edge on arcs
 MAX_MESH_VERTICES = 4000  # [-] per mesh (PyBullet's mesh size limit)
 STATION_TOL = 1e-6  # [m] a period boundary this close to a segment's end is not split at
 
-TextureKey = tuple[int, int, float, float]  # lanes, oncoming lanes, lane width, shoulder
+TextureKey = tuple[int, int, float, float, LinePaint | None]  # lanes, oncoming lanes, lane
+#   width, shoulder, the map file's paint
 
 
 @dataclass(frozen=True, eq=False)
@@ -83,7 +84,8 @@ class Marking:
 
 def texture_key(section: CrossSection) -> TextureKey:
     """What a cross-section's texture depends on (not its zone)."""
-    return (section.lanes, section.oncoming_lanes, section.lane_width, section.shoulder)
+    return (section.lanes, section.oncoming_lanes, section.lane_width, section.shoulder,
+            section.paint)
 
 
 def markings(section: CrossSection) -> list[Marking]:
@@ -94,6 +96,8 @@ def markings(section: CrossSection) -> list[Marking]:
     dashed between oncoming lanes, white solid at the left paved edge. Lines are centred on
     their lane boundary, except that an edge line keeps `EDGE_LINE_INSET` from a paved edge.
     """
+    if section.paint is not None:
+        return file_markings(section, section.paint)
     w, shoulder, width = section.lane_width, section.shoulder, section.paved_width
     lines = [Marking(max(shoulder, EDGE_LINE_INSET), LINE_WIDTH, False, WHITE_RGB)]
     lines += [
@@ -112,6 +116,27 @@ def markings(section: CrossSection) -> list[Marking]:
         ]
     lines.append(Marking(width - EDGE_LINE_INSET, LINE_WIDTH, False, WHITE_RGB))
     return lines
+
+
+def file_markings(section: CrossSection, paint: LinePaint) -> list[Marking]:
+    """The painted lines of a section whose map file paints them (OpenDRIVE road marks),
+    right to left: each centred on its lane boundary, an edge line kept `EDGE_LINE_INSET`
+    plus half its width from a paved edge; unpainted boundaries (`MarkKind.NONE`) left out."""
+    w, shoulder, width = section.lane_width, section.shoulder, section.paved_width
+    bounds = [shoulder + i * w for i in range(section.lanes + 1 + len(paint.oncoming))]
+    marks = [paint.right_edge, *paint.lane_lines, paint.left_edge, *paint.oncoming]
+    lines = []
+    for centre, mark in zip(bounds, marks, strict=True):
+        if mark.kind is MarkKind.NONE:
+            continue
+        inset = EDGE_LINE_INSET + 0.5 * mark.width
+        lines.append(Marking(min(max(centre, inset), width - inset), mark.width,
+                             mark.kind is MarkKind.BROKEN, _rgb(mark)))
+    return lines
+
+
+def _rgb(mark: LineMark) -> tuple[float, float, float]:
+    return YELLOW_RGB if mark.colour is PaintColour.YELLOW else WHITE_RGB
 
 
 def _coverage(lo: float, hi: float, n: int, extent: float) -> FloatArray:

@@ -268,12 +268,14 @@ def validated(declaration: Declaration[Any]) -> list[object]:
                          ids=lambda d: d.key or d.build(None, run_inputs())[0].name)
 def test_a_declaration_builds_and_runs_on_what_it_declares_it_needs(
         declaration: Declaration[Any]) -> None:
-    withheld = {n.value: Withheld(n) for n in Need if n not in declaration.needs}
-    inputs = dataclasses.replace(run_inputs(), **{k: v for k, v in withheld.items()
-                                                  if k != Need.ACTORS.value})
     for value in validated(declaration):
+        declared = declaration.needs | (declaration.needs_if_set if value is not None
+                                        else frozenset())
+        withheld = {n.value: Withheld(n) for n in Need if n not in declared}
+        inputs = dataclasses.replace(run_inputs(), **{k: v for k, v in withheld.items()
+                                                      if k != Need.ACTORS.value})
         criteria = declaration.build(value, inputs)
-        for sample in samples(Need.ACTORS in declaration.needs):
+        for sample in samples(Need.ACTORS in declared):
             for c in criteria:
                 c.update(sample)
         assert all(c.result().name == c.name for c in criteria)
@@ -286,6 +288,7 @@ def test_a_declaration_builds_and_runs_on_what_it_declares_it_needs(
     (PLAIN_ROAD, {"standstill_gap": (2.0, 6.0)}, True),
     (PLAIN_ROAD, {"resume_within": 15.0}, True),
     (PLAIN_ROAD, {"max_decel": 3.0, "reach_s": 300.0}, False),
+    (PLAIN_ROAD, {"unavoidable": "r157"}, True),  # cut-ins judged from the NPCs' poses
 ])
 def test_the_samples_carry_the_actors_only_when_a_criterion_needs_them(
         road: Any, settings: dict[str, object], actors: bool) -> None:

@@ -457,7 +457,9 @@ def test_metrics_keys_and_nan_where_nothing_was_scored() -> None:
     truth, scan = capture([Npc("far", 200.0, 0.0)])
     score.objects((det(10.0, 0.0),), (), truth, scan)
     m = score.metrics()
-    assert set(m) == LANE_KEYS | OBJECT_KEYS | {"detection_precision_car"}
+    assert set(m) == LANE_KEYS | OBJECT_KEYS | {"detection_precision_car",
+                                                "first_tracked_distance_far"}
+    assert math.isnan(m["first_tracked_distance_far"])  # never tracked
     assert m["detection_precision"] == m["detection_precision_car"] == 0.0
     for key in ("detection_recall", "track_recall", "track_position_rmse",
                 "track_speed_rmse"):
@@ -470,7 +472,8 @@ def test_metrics_keys_and_nan_where_nothing_was_scored() -> None:
     m = score.metrics()
     car_keys = {f"{k}_car" for k in ("detection_recall", "track_recall",
                                      "track_position_rmse", "track_speed_rmse", "id_switches")}
-    assert set(m) == LANE_KEYS | OBJECT_KEYS | car_keys  # no precision_car: no car detected
+    # no precision_car: no car detected
+    assert set(m) == LANE_KEYS | OBJECT_KEYS | car_keys | {"first_tracked_distance_a"}
     assert m["detection_recall"] == 0.0 and m["track_recall"] == 0.0
     assert m["detection_recall_car"] == 0.0 and m["track_recall_car"] == 0.0
     assert math.isnan(m["detection_precision"])
@@ -542,3 +545,17 @@ def test_default_classes_follow_the_type() -> None:
     score.objects(perfect_dets(truth, npcs[:1]), (), truth, scan)
     m = score.metrics()
     assert (m["detection_recall_car"], m["detection_recall_truck"]) == (1.0, 0.0)
+
+
+def test_the_range_at_which_each_actor_was_first_tracked() -> None:
+    """Recorded once, at the first confirmed track on the actor, at any range."""
+    score = PerceptionScore()
+    truth, scan = capture([Npc("far", 200.0, 0.0), Npc("near", 30.0, 3.5)])
+    score.objects((), (), truth, scan)  # nothing tracked yet
+    truth_far = capture([Npc("far", 120.0, 0.0), Npc("near", 30.0, 3.5)])
+    score.objects((), (track(1, 120.5, 0.3),), *truth_far)
+    truth_later = capture([Npc("far", 60.0, 0.0), Npc("near", 30.0, 3.5)])
+    score.objects((), (track(1, 60.0, 0.0),), *truth_later)
+    m = score.metrics()
+    assert m["first_tracked_distance_far"] == pytest.approx(120.0)
+    assert math.isnan(m["first_tracked_distance_near"])

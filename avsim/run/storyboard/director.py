@@ -1,0 +1,182 @@
+"""The director: plays an OpenSCENARIO storyboard on a world, step by step.
+
+At each trigger check (`world.core.rates.TRIGGER_RATE`) it takes the truth's snapshot
+(`truth.TruthTracker`), reports the actions whose commands reached their goal, steps the
+storyboard (`runtime.StoryRuntime`: which actions start and stop now), and turns each
+started action into a command on each of its actors' motions (`commands`). Commands the
+truth must steer every step (a distance to keep, a continuous relative speed) are renewed
+at each check. Actions on the car under test are its controller's (activation,
+assignment): they complete at once and change nothing, since avsim's stack drives it from
+the start (`avsim.scenario.openscenario.convert`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+
+from avsim.run.storyboard.commands import Commands, Follow
+from avsim.run.storyboard.runtime import StartedAction, StoryRuntime
+from avsim.run.storyboard.snapshot import Snapshot
+from avsim.run.storyboard.truth import TruthTracker
+from avsim.scenario.openscenario.model import (
+    ActivateControllerAction,
+    AssignControllerAction,
+    FollowTrajectoryAction,
+    LaneChangeAction,
+    LaneOffsetAction,
+    LongitudinalDistanceAction,
+    PrivateAction,
+    SpeedAction,
+)
+from avsim.scenario.openscenario.program import StoryProgram
+from avsim.scenario.openscenario.resolve import Resolver
+from world.actors.behaviour import NpcMotion
+from world.world import World
+
+CONTROLLER_ACTIONS = (ActivateControllerAction, AssignControllerAction)
+WALKING_TOP = 3.0  # [m/s] a pedestrian's or object's top speed when it keeps a distance
+INIT = "Init"  # the action id prefix of the Init actions the director starts itself
+
+
+class DirectorError(RuntimeError):
+    """An action that cannot be played (a lane that does not exist, ...)."""
+
+
+class Director:
+    """One storyboard on one world (module doc)."""
+
+    def __init__(self, program: StoryProgram, world: World) -> None:
+        self.program = program
+        self.world = world
+        self.truth = TruthTracker(program, world)
+        resolver = Resolver(program.road)
+
+        def resolve(position: object, snap: Snapshot) -> tuple[float, float, float, float]:
+            from avsim.scenario.openscenario.resolve import Pose
+            poses = {n: Pose(e.x, e.y, e.heading) for n, e in snap.entities.items()}
+            p = resolver.resolve(position, poses)  # type: ignore[arg-type]
+            s, d = world.road.local_coordinates((p.x, p.y))
+            return p.x, p.y, float(s), float(d)
+
+        osc = program.scenario
+        self.runtime = StoryRuntime(osc.storyboard, osc.parameters, resolve)
+        self.commands = Commands(world.road, resolver, program.lane_ids)
+        self._index = dict(program.actors)
+        self._pending: dict[str, set[str]] = {}  # action id -> tags still running
+        self._follows: dict[str, Follow] = {}  # tag -> a command renewed every check
+        self._tag_action: dict[str, str] = {}  # tag -> action id
+        self.ended = False
+        self.ended_at: float | None = None  # [s] when the StopTrigger fired
+        self._first = True
+        self._top = {e.name: getattr(e.object, "max_speed", WALKING_TOP)
+                     for e in osc.entities}  # [m/s] each entity's top speed
+
+    # -- stepping -------------------------------------------------------------------------------
+
+    def step(self, touching: frozenset[int]) -> bool:
+        """One trigger check; True once the storyboard's StopTrigger has fired."""
+        snap = self.truth.snapshot(touching)
+        self._collect_finished(snap)
+        if self._first:
+            self._first = False
+            for i, item in enumerate(self.program.init_commands):
+                started = StartedAction(f"{INIT}#{i}", f"init {item.entity}",
+                                        (item.entity,), item.action)
+                self._start(started, snap)
+        result = self.runtime.step(snap)
+        for action_id in result.stopped:
+            self._stop(action_id)
+        for started in result.started:
+            self._start(started, snap)
+        self._renew(snap)
+        if result.ended and not self.ended:
+            self.ended, self.ended_at = True, snap.time
+        return self.ended
+
+    def _motion(self, entity: str) -> NpcMotion | None:
+        i = self._index.get(entity)
+        return None if i is None else self.world.actors.motions[i]
+
+    def _collect_finished(self, snap: Snapshot) -> None:
+        """The commands that reached their goal since the last check end their actions."""
+        for motion in self.world.actors.motions:
+            done, motion.finished = motion.finished, []
+            self._finish(done, snap.time)
+
+    def _finish(self, tags: Iterable[str], t: float) -> None:
+        for tag in tags:
+            action_id = self._tag_action.pop(tag, None)
+            if action_id is None:
+                continue
+            pending = self._pending.get(action_id)
+            if pending is None:
+                continue
+            pending.discard(tag)
+            if not pending:
+                del self._pending[action_id]
+                if not action_id.startswith(INIT):
+                    self.runtime.action_done(action_id, t)
+
+    def _stop(self, action_id: str) -> None:
+        for tag in self._pending.pop(action_id, set()):
+            self._tag_action.pop(tag, None)
+            self._follows.pop(tag, None)
+            entity = tag.rpartition("@")[2]
+            motion = self._motion(entity)
+            if motion is not None:
+                motion.cancel(tag)
+
+    def _start(self, started: StartedAction, snap: Snapshot) -> None:
+        action = started.action
+        if isinstance(action, CONTROLLER_ACTIONS):
+            return  # the runtime completes these itself
+        tags = set()
+        for entity in started.entities:
+            motion = self._motion(entity)
+            if motion is None:
+                raise DirectorError(f"{started.name}: {type(action).__name__} on the car "
+                                    "under test: not supported yet (avsim's stack drives it)")
+            tag = f"{started.action_id}@{entity}"
+            tags.add(tag)
+            self._tag_action[tag] = started.action_id
+            self._command(tag, entity, motion, action, snap)
+        self._pending[started.action_id] = tags
+
+    def _command(self, tag: str, entity: str, motion: NpcMotion, action: PrivateAction,
+                 snap: Snapshot) -> None:
+        me = snap.entities[entity]
+        try:
+            if isinstance(action, SpeedAction):
+                cmd = self.commands.speed(tag, action, me, snap)
+                motion.command(cmd)
+                if cmd.continuous:
+                    self._follows[tag] = Follow(tag, entity, action,
+                                                after=snap.time + cmd.transition.span)
+            elif isinstance(action, LaneChangeAction):
+                motion.command(self.commands.lane_change(tag, action, me, motion.offset, snap))
+            elif isinstance(action, LaneOffsetAction):
+                motion.command(self.commands.lane_offset(tag, action, me, motion.offset, snap))
+            elif isinstance(action, FollowTrajectoryAction):
+                motion.command(self.commands.trajectory(tag, action, me, snap))
+            elif isinstance(action, LongitudinalDistanceAction):
+                self._follows[tag] = Follow(tag, entity, action)
+            else:
+                raise DirectorError(f"not supported yet ({type(action).__name__} in a story)")
+        except ValueError as e:
+            raise DirectorError(f"{tag}: {e}") from None
+
+    def _renew(self, snap: Snapshot) -> None:
+        """The commands the truth steers every check (module doc)."""
+        for tag, follow in list(self._follows.items()):
+            motion = self._motion(follow.entity)
+            assert motion is not None
+            if snap.time < follow.after:
+                continue  # its transition runs first
+            me = snap.entities[follow.entity]
+            cmd, reached = self.commands.follow(follow, me, snap, self._top[follow.entity])
+            motion.command(cmd)
+            action = follow.action
+            if reached and isinstance(action, LongitudinalDistanceAction) \
+                    and not action.continuous:
+                del self._follows[tag]
+                self._finish([tag], snap.time)

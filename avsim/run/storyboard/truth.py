@@ -1,0 +1,109 @@
+"""The storyboard's snapshot of the world's truth (`Snapshot`), step after step.
+
+Each entity's reference point is its body centre moved back along its heading by its
+`centre_ahead` (`StoryProgram`): the car under test's rear axle, the file's bounding box
+reference point for the others. Route coordinates are projected from those points onto the
+ego's route. Running figures (odometer, time at rest, off the road, beyond the road's ends)
+are integrated between snapshots. Contacts are the ego's (the NPC bodies are kinematic and
+do not touch each other in the physics).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from avsim.run.storyboard.snapshot import EntityState, Snapshot
+from avsim.scenario.openscenario.program import StoryProgram
+from world.hdmap import RoadMap
+from world.spec import ActorType
+from world.world import World
+
+AT_REST = 0.01  # [m/s] slower than this counts as standing still
+CATEGORIES = {ActorType.CAR: "vehicle", ActorType.TRUCK: "vehicle",
+              ActorType.PEDESTRIAN: "pedestrian", ActorType.OBSTACLE: "miscellaneous"}
+
+
+class TruthTracker:
+    """Snapshots of one world for one storyboard (module doc)."""
+
+    def __init__(self, program: StoryProgram, world: World) -> None:
+        self.program = program
+        self.world = world
+        self.road: RoadMap = world.road
+        self.names = (program.ego, *(name for name, _ in program.actors))
+        ahead = dict(program.centre_ahead)
+        self.ahead = np.array([ahead[n] for n in self.names])
+        g = world.ego.geometry
+        kinds = [world.actors.specs[i].type for _, i in program.actors]
+        self.categories = {program.ego: "vehicle"} | {
+            name: CATEGORIES[kind] for (name, _), kind in zip(program.actors, kinds, strict=True)}
+        sizes = world.actors.half_sizes * 2.0
+        self.lengths = np.concatenate([[g.body_length], sizes[:, 0]])
+        self.widths = np.concatenate([[g.body_width], sizes[:, 1]])
+        self.bodies = {world.ego.body: program.ego} | {
+            world.actors.bodies[i]: name for name, i in program.actors}
+        n = len(self.names)
+        self.odometer = np.zeros(n)
+        self.standing = np.zeros(n)
+        self.off_road = np.zeros(n)
+        self.beyond = np.zeros(n)
+        self._t: float | None = None
+
+    def snapshot(self, touching: frozenset[int]) -> Snapshot:
+        """The truth now; `touching`: the bodies the ego touches."""
+        w = self.world
+        t = w.t
+        dt = 0.0 if self._t is None else t - self._t
+        self._t = t
+        truth = w.ego_truth
+        poses = w.actors.poses
+        order = [i for _, i in self.program.actors]
+        cx = np.concatenate([[truth.position[0]], poses.centres[order, 0]])
+        cy = np.concatenate([[truth.position[1]], poses.centres[order, 1]])
+        yaw = np.concatenate([[truth.yaw], poses.yaws[order]])
+        speed = np.concatenate([[truth.speed], poses.speeds[order]])
+        x = cx - self.ahead * np.cos(yaw)
+        y = cy - self.ahead * np.sin(yaw)
+        s, d = self.road.local_coordinates(np.column_stack([x, y]))
+        self._integrate(dt, speed, s, d)
+        route_heading = self.road.heading_at(s)
+        entities = {
+            name: EntityState(
+                name=name, x=float(x[k]), y=float(y[k]), heading=float(yaw[k]),
+                speed=float(speed[k]), s=float(s[k]), offset=float(d[k]),
+                lane=_lane(self.road, float(s[k]), float(d[k])),
+                route_heading=float(route_heading[k]), length=float(self.lengths[k]),
+                width=float(self.widths[k]), centre_ahead=float(self.ahead[k]),
+                odometer=float(self.odometer[k]), standing_for=float(self.standing[k]),
+                off_road_for=float(self.off_road[k]), end_of_road_for=float(self.beyond[k]))
+            for k, name in enumerate(self.names)}
+        ego = self.program.ego
+        contacts = frozenset(frozenset({ego, self.bodies[b]}) for b in touching
+                             if b in self.bodies)
+        return Snapshot(t, entities, contacts, self.categories)
+
+    def _integrate(self, dt: float, speed: np.ndarray, s: np.ndarray, d: np.ndarray) -> None:
+        self.odometer += np.abs(speed) * dt
+        self.standing = np.where(np.abs(speed) < AT_REST, self.standing + dt, 0.0)
+        right, left = self.road.paved_edges(s)
+        off = (d < right) | (d > left)
+        self.off_road = np.where(off, self.off_road + dt, 0.0)
+        beyond = (s <= 0.0) | (s >= self.road.length)
+        self.beyond = np.where(beyond, self.beyond + dt, 0.0)
+
+
+def _lane(road: RoadMap, s: float, d: float) -> int | None:
+    """The route lane at (s, d) (None: off every lane), as `RoadMap.lane_at` bands them."""
+    c = road.cross_section_at(s)
+    w = c.lane_width
+    band = math.floor((d + 0.5 * w) / w)
+    if not 0.0 <= s <= road.length:
+        return None
+    if 0 <= band < c.lanes:
+        return band
+    if c.lanes <= band < c.lanes + c.oncoming_lanes:
+        return c.lanes - 1 - band
+    return None
+

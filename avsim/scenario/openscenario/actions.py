@@ -1,0 +1,177 @@
+"""Private actions (OpenSCENARIO's PrivateAction choice) and their parts. Speeds in m/s,
+distances in metres, times in seconds, angles in radians."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Literal
+
+from avsim.scenario.openscenario.entities import Controller
+from avsim.scenario.openscenario.positions import Position
+
+DynamicsShape = Literal["step", "linear", "sinusoidal", "cubic"]
+DynamicsDimension = Literal["rate", "time", "distance"]
+FollowingMode = Literal["position", "follow"]
+
+
+@dataclass(frozen=True, slots=True)
+class TransitionDynamics:
+    """How a value moves to its target: `value` is a rate ([unit/s], e.g. [m/s²] for a
+    speed, [m/s] for a lane change's lateral speed), a time [s] or a distance [m]."""
+
+    shape: DynamicsShape
+    dimension: DynamicsDimension
+    value: float  # [unit/s] | [s] | [m] by `dimension`
+    following_mode: FollowingMode | None  # 1.2 attribute; None when not written
+
+
+@dataclass(frozen=True, slots=True)
+class TeleportAction:
+    position: Position
+
+
+@dataclass(frozen=True, slots=True)
+class AbsoluteTargetSpeed:
+    value: float  # [m/s]
+
+
+@dataclass(frozen=True, slots=True)
+class RelativeTargetSpeed:
+    entity: str
+    value: float  # [m/s] for delta, [-] for factor
+    value_type: Literal["delta", "factor"]
+    continuous: bool  # keep tracking the entity's speed
+
+
+@dataclass(frozen=True, slots=True)
+class SpeedAction:
+    dynamics: TransitionDynamics
+    target: AbsoluteTargetSpeed | RelativeTargetSpeed
+
+
+@dataclass(frozen=True, slots=True)
+class DynamicConstraints:
+    max_acceleration: float | None  # [m/s²]
+    max_deceleration: float | None  # [m/s²]
+    max_speed: float | None  # [m/s]
+    max_acceleration_rate: float | None  # [m/s³] (1.2)
+    max_deceleration_rate: float | None  # [m/s³] (1.2)
+
+
+@dataclass(frozen=True, slots=True)
+class LongitudinalDistanceAction:
+    """Keep a distance or a time gap (exactly one is set) to `entity`."""
+
+    entity: str
+    distance: float | None  # [m]
+    time_gap: float | None  # [s]
+    freespace: bool  # between bounding boxes (True) or reference points (False)
+    continuous: bool
+    coordinate_system: str  # entity, lane, road, trajectory (1.1+; default entity)
+    displacement: str  # any, leadingReferencedEntity, trailingReferencedEntity (1.1+)
+    constraints: DynamicConstraints | None
+
+
+@dataclass(frozen=True, slots=True)
+class AbsoluteTargetLane:
+    value: str  # OpenDRIVE lane id
+
+
+@dataclass(frozen=True, slots=True)
+class RelativeTargetLane:
+    entity: str
+    value: int  # lanes to the left (positive) of the entity's lane
+
+
+@dataclass(frozen=True, slots=True)
+class LaneChangeAction:
+    dynamics: TransitionDynamics  # rate: lateral speed [m/s]
+    target: AbsoluteTargetLane | RelativeTargetLane
+    target_lane_offset: float | None  # [m] in the target lane, None = 0
+
+
+@dataclass(frozen=True, slots=True)
+class AbsoluteTargetLaneOffset:
+    value: float  # [m] from the current lane's centre, left positive
+
+
+@dataclass(frozen=True, slots=True)
+class RelativeTargetLaneOffset:
+    entity: str
+    value: float  # [m] relative to the entity's lane offset
+
+
+@dataclass(frozen=True, slots=True)
+class LaneOffsetDynamics:
+    max_lateral_acc: float | None  # [m/s²]
+    shape: DynamicsShape
+
+
+@dataclass(frozen=True, slots=True)
+class LaneOffsetAction:
+    continuous: bool
+    dynamics: LaneOffsetDynamics
+    target: AbsoluteTargetLaneOffset | RelativeTargetLaneOffset
+
+
+@dataclass(frozen=True, slots=True)
+class Vertex:
+    time: float | None  # [s] when the vertex is reached, None when not timed
+    position: Position
+
+
+@dataclass(frozen=True, slots=True)
+class Polyline:
+    vertices: tuple[Vertex, ...]
+
+
+@dataclass(frozen=True, slots=True)
+class Trajectory:
+    name: str
+    closed: bool
+    shape: Polyline  # Clothoid and Nurbs are not supported yet
+    parameters: dict[str, int | float | bool | str]  # its own ParameterDeclarations
+
+
+@dataclass(frozen=True, slots=True)
+class Timing:
+    domain: Literal["absolute", "relative"]  # vertex times: simulation time or since start
+    scale: float  # [-] vertex time multiplier
+    offset: float  # [s] added after scaling
+
+
+@dataclass(frozen=True, slots=True)
+class FollowTrajectoryAction:
+    trajectory: Trajectory
+    time_reference: Timing | None  # None: vertex times are ignored
+    following_mode: FollowingMode
+    initial_distance_offset: float | None  # [m] along the trajectory (1.1+)
+
+
+@dataclass(frozen=True, slots=True)
+class ActivateControllerAction:
+    lateral: bool | None  # None: unchanged
+    longitudinal: bool | None
+    lighting: bool | None  # 1.2
+    animation: bool | None  # 1.2
+
+
+@dataclass(frozen=True, slots=True)
+class AssignControllerAction:
+    controller: Controller
+    activate_lateral: bool | None  # 1.1+ attributes; None when not written
+    activate_longitudinal: bool | None
+    activate_lighting: bool | None  # 1.2
+    activate_animation: bool | None  # 1.2
+
+
+PrivateAction = (
+    TeleportAction
+    | SpeedAction
+    | LongitudinalDistanceAction
+    | LaneChangeAction
+    | LaneOffsetAction
+    | FollowTrajectoryAction
+    | ActivateControllerAction
+    | AssignControllerAction
+)

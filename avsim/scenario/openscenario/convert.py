@@ -1,0 +1,262 @@
+"""An OpenSCENARIO file as a scenario the runner takes (`avsim.scenario.scenario.Scenario`):
+the same world spec, driver settings and criteria as a YAML file gives, plus the storyboard
+(`StoryProgram`) that the director plays (`avsim.run.storyboard`).
+
+- The road: the file's OpenDRIVE road as the route (`world.map.opendrive.route`).
+- The car under test: the entity named `Ego` (any case), else the first vehicle. avsim's
+  stack drives it from the start, its set speed the Init speed (the speed its driver held
+  when the file's controller takes over); avsim's car keeps its own body (4.8 x 1.6 m), not
+  the file's bounding box.
+- The other entities become the world's actors with the file's bounding boxes: vehicles by
+  category (car, van, motorbike, bicycle: a car; truck, bus, trailer, semitrailer: a truck),
+  pedestrians, misc objects as obstacles.
+- Init: teleports place the entities in order (relative positions refer to entities placed
+  before); a speed action with a step sets the starting speed; a longitudinal distance
+  action without dynamic constraints places its entity at the distance (as esmini jumps);
+  every other Init action starts at t = 0 (`StoryProgram.init_commands`).
+- The run lasts until the StopTrigger fires, at most the sidecar's `duration`; the criteria,
+  seed and sensor noise come from the sidecar (`sidecar`).
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Mapping
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+from avsim.scenario.errors import ScenarioError
+from avsim.scenario.openscenario.model import (
+    AbsoluteTargetSpeed,
+    ActivateControllerAction,
+    AssignControllerAction,
+    Entity,
+    InitAction,
+    LongitudinalDistanceAction,
+    MiscObject,
+    OpenScenario,
+    Pedestrian,
+    SpeedAction,
+    TeleportAction,
+    Vehicle,
+)
+from avsim.scenario.openscenario.parse import load_openscenario
+from avsim.scenario.openscenario.program import StoryProgram
+from avsim.scenario.openscenario.resolve import Pose, PositionError, Resolver
+from avsim.scenario.openscenario.sidecar import load_sidecar, sidecar_path, split_overrides
+from avsim.scenario.scenario import DriverSettings, Scenario
+from vehicle_urdf.geometry import read_geometry
+from world import spec
+from world.actors.catalogue import VehicleClass, VehicleModel
+from world.hdmap import RoadMap
+from world.map.opendrive import OpenDriveError, load_opendrive
+from world.map.opendrive.route import OdrRoute, build_route
+from world.map.road import MapError, build_road_map
+
+EGO_NAMES = ("ego",)  # the car under test's entity name, compared in lower case
+TRUCKS = frozenset({"truck", "bus", "trailer", "semitrailer"})
+CLASSES = {"truck": VehicleClass.TRUCK, "trailer": VehicleClass.TRUCK,
+           "semitrailer": VehicleClass.TRUCK, "bus": VehicleClass.BUS,
+           "motorbike": VehicleClass.MOTORBIKE, "bicycle": VehicleClass.MOTORBIKE}
+
+
+@dataclass
+class _Placed:
+    """An entity as the Init actions leave it."""
+
+    pose: Pose | None = None
+    speed: float = 0.0  # [m/s]
+
+
+def load_xosc(path: Path, overrides: Mapping[str, object] | None = None,
+              criteria_file: Path | None = None) -> Scenario:
+    """The scenario of the OpenSCENARIO file `path` (module doc) with `overrides` (the
+    file's `parameters.NAME`, the sidecar's keys) and the sidecar `criteria_file` (None:
+    `NAME.criteria.yaml` beside it if there is one); `ScenarioError` (one line) for
+    anything it cannot run."""
+    params, rest = split_overrides(overrides or {})
+    side = load_sidecar(sidecar_path(path, criteria_file), rest)
+    osc = load_openscenario(path, params)
+    if osc.road_network is None:
+        raise ScenarioError(str(path), "RoadNetwork", "no OpenDRIVE LogicFile: avsim needs "
+                            "the road")
+    route = _route(osc.road_network)
+    try:
+        road_map = build_road_map(route.spec)
+    except MapError as e:
+        raise ScenarioError(str(osc.road_network), "(file)", str(e)) from None
+    ego = _ego(osc)
+    placed, deferred = _init(osc, Resolver(route.road))
+    ahead = {e.name: _centre_ahead(e, e.name == ego.name) for e in osc.entities}
+    ego_spec = _ego_spec(path, road_map, ego.name, placed, ahead[ego.name])
+    others = [e for e in osc.entities if e.name != ego.name]
+    actors = tuple(_actor_spec(path, road_map, e, placed, ahead[e.name]) for e in others)
+    program = StoryProgram(
+        scenario=osc, road=route.road, ego=ego.name,
+        actors=tuple((e.name, i) for i, e in enumerate(others)),
+        centre_ahead=tuple(ahead.items()), lane_ids=route.layout.lane_ids,
+        init_commands=tuple(deferred))
+    world = spec.WorldSpec(road=route.spec, ego=ego_spec, actors=actors, seed=side.seed,
+                           sensors=side.sensors)
+    return Scenario(name=_name(path), description=osc.description, situation="openscenario",
+                    duration=side.duration, world=world,
+                    driver=DriverSettings(set_speed=ego_spec.speed), criteria=side.criteria,
+                    story=program)
+
+
+def _name(path: Path) -> str:
+    """The scenario's name: the file's stem in [a-z0-9_]."""
+    return re.sub(r"[^a-z0-9_]+", "_", path.stem.lower()).strip("_") or "openscenario"
+
+
+def _route(xodr: Path) -> OdrRoute:
+    try:
+        return build_route(load_opendrive(xodr))
+    except OpenDriveError as e:
+        key = f"line {e.line}: {e.path}" if e.line is not None and e.path else "(file)"
+        raise ScenarioError(e.file, key, e.problem) from None
+
+
+def _ego(osc: OpenScenario) -> Entity:
+    """The car under test (module doc)."""
+    named = [e for e in osc.entities if e.name.lower() in EGO_NAMES]
+    vehicles = [e for e in osc.entities if isinstance(e.object, Vehicle)]
+    chosen = named[0] if named else (vehicles[0] if vehicles else None)
+    if chosen is None or not isinstance(chosen.object, Vehicle):
+        raise ScenarioError(str(osc.path), "Entities", "no vehicle to be the car under test "
+                            "(an entity named Ego, else the first vehicle)")
+    return chosen
+
+
+def _init(osc: OpenScenario, resolver: Resolver) -> tuple[dict[str, _Placed],
+                                                         list[InitAction]]:
+    """Each entity's start as the Init actions place it, and the actions left to run."""
+    placed = {e.name: _Placed() for e in osc.entities}
+    deferred: list[InitAction] = []
+    for item in osc.storyboard.init:
+        state, action = placed[item.entity], item.action
+        try:
+            if isinstance(action, TeleportAction):
+                poses = {n: p.pose for n, p in placed.items() if p.pose is not None}
+                state.pose = resolver.resolve(action.position, poses)
+            elif isinstance(action, SpeedAction) and action.dynamics.shape == "step":
+                state.speed = _target_speed(action, placed)
+            elif (isinstance(action, LongitudinalDistanceAction)
+                  and action.constraints is None and not action.continuous):
+                state.pose = _at_distance(action, placed, osc, resolver)
+            elif not isinstance(action, ActivateControllerAction | AssignControllerAction):
+                deferred.append(item)
+        except PositionError as e:
+            raise ScenarioError(str(osc.path), f"Storyboard.Init.{item.entity}", str(e)) from None
+    return placed, deferred
+
+
+def _target_speed(action: SpeedAction, placed: Mapping[str, _Placed]) -> float:
+    target = action.target
+    if isinstance(target, AbsoluteTargetSpeed):
+        return target.value
+    ref = placed[target.entity].speed
+    return ref + target.value if target.value_type == "delta" else ref * target.value
+
+
+def _at_distance(action: LongitudinalDistanceAction, placed: Mapping[str, _Placed],
+                 osc: OpenScenario, resolver: Resolver) -> Pose:
+    """Where a longitudinal distance action in Init puts its entity: at the distance (or
+    the time gap at the referenced entity's speed) ahead of it, or behind it for
+    `trailingReferencedEntity`, along the road, keeping its own lateral place."""
+    ref = placed[action.entity]
+    if ref.pose is None:
+        raise PositionError(f"entity {action.entity} has no position yet")
+    gap = action.distance if action.distance is not None else (action.time_gap or 0.0) * ref.speed
+    if action.freespace:
+        gap += 0.5 * (_length(osc.entity(action.entity)) + _length(_owner(osc, action)))
+    sign = -1.0 if action.displacement == "trailingReferencedEntity" else 1.0
+    s_ref, _ = resolver.road_coordinates(ref.pose.x, ref.pose.y)
+    own = placed[_owner(osc, action).name].pose
+    t = resolver.road_coordinates(own.x, own.y)[1] if own is not None else (
+        resolver.road_coordinates(ref.pose.x, ref.pose.y)[1])
+    s = s_ref + sign * gap
+    return resolver.road_pose(s, t, resolver.lane_id(s, t), None)
+
+
+def _owner(osc: OpenScenario, action: LongitudinalDistanceAction) -> Entity:
+    for item in osc.storyboard.init:
+        if item.action is action:
+            return osc.entity(item.entity)
+    raise KeyError("distance action without an entity")
+
+
+def _length(entity: Entity) -> float:
+    return entity.object.bbox.length
+
+
+def _centre_ahead(entity: Entity, is_ego: bool) -> float:
+    """[m] the body's centre ahead of the entity's reference point."""
+    if is_ego:
+        return read_geometry().rear_axle
+    return entity.object.bbox.center_x
+
+
+def _centre(path: Path, road_map: RoadMap, name: str, placed: Mapping[str, _Placed],
+            ahead: float) -> tuple[int | None, float, float]:
+    """(route lane, station, offset from that lane's centre) of the entity's body centre."""
+    pose = placed[name].pose
+    if pose is None:
+        raise ScenarioError(str(path), "Storyboard.Init", f"entity {name} is never placed "
+                            "(no TeleportAction in Init)")
+    xy = (pose.x + ahead * math.cos(pose.heading), pose.y + ahead * math.sin(pose.heading))
+    return road_map.lane_at(xy)
+
+
+def _ego_spec(path: Path, road_map: RoadMap, name: str, placed: Mapping[str, _Placed],
+              ahead: float) -> spec.EgoSpec:
+    lane, s, r = _centre(path, road_map, name, placed, ahead)
+    if lane is None or lane < 0:
+        raise ScenarioError(str(path), f"Storyboard.Init.{name}", "the car under test must "
+                            "start in a driving lane of the road's right-hand carriageway")
+    if abs(r) > 0.05:
+        raise ScenarioError(str(path), f"Storyboard.Init.{name}", "not supported yet (the "
+                            f"car under test starting {r:+.2f} m off its lane's centre)")
+    return spec.EgoSpec(lane=lane, s=s, speed=placed[name].speed,
+                        max_speed=max(placed[name].speed, 180.0 / 3.6))
+
+
+def _actor_spec(path: Path, road_map: RoadMap, entity: Entity,
+                placed: Mapping[str, _Placed], ahead: float) -> spec.ActorSpec:
+    lane, s, r = _centre(path, road_map, entity.name, placed, ahead)
+    if lane is None:  # off the lanes (a pedestrian on the verge): from the nearest lane
+        lane, r = _nearest_lane(road_map, s, r)
+    obj = entity.object
+    base = spec.ActorSpec(id=_actor_id(entity.name), type=spec.ActorType.OBSTACLE, lane=lane,
+                          s=s, offset=r, speed=placed[entity.name].speed)
+    if isinstance(obj, Vehicle):
+        kind = spec.ActorType.TRUCK if obj.category in TRUCKS else spec.ActorType.CAR
+        return replace(base, type=kind, model=_model(obj))
+    size = (obj.bbox.length, obj.bbox.width, obj.bbox.height)
+    if isinstance(obj, Pedestrian):
+        return replace(base, type=spec.ActorType.PEDESTRIAN, size=size)
+    assert isinstance(obj, MiscObject)
+    return replace(base, size=size)
+
+
+def _nearest_lane(road_map: RoadMap, s: float, d: float) -> tuple[int, float]:
+    """(route lane nearest to offset d [m] from the reference line at s, offset from it)."""
+    lanes = range(road_map.lanes_at(s))
+    best = min(lanes, key=lambda i: abs(d - float(road_map.lane(i).offset_at(s))))
+    return best, d - float(road_map.lane(best).offset_at(s))
+
+
+def _actor_id(name: str) -> str:
+    return re.sub(r"[^a-z0-9_]+", "_", name.lower()).strip("_") or "entity"
+
+
+def _model(vehicle: Vehicle) -> VehicleModel:
+    """A vehicle's body from the file: its bounding box and axles."""
+    box = vehicle.bbox
+    return VehicleModel(
+        name=vehicle.name, cls=CLASSES.get(vehicle.category, VehicleClass.CAR),
+        length=box.length, width=box.width, height=box.height,
+        wheelbase=vehicle.front_axle.position_x - vehicle.rear_axle.position_x,
+        mass=vehicle.mass if vehicle.mass is not None else 0.0,
+        source=f"OpenSCENARIO vehicle {vehicle.name} ({vehicle.category})")

@@ -1,0 +1,318 @@
+"""ParameterDeclarations: typed parameters, `$name` references and `${...}` expressions in
+attributes, ConstraintGroups, and overrides.
+
+A parameter's value may reference parameters declared before it. A value is valid when it
+satisfies every ValueConstraint of at least one of its ConstraintGroups (the groups are
+ORed, the constraints within one group ANDed; OpenSCENARIO 1.2, ValueConstraintGroup); a
+parameter without groups is unconstrained. Constraint values may be expressions over the
+other parameters of the same declarations, so the checks run once all are evaluated.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Mapping
+from dataclasses import dataclass
+from datetime import datetime
+from typing import Literal
+
+from avsim.scenario.errors import ScenarioError, fmt
+from avsim.scenario.openscenario.expressions import ExpressionError, Value, evaluate
+from avsim.scenario.openscenario.xmlread import Node
+
+ParamValue = int | float | bool | str  # a parameter's value (dateTime kept as its text)
+ParameterType = Literal[
+    "int", "integer", "unsignedInt", "unsignedShort", "double", "string", "boolean", "dateTime"
+]  # "int" is 1.2's name for 1.0/1.1's "integer"
+Rule = Literal["equalTo", "greaterThan", "lessThan", "greaterOrEqual", "lessOrEqual", "notEqualTo"]
+
+PARAMETER_TYPES: tuple[str, ...] = (
+    "int",
+    "integer",
+    "unsignedInt",
+    "unsignedShort",
+    "double",
+    "string",
+    "boolean",
+    "dateTime",
+)
+RULES: tuple[str, ...] = (
+    "equalTo",
+    "greaterThan",
+    "lessThan",
+    "greaterOrEqual",
+    "lessOrEqual",
+    "notEqualTo",
+)
+_INT = re.compile(r"[+-]?\d+")
+_DOUBLE = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|[+-]?INF|NaN")
+_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+_INT_RANGE: Mapping[str, tuple[int, int]] = {
+    "unsignedInt": (0, 2**32 - 1),
+    "unsignedShort": (0, 2**16 - 1),
+}
+
+
+@dataclass(frozen=True, slots=True)
+class ValueConstraint:
+    rule: Rule
+    value: str  # as written: a literal, `$name` or `${...}` (resolved when checked)
+
+
+@dataclass(frozen=True, slots=True)
+class ConstraintGroup:
+    constraints: tuple[ValueConstraint, ...]  # all must hold
+
+
+@dataclass(frozen=True, slots=True)
+class ParameterInfo:
+    """A declared parameter, as written (for sweeps and messages)."""
+
+    name: str
+    type: ParameterType
+    default: str  # the declared value as written (may be `$name` or `${...}`)
+    constraint_groups: tuple[ConstraintGroup, ...]  # any one fully satisfied; () = any value
+    line: int  # where it is declared
+
+
+class Scope:
+    """Parameter values by name, with the enclosing scope's as fallback."""
+
+    __slots__ = ("parent", "values")
+
+    def __init__(self, values: dict[str, ParamValue], parent: Scope | None = None) -> None:
+        self.values = values
+        self.parent = parent
+
+    def get(self, name: str) -> ParamValue | None:
+        scope: Scope | None = self
+        while scope is not None:
+            if name in scope.values:
+                return scope.values[name]
+            scope = scope.parent
+        return None
+
+
+class ResolveError(ValueError):
+    """A value cannot be resolved or converted: the message says why (one line)."""
+
+
+def _expression_value(name: str, scope: Scope) -> Value:
+    value = scope.get(name)
+    if value is None:
+        raise ExpressionError(f"unresolved parameter reference ${name}")
+    if isinstance(value, bool | float):
+        return value
+    if isinstance(value, int):
+        return float(value)
+    if _DOUBLE.fullmatch(value.strip()):
+        return float(value)
+    raise ExpressionError(f"parameter ${name} is not a number ({value!r})")
+
+
+def resolve(raw: str, scope: Scope) -> ParamValue:
+    """The value of an attribute as written: `${expr}` evaluated, `$name` looked up, else
+    the text itself; `ResolveError` for an unresolved reference or a bad expression."""
+    if raw.startswith("${"):
+        if not raw.endswith("}"):
+            raise ResolveError(f"expression {raw!r} lacks its closing brace")
+        try:
+            return evaluate(raw[2:-1], lambda n: _expression_value(n, scope))
+        except ExpressionError as exc:
+            raise ResolveError(f"expression {raw}: {exc}") from None
+    if raw.startswith("$"):
+        name = raw[1:]
+        if not _NAME.fullmatch(name):
+            raise ResolveError(f"bad parameter reference {raw!r}")
+        value = scope.get(name)
+        if value is None:
+            raise ResolveError(f"unresolved parameter reference {raw}")
+        return value
+    return raw
+
+
+def to_float(value: ParamValue) -> float:
+    """A number from a resolved value; `ResolveError` when it is not one."""
+    if isinstance(value, bool):
+        raise ResolveError(f"expected a number, got {str(value).lower()}")
+    if isinstance(value, int | float):
+        return float(value)
+    text = value.strip()
+    if not _DOUBLE.fullmatch(text):
+        raise ResolveError(f"expected a number, got {value!r}")
+    return float(text.replace("INF", "inf"))
+
+
+def to_int(value: ParamValue) -> int:
+    """An integer from a resolved value: an expression's double result is rounded half
+    away from zero; a written value must be an integer literal."""
+    if isinstance(value, bool):
+        raise ResolveError(f"expected an integer, got {str(value).lower()}")
+    if isinstance(value, int):
+        return value
+    if isinstance(value, float):
+        if not math.isfinite(value):
+            raise ResolveError(f"expected an integer, got {value}")
+        return math.floor(abs(value) + 0.5) * (1 if value >= 0 else -1)
+    text = value.strip()
+    if not _INT.fullmatch(text):
+        raise ResolveError(f"expected an integer, got {value!r}")
+    return int(text)
+
+
+def to_bool(value: ParamValue) -> bool:
+    """A boolean from a resolved value (`true`/`false`/`1`/`0`)."""
+    if isinstance(value, bool):
+        return value
+    if isinstance(value, str) and value.strip() in ("true", "false", "1", "0"):
+        return value.strip() in ("true", "1")
+    raise ResolveError(f"expected true or false, got {value!r}")
+
+
+def to_str(value: ParamValue) -> str:
+    """Text from a resolved value (numbers without a trailing `.0`, booleans lower case)."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, float):
+        return fmt(value)
+    return str(value)
+
+
+def convert(value: ParamValue, ptype: ParameterType) -> ParamValue:
+    """A resolved value as a parameter of type `ptype`; `ResolveError` if it is not one."""
+    if ptype == "double":
+        return to_float(value)
+    if ptype in ("int", "integer", "unsignedInt", "unsignedShort"):
+        number = to_int(value)
+        low, high = _INT_RANGE.get(ptype, (-(2**31), 2**31 - 1))
+        if not low <= number <= high:
+            raise ResolveError(f"{number} is out of range for {ptype} [{low}, {high}]")
+        return number
+    if ptype == "boolean":
+        return to_bool(value)
+    if ptype == "dateTime":
+        text = to_str(value)
+        try:
+            datetime.fromisoformat(text)
+        except ValueError:
+            raise ResolveError(f"expected a dateTime, got {text!r}") from None
+        return text
+    return to_str(value)
+
+
+def parse_declarations(node: Node | None) -> tuple[ParameterInfo, ...]:
+    """The ParameterDeclaration children of a ParameterDeclarations element, as written."""
+    if node is None:
+        return ()
+    infos: list[ParameterInfo] = []
+    for decl in node.all("ParameterDeclaration"):
+        name = decl.attrs.get("name")
+        ptype = decl.attrs.get("parameterType")
+        default = decl.attrs.get("value")
+        if name is None or ptype is None or default is None:
+            missing = "name" if name is None else "parameterType" if ptype is None else "value"
+            raise decl.error(f"missing attribute {missing}")
+        if ptype not in PARAMETER_TYPES:
+            raise decl.error(f"parameterType {ptype!r} is not one of {', '.join(PARAMETER_TYPES)}")
+        if any(i.name == name for i in infos):
+            raise decl.error(f"parameter {name} declared twice")
+        groups: list[ConstraintGroup] = []
+        for group in decl.all("ConstraintGroup"):
+            constraints: list[ValueConstraint] = []
+            for vc in group.all("ValueConstraint"):
+                rule = vc.attrs.get("rule")
+                value = vc.attrs.get("value")
+                if rule not in RULES or value is None:
+                    raise vc.error(f"needs rule (one of {', '.join(RULES)}) and value")
+                constraints.append(ValueConstraint(rule, value))  # type: ignore[arg-type]
+            groups.append(ConstraintGroup(tuple(constraints)))
+        infos.append(ParameterInfo(name, ptype, default, tuple(groups), decl.line))  # type: ignore[arg-type]
+    return tuple(infos)
+
+
+def _holds(rule: str, value: ParamValue, bound: ParamValue) -> bool:
+    if isinstance(value, bool):
+        if rule not in ("equalTo", "notEqualTo"):
+            raise ResolveError(f"{rule} cannot compare booleans")
+        return (value == to_bool(bound)) == (rule == "equalTo")
+    if isinstance(value, str):
+        left, right = to_str(value), to_str(bound)
+        if rule == "equalTo":
+            return left == right
+        if rule == "notEqualTo":
+            return left != right
+        raise ResolveError(f"{rule} cannot compare text")
+    a, b = float(value), to_float(bound)
+    return {
+        "equalTo": a == b,
+        "notEqualTo": a != b,
+        "greaterThan": a > b,
+        "lessThan": a < b,
+        "greaterOrEqual": a >= b,
+        "lessOrEqual": a <= b,
+    }[rule]
+
+
+def _shown(raw: str, value: ParamValue, bound: ParamValue) -> str:
+    """The constraint's value as compared (a number without a trailing `.0`), followed by
+    the reference or expression it came from."""
+    text = to_str(bound) if isinstance(value, str | bool) else fmt(to_float(bound))
+    return f"{text} ({raw})" if raw.startswith("$") else text
+
+
+def check_constraints(info: ParameterInfo, value: ParamValue, scope: Scope, where: Node) -> None:
+    """`ScenarioError` (at `where`) when `value` satisfies none of the constraint groups."""
+    broken: list[str] = []
+    for group in info.constraint_groups:
+        failed: list[str] = []
+        for vc in group.constraints:
+            try:
+                bound = resolve(vc.value, scope)
+                ok = _holds(vc.rule, value, bound)
+            except ResolveError as exc:
+                raise where.error(f"parameter {info.name}: constraint {vc.rule}: {exc}") from None
+            if not ok:
+                failed.append(f"{vc.rule} {_shown(vc.value, value, bound)}")
+        if not failed:
+            return
+        broken.append(" and ".join(failed))
+    if broken:
+        what = broken[0] if len(broken) == 1 else "every constraint group: " + "; ".join(broken)
+        raise where.error(f"parameter {info.name} = {to_str(value)}: breaks {what}")
+
+
+def evaluate_declarations(
+    node: Node | None,
+    parent: Scope | None,
+    overrides: Mapping[str, str],
+    *,
+    file: str,
+    overrides_from: str = "override",
+) -> Scope:
+    """The scope of the parameters declared under `node` (a ParameterDeclarations element),
+    each value `overrides[name]` if given, else its declared default; references resolve in
+    this scope (earlier parameters) then in `parent`. Checks types and constraints; raises
+    `ScenarioError` for an unknown override name, a badly typed value or a broken constraint.
+    """
+    infos = parse_declarations(node)
+    known = {i.name for i in infos}
+    for name in overrides:
+        if name not in known:
+            listing = ", ".join(sorted(known)) or "none"
+            problem = f"unknown parameter {name}; declared: {listing}"
+            raise ScenarioError(file, f"({overrides_from}s)", problem)
+    scope = Scope({}, parent)
+    assert node is not None or not infos
+    decls = node.all("ParameterDeclaration") if node is not None else []
+    for info, decl in zip(infos, decls, strict=True):
+        raw = overrides.get(info.name, info.default)
+        source = f" ({overrides_from} {raw!r})" if info.name in overrides else ""
+        try:
+            value = convert(resolve(raw, scope), info.type)
+        except ResolveError as exc:
+            raise decl.error(f"parameter {info.name}{source}: {exc}") from None
+        scope.values[info.name] = value
+    for info, decl in zip(infos, decls, strict=True):
+        check_constraints(info, scope.values[info.name], scope, decl)
+    return scope

@@ -1,0 +1,102 @@
+"""`load_openscenario`: an OpenSCENARIO 1.0-1.2 file (.xosc) read, its parameters and
+catalogs resolved, into the typed `OpenScenario` model; `declared_parameters` for sweeps.
+
+Every problem is one `ScenarioError` line: `<file>: line N: <element path>: <problem>`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from pathlib import Path
+from types import MappingProxyType
+
+from avsim.scenario.errors import FILE_KEY, ScenarioError
+from avsim.scenario.openscenario.attributes import Attributes
+from avsim.scenario.openscenario.catalogs import Catalogs
+from avsim.scenario.openscenario.context import Context
+from avsim.scenario.openscenario.model import OpenScenario
+from avsim.scenario.openscenario.parameters import (
+    ParameterInfo,
+    evaluate_declarations,
+    parse_declarations,
+)
+from avsim.scenario.openscenario.parse_entities import parse_entities
+from avsim.scenario.openscenario.parse_storyboard import parse_storyboard
+from avsim.scenario.openscenario.xmlread import Node, read_xml
+
+SUPPORTED_MINOR = (0, 1, 2)  # OpenSCENARIO 1.0, 1.1, 1.2
+_NO_OVERRIDES: Mapping[str, str] = MappingProxyType({})
+
+
+def _read_root(path: Path) -> tuple[Node, int, int]:
+    root = read_xml(path)
+    if root.tag != "OpenSCENARIO":
+        raise root.error("not an OpenSCENARIO file (the root element is not OpenSCENARIO)")
+    header = root.need("FileHeader")
+    try:
+        major = int(header.attrs.get("revMajor", ""))
+        minor = int(header.attrs.get("revMinor", ""))
+    except ValueError:
+        raise header.error("revMajor and revMinor must be integers") from None
+    if major != 1 or minor not in SUPPORTED_MINOR:
+        raise header.error(f"not supported yet (OpenSCENARIO {major}.{minor})")
+    for kind in ("Catalog", "ParameterValueDistribution"):
+        found = root.child(kind)
+        if found is not None:
+            raise found.error(f"not supported yet ({kind}): this is not a scenario file")
+    return root, major, minor
+
+
+def declared_parameters(path: Path) -> tuple[ParameterInfo, ...]:
+    """The scenario's global parameters as declared (type, default, constraint groups)."""
+    root, _, _ = _read_root(path)
+    return parse_declarations(root.child("ParameterDeclarations"))
+
+
+def _road_network(root: Node, base_dir: Path, attrs: Attributes) -> Path | None:
+    network = root.need("RoadNetwork")
+    signals = network.child("TrafficSignals")
+    if signals is not None and signals.children:
+        raise signals.children[0].error(f"not supported yet ({signals.children[0].tag})")
+    logic = network.child("LogicFile")
+    if logic is None:
+        return None
+    road = (base_dir / attrs.text(logic, "filepath")).resolve()
+    if not road.is_file():
+        raise logic.error(f"road network file not found: {road}")
+    return road
+
+
+def load_openscenario(path: Path, overrides: Mapping[str, str] = _NO_OVERRIDES) -> OpenScenario:
+    """The scenario in the .xosc file at `path`, with the parameter values in `overrides`
+    (name -> value as text) replacing the declared defaults; `ScenarioError` on any problem."""
+    path = Path(path)
+    root, major, minor = _read_root(path)
+    base_dir = path.resolve().parent
+    scope = evaluate_declarations(
+        root.child("ParameterDeclarations"), None, overrides, file=str(path)
+    )
+    attrs = Attributes(scope)
+    catalogs = Catalogs.load(root.child("CatalogLocations"), base_dir, attrs)
+    road_network = _road_network(root, base_dir, attrs)
+    ctx = Context(attrs, catalogs, None)
+    entities_node = root.child("Entities")
+    entities = parse_entities(entities_node, ctx) if entities_node is not None else ()
+    ctx = Context(attrs, catalogs, frozenset(e.name for e in entities))
+    storyboard_node = root.child("Storyboard")
+    if storyboard_node is None:
+        raise ScenarioError(str(path), FILE_KEY, "missing element Storyboard")
+    header = root.need("FileHeader")
+    return OpenScenario(
+        path=path,
+        rev_major=major,
+        rev_minor=minor,
+        description=header.attrs.get("description", ""),
+        parameters=dict(scope.values),
+        road_network=road_network,
+        entities=entities,
+        storyboard=parse_storyboard(storyboard_node, ctx),
+    )
+
+
+__all__ = ["declared_parameters", "load_openscenario"]

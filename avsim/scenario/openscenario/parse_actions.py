@@ -1,0 +1,271 @@
+"""Reading a PrivateAction element into one of the `actions` dataclasses. Any action not
+listed in `actions.PrivateAction` is reported as `not supported yet (<Name>)`."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+from avsim.scenario.openscenario.actions import (
+    AbsoluteTargetLane,
+    AbsoluteTargetLaneOffset,
+    AbsoluteTargetSpeed,
+    ActivateControllerAction,
+    AssignControllerAction,
+    DynamicConstraints,
+    FollowTrajectoryAction,
+    LaneChangeAction,
+    LaneOffsetAction,
+    LaneOffsetDynamics,
+    LongitudinalDistanceAction,
+    Polyline,
+    PrivateAction,
+    RelativeTargetLane,
+    RelativeTargetLaneOffset,
+    RelativeTargetSpeed,
+    SpeedAction,
+    TeleportAction,
+    Timing,
+    Trajectory,
+    TransitionDynamics,
+    Vertex,
+)
+from avsim.scenario.openscenario.attributes import unsupported
+from avsim.scenario.openscenario.context import Context
+from avsim.scenario.openscenario.parse_entities import parse_controller
+from avsim.scenario.openscenario.parse_positions import parse_position
+from avsim.scenario.openscenario.xmlread import Node
+
+SHAPES = ("step", "linear", "sinusoidal", "cubic")
+DIMENSIONS = ("rate", "time", "distance")
+FOLLOWING_MODES = ("position", "follow")
+COORDINATE_SYSTEMS = ("entity", "lane", "road", "trajectory")
+
+
+def parse_dynamics(node: Node, ctx: Context) -> TransitionDynamics:
+    a = ctx.attrs
+    mode = None
+    if "followingMode" in node.attrs:
+        mode = a.choice(node, "followingMode", FOLLOWING_MODES)
+    return TransitionDynamics(
+        shape=a.choice(node, "dynamicsShape", SHAPES),  # type: ignore[arg-type]
+        dimension=a.choice(node, "dynamicsDimension", DIMENSIONS),  # type: ignore[arg-type]
+        value=a.number(node, "value"),
+        following_mode=mode,  # type: ignore[arg-type]
+    )
+
+
+def _teleport(node: Node, ctx: Context) -> PrivateAction:
+    return TeleportAction(parse_position(node.need("Position"), ctx))
+
+
+def _speed(node: Node, ctx: Context) -> PrivateAction:
+    a = ctx.attrs
+    target = node.need("SpeedActionTarget").only_child()
+    speed_target: AbsoluteTargetSpeed | RelativeTargetSpeed
+    if target.tag == "AbsoluteTargetSpeed":
+        speed_target = AbsoluteTargetSpeed(a.number(target, "value"))
+    elif target.tag == "RelativeTargetSpeed":
+        speed_target = RelativeTargetSpeed(
+            entity=ctx.entity_ref(target),
+            value=a.number(target, "value"),
+            value_type=a.choice(target, "speedTargetValueType", ("delta", "factor")),  # type: ignore[arg-type]
+            continuous=a.boolean(target, "continuous"),
+        )
+    else:
+        raise unsupported(target)
+    return SpeedAction(parse_dynamics(node.need("SpeedActionDynamics"), ctx), speed_target)
+
+
+def _constraints(node: Node | None, ctx: Context) -> DynamicConstraints | None:
+    if node is None:
+        return None
+    a = ctx.attrs
+    return DynamicConstraints(
+        max_acceleration=a.opt_number(node, "maxAcceleration"),
+        max_deceleration=a.opt_number(node, "maxDeceleration"),
+        max_speed=a.opt_number(node, "maxSpeed"),
+        max_acceleration_rate=a.opt_number(node, "maxAccelerationRate"),
+        max_deceleration_rate=a.opt_number(node, "maxDecelerationRate"),
+    )
+
+
+def _longitudinal_distance(node: Node, ctx: Context) -> PrivateAction:
+    a = ctx.attrs
+    distance = a.opt_number(node, "distance")
+    time_gap = a.opt_number(node, "timeGap")
+    if (distance is None) == (time_gap is None):
+        raise node.error("needs exactly one of distance and timeGap")
+    return LongitudinalDistanceAction(
+        entity=ctx.entity_ref(node),
+        distance=distance,
+        time_gap=time_gap,
+        freespace=a.boolean(node, "freespace"),
+        continuous=a.boolean(node, "continuous"),
+        coordinate_system=a.choice_or(node, "coordinateSystem", COORDINATE_SYSTEMS, "entity"),
+        displacement=a.choice_or(
+            node,
+            "displacement",
+            ("any", "leadingReferencedEntity", "trailingReferencedEntity"),
+            "any",
+        ),
+        constraints=_constraints(node.child("DynamicConstraints"), ctx),
+    )
+
+
+def _lane_change(node: Node, ctx: Context) -> PrivateAction:
+    a = ctx.attrs
+    target = node.need("LaneChangeTarget").only_child()
+    lane_target: AbsoluteTargetLane | RelativeTargetLane
+    if target.tag == "RelativeTargetLane":
+        lane_target = RelativeTargetLane(ctx.entity_ref(target), a.integer(target, "value"))
+    elif target.tag == "AbsoluteTargetLane":
+        lane_target = AbsoluteTargetLane(a.text(target, "value"))
+    else:
+        raise unsupported(target)
+    return LaneChangeAction(
+        dynamics=parse_dynamics(node.need("LaneChangeActionDynamics"), ctx),
+        target=lane_target,
+        target_lane_offset=a.opt_number(node, "targetLaneOffset"),
+    )
+
+
+def _lane_offset(node: Node, ctx: Context) -> PrivateAction:
+    a = ctx.attrs
+    dyn = node.need("LaneOffsetActionDynamics")
+    target = node.need("LaneOffsetTarget").only_child()
+    offset_target: AbsoluteTargetLaneOffset | RelativeTargetLaneOffset
+    if target.tag == "AbsoluteTargetLaneOffset":
+        offset_target = AbsoluteTargetLaneOffset(a.number(target, "value"))
+    elif target.tag == "RelativeTargetLaneOffset":
+        offset_target = RelativeTargetLaneOffset(ctx.entity_ref(target), a.number(target, "value"))
+    else:
+        raise unsupported(target)
+    return LaneOffsetAction(
+        continuous=a.boolean(node, "continuous"),
+        dynamics=LaneOffsetDynamics(
+            max_lateral_acc=a.opt_number(dyn, "maxLateralAcc"),
+            shape=a.choice(dyn, "dynamicsShape", SHAPES),  # type: ignore[arg-type]
+        ),
+        target=offset_target,
+    )
+
+
+def parse_trajectory(node: Node, ctx: Context) -> Trajectory:
+    """A Trajectory element, or a CatalogReference to one (Polyline shapes only)."""
+    if node.tag == "CatalogReference":
+        entry = ctx.catalogs.resolve(node, ctx.attrs, ("Trajectory",))
+        return parse_trajectory(entry.node, ctx.in_scope(entry.scope, entry.node))
+    if node.tag != "Trajectory":
+        raise unsupported(node)
+    ctx = ctx.with_declarations(node)
+    a = ctx.attrs
+    shape = node.need("Shape").only_child()
+    if shape.tag != "Polyline":
+        raise unsupported(shape)
+    vertices = tuple(
+        Vertex(a.opt_number(v, "time"), parse_position(v.need("Position"), ctx))
+        for v in shape.all("Vertex")
+    )
+    if len(vertices) < 2:
+        raise shape.error("a Polyline needs at least two vertices")
+    params = ctx.attrs.scope.values if node.child("ParameterDeclarations") is not None else {}
+    return Trajectory(
+        name=a.text(node, "name"),
+        closed=a.boolean(node, "closed"),
+        shape=Polyline(vertices),
+        parameters=dict(params),
+    )
+
+
+def _follow_trajectory(node: Node, ctx: Context) -> PrivateAction:
+    a = ctx.attrs
+    holder = node.child("TrajectoryRef")
+    if holder is not None:
+        trajectory_node = holder.only_child()
+    else:  # 1.0 (deprecated in 1.1): the Trajectory or its CatalogReference directly
+        found = node.child("Trajectory") or node.child("CatalogReference")
+        if found is None:
+            raise node.error("missing element TrajectoryRef")
+        trajectory_node = found
+    time_ref = node.need("TimeReference").only_child()
+    timing: Timing | None
+    if time_ref.tag == "None":
+        timing = None
+    elif time_ref.tag == "Timing":
+        timing = Timing(
+            domain=a.choice(time_ref, "domainAbsoluteRelative", ("absolute", "relative")),  # type: ignore[arg-type]
+            scale=a.number(time_ref, "scale"),
+            offset=a.number(time_ref, "offset"),
+        )
+    else:
+        raise unsupported(time_ref)
+    mode = node.need("TrajectoryFollowingMode")
+    return FollowTrajectoryAction(
+        trajectory=parse_trajectory(trajectory_node, ctx),
+        time_reference=timing,
+        following_mode=a.choice(mode, "followingMode", FOLLOWING_MODES),  # type: ignore[arg-type]
+        initial_distance_offset=a.opt_number(node, "initialDistanceOffset"),
+    )
+
+
+def _activate_controller(node: Node, ctx: Context) -> PrivateAction:
+    a = ctx.attrs
+    return ActivateControllerAction(
+        lateral=a.opt_boolean(node, "lateral"),
+        longitudinal=a.opt_boolean(node, "longitudinal"),
+        lighting=a.opt_boolean(node, "lighting"),
+        animation=a.opt_boolean(node, "animation"),
+    )
+
+
+def _assign_controller(node: Node, ctx: Context) -> PrivateAction:
+    a = ctx.attrs
+    inner = [c for c in node.children if c.tag in ("Controller", "CatalogReference")]
+    if len(inner) != 1:
+        raise node.error("needs exactly one of Controller and CatalogReference")
+    return AssignControllerAction(
+        controller=parse_controller(inner[0], ctx),
+        activate_lateral=a.opt_boolean(node, "activateLateral"),
+        activate_longitudinal=a.opt_boolean(node, "activateLongitudinal"),
+        activate_lighting=a.opt_boolean(node, "activateLighting"),
+        activate_animation=a.opt_boolean(node, "activateAnimation"),
+    )
+
+
+def _controller(node: Node, ctx: Context) -> PrivateAction:
+    for child in node.children:  # 1.0 has a sequence; an override action is refused
+        if child.tag not in ("AssignControllerAction", "ActivateControllerAction"):
+            raise unsupported(child)
+    return _dispatch(node.only_child(), ctx)
+
+
+def _wrapper(node: Node, ctx: Context) -> PrivateAction:
+    return _dispatch(node.only_child(), ctx)
+
+
+_READERS: dict[str, Callable[[Node, Context], PrivateAction]] = {
+    "LongitudinalAction": _wrapper,
+    "LateralAction": _wrapper,
+    "RoutingAction": _wrapper,
+    "ControllerAction": _controller,
+    "TeleportAction": _teleport,
+    "SpeedAction": _speed,
+    "LongitudinalDistanceAction": _longitudinal_distance,
+    "LaneChangeAction": _lane_change,
+    "LaneOffsetAction": _lane_offset,
+    "FollowTrajectoryAction": _follow_trajectory,
+    "ActivateControllerAction": _activate_controller,
+    "AssignControllerAction": _assign_controller,
+}
+
+
+def _dispatch(node: Node, ctx: Context) -> PrivateAction:
+    reader = _READERS.get(node.tag)
+    if reader is None:
+        raise unsupported(node)
+    return reader(node, ctx)
+
+
+def parse_private_action(node: Node, ctx: Context) -> PrivateAction:
+    """The action a PrivateAction element holds."""
+    return _dispatch(node.only_child(), ctx)

@@ -1,0 +1,243 @@
+"""Reading StartTrigger/StopTrigger elements: condition groups, conditions, and the
+ByValue/ByEntity condition kinds in `conditions`. Others: `not supported yet (<Name>)`."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+from avsim.scenario.openscenario.attributes import unsupported
+from avsim.scenario.openscenario.conditions import (
+    CollisionCondition,
+    Condition,
+    ConditionGroup,
+    ConditionKind,
+    DistanceCondition,
+    EndOfRoadCondition,
+    OffroadCondition,
+    ParameterCondition,
+    ReachPositionCondition,
+    RelativeDistanceCondition,
+    RelativeSpeedCondition,
+    SimulationTimeCondition,
+    SpeedCondition,
+    StandStillCondition,
+    StoryboardElementStateCondition,
+    TimeHeadwayCondition,
+    TimeToCollisionCondition,
+    TraveledDistanceCondition,
+    Trigger,
+    TriggeringEntities,
+)
+from avsim.scenario.openscenario.context import Context
+from avsim.scenario.openscenario.parse_positions import parse_position
+from avsim.scenario.openscenario.xmlread import Node
+
+RULES = ("greaterThan", "lessThan", "equalTo", "greaterOrEqual", "lessOrEqual", "notEqualTo")
+EDGES = ("none", "rising", "falling", "risingOrFalling")
+DISTANCE_TYPES = ("longitudinal", "lateral", "cartesianDistance", "euclidianDistance")
+COORDINATE_SYSTEMS = ("entity", "lane", "road", "trajectory")
+ELEMENT_TYPES = ("story", "act", "maneuver", "event", "action", "maneuverGroup")
+STATES = (
+    "startTransition",
+    "endTransition",
+    "stopTransition",
+    "skipTransition",
+    "completeState",
+    "runningState",
+    "standbyState",
+)
+
+
+def _rule(node: Node, ctx: Context) -> str:
+    return ctx.attrs.choice(node, "rule", RULES)
+
+
+def _coordinates(node: Node, ctx: Context) -> str:
+    """coordinateSystem (1.1+), or 1.0's alongRoute (true: road), default entity."""
+    if "coordinateSystem" in node.attrs:
+        return ctx.attrs.choice(node, "coordinateSystem", COORDINATE_SYSTEMS)
+    return "road" if ctx.attrs.boolean_or(node, "alongRoute", False) else "entity"
+
+
+def _distance_type(node: Node, ctx: Context, default: str) -> str:
+    return ctx.attrs.choice_or(node, "relativeDistanceType", DISTANCE_TYPES, default)
+
+
+def _simulation_time(node: Node, ctx: Context) -> ConditionKind:
+    return SimulationTimeCondition(ctx.attrs.number(node, "value"), _rule(node, ctx))  # type: ignore[arg-type]
+
+
+def _element_state(node: Node, ctx: Context) -> ConditionKind:
+    a = ctx.attrs
+    element_type = a.choice(node, "storyboardElementType", ELEMENT_TYPES)
+    return StoryboardElementStateCondition(
+        element_type=element_type,
+        element_ref=ctx.element_ref(node, element_type, "storyboardElementRef"),
+        state=a.choice(node, "state", STATES),
+    )
+
+
+def _parameter(node: Node, ctx: Context) -> ConditionKind:
+    a = ctx.attrs
+    parameter = a.text(node, "parameterRef")
+    if a.scope.get(parameter) is None:
+        raise node.error(f"parameterRef: no parameter {parameter}")
+    return ParameterCondition(parameter, a.text(node, "value"), _rule(node, ctx))  # type: ignore[arg-type]
+
+
+def _relative_distance(node: Node, ctx: Context) -> ConditionKind:
+    a = ctx.attrs
+    return RelativeDistanceCondition(
+        entity=ctx.entity_ref(node),
+        distance_type=_distance_type(node, ctx, "euclidianDistance"),  # type: ignore[arg-type]
+        value=a.number(node, "value"),
+        freespace=a.boolean(node, "freespace"),
+        rule=_rule(node, ctx),  # type: ignore[arg-type]
+        coordinate_system=_coordinates(node, ctx),  # type: ignore[arg-type]
+    )
+
+
+def _distance(node: Node, ctx: Context) -> ConditionKind:
+    a = ctx.attrs
+    return DistanceCondition(
+        position=parse_position(node.need("Position"), ctx),
+        value=a.number(node, "value"),
+        freespace=a.boolean(node, "freespace"),
+        rule=_rule(node, ctx),  # type: ignore[arg-type]
+        distance_type=_distance_type(node, ctx, "euclidianDistance"),  # type: ignore[arg-type]
+        coordinate_system=_coordinates(node, ctx),  # type: ignore[arg-type]
+    )
+
+
+def _time_headway(node: Node, ctx: Context) -> ConditionKind:
+    a = ctx.attrs
+    return TimeHeadwayCondition(
+        entity=ctx.entity_ref(node),
+        value=a.number(node, "value"),
+        freespace=a.boolean(node, "freespace"),
+        rule=_rule(node, ctx),  # type: ignore[arg-type]
+        coordinate_system=_coordinates(node, ctx),  # type: ignore[arg-type]
+        distance_type=_distance_type(node, ctx, "euclidianDistance"),  # type: ignore[arg-type]
+    )
+
+
+def _time_to_collision(node: Node, ctx: Context) -> ConditionKind:
+    a = ctx.attrs
+    target = node.need("TimeToCollisionConditionTarget").only_child()
+    entity = position = None
+    if target.tag == "EntityRef":
+        entity = ctx.entity_ref(target)
+    elif target.tag == "Position":
+        position = parse_position(target, ctx)
+    else:
+        raise unsupported(target)
+    return TimeToCollisionCondition(
+        entity=entity,
+        position=position,
+        value=a.number(node, "value"),
+        freespace=a.boolean(node, "freespace"),
+        rule=_rule(node, ctx),  # type: ignore[arg-type]
+        coordinate_system=_coordinates(node, ctx),  # type: ignore[arg-type]
+        distance_type=_distance_type(node, ctx, "euclidianDistance"),  # type: ignore[arg-type]
+    )
+
+
+def _reach_position(node: Node, ctx: Context) -> ConditionKind:
+    return ReachPositionCondition(
+        parse_position(node.need("Position"), ctx), ctx.attrs.number(node, "tolerance")
+    )
+
+
+def _speed(node: Node, ctx: Context) -> ConditionKind:
+    if "direction" in node.attrs:  # 1.2: a directional speed
+        raise node.error("not supported yet (SpeedCondition direction)")
+    return SpeedCondition(ctx.attrs.number(node, "value"), _rule(node, ctx))  # type: ignore[arg-type]
+
+
+def _relative_speed(node: Node, ctx: Context) -> ConditionKind:
+    if "direction" in node.attrs:
+        raise node.error("not supported yet (RelativeSpeedCondition direction)")
+    return RelativeSpeedCondition(
+        ctx.entity_ref(node),
+        ctx.attrs.number(node, "value"),
+        _rule(node, ctx),  # type: ignore[arg-type]
+    )
+
+
+def _collision(node: Node, ctx: Context) -> ConditionKind:
+    target = node.only_child()
+    if target.tag == "EntityRef":
+        return CollisionCondition(ctx.entity_ref(target), None)
+    if target.tag == "ByType":
+        kinds = ("pedestrian", "vehicle", "miscellaneous", "external")
+        return CollisionCondition(None, ctx.attrs.choice(target, "type", kinds))
+    raise unsupported(target)
+
+
+_VALUE: dict[str, Callable[[Node, Context], ConditionKind]] = {
+    "SimulationTimeCondition": _simulation_time,
+    "StoryboardElementStateCondition": _element_state,
+    "ParameterCondition": _parameter,
+}
+_ENTITY: dict[str, Callable[[Node, Context], ConditionKind]] = {
+    "RelativeDistanceCondition": _relative_distance,
+    "DistanceCondition": _distance,
+    "TimeHeadwayCondition": _time_headway,
+    "TimeToCollisionCondition": _time_to_collision,
+    "ReachPositionCondition": _reach_position,
+    "TraveledDistanceCondition": lambda n, c: TraveledDistanceCondition(c.attrs.number(n, "value")),
+    "SpeedCondition": _speed,
+    "RelativeSpeedCondition": _relative_speed,
+    "StandStillCondition": lambda n, c: StandStillCondition(c.attrs.number(n, "duration")),
+    "EndOfRoadCondition": lambda n, c: EndOfRoadCondition(c.attrs.number(n, "duration")),
+    "OffroadCondition": lambda n, c: OffroadCondition(c.attrs.number(n, "duration")),
+    "CollisionCondition": _collision,
+}
+
+
+_Readers = dict[str, Callable[[Node, Context], ConditionKind]]
+
+
+def _kind(node: Node, ctx: Context, readers: _Readers) -> ConditionKind:
+    reader = readers.get(node.tag)
+    if reader is None:
+        raise unsupported(node)
+    return reader(node, ctx)
+
+
+def parse_condition(node: Node, ctx: Context) -> Condition:
+    a = ctx.attrs
+    body = node.only_child()
+    triggering: TriggeringEntities | None = None
+    if body.tag == "ByValueCondition":
+        kind = _kind(body.only_child(), ctx, _VALUE)
+    elif body.tag == "ByEntityCondition":
+        te = body.need("TriggeringEntities")
+        triggering = TriggeringEntities(
+            rule=a.choice(te, "triggeringEntitiesRule", ("any", "all")),  # type: ignore[arg-type]
+            entities=tuple(ctx.entity_ref(e) for e in te.all("EntityRef")),
+        )
+        if not triggering.entities:
+            raise te.error("needs at least one EntityRef")
+        kind = _kind(body.need("EntityCondition").only_child(), ctx, _ENTITY)
+    else:
+        raise unsupported(body)
+    return Condition(
+        name=a.text(node, "name"),
+        delay=a.number(node, "delay"),
+        edge=a.choice(node, "conditionEdge", EDGES),  # type: ignore[arg-type]
+        triggering_entities=triggering,
+        kind=kind,
+    )
+
+
+def parse_trigger(node: Node | None, ctx: Context) -> Trigger | None:
+    """A StartTrigger/StopTrigger element as OR of ANDs; None when there is none."""
+    if node is None:
+        return None
+    return Trigger(
+        tuple(
+            ConditionGroup(tuple(parse_condition(c, ctx) for c in g.all("Condition")))
+            for g in node.all("ConditionGroup")
+        )
+    )

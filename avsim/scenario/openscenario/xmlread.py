@@ -1,0 +1,147 @@
+"""Safe XML reading with line numbers: a small element tree (`Node`) built with expat.
+
+DOCTYPE declarations and entities are refused (nothing is expanded), the file size and the
+number of elements are bounded, and a UTF-8 byte-order mark is accepted. Every node knows
+its file, its line and its path (`/OpenSCENARIO/Storyboard/Story[CutInStory]/...`, with the
+`name` attribute in brackets where present) so that any problem is reported as one line
+`<file>: line N: <path>: <problem>`.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from xml.parsers import expat
+
+from avsim.scenario.errors import ScenarioError
+
+MAX_FILE_BYTES = 20 * 1024 * 1024  # the largest file read [bytes]
+MAX_ELEMENTS = 200_000  # the most elements a file may hold
+
+
+class Node:
+    """An XML element: tag, attributes (as written), child elements, and where it is."""
+
+    __slots__ = ("attrs", "children", "file", "line", "parent", "tag")
+
+    def __init__(
+        self, tag: str, attrs: dict[str, str], file: str, line: int, parent: Node | None
+    ) -> None:
+        self.tag = tag
+        self.attrs = attrs
+        self.file = file
+        self.line = line
+        self.parent = parent
+        self.children: list[Node] = []
+
+    @property
+    def path(self) -> str:
+        """`/OpenSCENARIO/Storyboard/Story[CutInStory]`: tags from the root, with names."""
+        parts: list[str] = []
+        node: Node | None = self
+        while node is not None:
+            name = node.attrs.get("name")
+            parts.append(f"{node.tag}[{name}]" if name is not None else node.tag)
+            node = node.parent
+        return "/" + "/".join(reversed(parts))
+
+    @property
+    def key(self) -> str:
+        """The key of a problem here: `line N: <path>`."""
+        return f"line {self.line}: {self.path}"
+
+    def error(self, problem: str) -> ScenarioError:
+        """A `ScenarioError` at this element (to raise)."""
+        return ScenarioError(self.file, self.key, problem)
+
+    def child(self, tag: str) -> Node | None:
+        """The first child element with this tag, or None."""
+        for c in self.children:
+            if c.tag == tag:
+                return c
+        return None
+
+    def need(self, tag: str) -> Node:
+        """The first child element with this tag; an error when there is none."""
+        found = self.child(tag)
+        if found is None:
+            raise self.error(f"missing element {tag}")
+        return found
+
+    def all(self, tag: str) -> list[Node]:
+        """Every child element with this tag, in order."""
+        return [c for c in self.children if c.tag == tag]
+
+    def only_child(self) -> Node:
+        """The single child element of a choice element (`<Position><LanePosition/>`)."""
+        if len(self.children) != 1:
+            raise self.error(f"expected exactly one child element, found {len(self.children)}")
+        return self.children[0]
+
+
+class _RefusedError(Exception):
+    """Raised from an expat handler to stop the parse."""
+
+
+def read_xml(
+    path: Path, *, max_bytes: int = MAX_FILE_BYTES, max_elements: int = MAX_ELEMENTS
+) -> Node:
+    """The root element of the XML file at `path`; `ScenarioError` when it cannot be read,
+    is too large, is not well-formed, or declares a DOCTYPE or entities."""
+    file = str(path)
+    try:
+        size = path.stat().st_size
+        if size > max_bytes:
+            raise ScenarioError(file, "(file)", f"file too large: {size} bytes > {max_bytes}")
+        data = path.read_bytes()
+    except FileNotFoundError:
+        raise ScenarioError(file, "(file)", f"file not found: {file}") from None
+    except OSError as exc:
+        raise ScenarioError(file, "(file)", f"cannot read: {exc.strerror}") from None
+    return parse_xml_bytes(data, file, max_elements=max_elements)
+
+
+def parse_xml_bytes(data: bytes, file: str, *, max_elements: int = MAX_ELEMENTS) -> Node:
+    """The root element of an XML document given as bytes (see `read_xml`)."""
+    parser = expat.ParserCreate()
+    parser.SetParamEntityParsing(expat.XML_PARAM_ENTITY_PARSING_NEVER)
+    stack: list[Node] = []
+    roots: list[Node] = []
+    count = 0
+
+    def start(tag: str, attrs: dict[str, str]) -> None:
+        nonlocal count
+        count += 1
+        if count > max_elements:
+            raise _RefusedError(f"too many elements (more than {max_elements})")
+        parent = stack[-1] if stack else None
+        node = Node(tag, attrs, file, parser.CurrentLineNumber, parent)
+        if parent is None:
+            roots.append(node)
+        else:
+            parent.children.append(node)
+        stack.append(node)
+
+    def end(_tag: str) -> None:
+        stack.pop()
+
+    def doctype(*_args: object) -> None:
+        raise _RefusedError("DOCTYPE declarations are not allowed")
+
+    def entity(*_args: object) -> None:
+        raise _RefusedError("entity declarations are not allowed")
+
+    parser.StartElementHandler = start
+    parser.EndElementHandler = end
+    parser.StartDoctypeDeclHandler = doctype
+    parser.EntityDeclHandler = entity
+    parser.ExternalEntityRefHandler = lambda *_a: 0  # never fetch anything
+    try:
+        parser.Parse(data, True)
+    except _RefusedError as exc:
+        raise ScenarioError(file, f"line {parser.CurrentLineNumber}", str(exc)) from None
+    except expat.ExpatError as exc:
+        problem = expat.ErrorString(exc.code) if exc.code is not None else str(exc)
+        raise ScenarioError(file, f"line {exc.lineno}", f"malformed XML: {problem}") from None
+    if not roots:  # pragma: no cover - expat reports "no element found" first
+        raise ScenarioError(file, "(file)", "no root element")
+    return roots[0]

@@ -1,0 +1,113 @@
+"""UN R157 5.2.5.2 from the truth: a car cutting in from the next lane, slower than the ego;
+whether the regulation requires avoiding a collision with it decides, under
+`unavoidable: r157`, whether `no_collision` fails or reports it."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from avsim.criteria.base import TruthSample, Verdict
+from avsim.criteria.collision import NoCollision
+from avsim.criteria.cut_in import INTRUSION, R157_VISIBLE, CutInWatch
+from tests.roads import make_map, seg
+from world.actors.actor_set import ActorPoses
+from world.spec import ActorType
+
+ROAD = make_map(seg(2000.0, lanes=2, oncoming=0))
+EGO_LENGTH = 4.8  # [m]
+HALF = np.array([[2.5, 1.0, 0.9]])  # [m] the cutting-in car's half sizes
+DT = 1.0 / 40.0  # [s] the criteria rate
+BODY = 7  # the car's body id
+
+
+def poses(station: float, offset: float, speed: float,
+          kind: ActorType = ActorType.CAR) -> ActorPoses:
+    return ActorPoses(ids=("cutter",), kinds=(kind,), centres=np.zeros((1, 3)),
+                      yaws=np.zeros(1), half_sizes=HALF, stations=np.array([station]),
+                      offsets=np.array([offset]), speeds=np.array([speed]),
+                      accels=np.zeros(1))
+
+
+def sample(t: float, ego_s: float, actors: ActorPoses, touching: bool = False) -> TruthSample:
+    """The ego in lane 0 (offset 0) at 60 km/h."""
+    return TruthSample(t=t, speed=60 / 3.6, station=ego_s, front_station=ego_s + 2.4,
+                       tyres=np.zeros((4, 2)), tyre_stations=np.full(4, ego_s),
+                       tyre_offsets=np.array([0.7, -0.7, 0.7, -0.7]),
+                       touching=frozenset({BODY}) if touching else frozenset(), offset=0.0,
+                       actors=actors)
+
+
+def cut_in(gap: float, lateral: float = 1.0, speed: float = 40 / 3.6,
+           kind: ActorType = ActorType.CAR, start_moving: float = 1.0) -> list[TruthSample]:
+    """The car in lane 1 (3.5 m left), `gap` [m] ahead of the ego's front when its lateral
+    move (at `lateral` m/s from `start_moving` s) starts; the ego closes in; samples until
+    it is in the ego's lane, then one touching it."""
+    out = []
+    ego_v = 60 / 3.6
+    t = 0.0
+    ego_s = 100.0
+    car_s = ego_s + 2.4 + gap + 2.5 + (ego_v - speed) * start_moving
+    offset = 3.5
+    while offset > 0.2:
+        out.append(sample(t, ego_s, poses(car_s, offset, speed, kind)))
+        t += DT
+        ego_s += ego_v * DT
+        car_s += speed * DT
+        if t > start_moving:
+            offset -= lateral * DT
+    out.append(sample(t, ego_s, poses(car_s, offset, speed, kind), touching=True))
+    return out
+
+
+def judge(samples: list[TruthSample]) -> tuple[CutInWatch, NoCollision]:
+    watch = CutInWatch(ROAD, EGO_LENGTH)
+    criterion = NoCollision({BODY: "actor cutter"}, {BODY: "cutter"}, watch)
+    for s in samples:
+        criterion.update(s)
+    return watch, criterion
+
+
+def test_a_cut_in_far_enough_ahead_must_be_avoided() -> None:
+    """30 m ahead at 20 km/h slower, 1 m/s across: TTC at the intrusion well over
+    5.56 / 12 + 0.35 s, its movement seen for more than 0.72 s: the collision fails."""
+    watch, criterion = judge(cut_in(30.0))
+    (c,) = watch.cut_ins.values()
+    assert c.required and c.v_rel == pytest.approx(20 / 3.6)
+    assert c.visible_for >= R157_VISIBLE
+    # the intrusion: the car's right side INTRUSION inside the lane's left edge (1.75 m)
+    assert c.t == pytest.approx(1.0 + (3.5 - 1.0 - 1.75 + INTRUSION) / 1.0, abs=2 * DT)
+    result = criterion.result()
+    assert result.verdict is Verdict.FAIL and criterion.count == 1
+
+
+def test_a_cut_in_too_close_is_reported_not_failed() -> None:
+    """7 m ahead when it starts across at 1 m/s: 1.6 m at the intrusion, TTC 0.3 s, under
+    the bound of 0.81 s: unavoidable."""
+    watch, criterion = judge(cut_in(7.0))
+    (c,) = watch.cut_ins.values()
+    assert not c.required and "TTC at lane intrusion" in c.reason()
+    result = criterion.result()
+    assert result.verdict is Verdict.NOT_APPLICABLE and criterion.count == 0
+    assert "unavoidable under UN R157 5.2.5.2" in (result.note or "")
+
+
+def test_a_lateral_move_seen_too_briefly_is_unavoidable() -> None:
+    """Across at 2 m/s: in the lane 0.49 s after it started moving: seen under 0.72 s."""
+    watch, _ = judge(cut_in(30.0, lateral=2.0))
+    (c,) = watch.cut_ins.values()
+    assert c.visible_for < R157_VISIBLE and not c.required
+    assert "visible" in c.reason()
+
+
+def test_a_pedestrian_is_no_cutting_in_vehicle() -> None:
+    watch, criterion = judge(cut_in(7.0, kind=ActorType.PEDESTRIAN))
+    assert watch.cut_ins == {}
+    assert criterion.result().verdict is Verdict.FAIL  # every collision with it fails
+
+
+def test_without_the_setting_every_collision_fails() -> None:
+    criterion = NoCollision({BODY: "actor cutter"})
+    for s in cut_in(7.0):
+        criterion.update(s)
+    assert criterion.result().verdict is Verdict.FAIL

@@ -1,0 +1,60 @@
+"""ALKS (UN R157) 4.1.1 free driving and 4.1.3 a side vehicle: 5 km of the curved road at
+60 km/h, and beside an 18.75 m truck in the next lane; the car keeps its lane to the
+StopTrigger (300 s), touches nothing and keeps its speed."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+import pytest
+
+from avsim.run.runner import RunResult
+from tests.scenarios import alks
+
+pytestmark = pytest.mark.slow
+
+
+@pytest.fixture(scope="module")
+def free(run_scenario: Callable[..., RunResult]) -> RunResult:
+    return alks.run(run_scenario, "4_1_1")
+
+
+@pytest.fixture(scope="module")
+def side(run_scenario: Callable[..., RunResult]) -> RunResult:
+    return alks.run(run_scenario, "4_1_3")
+
+
+def test_free_driving_covers_its_5_km_of_curves_in_its_lane(free: RunResult) -> None:
+    assert alks.ended_by_stop_trigger(free)
+    assert free.sim_time == pytest.approx(5000.0 / (60 * alks.KPH), abs=0.05)
+    log = free.log
+    assert log.array("station")[-1] - log.array("station")[0] > 4900.0  # it drove the road
+    curvature = np.abs([seg.curvature for seg in free.scenario.world.road.segments])
+    assert curvature.max() > 3e-3  # the road's 250 m arcs and the clothoids into them
+    assert not alks.failed(free), alks.failed(free)
+    v = log.array("speed")[log.array("t") > 5.0]
+    assert np.all(np.abs(v - 60 * alks.KPH) < 2 * alks.KPH)  # its Init speed held
+
+
+def test_the_side_truck_starts_beside_the_ego_in_the_next_lane(side: RunResult) -> None:
+    assert alks.ended_by_stop_trigger(side)
+    (truck,) = side.scenario.world.actors
+    assert truck.model is not None and truck.model.length == 18.75
+    s, offset = alks.actor(side, "SideVehicle")
+    ego_s = side.log.array("station")
+    beside = np.abs(s - ego_s) < 0.5 * (18.75 + 4.8)  # alongside, overlapping
+    assert beside[:40].all()  # the first second
+    lane = np.round(offset / alks.LANE_WIDTH)
+    assert np.all(lane == alks.EGO_LANE + 1)  # the next lane left, 0.5 m towards the ego
+    assert not alks.failed(side), alks.failed(side)
+    assert alks.verdicts(side)["tyres_in_lane"].value > 0.3  # margin to the lines [m]
+
+
+@pytest.mark.xfail(strict=True, reason="the truck's body hides the ego lane's left line from "
+                   "the front camera; the lane source drops to MAP_HOLD and the car slows to "
+                   "its hold speed (~7 m/s) until the truck is ahead: a one-line lane is not "
+                   "kept (issue K)")
+def test_the_ego_keeps_its_speed_beside_the_truck(side: RunResult) -> None:
+    v = side.log.array("speed")
+    assert np.all(np.abs(v - 60 * alks.KPH) < 2 * alks.KPH)

@@ -1,0 +1,226 @@
+"""An OpenDRIVE road as the simulator's route road: the `RoadSpec` that `world.map.road`
+lays into the HD map the stack reads, built from the same file as the world's meshes.
+
+The route runs along the road's driving lanes right of its reference line (right-hand
+traffic, increasing s). Route lane 0 is the outermost of them, and the route's reference line
+is that lane's centre: the OpenDRIVE reference line's arc spline (`arc_spline`, exact start
+points and headings, < `TOLERANCE` off the exact curve) offset sideways by the lane's
+constant offset `ref_t`. An arc offset sideways is an arc, so the route's pieces are exact
+offsets of the spline's.
+
+Across, from the lane section:
+
+- `lanes`: the contiguous run of `driving` lanes right of the reference line, equal widths,
+  constant along the section (width records with b = c = d = 0);
+- `shoulder`: the width of the lane right of the outermost driving lane when its type is
+  `shoulder` or `stop` (a hard shoulder), else 0;
+- `oncoming_lanes`: the driving lanes left of the reference line when they adjoin the ego's
+  (no median between them), of the same width; a carriageway beyond a median is not part
+  of the route (not drawn: said in docs/openscenario.md);
+- the paint: each lane's road mark lies on its outer border (OpenDRIVE); a boundary between
+  the route's lanes takes the mark of the lane nearer the reference line.
+
+The speed limit: a lane's `<speed max>`, else the road type record's, else the type's
+default (`TYPE_LIMITS`: the German rules, the motorway's advisory 130 km/h).
+
+What does not fit this yet is refused with `OpenDriveError` "not supported yet (...)":
+several lane sections with different layouts, lane widths varying along s, lane offsets,
+left-hand traffic, roads linked into a network, road marks other than solid / broken / none.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from world.frames import MPS_PER_KPH
+from world.hdmap import LineMark, LinePaint, MarkKind, PaintColour, Zone
+from world.map.opendrive.arcspline import ArcPiece, arc_spline, piece_points
+from world.map.opendrive.errors import OpenDriveError
+from world.map.opendrive.model import LaneSection, OdrLane, OpenDrive, Road, RoadMark
+from world.spec import RoadSpec, SegmentSpec
+
+TOLERANCE = 1e-3  # [m] the route's pieces keep this close to the file's exact reference line
+SHOULDER_TYPES = frozenset({"shoulder", "stop"})
+TYPE_LIMITS = {  # [km/h] a road type's limit where the file posts none (German rules)
+    "motorway": 130.0,  # the advisory speed (Richtgeschwindigkeit)
+    "rural": 100.0,
+    "town": 50.0,
+    "lowSpeed": 30.0,
+    "pedestrian": 7.0,
+    "bicycle": 25.0,
+    "unknown": 100.0,
+}
+ZONES = {"motorway": Zone.HIGHWAY, "rural": Zone.HIGHWAY}  # others: Zone.CITY
+MARK_KINDS = {"solid": MarkKind.SOLID, "broken": MarkKind.BROKEN, "none": MarkKind.NONE}
+WHITE = frozenset({"standard", "white"})
+
+
+@dataclass(frozen=True, slots=True)
+class Layout:
+    """A lane section's layout as the route sees it."""
+
+    lane_ids: tuple[int, ...]  # OpenDRIVE ids of route lanes 0, 1, ... (outermost first)
+    oncoming_ids: tuple[int, ...]  # ids of the adjoining oncoming lanes, nearest first
+    lane_width: float  # [m]
+    shoulder: float  # [m]
+    ref_t: float  # [m] route lane 0's centre offset from the OpenDRIVE reference line
+    paint: LinePaint
+    speed: float | None  # [m/s] the lanes' own <speed max>, if every one posts the same
+
+
+@dataclass(frozen=True, slots=True)
+class OdrRoute:
+    """An OpenDRIVE road as the route: the spec, and how the file's lanes map onto it."""
+
+    spec: RoadSpec
+    road: Road
+    layout: Layout
+
+    def lane_index(self, lane_id: int) -> int | None:
+        """The route lane index of OpenDRIVE lane `lane_id` (None: not a route lane)."""
+        ids = self.layout.lane_ids
+        return ids.index(lane_id) if lane_id in ids else None
+
+    def point(self, s: float, t: float) -> tuple[float, float, float]:
+        """([m] x, [m] y, [rad] heading) of the file's road coordinates (s, t): exact."""
+        x, y, h = self.road.plan_view.pose(np.array([s]))
+        heading = float(h[0])
+        return (float(x[0]) - t * math.sin(heading), float(y[0]) + t * math.cos(heading),
+                heading)
+
+
+def _refuse(odr: OpenDrive, what: str) -> OpenDriveError:
+    return OpenDriveError(odr.path, f"not supported yet ({what})")
+
+
+def build_route(odr: OpenDrive) -> OdrRoute:
+    """The route road of the file's one road (module doc); raises `OpenDriveError`."""
+    if len(odr.roads) != 1:
+        raise _refuse(odr, f"{len(odr.roads)} roads: road networks")
+    road = odr.roads[0]
+    if road.rule != "RHT":
+        raise _refuse(odr, "left-hand traffic")
+    if any(p.a != 0.0 or p.b != 0.0 or p.c != 0.0 or p.d != 0.0 for p in road.lane_offsets):
+        raise _refuse(odr, "lane offsets")
+    layouts = {_layout(odr, section) for section in road.lane_sections}
+    if len(layouts) != 1:
+        raise _refuse(odr, "lane sections with different layouts")
+    (layout,) = layouts
+    pieces = _split(arc_spline(road.plan_view, TOLERANCE),
+                    [r.s for r in road.speeds if 0.0 < r.s < road.plan_view.length])
+    segments = []
+    for piece in pieces:
+        scale = 1.0 - piece.curvature * layout.ref_t
+        if not scale > 0.0:
+            raise OpenDriveError(odr.path, f"the reference line's radius at s = "
+                                 f"{piece.s0:g} m is inside the route's lanes")
+        heading = piece.heading0
+        start = (piece.x0 - layout.ref_t * math.sin(heading),
+                 piece.y0 + layout.ref_t * math.cos(heading), heading)
+        limit, zone = _limit(road, layout, piece.s0)
+        segments.append(SegmentSpec(
+            length=piece.length * scale, curvature=piece.curvature / scale,
+            lanes=len(layout.lane_ids), oncoming_lanes=len(layout.oncoming_ids),
+            lane_width=layout.lane_width, shoulder=layout.shoulder, speed_limit=limit,
+            zone=zone, start=start, paint=layout.paint))
+    first = segments[0]
+    assert first.start is not None and first.speed_limit is not None
+    return OdrRoute(RoadSpec(tuple(segments), first.speed_limit, origin=first.start), road,
+                    layout)
+
+
+def _split(pieces: list[ArcPiece], stations: list[float]) -> list[ArcPiece]:
+    """`pieces` split at `stations` [m] (exactly: a part of an arc is an arc)."""
+    out: list[ArcPiece] = []
+    for p in pieces:
+        cuts = sorted(s for s in stations if p.s0 < s < p.s0 + p.length)
+        for a, b in zip([p.s0, *cuts], [*cuts, p.s0 + p.length], strict=True):
+            x, y = piece_points(p, np.array([a - p.s0]))
+            out.append(ArcPiece(a, b - a, p.curvature, float(x[0]), float(y[0]),
+                                p.heading0 + p.curvature * (a - p.s0)))
+    return out
+
+
+def _limit(road: Road, layout: Layout, s: float) -> tuple[float, Zone]:
+    """([m/s] the limit in force at station s, the zone) (module doc)."""
+    records = [r for r in road.speeds if r.s <= s + 1e-9]
+    record = records[-1] if records else None
+    road_type = record.road_type if record is not None else "unknown"
+    zone = ZONES.get(road_type, Zone.CITY)
+    if layout.speed is not None:
+        return layout.speed, zone
+    if record is not None and record.max_speed is not None:
+        return record.max_speed, zone
+    return TYPE_LIMITS.get(road_type, TYPE_LIMITS["unknown"]) * MPS_PER_KPH, zone
+
+
+def _constant_width(odr: OpenDrive, lane: OdrLane) -> float:
+    """[m] the lane's width, which must not change along its section."""
+    widths = {(w.a, w.b, w.c, w.d) for w in lane.widths}
+    if len(widths) != 1:
+        raise _refuse(odr, f"lane {lane.id}: widths that change along the lane section")
+    (a, b, c, d), = widths
+    if b != 0.0 or c != 0.0 or d != 0.0:
+        raise _refuse(odr, f"lane {lane.id}: widths that change along the lane section")
+    return a
+
+
+def _layout(odr: OpenDrive, section: LaneSection) -> Layout:
+    """The route's view of one lane section (module doc)."""
+    right = section.right
+    first = next((i for i, lane in enumerate(right) if lane.type == "driving"), None)
+    if first is None:
+        raise _refuse(odr, f"a lane section at s = {section.s:g} m without driving lanes "
+                           "right of the reference line")
+    end = first
+    while end < len(right) and right[end].type == "driving":
+        end += 1
+    drive = right[first:end]  # nearest the reference line first
+    widths = {_constant_width(odr, lane) for lane in drive}
+    if len(widths) != 1:
+        raise _refuse(odr, "driving lanes of different widths")
+    (w,) = widths
+    inner = sum(_constant_width(odr, lane) for lane in right[:first])
+    ref_t = -(inner + (len(drive) - 0.5) * w)
+    outside = right[end] if end < len(right) else None
+    shoulder = (_constant_width(odr, outside)
+                if outside is not None and outside.type in SHOULDER_TYPES else 0.0)
+    oncoming: tuple[OdrLane, ...] = ()
+    if first == 0:
+        n = 0
+        while n < len(section.left) and section.left[n].type == "driving":
+            n += 1
+        oncoming = section.left[:n]
+        if any(_constant_width(odr, lane) != w for lane in oncoming):
+            raise _refuse(odr, "oncoming lanes of another width than the route's")
+    # a lane's mark lies on its outer border: lane 0's right edge is its own mark, the line
+    # between route lanes i - 1 and i is lane i's (nearer the reference line), the left edge
+    # the mark of the lane inside the route's innermost (the centre lane's for -1)
+    marks = [_mark(odr, lane) for lane in reversed(drive)]  # outermost first
+    inside = right[first - 1] if first > 0 else section.center
+    paint = LinePaint(right_edge=marks[0], lane_lines=tuple(marks[1:]),
+                      left_edge=_mark(odr, inside),
+                      oncoming=tuple(_mark(odr, lane) for lane in oncoming))
+    speeds = {lane.speed for lane in drive}
+    speed = speeds.pop() if len(speeds) == 1 else None
+    return Layout(tuple(lane.id for lane in reversed(drive)),
+                  tuple(lane.id for lane in oncoming), w, shoulder, ref_t, paint, speed)
+
+
+def _mark(odr: OpenDrive, lane: OdrLane) -> LineMark:
+    """The line painted on `lane`'s outer border."""
+    if not lane.road_marks:
+        return LineMark(MarkKind.NONE, 0.0)
+    if len(lane.road_marks) > 1:
+        raise _refuse(odr, f"lane {lane.id}: road marks that change along the lane section")
+    mark: RoadMark = lane.road_marks[0]
+    kind = MARK_KINDS.get(mark.type)
+    if kind is None:
+        raise _refuse(odr, f"lane {lane.id}: road mark type {mark.type!r}")
+    if mark.color not in WHITE and mark.color != "yellow":
+        raise _refuse(odr, f"lane {lane.id}: road mark colour {mark.color!r}")
+    colour = PaintColour.YELLOW if mark.color == "yellow" else PaintColour.WHITE
+    return LineMark(kind, mark.width, colour)

@@ -1,0 +1,162 @@
+"""A minimal, safe XML element tree with the line of each start tag, for error messages.
+
+Built with the stdlib expat parser: no DTD (a DOCTYPE is refused, so no entity expansion), a
+bounded number of elements. Each `Node` knows its file, line and path
+(`/OpenDRIVE/road[id=0]/planView/geometry[3]/spiral`: an element with an `id` attribute is
+named by it, one of several same-tag siblings by its 1-based position as in XPath).
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass, field
+from xml.parsers import expat
+
+from world.map.opendrive.errors import OpenDriveError
+
+MAX_ELEMENTS = 5_000_000  # elements in one file
+MAX_MAGNITUDE = 1e9  # no number in a file is larger (coordinates [m], lengths, coefficients)
+IGNORED = frozenset({"userData"})  # children skipped wherever they appear
+NUMBER = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?")
+# how an unsupported element is named in "not supported yet (...)", where not by its tag
+UNSUPPORTED_AS = {"junction": "junctions", "border": "lane border"}
+
+
+@dataclass(eq=False)
+class Node:
+    """One element: tag, attributes, children (in file order), where it is."""
+
+    tag: str
+    attrib: dict[str, str]
+    file: str
+    line: int  # 1-based line of its start tag
+    parent: Node | None = None
+    children: list[Node] = field(default_factory=list)
+
+    @property
+    def path(self) -> str:
+        """Its element path from the root (module doc)."""
+        here = self.tag
+        if "id" in self.attrib:
+            here += f"[id={self.attrib['id']}]"
+        elif self.parent is not None:
+            same = [c for c in self.parent.children if c.tag == self.tag]
+            if len(same) > 1:
+                here += f"[{next(i for i, c in enumerate(same) if c is self) + 1}]"
+        return (self.parent.path if self.parent is not None else "") + "/" + here
+
+    def error(self, problem: str) -> OpenDriveError:
+        """The error `problem` at this element."""
+        return OpenDriveError(self.file, problem, self.line, self.path)
+
+    def unsupported(self, what: str | None = None) -> OpenDriveError:
+        """'not supported yet (what)' at this element (`what` defaults to its tag)."""
+        name = what or UNSUPPORTED_AS.get(self.tag, self.tag)
+        return self.error(f"not supported yet ({name})")
+
+    def get(self, name: str, default: str | None = None) -> str:
+        """The attribute `name`, else `default`; an error if missing and no default."""
+        value = self.attrib.get(name, default)
+        if value is None:
+            raise self.error(f"missing attribute {name}")
+        return value
+
+    def num(self, name: str, default: float | None = None) -> float:
+        """The finite number attribute `name` (else `default`)."""
+        raw = self.attrib.get(name)
+        if raw is None:
+            if default is None:
+                raise self.error(f"missing attribute {name}")
+            return default
+        if not NUMBER.fullmatch(raw.strip()):
+            raise self.error(f"{name} is not a number ({raw!r})")
+        value = float(raw)
+        if not math.isfinite(value):
+            raise self.error(f"{name} is not a finite number ({raw!r})")
+        if abs(value) > MAX_MAGNITUDE:
+            raise self.error(f"{name} is beyond the limit of {MAX_MAGNITUDE:g} ({raw!r})")
+        return value
+
+    def integer(self, name: str, default: int | None = None) -> int:
+        """The integer attribute `name` (else `default`)."""
+        raw = self.attrib.get(name)
+        if raw is None:
+            if default is None:
+                raise self.error(f"missing attribute {name}")
+            return default
+        if not re.fullmatch(r"[+-]?\d{1,18}", raw.strip()):
+            raise self.error(f"{name} is not an integer ({raw!r})")
+        return int(raw)
+
+    def only(self, *allowed: str) -> dict[str, list[Node]]:
+        """Its children by tag; an unsupported-error for a child not `allowed` (userData is
+        skipped)."""
+        groups: dict[str, list[Node]] = {tag: [] for tag in allowed}
+        for child in self.children:
+            if child.tag in IGNORED:
+                continue
+            if child.tag not in groups:
+                raise child.unsupported()
+            groups[child.tag].append(child)
+        return groups
+
+    def at_most_one(self, nodes: list[Node], tag: str) -> Node | None:
+        """The single node of `nodes` (children `tag`), None if none; an error if several."""
+        if len(nodes) > 1:
+            raise nodes[1].error(f"more than one <{tag}>")
+        return nodes[0] if nodes else None
+
+    def exactly_one(self, nodes: list[Node], tag: str) -> Node:
+        """The single node of `nodes` (children `tag`); an error if none or several."""
+        node = self.at_most_one(nodes, tag)
+        if node is None:
+            raise self.error(f"missing <{tag}>")
+        return node
+
+
+class _RefusedError(Exception):
+    """Raised inside an expat handler: the document uses something refused."""
+
+
+def parse_xml(file: str, data: bytes) -> Node:
+    """The root element of the XML document `data` read from `file`."""
+    parser = expat.ParserCreate()
+    parser.SetParamEntityParsing(expat.XML_PARAM_ENTITY_PARSING_NEVER)
+    stack: list[Node] = []
+    roots: list[Node] = []
+    count = [0]
+
+    def start(tag: str, attrib: dict[str, str]) -> None:
+        count[0] += 1
+        if count[0] > MAX_ELEMENTS:
+            raise _RefusedError(f"more than {MAX_ELEMENTS} elements")
+        parent = stack[-1] if stack else None
+        node = Node(tag, attrib, file, parser.CurrentLineNumber, parent)
+        (parent.children if parent is not None else roots).append(node)
+        stack.append(node)
+
+    def end(tag: str) -> None:
+        stack.pop()
+
+    def doctype(*args: object) -> None:
+        raise _RefusedError(f"DOCTYPE at line {parser.CurrentLineNumber} refused (no DTDs)")
+
+    def entity(*args: object) -> None:
+        raise _RefusedError(f"entity declaration at line {parser.CurrentLineNumber} refused")
+
+    parser.StartElementHandler = start
+    parser.EndElementHandler = end
+    parser.StartDoctypeDeclHandler = doctype
+    parser.EntityDeclHandler = entity
+    try:
+        parser.Parse(data, True)
+    except expat.ExpatError as e:
+        raise OpenDriveError(
+            file, f"malformed XML at line {e.lineno}: {expat.ErrorString(e.code)}"
+        ) from None
+    except _RefusedError as e:
+        raise OpenDriveError(file, str(e)) from None
+    if not roots:
+        raise OpenDriveError(file, "no root element")
+    return roots[0]
