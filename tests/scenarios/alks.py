@@ -29,16 +29,26 @@ def path(number: str) -> Path:
     return found
 
 
-def run(run_scenario: Callable[..., RunResult], number: str) -> RunResult:
-    return run_scenario(str(path(number)), record=False, profile=PROFILE, criteria="r157")
+def run(run_scenario: Callable[..., RunResult], number: str, **overrides: object) -> RunResult:
+    return run_scenario(str(path(number)), record=False, profile=PROFILE, criteria="r157",
+                        **overrides)
+
+
+def run_on_the_map(run_scenario: Callable[..., RunResult], number: str) -> RunResult:
+    """A run that judges no perception: map and GNSS only (no camera or LiDAR), the GNSS an
+    RTK receiver (a consumer one's metre of bias needs the camera's lane). The two 300 s
+    free-driving files run so: with the cameras they would cost 7 min of a worker."""
+    return run_scenario(str(path(number)), record=False, profile=None, criteria="r157",
+                        **{"sensors.gnss": {"preset": "rtk"}})
 
 
 def verdicts(result: RunResult) -> dict[str, CriterionResult]:
     return {c.name: c for c in result.criteria}
 
 
-def failed(result: RunResult) -> list[str]:
-    return [f"{c.name}: {c.note or c.value}" for c in result.criteria if c.failed]
+def failed(result: RunResult, ignore: tuple[str, ...] = ()) -> list[str]:
+    return [f"{c.name}: {c.note or c.value}" for c in result.criteria
+            if c.failed and c.name not in ignore]
 
 
 def actor(result: RunResult, entity: str) -> tuple[NDArray[np.float64], NDArray[np.float64]]:

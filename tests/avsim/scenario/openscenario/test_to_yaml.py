@@ -29,7 +29,7 @@ def test_the_cut_in_converts_to_a_yaml_scenario_that_loads(tmp_path: Path) -> No
     path = tmp_path / "cut_in.yaml"
     path.write_text(yaml.safe_dump(doc, sort_keys=False), encoding="utf-8")
     scenario = load_scenario(path)
-    assert scenario.world.actors[0].s == pytest.approx(5.0 + 30.0 + 200.0 / 36.0 + 1.4)
+    assert scenario.world.actors[0].s == pytest.approx(5.0 + 30.0 + 200.0 / 3.6 + 1.4)
     misfits = "\n".join(conversion.misfits)
     assert "sinusoidal shape" in misfits and "StopTrigger" in misfits
     assert "box 5 x 2 x 1.8 m" in misfits  # the catalogue has no such car
