@@ -625,13 +625,19 @@ class RoadMap:
         """
         s_arr, d_arr = self.local_coordinates(_as_float(xy).reshape(2))
         s, d = float(s_arr), float(d_arr)
+        lane, r = self.lane_of(s, d)
+        return lane, s, r
+
+    def lane_of(self, s: float, d: float) -> tuple[int | None, float]:
+        """(lane index or None, r from that lane's centre, or d with None) of route
+        coordinates (s, d): `lane_at` for a point already projected."""
         c = self.cross_section_at(s)
         w = c.lane_width
         if not 0.0 <= s <= self.length:
-            return None, s, d
+            return None, d
         band = int(np.floor((d + 0.5 * w) / w))  # 0 .. lanes - 1 ego, then oncoming
         if 0 <= band < c.lanes:
-            return band, s, d - band * w
+            return band, d - band * w
         if c.lanes <= band < c.lanes + c.oncoming_lanes:
-            return c.lanes - 1 - band, s, d - band * w
-        return None, s, d
+            return c.lanes - 1 - band, d - band * w
+        return None, d

@@ -10,8 +10,6 @@ do not touch each other in the physics).
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from avsim.run.storyboard.snapshot import EntityState, Snapshot
@@ -73,7 +71,7 @@ class TruthTracker:
             name: EntityState(
                 name=name, x=float(x[k]), y=float(y[k]), heading=float(yaw[k]),
                 speed=float(speed[k]), s=float(s[k]), offset=float(d[k]),
-                lane=_lane(self.road, float(s[k]), float(d[k])),
+                lane=self.road.lane_of(float(s[k]), float(d[k]))[0],
                 route_heading=float(route_heading[k]), length=float(self.lengths[k]),
                 width=float(self.widths[k]), centre_ahead=float(self.ahead[k]),
                 odometer=float(self.odometer[k]), standing_for=float(self.standing[k]),
@@ -92,18 +90,4 @@ class TruthTracker:
         self.off_road = np.where(off, self.off_road + dt, 0.0)
         beyond = (s <= 0.0) | (s >= self.road.length)
         self.beyond = np.where(beyond, self.beyond + dt, 0.0)
-
-
-def _lane(road: RoadMap, s: float, d: float) -> int | None:
-    """The route lane at (s, d) (None: off every lane), as `RoadMap.lane_at` bands them."""
-    c = road.cross_section_at(s)
-    w = c.lane_width
-    band = math.floor((d + 0.5 * w) / w)
-    if not 0.0 <= s <= road.length:
-        return None
-    if 0 <= band < c.lanes:
-        return band
-    if c.lanes <= band < c.lanes + c.oncoming_lanes:
-        return c.lanes - 1 - band
-    return None
 
