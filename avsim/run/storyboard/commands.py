@@ -133,7 +133,7 @@ class Commands:
 
     def trajectory(self, tag: str, action: FollowTrajectoryAction, me: EntityState,
                    snap: Snapshot) -> PathCommand:
-        poses = {name: Pose(e.x, e.y, e.heading) for name, e in snap.entities.items()}
+        poses = poses_of(snap)
         points = [self.resolver.resolve(v.position, poses) for v in
                   action.trajectory.shape.vertices]
         ahead = me.centre_ahead
@@ -171,6 +171,11 @@ class Commands:
         top = c.max_speed if c is not None and c.max_speed else max_speed
         reached = abs(gap - want) < GAP_REACHED and abs(me.speed - ref.speed) < SPEED_MATCHED
         return TrackCommand(follow.tag, min(target, top), accel, decel, top), reached
+
+
+def poses_of(snap: Snapshot) -> dict[str, Pose]:
+    """Each entity's reference point pose, as positions refer to them."""
+    return {name: Pose(e.x, e.y, e.heading) for name, e in snap.entities.items()}
 
 
 def _speed_target(action: SpeedAction, snap: Snapshot) -> float:

@@ -14,7 +14,8 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 
-from avsim.run.storyboard.commands import Commands, Follow
+from avsim.run.storyboard.commands import Commands, Follow, poses_of
+from avsim.run.storyboard.conditions import Resolved
 from avsim.run.storyboard.runtime import StartedAction, StoryRuntime
 from avsim.run.storyboard.snapshot import Snapshot
 from avsim.run.storyboard.truth import TruthTracker
@@ -25,6 +26,7 @@ from avsim.scenario.openscenario.model import (
     LaneChangeAction,
     LaneOffsetAction,
     LongitudinalDistanceAction,
+    Position,
     PrivateAction,
     SpeedAction,
 )
@@ -49,18 +51,10 @@ class Director:
         self.program = program
         self.world = world
         self.truth = TruthTracker(program, world)
-        resolver = Resolver(program.road)
-
-        def resolve(position: object, snap: Snapshot) -> tuple[float, float, float, float]:
-            from avsim.scenario.openscenario.resolve import Pose
-            poses = {n: Pose(e.x, e.y, e.heading) for n, e in snap.entities.items()}
-            p = resolver.resolve(position, poses)  # type: ignore[arg-type]
-            s, d = world.road.local_coordinates((p.x, p.y))
-            return p.x, p.y, float(s), float(d)
-
+        self.resolver = Resolver(program.road)
         osc = program.scenario
-        self.runtime = StoryRuntime(osc.storyboard, osc.parameters, resolve)
-        self.commands = Commands(world.road, resolver, program.lane_ids)
+        self.runtime = StoryRuntime(osc.storyboard, osc.parameters, self._resolve)
+        self.commands = Commands(world.road, self.resolver, program.lane_ids)
         self._index = dict(program.actors)
         self._pending: dict[str, set[str]] = {}  # action id -> tags still running
         self._follows: dict[str, Follow] = {}  # tag -> a command renewed every check
@@ -70,6 +64,12 @@ class Director:
         self._first = True
         self._top = {e.name: getattr(e.object, "max_speed", WALKING_TOP)
                      for e in osc.entities}  # [m/s] each entity's top speed
+
+    def _resolve(self, position: Position, snap: Snapshot) -> Resolved:
+        """Where a condition's position is now: map (x, y), route (s, offset)."""
+        p = self.resolver.resolve(position, poses_of(snap))
+        s, d = self.world.road.local_coordinates((p.x, p.y))
+        return p.x, p.y, float(s), float(d)
 
     # -- stepping -------------------------------------------------------------------------------
 
