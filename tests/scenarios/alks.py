@@ -76,3 +76,11 @@ def ended_by_stop_trigger(result: RunResult) -> bool:
 
 def passed(result: RunResult, name: str) -> bool:
     return verdicts(result)[name].verdict is Verdict.PASS
+
+
+def stopped_short(result: RunResult, entity: str) -> float:
+    """[m] how far the ego's front stood from the target's centre at the end (> 0: short)."""
+    s, _ = actor(result, entity)
+    front = result.log.array("station")[-1] + 2.4
+    assert result.log.array("speed")[-1] < 0.1  # it stands
+    return float(s[-1] - front)
