@@ -10,9 +10,9 @@ its file, its line and its path (`/OpenSCENARIO/Storyboard/Story[CutInStory]/...
 from __future__ import annotations
 
 from pathlib import Path
-from xml.parsers import expat
 
 from avsim.scenario.errors import ScenarioError
+from world.core.safe_xml import Refusal, XmlMalformedError, XmlRefusedError, parse_tree
 
 MAX_FILE_BYTES = 20 * 1024 * 1024  # the largest file read [bytes]
 MAX_ELEMENTS = 200_000  # the most elements a file may hold
@@ -78,10 +78,6 @@ class Node:
         return self.children[0]
 
 
-class _RefusedError(Exception):
-    """Raised from an expat handler to stop the parse."""
-
-
 def read_xml(
     path: Path, *, max_bytes: int = MAX_FILE_BYTES, max_elements: int = MAX_ELEMENTS
 ) -> Node:
@@ -101,47 +97,21 @@ def read_xml(
 
 
 def parse_xml_bytes(data: bytes, file: str, *, max_elements: int = MAX_ELEMENTS) -> Node:
-    """The root element of an XML document given as bytes (see `read_xml`)."""
-    parser = expat.ParserCreate()
-    parser.SetParamEntityParsing(expat.XML_PARAM_ENTITY_PARSING_NEVER)
-    stack: list[Node] = []
-    roots: list[Node] = []
-    count = 0
+    """The root element of an XML document given as bytes (see `read_xml`;
+    `world.core.safe_xml` parses)."""
 
-    def start(tag: str, attrs: dict[str, str]) -> None:
-        nonlocal count
-        count += 1
-        if count > max_elements:
-            raise _RefusedError(f"too many elements (more than {max_elements})")
-        parent = stack[-1] if stack else None
-        node = Node(tag, attrs, file, parser.CurrentLineNumber, parent)
-        if parent is None:
-            roots.append(node)
-        else:
-            parent.children.append(node)
-        stack.append(node)
+    def make(tag: str, attrs: dict[str, str], line: int, parent: Node | None) -> Node:
+        return Node(tag, attrs, file, line, parent)
 
-    def end(_tag: str) -> None:
-        stack.pop()
-
-    def doctype(*_args: object) -> None:
-        raise _RefusedError("DOCTYPE declarations are not allowed")
-
-    def entity(*_args: object) -> None:
-        raise _RefusedError("entity declarations are not allowed")
-
-    parser.StartElementHandler = start
-    parser.EndElementHandler = end
-    parser.StartDoctypeDeclHandler = doctype
-    parser.EntityDeclHandler = entity
-    parser.ExternalEntityRefHandler = lambda *_a: 0  # never fetch anything
     try:
-        parser.Parse(data, True)
-    except _RefusedError as exc:
-        raise ScenarioError(file, f"line {parser.CurrentLineNumber}", str(exc)) from None
-    except expat.ExpatError as exc:
-        problem = expat.ErrorString(exc.code) if exc.code is not None else str(exc)
-        raise ScenarioError(file, f"line {exc.lineno}", f"malformed XML: {problem}") from None
-    if not roots:  # pragma: no cover - expat reports "no element found" first
+        root = parse_tree(data, make, max_elements)
+    except XmlRefusedError as exc:
+        problem = {Refusal.TOO_MANY: f"too many elements (more than {max_elements})",
+                   Refusal.DOCTYPE: "DOCTYPE declarations are not allowed",
+                   Refusal.ENTITY: "entity declarations are not allowed"}[exc.what]
+        raise ScenarioError(file, f"line {exc.line}", problem) from None
+    except XmlMalformedError as exc:
+        raise ScenarioError(file, f"line {exc.line}", f"malformed XML: {exc.problem}") from None
+    if root is None:  # pragma: no cover - expat reports "no element found" first
         raise ScenarioError(file, "(file)", "no root element")
-    return roots[0]
+    return root

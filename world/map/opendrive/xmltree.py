@@ -1,7 +1,7 @@
 """A minimal, safe XML element tree with the line of each start tag, for error messages.
 
-Built with the stdlib expat parser: no DTD (a DOCTYPE is refused, so no entity expansion), a
-bounded number of elements. Each `Node` knows its file, line and path
+Built by `world.core.safe_xml` (expat): no DTD (a DOCTYPE is refused, so no entity
+expansion), a bounded number of elements. Each `Node` knows its file, line and path
 (`/OpenDRIVE/road[id=0]/planView/geometry[3]/spiral`: an element with an `id` attribute is
 named by it, one of several same-tag siblings by its 1-based position as in XPath).
 """
@@ -11,8 +11,8 @@ from __future__ import annotations
 import math
 import re
 from dataclasses import dataclass, field
-from xml.parsers import expat
 
+from world.core.safe_xml import Refusal, XmlMalformedError, XmlRefusedError, parse_tree
 from world.map.opendrive.errors import OpenDriveError
 
 MAX_ELEMENTS = 5_000_000  # elements in one file
@@ -115,48 +115,23 @@ class Node:
         return node
 
 
-class _RefusedError(Exception):
-    """Raised inside an expat handler: the document uses something refused."""
-
-
 def parse_xml(file: str, data: bytes) -> Node:
-    """The root element of the XML document `data` read from `file`."""
-    parser = expat.ParserCreate()
-    parser.SetParamEntityParsing(expat.XML_PARAM_ENTITY_PARSING_NEVER)
-    stack: list[Node] = []
-    roots: list[Node] = []
-    count = [0]
+    """The root element of the XML document `data` read from `file` (`world.core.safe_xml`)."""
 
-    def start(tag: str, attrib: dict[str, str]) -> None:
-        count[0] += 1
-        if count[0] > MAX_ELEMENTS:
-            raise _RefusedError(f"more than {MAX_ELEMENTS} elements")
-        parent = stack[-1] if stack else None
-        node = Node(tag, attrib, file, parser.CurrentLineNumber, parent)
-        (parent.children if parent is not None else roots).append(node)
-        stack.append(node)
+    def make(tag: str, attrib: dict[str, str], line: int, parent: Node | None) -> Node:
+        return Node(tag, attrib, file, line, parent)
 
-    def end(tag: str) -> None:
-        stack.pop()
-
-    def doctype(*args: object) -> None:
-        raise _RefusedError(f"DOCTYPE at line {parser.CurrentLineNumber} refused (no DTDs)")
-
-    def entity(*args: object) -> None:
-        raise _RefusedError(f"entity declaration at line {parser.CurrentLineNumber} refused")
-
-    parser.StartElementHandler = start
-    parser.EndElementHandler = end
-    parser.StartDoctypeDeclHandler = doctype
-    parser.EntityDeclHandler = entity
     try:
-        parser.Parse(data, True)
-    except expat.ExpatError as e:
-        raise OpenDriveError(
-            file, f"malformed XML at line {e.lineno}: {expat.ErrorString(e.code)}"
-        ) from None
-    except _RefusedError as e:
-        raise OpenDriveError(file, str(e)) from None
-    if not roots:
+        root = parse_tree(data, make, MAX_ELEMENTS)
+    except XmlMalformedError as e:
+        raise OpenDriveError(file, f"malformed XML at line {e.line}: {e.problem}") from None
+    except XmlRefusedError as e:
+        raise OpenDriveError(file, _REFUSED[e.what].format(line=e.line)) from None
+    if root is None:
         raise OpenDriveError(file, "no root element")
-    return roots[0]
+    return root
+
+
+_REFUSED = {Refusal.TOO_MANY: f"more than {MAX_ELEMENTS} elements",
+            Refusal.DOCTYPE: "DOCTYPE at line {line} refused (no DTDs)",
+            Refusal.ENTITY: "entity declaration at line {line} refused"}
