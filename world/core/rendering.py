@@ -74,6 +74,14 @@ def switch_off_shadows(plugin: Path) -> bool:
     return True
 
 
+def read_plugin_symbols() -> None:
+    """Read the EGL plugin's symbol table now (it is read once per process): a process that
+    forks workers does it once for all of them."""
+    spec = importlib.util.find_spec("eglRenderer")
+    if spec is not None and spec.origin is not None:
+        _symbols(Path(spec.origin), (_SHADOW_SWITCH, _ANCHOR))
+
+
 def shadow_switch(plugin: Path) -> ctypes.c_uint8 | None:
     """The loaded EGL plugin's ``useShadowMap`` (a C++ bool: one byte), or None when its
     symbols cannot be found (a stripped or different build)."""
