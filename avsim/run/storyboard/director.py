@@ -51,7 +51,7 @@ class Director:
         self.program = program
         self.world = world
         self.truth = TruthTracker(program, world)
-        self.resolver = Resolver(program.road)
+        self.resolver = Resolver(program.chain)
         osc = program.scenario
         self.runtime = StoryRuntime(osc.storyboard, osc.parameters, self._resolve)
         self.commands = Commands(world.road, self.resolver, program.lane_ids)

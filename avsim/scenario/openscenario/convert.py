@@ -2,7 +2,8 @@
 the same world spec, driver settings and criteria as a YAML file gives, plus the storyboard
 (`StoryProgram`) that the director plays (`avsim.run.storyboard`).
 
-- The road: the file's OpenDRIVE road as the route (`world.map.opendrive.route`).
+- The road: the file's OpenDRIVE roads, linked end to end into one, as the route
+  (`world.map.opendrive.route`); positions on any of them are placed on it.
 - The car under test: the entity named `Ego` (any case), else the first vehicle. avsim's
   stack drives it from the start, its set speed the Init speed (the speed its driver held
   when the file's controller takes over); avsim's car keeps its own body (4.8 x 1.6 m), not
@@ -87,13 +88,13 @@ def load_xosc(path: Path, overrides: Mapping[str, object] | None = None,
     except MapError as e:
         raise ScenarioError(str(osc.road_network), "(file)", str(e)) from None
     ego = _ego(osc)
-    placed, deferred = _init(osc, Resolver(route.road))
+    placed, deferred = _init(osc, Resolver(route.chain))
     ahead = {e.name: _centre_ahead(e, e.name == ego.name) for e in osc.entities}
     ego_spec = _ego_spec(path, road_map, ego.name, placed, ahead[ego.name])
     others = [e for e in osc.entities if e.name != ego.name]
     actors = tuple(_actor_spec(path, road_map, e, placed, ahead[e.name]) for e in others)
     program = StoryProgram(
-        scenario=osc, road=route.road, ego=ego.name,
+        scenario=osc, chain=route.chain, ego=ego.name,
         actors=tuple((e.name, i) for i, e in enumerate(others)),
         centre_ahead=tuple(ahead.items()), lane_ids=route.layout.lane_ids,
         init_commands=tuple(deferred))

@@ -6,7 +6,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from avsim.scenario.openscenario.model import InitAction, OpenScenario
-from world.map.opendrive import Road
+from world.map.opendrive import Chain
 
 
 @dataclass(frozen=True, slots=True)
@@ -14,7 +14,7 @@ class StoryProgram:
     """An OpenSCENARIO file's storyboard, ready for the director (`avsim.run.storyboard`)."""
 
     scenario: OpenScenario  # the parsed file (its storyboard and parameters)
-    road: Road  # the OpenDRIVE road the positions refer to
+    chain: Chain  # the OpenDRIVE roads (linked end to end) the positions refer to
     ego: str  # the entity that is the car under test
     actors: tuple[tuple[str, int], ...]  # (entity name, index in `WorldSpec.actors`)
     centre_ahead: tuple[tuple[str, float], ...]  # (entity name, [m] its body's centre ahead

@@ -1,13 +1,17 @@
-"""Where an OpenSCENARIO position is, on the file's OpenDRIVE road: the map-frame pose of
+"""Where an OpenSCENARIO position is, on the file's OpenDRIVE roads: the map-frame pose of
 an entity's reference point.
 
-Road coordinates (s along the road's reference line, t left +) come from the road's exact
-geometry (`world.map.opendrive`); a lane position's t is its lane's centre plus the offset.
+The roads are linked end to end into one (`world.map.opendrive.chain`): a lane or road
+position's (roadId, s) is the merged road's station `starts[roadId] + s`, s within that
+road's own length; an unknown roadId is a `PositionError`. Road coordinates (s along the
+merged road's reference line, t left +) come from the roads' exact geometry
+(`world.map.opendrive`); a lane position's t is its lane's centre plus the offset.
 Relative positions start from the referenced entity's reference point (`Pose`): a relative
 lane position moves `d_lane` lanes (OpenDRIVE ids, the centre lane 0 skipped) from the lane
 the entity is in and `ds` along the reference line (`ds_lane` along the lane's centre);
 a relative road position adds (ds, dt) to its road coordinates; a relative world position
-adds (dx, dy) in map axes, a relative object position in the entity's axes.
+adds (dx, dy) in map axes, a relative object position in the entity's axes. Relative
+positions work on the merged road, so they run on across a road's end into the next road.
 
 The heading of a position on the road is the road's at s (right-hand lanes travel along it,
 left-hand lanes against it) unless an orientation says otherwise: a relative orientation
@@ -33,7 +37,7 @@ from avsim.scenario.openscenario.model import (
     RoadPosition,
     WorldPosition,
 )
-from world.map.opendrive import Road, lane_borders
+from world.map.opendrive import Chain, lane_borders
 
 
 @dataclass(frozen=True, slots=True)
@@ -50,10 +54,24 @@ class PositionError(ValueError):
 
 
 class Resolver:
-    """Positions on one OpenDRIVE road (module doc)."""
+    """Positions on the OpenDRIVE roads linked end to end (module doc)."""
 
-    def __init__(self, road: Road) -> None:
-        self.road = road
+    def __init__(self, chain: Chain) -> None:
+        self.chain = chain
+        self.road = chain.road  # the merged road
+
+    def station(self, road_id: str, s: float) -> float:
+        """[m] the merged road's station of (road `road_id`, its own s); `PositionError` if
+        the file has no such road or s is off it."""
+        try:
+            span = self.chain.span(road_id)
+        except KeyError:
+            ids = ", ".join(sp.road_id for sp in self.chain.spans)
+            raise PositionError(f"no road {road_id} in the OpenDRIVE file (roads: {ids})"
+                                ) from None
+        if not 0.0 <= s <= span.length + 1e-6:
+            raise PositionError(f"s = {s:g} m is off road {road_id} (0 to {span.length:g} m)")
+        return span.start + s
 
     def road_coordinates(self, x: float, y: float) -> tuple[float, float]:
         """([m] s, [m] t) of a map point on the road (exact projection)."""
@@ -69,16 +87,18 @@ class Resolver:
         return None
 
     def lane_t(self, lane_id: int, s: float) -> float:
-        """[m] the centre of lane `lane_id` at s."""
+        """[m] the centre of lane `lane_id` at s (the merged road's station)."""
         borders = lane_borders(self.road, s)
         if lane_id == 0 or lane_id not in borders:
-            raise PositionError(f"road {self.road.id} has no lane {lane_id} at s = {s:g} m")
+            road_id, own_s = self.chain.locate(s)
+            raise PositionError(f"road {road_id} has no lane {lane_id} at s = {own_s:g} m")
         inner, outer = borders[lane_id]
         return 0.5 * (inner + outer)
 
     def road_pose(self, s: float, t: float, lane_id: int | None,
                   orientation: Orientation | None) -> Pose:
-        """The pose at road coordinates (s, t), headed along the lane's travel (module doc)."""
+        """The pose at the merged road's coordinates (s, t), headed along the lane's travel
+        (module doc)."""
         if not 0.0 <= s <= self.road.length + 1e-6:
             raise PositionError(f"s = {s:g} m is off road {self.road.id} "
                                 f"(0 to {self.road.length:g} m)")
@@ -95,10 +115,12 @@ class Resolver:
             return Pose(position.x, position.y, position.h if position.h is not None else 0.0)
         if isinstance(position, LanePosition):
             lane_id = int(position.lane_id)
-            t = self.lane_t(lane_id, position.s) + position.offset
-            return self.road_pose(position.s, t, lane_id, position.orientation)
+            s = self.station(position.road_id, position.s)
+            t = self.lane_t(lane_id, s) + position.offset
+            return self.road_pose(s, t, lane_id, position.orientation)
         if isinstance(position, RoadPosition):
-            return self.road_pose(position.s, position.t, None, position.orientation)
+            s = self.station(position.road_id, position.s)
+            return self.road_pose(s, position.t, None, position.orientation)
         base = _entity(entities, position.entity)
         if isinstance(position, RelativeWorldPosition):
             return Pose(base.x + position.dx, base.y + position.dy,

@@ -1,9 +1,11 @@
 """The OpenDRIVE map kind: an ASAM OpenDRIVE (.xodr, 1.4-1.8) reader with exact
-reference-line geometry (`load_opendrive`, `PlanView`, `arc_spline`, lane borders)."""
+reference-line geometry (`load_opendrive`, `PlanView`, `arc_spline`, lane borders) and
+roads linked end to end merged into one (`chain_roads`)."""
 
 from __future__ import annotations
 
 from world.map.opendrive.arcspline import ArcPiece, arc_spline, piece_deviation
+from world.map.opendrive.chain import Chain, Span, chain_roads
 from world.map.opendrive.errors import OpenDriveError
 from world.map.opendrive.geometry import PlanView
 from world.map.opendrive.lanes import (
@@ -36,6 +38,7 @@ from world.map.opendrive.parse import load_opendrive
 __all__ = [
     "Arc",
     "ArcPiece",
+    "Chain",
     "Geometry",
     "LaneSection",
     "Line",
@@ -50,9 +53,11 @@ __all__ = [
     "Road",
     "RoadMark",
     "Shape",
+    "Span",
     "SpeedRecord",
     "Spiral",
     "arc_spline",
+    "chain_roads",
     "lane_borders",
     "lane_centre_t",
     "lane_offset",

@@ -73,6 +73,9 @@ class OdrLane:
     widths: tuple[Poly3, ...]  # [m] s = sOffset relative to the lane section's start
     road_marks: tuple[RoadMark, ...]
     speed: float | None  # [m/s] the lane's <speed max>, None if none or "no limit"
+    predecessors: tuple[int, ...] = ()  # [1] <link><predecessor id>: the lanes it continues
+    #   in the section (or road) before, in the order given; () if the file names none
+    successors: tuple[int, ...] = ()  # [1] <link><successor id>: the lanes after it
 
 
 @dataclass(frozen=True, slots=True)

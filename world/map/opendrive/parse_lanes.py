@@ -1,7 +1,8 @@
 """Reading a road's <lanes>: lane offsets, lane sections, lanes, widths, road marks, speeds.
 
 Lenient on lane annotations that do not change the geometry (material, access, height, rule,
-visibility, link, userData), strict on anything geometric (a lane <border> is refused).
+visibility, userData), strict on anything geometric (a lane <border> is refused). A lane's
+<link> is kept: the ids of its predecessor and successor lanes.
 """
 
 from __future__ import annotations
@@ -12,7 +13,7 @@ from world.map.opendrive.xmltree import Node
 SPEED_UNITS = {"m/s": 1.0, "km/h": 1 / 3.6, "mph": 0.44704}  # [m/s] per unit
 NO_LIMIT = frozenset({"no limit", "undefined"})
 DEFAULT_MARK_WIDTH = 0.12  # [m]
-LANE_ANNOTATIONS = ("link", "material", "access", "height", "rule", "visibility")
+LANE_ANNOTATIONS = ("material", "access", "height", "rule", "visibility")
 
 
 def poly3(node: Node, s_name: str) -> Poly3:
@@ -85,9 +86,22 @@ def _level(node: Node) -> bool:
     return raw in ("true", "1")
 
 
+def lane_links(node: Node | None) -> tuple[tuple[int, ...], tuple[int, ...]]:
+    """A lane's <link>: the ids of its predecessor and successor lanes (in file order)."""
+    if node is None:
+        return (), ()
+    kids = node.only("predecessor", "successor")
+    ids: list[tuple[int, ...]] = []
+    for tag in ("predecessor", "successor"):
+        for n in kids[tag]:
+            n.only()
+        ids.append(tuple(n.integer("id") for n in kids[tag]))
+    return ids[0], ids[1]
+
+
 def lane(node: Node) -> OdrLane:
     """One <lane>."""
-    kids = node.only("width", "border", "roadMark", "speed", *LANE_ANNOTATIONS)
+    kids = node.only("width", "border", "roadMark", "speed", "link", *LANE_ANNOTATIONS)
     if kids["border"]:
         raise kids["border"][0].unsupported()
     lane_id = node.integer("id")
@@ -103,6 +117,7 @@ def lane(node: Node) -> OdrLane:
     for prev, mark, m in zip(marks, marks[1:], kids["roadMark"][1:], strict=False):
         if mark.s_offset < prev.s_offset:
             raise m.error("roadMark records do not ascend in sOffset")
+    predecessors, successors = lane_links(node.at_most_one(kids["link"], "link"))
     return OdrLane(
         id=lane_id,
         type=node.get("type", "none"),
@@ -110,6 +125,8 @@ def lane(node: Node) -> OdrLane:
         widths=widths,
         road_marks=marks,
         speed=speeds.pop() if speeds else None,
+        predecessors=predecessors,
+        successors=successors,
     )
 
 

@@ -1,6 +1,10 @@
 """An OpenDRIVE road as the simulator's route road: the `RoadSpec` that `world.map.road`
 lays into the HD map the stack reads, built from the same file as the world's meshes.
 
+The road is the file's roads linked end to end as one (`world.map.opendrive.chain`; a file
+of one road is that road); the route's stations are the merged road's, and `OdrRoute.chain`
+says where each file road lies on it.
+
 The route runs along the road's driving lanes right of its reference line (right-hand
 traffic, increasing s). Route lane 0 is the outermost of them, and the route's reference line
 is that lane's centre: the OpenDRIVE reference line's arc spline (`arc_spline`, exact start
@@ -25,7 +29,9 @@ default (`TYPE_LIMITS`: the German rules, the motorway's advisory 130 km/h).
 
 What does not fit this yet is refused with `OpenDriveError` "not supported yet (...)":
 several lane sections with different layouts, lane widths varying along s, lane offsets,
-left-hand traffic, roads linked into a network, road marks other than solid / broken / none.
+left-hand traffic, road marks other than solid / broken / none; and what the chain refuses
+(junctions, roads not linked end to end into one line, reversed roads, loops, lane links that
+renumber lanes).
 """
 
 from __future__ import annotations
@@ -38,6 +44,7 @@ import numpy as np
 from world.frames import MPS_PER_KPH
 from world.hdmap import LineMark, LinePaint, MarkKind, PaintColour, Zone
 from world.map.opendrive.arcspline import ArcPiece, arc_spline, piece_points
+from world.map.opendrive.chain import Chain, chain_roads
 from world.map.opendrive.errors import OpenDriveError
 from world.map.opendrive.model import LaneSection, OdrLane, OpenDrive, Road, RoadMark
 from world.spec import RoadSpec, SegmentSpec
@@ -73,11 +80,17 @@ class Layout:
 
 @dataclass(frozen=True, slots=True)
 class OdrRoute:
-    """An OpenDRIVE road as the route: the spec, and how the file's lanes map onto it."""
+    """An OpenDRIVE road as the route: the spec, and how the file's roads and lanes map
+    onto it."""
 
     spec: RoadSpec
-    road: Road
+    chain: Chain  # the file's roads as one road, and where each lies on it
     layout: Layout
+
+    @property
+    def road(self) -> Road:
+        """The merged road (the file's one road if it has only one)."""
+        return self.chain.road
 
     def lane_index(self, lane_id: int) -> int | None:
         """The route lane index of OpenDRIVE lane `lane_id` (None: not a route lane)."""
@@ -97,10 +110,10 @@ def _refuse(odr: OpenDrive, what: str) -> OpenDriveError:
 
 
 def build_route(odr: OpenDrive) -> OdrRoute:
-    """The route road of the file's one road (module doc); raises `OpenDriveError`."""
-    if len(odr.roads) != 1:
-        raise _refuse(odr, f"{len(odr.roads)} roads: road networks")
-    road = odr.roads[0]
+    """The route road of the file's roads linked end to end (module doc); raises
+    `OpenDriveError`."""
+    chain = chain_roads(odr)
+    road = chain.road
     if road.rule != "RHT":
         raise _refuse(odr, "left-hand traffic")
     if any(p.a != 0.0 or p.b != 0.0 or p.c != 0.0 or p.d != 0.0 for p in road.lane_offsets):
@@ -128,7 +141,7 @@ def build_route(odr: OpenDrive) -> OdrRoute:
             zone=zone, start=start, paint=layout.paint))
     first = segments[0]
     assert first.start is not None and first.speed_limit is not None
-    return OdrRoute(RoadSpec(tuple(segments), first.speed_limit, origin=first.start), road,
+    return OdrRoute(RoadSpec(tuple(segments), first.speed_limit, origin=first.start), chain,
                     layout)
 
 

@@ -76,6 +76,7 @@ def test_mixed_road_model() -> None:
     assert first.lane(-2).level and second.lane(-1).level is False
     mark = first.lane(1).road_marks[0]
     assert (mark.type, mark.color, mark.width, mark.lane_change) == ("solid", "white", 0.15, "none")
+    assert (first.lane(1).predecessors, first.lane(1).successors) == ((), ())
     centre_mark = first.center.road_marks[0]
     assert (centre_mark.type, centre_mark.color, centre_mark.width) == ("broken", "yellow", 0.12)
     assert first.lane(-1).road_marks[0].type == "solid solid"
@@ -184,6 +185,16 @@ def variant(tmp_path: Path, old: str, new: str) -> Path:
             "(roadMark type width",
         ),
         ("<OpenDRIVE>", "<!DOCTYPE x [<!ENTITY a 'b'>]><OpenDRIVE>", "DOCTYPE at line 3 refused"),
+        (
+            "<link/>",
+            '<link><successor id="x"/></link>',
+            "/lane[id=1]/link/successor[id=x]: id is not an integer ('x')",
+        ),
+        (
+            "<link/>",
+            '<link><neighbor id="1"/></link>',
+            "/link/neighbor[id=1]: not supported yet (neighbor)",
+        ),
     ],
 )
 def test_refused_input(tmp_path: Path, old: str, new: str, expected: str) -> None:

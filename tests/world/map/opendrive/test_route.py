@@ -137,7 +137,7 @@ CURB = '<roadMark sOffset="0" type="curb"/>'
     (CENTRE + "<right>" + lane(-1) + "</right>", {"rule": "LHT"},
      "not supported yet (left-hand traffic)"),
     (CENTRE + "<right>" + lane(-1) + "</right>", {"roads": 2},
-     "not supported yet (2 roads: road networks)"),
+     "not supported yet (roads not linked end to end into one route: road networks)"),
     (CENTRE + "<right>" + lane(-1, "sidewalk") + "</right>", {},
      "without driving lanes right of the reference line"),
     (CENTRE + "<right>" + lane(-1, mark=CURB) + "</right>", {},
