@@ -1,15 +1,30 @@
 """The vehicle ahead in the ego's lane, from the LiDAR tracks (the ACC layer's d and V_l).
 
-`select_lead`: the lead is the nearest confirmed track ahead (vehicle frame of the track's
-time, x forward, y left; not of class OTHER) whose centre lies within ``half_width`` of the
-ego lane's centre line (the camera's lane when it is the path, else straight ahead); its
-gap [m] is bumper to bumper along the ego's heading, its speed [m/s] the track's over
-ground along the ego's heading (>= 0), both at the track's time.
+Two steps. Geometry first: every vehicle track ahead (not of class OTHER) is a `Candidate`,
+with its gap, speed and lateral offset from the lane's centre line.
 
-`route_lead`, through a town junction, where the lane is the map's turn path: the lead is
-the nearest track (map frame) up to ``path_reach`` ahead along the map lane kept whose
-centre is within ``half_width`` of it; its gap is along the lane, its speed along the
-lane's heading where it is.
+- `lane_candidates`: in the vehicle frame of the track's time (x forward, y left), the
+  offset from the ego lane's centre line (the camera's lane when it is the path, else
+  straight ahead); the gap [m] is bumper to bumper along the ego's heading, the speed [m/s]
+  the track's over ground along the ego's heading (>= 0), both at the track's time;
+- `route_candidates`, through a town junction, where the lane is the map's turn path: the
+  tracks (map frame) up to ``path_reach`` ahead along the map lane kept; the gap is along the
+  lane, the speed along the lane's heading where the track is.
+
+Then `LeadSelector` picks the lead, as a production ACC's target selection does, so that a
+car in the next lane that strays near the line for a moment, or a lane's centre drawn a
+little off far ahead, does not make the car brake and release:
+
+- a vehicle enters the lane within ``half_width`` of its centre line and must stay there
+  for ``confirm`` before it can become the lead (a new track or one that swerved in),
+  unless it is urgent: closing with a time to collision under ``urgent_ttc`` (a cut-in
+  close ahead is taken at once);
+- the lead stays the lead while it is within ``keep_width`` (hysteresis: a lead swerving
+  within its lane, or seen through a curve, is not dropped and taken again);
+- the lead is the nearest of the vehicles that qualify.
+
+`select_lead` and `route_lead` are the one-shot forms (no memory: every in-lane vehicle
+qualifies at once), for callers that judge one moment.
 """
 
 from __future__ import annotations
@@ -27,49 +42,111 @@ from world.hdmap import Lane
 
 @dataclass(frozen=True, slots=True)
 class LeadParams:
-    half_width: float = 1.6  # [m] a track is in the lane within this of its centre line
+    half_width: float = 1.6  # [m] a track enters the lane within this of its centre line
+    keep_width: float = 2.0  # [m] the lead stays the lead within this (hysteresis)
+    confirm: float = 0.3  # [s] a vehicle is in the lane this long before it can be the lead
+    urgent_ttc: float = 2.5  # [s] ... unless it closes in faster than this
     path_reach: float = 60.0  # [m] along a map path, tracks farther ahead are not looked at
+
+
+@dataclass(frozen=True, slots=True)
+class Candidate:
+    """A vehicle ahead: the lead it would be, and where it is across the lane."""
+
+    lead: Lead
+    lateral: float  # [m] its centre's offset from the lane's centre line, left +
+
+
+def lane_candidates(tracks: Sequence[Track], centre_y: Callable[[float], float],
+                    ego_heading: float, front_overhang: float) -> list[Candidate]:
+    """The vehicles ahead; `centre_y(x)` is the lane centre's lateral position [m] at x [m]
+    ahead, in the vehicle frame of the tracks' time; `front_overhang` [m] the ego's centre
+    to its front bumper."""
+    out: list[Candidate] = []
+    for tr in tracks:
+        if tr.cls is ObjectClass.OTHER or tr.rel_x <= 0.0:
+            continue
+        gap = tr.rel_x - front_overhang - 0.5 * tr.length
+        speed = max(0.0, tr.vx * math.cos(ego_heading) + tr.vy * math.sin(ego_heading))
+        out.append(Candidate(Lead(tr.id, tr.t, gap, speed), tr.rel_y - centre_y(tr.rel_x)))
+    return out
+
+
+def route_candidates(tracks: Sequence[Track], lane: Lane, station: float, p: LeadParams,
+                     front_overhang: float) -> list[Candidate]:
+    """The vehicles ahead on the map lane `lane` from the car's centre at `station` (the
+    turn path through a town junction; map frame), up to ``path_reach``."""
+    vehicles = [tr for tr in tracks if tr.cls is not ObjectClass.OTHER]
+    if not vehicles:
+        return []
+    s, r = lane.local_coordinates(np.array([[tr.x, tr.y] for tr in vehicles]))
+    out: list[Candidate] = []
+    for tr, s_tr, r_tr in zip(vehicles, np.atleast_1d(s), np.atleast_1d(r), strict=True):
+        ahead = float(s_tr) - station
+        if not 0.0 < ahead <= p.path_reach:
+            continue
+        heading = float(lane.heading_at(float(s_tr)))
+        speed = max(0.0, tr.vx * math.cos(heading) + tr.vy * math.sin(heading))
+        gap = ahead - front_overhang - 0.5 * tr.length
+        out.append(Candidate(Lead(tr.id, tr.t, gap, speed), float(r_tr)))
+    return out
+
+
+def _nearest(candidates: Sequence[Candidate]) -> Lead | None:
+    best = min(candidates, key=lambda c: c.lead.gap, default=None)
+    return None if best is None else best.lead
 
 
 def select_lead(tracks: Sequence[Track], centre_y: Callable[[float], float],
                 ego_heading: float, p: LeadParams, front_overhang: float) -> Lead | None:
-    """The nearest in-lane vehicle ahead; `centre_y(x)` is the lane centre's lateral position
-    [m] at x [m] ahead, in the vehicle frame of the tracks' time; `front_overhang` [m] the
-    ego's centre to its front bumper."""
-    best: Lead | None = None
-    for tr in tracks:
-        if tr.cls is ObjectClass.OTHER or tr.rel_x <= 0.0:
-            continue
-        if abs(tr.rel_y - centre_y(tr.rel_x)) > p.half_width:
-            continue
-        gap = tr.rel_x - front_overhang - 0.5 * tr.length
-        if best is not None and gap >= best.gap:
-            continue
-        speed = max(0.0, tr.vx * math.cos(ego_heading) + tr.vy * math.sin(ego_heading))
-        best = Lead(tr.id, tr.t, gap, speed)
-    return best
+    """The nearest vehicle ahead within ``half_width`` of the lane's centre line, now
+    (`lane_candidates`; no confirmation)."""
+    return _nearest([c for c in lane_candidates(tracks, centre_y, ego_heading, front_overhang)
+                     if abs(c.lateral) <= p.half_width])
 
 
 def route_lead(tracks: Sequence[Track], lane: Lane, station: float, p: LeadParams,
                front_overhang: float) -> Lead | None:
-    """The nearest vehicle ahead on the map lane `lane` from the car's centre at `station`
-    (the turn path through a town junction; map frame)."""
-    vehicles = [tr for tr in tracks if tr.cls is not ObjectClass.OTHER]
-    if not vehicles:
-        return None
-    s, r = lane.local_coordinates(np.array([[tr.x, tr.y] for tr in vehicles]))
-    best: Lead | None = None
-    for tr, s_tr, r_tr in zip(vehicles, np.atleast_1d(s), np.atleast_1d(r), strict=True):
-        ahead = float(s_tr) - station
-        if not 0.0 < ahead <= p.path_reach or abs(float(r_tr)) > p.half_width:
-            continue
-        gap = ahead - front_overhang - 0.5 * tr.length
-        if best is not None and gap >= best.gap:
-            continue
-        heading = float(lane.heading_at(float(s_tr)))
-        speed = max(0.0, tr.vx * math.cos(heading) + tr.vy * math.sin(heading))
-        best = Lead(tr.id, tr.t, gap, speed)
-    return best
+    """The nearest vehicle ahead within ``half_width`` of the map lane `lane`, now
+    (`route_candidates`; no confirmation)."""
+    return _nearest([c for c in route_candidates(tracks, lane, station, p, front_overhang)
+                     if abs(c.lateral) <= p.half_width])
+
+
+class LeadSelector:
+    """The lead over time: confirmation and hysteresis (module doc)."""
+
+    def __init__(self, p: LeadParams) -> None:
+        self.p = p
+        self.lead_id: int | None = None  # the lead's track id
+        self._since: dict[int, float] = {}  # [s] track id -> when it entered the lane
+
+    def select(self, t: float, ego_speed: float, candidates: Sequence[Candidate],
+               ) -> Lead | None:
+        """The lead at time `t` [s] from this tick's `candidates`, the ego at `ego_speed`
+        [m/s]."""
+        p = self.p
+        inside = {c.lead.track_id for c in candidates if abs(c.lateral) <= p.half_width}
+        self._since = {i: self._since.get(i, t) for i in inside}
+        qualified = [c for c in candidates if self._qualifies(c, t, ego_speed)]
+        lead = _nearest(qualified)
+        self.lead_id = None if lead is None else lead.track_id
+        return lead
+
+    def take(self, lead: Lead | None) -> None:
+        """`lead` is the lead by another rule (during a lane change): keep it as the lead."""
+        self.lead_id = None if lead is None else lead.track_id
+
+    def _qualifies(self, c: Candidate, t: float, ego_speed: float) -> bool:
+        p, i = self.p, c.lead.track_id
+        if i == self.lead_id and abs(c.lateral) <= p.keep_width:
+            return True
+        if i not in self._since:
+            return False
+        if t - self._since[i] >= p.confirm - 1e-9:
+            return True
+        closing = ego_speed - c.lead.speed
+        return closing > 0.0 and c.lead.gap < p.urgent_ttc * closing
 
 
 class LeadAccel:

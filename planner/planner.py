@@ -56,7 +56,13 @@ from planner.fsm.hazard import HazardLights
 from planner.fsm.lane_source import LaneSource, LaneSourceInput, LaneSourceParams
 from planner.fsm.machine import Machine, StateChange
 from planner.junctions import JunctionMonitor, JunctionParams
-from planner.lead import LeadAccel, LeadParams, route_lead, select_lead
+from planner.lead import (
+    LeadAccel,
+    LeadParams,
+    LeadSelector,
+    lane_candidates,
+    route_candidates,
+)
 from planner.messages import Lead, Plan, ReferencePath, SpeedSource
 from planner.motion_layer import Manoeuvre, MotionLayer, MotionLayerParams
 from planner.route import lane_path
@@ -126,6 +132,7 @@ class Planner:
         self.motion = MotionLayer(self.road, p.lane, p.acc.modes, p.vehicle, p.motion)
         self.control = ControlLayer()
         self.lead_accel = LeadAccel()
+        self.leads = LeadSelector(self.params.lead)
         self.driver = DriverOverride(p.override)
         self.events = EventMonitor(self.road, p.vehicle, p.events)
         self.junctions = JunctionMonitor(self.road, p.vehicle, p.junctions)
@@ -282,25 +289,28 @@ class Planner:
     def _lead(self, view: LaneView | None, tracks: Sequence[Track], ego: EgoState,
               manoeuvre: Manoeuvre, camera: bool) -> Lead | None:
         """The vehicle ahead in the lane (the camera's lane when it is the path, else
-        straight ahead); through a junction, along the map lane kept; during a lane change
-        (or the way back from an abort), the nearest ahead in the lanes the car occupies
-        (`MotionLayer`)."""
+        straight ahead), confirmed and held by the `LeadSelector`; through a junction, along
+        the map lane kept; during a lane change (or the way back from an abort), the nearest
+        ahead in the lanes the car occupies (`MotionLayer`)."""
         if manoeuvre.path is not None:
             if not manoeuvre.leads:
+                self.leads.take(None)
                 return None
             n = min(manoeuvre.leads, key=lambda n: n.gap)
             gap = n.gap - (n.speed - ego.speed) * max(ego.t - n.t, 0.0)  # at the track's time
-            return Lead(n.track_id, n.t, gap, max(n.speed, 0.0))
-        if not tracks:
-            return None
+            lead = Lead(n.track_id, n.t, gap, max(n.speed, 0.0))
+            self.leads.take(lead)
+            return lead
+        p = self.params
         if self.source.state is LaneSource.JUNCTION:  # on the map's path through the junction
-            return route_lead(tracks, self.lane, self.localise(ego)[0], self.params.lead,
-                              self.params.vehicle.front_overhang)
-        centre: Callable[[float], float] = _straight_ahead
-        if view is not None and camera:
-            centre = view.estimate.centre_y
-        return select_lead(tracks, centre, ego.heading, self.params.lead,
-                           self.params.vehicle.front_overhang)
+            candidates = route_candidates(tracks, self.lane, self.localise(ego)[0], p.lead,
+                                          p.vehicle.front_overhang)
+        else:
+            centre: Callable[[float], float] = _straight_ahead
+            if view is not None and camera:
+                centre = view.estimate.centre_y
+            candidates = lane_candidates(tracks, centre, ego.heading, p.vehicle.front_overhang)
+        return self.leads.select(ego.t, ego.speed, candidates)
 
     def near_junction(self, station: float) -> bool:
         """Whether the car's centre is near or in a town junction, where the map's path is

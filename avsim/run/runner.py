@@ -44,6 +44,7 @@ from avsim.criteria.lane import TyresInLane
 from avsim.criteria.registry import build_criteria
 from avsim.criteria.route import Completes
 from avsim.record.recorder import Recorder
+from avsim.run.holds import shortest_hold
 from avsim.run.sensor_loop import FrameHook, SensorLoop, sensing_mode
 from avsim.run.stack import Stack, StackOutput
 from avsim.run.story import ScriptedStory, StoryboardStory, StoryEntry
@@ -413,6 +414,7 @@ class Runner:
             "max_speed": float(np.max(speed)) if len(speed) else 0.0,
             "distance": float(self.log.station[-1] - self.log.station[0]) if xte.size else 0.0,
             "collisions": float(self.collisions.count),
+            "acc_shortest_mode": shortest_hold(self.state_changes, "acc"),
         } | (self.sensors.metrics() if self.setup is not None else {})
 
     # -- recording -----------------------------------------------------------------------------

@@ -27,7 +27,8 @@ that leave it are tried in this order and the first that holds is taken. The eve
 pedestrian, stop sign, red light, give way, speed bump, off-ramp. An event mode holds while
 its own event does, unless a row leaves it for another event's mode (only where the table
 has one: a stop sign does not interrupt a speed bump); when its event is over the car
-cruises (the chart's default ACC_ACTIVE state) and the next tick's rows settle the mode.
+cruises (the chart's default ACC_ACTIVE state), and CRUISE's rows settle the mode on the same
+input (`transition`: one change, from the event's mode to the mode they reach).
 Table 2's conditions overlap: out of BRAKE with the lead beyond d_max, Trail's row also
 holds, so Cruise and SpeedLimit are tried first.
 
@@ -291,8 +292,18 @@ TABLE: Table[AccMode, AccInput, Gaps] = Table(AccMode, (
 
 
 def transition(mode: AccMode, x: AccInput, p: AccParams) -> Transition[AccMode] | None:
-    """The change of mode for input `x`, or None to stay (`TABLE`)."""
-    return next_state(TABLE, mode, x, gaps(x.v, x.v_l, p))
+    """The change of mode for input `x`, or None to stay (`TABLE`). A row into CRUISE from
+    outside ACC_ACTIVE (ACC switched on, an event over) enters the chart's default state,
+    which the same input then settles: CRUISE's own rows are tried at once, and the change
+    is the one to the mode they reach (so a mode is never held for a single tick)."""
+    g = gaps(x.v, x.v_l, p)
+    step = next_state(TABLE, mode, x, g)
+    if step is None or step.to is not M.CRUISE or mode in ACC_ACTIVE:
+        return step
+    settled = next_state(TABLE, M.CRUISE, x, g)
+    if settled is None or settled.to is mode:
+        return step
+    return Transition(settled.to, f"{step.reason}; {settled.reason}")
 
 
 def source_names(states: frozenset[AccMode]) -> str:

@@ -50,7 +50,7 @@ def ramp(v_from: float, v_to: float, a: float) -> list[float]:
 
 def test_follows_a_slower_lead_at_the_desired_gap() -> None:
     run = drive([15.0] * 2400, v0=20.0, gap0=60.0, set_speed=22.0)
-    assert list(run["modes"][:2]) == ["cruise", "trail"]
+    assert run["modes"][0] == "trail"  # engaged behind it: settled at once (no tick of cruise)
     end = run["t"] > 40.0
     d_des = max(4.0 + 1.5 * 15.0, r157_min_gap(15.0))
     assert np.allclose(run["gap"][end], d_des, atol=0.5)
@@ -81,7 +81,7 @@ def test_cut_in_close_ahead_brakes_eased_then_recovers() -> None:
     above the hard limit, and the gap is back above d_min."""
     v0 = 60 / 3.6
     run = drive([v0 - 20 / 3.6] * 800, v0=v0, gap0=15.0, set_speed=v0)
-    assert run["modes"][0] == "cruise" and "brake" in list(run["modes"])
+    assert run["modes"][0] == "brake"  # engaged with it inside d_min: braking at once
     decel = -run["a"]
     assert float(decel.max()) <= 5.0 + 1e-9
     assert float(decel[0]) < 1.0  # eased in: no step at the cut-in

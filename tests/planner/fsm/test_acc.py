@@ -197,3 +197,27 @@ def test_every_state_is_left_and_entered_in_the_table() -> None:
     edges = {(row[1], row[3]) for row in TABLE_CASES if row[3] is not None}
     assert table2 <= edges
     assert edges <= TABLE.edges  # every case's change is an edge of the data
+
+
+SETTLE_CASES = [
+    # (name, state, input, mode reached, reason's parts)
+    ("switched_on_behind_a_lead", M.ACC_OFF, x(d=0.5 * (G.d_des + G.d_max), v_l=VL),
+     M.TRAIL, ("ACC switched on", "a slower vehicle ahead within d_max")),
+    ("bump_done_below_the_limit", M.SPEED_BUMP, x(v_gps=10.0), M.SPEED_LIMIT,
+     ("speed_bump done", "the posted limit is below the set speed")),
+    ("stop_done_too_close", M.STOP_SIGN, x(d=0.5 * G.d_min, v_l=0.0), M.BRAKE,
+     ("stop_sign done", "gap at or below d_min")),
+    ("bump_done_nothing_else", M.SPEED_BUMP, x(), M.CRUISE, ("speed_bump done",)),
+]
+
+
+@pytest.mark.parametrize(("name", "state", "inp", "expected", "reasons"), SETTLE_CASES,
+                         ids=[c[0] for c in SETTLE_CASES])
+def test_the_default_state_is_settled_at_once(name: str, state: AccMode, inp: AccInput,
+                                              expected: AccMode,
+                                              reasons: tuple[str, ...]) -> None:
+    """Into CRUISE from outside ACC_ACTIVE, CRUISE's rows are tried on the same input: one
+    change, to the mode they reach, with both reasons (no mode held for a single tick)."""
+    change = transition(state, inp, P)
+    assert change is not None and change.to is expected, name
+    assert change.reason == "; ".join(reasons)

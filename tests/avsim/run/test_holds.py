@@ -1,0 +1,35 @@
+"""The shortest hold of a machine's modes (`avsim.run.holds`), the measure of chatter."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from avsim.run.holds import shortest_hold
+from planner.fsm.machine import StateChange
+
+
+def change(t: float, source: str, target: str, machine: str = "acc") -> StateChange:
+    return StateChange(t, machine, source, target, "")
+
+
+@pytest.mark.parametrize(("changes", "expected"), [
+    ([], math.inf),
+    ([change(0.0, "acc_off", "cruise")], math.inf),  # held to the end: not counted
+    ([change(0.0, "acc_off", "cruise"), change(5.0, "cruise", "trail"),
+      change(5.1, "trail", "cruise"), change(9.0, "cruise", "trail")], pytest.approx(0.1)),
+    # a hold ended by braking (d <= d_min) is a safety transition
+    ([change(0.0, "acc_off", "cruise"), change(5.0, "cruise", "trail"),
+      change(5.1, "trail", "brake"), change(7.0, "brake", "trail"),
+      change(9.5, "trail", "cruise")], pytest.approx(2.5)),
+    # ... and so is a short hold of the braking mode itself
+    ([change(0.0, "acc_off", "cruise"), change(5.0, "cruise", "brake"),
+      change(5.1, "brake", "trail"), change(8.0, "trail", "cruise")], pytest.approx(2.9)),
+    # other machines' changes are not this machine's holds
+    ([change(0.0, "acc_off", "cruise"), change(0.2, "keep", "change", "motion"),
+      change(0.3, "change", "keep", "motion"), change(3.0, "cruise", "trail")],
+     pytest.approx(3.0)),
+])
+def test_shortest_hold(changes: list[StateChange], expected: object) -> None:
+    assert shortest_hold(changes, "acc") == expected

@@ -1,0 +1,87 @@
+"""The lead over time (`planner.lead.LeadSelector`): a vehicle is confirmed in the lane
+before it is the lead, unless it is urgent; the lead is held within a wider band; the
+nearest qualified vehicle wins. Table tests on `Candidate`s (gaps and offsets given)."""
+
+from __future__ import annotations
+
+import itertools
+
+import pytest
+
+from planner.lead import Candidate, LeadParams, LeadSelector
+from planner.messages import Lead
+
+P = LeadParams()  # half_width 1.6 m, keep_width 2.0 m, confirm 0.3 s, urgent_ttc 2.5 s
+DT = 0.05  # [s] the planner's tick
+
+
+def car(ident: int, gap: float, lateral: float, speed: float = 20.0) -> Candidate:
+    return Candidate(Lead(ident, 0.0, gap, speed), lateral)
+
+
+def run(frames: list[list[Candidate]], ego_speed: float = 20.0) -> list[int | None]:
+    """The lead's id at each tick of `frames` (one list of candidates per tick)."""
+    selector = LeadSelector(P)
+    out = []
+    for k, frame in enumerate(frames):
+        lead = selector.select(k * DT, ego_speed, frame)
+        out.append(None if lead is None else lead.track_id)
+    return out
+
+
+def test_a_vehicle_is_the_lead_after_it_has_been_in_the_lane_for_the_confirm_time() -> None:
+    ids = run([[car(1, 40.0, 0.2)]] * 10)
+    first = ids.index(1)
+    assert ids[:first] == [None] * first and set(ids[first:]) == {1}
+    assert first * DT == pytest.approx(P.confirm)
+
+
+def test_a_car_in_the_next_lane_straying_near_the_line_for_a_moment_is_no_lead() -> None:
+    """0.1 s within 1.6 m of the centre line (the next lane's car at 3.5 m), then back."""
+    frames = [[car(7, 30.0, 3.5)]] * 5 + [[car(7, 30.0, 1.5)]] * 2 + [[car(7, 30.0, 3.5)]] * 10
+    assert run(frames) == [None] * len(frames)
+
+
+@pytest.mark.parametrize(("gap", "lead_speed", "urgent"), [
+    (10.0, 10.0, True),  # closing at 10 m/s, 1 s to collision: taken at once
+    (24.0, 10.0, True),  # 2.4 s
+    (26.0, 10.0, False),  # 2.6 s: confirmed first
+    (10.0, 20.0, False),  # not closing
+])
+def test_an_urgent_cut_in_is_the_lead_at_once(gap: float, lead_speed: float,
+                                              urgent: bool) -> None:
+    ids = run([[car(3, gap, 0.5, lead_speed)]] * 8, ego_speed=20.0)
+    assert (ids[0] == 3) is urgent
+    assert ids[-1] == 3
+
+
+def test_the_lead_is_held_within_the_keep_band_and_dropped_beyond_it() -> None:
+    confirmed = [[car(1, 30.0, 0.0)]] * 8
+    swerve = [[car(1, 30.0, 1.9)]] * 5  # inside keep_width, outside half_width
+    out = [[car(1, 30.0, 2.2)]] * 3  # beyond keep_width (a cut-out)
+    back = [[car(1, 30.0, 1.9)]] * 3  # near again, but must re-enter within half_width
+    ids = run(confirmed + swerve + out + back)
+    assert ids[7] == 1 and ids[8:13] == [1] * 5
+    assert ids[13:] == [None] * 6
+
+
+def test_a_cut_out_reveals_the_stopped_car_ahead_in_one_transition() -> None:
+    """The lead (1) leaves the lane; the stopped car (2) 60 m ahead, in the lane all along
+    and confirmed, is the lead as soon as the first is out: one change of lead, no gap."""
+    frames = ([[car(1, 25.0, 0.1 * k), car(2, 60.0, 0.0, 0.0)] for k in range(25)])
+    ids = run(frames)
+    changes = [(a, b) for a, b in itertools.pairwise(ids) if a != b]
+    assert changes == [(None, 1), (1, 2)]
+    assert ids.index(2) == 21  # the first tick the cut-out car is beyond keep_width (2.1 m)
+
+
+def test_the_nearest_qualified_vehicle_wins() -> None:
+    frames = [[car(1, 50.0, 0.0), car(2, 30.0, 0.3)]] * 8
+    assert run(frames)[-1] == 2
+
+
+def test_a_lead_taken_during_a_lane_change_is_held_after_it() -> None:
+    selector = LeadSelector(P)
+    selector.take(Lead(9, 0.0, 20.0, 15.0))
+    lead = selector.select(0.0, 20.0, [car(9, 20.0, 1.8, 15.0)])
+    assert lead is not None and lead.track_id == 9  # held (keep band), not re-confirmed
