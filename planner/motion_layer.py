@@ -20,9 +20,12 @@ Entering a lane change makes the target lane the lane kept (its speed plan and, 
 its camera lane) and plans the Hermite path into it from the car's pose
 (`planner.lane_change_path`); the change is done when the car's station reaches the path's
 end. An abort plans the same kind of path back to the origin lane, followed in LANE_KEEP
-until its end. While a path is followed, the vehicles ahead in the lane kept and, while the
-car's body (mirrors included) still overlaps the origin lane, in the origin lane are both
-leads for the ACC (`leads`): the car does not run into the vehicle it is leaving.
+until its end. While a path is followed, the vehicle ahead in the lane kept (the target
+lane) is the ACC's lead; the vehicle ahead in the origin lane is a lead too while the car's
+body (mirrors included) still overlaps that lane, once it is near: within UN R157's d_min or
+under ``pass_ttc`` to collision (`leads`). So the car does not run into the vehicle it is
+leaving, nor trail it through the pass. Keeping right after a pass waits for a car behind
+in the right lane to be ``keep_right_gap`` back (a margin over the gap that aborts).
 
 At a town junction where the route turns, the turn is entered when the car's centre passes
 the stop line and done at the junction's exit (`RoadMap.junctions`); its path is the map's
@@ -40,7 +43,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from perception.messages import EgoState, Track
-from planner.fsm.acc import AccParams
+from planner.fsm.acc import AccParams, r157_min_gap
 from planner.fsm.machine import Machine, StateChange
 from planner.fsm.motion import (
     LANE_CHANGES,
@@ -72,6 +75,11 @@ class MotionLayerParams:
     mirrors: float = 0.1  # [m] how far each mirror stands out beyond the body's side
     prepare_distance: float = 150.0  # [m] a lane ending this near ahead is left ...
     prepare_time: float = 12.0  # [s] ... or this many seconds ahead at the present speed
+    pass_ttc: float = 4.0  # [s] during a change, the car being left is a lead once closer
+    #   in time than this (or within d_min)
+    keep_right_gap: float = 2.0  # [s] keeping right waits for this time gap to a car behind
+    #   in the right lane (UN R157's t_G of 1 s aborts a change: the margin between the two
+    #   keeps a gap that hovers near t_G from starting and aborting changes)
     motion: MotionParams = field(default_factory=MotionParams)
     occupancy: OccupancyParams = field(default_factory=OccupancyParams)
     lane_change: LaneChangeParams = field(default_factory=LaneChangeParams)
@@ -101,6 +109,7 @@ class MotionLayer:
         self.path: LaneChangePath | None = None
         self._blocked_since: float | None = None
         self._turn_end = math.inf  # [m] where the turn in hand ends (its junction's exit)
+        self._near: set[int] = set()  # tracks of the lane being left found near (`_leads`)
 
     def update(self, ego: EgoState, v_want: float, tracks: Sequence[Track],
                pull_over: bool = False) -> tuple[Manoeuvre, tuple[StateChange, ...]]:
@@ -121,7 +130,7 @@ class MotionLayer:
             self.origin = self.lane
         changes = self.machine.apply(ego.t, change)
         return Manoeuvre(self.motion, self.lane, self.origin, self.path,
-                         self._leads(traffic, s, d)), changes
+                         self._leads(traffic, s, d, ego.speed)), changes
 
     @property
     def motion(self) -> Motion:
@@ -171,6 +180,9 @@ class MotionLayer:
             t=t, since=self.machine.since, overtake=p.overtake, blocked=blocked,
             left_free=left is not None and is_free(left, v, p.occupancy),
             right_free=right is not None and is_free(right, v, p.occupancy),
+            right_clear=right is not None and right.lane != SHOULDER
+            and not is_blocked(right, v, v_want, p.occupancy, self.acc)
+            and (right.behind is None or right.behind.gap >= v * p.keep_right_gap),
             route_lane=min(self._lanes_ahead(s, v) - 1 - self.lane, 0),
             pull_over=pull_over and self.lane != SHOULDER,
             turn=_turn(self._junction_at(s)),
@@ -200,6 +212,7 @@ class MotionLayer:
             junction = self._junction_at(s)
             assert junction is not None  # a turn is entered inside its junction
             self._turn_end = junction.s_exit
+        self._near = set()
         if to in LANE_CHANGES:
             self.origin = self.lane
             self.lane = self.lane + 1 if to is Motion.LANE_CHANGE_LEFT else \
@@ -216,17 +229,33 @@ class MotionLayer:
         return start_lane_change(self.road.lane(lane), lane, ego.x, ego.y, ego.heading,
                                  ego.speed, self.params.lane_change)
 
-    def _leads(self, traffic: dict[int, LaneTraffic], s: float,
-               d: float) -> tuple[Neighbour, ...]:
+    def _leads(self, traffic: dict[int, LaneTraffic], s: float, d: float,
+               v: float) -> tuple[Neighbour, ...]:
+        """On a path: the vehicle ahead in the target lane, and the one ahead in the origin
+        lane while the car's body still overlaps that lane, from the moment it is near
+        enough to matter (`_still_near`) on (so that braking for it does not make it far
+        again and release it: no chatter)."""
         if self.path is None:
             return ()
-        lanes = [self.lane]
+        leads = [n for n in (traffic[self.lane].ahead,) if n is not None] \
+            if self.lane in traffic else []
         origin = self.road.lane(self.origin)
         clear = 0.5 * float(origin.width_at(s)) + 0.5 * self.vehicle.width + self.params.mirrors
-        if abs(d - float(origin.offset_at(s))) < clear:
-            lanes.append(self.origin)  # the car's body still overlaps the origin lane
-        return tuple(n for k in lanes if k in traffic
-                     for n in (traffic[k].ahead,) if n is not None)
+        left_behind = traffic[self.origin].ahead if self.origin in traffic else None
+        if left_behind is not None and abs(d - float(origin.offset_at(s))) < clear and (
+                left_behind.track_id in self._near or self._still_near(left_behind, v)):
+            self._near.add(left_behind.track_id)  # near once: a lead until the body is out
+            leads.append(left_behind)
+        return tuple(leads)
+
+    def _still_near(self, n: Neighbour, v: float) -> bool:
+        """The vehicle ahead in the lane being left still constrains the car's speed: within
+        UN R157's d_min at speed `v` [m/s], or closing with under ``pass_ttc`` to collision.
+        Farther, the target lane's vehicle is the lead: a pass does not trail the car it
+        passes."""
+        closing = v - n.speed
+        return n.gap < r157_min_gap(v) or (closing > 0.0 and
+                                           n.gap < self.params.pass_ttc * closing)
 
 
 def _turn(junction: Junction | None) -> Turn | None:

@@ -28,16 +28,22 @@ tried in this order and the first that holds is taken:
    `keep_time` since the last change, and the route needs no other lane
 8. lane_keep -> lane_change_right: overtaking allowed, the lane blocked, only the right free
    (as above)
-9. lane_change_left, lane_change_right -> lane_keep: the change is done (in the target lane)
-10. lane_change_left, lane_change_right -> lane_keep: abort: the target lane is no longer
+9. lane_keep -> lane_change_right: keep right: overtaking allowed, the lane not blocked, the
+   right free and clear (nothing slower ahead in it to block it), `keep_time` since the last
+   change, and the route needs no other lane
+10. lane_change_left, lane_change_right -> lane_keep: the change is done (in the target
+    lane)
+11. lane_change_left, lane_change_right -> lane_keep: abort: the target lane is no longer
     free, not yet committed
-11. turn_right, turn_left, u_turn -> lane_keep: the turn is done (in the exit lane)
+12. turn_right, turn_left, u_turn -> lane_keep: the turn is done (in the exit lane)
 
 A flat tyre comes first and stops everything else out of LANE_KEEP: the car moves right
 lane by lane (`right_free` then means the next lane, or the paved shoulder from lane 0) and
-stays on the shoulder. Then the route's turns, then its lane needs, then overtaking.
-Overtaking waits `keep_time` after the last change (no weaving); a route lane change waits
-`route_keep_time` only.
+stays on the shoulder. Then the route's turns, then its lane needs, then overtaking, then
+keeping right: where the driver lets the car change lanes to pass, it goes back to the
+right once that lane is free and clear (no slower vehicle ahead in it within the ACC's
+d_max, which would make it pass again). Overtaking and keeping right wait `keep_time` after
+the last change (no weaving); a route lane change waits `route_keep_time` only.
 """
 
 from __future__ import annotations
@@ -85,6 +91,7 @@ class MotionInput:
     blocked: bool = False  # a slower vehicle blocks the lane ahead (debounced upstream)
     left_free: bool = False  # a lane to the left exists and is free by the tracks
     right_free: bool = False  # a lane to the right exists and is free by the tracks
+    right_clear: bool = False  # ... and nothing slower ahead in it would block it
     route_lane: int = 0  # [lanes] the route needs the car to move: > 0 left, < 0 right
     target_free: bool = True  # the target lane of the change in hand is still free
     committed: bool = False  # the car's centre is in the target lane of the change
@@ -142,6 +149,11 @@ def _overtake_right(_m: Motion, x: MotionInput, p: MotionParams) -> bool:
     return _may_overtake(x, p) and x.right_free
 
 
+def _keep_right(_m: Motion, x: MotionInput, p: MotionParams) -> bool:
+    return (_free_to_choose(x) and not _route_holds(x, p) and x.overtake and not x.blocked
+            and x.right_free and x.right_clear and _waited(x) >= p.keep_time)
+
+
 def _change_done(_m: Motion, x: MotionInput, _p: MotionParams) -> bool:
     return x.change_done
 
@@ -180,6 +192,10 @@ TABLE: Table[Motion, MotionInput, MotionParams] = Table(Motion, (
     Row(_KEEP, M.LANE_CHANGE_RIGHT, _overtake_right,
         "overtaking allowed, the lane blocked, only the right free (as above)",
         "a slower vehicle ahead, only the right lane free"),
+    Row(_KEEP, M.LANE_CHANGE_RIGHT, _keep_right,
+        "keep right: overtaking allowed, the lane not blocked, the right free and clear "
+        "(nothing slower ahead in it to block it), `keep_time` since the last change, and the "
+        "route needs no other lane", "keep right: the right lane is free"),
     Row(LANE_CHANGES, M.LANE_KEEP, _change_done, "the change is done (in the target lane)",
         "in the target lane"),
     Row(LANE_CHANGES, M.LANE_KEEP, _abort,

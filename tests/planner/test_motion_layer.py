@@ -4,13 +4,14 @@ end, and aborts back to its lane when a fast car comes up behind in the target l
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import replace
 
 import numpy as np
 import pytest
 
 from perception.messages import EgoState, ObjectClass, Track
-from planner.fsm.acc import AccParams
+from planner.fsm.acc import AccParams, r157_min_gap
 from planner.fsm.motion import Motion
 from planner.motion_layer import MotionLayer, MotionLayerParams
 from tests.roads import W, make_map, seg
@@ -60,7 +61,7 @@ def drive(m: MotionLayer, t0: float, t1: float, slow_x0: float,
 
 def test_overtakes_a_blocking_car_when_the_left_lane_is_free() -> None:
     m = layer()
-    steps = drive(m, 0.0, 12.0, slow_x0=170.0)
+    steps = drive(m, 0.0, 8.0, slow_x0=170.0)
     motions = [s[1] for s in steps]
     start = motions.index(Motion.LANE_CHANGE_LEFT)
     assert steps[start][0] == pytest.approx(1.0, abs=0.05)  # blocked for blocked_time
@@ -68,6 +69,26 @@ def test_overtakes_a_blocking_car_when_the_left_lane_is_free() -> None:
     duration = steps[end][0] - steps[start][0]
     assert m.path is None and steps[-1][2] == 1 and m.origin == 1
     assert 4.0 < duration < 5.5  # the path's length at this speed
+
+
+def test_after_passing_it_keeps_right_once_the_passed_car_is_far_enough_behind() -> None:
+    """Back to lane 0 `keep_time` after the pass is done and with the passed car at least
+    `keep_right_gap` (2 s) behind; once, and to stay (no weaving)."""
+    m = layer()
+    steps = drive(m, 0.0, 20.0, slow_x0=170.0)
+    runs = [steps[0][1]] + [b[1] for a, b in itertools.pairwise(steps)
+                            if b[1] is not a[1]]
+    assert runs == [Motion.LANE_KEEP, Motion.LANE_CHANGE_LEFT, Motion.LANE_KEEP,
+                    Motion.LANE_CHANGE_RIGHT, Motion.LANE_KEEP]
+    motions = [s[1] for s in steps]
+    left_done = motions.index(Motion.LANE_KEEP, motions.index(Motion.LANE_CHANGE_LEFT))
+    back = motions.index(Motion.LANE_CHANGE_RIGHT)
+    t_back = steps[back][0]
+    assert t_back - steps[left_done][0] >= 3.0 - 1e-9  # keep_time
+    ego_rear = 100.0 + V * t_back - VEHICLE.rear_overhang
+    slow_front = 170.0 + 5.56 * t_back + 2.3
+    assert ego_rear - slow_front >= V * 2.0  # keep_right_gap behind
+    assert steps[-1][2] == 0 and m.path is None
 
 
 def test_follows_when_overtaking_is_not_allowed() -> None:
@@ -141,3 +162,29 @@ def test_a_town_turn_from_the_stop_line_to_the_junction_exit(manoeuvre: str,
     assert turning[-1] == pytest.approx(j.s_exit, abs=0.6)
     assert seen[-1][1] is Motion.LANE_KEEP
     assert all(motion in (state, Motion.LANE_KEEP) for _, motion in seen)
+
+
+def test_a_pass_trails_the_car_it_leaves_only_while_it_is_near() -> None:
+    """During the change, the slow car ahead in the origin lane (closing at 8.3 m/s) is a
+    lead only while the body still overlaps its lane and it is under `pass_ttc` (4 s) to
+    collision: at the change's start (6.6 s away) the pass does not trail it."""
+    m = layer()
+    t, x, y = 0.0, 100.0, 0.0
+    seen: list[tuple[float, bool, float]] = []  # (gap, slow car a lead, |y|) on the path
+    while t < 8.0:
+        slow = car(t, 170.0 + 5.56 * t, 0.0, 5.56, 1)
+        man, _ = m.update(ego(t, x, y), V, [slow])
+        if man.motion is Motion.LANE_CHANGE_LEFT:
+            gap = slow.x - 2.3 - x - VEHICLE.front_overhang
+            seen.append((gap, any(n.track_id == 1 for n in man.leads), y))
+        if man.path is not None:
+            y = float(ROAD.lane(man.path.target_index).offset_at(x)) + float(
+                man.path.offset_at(x))
+        t += 0.025
+        x += V * 0.025
+    assert seen and not seen[0][1]  # at the start: 6.6 s to collision, not a lead
+    overlap = W / 2 + VEHICLE.width / 2 + 0.1  # [m] the body (mirrors) still in lane 0
+    for gap, lead, lateral in seen:
+        near = gap < 4.0 * (V - 5.56) or gap < r157_min_gap(V)
+        assert lead == (near and lateral < overlap), (gap, lateral)
+    assert any(lead for _, lead, _ in seen)  # near and still overlapping at some point

@@ -1,7 +1,8 @@
 """ICCAS lane changing: a car 30 km/h slower ahead, the left lane free; the ego changes lanes
 left to pass it (the motion FSM's decision from the tracks), without contact, taking under
 5 s from leaving its lane to being inside the target lane, at no more than 1 m/s^2 of lateral
-acceleration, and ends with every tyre inside the target lane."""
+acceleration; once the passed car is 2 s behind it keeps right (issue K, item 7), and ends
+with every tyre inside its lane."""
 
 from __future__ import annotations
 
@@ -36,17 +37,22 @@ def test_the_ego_overtook_the_slower_car(result: RunResult) -> None:
     assert rel[i] > 20 * KPH  # still closing fast when it pulled out (the ACC trailed 1 s)
     assert 10.0 < slow_s[i] - s[i] < 100.0  # it was ahead when the change began
     assert s[-1] > slow_s[-1] + 30.0  # and is behind now
-    assert log.lane[0] == 0 and log.lane[-1] == 1
+    assert log.lane[0] == 0 and max(log.lane) == 1 and log.lane[-1] == 0  # passed, kept right
 
 
-def test_the_motion_fsm_changed_left_once(result: RunResult) -> None:
+def test_the_motion_fsm_changed_left_to_pass_then_kept_right(result: RunResult) -> None:
     motion = [(c.source, c.target, c.reason) for c in result.state_changes
               if c.machine == "motion"]
     assert [m[:2] for m in motion] == [("lane_keep", "lane_change_left"),
-                                       ("lane_change_left", "lane_keep")]
-    assert "slower vehicle" in motion[0][2]
+                                       ("lane_change_left", "lane_keep"),
+                                       ("lane_keep", "lane_change_right"),
+                                       ("lane_change_right", "lane_keep")]
+    assert "slower vehicle" in motion[0][2] and "keep right" in motion[2][2]
     acc = [c.target for c in result.state_changes if c.machine == "acc"]
-    assert acc == ["cruise", "trail", "cruise"]  # slowed behind it, then free again
+    # slowed behind it; as the pass begins (6.6 s to collision) it is no lead; it is again
+    # once under `pass_ttc` (4 s) while the body still overlaps its lane; free once out
+    assert acc == ["cruise", "trail", "cruise", "trail", "cruise"]
+    assert result.metrics["acc_shortest_mode"] >= 0.5
 
 
 def test_verdict_and_the_lane_change_figures(result: RunResult) -> None:
@@ -55,11 +61,12 @@ def test_verdict_and_the_lane_change_figures(result: RunResult) -> None:
     assert 0.5 < c["lane_change_duration"].value < 5.0
     assert 0.2 < c["lane_change_lateral_accel"].value <= 1.0
     assert c["tyres_in_lane"].value > 0.0  # in the target lane after, in the two during
-    # settled in the target lane: the cross-track error (from lane 1 now) is small
+    # settled back in lane 0: the cross-track error is small
     assert abs(result.log.cross_track[-1]) < 0.15
     # the camera's lane moved with the car: off by a lane width only in the frames while
-    # the car's centre is between the line and the 0.2 m re-assignment margin
-    assert result.metrics["lane_offset_rmse"] < 0.4
+    # the car's centre is between the line and the 0.2 m re-assignment margin, at each of
+    # the two crossings (0.4 m for one: the squared error doubles with two)
+    assert result.metrics["lane_offset_rmse"] < 0.4 * np.sqrt(2.0)
     sources = [c.target for c in result.state_changes if c.machine == "lane_source"]
     assert sources == ["camera"]
 
