@@ -809,6 +809,20 @@ class RoadMap:
             return c.lanes - 1 - band, d - band * w
         return None, d
 
+    def band_edges(self, s: float, d: float) -> tuple[int, float, float]:
+        """(band, [m] right, [m] left) of the lane band across that holds offset d at
+        station s on a segment with a lane profile: band 0 .. lanes + oncoming_lanes - 1
+        counts the lanes right to left (ego lanes, then oncoming from the centre line), its
+        edges from `lane_boundaries`; beyond the lanes, -1 (right of lane 0) or the count,
+        a band as wide as the lane next to it."""
+        b = self.lane_boundaries(s)[1:]
+        band = int(np.searchsorted(b, d, side="right")) - 1
+        if band < 0:
+            return band, float(2.0 * b[0] - b[1]), float(b[0])
+        if band >= len(b) - 1:
+            return band, float(b[-1]), float(2.0 * b[-1] - b[-2])
+        return band, float(b[band]), float(b[band + 1])
+
     def _profiled_lane_of(self, c: CrossSection, s: float, d: float) -> tuple[int | None, float]:
         """`lane_of` on a segment with a lane profile: the band of boundaries holding d."""
         bounds = self.lane_boundaries(s)
