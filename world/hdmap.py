@@ -15,17 +15,28 @@ lane's `offset_at(s)`. Lateral `r` is metres from the lane's centre, left of the
 direction positive (for oncoming lanes too: their travel `direction` is -1 but s and r stay
 in route coordinates).
 
-Across, on a segment with `lanes` ego lanes of width w and `oncoming_lanes` oncoming lanes
-(offsets from the reference line, left +):
+Across, on a uniform segment with `lanes` ego lanes of width w and `oncoming_lanes`
+oncoming lanes (offsets from the reference line, left +):
 
 - ego lane i: centre at i * w;
 - yellow centre line: (lanes - 0.5) * w;
 - oncoming lane -j (j = 1 next to the centre line): centre at (lanes + j - 1) * w;
 - paved edges: right -(w / 2 + shoulder), left (lanes + oncoming_lanes - 0.5) * w.
 
-Lane layout is per segment: a value changes in a step at the segment's start station.
-An arc turns at most 360 degrees. Beyond the route's ends the reference line goes on
-straight (the extension of the first and last piece) with the first / last segment's layout.
+A segment whose lanes change along it (a map file's polynomial lane widths and lane offsets)
+carries a `LaneProfile`: every lane boundary, from the right paved edge to the left one, as
+a cubic in the segment's station u = s - s0, lane 0's edges -w0(u) / 2 and +w0(u) / 2. A
+lane's centre is the middle of its two boundaries and its width their difference, both
+cubics; lane 0's centre is the reference line (offset 0) on every segment. Every lane,
+edge and boundary is a cubic per segment (`SegmentCubics`, evaluated by Horner): a uniform
+segment's are constants (b = c = d = 0) made by the rules above, so its numbers are exactly
+those rules' (`RoadMap.lane_boundaries` at any station, `paved_edges`, `centre_line_at`,
+`lane_of`). `Lane.curvature_at` is exact for offsets varying along s.
+
+Lane layout is per segment: where a segment has no profile a value changes in a step at
+its start station. An arc turns at most 360 degrees. Beyond the route's ends the
+reference line goes on straight (the extension of the first and last piece) with the
+first / last segment's layout (a profile's held at its ends' values).
 `heading_at` is continuous along the route (not wrapped to (-pi, pi]).
 
 No PyBullet here: the planner reads this module.

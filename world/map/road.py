@@ -4,13 +4,13 @@ lane layout, limits, features and exits) laid out into the HD map (`world.hdmap.
 Steps: each segment becomes a reference-line piece laid from the end of the one before
 (from the spec's `origin` pose), or from its own exact `start` pose where the map kind
 gives one (an OpenDRIVE road's arc spline: `world.map.opendrive`), with its cross-section
-(lanes, oncoming lanes, widths, shoulder, zone, the file's paint; a zone carries on until a
-segment names another); the segments are checked (`MapError`); the speed-limit postings
-are the road's limit at s = 0, each segment's at its start and each sign's at its station
-(of several at one station the last listed wins); each feature goes onto the map, a
-traffic light as its place only: its head where the spec puts it, else on a pole
-`LIGHT_AHEAD` past its stop line, `LIGHT_SIDE` right of the paved edge, `LIGHT_HEIGHT` high,
-facing the route's traffic. The signal plan stays in the spec.
+(lanes, oncoming lanes, widths, shoulder, zone, the file's paint and lane profile; a zone
+carries on until a segment names another); the segments are checked (`MapError`); the
+speed-limit postings are the road's limit at s = 0, each segment's at its start and each
+sign's at its station (of several at one station the last listed wins); each feature goes
+onto the map, a traffic light as its place only: its head where the spec puts it, else on
+a pole `LIGHT_AHEAD` past its stop line, `LIGHT_SIDE` right of the paved edge,
+`LIGHT_HEIGHT` high, facing the route's traffic. The signal plan stays in the spec.
 """
 
 from __future__ import annotations

@@ -3,20 +3,26 @@ lays into the HD map the stack reads, built from the same file as the world's me
 
 The route runs along the road's driving lanes right of its reference line (right-hand
 traffic, increasing s). Route lane 0 is the outermost of them, and the route's reference line
-is that lane's centre: the OpenDRIVE reference line's arc spline (`arc_spline`, exact start
-points and headings, < `TOLERANCE` off the exact curve) offset sideways by the lane's
-constant offset `ref_t`. An arc offset sideways is an arc, so the route's pieces are exact
-offsets of the spline's.
+is that lane's centre t0(s) (the lane offset and every width polynomial included):
 
-Across, from the lane section:
+- where every lane of the route is constant along the road (one `uniform` layout in every
+  lane section, no lane offset): the OpenDRIVE reference line's arc spline (`arc_spline`,
+  exact start points and headings, < `TOLERANCE` off the exact curve) offset sideways by
+  the lane's constant offset `ref_t`. An arc offset sideways is an arc, so the route's
+  pieces are exact offsets of the spline's, each section uniform (one lane width);
+- else: the curve ref(s) + t0(s) n(s) as an arc spline of its own and every other lane
+  boundary as a cubic per piece (`lane_fit`: split also where a lane section, a width
+  record or a lane-offset record starts), each segment with its `LaneProfile` (uniform
+  where its boundaries are constant and its lanes equally wide).
 
-- `lanes`: the contiguous run of `driving` lanes right of the reference line, equal widths,
-  constant along the section (width records with b = c = d = 0);
-- `shoulder`: the width of the lane right of the outermost driving lane when its type is
-  `shoulder` or `stop` (a hard shoulder), else 0;
+Across, from each lane section:
+
+- `lanes`: the contiguous run of `driving` lanes right of the reference line;
+- `shoulder`: the lane right of the outermost driving lane when its type is `shoulder` or
+  `stop` (a hard shoulder), else none (width 0);
 - `oncoming_lanes`: the driving lanes left of the reference line when they adjoin the ego's
-  (no median between them), of the same width; a carriageway beyond a median is not part
-  of the route (not drawn: said in docs/openscenario.md);
+  (no median between them); a carriageway beyond a median is not part of the route (not
+  drawn: said in docs/openscenario.md);
 - the paint: each lane's road mark lies on its outer border (OpenDRIVE); a boundary between
   the route's lanes takes the mark of the lane nearer the reference line.
 
@@ -24,8 +30,11 @@ The speed limit: a lane's `<speed max>`, else the road type record's, else the t
 default (`TYPE_LIMITS`: the German rules, the motorway's advisory 130 km/h).
 
 What does not fit this yet is refused with `OpenDriveError` "not supported yet (...)":
-several lane sections with different layouts, lane widths varying along s, lane offsets,
-left-hand traffic, roads linked into a network, road marks other than solid / broken / none.
+lane sections whose route lanes differ (lanes that begin or end), widths or a lane offset
+that jump (route lane 0's centre would step), a route lane whose width reaches 0, lane 0
+changing so fast that its edges' middle along the route's normal is more than
+`SKEW_SHARE * TOLERANCE` off its centre (`lane_fit`), left-hand traffic, roads linked into
+a network, road marks other than solid / broken / none.
 """
 
 from __future__ import annotations
@@ -61,7 +70,7 @@ MARK_KINDS = {"solid": MarkKind.SOLID, "broken": MarkKind.BROKEN, "none": MarkKi
 WHITE = frozenset({"standard", "white"})
 WIDTH_CHECKS = 9  # [-] stations per piece where the route's lanes must be wider than 0
 UNIFORM_EPS = 1e-9  # [m] lanes this close in width make a uniform cross-section
-SKEW_SHARE = 0.1  # [-] of TOLERANCE: how far lane 0's edges may be off symmetric about its
+SKEW_SHARE = 0.2  # [-] of TOLERANCE: how far lane 0's edges may be off symmetric about its
 #   centre along the route's normal (`lane_fit` module doc)
 
 
