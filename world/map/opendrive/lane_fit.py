@@ -170,5 +170,8 @@ def _fit_interval(road: Road, borders: tuple[int, ...], a: float, b: float,
     for p in pieces:  # a piece at MIN_PIECE may have skipped `accept`
         if (p.s0, p.s1) not in fits:
             accept(p)
-    return [FittedPiece(p, *fits[(p.s0, p.s1)][:1], False, fits[(p.s0, p.s1)][1])
-            for p in pieces]
+    out = []
+    for p in pieces:
+        coef, skew = fits[(p.s0, p.s1)]
+        out.append(FittedPiece(p, coef, False, skew))
+    return out
