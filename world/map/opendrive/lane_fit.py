@@ -76,17 +76,48 @@ def cubic_values(coef: FloatArray, u: FloatArray) -> FloatArray:
 def normal_offsets(curve: OffsetCurve, piece: CurvePiece, u: FloatArray) -> FloatArray:
     """[m] (len(u),) the offsets (left +) along the piece's normals at stations u where
     they cross `curve` (module doc)."""
+    out: FloatArray = crossings([curve], piece, u)[0]
+    return out
+
+
+def _polynomial(c: FloatArray, x: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """(value, derivative) of polynomials `c` (n, deg + 1), ascending, at x (n, m)."""
+    value = np.broadcast_to(c[:, -1:], x.shape).copy()
+    slope = np.zeros_like(x)
+    for j in range(c.shape[1] - 2, -1, -1):
+        slope = slope * x + value
+        value = value * x + c[:, j:j + 1]
+    return value, slope
+
+
+def crossings(curves: list[OffsetCurve], piece: CurvePiece, u: FloatArray) -> FloatArray:
+    """[m] (len(curves), len(u)) `normal_offsets` of curves that share one reference line
+    and origin, in one Newton iteration over all of them."""
+    record, origin = curves[0].plan_view, curves[0].origin
+    if any(c.plan_view is not record or c.origin != origin for c in curves):
+        raise ValueError("crossings: the curves must share their reference line and origin")
+    coef = np.zeros((len(curves), max(len(c.t) for c in curves)))
+    for i, c in enumerate(curves):
+        coef[i, :len(c.t)] = c.t
     ax, ay = arc_points(piece.arc(), u)
     th = piece.heading0 + piece.curvature * u
     tx, ty = np.cos(th), np.sin(th)
-    s = piece.s0 + (piece.s1 - piece.s0) * u / piece.length
+    s = np.tile(piece.s0 + (piece.s1 - piece.s0) * u / piece.length, (len(curves), 1))
+
+    def pose(s: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+        x, y, h = record.pose_unwrapped(s)
+        t, slope = _polynomial(coef, s - origin)
+        along = 1.0 - record.curvature(s) * t
+        return (x - t * np.sin(h), y + t * np.cos(h), h + np.arctan2(slope, along),
+                np.hypot(along, slope))
+
     for _ in range(NEWTON_STEPS):
-        bx, by, bh, speed = curve.pose(s)
-        along = (bx - ax) * tx + (by - ay) * ty
-        s = s - along / (speed * np.cos(bh - th))
-        if np.all(np.abs(along) < NEWTON_TOL):
+        bx, by, bh, speed = pose(s)
+        gap = (bx - ax) * tx + (by - ay) * ty
+        s = s - gap / (speed * np.cos(bh - th))
+        if np.all(np.abs(gap) < NEWTON_TOL):
             break
-    bx, by, _, _ = curve.pose(s)
+    bx, by, _, _ = pose(s)
     return np.asarray((by - ay) * tx - (bx - ax) * ty, dtype=np.float64)
 
 
@@ -95,18 +126,15 @@ def fit_boundaries(curves: list[OffsetCurve], centre: OffsetCurve,
     """(cubics (n, 4) in u of the boundaries `curves` across `piece`, [m] their largest
     error at `FIT_CHECKS` stations, [m] lane 0's `skew`); curves[1] and curves[2] are lane
     0's edges, returned as -w0 / 2 and +w0 / 2, `centre` its exact centre (module doc)."""
-    def exact(u: FloatArray) -> FloatArray:
-        return np.array([normal_offsets(c, piece, u) for c in curves])
-
     length = piece.length
-    values = exact(length * CHEBYSHEV)  # (n, 4)
+    u = np.linspace(0.0, length, FIT_CHECKS)
+    exact = crossings([*curves, centre], piece, np.concatenate([length * CHEBYSHEV, u]))
+    values, checked = exact[:-1, :4], exact[:-1, 4:]
     vander = np.vander(CHEBYSHEV, 4, increasing=True)
     coef = np.linalg.solve(vander, values.T).T / length ** np.arange(4)
-    u = np.linspace(0.0, length, FIT_CHECKS)
-    checked = exact(u)
     error = float(np.max(np.abs(cubic_values(coef, u) - checked)))
     middle = 0.5 * (checked[1] + checked[2])  # the piece is off `centre` by its deviation
-    skew = float(np.max(np.abs(middle - normal_offsets(centre, piece, u))))
+    skew = float(np.max(np.abs(middle - exact[-1, 4:])))
     width = coef[2] - coef[1]
     coef[1], coef[2] = -0.5 * width, 0.5 * width
     return coef, error, skew

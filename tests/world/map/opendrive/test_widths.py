@@ -208,3 +208,34 @@ def test_a_world_builds_on_the_road() -> None:
         assert np.all(np.abs(truth.offsets[2:]) < half)
     finally:
         world.close()
+
+
+def test_every_plan_view_shape_takes_a_varying_lane_offset(tmp_path: Path) -> None:
+    """`curvy.xodr` (lines, spirals, arcs, poly3, both paramPoly3 ranges; two lanes each way,
+    a hard shoulder) with a cubic lane offset 0 -> 0.6 m along the whole road added: every
+    lane of the route (ego and oncoming) and the shoulder within 1 mm of the file's, at
+    stations all along the map."""
+    length = 220.0149959845117
+    a, b, c, d = 0.0, 0.0, 3.0 * 0.6 / length**2, -2.0 * 0.6 / length**3
+    text = (DATA / "curvy.xodr").read_text().replace(
+        "<lanes>", f'<lanes><laneOffset s="0" a="{a}" b="{b}" c="{c!r}" d="{d!r}"/>', 1)
+    path = tmp_path / "curvy_offset.xodr"
+    path.write_text(text)
+    route = build_route(load_opendrive(path))
+    road_map = build_road_map(route.spec)
+    road = route.road
+    assert road_map.section_profiled.all()  # every piece's lanes move along it
+    stations = np.linspace(0.0, road_map.length, 500)
+    ids = {0: -2, 1: -1, -1: 1, -2: 2}  # route lane: file lane
+    for index, lane_id in ids.items():
+        lane = road_map.lane(index)
+        s_file, t = road.plan_view.project(lane.position(stations, 0.0))
+        for k, s in enumerate(np.clip(s_file, 0.0, road.length).tolist()):
+            assert abs(t[k] - lane_centre_t(road, lane_id, s)) < TOLERANCE, (lane_id, s)
+            inner, outer = lane_borders(road, s)[lane_id]
+            width = float(lane.width_at(stations[k]))
+            assert abs(width - abs(inner - outer)) < TOLERANCE, (lane_id, s)
+    right, _ = road_map.paved_edges(stations)
+    s_file, t = road.plan_view.project(road_map.position(stations, right))
+    for k, s in enumerate(np.clip(s_file, 0.0, road.length).tolist()):
+        assert abs(t[k] - lane_borders(road, s)[-3][1]) < TOLERANCE, s
