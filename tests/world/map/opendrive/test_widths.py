@@ -239,3 +239,31 @@ def test_every_plan_view_shape_takes_a_varying_lane_offset(tmp_path: Path) -> No
     s_file, t = road.plan_view.project(road_map.position(stations, right))
     for k, s in enumerate(np.clip(s_file, 0.0, road.length).tolist()):
         assert abs(t[k] - lane_borders(road, s)[-3][1]) < TOLERANCE, s
+
+
+def test_constant_lanes_of_different_widths_make_a_constant_profile(tmp_path: Path) -> None:
+    """Driving lanes of 3.0 and 3.5 m and an oncoming lane of 3.25 m, constant along the
+    road: each map lane exactly its width, the boundaries constant on every segment."""
+    def lane(i: int, width: float) -> str:
+        return (f'<lane id="{i}" type="driving"><width sOffset="0" a="{width}" b="0" c="0" '
+                f'd="0"/><roadMark sOffset="0" type="solid" width="0.12"/></lane>')
+
+    text = ('<?xml version="1.0"?><OpenDRIVE><header revMajor="1" revMinor="6"/>'
+            '<road name="r" length="100" id="1" junction="-1" rule="RHT"><planView>'
+            '<geometry s="0" x="0" y="0" hdg="0" length="100"><arc curvature="0.01"/>'
+            '</geometry></planView><lanes><laneSection s="0"><left>' + lane(1, 3.25)
+            + '</left><center><lane id="0" type="none"/></center><right>' + lane(-1, 3.5)
+            + lane(-2, 3.0) + "</right></laneSection></lanes></road></OpenDRIVE>")
+    path = tmp_path / "r.xodr"
+    path.write_text(text)
+    route = build_route(load_opendrive(path))
+    road_map = build_road_map(route.spec)
+    assert len(road_map.sections) == 1
+    (section,) = road_map.sections
+    assert section.profile is not None
+    assert np.all(np.asarray(section.profile.boundaries)[:, 1:] == 0.0)
+    s = np.linspace(0.0, road_map.length, 50)
+    for index, width in ((0, 3.0), (1, 3.5), (-1, 3.25)):
+        np.testing.assert_allclose(road_map.lane(index).width_at(s), width, atol=1e-12)
+    assert road_map.pieces[0].curvature == pytest.approx(1.0 / (100.0 + 3.5 + 1.5),
+                                                         rel=1e-12)
