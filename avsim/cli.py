@@ -71,7 +71,9 @@ def main() -> None:
 @click.option("--plot", "plot", is_flag=False, flag_value=PLOT_NEXT_TO_RECORDING, default=None,
               metavar="[PNG]",
               help="Also write the speed profile (ego, lead, limit and set speed over time, "
-                   "ACC / event mode as bands; the DECS paper's Fig. 3) as a 1600x700 PNG. "
+                   "ACC / event mode as bands; the DECS paper's Fig. 3) and the margins "
+                   "under it (manoeuvres, gap and time to collision to the lead, lateral "
+                   "offset) as a 1600x1200 PNG. "
                    "Without a value: next to the recording, <name>.png")
 @click.option("--set", "sets", multiple=True, metavar="PATH=VALUE",
               help="Set a key of the file before validation, as sweep does (one value).")

@@ -15,17 +15,28 @@ lane's `offset_at(s)`. Lateral `r` is metres from the lane's centre, left of the
 direction positive (for oncoming lanes too: their travel `direction` is -1 but s and r stay
 in route coordinates).
 
-Across, on a segment with `lanes` ego lanes of width w and `oncoming_lanes` oncoming lanes
-(offsets from the reference line, left +):
+Across, on a uniform segment with `lanes` ego lanes of width w and `oncoming_lanes`
+oncoming lanes (offsets from the reference line, left +):
 
 - ego lane i: centre at i * w;
 - yellow centre line: (lanes - 0.5) * w;
 - oncoming lane -j (j = 1 next to the centre line): centre at (lanes + j - 1) * w;
 - paved edges: right -(w / 2 + shoulder), left (lanes + oncoming_lanes - 0.5) * w.
 
-Lane layout is per segment: a value changes in a step at the segment's start station.
-An arc turns at most 360 degrees. Beyond the route's ends the reference line goes on
-straight (the extension of the first and last piece) with the first / last segment's layout.
+A segment whose lanes change along it (a map file's polynomial lane widths and lane offsets)
+carries a `LaneProfile`: every lane boundary, from the right paved edge to the left one, as
+a cubic in the segment's station u = s - s0, lane 0's edges -w0(u) / 2 and +w0(u) / 2. A
+lane's centre is the middle of its two boundaries and its width their difference, both
+cubics; lane 0's centre is the reference line (offset 0) on every segment. Every lane,
+edge and boundary is a cubic per segment (`SegmentCubics`, evaluated by Horner): a uniform
+segment's are constants (b = c = d = 0) made by the rules above, so its numbers are exactly
+those rules' (`RoadMap.lane_boundaries` at any station, `paved_edges`, `centre_line_at`,
+`lane_of`). `Lane.curvature_at` is exact for offsets varying along s.
+
+Lane layout is per segment: where a segment has no profile a value changes in a step at
+its start station. An arc turns at most 360 degrees. Beyond the route's ends the
+reference line goes on straight (the extension of the first and last piece) with the
+first / last segment's layout (a profile's held at its ends' values).
 `heading_at` is continuous along the route (not wrapped to (-pi, pi]).
 
 No PyBullet here: the planner reads this module.
@@ -210,37 +221,90 @@ class LinePaint:
     oncoming: tuple[LineMark, ...] = ()  # each oncoming lane's outer edge, from the centre
 
 
+Cubic = tuple[float, float, float, float]  # a [m], b [1], c [1/m], d [1/m^2]: the value
+#   a + b u + c u^2 + d u^3 at u [m] past a segment's start
+
+
+@dataclass(frozen=True, slots=True)
+class LaneProfile:
+    """Lane boundaries that change along a segment (a map file's polynomial lane widths and
+    lane offsets): each boundary's offset from the reference line (left +) as a cubic in the
+    segment's station u = s - s0 [m], from the right paved edge to the left paved edge:
+
+    the shoulder's outer edge (lane 0's right edge again where there is no shoulder), lane
+    0's right edge, each ego lane's left edge (the last one is the centre line), each
+    oncoming lane's outer edge: `lanes + oncoming_lanes + 2` cubics. Lane 0's edges are
+    -w0(u) / 2 and +w0(u) / 2 (the reference line is its centre)."""
+
+    boundaries: tuple[Cubic, ...]  # [m, 1, 1/m, 1/m^2] right to left
+
+    def at(self, u: ArrayLike) -> FloatArray:
+        """[m] the boundaries' offsets at stations u past the segment's start, shape
+        u.shape + (n,)."""
+        return horner(np.asarray(self.boundaries, dtype=np.float64), _as_float(u)[..., None])
+
+
 @dataclass(frozen=True, slots=True)
 class CrossSection:
-    """The road's layout across, on one segment."""
+    """The road's layout across, on one segment: uniform (every lane `lane_width` wide), or
+    as its `profile` says where the widths change along the segment."""
 
     lanes: int  # [-] ego-direction lanes
     oncoming_lanes: int  # [-] lanes against the route direction
-    lane_width: float  # [m] every lane's width
-    shoulder: float  # [m] paved right shoulder's width, 0 for none
+    lane_width: float  # [m] every lane's width (with a profile: lane 0's at the start)
+    shoulder: float  # [m] paved right shoulder's width, 0 for none (with a profile: at the
+    #   start)
     zone: Zone
     paint: LinePaint | None = None  # the map file's lines; None: the road's own rules
+    profile: LaneProfile | None = None  # the boundaries along the segment; None: uniform
+
+    def __post_init__(self) -> None:
+        n = self.lanes + self.oncoming_lanes + 2
+        if self.profile is not None and len(self.profile.boundaries) != n:
+            raise ValueError(f"a lane profile of {self.lanes} + {self.oncoming_lanes} lanes "
+                             f"needs {n} boundaries, got {len(self.profile.boundaries)}")
 
     @property
     def right_edge(self) -> float:
-        """[m] offset of the right paved edge (outer edge of the shoulder), negative."""
+        """[m] offset of the right paved edge (outer edge of the shoulder), negative (with a
+        profile: at the segment's start, `RoadMap.paved_edges` at any station)."""
+        if self.profile is not None:
+            return self.profile.boundaries[0][0]
         return -(0.5 * self.lane_width + self.shoulder)
 
     @property
     def left_edge(self) -> float:
-        """[m] offset of the left paved edge (left edge of the outermost lane)."""
+        """[m] offset of the left paved edge (left edge of the outermost lane; with a
+        profile: at the segment's start)."""
+        if self.profile is not None:
+            return self.profile.boundaries[-1][0]
         return (self.lanes + self.oncoming_lanes - 0.5) * self.lane_width
 
     @property
     def centre_line(self) -> float:
         """[m] offset of the boundary between ego and oncoming lanes (the left road edge
-        when there are no oncoming lanes)."""
+        when there are no oncoming lanes; with a profile: at the segment's start,
+        `RoadMap.centre_line_at` at any station)."""
+        if self.profile is not None:
+            return self.profile.boundaries[self.lanes + 1][0]
         return (self.lanes - 0.5) * self.lane_width
 
     @property
     def paved_width(self) -> float:
-        """[m] width of the paved road, shoulder included."""
+        """[m] width of the paved road, shoulder included (with a profile: at the start)."""
         return self.left_edge - self.right_edge
+
+    def boundary_cubics(self) -> FloatArray:
+        """[m, 1, 1/m, 1/m^2] (lanes + oncoming_lanes + 2, 4) the boundaries' cubics as
+        `LaneProfile` orders them; a uniform section's are constants (b = c = d = 0): the
+        right edge, then (k - 1/2) w for k = 0 .. lanes + oncoming_lanes."""
+        if self.profile is not None:
+            return np.asarray(self.profile.boundaries, dtype=np.float64)
+        n = self.lanes + self.oncoming_lanes
+        out = np.zeros((n + 2, 4))
+        out[0, 0] = self.right_edge
+        out[1:, 0] = [(k - 0.5) * self.lane_width for k in range(n + 1)]
+        return out
 
 
 @dataclass(frozen=True, slots=True)
@@ -429,6 +493,46 @@ def _as_float(a: ArrayLike) -> FloatArray:
     return np.asarray(a, dtype=np.float64)
 
 
+def horner(coef: FloatArray, u: FloatArray) -> FloatArray:
+    """a + u (b + u (c + u d)) of cubics `coef` (..., 4) at u (broadcast): exactly a where
+    b = c = d = 0."""
+    a, b, c, d = coef[..., 0], coef[..., 1], coef[..., 2], coef[..., 3]
+    out: FloatArray = a + u * (b + u * (c + u * d))
+    return out
+
+
+class SegmentCubics:
+    """A value per segment as a cubic in the segment's station u = s - s0, held constant
+    beyond the segment's ends (so before the route's start and after its end too)."""
+
+    def __init__(self, line: ReferenceLine, coef: FloatArray) -> None:
+        """`coef`: [m, 1, 1/m, 1/m^2] shape (P, 4), one cubic per segment."""
+        self._line = line
+        self.coef = coef
+        self.constant = not bool(np.any(coef[:, 1:]))  # every segment's b = c = d = 0
+        self.varying: NDArray[np.bool_] = np.any(coef[:, 1:] != 0.0, axis=1)  # per segment
+
+    def station(self, s: FloatArray) -> tuple[IntArray, FloatArray]:
+        """(segment index, [m] u clipped to the segment) of stations s."""
+        seg = self._line.segment_index(s)
+        bounds = self._line.bounds
+        return seg, np.clip(s - bounds[seg], 0.0, bounds[seg + 1] - bounds[seg])
+
+    def at(self, s: FloatArray) -> FloatArray:
+        """The value at stations s (a constant segment's a exactly)."""
+        if self.constant:
+            out: FloatArray = self.coef[self._line.segment_index(s), 0]
+            return out
+        seg, u = self.station(s)
+        return horner(self.coef[seg], u)
+
+    def slopes(self, s: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """(first, second) derivatives along s at stations s ([1], [1/m])."""
+        seg, u = self.station(s)
+        _, b, c, d = (self.coef[seg, k] for k in range(4))
+        return b + u * (2.0 * c + 3.0 * d * u), 2.0 * c + 6.0 * d * u
+
+
 class Lane:
     """One lane: the reference line shifted by the lane's offset. Vectorised over arrays."""
 
@@ -441,23 +545,24 @@ class Lane:
         index: int,
         line: ReferenceLine,
         offsets: FloatArray,
-        exists: NDArray[np.bool_],
         widths: FloatArray,
+        exists: NDArray[np.bool_],
     ) -> None:
-        """`offsets`, `exists`, `widths`: per segment, shape (P,) ([m], -, [m])."""
+        """`offsets`, `widths`: per segment cubics in u = s - s0, shape (P, 4) ([m, 1, 1/m,
+        1/m^2]; constants have b = c = d = 0); `exists`: per segment, shape (P,)."""
         self.index = index
         self.direction = 1 if index >= 0 or index == SHOULDER else -1
         self._line = line
-        self._offsets = offsets
+        self._offsets = SegmentCubics(line, offsets)
         self._exists = exists
-        self._widths = widths
+        self._widths = SegmentCubics(line, widths)
 
     def __repr__(self) -> str:
         return f"Lane(index={self.index}, direction={self.direction})"
 
     def offset_at(self, s: ArrayLike) -> FloatArray:
         """[m] lateral offset of this lane's centre from the reference line at stations s."""
-        return self._offsets[self._line.segment_index(_as_float(s))]
+        return self._offsets.at(_as_float(s))
 
     def exists_at(self, s: ArrayLike) -> NDArray[np.bool_]:
         """Whether the lane exists at stations s (a segment may drop lanes)."""
@@ -488,13 +593,23 @@ class Lane:
 
     def width_at(self, s: ArrayLike) -> FloatArray:
         """[m] lane width at s."""
-        return self._widths[self._line.segment_index(_as_float(s))]
+        return self._widths.at(_as_float(s))
 
     def curvature_at(self, s: ArrayLike) -> FloatArray:
-        """[1/m] signed curvature of this lane's centre line at s: k / (1 - k * offset)."""
+        """[1/m] signed curvature of this lane's centre line at s, exact: with the offset o
+        and a = 1 - k o, (k a^2 + a o'' + 2 k o'^2) / (a^2 + o'^2)^(3/2) (o' = do/ds); on a
+        segment of constant offset that is k / a, computed so."""
         s_arr = _as_float(s)
         k = self._line.curvature(s_arr)
-        return k / (1.0 - k * self.offset_at(s_arr))
+        a = 1.0 - k * self.offset_at(s_arr)
+        uniform = k / a
+        if self._offsets.constant:
+            return uniform
+        slope, bend = self._offsets.slopes(s_arr)
+        exact = (k * a * a + a * bend + 2.0 * k * slope * slope) / (a * a + slope * slope) ** 1.5
+        varying = self._offsets.varying[self._line.segment_index(s_arr)]
+        out: FloatArray = np.where(varying, exact, uniform)
+        return out
 
 
 class RoadMap:
@@ -541,21 +656,60 @@ class RoadMap:
         w = np.array([c.lane_width for c in sections])
         n_ego = np.array([c.lanes for c in sections])
         n_onc = np.array([c.oncoming_lanes for c in sections])
-        self._right: FloatArray = np.array([c.right_edge for c in sections])
-        self._left: FloatArray = np.array([c.left_edge for c in sections])
-        self.lanes = tuple(Lane(i, self.line, i * w, n_ego > i, w) for i in range(int(n_ego.max())))
+        shoulder = np.array([c.shoulder for c in sections])
+        self._bounds = [c.boundary_cubics() for c in sections]  # [m, ...] per segment (n, 4)
+        self.section_profiled: NDArray[np.bool_] = np.array(
+            [c.profile is not None for c in sections])  # per segment: widths change along it
+        self._right = SegmentCubics(self.line, np.array([b[0] for b in self._bounds]))
+        self._left = SegmentCubics(self.line, np.array([b[-1] for b in self._bounds]))
+        self._centre = SegmentCubics(
+            self.line, np.array([b[c.lanes + 1] for b, c in zip(self._bounds, sections,
+                                                                  strict=True)]))
+        self.lanes = tuple(Lane(i, self.line, *self._lane_cubics(i, w, n_ego), n_ego > i)
+                           for i in range(int(n_ego.max())))
         self.oncoming = tuple(
-            Lane(-j, self.line, (n_ego + j - 1) * w, n_onc >= j, w)
+            Lane(-j, self.line, *self._lane_cubics(-j, w, n_ego), n_onc >= j)
             for j in range(1, int(n_onc.max()) + 1)
         )
-        shoulder = np.array([c.shoulder for c in sections])
-        self.shoulder = Lane(SHOULDER, self.line, -0.5 * (w + shoulder), shoulder > 0.0,
-                             shoulder)
+        has_shoulder = shoulder > 0.0
+        for k, b in enumerate(self._bounds):  # a varying shoulder: wide at either end
+            if self.section_profiled[k]:
+                ends = horner(b[1] - b[0], np.array([0.0, pieces[k].length]))
+                has_shoulder[k] = bool(np.any(ends > 0.0))
+        self.shoulder = Lane(SHOULDER, self.line, *self._lane_cubics(SHOULDER, w, n_ego),
+                             has_shoulder)
         self.section_lanes: IntArray = n_ego  # [-] per segment: `CrossSection.lanes`
         self.section_widths: FloatArray = w  # [m] per segment: `CrossSection.lane_width`
         self.section_shoulders: FloatArray = shoulder  # [m] per segment: the shoulder's width
         self._limit_s: FloatArray = np.array([p.s for p in speed_limits])
         self._limit_v: FloatArray = np.array([p.limit for p in speed_limits])
+
+    def _lane_cubics(self, index: int, w: FloatArray,
+                     n_ego: IntArray) -> tuple[FloatArray, FloatArray]:
+        """(offset cubics (P, 4), width cubics (P, 4)) of lane `index` per segment; a
+        uniform segment's constants as ever: ego lane i at i w, oncoming lane -j at
+        (lanes + j - 1) w, the shoulder at -(w + shoulder) / 2; a profiled one's from its
+        boundaries (lane 0 at 0; a lane the segment lacks goes on at lane 0's width)."""
+        offsets = np.zeros((len(w), 4))
+        widths = np.zeros((len(w), 4))
+        for k, b in enumerate(self._bounds):
+            c = self.sections[k]
+            if index == SHOULDER:
+                i = -1  # the band between boundaries 0 and 1
+                offsets[k, 0], widths[k, 0] = -0.5 * (w[k] + c.shoulder), c.shoulder
+            else:
+                i = index if index >= 0 else int(n_ego[k]) - index - 1
+                offsets[k, 0], widths[k, 0] = i * w[k], w[k]
+            if c.profile is None:
+                continue
+            if i + 2 < len(b):
+                lo, hi = b[i + 1], b[i + 2]
+            else:  # beyond the segment's lanes: lane 0's width on from the left edge
+                lo = b[-1] + (i + 1 - (len(b) - 1)) * (b[2] - b[1])
+                hi = lo + (b[2] - b[1])
+            offsets[k] = 0.0 if i == 0 else 0.5 * (lo + hi)
+            widths[k] = hi - lo
+        return offsets, widths
 
     def through_road(self, exit_: Exit, length: float) -> RoadMap:
         """The road `exit_` leaves, from its fork straight on for `length` [m] (scenery),
@@ -577,6 +731,28 @@ class RoadMap:
 
     def cross_section_at(self, s: float) -> CrossSection:
         return self.sections[int(self.line.segment_index(_as_float(s)))]
+
+    def lane_boundaries(self, s: float) -> FloatArray:
+        """[m] offsets from the reference line (left +) of every lane boundary at station s,
+        right to left: the right paved edge (the shoulder's outer edge), lane 0's right
+        edge, each ego lane's left edge (the last is the centre line), each oncoming lane's
+        outer edge (the last is the left paved edge); `CrossSection.boundary_cubics`."""
+        return self.segment_boundaries(int(self.line.segment_index(_as_float(s))),
+                                       _as_float(s))
+
+    def segment_boundaries(self, index: int, s: ArrayLike) -> FloatArray:
+        """[m] `lane_boundaries` of segment `index` at stations s (held at the segment's
+        ends beyond them), shape s.shape + (lanes + oncoming_lanes + 2,)."""
+        s_arr = _as_float(s)
+        b = self._bounds[index]
+        if not self.section_profiled[index]:
+            return np.broadcast_to(b[:, 0], (*s_arr.shape, len(b))).copy()
+        lo, hi = self.line.bounds[index], self.line.bounds[index + 1]
+        return horner(b, (np.clip(s_arr, lo, hi) - lo)[..., None])
+
+    def centre_line_at(self, s: ArrayLike) -> FloatArray:
+        """[m] offset of the centre line (the ego lanes' left edge) at stations s."""
+        return self._centre.at(_as_float(s))
 
     def lanes_at(self, s: float) -> int:
         """Number of ego-direction lanes at station s."""
@@ -608,8 +784,8 @@ class RoadMap:
         """([m] right, [m] left) offsets of the paved edges from the reference line at s:
         right is the shoulder's outer edge -(w / 2 + shoulder), left the outermost lane's
         left edge (oncoming lanes included)."""
-        seg = self.line.segment_index(_as_float(s))
-        return self._right[seg], self._left[seg]
+        s_arr = _as_float(s)
+        return self._right.at(s_arr), self._left.at(s_arr)
 
     def speed_limit_at(self, s: ArrayLike) -> FloatArray:
         """[m/s] the posted limit in force at station s (the last posting at or before s)."""
@@ -635,9 +811,34 @@ class RoadMap:
         w = c.lane_width
         if not 0.0 <= s <= self.length:
             return None, d
+        if c.profile is not None:
+            return self._profiled_lane_of(c, s, d)
         band = int(np.floor((d + 0.5 * w) / w))  # 0 .. lanes - 1 ego, then oncoming
         if 0 <= band < c.lanes:
             return band, d - band * w
         if c.lanes <= band < c.lanes + c.oncoming_lanes:
             return c.lanes - 1 - band, d - band * w
         return None, d
+
+    def band_edges(self, s: float, d: float) -> tuple[int, float, float]:
+        """(band, [m] right, [m] left) of the lane band across that holds offset d at
+        station s on a segment with a lane profile: band 0 .. lanes + oncoming_lanes - 1
+        counts the lanes right to left (ego lanes, then oncoming from the centre line), its
+        edges from `lane_boundaries`; beyond the lanes, -1 (right of lane 0) or the count,
+        a band as wide as the lane next to it."""
+        b = self.lane_boundaries(s)[1:]
+        band = int(np.searchsorted(b, d, side="right")) - 1
+        if band < 0:
+            return band, float(2.0 * b[0] - b[1]), float(b[0])
+        if band >= len(b) - 1:
+            return band, float(b[-1]), float(2.0 * b[-1] - b[-2])
+        return band, float(b[band]), float(b[band + 1])
+
+    def _profiled_lane_of(self, c: CrossSection, s: float, d: float) -> tuple[int | None, float]:
+        """`lane_of` on a segment with a lane profile: the band of boundaries holding d."""
+        bounds = self.lane_boundaries(s)
+        band = int(np.searchsorted(bounds[1:], d, side="right")) - 1
+        if not 0 <= band < c.lanes + c.oncoming_lanes:
+            return None, d
+        index = band if band < c.lanes else c.lanes - 1 - band
+        return index, d - float(self.lane(index).offset_at(s))

@@ -23,6 +23,7 @@ from world.frames import Wheel
 from world.hdmap import (
     Crosswalk,
     Junction,
+    LaneProfile,
     LightHead,
     LinePaint,
     Side,
@@ -60,6 +61,8 @@ class SegmentSpec:
     #   pose (x, y, heading) where the map kind knows it (an OpenDRIVE road's arc spline);
     #   None: laid from the end of the piece before
     paint: LinePaint | None = None  # the map file's lane lines; None: the road's own rules
+    profile: LaneProfile | None = None  # lane boundaries that change along the segment (a
+    #   map file's polynomial widths and lane offsets); None: uniform, `lane_width` each
 
 
 @dataclass(frozen=True, slots=True)

@@ -111,6 +111,9 @@ def ego_lane_edges(road: RoadMap, station: float, offset: float) -> tuple[float,
     """([m] right, [m] left) offsets from the reference line of the edges of the lane the
     ego's centre (at `station`, `offset`) is in: the band of lane width that holds it, of
     the route's lanes as they lie at that station."""
+    if road.cross_section_at(station).profile is not None:
+        _, right, left = road.band_edges(station, offset)
+        return right, left
     c0 = float(road.lane(0).offset_at(station))
     w = float(road.lane(0).width_at(station))
     band = math.floor((offset - c0 + 0.5 * w) / w)

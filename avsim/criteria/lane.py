@@ -61,20 +61,25 @@ def footprint(road: RoadMap, sample: TruthSample, half_tread: float) -> Footprin
     """The footprint of `sample`'s tyres on `road` (`half_tread`: [m] a tyre's half width)."""
     s, y = sample.tyre_stations, sample.tyre_offsets
     seg = road.line.segment_index(s)
-    w, n = road.section_widths[seg], road.section_lanes[seg]
-    c0 = np.asarray(road.lane(0).offset_at(s), dtype=np.float64)
-    top = c0 + (n - 0.5) * w  # the leftmost lane's left edge
-    bottom = c0 - 0.5 * w  # lane 0's right edge
+    if road.section_profiled[seg].any():
+        bottom, top, band, lo, hi, shoulder = _profiled_bands(road, s, y)
+    else:
+        w, n = road.section_widths[seg], road.section_lanes[seg]
+        c0 = np.asarray(road.lane(0).offset_at(s), dtype=np.float64)
+        top = c0 + (n - 0.5) * w  # the leftmost lane's left edge
+        bottom = c0 - 0.5 * w  # lane 0's right edge
+        band = np.floor((y - c0 + 0.5 * w) / w)  # the lane whose edges hold the patch centre
+        lo, hi = c0 + (band - 0.5) * w, c0 + (band + 0.5) * w
+        shoulder = road.section_shoulders[seg]
     junction = any(j.s_enter <= sample.station <= j.s_exit for j in road.junctions)
     if junction:
         margins = np.minimum(y - half_tread - bottom, top - (y + half_tread))
         return Footprint(None, float(margins.min()), (math.inf, math.inf), True)
-    shoulder = road.section_shoulders[seg] if sample.flat else np.zeros(4)
+    shoulder = shoulder if sample.flat else np.zeros(4)
     low = np.where(shoulder > 0.0, bottom - shoulder, bottom + LINE_HALF_WIDTH)
     margins = np.minimum(y - half_tread - low, top - LINE_HALF_WIDTH - (y + half_tread))
-    band = np.floor((y - c0 + 0.5 * w) / w)  # the lane whose edges hold the patch centre
-    right = y - half_tread - (c0 + (band - 0.5) * w + LINE_HALF_WIDTH)
-    left = c0 + (band + 0.5) * w - LINE_HALF_WIDTH - (y + half_tread)
+    right = y - half_tread - (lo + LINE_HALF_WIDTH)
+    left = hi - LINE_HALF_WIDTH - (y + half_tread)
     on_shoulder = (band < 0) & (shoulder > 0.0)
     right = np.where(on_shoulder, y - half_tread - low, right)
     left = np.where(on_shoulder, bottom - LINE_HALF_WIDTH - (y + half_tread), left)
@@ -84,6 +89,20 @@ def footprint(road: RoadMap, sample: TruthSample, half_tread: float) -> Footprin
         return Footprint(int(lanes[0]), float(margins.min()),
                          (float(right.min()), float(left.min())), False)
     return Footprint(None, float(margins.min()), (math.inf, math.inf), False)
+
+
+def _profiled_bands(road: RoadMap, s: NDArray[np.float64],
+                    y: NDArray[np.float64]) -> tuple[NDArray[np.float64], ...]:
+    """`footprint`'s edges where a tyre's segment has a lane profile (the lanes where they
+    lie at each tyre's station): ([m] lane 0's right edge, the leftmost ego lane's left
+    edge, [-] the band of lanes holding the patch centre (`RoadMap.band_edges`), [m] its
+    right and left edge, the shoulder's width), each (4,)."""
+    out = np.empty((6, len(s)))
+    for k, (si, yi) in enumerate(zip(s.tolist(), y.tolist(), strict=True)):
+        b = road.lane_boundaries(si)
+        band, lo, hi = road.band_edges(si, yi)
+        out[:, k] = b[1], b[road.cross_section_at(si).lanes + 1], band, lo, hi, b[1] - b[0]
+    return tuple(out)
 
 
 @dataclass(frozen=True, slots=True)

@@ -177,6 +177,11 @@ class Crosswalks(Criterion):
         """([m] right, [m] left) offsets of the band of ego-direction lanes the tyres are
         in, at station s (a tyre off the lanes counts in the nearest lane)."""
         c = self.road.cross_section_at(s)
+        if c.profile is not None:  # the lanes' edges where they lie at s
+            edges = self.road.lane_boundaries(s)[1:c.lanes + 2]
+            index = np.clip(np.searchsorted(edges, sample.tyre_offsets, side="right") - 1,
+                            0, c.lanes - 1)
+            return float(edges[index.min()]), float(edges[index.max() + 1])
         w = c.lane_width
         index = np.clip(np.floor((sample.tyre_offsets + 0.5 * w) / w), 0, c.lanes - 1)
         lo = self.road.lane(int(index.min())).offset_at(s)

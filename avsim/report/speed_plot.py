@@ -1,46 +1,61 @@
-"""The speed profile of a run as a PNG, like the DECS paper's Fig. 3 (`avsim run --plot`).
+"""The speed profile and the margins of a run as a PNG, like the DECS paper's Fig. 3 with more
+below it (`avsim run --plot`). Panels, top to bottom, on one time axis [s]:
 
-Speeds over time in km/h: the ego's (true), the lead vehicle's, the posted limit at the
-ego's front bumper and the driver's set speed, with the ACC / event layer's mode
-(`planner.fsm.acc.AccMode`) as coloured bands behind them, one colour per mode; under them a
-strip of bands says which constraint set the plan's speed at each tick
-(`planner.messages.SpeedSource`: set speed, limit, curve, following, event, pedal, degraded
-lane, emergency).
+1. Speeds in km/h: the ego's (true), the lead vehicle's, the posted limit at the ego's front
+   bumper and the driver's set speed, with the ACC / event layer's mode
+   (`planner.fsm.acc.AccMode`) as coloured bands behind them, one colour per mode.
+2. A strip of the motion FSM's manoeuvres (`planner.fsm.motion.Motion`): lane changes left
+   and right, an aborted one, a flat tyre's pull over, turns and U-turns, one colour per
+   manoeuvre; lane keeping blank (`avsim.report.margins.motion_runs`).
+3. A strip saying which constraint set the plan's speed at each tick
+   (`planner.messages.SpeedSource`: set speed, limit, curve, following, event, pedal, degraded
+   lane, emergency).
+4. The bumper gap to the lead [m] with UN R157's d_min at the ego's speed, shaded where the
+   gap is under it.
+5. The time to collision to the lead [s] (gap / closing speed while the ego closes on it),
+   0-10 s, with the stack's `ttc_hard` (2.5 s) dashed.
+6. The ego's true lateral offset [m] from the centre of the lane the stack keeps, with
+   +-(lane width - car width) / 2, where the body touches the lane's edge.
+
+(`avsim.report.margins` has what panels 2, 4, 5 and 6 show and how.)
 
 The lead vehicle at a tick is the nearest car or truck ahead of the ego in its lane, as the
 run's log has it from the truth and the map by the `min_gap` criterion's rule
 (`world.truth.vehicles_ahead`: its footprint in the lane the ego's centre is in, ahead along
-the ego's route, travelling along the lane; in a town as on a road); a gap in the line where
-there is none.
+the ego's route, travelling along the lane; in a town as on a road); a gap in the lines
+where there is none.
 
-Pure: no PyBullet, no pyplot (a bare `Figure` on the Agg canvas, so no display is needed).
+Pure and deterministic: no PyBullet, no pyplot (a bare `Figure` on the Agg canvas, so no
+display is needed).
 """
 
 from __future__ import annotations
 
-import enum
 import math
-from collections.abc import Sequence
+from functools import cache
 from pathlib import Path
-from typing import TYPE_CHECKING, Literal
+from typing import TYPE_CHECKING
 
 import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.backends.backend_agg import FigureCanvasAgg
-from matplotlib.collections import PolyCollection
 from matplotlib.figure import Figure
-from numpy.typing import NDArray
 
+from avsim.report import margins
+from avsim.report.bands import BAND_ALPHA, FloatArray, draw_bands, mode_runs
 from planner.fsm.acc import AccMode
 from planner.messages import SpeedSource
+from vehicle_urdf.geometry import read_geometry
 from world.frames import MPS_PER_KPH
 
 if TYPE_CHECKING:
     from avsim.run.runner import RunResult
 
-SIZE = (16.0, 7.0)  # [in] at DPI: 1600 x 700 px
+__all__ = ["BAND_ALPHA", "MODE_COLOURS", "SOURCE_COLOURS", "lead_speed", "mode_runs",
+           "plot_speed_profile", "speed_profile_figure"]
+
+SIZE = (16.0, 12.0)  # [in] at DPI: 1600 x 1200 px
 DPI = 100  # [px/in]
-BAND_ALPHA = 0.3  # [-] opacity of the mode and source bands
 VEHICLES = frozenset({"car", "truck"})  # actor types that can be a lead
 # one colour per ACC / event mode, by `AccMode` value (legend order: AccMode's)
 MODE_COLOURS: dict[str, str] = {
@@ -57,7 +72,6 @@ MODE_COLOURS: dict[str, str] = {
     AccMode.RED_LIGHT.value: "#b71c1c",
     AccMode.YIELD.value: "#ff9800",
 }
-OTHER_MODE_COLOUR = "#9e9e9e"  # a mode this table does not know yet
 # one colour per speed source, by `SpeedSource` value (legend order: SpeedSource's)
 SOURCE_COLOURS: dict[str, str] = {
     SpeedSource.SET_SPEED.value: "#66bb6a",
@@ -69,7 +83,10 @@ SOURCE_COLOURS: dict[str, str] = {
     SpeedSource.DEGRADED.value: "#ff7043",
     SpeedSource.EMERGENCY.value: "#d50000",
 }
-SOURCE_STRIP = 0.08  # [-] the speed-source strip's height, a fraction of the speed axes'
+# [-] the panels' heights, relative to the speed panel's
+PANELS = {"speed": 1.0, "motion": 0.07, "source": 0.07, "gap": 0.45, "ttc": 0.35,
+          "offset": 0.35}
+STRIP_LABELS = {"motion": "manoeuvre", "source": "speed set by"}
 LINES = {  # series -> (label, colour, style, width)
     "ego": ("ego speed", "#000000", "-", 2.0),
     "lead": ("lead speed", "#1a237e", "-", 1.5),
@@ -77,31 +94,17 @@ LINES = {  # series -> (label, colour, style, width)
     "set": ("set speed", "#1b5e20", ":", 1.8),
 }
 
-FloatArray = NDArray[np.float64]
-
-
-def mode_runs(t: Sequence[float],
-              modes: Sequence[enum.Enum]) -> list[tuple[str, float, float]]:
-    """(mode's value, start [s], end [s]) of each run of equal modes (or sources); a run
-    ends where the next one starts, the last one a tick after the last sample."""
-    if not len(t):
-        return []
-    times = np.asarray(t, dtype=np.float64)
-    dt = float(times[-1] - times[-2]) if len(times) > 1 else 0.0
-    ends = np.append(times[1:], times[-1] + dt)
-    runs: list[tuple[str, float, float]] = []
-    start = 0
-    for i in range(1, len(modes) + 1):
-        if i == len(modes) or modes[i] != modes[start]:
-            runs.append((modes[start].value, float(times[start]), float(ends[i - 1])))
-            start = i
-    return runs
-
 
 def lead_speed(result: RunResult) -> FloatArray:
     """[m/s] per tick: the speed of the vehicle ahead in the ego's lane (the run's log, from
     the truth and the map), NaN where there is none."""
     return result.log.array("lead_speed")
+
+
+@cache
+def car_width() -> float:
+    """[m] the ego's body width, from its URDF."""
+    return read_geometry().body_width
 
 
 def _title(result: RunResult) -> str:
@@ -111,34 +114,9 @@ def _title(result: RunResult) -> str:
     return f"{result.scenario.name} ({result.scenario.situation}): {verdict}"
 
 
-def _draw_bands(fig: Figure, ax: Axes, runs: list[tuple[str, float, float]],
-                colours: dict[str, str], title: str,
-                loc: Literal["outside right lower", "outside lower center"]) -> None:
-    """One collection per mode (or source) over `ax`'s full height, and their legend, in
-    the order of `colours`."""
-    by_mode: dict[str, list[tuple[float, float]]] = {}
-    for mode, start, end in runs:
-        by_mode.setdefault(mode, []).append((start, end))
-    known = list(colours)
-    order = sorted(by_mode, key=lambda m: (known.index(m) if m in known else len(known), m))
-    handles = []
-    for mode in order:
-        verts = [[(a, 0.0), (b, 0.0), (b, 1.0), (a, 1.0)] for a, b in by_mode[mode]]
-        band = PolyCollection(verts, transform=ax.get_xaxis_transform(), linewidths=0,
-                              facecolors=colours.get(mode, OTHER_MODE_COLOUR),
-                              alpha=BAND_ALPHA, zorder=0, label=mode.replace("_", " "))
-        ax.add_collection(band, autolim=False)
-        handles.append(band)
-    if handles:
-        fig.legend(handles=handles, loc=loc, title=title, fontsize="small")
-
-
-def speed_profile_figure(result: RunResult) -> Figure:
-    """The figure of `plot_speed_profile`, not yet written."""
+def _draw_speeds(ax: Axes, result: RunResult) -> None:
+    """Panel 1's lines, limits, title and grid (its bands are drawn apart)."""
     log = result.log
-    fig = Figure(figsize=SIZE, dpi=DPI, layout="constrained")
-    FigureCanvasAgg(fig)
-    ax, strip = fig.subplots(2, 1, sharex=True, height_ratios=(1.0, SOURCE_STRIP))
     t = log.array("t")
     limit = log.array("speed_limit")
     series = {
@@ -151,29 +129,58 @@ def speed_profile_figure(result: RunResult) -> Figure:
         label, colour, style, width = LINES[key]
         ax.plot(t, values, style, color=colour, linewidth=width, label=label,
                 drawstyle="steps-post" if key == "limit" else "default", zorder=2)
-    runs = mode_runs(log.t, log.acc_mode)
-    _draw_bands(fig, ax, runs, MODE_COLOURS, "ACC / event mode", "outside right lower")
-    _draw_bands(fig, strip, mode_runs(log.t, log.speed_source), SOURCE_COLOURS,
-                "speed set by", "outside lower center")
-    strip.set_yticks([])
-    strip.set_ylabel("speed set by", rotation=0, ha="right", va="center")
     top = max([float(np.nanmax(v)) for v in series.values() if np.isfinite(v).any()],
               default=50.0)
     ax.set_ylim(min(0.0, float(np.nanmin(series["ego"]))) if len(t) else 0.0,
                 top * 1.08 + 2.0)
-    if runs:
-        ax.set_xlim(runs[0][1], runs[-1][2])
-    strip.set_xlabel("time [s]")
     ax.set_ylabel("speed [km/h]")
     ax.set_title(_title(result))
     ax.grid(True, alpha=0.3, zorder=1)
+
+
+def _draw_margins(axes: dict[str, Axes], result: RunResult) -> None:
+    """Panels 4-6: the gap and d_min, the time to collision, the lateral offset."""
+    log = result.log
+    t, speed, gap = log.array("t"), log.array("speed"), log.array("lead_gap")
+    margins.draw_gap(axes["gap"], t, gap, margins.min_gap(speed))
+    margins.draw_ttc(axes["ttc"], t, margins.time_to_collision(gap, speed, lead_speed(result)))
+    bound = margins.lane_margin(result.scenario.world.road, log.array("station"), car_width())
+    margins.draw_offset(axes["offset"], t, log.array("cross_track"), bound)
+
+
+def speed_profile_figure(result: RunResult) -> Figure:
+    """The figure of `plot_speed_profile`, not yet written: its axes in the order of
+    `PANELS`."""
+    log = result.log
+    fig = Figure(figsize=SIZE, dpi=DPI, layout="constrained")
+    FigureCanvasAgg(fig)
+    axes = dict(zip(PANELS, fig.subplots(len(PANELS), 1, sharex=True,
+                                         height_ratios=tuple(PANELS.values())), strict=True))
+    ax = axes["speed"]
+    _draw_speeds(ax, result)
     fig.legend(handles=ax.get_lines(), loc="outside right upper", fontsize="small")
+    runs = mode_runs(log.t, log.acc_mode)
+    draw_bands(fig, ax, runs, MODE_COLOURS, "ACC / event mode", "outside right lower")
+    draw_bands(fig, axes["motion"],
+               margins.motion_runs(log.t, log.motion, result.state_changes),
+               margins.MOTION_COLOURS, "manoeuvre", "outside right center",
+               skip=margins.NEUTRAL)
+    draw_bands(fig, axes["source"], mode_runs(log.t, log.speed_source), SOURCE_COLOURS,
+               "speed set by", "outside lower center")
+    for key, label in STRIP_LABELS.items():
+        axes[key].set_yticks([])
+        axes[key].set_ylabel(label, rotation=0, ha="right", va="center")
+    _draw_margins(axes, result)
+    if runs:
+        ax.set_xlim(runs[0][1], runs[-1][2])
+    axes["offset"].set_xlabel("time [s]")
     return fig
 
 
 def plot_speed_profile(result: RunResult, path: Path) -> Path:
-    """Write the run's speed profile as a PNG of `SIZE` at `DPI` to `path` (its directory is
-    made; the file appears whole, through a temporary file beside it). Returns `path`."""
+    """Write the run's speed profile and margins as a PNG of `SIZE` at `DPI` to `path` (its
+    directory is made; the file appears whole, through a temporary file beside it). Returns
+    `path`."""
     fig = speed_profile_figure(result)
     path.parent.mkdir(parents=True, exist_ok=True)
     partial = path.with_name(f".{path.name}.partial")

@@ -285,7 +285,7 @@ def _run_row(outcome: RunOutcome, out_dir: Path) -> str:
 def _runs_table(outcomes: Sequence[RunOutcome], out_dir: Path) -> list[str]:
     """The table of runs, a row each."""
     lines = ["| run | verdict | sim time [s] | wall time [s] | recording | result | "
-             "speed profile |",
+             "speeds + margins |",
              "|---|---|--:|--:|---|---|---|"]
     lines += [_run_row(o, out_dir) for o in outcomes]
     return [*lines, ""]

@@ -4,13 +4,13 @@ lane layout, limits, features and exits) laid out into the HD map (`world.hdmap.
 Steps: each segment becomes a reference-line piece laid from the end of the one before
 (from the spec's `origin` pose), or from its own exact `start` pose where the map kind
 gives one (an OpenDRIVE road's arc spline: `world.map.opendrive`), with its cross-section
-(lanes, oncoming lanes, widths, shoulder, zone, the file's paint; a zone carries on until a
-segment names another); the segments are checked (`MapError`); the speed-limit postings
-are the road's limit at s = 0, each segment's at its start and each sign's at its station
-(of several at one station the last listed wins); each feature goes onto the map, a
-traffic light as its place only: its head where the spec puts it, else on a pole
-`LIGHT_AHEAD` past its stop line, `LIGHT_SIDE` right of the paved edge, `LIGHT_HEIGHT` high,
-facing the route's traffic. The signal plan stays in the spec.
+(lanes, oncoming lanes, widths, shoulder, zone, the file's paint and lane profile; a zone
+carries on until a segment names another); the segments are checked (`MapError`); the
+speed-limit postings are the road's limit at s = 0, each segment's at its start and each
+sign's at its station (of several at one station the last listed wins); each feature goes
+onto the map, a traffic light as its place only: its head where the spec puts it, else on
+a pole `LIGHT_AHEAD` past its stop line, `LIGHT_SIDE` right of the paved edge,
+`LIGHT_HEIGHT` high, facing the route's traffic. The signal plan stays in the spec.
 """
 
 from __future__ import annotations
@@ -36,6 +36,7 @@ from world.spec import FeatureSpec, RoadSpec, TrafficLightSpec
 LIGHT_AHEAD = 12.0  # [m] a road light's head stands this far past its stop line ...
 LIGHT_SIDE = 1.0  # [m] ... this far right of the paved edge ...
 LIGHT_HEIGHT = 3.5  # [m] ... with its housing's centre this high (a town places its own)
+PROFILE_CHECKS = 33  # [-] stations where a segment's varying edges are checked against its arc
 
 
 class MapError(ValueError):
@@ -54,8 +55,8 @@ def build_road_map(spec: RoadSpec) -> RoadMap:
     for i, seg in enumerate(spec.segments):
         zone = seg.zone if seg.zone is not None else zone
         section = CrossSection(
-            seg.lanes, seg.oncoming_lanes, seg.lane_width, seg.shoulder, zone, seg.paint
-        )
+            seg.lanes, seg.oncoming_lanes, seg.lane_width, seg.shoulder, zone, seg.paint,
+            seg.profile)
         _check_segment(i, seg.length, seg.curvature, section)
         if seg.exit is not None:
             _check_exit(i, seg.exit, sections)
@@ -105,7 +106,7 @@ def _check_exit(i: int, side: Side, before: list[CrossSection]) -> None:
 def _check_segment(i: int, length: float, curvature: float, c: CrossSection) -> None:
     """Raise MapError if the segment is empty, its arc turns more than a full circle, or
     the arc is tighter than the road's inner half (the inner paved edge would cross the
-    arc's centre)."""
+    arc's centre; a lane profile's edges checked at `PROFILE_CHECKS` stations)."""
     if not length > 0.0:
         raise MapError(f"road.segments[{i}]: length {length} m must be > 0")
     if curvature == 0.0:
@@ -115,7 +116,9 @@ def _check_segment(i: int, length: float, curvature: float, c: CrossSection) -> 
             f"road.segments[{i}]: an arc may turn at most 360 degrees (it would lie on itself)"
         )
     radius = 1.0 / abs(curvature)
-    inner = c.left_edge if curvature > 0.0 else -c.right_edge
+    edges = (c.profile.at(np.linspace(0.0, length, PROFILE_CHECKS))[:, [0, -1]]
+             if c.profile is not None else np.array([[c.right_edge, c.left_edge]]))
+    inner = float(edges[:, 1].max()) if curvature > 0.0 else float(-edges[:, 0].min())
     if not radius > inner:
         side = "left" if curvature > 0.0 else "right"
         raise MapError(

@@ -68,8 +68,8 @@ def layout_speed_bumps(road_map: RoadMap) -> list[BumpPlacement]:
     for f in road_map.features:
         if not isinstance(f, SpeedBump):
             continue
-        c = road_map.cross_section_at(f.s)
-        band = (c.right_edge, c.centre_line)
+        bounds = road_map.lane_boundaries(f.s)
+        band = (float(bounds[0]), float(bounds[road_map.cross_section_at(f.s).lanes + 1]))
         xy = road_map.position(f.s, 0.5 * (band[0] + band[1]))
         bumps.append(BumpPlacement(
             s=f.s, centre=(float(xy[0]), float(xy[1])), yaw=float(road_map.heading_at(f.s)),

@@ -45,8 +45,8 @@ def paint_texture() -> NDArray[np.uint8]:
 def stop_line_band(road_map: RoadMap, s: float) -> tuple[float, float]:
     """([m] right, [m] left) offsets of a stop line at station s: lane 0's right edge and the
     centre line (the ego's lanes)."""
-    c = road_map.cross_section_at(s)
-    return -0.5 * c.lane_width, c.centre_line
+    bounds = road_map.lane_boundaries(s)
+    return float(bounds[1]), float(bounds[road_map.cross_section_at(s).lanes + 1])
 
 
 def zebra_bars(road_map: RoadMap, s: float) -> list[tuple[float, float]]:

@@ -10,7 +10,14 @@ a cross-section is one dash period of the paved road:
   v in [i / H, (i + 1) / H), and the dashes are painted at v in [0, DASH_LENGTH / DASH_PERIOD).
 
 The surface is a strip with two vertices across (right and left paved edge) per station:
-the texture carries every marking, so the strip needs no more. Stations are at most
+the texture carries every marking, so the strip needs no more. A segment whose lane widths
+change along it (a `LaneProfile`) is textured as its uniform `canonical` section (lanes
+`PROFILE_LANE` wide, a shoulder `PROFILE_SHOULDER` wide where it has one), and its strip
+has a vertex across at every lane boundary and at both edges of every painted line: the
+texture's columns between those cuts stretch to where the boundaries are at each station,
+while each line keeps its width and its place on its boundary (its offset from the
+boundary nearest to it in the canonical section), so the camera sees the lines where the
+map has them. Stations are at most
 `MAX_STEP` apart (closer on tight arcs, for a chord error below `MAX_CHORD_ERROR` at the
 outer edge) and include every multiple of `DASH_PERIOD`, where the strip's vertices are
 duplicated (v = 1 ending one period, v = 0 starting the next) so that v never wraps
@@ -29,6 +36,7 @@ from numpy.typing import NDArray
 from world.hdmap import CrossSection, LineMark, LinePaint, MarkKind, PaintColour, RoadMap
 
 FloatArray = NDArray[np.float64]
+IntArray = NDArray[np.intp]
 ImageRGB = NDArray[np.uint8]
 
 # -- markings -----------------------------------------------------------------------------
@@ -55,6 +63,9 @@ MAX_STEP = 2.0  # [m] station spacing of the strip
 MAX_CHORD_ERROR = 0.02  # [m] at the outermost paved edge on arcs
 MAX_MESH_VERTICES = 4000  # [-] per mesh (PyBullet's mesh size limit)
 STATION_TOL = 1e-6  # [m] a period boundary this close to a segment's end is not split at
+
+PROFILE_LANE = 3.5  # [m] a canonical lane's width (the texture of a varying section)
+PROFILE_SHOULDER = 2.5  # [m] a canonical shoulder's width
 
 TextureKey = tuple[int, int, float, float, LinePaint | None]  # lanes, oncoming lanes, lane
 #   width, shoulder, the map file's paint
@@ -83,9 +94,22 @@ class Marking:
 
 
 def texture_key(section: CrossSection) -> TextureKey:
-    """What a cross-section's texture depends on (not its zone)."""
-    return (section.lanes, section.oncoming_lanes, section.lane_width, section.shoulder,
-            section.paint)
+    """What a cross-section's texture depends on (not its zone; a varying section's is its
+    `canonical` one's)."""
+    c = canonical(section)
+    return c.lanes, c.oncoming_lanes, c.lane_width, c.shoulder, c.paint
+
+
+def canonical(section: CrossSection) -> CrossSection:
+    """The uniform section that textures `section`: itself if it has no lane profile, else
+    its lanes `PROFILE_LANE` wide and a shoulder `PROFILE_SHOULDER` wide if its shoulder
+    is ever wider than 0 on it (module doc)."""
+    if section.profile is None:
+        return section
+    bounds = np.asarray(section.profile.boundaries)
+    shoulder = PROFILE_SHOULDER if np.any(bounds[1] != bounds[0]) else 0.0
+    return CrossSection(section.lanes, section.oncoming_lanes, PROFILE_LANE, shoulder,
+                        section.zone, section.paint)
 
 
 def markings(section: CrossSection) -> list[Marking]:
@@ -95,7 +119,9 @@ def markings(section: CrossSection) -> list[Marking]:
     ego lanes, double yellow at the centre line (when there are oncoming lanes), white
     dashed between oncoming lanes, white solid at the left paved edge. Lines are centred on
     their lane boundary, except that an edge line keeps `EDGE_LINE_INSET` from a paved edge.
+    A varying section's are its `canonical` section's (the texture's).
     """
+    section = canonical(section)
     if section.paint is not None:
         return file_markings(section, section.paint)
     w, shoulder, width = section.lane_width, section.shoulder, section.paved_width
@@ -147,12 +173,14 @@ def _coverage(lo: float, hi: float, n: int, extent: float) -> FloatArray:
 
 
 def make_road_texture(section: CrossSection) -> ImageRGB:
-    """(H, W, 3) uint8 RGB texture of one dash period of the cross-section.
+    """(H, W, 3) uint8 RGB texture of one dash period of the cross-section (its
+    `canonical` one's).
 
     W = paved width / TEXEL_ACROSS columns (u = 0 at the right paved edge), H =
     DASH_PERIOD / TEXEL_ALONG rows. Asphalt with deterministic noise, the shoulder a little
     lighter, then each marking blended in by its area coverage of each texel.
     """
+    section = canonical(section)
     width = section.paved_width
     cols = max(1, round(width / TEXEL_ACROSS))
     rows = max(1, round(DASH_PERIOD / TEXEL_ALONG))
@@ -173,11 +201,18 @@ def make_road_texture(section: CrossSection) -> ImageRGB:
 def _max_step(road_map: RoadMap, piece_index: int) -> float:
     """[m] station spacing on a piece: MAX_STEP, or less on an arc so that the chord error
     at the paved edge farthest from the arc's centre stays below MAX_CHORD_ERROR."""
-    k = road_map.pieces[piece_index].curvature
+    piece = road_map.pieces[piece_index]
+    k = piece.curvature
     if k == 0.0:
         return MAX_STEP
     c = road_map.sections[piece_index]
-    outer = max(abs(1.0 / k - c.right_edge), abs(1.0 / k - c.left_edge))  # [m] radius
+    if c.profile is None:
+        right, left = c.right_edge, c.left_edge
+    else:  # the edges farthest out along the segment
+        edges = road_map.segment_boundaries(
+            piece_index, np.linspace(piece.s0, piece.s0 + piece.length, 33))
+        right, left = float(edges[:, 0].min()), float(edges[:, -1].max())
+    outer = max(abs(1.0 / k - right), abs(1.0 / k - left))  # [m] radius
     dtheta = 2.0 * math.acos(max(-1.0, 1.0 - MAX_CHORD_ERROR / outer))
     return min(MAX_STEP, dtheta / abs(k))
 
@@ -202,15 +237,18 @@ class _MeshBuffer:
     texture: ImageRGB
     xy: list[FloatArray] = field(default_factory=list)
     uv: list[FloatArray] = field(default_factory=list)
+    cols: list[int] = field(default_factory=list)  # vertices across, per strip
     count: int = 0  # vertices in xy
     meshes: list[TexturedMesh] = field(default_factory=list)
 
-    def add(self, xy: FloatArray, uv: FloatArray) -> None:
-        """Collect one strip, first flushing if it would overfill the mesh."""
+    def add(self, xy: FloatArray, uv: FloatArray, cols: int = 2) -> None:
+        """Collect one strip (`cols` vertices across per station), first flushing if it
+        would overfill the mesh."""
         if self.count + len(xy) > MAX_MESH_VERTICES:
             self.flush()
         self.xy.append(xy)
         self.uv.append(uv)
+        self.cols.append(cols)
         self.count += len(xy)
 
     def flush(self) -> None:
@@ -218,8 +256,9 @@ class _MeshBuffer:
         if not self.xy:
             return
         indices, base = [], 0
-        for xy in self.xy:
-            indices.append(_strip_indices(len(xy) // 2, base))
+        for xy, cols in zip(self.xy, self.cols, strict=True):
+            indices.append(_strip_indices(len(xy) // 2, base) if cols == 2
+                           else _grid_indices(len(xy) // cols, cols, base))
             base += len(xy)
         xy_all = np.concatenate(self.xy)
         vertices = np.column_stack([xy_all, np.full(len(xy_all), SURFACE_Z)])
@@ -234,7 +273,7 @@ class _MeshBuffer:
             texture=self.texture,
         )
         self.meshes.append(mesh)
-        self.xy, self.uv, self.count = [], [], 0
+        self.xy, self.uv, self.cols, self.count = [], [], [], 0
 
 
 def _strip(road_map: RoadMap, piece_index: int, s: FloatArray) -> tuple[FloatArray, FloatArray]:
@@ -248,6 +287,55 @@ def _strip(road_map: RoadMap, piece_index: int, s: FloatArray) -> tuple[FloatArr
     xy = np.stack([right, left], axis=1).reshape(-1, 2)
     uv = np.stack([np.zeros_like(v), v, np.ones_like(v), v], axis=1).reshape(-1, 2)
     return xy, uv
+
+
+def _cuts(section: CrossSection) -> tuple[FloatArray, IntArray, FloatArray]:
+    """Where a varying section's strip is cut across, in its `canonical` section: ([m]
+    each cut from the right paved edge, sorted; the boundary (`RoadMap.lane_boundaries`
+    index) each cut keeps its offset from; [m] that offset): every boundary (offset 0) and
+    both edges of every painted line (module doc)."""
+    c = canonical(section)
+    bounds = c.boundary_cubics()[:, 0]
+    bounds = bounds - bounds[0]
+    cut, ref = list(bounds), list(range(len(bounds)))
+    for m in markings(c):
+        k = int(np.argmin(np.abs(bounds - m.centre)))
+        for edge in (m.centre - 0.5 * m.width, m.centre + 0.5 * m.width):
+            cut.append(edge)
+            ref.append(k)
+    order = np.argsort(cut, kind="stable")
+    cuts = np.asarray(cut)[order]
+    refs = np.asarray(ref, dtype=np.intp)[order]
+    return cuts, refs, cuts - bounds[refs]
+
+
+def _profiled_strip(road_map: RoadMap, piece_index: int,
+                    s: FloatArray) -> tuple[FloatArray, FloatArray, int]:
+    """(xy (n m, 2), uv (n m, 2), m) of a varying section's strip at stations s (n,) within
+    one dash period: m vertices across per station at the `_cuts`, station-major."""
+    section = road_map.sections[piece_index]
+    cuts, refs, shift = _cuts(section)
+    bounds = road_map.segment_boundaries(piece_index, s)  # (n, boundaries)
+    d = bounds[:, refs] + shift  # (n, m) [m] offsets from the reference line
+    d = np.clip(np.maximum.accumulate(d, axis=1), bounds[:, :1], bounds[:, -1:])
+    n, m = d.shape
+    xy = road_map.position(np.repeat(s, m), d.reshape(-1))
+    period = math.floor(0.5 * (s[0] + s[-1]) / DASH_PERIOD)
+    v = np.clip(s / DASH_PERIOD - period, 0.0, 1.0)
+    u = cuts / canonical(section).paved_width
+    uv = np.stack([np.broadcast_to(u, (n, m)), np.broadcast_to(v[:, None], (n, m))], axis=-1)
+    return xy, uv.reshape(-1, 2), m
+
+
+def _grid_indices(n_stations: int, cols: int, base: int) -> NDArray[np.int32]:
+    """(2 (n - 1) (cols - 1), 3) triangles of a station-major grid of n stations by `cols`
+    vertices across (right to left) whose first vertex is `base`."""
+    i, j = np.meshgrid(np.arange(n_stations - 1), np.arange(cols - 1), indexing="ij")
+    a = base + i * cols + j
+    b, c = a + 1, a + cols
+    d = c + 1
+    tris = np.stack([np.stack([a, c, d], -1), np.stack([a, d, b], -1)], axis=-2)
+    return tris.reshape(-1, 3).astype(np.int32)
 
 
 def _strip_indices(n_stations: int, base: int) -> NDArray[np.int32]:
@@ -272,7 +360,10 @@ def build_road_surface(road_map: RoadMap) -> list[TexturedMesh]:
         if key not in buffers:
             buffers[key] = _MeshBuffer(len(buffers), make_road_texture(section))
         for s in _runs(piece.s0, piece.s0 + piece.length, _max_step(road_map, i)):
-            buffers[key].add(*_strip(road_map, i, s))
+            if section.profile is None:
+                buffers[key].add(*_strip(road_map, i, s))
+            else:
+                buffers[key].add(*_profiled_strip(road_map, i, s))
     meshes: list[TexturedMesh] = []
     for buf in buffers.values():
         buf.flush()

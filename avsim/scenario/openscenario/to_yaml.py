@@ -140,6 +140,10 @@ def _road(road: RoadSpec, out: Conversion) -> dict[str, Any]:
                            "an OpenDRIVE clothoid or cubic as arcs within 1 mm of it")
     if first.paint is not None:
         out.misfits.append("the road's marks (the YAML road paints its own lines)")
+    if any(seg.profile is not None or (seg.lane_width, seg.shoulder)
+           != (first.lane_width, first.shoulder) for seg in road.segments):
+        out.misfits.append("the road's lane widths that change along it (the YAML road has "
+                           "one lane width and shoulder: the start's)")
     if first.start is not None and any(first.start):
         out.misfits.append("the road's place in the map frame (the YAML road starts at the "
                            "origin, heading +x)")

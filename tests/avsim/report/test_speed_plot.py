@@ -1,14 +1,19 @@
-"""Tests of the speed-profile plot (`avsim.report.speed_plot`, `avsim run --plot`), on a
-synthetic run.
+"""Tests of the run's plot (`avsim.report.speed_plot`, `avsim run --plot`) and its margin
+panels (`avsim.report.margins`), on a synthetic run.
 
 No simulation: a `RunResult` is built from the bundled traffic_jam scenario's spec and a
-short made-up log (60 s at 40 Hz): the lead car 30 m or more ahead in the ego's lane at 10 m/s, then
-5 m/s, leaving for lane 1 at 50 s; a faster car in lane 1 that is never the lead. The CLI's
-wiring is checked with the simulator replaced by a stand-in that returns that run.
+short made-up log (60 s at 40 Hz): the lead car 25 m or more ahead in the ego's lane at
+10 m/s while the ego does 9 m/s, then at 30 s it slows to 2 m/s and the ego to 4.5 m/s, so
+the ego closes on it at 2.5 m/s (its time to collision falls under 10 s at ~41.7 s, its gap
+under R157's d_min at ~49.6 s) until it leaves for lane 1 at 50 s; a faster car in lane 1
+that is never the lead. The motion FSM changes lane to the left from 5 s to 9 s and starts
+one to the right at 12 s that it aborts at 14 s. The CLI's wiring is checked with the
+simulator replaced by a stand-in that returns that run.
 """
 
 from __future__ import annotations
 
+import itertools
 import math
 from pathlib import Path
 
@@ -17,14 +22,21 @@ import pytest
 from click.testing import CliRunner
 from matplotlib import colors
 from matplotlib import image as mpimg
+from matplotlib.lines import Line2D
+from numpy.typing import NDArray
 
 from avsim.cli import main
 from avsim.criteria.base import CriterionResult
+from avsim.report import margins
 from avsim.report import speed_plot as plot
 from avsim.run.runner import RunResult, TrajectoryLog
 from avsim.scenario.load import load_scenario
-from planner.fsm.acc import AccMode
+from planner.fsm.acc import AccMode, r157_min_gap
+from planner.fsm.machine import StateChange
+from planner.fsm.motion import TABLE as MOTION_TABLE
+from planner.fsm.motion import Motion
 from planner.messages import SpeedSource
+from world.spec import RoadSpec, SegmentSpec
 
 REPO = Path(__file__).parents[3]
 TRAFFIC_JAM = REPO / "scenarios" / "traffic_jam.yaml"
@@ -36,11 +48,30 @@ MODES = ((0.0, AccMode.CRUISE), (20.0, AccMode.TRAIL), (40.0, AccMode.BRAKE),
 SOURCES = {AccMode.CRUISE: SpeedSource.SET_SPEED, AccMode.TRAIL: SpeedSource.FOLLOWING,
            AccMode.BRAKE: SpeedSource.FOLLOWING, AccMode.SPEED_LIMIT: SpeedSource.LIMIT}
 LEAD_LEAVES = 50.0  # [s] the lead moves to lane 1
+SLOW_DOWN = 30.0  # [s] the lead slows to 2 m/s, the ego to 4.5 m/s
+EGO_SPEED, LEAD_SPEED = (9.0, 4.5), (10.0, 2.0)  # [m/s] before, after SLOW_DOWN
+CLOSING = EGO_SPEED[1] - LEAD_SPEED[1]  # [m/s] after SLOW_DOWN
+# the motion FSM: (start [s], state, the reason of the change into it)
+MOTIONS = ((0.0, Motion.LANE_KEEP, ""),
+           (5.0, Motion.LANE_CHANGE_LEFT, "a slower vehicle ahead, the left lane free"),
+           (9.0, Motion.LANE_KEEP, "in the target lane"),
+           (12.0, Motion.LANE_CHANGE_RIGHT, "the route needs a lane to the right"),
+           (14.0, Motion.LANE_KEEP, "the target lane is no longer free: abort"))
+PX = (1200, 1600)  # [px] the PNG's height, width
 EXIT_BAD_INPUT = 2
 
 
 def _mode_at(t: float) -> AccMode:
     return [m for start, m in MODES if t >= start][-1]
+
+
+def _motion_at(t: float) -> Motion:
+    return [m for start, m, _ in MOTIONS if t >= start - 1e-9][-1]
+
+
+def _motion_changes() -> tuple[StateChange, ...]:
+    return tuple(StateChange(t, "motion", before.value, after.value, reason)
+                 for (_, before, _), (t, after, reason) in itertools.pairwise(MOTIONS))
 
 
 def synthetic_result(passed: bool = True) -> RunResult:
@@ -51,8 +82,8 @@ def synthetic_result(passed: bool = True) -> RunResult:
     dt = 1.0 / RATE
     for i in range(round(DURATION * RATE)):
         t = i * dt
-        ego_v = 9.0 if t < 30 else 4.5
-        lead_v = 10.0 if t < 30 else 5.0
+        ego_v = EGO_SPEED[t >= SLOW_DOWN]
+        lead_v = LEAD_SPEED[t >= SLOW_DOWN]
         log.t.append(t)
         log.speed.append(ego_v)
         log.station.append(ego_s)
@@ -60,6 +91,7 @@ def synthetic_result(passed: bool = True) -> RunResult:
         log.lane.append(0)
         log.speed_limit.append(50 / 3.6)
         log.acc_mode.append(_mode_at(t))
+        log.motion.append(_motion_at(t))
         log.speed_source.append(SOURCES[_mode_at(t)])
         ahead = t < LEAD_LEAVES  # then it moves to lane 1: no vehicle ahead
         log.lead_gap.append(lead_s - ego_s - 4.8 if ahead else math.nan)
@@ -70,7 +102,8 @@ def synthetic_result(passed: bool = True) -> RunResult:
     criteria = [CriterionResult("no_collision", True, 0.0, 0.0, "-"),
                 CriterionResult("min_gap", passed, 12.0, 14.0, "m")]
     return RunResult(scenario=scenario, criteria=criteria, metrics={"max_speed": 9.0},
-                     sim_time=DURATION, wall_time=1.0, log=log, recording=None)
+                     sim_time=DURATION, wall_time=1.0, log=log, recording=None,
+                     state_changes=_motion_changes())
 
 
 def test_lead_speed_is_the_runs_vehicle_ahead_from_the_truth() -> None:
@@ -80,8 +113,8 @@ def test_lead_speed_is_the_runs_vehicle_ahead_from_the_truth() -> None:
     t = result.log.array("t")
     lead = plot.lead_speed(result)
     assert lead.shape == t.shape
-    np.testing.assert_allclose(lead[t < 30], 10.0)
-    np.testing.assert_allclose(lead[(t >= 30) & (t < LEAD_LEAVES)], 5.0)
+    np.testing.assert_allclose(lead[t < SLOW_DOWN], 10.0)
+    np.testing.assert_allclose(lead[(t >= SLOW_DOWN) & (t < LEAD_LEAVES)], 2.0)
     assert np.isnan(lead[t >= LEAD_LEAVES]).all()
 
 
@@ -97,6 +130,11 @@ def test_every_acc_mode_has_its_own_colour() -> None:
     assert len(set(plot.MODE_COLOURS.values())) == len(AccMode)
     assert set(plot.SOURCE_COLOURS) == {s.value for s in SpeedSource}
     assert len(set(plot.SOURCE_COLOURS.values())) == len(SpeedSource)
+    moves = {m.value for m in Motion} - margins.NEUTRAL | {margins.ABORTED, margins.PULL_OVER}
+    assert set(margins.MOTION_COLOURS) == moves
+    every = [*plot.MODE_COLOURS.values(), *plot.SOURCE_COLOURS.values(),
+             *margins.MOTION_COLOURS.values()]
+    assert len(set(every)) == len(every)  # a band's pixels tell which table it is from
 
 
 def _band_pixels(png: np.ndarray, colour: str) -> int:
@@ -114,7 +152,7 @@ def test_plot_writes_a_png_of_the_expected_size_with_mode_bands(tmp_path: Path) 
     assert 20_000 <= path.stat().st_size <= 1_000_000, path.stat().st_size
     assert [p.name for p in path.parent.iterdir()] == [path.name]  # no partial file left
     png = mpimg.imread(path)
-    assert png.shape[:2] == (700, 1600)
+    assert png.shape[:2] == PX
     # each mode of the run covers a band of the plot (thousands of pixels; its legend
     # patch alone is a few hundred), the modes it never had do not appear at all
     for mode in {m.value for _, m in MODES}:
@@ -122,19 +160,29 @@ def test_plot_writes_a_png_of_the_expected_size_with_mode_bands(tmp_path: Path) 
     for mode in set(plot.MODE_COLOURS) - {m.value for _, m in MODES}:
         assert _band_pixels(png, plot.MODE_COLOURS[mode]) < 50, mode
     # the speed-source strip: a band per source the run had (a few hundred pixels: the strip
-    # is ~45 px high), none for the others
+    # is ~35 px high), none for the others
     for source in {s.value for s in SOURCES.values()}:
         assert _band_pixels(png, plot.SOURCE_COLOURS[source]) > 1_000, source
     for source in set(plot.SOURCE_COLOURS) - {s.value for s in SOURCES.values()}:
         assert _band_pixels(png, plot.SOURCE_COLOURS[source]) < 50, source
+    # the manoeuvre strip: the lane change left (4 s of 60, ~90 px wide) and the aborted one
+    # (2 s), nothing for the manoeuvres the run did not make (lane keeping has no band)
+    had = {Motion.LANE_CHANGE_LEFT.value, margins.ABORTED}
+    for move in had:
+        assert _band_pixels(png, margins.MOTION_COLOURS[move]) > 700, move
+    for move in set(margins.MOTION_COLOURS) - had:
+        assert _band_pixels(png, margins.MOTION_COLOURS[move]) < 50, move
 
 
 def test_figure_title_axes_and_legends() -> None:
     fig = plot.speed_profile_figure(synthetic_result(passed=False))
-    ax, strip = fig.axes
+    ax = fig.axes[0]
     assert ax.get_title() == "traffic_jam (traffic_jam): FAIL (min_gap)"
-    assert strip.get_xlabel() == "time [s]" and ax.get_ylabel() == "speed [km/h]"
-    assert strip.get_ylabel() == "speed set by"
+    assert [a.get_ylabel() for a in fig.axes] == [
+        "speed [km/h]", "manoeuvre", "speed set by", "gap [m]", "TTC [s]",
+        "lateral offset [m]"]
+    assert [a.get_xlabel() for a in fig.axes] == [""] * 5 + ["time [s]"]
+    assert all(a.get_shared_x_axes().joined(ax, a) for a in fig.axes)
     assert [line.get_label() for line in ax.get_lines()] == [
         "ego speed", "lead speed", "posted limit", "set speed"]
     ego, lead, limit, set_speed = (line.get_ydata() for line in ax.get_lines())
@@ -145,7 +193,121 @@ def test_figure_title_axes_and_legends() -> None:
     legends = [[text.get_text() for text in legend.get_texts()] for legend in fig.legends]
     assert ["cruise", "trail", "brake", "speed limit"] in legends
     assert ["set speed", "limit", "following"] in legends
+    assert ["lane change left", "lane change aborted"] in legends
     assert ax.get_xlim() == pytest.approx((0.0, DURATION))
+
+
+def _ydata(line: Line2D) -> NDArray[np.float64]:
+    return np.asarray(line.get_ydata(), dtype=np.float64)
+
+
+def test_margin_panels_show_the_gap_ttc_and_offset() -> None:
+    result = synthetic_result()
+    log = result.log
+    _, _, _, gap, ttc, offset = plot.speed_profile_figure(result).axes
+    # the gap and d_min at the ego's speed, shaded where the gap is under d_min
+    assert [line.get_label() for line in gap.get_lines()] == [
+        "gap to the lead", "R157 d_min at ego speed"]
+    gap_line, d_min = (_ydata(line) for line in gap.get_lines())
+    np.testing.assert_array_equal(gap_line, log.array("lead_gap"))
+    np.testing.assert_allclose(np.unique(d_min), [r157_min_gap(4.5), r157_min_gap(9.0)])
+    assert len(gap.collections) == 1  # the shading: the gap ends under d_min (~49.6 s)
+    assert gap.get_ylim()[0] == 0.0
+    # the time to collision and ttc_hard
+    assert [line.get_label() for line in ttc.get_lines()] == [
+        "time to collision", "ttc_hard 2.5 s"]
+    np.testing.assert_array_equal(_ydata(ttc.get_lines()[0]), margins.time_to_collision(
+        log.array("lead_gap"), log.array("speed"), log.array("lead_speed")))
+    assert ttc.get_ylim() == (0.0, margins.TTC_VIEW)
+    np.testing.assert_allclose(_ydata(ttc.get_lines()[1]), margins.TTC_HARD)
+    # the true offset, and the body's bound in traffic_jam's 3.5 m lanes: +-(3.5 - 1.6) / 2
+    off, upper, lower = (_ydata(line) for line in offset.get_lines()[1:])
+    np.testing.assert_array_equal(off, log.array("cross_track"))
+    np.testing.assert_allclose(upper, (LANE_WIDTH - 1.6) / 2)
+    np.testing.assert_allclose(lower, -(LANE_WIDTH - 1.6) / 2)
+
+
+def test_time_to_collision_where_the_ego_closes_on_a_lead() -> None:
+    nan = math.nan
+    gap = np.array([10.0, 10.0, nan, 10.0, -1.0, 12.0, 6.0])
+    ego = np.array([5.0, 5.0, 5.0, 5.0, 5.0, 5.0, 0.0])
+    lead = np.array([3.0, 5.0, nan, 7.0, 4.0, nan, -2.0])
+    ttc = margins.time_to_collision(gap, ego, lead)
+    # closing, level, no lead, opening, overlapping (0), lead speed unknown, backing lead
+    np.testing.assert_array_equal(ttc, [5.0, nan, nan, nan, 0.0, nan, 3.0])
+
+
+def test_time_to_collision_of_the_synthetic_run() -> None:
+    log = synthetic_result().log
+    t, gap = log.array("t"), log.array("lead_gap")
+    ttc = margins.time_to_collision(gap, log.array("speed"), log.array("lead_speed"))
+    closing = (t >= SLOW_DOWN) & (t < LEAD_LEAVES)
+    assert np.isnan(ttc[~closing]).all()  # opening before, no lead after
+    np.testing.assert_allclose(ttc[closing], gap[closing] / CLOSING)
+    assert ttc[closing].max() > 20.0 and 1.5 < ttc[closing].min() < margins.TTC_HARD
+
+
+def test_min_gap_is_r157s_at_each_speed() -> None:
+    speeds = np.array([0.0, 2.0, 10.0, 30.0])
+    np.testing.assert_allclose(margins.min_gap(speeds), [2.0, 2.0 * 1.1, 10.0 * 1.36,
+                                                         30.0 * 2.08])
+    assert margins.min_gap(np.array([])).shape == (0,)
+
+
+def _segment(length: float, lane_width: float) -> SegmentSpec:
+    return SegmentSpec(length=length, curvature=0.0, lanes=2, oncoming_lanes=0,
+                       lane_width=lane_width, shoulder=0.0)
+
+
+def test_lane_margin_follows_the_segment_at_the_station() -> None:
+    road = RoadSpec(segments=(_segment(100.0, 3.5), _segment(50.0, 3.0)), speed_limit=20.0)
+    stations = np.array([-5.0, 0.0, 99.9, 100.0, 149.0, 400.0])
+    np.testing.assert_allclose(margins.lane_margin(road, stations, 1.6),
+                               [0.95, 0.95, 0.95, 0.7, 0.7, 0.7])
+    empty = RoadSpec(segments=(), speed_limit=20.0)
+    assert np.isnan(margins.lane_margin(empty, stations, 1.6)).all()
+
+
+def test_motion_runs_tell_aborted_and_pull_over_lane_changes() -> None:
+    result = synthetic_result()
+    assert margins.motion_runs(result.log.t, result.log.motion, result.state_changes) == [
+        ("lane_keep", 0.0, pytest.approx(5.0)),
+        ("lane_change_left", pytest.approx(5.0), pytest.approx(9.0)),
+        ("lane_keep", pytest.approx(9.0), pytest.approx(12.0)),
+        ("lane_change_aborted", pytest.approx(12.0), pytest.approx(14.0)),
+        ("lane_keep", pytest.approx(14.0), DURATION)]
+    # without the changes' reasons, a lane change is only its state
+    assert [r[0] for r in margins.motion_runs(result.log.t, result.log.motion, ())] == [
+        "lane_keep", "lane_change_left", "lane_keep", "lane_change_right", "lane_keep"]
+    keep, right = Motion.LANE_KEEP, Motion.LANE_CHANGE_RIGHT
+    pull = (StateChange(1.0, "motion", "lane_keep", "lane_change_right",
+                        "a flat tyre: pull over"),
+            StateChange(3.0, "acc", "cruise", "flat", "a flat tyre"),
+            StateChange(3.0, "motion", "lane_change_right", "lane_keep", "in the target lane"))
+    assert margins.motion_runs([0.0, 1.0, 2.0, 3.0], [keep, right, right, keep], pull) == [
+        ("lane_keep", 0.0, 1.0), ("pull_over", 1.0, 3.0), ("lane_keep", 3.0, 4.0)]
+    # an abort logged by another machine, or far from the run's end, is not this one's
+    other = (StateChange(3.0, "acc", "lane_change_right", "lane_keep", "abort"),
+             StateChange(2.0, "motion", "lane_change_right", "lane_keep", "abort"))
+    assert margins.motion_runs([0.0, 1.0, 2.0, 3.0], [keep, right, right, keep], other)[1] \
+        == ("lane_change_right", 1.0, 3.0)
+
+
+def test_motion_reasons_are_the_motion_tables() -> None:
+    """The labels read the motion FSM's logged reasons: each keyword is in exactly one row's
+    (the abort's; the pull over's, into lane_change_right)."""
+    for label, word in margins.MOTION_REASONS.items():
+        rows = [r for r in MOTION_TABLE.rows if isinstance(r.reason, str) and word in r.reason]
+        assert len(rows) == 1, (label, rows)
+    pull = next(r for r in MOTION_TABLE.rows if isinstance(r.reason, str)
+                and margins.MOTION_REASONS[margins.PULL_OVER] in r.reason)
+    assert pull.target is Motion.LANE_CHANGE_RIGHT
+
+
+def test_the_png_is_deterministic(tmp_path: Path) -> None:
+    result = synthetic_result()
+    first = plot.plot_speed_profile(result, tmp_path / "a.png").read_bytes()
+    assert plot.plot_speed_profile(result, tmp_path / "b.png").read_bytes() == first
 
 
 def test_an_empty_run_still_plots(tmp_path: Path) -> None:
@@ -153,7 +315,7 @@ def test_an_empty_run_still_plots(tmp_path: Path) -> None:
     empty = RunResult(scenario=result.scenario, criteria=[], metrics={}, sim_time=0.0,
                       wall_time=0.0, log=TrajectoryLog(), recording=None)
     path = plot.plot_speed_profile(empty, tmp_path / "empty.png")
-    assert mpimg.imread(path).shape[:2] == (700, 1600)
+    assert mpimg.imread(path).shape[:2] == PX
 
 
 # -- the command line -------------------------------------------------------------------------
@@ -187,7 +349,7 @@ def test_run_plot_writes_the_png(fake_runner: Path, args: list[str], png: str) -
     result = CliRunner().invoke(main, ["run", str(TRAFFIC_JAM), "--out", "tmp/x.rrd", *args])
     assert result.exit_code == 0, (result.output, result.exception)
     assert (fake_runner / png).is_file()
-    assert mpimg.imread(fake_runner / png).shape[:2] == (700, 1600)
+    assert mpimg.imread(fake_runner / png).shape[:2] == PX
     assert (fake_runner / "tmp" / "x.json").is_file()
 
 

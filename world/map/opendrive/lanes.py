@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike
 
-from world.map.opendrive.model import FloatArray, LaneSection, OdrLane, Road, poly3_at
+from world.map.opendrive.model import FloatArray, LaneSection, OdrLane, Poly3, Road, poly3_at
 
 
 def lane_section_index(road: Road, s: float) -> int:
@@ -51,3 +51,37 @@ def lane_centre_t(road: Road, lane_id: int, s: float) -> float:
     section there has no such lane."""
     inner, outer = lane_borders(road, s)[lane_id]
     return 0.5 * (inner + outer)
+
+
+def record_at(records: tuple[Poly3, ...], s: float) -> Poly3 | None:
+    """The record of `records` (ascending `s`) in force at station `s` (None before the
+    first, as `poly3_at`'s default 0)."""
+    i = int(np.searchsorted([r.s for r in records], s, side="right")) - 1
+    return records[i] if i >= 0 else None
+
+
+def shifted(record: Poly3 | None, start: float, origin: float) -> FloatArray:
+    """[m, 1, 1/m, 1/m^2] the record's cubic (starting at station start + record.s) as
+    coefficients of x = s - origin, ascending powers (zeros for None)."""
+    if record is None:
+        return np.zeros(4)
+    x0 = origin - (start + record.s)  # the record's ds at x = 0
+    a, b, c, d = record.a, record.b, record.c, record.d
+    return np.array([a + x0 * (b + x0 * (c + x0 * d)), b + x0 * (2.0 * c + 3.0 * d * x0),
+                     c + 3.0 * d * x0, d])
+
+
+def border_polynomials(road: Road, s: float, origin: float) -> dict[int, FloatArray]:
+    """For each lane id of the section at station `s`: the lateral offset t [m] of the
+    lane's outer border, with the width and lane-offset records in force at `s`, as cubic
+    coefficients (4,) of x = station - `origin`, ascending powers; id 0 (the centre lane):
+    the lane offset. Exact where those records hold (a piece between record starts)."""
+    section = road.lane_sections[lane_section_index(road, s)]
+    centre = shifted(record_at(road.lane_offsets, s), 0.0, origin)
+    out = {0: centre}
+    for sign, side in ((1.0, section.left), (-1.0, section.right)):
+        t = centre
+        for lane in side:
+            t = t + sign * shifted(record_at(lane.widths, s - section.s), section.s, origin)
+            out[lane.id] = t
+    return out

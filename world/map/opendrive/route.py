@@ -7,20 +7,26 @@ says where each file road lies on it.
 
 The route runs along the road's driving lanes right of its reference line (right-hand
 traffic, increasing s). Route lane 0 is the outermost of them, and the route's reference line
-is that lane's centre: the OpenDRIVE reference line's arc spline (`arc_spline`, exact start
-points and headings, < `TOLERANCE` off the exact curve) offset sideways by the lane's
-constant offset `ref_t`. An arc offset sideways is an arc, so the route's pieces are exact
-offsets of the spline's.
+is that lane's centre t0(s) (the lane offset and every width polynomial included):
 
-Across, from the lane section:
+- where every lane of the route is constant along the road (one `uniform` layout in every
+  lane section, no lane offset): the OpenDRIVE reference line's arc spline (`arc_spline`,
+  exact start points and headings, < `TOLERANCE` off the exact curve) offset sideways by
+  the lane's constant offset `ref_t`. An arc offset sideways is an arc, so the route's
+  pieces are exact offsets of the spline's, each section uniform (one lane width);
+- else: the curve ref(s) + t0(s) n(s) as an arc spline of its own and every other lane
+  boundary as a cubic per piece (`lane_fit`: split also where a lane section, a width
+  record or a lane-offset record starts), each segment with its `LaneProfile` (uniform
+  where its boundaries are constant and its lanes equally wide).
 
-- `lanes`: the contiguous run of `driving` lanes right of the reference line, equal widths,
-  constant along the section (width records with b = c = d = 0);
-- `shoulder`: the width of the lane right of the outermost driving lane when its type is
-  `shoulder` or `stop` (a hard shoulder), else 0;
+Across, from each lane section:
+
+- `lanes`: the contiguous run of `driving` lanes right of the reference line;
+- `shoulder`: the lane right of the outermost driving lane when its type is `shoulder` or
+  `stop` (a hard shoulder), else none (width 0);
 - `oncoming_lanes`: the driving lanes left of the reference line when they adjoin the ego's
-  (no median between them), of the same width; a carriageway beyond a median is not part
-  of the route (not drawn: said in docs/openscenario.md);
+  (no median between them); a carriageway beyond a median is not part of the route (not
+  drawn: said in docs/openscenario.md);
 - the paint: each lane's road mark lies on its outer border (OpenDRIVE); a boundary between
   the route's lanes takes the mark of the lane nearer the reference line.
 
@@ -28,10 +34,12 @@ The speed limit: a lane's `<speed max>`, else the road type record's, else the t
 default (`TYPE_LIMITS`: the German rules, the motorway's advisory 130 km/h).
 
 What does not fit this yet is refused with `OpenDriveError` "not supported yet (...)":
-several lane sections with different layouts, lane widths varying along s, lane offsets,
-left-hand traffic, road marks other than solid / broken / none; and what the chain refuses
-(junctions, roads not linked end to end into one line, reversed roads, loops, lane links that
-renumber lanes).
+lane sections whose route lanes differ (lanes that begin or end), widths or a lane offset
+that jump (route lane 0's centre would step), a route lane whose width reaches 0, lane 0
+changing so fast that its edges' middle along the route's normal is more than
+`SKEW_SHARE * TOLERANCE` off its centre (`lane_fit`), left-hand traffic, road marks other
+than solid / broken / none; and what the chain refuses (junctions, roads not linked end to
+end into one line, reversed roads, loops, lane links that renumber lanes).
 """
 
 from __future__ import annotations
@@ -42,11 +50,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from world.frames import MPS_PER_KPH
-from world.hdmap import LineMark, LinePaint, MarkKind, PaintColour, Zone
+from world.hdmap import CrossSection, LaneProfile, LineMark, LinePaint, MarkKind, PaintColour, Zone
 from world.map.opendrive.arcspline import ArcPiece, arc_spline, piece_points
 from world.map.opendrive.chain import Chain, chain_roads
 from world.map.opendrive.errors import OpenDriveError
+from world.map.opendrive.lane_fit import FittedPiece, cubic_values, fit_lanes
+from world.map.opendrive.lanes import lane_centre_t, lane_section_index, lane_width
 from world.map.opendrive.model import LaneSection, OdrLane, OpenDrive, Road, RoadMark
+from world.map.opendrive.offset_spline import CurvePiece
 from world.spec import RoadSpec, SegmentSpec
 
 TOLERANCE = 1e-3  # [m] the route's pieces keep this close to the file's exact reference line
@@ -63,6 +74,10 @@ TYPE_LIMITS = {  # [km/h] a road type's limit where the file posts none (German 
 ZONES = {"motorway": Zone.HIGHWAY, "rural": Zone.HIGHWAY}  # others: Zone.CITY
 MARK_KINDS = {"solid": MarkKind.SOLID, "broken": MarkKind.BROKEN, "none": MarkKind.NONE}
 WHITE = frozenset({"standard", "white"})
+WIDTH_CHECKS = 9  # [-] stations per piece where the route's lanes must be wider than 0
+UNIFORM_EPS = 1e-9  # [m] lanes this close in width make a uniform cross-section
+SKEW_SHARE = 0.2  # [-] of TOLERANCE: how far lane 0's edges may be off symmetric about its
+#   centre along the route's normal (`lane_fit` module doc)
 
 
 @dataclass(frozen=True, slots=True)
@@ -71,11 +86,15 @@ class Layout:
 
     lane_ids: tuple[int, ...]  # OpenDRIVE ids of route lanes 0, 1, ... (outermost first)
     oncoming_ids: tuple[int, ...]  # ids of the adjoining oncoming lanes, nearest first
-    lane_width: float  # [m]
-    shoulder: float  # [m]
-    ref_t: float  # [m] route lane 0's centre offset from the OpenDRIVE reference line
+    lane_width: float  # [m] route lane 0's width at the section's start
+    shoulder: float  # [m] at the section's start
+    ref_t: float  # [m] route lane 0's centre offset from the OpenDRIVE reference line, at
+    #   the section's start (along it too where the layout is `uniform`)
     paint: LinePaint
     speed: float | None  # [m/s] the lanes' own <speed max>, if every one posts the same
+    shoulder_id: int | None  # the hard shoulder's lane id (None: no shoulder)
+    uniform: bool  # every lane of the route constant along the section, the driving lanes
+    #   (oncoming ones too) all `lane_width` wide: the route's offset arcs are exact
 
 
 @dataclass(frozen=True, slots=True)
@@ -116,12 +135,26 @@ def build_route(odr: OpenDrive) -> OdrRoute:
     road = chain.road
     if road.rule != "RHT":
         raise _refuse(odr, "left-hand traffic")
-    if any(p.a != 0.0 or p.b != 0.0 or p.c != 0.0 or p.d != 0.0 for p in road.lane_offsets):
-        raise _refuse(odr, "lane offsets")
-    layouts = {_layout(odr, section) for section in road.lane_sections}
-    if len(layouts) != 1:
-        raise _refuse(odr, "lane sections with different layouts")
-    (layout,) = layouts
+    layouts = [_layout(odr, road, section) for section in road.lane_sections]
+    if len({(lay.lane_ids, lay.oncoming_ids) for lay in layouts}) != 1:
+        raise _refuse(odr, "lane sections with different route lanes: lanes that begin or "
+                           "end")
+    layout = layouts[0]
+    offsets = any(p.a != 0.0 or p.b != 0.0 or p.c != 0.0 or p.d != 0.0
+                  for p in road.lane_offsets)
+    if offsets or len(set(layouts)) != 1 or not layout.uniform:
+        segments = _fitted_segments(odr, road, layouts)
+    else:
+        segments = _offset_segments(odr, road, layout)
+    first = segments[0]
+    assert first.start is not None and first.speed_limit is not None
+    return OdrRoute(RoadSpec(tuple(segments), first.speed_limit, origin=first.start), chain,
+                    layout)
+
+
+def _offset_segments(odr: OpenDrive, road: Road, layout: Layout) -> list[SegmentSpec]:
+    """The segments of a road whose every lane is constant (one `uniform` layout, no lane
+    offset): the reference line's arc spline offset by `ref_t`, exactly (module doc)."""
     pieces = _split(arc_spline(road.plan_view, TOLERANCE),
                     [r.s for r in road.speeds if 0.0 < r.s < road.plan_view.length])
     segments = []
@@ -139,10 +172,73 @@ def build_route(odr: OpenDrive) -> OdrRoute:
             lanes=len(layout.lane_ids), oncoming_lanes=len(layout.oncoming_ids),
             lane_width=layout.lane_width, shoulder=layout.shoulder, speed_limit=limit,
             zone=zone, start=start, paint=layout.paint))
-    first = segments[0]
-    assert first.start is not None and first.speed_limit is not None
-    return OdrRoute(RoadSpec(tuple(segments), first.speed_limit, origin=first.start), chain,
-                    layout)
+    return segments
+
+
+def _borders(layout: Layout) -> tuple[int, ...]:
+    """The lane ids whose outer border is each of the route's boundaries, right to left
+    (`lane_fit.fit_lanes`): the shoulder's (lane 0's without one), lane 0's, each route
+    lane's inner border (the outer one of the lane inside it, 0: the lane offset), each
+    oncoming lane's."""
+    ids = layout.lane_ids
+    right = layout.shoulder_id if layout.shoulder_id is not None else ids[0]
+    return (right, ids[0], *(i + 1 for i in ids), *layout.oncoming_ids)
+
+
+def _fitted_segments(odr: OpenDrive, road: Road,
+                     layouts: list[Layout]) -> list[SegmentSpec]:
+    """The segments of a road whose lanes change along it (module doc): lane 0's centre
+    as an arc spline, the other boundaries as cubics per piece (`lane_fit`)."""
+    view = road.plan_view
+    fits = fit_lanes(road, [_borders(lay) for lay in layouts],
+                     [r.s for r in road.speeds if view.start < r.s < view.end], TOLERANCE)
+    segments = []
+    for k, fit in enumerate(fits):
+        piece = fit.piece
+        if k > 0:
+            _check_joint(odr, fits[k - 1].piece, piece)
+        layout = layouts[lane_section_index(road, 0.5 * (piece.s0 + piece.s1))]
+        section = _fitted_section(odr, layout, fit)
+        limit, zone = _limit(road, layout, piece.s0)
+        segments.append(SegmentSpec(
+            length=piece.length, curvature=piece.curvature, lanes=section.lanes,
+            oncoming_lanes=section.oncoming_lanes, lane_width=section.lane_width,
+            shoulder=section.shoulder, speed_limit=limit, zone=zone,
+            start=(piece.x0, piece.y0, piece.heading0), paint=layout.paint,
+            profile=section.profile))
+    return segments
+
+
+def _check_joint(odr: OpenDrive, before: CurvePiece, after: CurvePiece) -> None:
+    """Refuse a step in lane 0's centre between two pieces (widths or an offset that
+    jump at a record start)."""
+    x, y = piece_points(before.arc(), np.array([before.length]))
+    step = math.hypot(float(x[0]) - after.x0, float(y[0]) - after.y0)
+    if step > 2.0 * TOLERANCE:
+        raise _refuse(odr, f"route lane 0's centre steps by {step:.3g} m at s = "
+                           f"{after.s0:g} m: lane widths or a lane offset that jump")
+
+
+def _fitted_section(odr: OpenDrive, layout: Layout, fit: FittedPiece) -> CrossSection:
+    """The cross-section of one fitted piece: uniform where every boundary is constant and
+    the lanes equally wide (within `UNIFORM_EPS`), else with its lane profile; refused if
+    a lane of the route narrows to nothing on it."""
+    b = fit.boundaries
+    if fit.skew > SKEW_SHARE * TOLERANCE:
+        raise _refuse(odr, f"lane widths or a lane offset that change this fast: route lane "
+                           f"0's edges' middle {fit.skew * 1e3:.2g} mm off its "
+                           f"centre at s = {fit.piece.s0:g} m")
+    lanes, oncoming = len(layout.lane_ids), len(layout.oncoming_ids)
+    u = np.linspace(0.0, fit.piece.length, WIDTH_CHECKS)
+    across = cubic_values(b, u)  # (n, len(u))
+    if np.min(np.diff(across[1:], axis=0)) <= 0.0:
+        raise _refuse(odr, f"a lane width that reaches 0 at s = {fit.piece.s0:g} .. "
+                           f"{fit.piece.s1:g} m")
+    width, shoulder = float(b[2, 0] - b[1, 0]), float(b[1, 0] - b[0, 0])
+    even = fit.constant and bool(np.all(np.abs(np.diff(b[1:, 0]) - width) <= UNIFORM_EPS))
+    profile = None if even else LaneProfile(tuple(
+        (float(r[0]), float(r[1]), float(r[2]), float(r[3])) for r in b))
+    return CrossSection(lanes, oncoming, width, shoulder, Zone.HIGHWAY, layout.paint, profile)
 
 
 def _split(pieces: list[ArcPiece], stations: list[float]) -> list[ArcPiece]:
@@ -170,18 +266,22 @@ def _limit(road: Road, layout: Layout, s: float) -> tuple[float, Zone]:
     return TYPE_LIMITS.get(road_type, TYPE_LIMITS["unknown"]) * MPS_PER_KPH, zone
 
 
-def _constant_width(odr: OpenDrive, lane: OdrLane) -> float:
-    """[m] the lane's width, which must not change along its section."""
+def _constant_width(lane: OdrLane) -> float | None:
+    """[m] the lane's width where it does not change along its section (one record, b = c =
+    d = 0), else None."""
     widths = {(w.a, w.b, w.c, w.d) for w in lane.widths}
     if len(widths) != 1:
-        raise _refuse(odr, f"lane {lane.id}: widths that change along the lane section")
+        return None
     (a, b, c, d), = widths
-    if b != 0.0 or c != 0.0 or d != 0.0:
-        raise _refuse(odr, f"lane {lane.id}: widths that change along the lane section")
-    return a
+    return a if b == 0.0 and c == 0.0 and d == 0.0 else None
 
 
-def _layout(odr: OpenDrive, section: LaneSection) -> Layout:
+def _start_width(section: LaneSection, lane: OdrLane) -> float:
+    """[m] the lane's width at its section's start."""
+    return float(lane_width(section, lane, section.s))
+
+
+def _layout(odr: OpenDrive, road: Road, section: LaneSection) -> Layout:
     """The route's view of one lane section (module doc)."""
     right = section.right
     first = next((i for i, lane in enumerate(right) if lane.type == "driving"), None)
@@ -192,23 +292,28 @@ def _layout(odr: OpenDrive, section: LaneSection) -> Layout:
     while end < len(right) and right[end].type == "driving":
         end += 1
     drive = right[first:end]  # nearest the reference line first
-    widths = {_constant_width(odr, lane) for lane in drive}
-    if len(widths) != 1:
-        raise _refuse(odr, "driving lanes of different widths")
-    (w,) = widths
-    inner = sum(_constant_width(odr, lane) for lane in right[:first])
-    ref_t = -(inner + (len(drive) - 0.5) * w)
     outside = right[end] if end < len(right) else None
-    shoulder = (_constant_width(odr, outside)
-                if outside is not None and outside.type in SHOULDER_TYPES else 0.0)
+    hard = outside if outside is not None and outside.type in SHOULDER_TYPES else None
     oncoming: tuple[OdrLane, ...] = ()
     if first == 0:
         n = 0
         while n < len(section.left) and section.left[n].type == "driving":
             n += 1
         oncoming = section.left[:n]
-        if any(_constant_width(odr, lane) != w for lane in oncoming):
-            raise _refuse(odr, "oncoming lanes of another width than the route's")
+    constant = [_constant_width(lane) for lane in (*right[:end], *oncoming)]
+    widths = {_constant_width(lane) for lane in (*drive, *oncoming)}
+    uniform = (None not in constant and len(widths) == 1
+               and (hard is None or _constant_width(hard) is not None))
+    if uniform:  # the numbers as ever
+        (w,) = widths
+        assert w is not None
+        inner = sum(_constant_width(lane) or 0.0 for lane in right[:first])
+        ref_t = -(inner + (len(drive) - 0.5) * w)
+        shoulder = _constant_width(hard) or 0.0 if hard is not None else 0.0
+    else:
+        w = _start_width(section, drive[-1])
+        ref_t = lane_centre_t(road, drive[-1].id, section.s)
+        shoulder = _start_width(section, hard) if hard is not None else 0.0
     # a lane's mark lies on its outer border: lane 0's right edge is its own mark, the line
     # between route lanes i - 1 and i is lane i's (nearer the reference line), the left edge
     # the mark of the lane inside the route's innermost (the centre lane's for -1)
@@ -220,7 +325,8 @@ def _layout(odr: OpenDrive, section: LaneSection) -> Layout:
     speeds = {lane.speed for lane in drive}
     speed = speeds.pop() if len(speeds) == 1 else None
     return Layout(tuple(lane.id for lane in reversed(drive)),
-                  tuple(lane.id for lane in oncoming), w, shoulder, ref_t, paint, speed)
+                  tuple(lane.id for lane in oncoming), w, shoulder, ref_t, paint, speed,
+                  hard.id if hard is not None else None, uniform)
 
 
 def _mark(odr: OpenDrive, lane: OdrLane) -> LineMark:

@@ -124,16 +124,24 @@ def lane(i: int, kind: str = "driving", width: str = 'a="3.5" b="0" c="0" d="0"'
     return (f'<lane id="{i}" type="{kind}"><width sOffset="0" {width}/>{mark}</lane>')
 
 
-SLOPED = 'a="3.5" b="0.01" c="0" d="0"'
-NARROW = 'a="3.0" b="0" c="0" d="0"'
+VANISHING = 'a="1.0" b="-0.02" c="0" d="0"'  # 0 m wide at s = 50 m
+STEP = 'a="3.0" b="0" c="0" d="0"'
+STEEP = 'a="3.5" b="0.05" c="0" d="0"'  # 5 m wider over 100 m
 CURB = '<roadMark sOffset="0" type="curb"/>'
 
 
 @pytest.mark.parametrize(("lanes", "kw", "problem"), [
-    (CENTRE + "<right>" + lane(-1, width=SLOPED) + "</right>", {},
-     "not supported yet (lane -1: widths that change along the lane section)"),
-    (CENTRE + "<right>" + lane(-1) + lane(-2, width=NARROW) + "</right>", {},
-     "not supported yet (driving lanes of different widths)"),
+    (CENTRE + "<right>" + lane(-1, width=VANISHING) + "</right>", {},
+     "not supported yet (a lane width that reaches 0 at s = "),
+    (CENTRE + "<right>" + lane(-1) + "</right></laneSection><laneSection s=\"50\">" + CENTRE
+     + "<right>" + lane(-1) + lane(-2) + "</right>", {},
+     "not supported yet (lane sections with different route lanes: lanes that begin or end)"),
+    (CENTRE + "<right>" + lane(-1) + "</right></laneSection><laneSection s=\"50\">" + CENTRE
+     + "<right>" + lane(-1, width=STEP) + "</right>", {},
+     "not supported yet (route lane 0's centre steps by 0.25 m at s = 50 m"),
+    (CENTRE + "<right>" + lane(-1, width=STEEP) + "</right>", {},
+     "not supported yet (lane widths or a lane offset that change this fast: route lane 0's "
+     "edges' middle 2.7 mm off its centre at s = 0 m)"),
     (CENTRE + "<right>" + lane(-1) + "</right>", {"rule": "LHT"},
      "not supported yet (left-hand traffic)"),
     (CENTRE + "<right>" + lane(-1) + "</right>", {"roads": 2},
