@@ -22,10 +22,13 @@ its camera lane) and plans the Hermite path into it from the car's pose
 end. An abort plans the same kind of path back to the origin lane, followed in LANE_KEEP
 until its end. While a path is followed, the vehicle ahead in the lane kept (the target
 lane) is the ACC's lead; the vehicle ahead in the origin lane is a lead too while the car's
-body (mirrors included) still overlaps that lane, once it is near: within UN R157's d_min or
-under ``pass_ttc`` to collision (`leads`). So the car does not run into the vehicle it is
-leaving, nor trail it through the pass. Keeping right after a pass waits for a car behind
-in the right lane to be ``keep_right_gap`` back (a margin over the gap that aborts).
+body (mirrors included) still overlaps that lane (`leads`): the car does not run into the
+vehicle it is leaving. On a pass (a change taken to pass a slower vehicle), the vehicle
+passed counts only once it is near, within UN R157's d_min or under ``pass_ttc`` to
+collision: the car does not trail it through the pass. A change the route or a flat tyre
+asks for keeps trailing it (the car may be moving into that vehicle's path). Keeping right
+after a pass waits for a car behind in the right lane to be ``keep_right_gap`` back (a
+margin over the gap that aborts).
 
 At a town junction where the route turns, the turn is entered when the car's centre passes
 the stop line and done at the junction's exit (`RoadMap.junctions`); its path is the map's
@@ -52,6 +55,7 @@ from planner.fsm.motion import (
     MotionInput,
     MotionParams,
     Turn,
+    is_pass,
     transition,
 )
 from planner.lane_change_path import LaneChangeParams, LaneChangePath, start_lane_change
@@ -110,6 +114,7 @@ class MotionLayer:
         self._blocked_since: float | None = None
         self._turn_end = math.inf  # [m] where the turn in hand ends (its junction's exit)
         self._near: set[int] = set()  # tracks of the lane being left found near (`_leads`)
+        self._passing = False  # the change in hand is one to pass a slower vehicle
 
     def update(self, ego: EgoState, v_want: float, tracks: Sequence[Track],
                pull_over: bool = False) -> tuple[Manoeuvre, tuple[StateChange, ...]]:
@@ -122,6 +127,7 @@ class MotionLayer:
         x = self._input(ego, s, d, v_want, traffic, pull_over)
         change = transition(self.machine.state, x, self.params.motion)
         if change is not None:
+            self._passing = is_pass(self.machine.state, x, self.params.motion)
             # a lane change given up before it was done: back to the origin lane
             abort = self.machine.state in LANE_CHANGES and not x.change_done
             self._enter(change.to, abort, ego, s, pull_over)
@@ -232,9 +238,9 @@ class MotionLayer:
     def _leads(self, traffic: dict[int, LaneTraffic], s: float, d: float,
                v: float) -> tuple[Neighbour, ...]:
         """On a path: the vehicle ahead in the target lane, and the one ahead in the origin
-        lane while the car's body still overlaps that lane, from the moment it is near
-        enough to matter (`_still_near`) on (so that braking for it does not make it far
-        again and release it: no chatter)."""
+        lane while the car's body still overlaps that lane; on a pass, only from the moment
+        it is near enough to matter (`_still_near`) on (so that braking for it does not make
+        it far again and release it: no chatter)."""
         if self.path is None:
             return ()
         leads = [n for n in (traffic[self.lane].ahead,) if n is not None] \
@@ -243,7 +249,8 @@ class MotionLayer:
         clear = 0.5 * float(origin.width_at(s)) + 0.5 * self.vehicle.width + self.params.mirrors
         left_behind = traffic[self.origin].ahead if self.origin in traffic else None
         if left_behind is not None and abs(d - float(origin.offset_at(s))) < clear and (
-                left_behind.track_id in self._near or self._still_near(left_behind, v)):
+                not self._passing or left_behind.track_id in self._near
+                or self._still_near(left_behind, v)):
             self._near.add(left_behind.track_id)  # near once: a lead until the body is out
             leads.append(left_behind)
         return tuple(leads)

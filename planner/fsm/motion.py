@@ -51,7 +51,7 @@ from __future__ import annotations
 import enum
 from dataclasses import dataclass
 
-from planner.fsm.machine import Row, Table, Transition, next_state, render
+from planner.fsm.machine import Row, Table, Transition, fired_row, next_state, render
 
 
 class Motion(enum.Enum):
@@ -209,6 +209,16 @@ TABLE: Table[Motion, MotionInput, MotionParams] = Table(Motion, (
 def transition(state: Motion, x: MotionInput, p: MotionParams) -> Transition[Motion] | None:
     """The change of state for input `x`, or None to stay (`TABLE`)."""
     return next_state(TABLE, state, x, p)
+
+
+PASSES = frozenset({_overtake_left, _overtake_right})  # the rows' guards of a change to pass
+
+
+def is_pass(state: Motion, x: MotionInput, p: MotionParams) -> bool:
+    """Whether the change taken from `state` for input `x` is one to pass a slower vehicle
+    (an overtaking row), not one the route or a flat tyre asks for."""
+    row = fired_row(TABLE, state, x, p)
+    return row is not None and row.guard in PASSES
 
 
 if __name__ == "__main__":  # print the table for the module doc

@@ -8,7 +8,15 @@ import pytest
 
 from planner.fsm import motion
 from planner.fsm.machine import fired_row
-from planner.fsm.motion import TABLE, Motion, MotionInput, MotionParams, Turn, transition
+from planner.fsm.motion import (
+    TABLE,
+    Motion,
+    MotionInput,
+    MotionParams,
+    Turn,
+    is_pass,
+    transition,
+)
 from tests.planner.fsm.tables import doc_shows_table, unwalked_rows
 
 P = MotionParams()
@@ -130,3 +138,16 @@ def test_every_transition_of_the_table_has_a_row() -> None:
     }
     assert {row[1] for row in TABLE_CASES} == set(Motion)
     assert pairs == TABLE.edges
+
+
+@pytest.mark.parametrize(("state", "inp", "passing"), [
+    (M.LANE_KEEP, x(blocked=True, left_free=True), True),  # overtake left
+    (M.LANE_KEEP, x(blocked=True, right_free=True), True),  # overtake right
+    (M.LANE_KEEP, x(route_lane=-1, right_free=True), False),  # the route's change
+    (M.LANE_KEEP, x(pull_over=True, right_free=True), False),  # a flat tyre's
+    (M.LANE_KEEP, x(right_free=True, right_clear=True), False),  # keeping right
+    (M.LANE_KEEP, x(), False),  # no change
+])
+def test_a_change_to_pass_is_told_from_the_others(state: Motion, inp: MotionInput,
+                                                  passing: bool) -> None:
+    assert is_pass(state, inp, MotionParams()) is passing
