@@ -357,3 +357,6 @@ class WorldSpec:
     sensors: SensorsSpec = field(default_factory=SensorsSpec)
     events: tuple[EventSpec, ...] = ()  # what happens to the ego car
     town: TownSpec | None = None  # map kind 2: `road` is then the ego's route through it
+    scenery_roads: tuple[RoadSpec, ...] = ()  # roads drawn in the world (surface and paint)
+    #   but not on the HD map the stack reads, with no traffic and no traffic rules from them
+    #   (an OpenDRIVE dual carriageway's far side: `world.map.opendrive.far_side`)

@@ -51,6 +51,7 @@ from world.scene.scenery import (
     speed_limit_sign_image,
     stop_sign_image,
 )
+from world.scene.scenery_roads import build_scenery_roads
 from world.scene.town_scene import Pavement, build_town_scene
 from world.scene.traffic_light import TrafficLightBody, add_traffic_light
 from world.sensors.camera import Camera, CameraSensor
@@ -73,7 +74,8 @@ class StaticScene:
     """What was built once: for the recording and the collision criterion."""
 
     road_meshes: tuple[TexturedMesh, ...]  # the road surfaces, then the painted marks (stop
-    #   lines, crosswalks) and the speed bumps' visible surfaces
+    #   lines, crosswalks), the scenery roads' surfaces and marks (`scenery<k>_...`) and the
+    #   speed bumps' visible surfaces
     buildings: tuple[BuildingBox, ...]
     signs: tuple[SignPlacement, ...]  # speed-limit signs
     ground: int  # body id
@@ -173,7 +175,7 @@ class World:
             return self._build_town(self.spec.town, rng)
         ground = add_ground(self.client)
         painted = (*build_road_surface(self.road), *build_through_roads(self.road),
-                   *build_road_marks(self.road))
+                   *build_road_marks(self.road), *build_scenery_roads(self.spec.scenery_roads))
         for mesh in painted:
             self._add_textured_mesh(mesh.name, mesh.vertices, mesh.indices, mesh.uvs,
                                     mesh.normals, mesh.texture)

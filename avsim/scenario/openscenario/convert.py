@@ -3,7 +3,8 @@ the same world spec, driver settings and criteria as a YAML file gives, plus the
 (`StoryProgram`) that the director plays (`avsim.run.storyboard`).
 
 - The road: the file's OpenDRIVE roads, linked end to end into one, as the route
-  (`world.map.opendrive.route`); positions on any of them are placed on it.
+  (`world.map.opendrive.route`); positions on any of them are placed on it. A dual
+  carriageway's far side is drawn as a scenery road (`WorldSpec.scenery_roads`).
 - The car under test: the entity named `Ego` (any case), else the first vehicle. avsim's
   stack drives it from the start, its set speed the Init speed (the speed its driver held
   when the file's controller takes over); avsim's car keeps its own body (4.8 x 1.6 m), not
@@ -99,7 +100,7 @@ def load_xosc(path: Path, overrides: Mapping[str, object] | None = None,
         centre_ahead=tuple(ahead.items()), lane_ids=route.layout.lane_ids,
         init_commands=tuple(deferred))
     world = spec.WorldSpec(road=route.spec, ego=ego_spec, actors=actors, seed=side.seed,
-                           sensors=side.sensors)
+                           sensors=side.sensors, scenery_roads=route.scenery)
     return Scenario(name=_name(path), description=osc.description, situation="openscenario",
                     duration=side.duration, world=world,
                     driver=DriverSettings(set_speed=ego_spec.speed), criteria=side.criteria,

@@ -78,6 +78,7 @@ def convert_xosc(path: Path, criteria_file: Path | None = None) -> Conversion:
                 "set_speed_kph": _kph(scenario.driver.set_speed),
                 "max_speed_kph": _kph(ego.max_speed)},
     }
+    _scenery(scenario, out)
     actors = [_actor(a, out) for a in scenario.world.actors]
     names = {name: i for name, i in story.actors}
     _story(scenario, names, actors, out)
@@ -150,6 +151,15 @@ def _road(road: RoadSpec, out: Conversion) -> dict[str, Any]:
     return {"lanes": first.lanes, "oncoming_lanes": first.oncoming_lanes,
             "lane_width": _r(first.lane_width), "shoulder": _r(first.shoulder),
             "speed_limit_kph": _kph(road.speed_limit), "segments": segments}
+
+
+def _scenery(scenario: Scenario, out: Conversion) -> None:
+    """The scenery roads (a dual carriageway's far side): the YAML has none."""
+    for road in scenario.world.scenery_roads:
+        lanes = road.segments[0].lanes
+        out.misfits.append(f"the road's far carriageway ({lanes} lanes beyond the median, "
+                           "drawn as scenery): the YAML road has no scenery roads, it is "
+                           "not drawn")
 
 
 def _actor(actor: ActorSpec, out: Conversion) -> dict[str, Any]:

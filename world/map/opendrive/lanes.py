@@ -12,6 +12,8 @@ from numpy.typing import ArrayLike
 
 from world.map.opendrive.model import FloatArray, LaneSection, OdrLane, Poly3, Road, poly3_at
 
+SHOULDER_TYPES = frozenset({"shoulder", "stop"})  # lane types that are a hard shoulder
+
 
 def lane_section_index(road: Road, s: float) -> int:
     """The index of the lane section holding station `s` [m] (the later one at a boundary,
@@ -29,6 +31,16 @@ def lane_offset(road: Road, s: ArrayLike) -> FloatArray:
 def lane_width(section: LaneSection, lane: OdrLane, s: ArrayLike) -> FloatArray:
     """[m] the width of `lane` of `section` at road stations `s` (0 for the centre lane)."""
     return poly3_at(lane.widths, np.asarray(s, dtype=float) - section.s)
+
+
+def constant_width(lane: OdrLane) -> float | None:
+    """[m] the lane's width where it does not change along its section (one record, b = c =
+    d = 0), else None."""
+    widths = {(w.a, w.b, w.c, w.d) for w in lane.widths}
+    if len(widths) != 1:
+        return None
+    (a, b, c, d), = widths
+    return a if b == 0.0 and c == 0.0 and d == 0.0 else None
 
 
 def lane_borders(road: Road, s: float) -> dict[int, tuple[float, float]]:

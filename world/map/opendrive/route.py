@@ -25,10 +25,12 @@ Across, from each lane section:
 - `shoulder`: the lane right of the outermost driving lane when its type is `shoulder` or
   `stop` (a hard shoulder), else none (width 0);
 - `oncoming_lanes`: the driving lanes left of the reference line when they adjoin the ego's
-  (no median between them); a carriageway beyond a median is not part of the route (not
-  drawn: said in docs/openscenario.md);
+  (no median between them); a carriageway beyond a median is not part of the route: it is
+  `OdrRoute.scenery`, a road drawn in the world and not on the HD map (`far_side`: only
+  where the route is built from offset arcs, the far lanes constant too; not drawn where
+  the lanes vary, the fitted path above);
 - the paint: each lane's road mark lies on its outer border (OpenDRIVE); a boundary between
-  the route's lanes takes the mark of the lane nearer the reference line.
+  the route's lanes takes the mark of the lane nearer the reference line (`lane_paint`).
 
 The speed limit: a lane's `<speed max>`, else the road type record's, else the type's
 default (`TYPE_LIMITS`: the German rules, the motorway's advisory 130 km/h).
@@ -50,18 +52,25 @@ from dataclasses import dataclass
 import numpy as np
 
 from world.frames import MPS_PER_KPH
-from world.hdmap import CrossSection, LaneProfile, LineMark, LinePaint, MarkKind, PaintColour, Zone
+from world.hdmap import CrossSection, LaneProfile, LinePaint, Zone
 from world.map.opendrive.arcspline import ArcPiece, arc_spline, piece_points
 from world.map.opendrive.chain import Chain, chain_roads
 from world.map.opendrive.errors import OpenDriveError
+from world.map.opendrive.far_side import far_side
 from world.map.opendrive.lane_fit import FittedPiece, cubic_values, fit_lanes
-from world.map.opendrive.lanes import lane_centre_t, lane_section_index, lane_width
-from world.map.opendrive.model import LaneSection, OdrLane, OpenDrive, Road, RoadMark
+from world.map.opendrive.lane_paint import carriageway_paint
+from world.map.opendrive.lanes import (
+    SHOULDER_TYPES,
+    constant_width,
+    lane_centre_t,
+    lane_section_index,
+    lane_width,
+)
+from world.map.opendrive.model import LaneSection, OdrLane, OpenDrive, Road
 from world.map.opendrive.offset_spline import CurvePiece
 from world.spec import RoadSpec, SegmentSpec
 
 TOLERANCE = 1e-3  # [m] the route's pieces keep this close to the file's exact reference line
-SHOULDER_TYPES = frozenset({"shoulder", "stop"})
 TYPE_LIMITS = {  # [km/h] a road type's limit where the file posts none (German rules)
     "motorway": 130.0,  # the advisory speed (Richtgeschwindigkeit)
     "rural": 100.0,
@@ -72,8 +81,6 @@ TYPE_LIMITS = {  # [km/h] a road type's limit where the file posts none (German 
     "unknown": 100.0,
 }
 ZONES = {"motorway": Zone.HIGHWAY, "rural": Zone.HIGHWAY}  # others: Zone.CITY
-MARK_KINDS = {"solid": MarkKind.SOLID, "broken": MarkKind.BROKEN, "none": MarkKind.NONE}
-WHITE = frozenset({"standard", "white"})
 WIDTH_CHECKS = 9  # [-] stations per piece where the route's lanes must be wider than 0
 UNIFORM_EPS = 1e-9  # [m] lanes this close in width make a uniform cross-section
 SKEW_SHARE = 0.2  # [-] of TOLERANCE: how far lane 0's edges may be off symmetric about its
@@ -105,6 +112,8 @@ class OdrRoute:
     spec: RoadSpec
     chain: Chain  # the file's roads as one road, and where each lies on it
     layout: Layout
+    scenery: tuple[RoadSpec, ...] = ()  # drawn, not on the map: the far carriageway of a
+    #   dual carriageway (`far_side`), at most one
 
     @property
     def road(self) -> Road:
@@ -142,21 +151,27 @@ def build_route(odr: OpenDrive) -> OdrRoute:
     layout = layouts[0]
     offsets = any(p.a != 0.0 or p.b != 0.0 or p.c != 0.0 or p.d != 0.0
                   for p in road.lane_offsets)
+    scenery: tuple[RoadSpec, ...] = ()
     if offsets or len(set(layouts)) != 1 or not layout.uniform:
         segments = _fitted_segments(odr, road, layouts)
     else:
-        segments = _offset_segments(odr, road, layout)
+        pieces = _split(arc_spline(road.plan_view, TOLERANCE),
+                        [r.s for r in road.speeds if 0.0 < r.s < road.plan_view.length])
+        segments = _offset_segments(odr, road, layout, pieces)
+        far = None if layout.oncoming_ids else far_side(
+            odr, road, pieces, [_limit(road, layout, p.s0) for p in pieces])
+        scenery = (far,) if far is not None else ()
     first = segments[0]
     assert first.start is not None and first.speed_limit is not None
     return OdrRoute(RoadSpec(tuple(segments), first.speed_limit, origin=first.start), chain,
-                    layout)
+                    layout, scenery)
 
 
-def _offset_segments(odr: OpenDrive, road: Road, layout: Layout) -> list[SegmentSpec]:
+def _offset_segments(odr: OpenDrive, road: Road, layout: Layout,
+                     pieces: list[ArcPiece]) -> list[SegmentSpec]:
     """The segments of a road whose every lane is constant (one `uniform` layout, no lane
-    offset): the reference line's arc spline offset by `ref_t`, exactly (module doc)."""
-    pieces = _split(arc_spline(road.plan_view, TOLERANCE),
-                    [r.s for r in road.speeds if 0.0 < r.s < road.plan_view.length])
+    offset): the reference line's arc spline `pieces` (split at the speed records) offset
+    by `ref_t`, exactly (module doc)."""
     segments = []
     for piece in pieces:
         scale = 1.0 - piece.curvature * layout.ref_t
@@ -266,16 +281,6 @@ def _limit(road: Road, layout: Layout, s: float) -> tuple[float, Zone]:
     return TYPE_LIMITS.get(road_type, TYPE_LIMITS["unknown"]) * MPS_PER_KPH, zone
 
 
-def _constant_width(lane: OdrLane) -> float | None:
-    """[m] the lane's width where it does not change along its section (one record, b = c =
-    d = 0), else None."""
-    widths = {(w.a, w.b, w.c, w.d) for w in lane.widths}
-    if len(widths) != 1:
-        return None
-    (a, b, c, d), = widths
-    return a if b == 0.0 and c == 0.0 and d == 0.0 else None
-
-
 def _start_width(section: LaneSection, lane: OdrLane) -> float:
     """[m] the lane's width at its section's start."""
     return float(lane_width(section, lane, section.s))
@@ -300,16 +305,16 @@ def _layout(odr: OpenDrive, road: Road, section: LaneSection) -> Layout:
         while n < len(section.left) and section.left[n].type == "driving":
             n += 1
         oncoming = section.left[:n]
-    constant = [_constant_width(lane) for lane in (*right[:end], *oncoming)]
-    widths = {_constant_width(lane) for lane in (*drive, *oncoming)}
+    constant = [constant_width(lane) for lane in (*right[:end], *oncoming)]
+    widths = {constant_width(lane) for lane in (*drive, *oncoming)}
     uniform = (None not in constant and len(widths) == 1
-               and (hard is None or _constant_width(hard) is not None))
+               and (hard is None or constant_width(hard) is not None))
     if uniform:  # the numbers as ever
         (w,) = widths
         assert w is not None
-        inner = sum(_constant_width(lane) or 0.0 for lane in right[:first])
+        inner = sum(constant_width(lane) or 0.0 for lane in right[:first])
         ref_t = -(inner + (len(drive) - 0.5) * w)
-        shoulder = _constant_width(hard) or 0.0 if hard is not None else 0.0
+        shoulder = constant_width(hard) or 0.0 if hard is not None else 0.0
     else:
         w = _start_width(section, drive[-1])
         ref_t = lane_centre_t(road, drive[-1].id, section.s)
@@ -317,29 +322,10 @@ def _layout(odr: OpenDrive, road: Road, section: LaneSection) -> Layout:
     # a lane's mark lies on its outer border: lane 0's right edge is its own mark, the line
     # between route lanes i - 1 and i is lane i's (nearer the reference line), the left edge
     # the mark of the lane inside the route's innermost (the centre lane's for -1)
-    marks = [_mark(odr, lane) for lane in reversed(drive)]  # outermost first
     inside = right[first - 1] if first > 0 else section.center
-    paint = LinePaint(right_edge=marks[0], lane_lines=tuple(marks[1:]),
-                      left_edge=_mark(odr, inside),
-                      oncoming=tuple(_mark(odr, lane) for lane in oncoming))
+    paint = carriageway_paint(odr, drive, inside, oncoming)
     speeds = {lane.speed for lane in drive}
     speed = speeds.pop() if len(speeds) == 1 else None
     return Layout(tuple(lane.id for lane in reversed(drive)),
                   tuple(lane.id for lane in oncoming), w, shoulder, ref_t, paint, speed,
                   hard.id if hard is not None else None, uniform)
-
-
-def _mark(odr: OpenDrive, lane: OdrLane) -> LineMark:
-    """The line painted on `lane`'s outer border."""
-    if not lane.road_marks:
-        return LineMark(MarkKind.NONE, 0.0)
-    if len(lane.road_marks) > 1:
-        raise _refuse(odr, f"lane {lane.id}: road marks that change along the lane section")
-    mark: RoadMark = lane.road_marks[0]
-    kind = MARK_KINDS.get(mark.type)
-    if kind is None:
-        raise _refuse(odr, f"lane {lane.id}: road mark type {mark.type!r}")
-    if mark.color not in WHITE and mark.color != "yellow":
-        raise _refuse(odr, f"lane {lane.id}: road mark colour {mark.color!r}")
-    colour = PaintColour.YELLOW if mark.color == "yellow" else PaintColour.WHITE
-    return LineMark(kind, mark.width, colour)

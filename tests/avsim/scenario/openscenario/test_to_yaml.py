@@ -33,6 +33,7 @@ def test_the_cut_in_converts_to_a_yaml_scenario_that_loads(tmp_path: Path) -> No
     misfits = "\n".join(conversion.misfits)
     assert "sinusoidal shape" in misfits and "StopTrigger" in misfits
     assert "box 5 x 2 x 1.8 m" in misfits  # the catalogue has no such car
+    assert "far carriageway (3 lanes" in misfits  # drawn in the world, not in the YAML
 
 
 def test_a_curved_road_becomes_arcs_and_says_so() -> None:
