@@ -47,7 +47,7 @@ end into one line, reversed roads, loops, lane links that renumber lanes).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -161,10 +161,26 @@ def build_route(odr: OpenDrive) -> OdrRoute:
         far = None if layout.oncoming_ids else far_side(
             odr, road, pieces, [_limit(road, layout, p.s0) for p in pieces])
         scenery = (far,) if far is not None else ()
+    segments = posted_once(segments)
     first = segments[0]
     assert first.start is not None and first.speed_limit is not None
     return OdrRoute(RoadSpec(tuple(segments), first.speed_limit, origin=first.start), chain,
                     layout, scenery)
+
+
+def posted_once(segments: list[SegmentSpec]) -> list[SegmentSpec]:
+    """`segments` with a limit posted only where it changes (None where the segment before
+    has the same): a limit is posted, and its sign stands, where the file's speed records
+    change it, not at every piece of the arc spline."""
+    out: list[SegmentSpec] = []
+    in_force: float | None = None  # [m/s]
+    for seg in segments:
+        if out and seg.speed_limit == in_force:
+            out.append(replace(seg, speed_limit=None))
+        else:
+            out.append(seg)
+            in_force = seg.speed_limit if seg.speed_limit is not None else in_force
+    return out
 
 
 def _offset_segments(odr: OpenDrive, road: Road, layout: Layout,

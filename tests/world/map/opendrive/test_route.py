@@ -63,6 +63,16 @@ def test_the_alks_road_is_three_lanes_of_3_5_m_with_a_hard_shoulder() -> None:
     assert float(road_map.speed_limit_at(100.0)) == pytest.approx(130.0 / 3.6)
 
 
+@pytest.mark.parametrize("name", ["alks_road_different_curvatures.xodr", "curvy.xodr"])
+def test_a_limit_is_posted_once_not_at_every_piece_of_the_spline(name: str) -> None:
+    """One speed record: one posting (one sign), however many pieces the curves need."""
+    path = ALKS / name if name.startswith("alks") else DATA / name
+    route, road_map = route_and_map(path)
+    records = {r.max_speed for r in route.road.speeds}
+    assert len(road_map.pieces) > 10
+    assert len(road_map.speed_limits) == 1 and len(records) <= 1
+
+
 def test_the_paint_is_the_files_road_marks() -> None:
     """ALKS: 0.30 m solid edges, 0.15 m broken lane lines; painted where the map's lane
     boundaries are."""
