@@ -4,7 +4,9 @@ from __future__ import annotations
 
 import math
 
-from world.hdmap import RoadMap, Zone
+import numpy as np
+
+from world.hdmap import Lane, RoadMap, Zone
 from world.map.road import build_road_map
 from world.spec import FeatureSpec, RoadSpec, SegmentSpec
 
@@ -46,3 +48,12 @@ def make_map(
     *segments: SegmentSpec, speed_kph: float = 50.0, features: tuple[FeatureSpec, ...] = ()
 ) -> RoadMap:
     return build_road_map(RoadSpec(tuple(segments), speed_kph * KPH, features))
+
+
+def numeric_curvature(lane: Lane, s: float, h: float = 1e-3) -> float:
+    """[1/m] the curvature of `lane`'s centre line at station `s` from its points: the turn
+    between the chords over [s - h, s] and [s, s + h] per their mean length."""
+    p = lane.position(np.array([s - h, s, s + h]), np.zeros(3))
+    d1, d2 = p[1] - p[0], p[2] - p[1]
+    turn = math.atan2(d1[0] * d2[1] - d1[1] * d2[0], float(np.dot(d1, d2)))
+    return turn / (0.5 * (math.hypot(*d1) + math.hypot(*d2)))

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from numpy.typing import NDArray
 
-from tests.roads import SHOULDER, W, make_map, seg
+from tests.roads import SHOULDER, W, make_map, numeric_curvature, seg
 from world.hdmap import SHOULDER as SHOULDER_LANE
 from world.hdmap import CrossSection, LaneProfile, RoadMap, Zone
 from world.map.road import MapError
@@ -153,11 +153,7 @@ def test_lane_curvature_is_exact_where_the_offset_varies(radius: float) -> None:
     m = profiled_road(radius)
     lane = m.lane(1)
     for s in (60.0, 85.0, 100.0, 140.0):
-        h = 1e-3
-        p = lane.position(np.array([s - h, s, s + h]), np.zeros(3))
-        d1, d2 = p[1] - p[0], p[2] - p[1]
-        turn = math.atan2(d1[0] * d2[1] - d1[1] * d2[0], float(np.dot(d1, d2)))
-        numeric = turn / (0.5 * (math.hypot(*d1) + math.hypot(*d2)))
+        numeric = numeric_curvature(lane, s)
         assert float(lane.curvature_at(s)) == pytest.approx(numeric, abs=2e-6), s
     if radius == 0.0:  # a straight's lane bends where its offset does (k / a would be 0)
         assert abs(float(lane.curvature_at(60.0))) > 1e-4

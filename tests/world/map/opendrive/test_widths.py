@@ -7,15 +7,15 @@ lines of the road surface; the world builds on it."""
 
 from __future__ import annotations
 
-import math
 from functools import cache
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from world.hdmap import RoadMap
-from world.map.opendrive import lane_borders, lane_centre_t, load_opendrive
+from tests.roads import numeric_curvature
+from world.hdmap import FloatArray, RoadMap
+from world.map.opendrive import Road, lane_borders, lane_centre_t, load_opendrive
 from world.map.opendrive.route import OdrRoute, build_route
 from world.map.road import build_road_map
 from world.scene.road_mesh import build_road_surface, markings
@@ -67,6 +67,21 @@ def test_the_file_is_what_the_tests_say() -> None:
         assert borders[0][0] == pytest.approx(lane_offset(s), abs=1e-12)
 
 
+def assert_lanes_on_the_file(road: Road, road_map: RoadMap, ids: dict[int, int],
+                             stations: FloatArray) -> None:
+    """Each map lane (route index: file lane id in `ids`) at `stations`: its centre within
+    `TOLERANCE` of the file's lane centre (the point projected onto the file's reference
+    line), its width within `TOLERANCE` of the file's there."""
+    for index, lane_id in ids.items():
+        lane = road_map.lane(index)
+        s_file, t = road.plan_view.project(lane.position(stations, 0.0))
+        for k, s in enumerate(np.clip(s_file, 0.0, road.length).tolist()):
+            assert abs(t[k] - lane_centre_t(road, lane_id, s)) < TOLERANCE, (lane_id, s)
+            inner, outer = lane_borders(road, s)[lane_id]
+            width = float(lane.width_at(stations[k]))
+            assert abs(width - abs(inner - outer)) < TOLERANCE, (lane_id, s)
+
+
 def test_every_lane_centre_and_width_is_within_1_mm_of_the_files() -> None:
     """Each route lane's centre line `Lane.position(s, 0)`, at stations all along the map,
     within 1 mm of the file's exact lane centre (the point projected onto the file's
@@ -76,14 +91,7 @@ def test_every_lane_centre_and_width_is_within_1_mm_of_the_files() -> None:
     road = route.road
     assert route.layout.lane_ids == LANE_IDS and route.layout.oncoming_ids == (ONCOMING_ID,)
     stations = np.linspace(0.0, road_map.length, 700)
-    for index, lane_id in enumerate(LANE_IDS):
-        lane = road_map.lane(index)
-        s_file, t = road.plan_view.project(lane.position(stations, 0.0))
-        for k, s in enumerate(np.clip(s_file, 0.0, road.length).tolist()):
-            assert abs(t[k] - lane_centre_t(road, lane_id, s)) < TOLERANCE, (lane_id, s)
-            inner, outer = lane_borders(road, s)[lane_id]
-            width = float(lane.width_at(stations[k]))
-            assert abs(width - (inner - outer)) < TOLERANCE, (lane_id, s)
+    assert_lanes_on_the_file(road, road_map, dict(enumerate(LANE_IDS)), stations)
 
 
 def test_the_files_lane_centres_are_on_the_maps_lanes() -> None:
@@ -149,11 +157,7 @@ def test_the_lane_curvature_is_exact_for_varying_offsets() -> None:
     _, road_map = route_and_map()
     lane = road_map.lane(1)
     for s in (20.0, 70.0, 100.0, 180.0):
-        h = 1e-3
-        p = lane.position(np.array([s - h, s, s + h]), np.zeros(3))
-        d1, d2 = p[1] - p[0], p[2] - p[1]
-        turn = math.atan2(d1[0] * d2[1] - d1[1] * d2[0], float(np.dot(d1, d2)))
-        numeric = turn / (0.5 * (np.hypot(*d1) + np.hypot(*d2)))
+        numeric = numeric_curvature(lane, s)
         assert float(lane.curvature_at(s)) == pytest.approx(numeric, abs=1e-5), s
 
 
@@ -227,14 +231,7 @@ def test_every_plan_view_shape_takes_a_varying_lane_offset(tmp_path: Path) -> No
     assert road_map.section_profiled.all()  # every piece's lanes move along it
     stations = np.linspace(0.0, road_map.length, 500)
     ids = {0: -2, 1: -1, -1: 1, -2: 2}  # route lane: file lane
-    for index, lane_id in ids.items():
-        lane = road_map.lane(index)
-        s_file, t = road.plan_view.project(lane.position(stations, 0.0))
-        for k, s in enumerate(np.clip(s_file, 0.0, road.length).tolist()):
-            assert abs(t[k] - lane_centre_t(road, lane_id, s)) < TOLERANCE, (lane_id, s)
-            inner, outer = lane_borders(road, s)[lane_id]
-            width = float(lane.width_at(stations[k]))
-            assert abs(width - abs(inner - outer)) < TOLERANCE, (lane_id, s)
+    assert_lanes_on_the_file(road, road_map, ids, stations)
     right, _ = road_map.paved_edges(stations)
     s_file, t = road.plan_view.project(road_map.position(stations, right))
     for k, s in enumerate(np.clip(s_file, 0.0, road.length).tolist()):
