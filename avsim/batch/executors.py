@@ -7,7 +7,7 @@ arrive does, and the batch sorts them back into job order.
 - `LocalExecutor`: a pool of ``jobs`` worker processes, one run per worker process
   (``max_tasks_per_child=1``: nothing carries over from one run to the next, and each
   run's memory is given back). Workers are forked from a ``forkserver`` that has done what
-  every run needs first (`PRELOAD`: `avsim.batch.warm`, 4-5 s of imports) and nothing
+  every run needs first (`PRELOAD`: `avsim.run.warm`, 4-5 s of imports) and nothing
   else: no PyBullet client, no GL context, no run's state to inherit. (Workers started
   with ``spawn`` paid those seconds in every run: a 3 x 3 sweep of 3 s runs took 66 s on
   two workers, 30 s now.) The workers send their simulated time through a queue for the
@@ -40,7 +40,9 @@ from avsim.files import write_atomic
 POLL = 0.2  # [s] how often the display is refreshed while runs are under way
 PROGRESS_EVERY = 1.0  # [s] of simulated time between a worker's progress messages
 RAY_EXTRA = "pip install 'avsim[ray]'"  # how to get Ray, for the error message
-PRELOAD = ["avsim.batch.warm"]  # what the local workers' forkserver imports once (module doc)
+
+
+PRELOAD = ["avsim.run.warm"]  # what the local workers' forkserver imports once (module doc)
 
 
 class ExecutorError(Exception):

@@ -141,21 +141,35 @@ def render_threads(setup: SensorSetup) -> int:
     return 1 if pixels < LIGHT_RENDERING else 0
 
 
+PRELOAD = ("world.sensors.warm",)  # what the workers' forkserver imports once (`SensingWorker`)
+
+
 class SensingWorker:
     """The worker process of a `ProcessSensing`, started on its own: it builds its mirror of
     the scenario's world while the main process builds the simulated one (about 2 s and 1 s
-    here, side by side instead of one after the other)."""
+    here, side by side instead of one after the other).
 
-    def __init__(self, spec: WorldSpec, setup: SensorSetup) -> None:
+    Workers are forked from multiprocessing's ``forkserver``: a fresh interpreter (no physics
+    or GL state is ever inherited) that has imported `preload` once, so that the second and
+    later workers of a process (a test session's runs) start without the imports and the EGL
+    plugin's symbol scan (about 2 s a run, `world.sensors.warm`); the first costs what a
+    spawned worker did. The forkserver is one per process and keeps the preload of whoever
+    started it (a local batch's is a superset of this one, `avsim.run.warm`). The worker
+    gets this process's environment and directory at its start, as a spawned one would (the
+    forkserver's are those of its own start)."""
+
+    def __init__(self, spec: WorldSpec, setup: SensorSetup,
+                 preload: tuple[str, ...] = PRELOAD) -> None:
         self.spec = spec
         fd, name = tempfile.mkstemp(prefix="avsim-frames-", dir=shared_dir())
         os.close(fd)
         self.slots = FrameSlots(Path(name), setup.cameras, create=True)
-        ctx = mp.get_context("spawn")  # a fresh interpreter: no inherited physics or GL state
+        ctx = mp.get_context("forkserver")
+        ctx.set_forkserver_preload(list(preload))  # no effect once the forkserver runs
         self._conn, child = ctx.Pipe()
         self._proc = ctx.Process(target=sensing_worker.main,
                                  args=(child, spec, setup, self.slots.path,
-                                       render_threads(setup)),
+                                       render_threads(setup), dict(os.environ), os.getcwd()),
                                  name="avsim-sensing", daemon=True)
         self._proc.start()
         child.close()

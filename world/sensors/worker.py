@@ -17,7 +17,14 @@ from multiprocessing.connection import Connection
 from typing import Any
 
 
-def main(conn: Connection, spec: Any, setup: Any, slots_file: Any, render_threads: int) -> None:
+def main(conn: Connection, spec: Any, setup: Any, slots_file: Any, render_threads: int,
+         environ: dict[str, str], cwd: str) -> None:
+    """Serve `conn` (`world.sensors.pipeline.serve`) in the environment `environ` and the
+    directory `cwd` of the process that started the worker (a forked worker has its
+    forkserver's otherwise)."""
+    os.environ.clear()
+    os.environ.update(environ)
+    os.chdir(cwd)
     devnull = os.open(os.devnull, os.O_WRONLY)
     os.dup2(devnull, 1)
     os.dup2(devnull, 2)
