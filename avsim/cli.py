@@ -217,8 +217,7 @@ def suite(paths: tuple[str, ...], out: Path, jobs: int | None, executor: str,
 
     try:
         batch.validate_out_dir(out)
-        entries: list[tuple[str | None, str, dict[str, object]]] = [
-            (None, s, {}) for s in batch.collect_scenarios(paths)]
+        entries = batch.suite_entries(batch.collect_scenarios(paths))
         planned = batch.plan(entries, out, profile)
     except (ScenarioError, batch.BatchError) as exc:
         _bad_input(str(exc))
@@ -242,17 +241,20 @@ def suite(paths: tuple[str, ...], out: Path, jobs: int | None, executor: str,
 def sweep(scenario: str, sets: tuple[str, ...], params: tuple[str, ...], out: Path | None,
           metric: str, jobs: int | None, executor: str, address: str | None, profile: str,
           snapshots: bool) -> None:
-    """Run SCENARIO over the grid of --set values, like a suite; write sweep.csv,
-    sweep.md and, over two swept keys, heatmap.png of --metric."""
+    """Run SCENARIO over the grid of --set values (default: the file's own `grid`), like a
+    suite; write sweep.csv, sweep.md and, over two swept keys, heatmap.png of --metric."""
     from avsim.batch import suite as batch
-    from avsim.batch.sweep import SweepError, grid, parse_set
+    from avsim.batch.sweep import Axis, SweepError, grid, parse_set
 
     try:
         axes = [parse_set(s) for s in sets + tuple(PARAMETER_PREFIX + p for p in params)]
+        loaded = load_scenario(scenario)
+        axes = axes or [Axis(path, values) for path, values in loaded.grid]
         if not axes:
-            raise SweepError("give at least one --set or --param to sweep")
+            raise SweepError("give at least one --set or --param to sweep (the file has "
+                             "no grid)")
         runs = grid(axes)
-        name = load_scenario(scenario).name
+        name = loaded.name
         out = out if out is not None else Path("runs") / f"sweep_{name}"
         batch.validate_out_dir(out)
         entries = [(f"{name}_{k:03d}", scenario, overrides) for k, overrides in enumerate(runs)]

@@ -57,6 +57,23 @@ def collect_scenarios(args: Sequence[str]) -> list[str]:
     return found
 
 
+def suite_entries(scenarios: Sequence[str]) -> list[tuple[str | None, str, dict[str, object]]]:
+    """The runs of a suite over `scenarios` (`plan`'s entries): one per scenario, or one per
+    point of its file's `grid` (named ``<name>_<k:03d>``, as a sweep names its runs)."""
+    from avsim.batch.sweep import Axis, grid
+
+    entries: list[tuple[str | None, str, dict[str, object]]] = []
+    for scenario in scenarios:
+        loaded = load_scenario(scenario)
+        if not loaded.grid:
+            entries.append((None, scenario, {}))
+            continue
+        points = grid([Axis(path, values) for path, values in loaded.grid])
+        entries += [(f"{loaded.name}_{k:03d}", scenario, point)
+                    for k, point in enumerate(points)]
+    return entries
+
+
 def plan(entries: Sequence[tuple[str | None, str, Mapping[str, object]]], out_dir: Path,
          profile: str) -> list[RunJob]:
     """Validate each (job name or None for the scenario's own, scenario, overrides) and make

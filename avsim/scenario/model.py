@@ -20,6 +20,7 @@ the message (`problem`) and optionally the offending key (`key`) below the model
 
 from __future__ import annotations
 
+import math
 from typing import TYPE_CHECKING, Annotated, Any, Literal
 
 from pydantic import (
@@ -74,6 +75,10 @@ ACTION_KINDS = ("speed", "lane_change", "walk", "stop")
 EVENT_KINDS = ("accelerator_override", "flat_tire")
 
 Identifier = Annotated[str, Field(pattern=NAME_PATTERN)]
+MAX_GRID_POINTS = 1000  # runs a file's `grid` may ask for
+MAX_GRID_VALUES = 100  # values of one grid key
+GridPath = Annotated[str, Field(pattern=r"^[a-z0-9_]+(\.[a-z0-9_]+)*$")]
+GridValues = Annotated[list[Any], Field(min_length=1, max_length=MAX_GRID_VALUES)]
 
 
 def _one_of(names: tuple[str, ...]) -> dict[str, Any]:
@@ -750,6 +755,23 @@ class ScenarioModel(FormatModel):
         + ", ".join(setting_keys())
         + ". The default criteria always apply. Default: none added.",
     )
+    grid: dict[GridPath, GridValues] = Field(
+        default_factory=dict,
+        description="A test grid: dotted key paths of this file (list indices as numbers) "
+        "and the values each takes, as `avsim sweep --set` gives them. `avsim suite` runs "
+        f"every point (at most {MAX_GRID_POINTS}, the last key varying fastest, named "
+        "NAME_000, NAME_001, ...); `avsim run` runs the file's own values. Default: none.",
+    )
+
+    @model_validator(mode="after")
+    def _grid_size(self) -> ScenarioModel:
+        for path in self.grid:
+            if path.split(".")[0] in ("grid", "format", "name"):
+                raise problem(f"{path!r}: a grid cannot vary this key", key="grid")
+        points = math.prod(len(values) for values in self.grid.values())
+        if points > MAX_GRID_POINTS:
+            raise problem(f"{points} points: at most {MAX_GRID_POINTS}", key="grid")
+        return self
 
     @model_validator(mode="after")
     def _one_map(self) -> ScenarioModel:

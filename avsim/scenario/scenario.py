@@ -40,6 +40,8 @@ class Scenario:
     criteria: CriteriaSettings = field(default_factory=CriteriaSettings)
     story: StoryProgram | None = None  # an OpenSCENARIO file's storyboard (its director
     #   plays it: `avsim.run.storyboard`); None: the world spec's own scripted actions
+    grid: tuple[tuple[str, tuple[object, ...]], ...] = ()  # the file's test grid: key paths
+    #   and their values (`avsim suite` runs every point: `avsim.batch.suite.grid_entries`)
 
     @property
     def seed(self) -> int:

@@ -84,3 +84,33 @@ def test_results_compare_equal_with_non_finite_numbers() -> None:
     assert comparable(one) == comparable(two)
     other = RunOutcome(job, Status.PASSED, {**result, "sim_time": 5.1})
     assert comparable(one) != comparable(other)
+
+
+GRID_FILE = """\
+format: avsim/1
+name: grid_file
+duration: 5
+road: {lanes: 1, speed_limit_kph: 50, segments: [{straight: 300}]}
+ego: {lane: 0, s: 20, speed_kph: 30, set_speed_kph: 30}
+actors: [{id: lead, type: car, lane: 0, s: 80, speed_kph: 10}]
+"""
+
+
+def test_a_files_grid_gives_a_suite_one_run_per_point(tmp_path: Path) -> None:
+    from avsim.batch.suite import suite_entries
+    from avsim.scenario.load import load_scenario
+
+    plain = tmp_path / "plain.yaml"
+    plain.write_text(GRID_FILE, encoding="utf-8")
+    gridded = tmp_path / "gridded.yaml"
+    gridded.write_text(GRID_FILE + "grid:\n  ego.speed_kph: [20, 30]\n"
+                       "  actors.0.offset: [-0.8, 0, 0.8]\n", encoding="utf-8")
+    assert load_scenario(gridded).world.ego.speed == pytest.approx(30 / 3.6)  # its own values
+    entries = suite_entries([str(plain), str(gridded)])
+    assert entries[0] == (None, str(plain), {})
+    assert [e[0] for e in entries[1:]] == [f"grid_file_{k:03d}" for k in range(6)]
+    assert [e[2] for e in entries[1:]] == [
+        {"ego.speed_kph": v, "actors.0.offset": o} for v in (20, 30) for o in (-0.8, 0, 0.8)]
+    for _, path, overrides in entries[1:]:  # every point is a valid scenario
+        point = load_scenario(path, overrides)
+        assert point.world.actors[0].offset == overrides["actors.0.offset"]

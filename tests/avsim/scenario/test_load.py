@@ -204,6 +204,9 @@ BAD: dict[str, tuple[str, str]] = {
     ),
     "model_on_pedestrian": ("actors.0.model", "only a car or truck takes a model"),
     "model_type_mismatch": ("actors.0.model", "a semi_trailer needs type: truck, not car"),
+    "grid_too_big": ("grid", "1089 points: at most 1000"),
+    "grid_varies_grid": ("grid", "'grid.x': a grid cannot vary this key"),
+    "grid_empty_values": ("grid.ego.speed_kph", "must have at least 1 item(s), got 0"),
 }
 
 
