@@ -253,7 +253,7 @@ def sweep(scenario: str, sets: tuple[str, ...], params: tuple[str, ...], out: Pa
         if not axes:
             raise SweepError("give at least one --set or --param to sweep (the file has "
                              "no grid)")
-        runs = grid(axes)
+        runs = [batch.overrides_of(point) for point in grid(axes)]
         name = loaded.name
         out = out if out is not None else Path("runs") / f"sweep_{name}"
         batch.validate_out_dir(out)

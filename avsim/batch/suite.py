@@ -26,6 +26,7 @@ from avsim.batch.jobs import RunJob, RunOutcome, Status
 from avsim.files import write_atomic
 from avsim.run.result import dumps
 from avsim.scenario.load import bundled_scenarios, load_scenario
+from avsim.scenario.model import grid_paths
 from avsim.scenario.openscenario.sidecar import SUFFIX as SIDECAR_SUFFIX
 from avsim.scenario.profile_fit import check_profile
 
@@ -68,10 +69,23 @@ def suite_entries(scenarios: Sequence[str]) -> list[tuple[str | None, str, dict[
         if not loaded.grid:
             entries.append((None, scenario, {}))
             continue
-        points = grid([Axis(path, values) for path, values in loaded.grid])
-        entries += [(f"{loaded.name}_{k:03d}", scenario, point)
+        points = grid([Axis(key, values) for key, values in loaded.grid])
+        entries += [(f"{loaded.name}_{k:03d}", scenario, overrides_of(point))
                     for k, point in enumerate(points)]
     return entries
+
+
+def overrides_of(point: Mapping[str, object]) -> dict[str, object]:
+    """A grid point's overrides: a key of several comma-joined paths gives each its item."""
+    overrides: dict[str, object] = {}
+    for key, value in point.items():
+        paths = grid_paths(key)
+        if len(paths) == 1:
+            overrides[key] = value
+        else:
+            assert isinstance(value, list)  # the model checked it: one item per path
+            overrides.update(zip(paths, value, strict=True))
+    return overrides
 
 
 def plan(entries: Sequence[tuple[str | None, str, Mapping[str, object]]], out_dir: Path,

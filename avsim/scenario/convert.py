@@ -257,7 +257,7 @@ def _scenario(model: ScenarioModel, road_spec: spec.RoadSpec,
         driver=DriverSettings(set_speed=_kph(ego.set_speed_kph), overtake=ego.overtake),
         criteria=CriteriaSettings.of({key: getattr(model.criteria, key)
                                       for key in setting_keys()}),
-        grid=tuple((path, tuple(values)) for path, values in model.grid.items()),
+        grid=tuple((key, tuple(values)) for key, values in model.grid.items()),
     )
 
 

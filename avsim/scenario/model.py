@@ -77,8 +77,14 @@ EVENT_KINDS = ("accelerator_override", "flat_tire")
 Identifier = Annotated[str, Field(pattern=NAME_PATTERN)]
 MAX_GRID_POINTS = 1000  # runs a file's `grid` may ask for
 MAX_GRID_VALUES = 100  # values of one grid key
-GridPath = Annotated[str, Field(pattern=r"^[a-z0-9_]+(\.[a-z0-9_]+)*$")]
+GridPath = Annotated[str, Field(  # a key path, or several joined by commas (values go together)
+    pattern=r"^[a-z0-9_]+(\.[a-z0-9_]+)*(, *[a-z0-9_]+(\.[a-z0-9_]+)*)*$")]
 GridValues = Annotated[list[Any], Field(min_length=1, max_length=MAX_GRID_VALUES)]
+
+
+def grid_paths(key: str) -> list[str]:
+    """The key paths of one `grid` key: one, or several joined by commas."""
+    return [path.strip() for path in key.split(",")]
 
 
 def _one_of(names: tuple[str, ...]) -> dict[str, Any]:
@@ -758,16 +764,24 @@ class ScenarioModel(FormatModel):
     grid: dict[GridPath, GridValues] = Field(
         default_factory=dict,
         description="A test grid: dotted key paths of this file (list indices as numbers) "
-        "and the values each takes, as `avsim sweep --set` gives them. `avsim suite` runs "
+        "and the values each takes, as `avsim sweep --set` gives them; several paths joined "
+        "by commas take their values together (each value a list, one item per path). "
+        "`avsim suite` runs "
         f"every point (at most {MAX_GRID_POINTS}, the last key varying fastest, named "
         "NAME_000, NAME_001, ...); `avsim run` runs the file's own values. Default: none.",
     )
 
     @model_validator(mode="after")
     def _grid_size(self) -> ScenarioModel:
-        for path in self.grid:
-            if path.split(".")[0] in ("grid", "format", "name"):
-                raise problem(f"{path!r}: a grid cannot vary this key", key="grid")
+        for key, values in self.grid.items():
+            paths = grid_paths(key)
+            for path in paths:
+                if path.split(".")[0] in ("grid", "format", "name"):
+                    raise problem(f"{path!r}: a grid cannot vary this key", key="grid")
+            if len(paths) > 1 and any(not isinstance(v, list) or len(v) != len(paths)
+                                      for v in values):
+                raise problem(f"each value must be a list of {len(paths)} (one per key)",
+                              key=f"grid.{key}")
         points = math.prod(len(values) for values in self.grid.values())
         if points > MAX_GRID_POINTS:
             raise problem(f"{points} points: at most {MAX_GRID_POINTS}", key="grid")

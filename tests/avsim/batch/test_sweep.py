@@ -114,3 +114,23 @@ def test_a_files_grid_gives_a_suite_one_run_per_point(tmp_path: Path) -> None:
     for _, path, overrides in entries[1:]:  # every point is a valid scenario
         point = load_scenario(path, overrides)
         assert point.world.actors[0].offset == overrides["actors.0.offset"]
+
+
+def test_comma_joined_grid_keys_take_their_values_together(tmp_path: Path) -> None:
+    from avsim.batch.suite import suite_entries
+    from avsim.scenario.load import ScenarioError, load_scenario
+
+    path = tmp_path / "tied.yaml"
+    path.write_text(GRID_FILE + "grid:\n  ego.speed_kph, ego.set_speed_kph: [[20, 25], [40, 45]]\n"
+                    "  seed: [1, 2]\n", encoding="utf-8")
+    entries = suite_entries([str(path)])
+    assert [e[2] for e in entries] == [
+        {"ego.speed_kph": 20, "ego.set_speed_kph": 25, "seed": 1},
+        {"ego.speed_kph": 20, "ego.set_speed_kph": 25, "seed": 2},
+        {"ego.speed_kph": 40, "ego.set_speed_kph": 45, "seed": 1},
+        {"ego.speed_kph": 40, "ego.set_speed_kph": 45, "seed": 2}]
+    path.write_text(GRID_FILE + "grid:\n  ego.speed_kph, ego.set_speed_kph: [[20, 25], 40]\n",
+                    encoding="utf-8")
+    with pytest.raises(ScenarioError, match=r"grid\.ego\.speed_kph, ego\.set_speed_kph: each "
+                       r"value must be a list of 2 \(one per key\)"):
+        load_scenario(path)
