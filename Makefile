@@ -6,7 +6,7 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 PYTEST_ARGS ?=
 
-.PHONY: setup demo test test-quick lint golden bench clean
+.PHONY: setup demo test test-quick acceptance lint golden bench clean
 
 # The virtual environment with the pinned dependencies (pyproject.toml), installed once.
 $(STAMP): pyproject.toml
@@ -35,10 +35,15 @@ lint: $(STAMP)
 	$(BIN)/mypy
 
 test: lint
-	$(BIN)/pytest -n 2 --dist loadfile $(PYTEST_ARGS)
+	$(BIN)/pytest -n 2 --dist loadfile -m "not acceptance" $(PYTEST_ARGS)
 
 test-quick: lint
 	$(BIN)/pytest -n 2 --dist loadfile -m "not slow" $(PYTEST_ARGS)
+
+# The acceptance set (scenarios/acceptance: Euro NCAP, UN R157, ISO 22179 grids), one test
+# per run, each asserting its situation happened and its verdicts; too long for `make test`.
+acceptance: $(STAMP)
+	$(BIN)/pytest -n 2 --dist load -m acceptance tests/scenarios $(PYTEST_ARGS)
 
 # Rewrite the golden results (tests/scenarios/golden/) from the scenario tests' own runs: only
 # for a change meant to alter behaviour, whose commit says which and why.
