@@ -144,3 +144,15 @@ def vehicles_ahead(road: RoadMap, poses: ActorPoses, station: float, offset: flo
                         float(poses.accels[i]))
            for i in np.flatnonzero(candidates) if poses.kinds[i] in VEHICLES]
     return tuple(sorted(out, key=lambda v: v.gap))
+
+
+def time_to_collision(gap: NDArray[np.float64], ego_speed: NDArray[np.float64],
+                      lead_speed: NDArray[np.float64]) -> NDArray[np.float64]:
+    """[s] per tick: the gap [m] (a negative one as 0) over the closing speed
+    ego_speed - lead_speed [m/s] where that is > 0; NaN where there is no lead (a NaN gap or
+    lead speed) or the ego does not close on it."""
+    closing = ego_speed - lead_speed
+    valid = np.isfinite(gap) & np.isfinite(closing) & (closing > 0.0)
+    ttc = np.full(np.shape(gap), np.nan, dtype=np.float64)
+    ttc[valid] = np.maximum(gap[valid], 0.0) / closing[valid]
+    return ttc

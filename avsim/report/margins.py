@@ -6,9 +6,9 @@ collision to the lead, the lateral offset in the lane, and the motion FSM's mano
   (`planner.fsm.acc.r157_min_gap`) as the reference; where the gap is under d_min the space
   between them is shaded. The gap axis shows at most `GAP_VIEW` times the run's largest
   d_min (a far lead leaves the top).
-- Time to collision [s] (`time_to_collision`): gap / closing speed where the ego closes on
-  its lead (ego speed - lead speed > 0), nothing where there is no lead or it pulls away;
-  shown from 0 to `TTC_VIEW` (longer ones leave the top), with the stack's `ttc_hard`
+- Time to collision [s] (`world.truth.time_to_collision`): gap / closing speed where the
+  ego closes on its lead (ego speed - lead speed > 0), nothing where there is no lead or it
+  pulls away; shown from 0 to `TTC_VIEW` (longer ones leave the top), with the stack's `ttc_hard`
   (`planner.acc_control.AccControlParams`: below it BRAKE may brake hard) as a dashed line.
 - Lateral offset [m]: the ego centre's true offset from the centre of the lane the stack
   keeps (the log's `cross_track`, left +), with +-(lane width - car width) / 2 as the bound
@@ -65,18 +65,6 @@ GAP_LINES = {  # series -> (label, colour, style, width); no band's colour (thei
     "bound": ("body at the lane's edge", "#c62828", "--", 1.0),
 }
 UNDER_D_MIN = "#ef9a9a"  # the shading where the gap is under d_min
-
-
-def time_to_collision(gap: FloatArray, ego_speed: FloatArray,
-                      lead_speed: FloatArray) -> FloatArray:
-    """[s] per tick: the gap [m] (a negative one as 0) over the closing speed
-    ego_speed - lead_speed [m/s] where that is > 0; NaN where there is no lead (a NaN gap or
-    lead speed) or the ego does not close on it."""
-    closing = ego_speed - lead_speed
-    valid = np.isfinite(gap) & np.isfinite(closing) & (closing > 0.0)
-    ttc = np.full(np.shape(gap), np.nan, dtype=np.float64)
-    ttc[valid] = np.maximum(gap[valid], 0.0) / closing[valid]
-    return ttc
 
 
 def min_gap(speed: FloatArray) -> FloatArray:

@@ -47,6 +47,7 @@ from planner.fsm.acc import AccMode
 from planner.messages import SpeedSource
 from vehicle_urdf.geometry import read_geometry
 from world.frames import MPS_PER_KPH
+from world.truth import time_to_collision
 
 if TYPE_CHECKING:
     from avsim.run.runner import RunResult
@@ -143,7 +144,7 @@ def _draw_margins(axes: dict[str, Axes], result: RunResult) -> None:
     log = result.log
     t, speed, gap = log.array("t"), log.array("speed"), log.array("lead_gap")
     margins.draw_gap(axes["gap"], t, gap, margins.min_gap(speed))
-    margins.draw_ttc(axes["ttc"], t, margins.time_to_collision(gap, speed, lead_speed(result)))
+    margins.draw_ttc(axes["ttc"], t, time_to_collision(gap, speed, lead_speed(result)))
     bound = margins.lane_margin(result.scenario.world.road, log.array("station"), car_width())
     margins.draw_offset(axes["offset"], t, log.array("cross_track"), bound)
 

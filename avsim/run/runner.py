@@ -65,9 +65,10 @@ from world.sensors.lidar import RayBackend
 from world.sensors.pipeline import SensingWorker
 from world.sensors.setup import Profile, sensor_setup
 from world.spec import FlatTire
-from world.truth import ego_lane_edges, touching, vehicles_ahead
+from world.truth import ego_lane_edges, time_to_collision, touching, vehicles_ahead
 from world.world import World
 
+MOVING = 2.0  # [m/s] the ego moves (`min_lead_gap`; `min_gap` judges from the same speed)
 SETTLE_AFTER_DONE = 1.0  # [s] the run goes on this long after it may end: `completes`
 #   reached and every required action and event fired
 
@@ -415,7 +416,17 @@ class Runner:
             "distance": float(self.log.station[-1] - self.log.station[0]) if xte.size else 0.0,
             "collisions": float(self.collisions.count),
             "acc_shortest_mode": shortest_hold(self.state_changes, "acc"),
-        } | (self.sensors.metrics() if self.setup is not None else {})
+        } | self._lead_margins() | (self.sensors.metrics() if self.setup is not None else {})
+
+    def _lead_margins(self) -> dict[str, float]:
+        """The closest the ego came to the vehicle ahead in its lane, from the truth
+        (`world.truth.vehicles_ahead`): the least bumper gap while the ego moved (faster than
+        `MOVING`) and the least time to collision; NaN where there was none."""
+        gap, speed = self.log.array("lead_gap"), self.log.array("speed")
+        ttc = time_to_collision(gap, speed, self.log.array("lead_speed"))
+        moving = gap[np.isfinite(gap) & (speed > MOVING)]
+        return {"min_lead_gap": float(np.min(moving)) if moving.size else math.nan,
+                "min_ttc": float(np.nanmin(ttc)) if np.isfinite(ttc).any() else math.nan}
 
     # -- recording -----------------------------------------------------------------------------
 

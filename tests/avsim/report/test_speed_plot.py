@@ -37,6 +37,7 @@ from planner.fsm.motion import TABLE as MOTION_TABLE
 from planner.fsm.motion import Motion
 from planner.messages import SpeedSource
 from world.spec import RoadSpec, SegmentSpec
+from world.truth import time_to_collision
 
 REPO = Path(__file__).parents[3]
 TRAFFIC_JAM = REPO / "scenarios" / "traffic_jam.yaml"
@@ -216,7 +217,7 @@ def test_margin_panels_show_the_gap_ttc_and_offset() -> None:
     # the time to collision and ttc_hard
     assert [line.get_label() for line in ttc.get_lines()] == [
         "time to collision", "ttc_hard 2.5 s"]
-    np.testing.assert_array_equal(_ydata(ttc.get_lines()[0]), margins.time_to_collision(
+    np.testing.assert_array_equal(_ydata(ttc.get_lines()[0]), time_to_collision(
         log.array("lead_gap"), log.array("speed"), log.array("lead_speed")))
     assert ttc.get_ylim() == (0.0, margins.TTC_VIEW)
     np.testing.assert_allclose(_ydata(ttc.get_lines()[1]), margins.TTC_HARD)
@@ -232,7 +233,7 @@ def test_time_to_collision_where_the_ego_closes_on_a_lead() -> None:
     gap = np.array([10.0, 10.0, nan, 10.0, -1.0, 12.0, 6.0])
     ego = np.array([5.0, 5.0, 5.0, 5.0, 5.0, 5.0, 0.0])
     lead = np.array([3.0, 5.0, nan, 7.0, 4.0, nan, -2.0])
-    ttc = margins.time_to_collision(gap, ego, lead)
+    ttc = time_to_collision(gap, ego, lead)
     # closing, level, no lead, opening, overlapping (0), lead speed unknown, backing lead
     np.testing.assert_array_equal(ttc, [5.0, nan, nan, nan, 0.0, nan, 3.0])
 
@@ -240,7 +241,7 @@ def test_time_to_collision_where_the_ego_closes_on_a_lead() -> None:
 def test_time_to_collision_of_the_synthetic_run() -> None:
     log = synthetic_result().log
     t, gap = log.array("t"), log.array("lead_gap")
-    ttc = margins.time_to_collision(gap, log.array("speed"), log.array("lead_speed"))
+    ttc = time_to_collision(gap, log.array("speed"), log.array("lead_speed"))
     closing = (t >= SLOW_DOWN) & (t < LEAD_LEAVES)
     assert np.isnan(ttc[~closing]).all()  # opening before, no lead after
     np.testing.assert_allclose(ttc[closing], gap[closing] / CLOSING)
