@@ -291,6 +291,41 @@ def _runs_table(outcomes: Sequence[RunOutcome], out_dir: Path) -> list[str]:
     return [*lines, ""]
 
 
+MARGINS = (  # the scenario table's worst margins: metric, heading, the worst of the runs
+    ("min_ttc", "least time to collision [s]", min),
+    ("min_lead_gap", "least gap moving [m]", min),
+    ("max_decel", "most deceleration [m/s^2]", max),
+)
+
+
+def _metric(outcome: RunOutcome, name: str) -> float | None:
+    """A finished run's metric, None where it has none (or it is null: no lead)."""
+    metrics = (outcome.result or {}).get("metrics")
+    value = metrics.get(name) if isinstance(metrics, Mapping) else None
+    return float(value) if isinstance(value, int | float) else None
+
+
+def _scenario_table(outcomes: Sequence[RunOutcome]) -> list[str]:
+    """A row per scenario file (a grid's points together): runs, passed, the pass rate and
+    the worst of each of `MARGINS` over its finished runs."""
+    groups: dict[str, list[RunOutcome]] = {}
+    for outcome in outcomes:
+        groups.setdefault(outcome.job.scenario, []).append(outcome)
+    lines = ["| scenario | runs | passed | pass rate | "
+             + " | ".join(heading for _, heading, _ in MARGINS) + " |",
+             "|---|--:|--:|--:|" + "--:|" * len(MARGINS)]
+    for scenario, runs in groups.items():
+        passed = sum(o.passed for o in runs)
+        worst = []
+        for name, _, pick in MARGINS:
+            values = [v for o in runs if (v := _metric(o, name)) is not None]
+            worst.append(format_value(pick(values)) if values else DASH)
+        lines.append("| " + " | ".join([_md_code(Path(scenario).stem), str(len(runs)),
+                                        str(passed), f"{100 * passed / len(runs):.0f} %",
+                                        *worst]) + " |")
+    return [*lines, ""]
+
+
 def _criterion_row(c: Mapping[str, object]) -> str:
     """A criterion's row of a run's section."""
     verdict = "n/a" if c["passed"] is None else "pass" if c["passed"] else "**FAIL**"
@@ -338,13 +373,15 @@ def summary_markdown(outcomes: Sequence[RunOutcome], *, title: str, out_dir: Pat
                      snapshots: Mapping[str, Path] = _NO_SNAPSHOTS) -> str:
     """The text of `summary.md`, written into `out_dir` (links are relative to it).
 
-    A header with the counts and total sim and wall times [s]; a table with a row per run
+    A header with the counts and total sim and wall times [s]; a table with a row per
+    scenario file (a grid's runs together: pass rate and worst margins, `MARGINS`); a table
+    with a row per run
     (verdict, times, links to its .rrd and .json, and its speed-profile .png if that file
     exists); a section per run with its scenario, seed, profile, overrides and a row per
     criterion (or its error line); then, for each failed run with a snapshot in `snapshots`
     (job name -> PNG), the image, titled with its first failure's time.
     """
-    lines = _header(outcomes, title) + _runs_table(outcomes, out_dir)
+    lines = _header(outcomes, title) + _scenario_table(outcomes) + _runs_table(outcomes, out_dir)
     for outcome in outcomes:
         lines += _run_section(outcome)
     lines += _snapshots(outcomes, out_dir, snapshots)

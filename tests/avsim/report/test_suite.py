@@ -259,7 +259,7 @@ def test_summary_header_and_run_table(tmp_path: Path) -> None:
     assert "**4 runs**: 1 passed, 1 failed, 2 errors" in text
     assert "sim time 75 s" in text and "wall time 35.85 s" in text
     rows = [line for line in text.splitlines() if line.startswith("| `")]
-    first = {line.split(" | ")[0]: line for line in rows[:4]}
+    first = {line.split(" | ")[0]: line for line in rows[2:6]}  # after the scenarios
     assert "**PASS** | 45 | 21.5 |" in first["| `cut_in_ok`"]
     assert "**FAIL** | 30 | 12.25 |" in first["| `cut_in_fail`"]
     assert "**BAD INPUT** | — | 0.1 | — | — | — |" in first["| `typo`"]
@@ -345,3 +345,16 @@ def test_summary_table(tmp_path: Path) -> None:
     for word, code in (("PASS", "1;32"), ("FAIL", "1;31"), ("BAD INPUT", "1;33"),
                        ("ERROR", "1;35")):
         assert f"\x1b[{code}m{word}" in coloured
+
+
+def test_summary_scenario_table_gives_pass_rates_and_worst_margins(tmp_path: Path) -> None:
+    out_dir = tmp_path / "out"
+    outcomes = _outcomes(out_dir)
+    for k, (ttc, gap, decel) in enumerate([(2.5, 12.0, 1.5), (1.1, None, 4.2)]):
+        result = outcomes[k].result
+        assert result is not None
+        result["metrics"] = {"min_ttc": ttc, "min_lead_gap": gap, "max_decel": decel}
+    text = summary_markdown(outcomes, title="T", out_dir=out_dir)
+    rows = [line for line in text.splitlines() if line.startswith("| `")][:2]
+    assert rows == ["| `cut_in` | 3 | 1 | 33 % | 1.1 | 12 | 4.2 |",
+                    "| `typo` | 1 | 0 | 0 % | — | — | — |"]
