@@ -4,8 +4,9 @@ Each `--set` names one dotted key path of the scenario file (list indices as num
 ``actors.0.speed_kph``) and its values, separated by commas outside brackets, so that a
 value may itself be a list (``actors.0.start=[2,1,west],[3,1,west]``). Every value is
 read as YAML (``20`` an int, ``2.5`` a float, ``west`` a string, ``[2, 1, west]`` a list),
-exactly as it would be written in the file. The grid is the product of the `--set`s in
-the order given, the last varying fastest; run k is named ``<scenario>_<k:03d>``.
+exactly as it would be written in the file (`avsim.scenario.files.parse_value`: YAML 1.2).
+The grid is the product of the `--set`s in the order given, the last varying fastest; run k
+is named ``<scenario>_<k:03d>``.
 """
 
 from __future__ import annotations
@@ -15,6 +16,8 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import yaml
+
+from avsim.scenario.files import parse_value
 
 PATH_CHARS = set("abcdefghijklmnopqrstuvwxyz0123456789_.")  # of a dotted key path
 PARAMETERS = "parameters."  # an OpenSCENARIO file's parameter: `parameters.NAME`
@@ -52,7 +55,7 @@ def parse_set(text: str) -> Axis:
     parsed = []
     for item in items:
         try:
-            parsed.append(yaml.safe_load(item))
+            parsed.append(parse_value(item))
         except yaml.YAMLError:
             raise SweepError(f"--set {text}: {item!r} is not a YAML value") from None
     if len({format_value(v) for v in parsed}) != len(parsed):

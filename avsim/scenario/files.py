@@ -2,13 +2,15 @@
 
 A scenario argument is a file path, or the name of a bundled scenario in `<repo>/scenarios/`
 (`SCENARIO_DIR`). The YAML is read with a strict safe loader: a key written twice in one
-mapping is an error (PyYAML would keep the last). Problems are `LocatedError`s keyed
+mapping is an error (PyYAML would keep the last), and plain scalars are read by the YAML
+1.2 core schema (``1e9`` is a number, ``yes`` is text). Problems are `LocatedError`s keyed
 `(file)` or `line N`.
 """
 
 from __future__ import annotations
 
 import os
+import re
 from collections.abc import Hashable
 from pathlib import Path
 from typing import Any
@@ -57,7 +59,12 @@ _MERGE_TAG = "tag:yaml.org,2002:merge"
 
 
 class _StrictLoader(yaml.SafeLoader):
-    """A safe YAML loader that refuses duplicate keys instead of keeping the last one."""
+    """A safe YAML loader that refuses duplicate keys instead of keeping the last one, and
+    reads plain scalars by the YAML 1.2 core schema (`_core_schema`) instead of PyYAML's YAML
+    1.1 rules: ``1e9`` and ``.5`` are numbers, ``yes`` / ``on`` and ``2024-01-01`` are text,
+    ``010`` is ten."""
+
+    yaml_implicit_resolvers: dict[Any, list[tuple[str, re.Pattern[str]]]] = {}  # noqa: RUF012
 
     def construct_mapping(self, node: yaml.MappingNode, deep: bool = False) -> dict[Hashable, Any]:
         """The mapping, or a `LocatedError` at the line of a key's second occurrence."""
@@ -75,6 +82,43 @@ class _StrictLoader(yaml.SafeLoader):
             if isinstance(key, Hashable):
                 seen[key] = key_node
         return super().construct_mapping(node, deep=deep)
+
+
+def _core_schema(loader: type[yaml.SafeLoader]) -> None:
+    """Resolve plain scalars in `loader` by the YAML 1.2 core schema (spec 10.3.2): null,
+    bool, int (decimal, 0o octal, 0x hex) and float (with or without a point or an exponent,
+    .inf, .nan), plus PyYAML's merge key; anything else is a string."""
+    resolvers = [
+        ("tag:yaml.org,2002:null", r"^(?:~|null|Null|NULL|)$", ["~", "n", "N", ""]),
+        ("tag:yaml.org,2002:bool", r"^(?:true|True|TRUE|false|False|FALSE)$", list("tTfF")),
+        ("tag:yaml.org,2002:int", r"^(?:[-+]?[0-9]+|0o[0-7]+|0x[0-9a-fA-F]+)$",
+         list("-+0123456789")),
+        ("tag:yaml.org,2002:float",
+         r"^(?:[-+]?(?:\.[0-9]+|[0-9]+(?:\.[0-9]*)?)(?:[eE][-+]?[0-9]+)?"
+         r"|[-+]?\.(?:inf|Inf|INF)|\.(?:nan|NaN|NAN))$", list("-+.0123456789")),
+        (_MERGE_TAG, r"^(?:<<)$", ["<"]),
+    ]
+    for tag, pattern, first in resolvers:
+        loader.add_implicit_resolver(tag, re.compile(pattern), first)
+    loader.add_constructor("tag:yaml.org,2002:int", _core_int)
+
+
+def _core_int(loader: yaml.SafeLoader, node: yaml.Node) -> int:
+    """An int of the core schema: ``0o17`` octal, ``0x1f`` hex, else decimal (``010`` is 10,
+    not YAML 1.1's octal 8)."""
+    text = str(loader.construct_scalar(node))  # type: ignore[arg-type]
+    if text.startswith(("0o", "0x")):
+        return int(text[2:], 8 if text[1] == "o" else 16)
+    return int(text, 10)
+
+
+_core_schema(_StrictLoader)
+
+
+def parse_value(text: str) -> Any:
+    """One YAML value as the scenario files read it (`_StrictLoader`: the core schema), for
+    a value given on the command line (`--set PATH=VALUE`). Raises `yaml.YAMLError`."""
+    return yaml.load(text, Loader=_StrictLoader)
 
 
 def read_raw(path: Path) -> dict[str, Any]:

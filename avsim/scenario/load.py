@@ -56,7 +56,7 @@ def load_scenario(
     `path_or_name` is a file path or the name of a bundled scenario (`scenarios/<name>.yaml`
     in the repository). `overrides` maps dotted key paths with list indices
     (`actors.0.speed_kph`) to values set into the file's data before validation; values are
-    used as given (parse command-line text with `yaml.safe_load` first).
+    used as given (parse command-line text with `avsim.scenario.files.parse_value` first).
 
     An OpenSCENARIO file (`.xosc`) loads with its sidecar (`criteria_file`, else
     `NAME.criteria.yaml` beside it): `avsim.scenario.openscenario.convert.load_xosc`.

@@ -18,7 +18,7 @@ from avsim.scenario import convert as conversion
 from avsim.scenario import files as scenario_files
 from avsim.scenario import load as scenario_module
 from avsim.scenario import model as scenario_model
-from avsim.scenario.files import SCENARIO_DIR
+from avsim.scenario.files import SCENARIO_DIR, parse_value
 from avsim.scenario.load import (
     UNSUPPORTED,
     ScenarioError,
@@ -520,3 +520,25 @@ def test_doc_names_every_key_and_unsupported_entry() -> None:
             assert f"`{name}`" in doc, f"{model.__name__}.{name} is not in {DOC.name}"
     for pattern in UNSUPPORTED:
         assert f"`{pattern}`" in doc, pattern
+
+
+def test_plain_numbers_read_by_yaml_1_2(tmp_path: Path) -> None:
+    """The YAML 1.2 core schema (issue L): `1e9` and `.5` are numbers, `yes` is text."""
+    path = tmp_path / "numbers.yaml"
+    path.write_text(MINIMAL.replace("duration: 10", "duration: 1e2").replace(
+        "set_speed_kph: 40", "set_speed_kph: .5e2"), encoding="utf-8")
+    scenario = load_scenario(path)
+    assert scenario.duration == 100.0
+    assert scenario.driver.set_speed == pytest.approx(50 / 3.6)
+    path.write_text(MINIMAL + "criteria: {completes: yes}\n", encoding="utf-8")
+    with pytest.raises(ScenarioError, match=r"criteria\.completes: .*'yes'"):
+        load_scenario(path)
+
+
+@pytest.mark.parametrize(("text", "value"), [
+    ("1e9", 1e9), (".5", 0.5), ("-2.5E-3", -2.5e-3), ("010", 10), ("0o17", 15), ("0x1f", 31),
+    ("yes", "yes"), ("on", "on"), ("2024-01-01", "2024-01-01"), ("1_000", "1_000"),
+    ("true", True), ("~", None), ("-.inf", -math.inf), ("[1e3, west]", [1000.0, "west"]),
+])
+def test_a_value_reads_by_the_core_schema(text: str, value: object) -> None:
+    assert parse_value(text) == value
