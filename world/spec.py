@@ -234,7 +234,7 @@ class ActorSpec:
     #   its type's default model (a car or truck), or no vehicle (pedestrian, obstacle)
     size: tuple[float, float, float] | None = None  # [m] length, width, height of a
     #   pedestrian's or an obstacle's box (a scenario file's bounding box); None: the type's
-    #   (`world.actors.actor_set.SIZES`)
+    #   (`world.actors.bodies.SIZES`)
 
 
 @dataclass(frozen=True, slots=True)

@@ -2,7 +2,8 @@
 make: a lane exists at its station, stations lie on the route (so does a criteria setting
 declared a station, `reach_s`), `after` names an earlier action, arcs are wider than the
 road, actor ids are unique, speeds fit the car, a speed action's acceleration has the sign
-its change of speed needs, and in a town every car starts on its route.
+its change of speed needs, in a town every car starts on its route, and on a road no two
+bodies overlap where they start (`check_spawn`).
 
 Each check raises the first problem it finds as a `LocatedError` at its key; the order of
 the checks is the order in which a file's problems are reported. Stations are metres along
@@ -17,7 +18,10 @@ from typing import TypeVar
 from avsim.criteria.registry import keyed
 from avsim.scenario.errors import LocatedError, fmt
 from avsim.scenario.model import ActorModel, RoadModel, ScenarioModel, TriggerModel
+from vehicle_urdf import CarDimensions
 from world import spec
+from world.actors.bodies import body_size
+from world.map.road import build_road_map
 
 DEFAULT_SPEED_UP = 2.0  # [m/s^2] a speed action's accel when it speeds up
 DEFAULT_SLOW_DOWN = -3.0  # [m/s^2] a speed action's accel when it slows down
@@ -53,6 +57,31 @@ def check_town(model: ScenarioModel, ego_road: spec.RoadSpec,
             raise LocatedError(f"ego.{key}", f"must be <= max_speed_kph "
                                f"({fmt(model.ego.max_speed_kph)}), got "
                                f"{fmt(getattr(model.ego, key))}")
+
+
+def check_spawn(world: spec.WorldSpec) -> None:
+    """No two bodies overlap where they start (issue L): the ego and each actor on a road,
+    each a box of its length and width along the lane it starts in (at its offset), the
+    ego's `vehicle_urdf.CarDimensions`'; the first overlap found is refused at the later
+    body's key: ``actors.2: overlaps the ego at s = 11 m``. Pedestrians and obstacles count
+    like vehicles. Along the route the boxes are compared station by station (an arc's
+    radius is far larger than a car)."""
+    road = build_road_map(world.road)
+    car = CarDimensions()
+    boxes = [("the ego", world.ego.s, road.lane(world.ego.lane).offset_at(world.ego.s),
+              car.body_length, car.body_width)]
+    for index, actor in enumerate(world.actors):
+        if actor.road is not None:  # in a town: on its own route
+            continue
+        size = body_size(actor)
+        lateral = road.lane(actor.lane).offset_at(actor.s) + actor.offset
+        box = (f"actors.{index} ({actor.id})", actor.s, lateral, size.length, size.width)
+        for name, s, offset, length, width in boxes:
+            if (abs(actor.s - s) < (size.length + length) / 2
+                    and abs(lateral - offset) < (size.width + width) / 2):
+                raise LocatedError(f"actors.{index}",
+                                   f"overlaps {name} at s = {fmt(actor.s)} m")
+        boxes.append(box)
 
 
 def route_length(segments: Sequence[spec.SegmentSpec]) -> float:

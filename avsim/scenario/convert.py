@@ -19,6 +19,7 @@ from avsim.criteria.registry import CriteriaSettings, setting_keys
 from avsim.scenario.checks import (
     DEFAULT_SPEED_UP,
     check_road,
+    check_spawn,
     check_town,
     given_or,
     speed_accels,
@@ -56,8 +57,10 @@ def convert(model: ScenarioModel) -> Scenario:
         return _convert_town(model)
     road_spec = _road_spec(model.road)
     check_road(model, model.road, road_spec.segments)
-    return _scenario(model, road_spec,
-                     tuple(_actor_spec(i, actor) for i, actor in enumerate(model.actors)))
+    scenario = _scenario(model, road_spec,
+                         tuple(_actor_spec(i, actor) for i, actor in enumerate(model.actors)))
+    check_spawn(scenario.world)
+    return scenario
 
 
 def _kph(value: float) -> float:

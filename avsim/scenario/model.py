@@ -34,13 +34,10 @@ from pydantic import (
 )
 
 from avsim.criteria.registry import keyed, setting_keys, switches
+from avsim.scenario import bounds as b
 from avsim.scenario.fields import (
     FormatModel,
     Fraction,
-    NonNegFloat,
-    NonNegInt,
-    PosFloat,
-    PosInt,
     problem,
 )
 from world.actors.catalogue import CATALOGUE, TYPE_CLASSES
@@ -134,7 +131,7 @@ def _exactly_one(model: BaseModel, kinds: tuple[str, ...], what: str) -> str:
 class ArcModel(FormatModel):
     """A constant-curvature arc of the route's reference line (lane 0's centre line)."""
 
-    radius: PosFloat = Field(
+    radius: b.Radius = Field(
         description="[m] radius of the reference line (lane 0's centre line); required, > 0, "
         "and larger than the road's paved width (lanes x lane_width + shoulder)."
     )
@@ -156,27 +153,27 @@ class SegmentModel(FormatModel):
 
     model_config = ConfigDict(json_schema_extra=_one_of(("straight", "arc")))
 
-    straight: PosFloat | None = Field(
+    straight: b.Length | None = Field(
         default=None, description="[m] length of a straight piece, > 0; give this or `arc`."
     )
     arc: ArcModel | None = Field(
         default=None, description="An arc piece `{radius, angle_deg}`; give this or `straight`."
     )
-    lanes: PosInt | None = Field(
+    lanes: b.Lanes | None = Field(
         default=None,
         description="Driving lanes in the ego's direction on this segment, >= 1. "
         "Default: the road's `lanes`.",
     )
-    oncoming_lanes: NonNegInt | None = Field(
+    oncoming_lanes: b.OncomingLanes | None = Field(
         default=None,
         description="Oncoming lanes on this segment, >= 0. Default: the road's `oncoming_lanes`.",
     )
-    shoulder: NonNegFloat | None = Field(
+    shoulder: b.Shoulder | None = Field(
         default=None,
         description="[m] paved right shoulder on this segment, >= 0. Default: the road's "
         "`shoulder`.",
     )
-    speed_limit_kph: PosFloat | None = Field(
+    speed_limit_kph: b.PosSpeed | None = Field(
         default=None,
         description="[km/h] limit posted at the segment's start, > 0. Default: unchanged "
         "(the limit in force goes on).",
@@ -203,35 +200,36 @@ class SpeedLimitFeature(FormatModel):
     """A speed limit sign: the limit applies from its station on."""
 
     type: Literal["speed_limit"] = Field(description="Feature type `speed_limit`.")
-    s: NonNegFloat = Field(description="[m] station of the sign; required, on the route.")
-    kph: PosFloat = Field(description="[km/h] the posted limit; required, > 0.")
+    s: b.Station = Field(description="[m] station of the sign; required, on the route.")
+    kph: b.PosSpeed = Field(description="[km/h] the posted limit; required, > 0.")
 
 
 class StopSignFeature(FormatModel):
     """A stop line across the route with a stop sign on the right."""
 
     type: Literal["stop_sign"] = Field(description="Feature type `stop_sign`.")
-    s: NonNegFloat = Field(description="[m] station of the stop line; required, on the route.")
+    s: b.Station = Field(description="[m] station of the stop line; required, on the route.")
 
 
 class CrosswalkFeature(FormatModel):
     """A zebra crossing from `s` to `s + width`."""
 
     type: Literal["crosswalk"] = Field(description="Feature type `crosswalk`.")
-    s: NonNegFloat = Field(description="[m] station of the near edge; required, on the route.")
-    width: PosFloat = Field(default=4.0, description="[m] extent along the route, > 0. Default 4.")
+    s: b.Station = Field(description="[m] station of the near edge; required, on the route.")
+    width: b.FeatureSize = Field(default=4.0,
+                                 description="[m] extent along the route, > 0. Default 4.")
 
 
 class SpeedBumpFeature(FormatModel):
     """A speed bump across the road."""
 
     type: Literal["speed_bump"] = Field(description="Feature type `speed_bump`.")
-    s: NonNegFloat = Field(description="[m] station of the bump's centre; required, on the route.")
-    height: PosFloat = Field(default=0.1, description="[m] height, > 0. Default 0.1.")
-    length: PosFloat = Field(
+    s: b.Station = Field(description="[m] station of the bump's centre; required, on the route.")
+    height: b.BumpHeight = Field(default=0.1, description="[m] height, > 0. Default 0.1.")
+    length: b.FeatureSize = Field(
         default=0.9, description="[m] extent along the route, > 0. Default 0.9."
     )
-    pass_kph: PosFloat = Field(
+    pass_kph: b.PosSpeed = Field(
         default=5.0, description="[km/h] the speed to take it at, > 0. Default 5."
     )
 
@@ -240,11 +238,11 @@ class TrafficLightFeature(FormatModel):
     """A traffic light with a stop line; a fixed green-yellow-red cycle."""
 
     type: Literal["traffic_light"] = Field(description="Feature type `traffic_light`.")
-    s: NonNegFloat = Field(description="[m] station of the stop line; required, on the route.")
-    green: PosFloat = Field(default=20.0, description="[s] green time, > 0. Default 20.")
-    yellow: PosFloat = Field(default=3.0, description="[s] yellow time, > 0. Default 3.")
-    red: PosFloat = Field(default=15.0, description="[s] red time, > 0. Default 15.")
-    phase: NonNegFloat = Field(
+    s: b.Station = Field(description="[m] station of the stop line; required, on the route.")
+    green: b.Duration = Field(default=20.0, description="[s] green time, > 0. Default 20.")
+    yellow: b.Duration = Field(default=3.0, description="[s] yellow time, > 0. Default 3.")
+    red: b.Duration = Field(default=15.0, description="[s] red time, > 0. Default 15.")
+    phase: b.Time = Field(
         default=0.0, description="[s] time into the cycle (from green) at t = 0, >= 0. Default 0."
     )
 
@@ -263,7 +261,7 @@ class BuildingsModel(FormatModel):
         default=0.5,
         description="[-] built-up fraction of the roadside frontage, 0..1. Default 0.5.",
     )
-    setback: NonNegFloat = Field(
+    setback: b.Setback = Field(
         default=6.0,
         description="[m] from the road's outer paved edge to the building fronts, >= 0. Default 6.",
     )
@@ -273,41 +271,53 @@ class RoadModel(FormatModel):
     """Map kind 1: one route road of straight and arc segments laid end to end from the
     origin, heading +x."""
 
-    lanes: PosInt = Field(
+    lanes: b.Lanes = Field(
         default=1,
         description="Driving lanes in the ego's direction, >= 1; lane 0 is the rightmost. "
         "Default 1.",
     )
-    oncoming_lanes: NonNegInt = Field(
+    oncoming_lanes: b.OncomingLanes = Field(
         default=0,
         description="Lanes in the other direction, left of a yellow centre line, >= 0. Default 0.",
     )
-    lane_width: PosFloat = Field(default=3.5, description="[m] lane width, > 0. Default 3.5.")
-    shoulder: NonNegFloat = Field(
+    lane_width: b.LaneWidth = Field(default=3.5, description="[m] lane width, > 0. Default 3.5.")
+    shoulder: b.Shoulder = Field(
         default=2.5, description="[m] paved right shoulder, >= 0. Default 2.5."
     )
-    speed_limit_kph: PosFloat = Field(description="[km/h] limit posted at s = 0; required, > 0.")
+    speed_limit_kph: b.PosSpeed = Field(description="[km/h] limit posted at s = 0; required, > 0.")
     segments: list[SegmentModel] = Field(
-        min_length=1, description="The ego's route, at least one segment; required."
+        min_length=1, max_length=b.MAX_SEGMENTS,
+        description="The ego's route, at least one segment; required."
     )
     features: list[FeatureModel] = Field(
-        default_factory=list,
+        default_factory=list, max_length=b.MAX_FEATURES,
         description="Features at stations along the route, each with a `type`. Default none.",
     )
     buildings: BuildingsModel | None = Field(
         default=None, description="Optional scenery buildings `{density, setback}`. Default none."
     )
 
+    @model_validator(mode="after")
+    def _route_length(self) -> RoadModel:
+        """The route, its segments' lengths added up, is at most `MAX_ROUTE_LENGTH`."""
+        length = sum(seg.straight if seg.straight is not None else
+                     seg.arc.radius * math.radians(abs(seg.arc.angle_deg)) if seg.arc else 0.0
+                     for seg in self.segments)
+        if length > b.MAX_ROUTE_LENGTH:
+            raise problem(f"the route is {length:.0f} m long: at most "
+                          f"{b.MAX_ROUTE_LENGTH:.0f} m", key="segments")
+        return self
+
 
 class TownModel(FormatModel):
     """Map kind 2: a grid town of two-way streets, junctions, stop signs and lights."""
 
-    blocks_x: PosInt = Field(description="Blocks along x, >= 1; required.")
-    blocks_y: PosInt = Field(description="Blocks along y, >= 1; required.")
-    block: PosFloat = Field(description="[m] block size (junction spacing), > 0; required.")
-    lanes: PosInt = Field(default=1, description="Lanes per direction, >= 1. Default 1.")
-    lane_width: PosFloat = Field(default=3.5, description="[m] lane width, > 0. Default 3.5.")
-    speed_limit_kph: PosFloat = Field(description="[km/h] limit on every street; required, > 0.")
+    blocks_x: b.Blocks = Field(description="Blocks along x, >= 1; required.")
+    blocks_y: b.Blocks = Field(description="Blocks along y, >= 1; required.")
+    block: b.Block = Field(description="[m] block size (junction spacing), > 0; required.")
+    lanes: b.TownLanes = Field(default=1, description="Lanes per direction, >= 1. Default 1.")
+    lane_width: b.LaneWidth = Field(default=3.5, description="[m] lane width, > 0. Default 3.5.")
+    speed_limit_kph: b.PosSpeed = Field(description="[km/h] limit on every street; required, > 0.")
     junctions: Junctions = Field(
         default="stop_signs",
         description="Junction control: stop_signs | traffic_lights | mixed. Default stop_signs.",
@@ -333,21 +343,21 @@ class TriggerModel(FormatModel):
 
     model_config = ConfigDict(json_schema_extra=_one_of(TRIGGER_KINDS))
 
-    time: NonNegFloat | None = Field(default=None, description="[s] simulated time, >= 0.")
-    ego_s: NonNegFloat | None = Field(
+    time: b.Time | None = Field(default=None, description="[s] simulated time, >= 0.")
+    ego_s: b.Station | None = Field(
         default=None, description="[m] the ego's station reached, >= 0, on the route."
     )
-    gap: NonNegFloat | None = Field(
+    gap: b.Station | None = Field(
         default=None,
         description="[m] bumper-to-bumper distance from this actor to the ego along the route "
         "falls to this or below, >= 0.",
     )
-    after: NonNegInt | None = Field(
+    after: b.ActionIndex | None = Field(
         default=None,
         description="Index of an EARLIER action of the same actor (or event of the list); "
         "fires `delay` seconds after it ended.",
     )
-    delay: NonNegFloat | None = Field(
+    delay: b.Time | None = Field(
         default=None, description="[s] with `after` only: wait after that action ended. Default 0."
     )
 
@@ -373,8 +383,8 @@ class TriggerModel(FormatModel):
 class SpeedActionModel(FormatModel):
     """Change speed to `kph` at a signed acceleration."""
 
-    kph: NonNegFloat = Field(description="[km/h] target speed, >= 0; required.")
-    accel: float | None = Field(
+    kph: b.Speed = Field(description="[km/h] target speed, >= 0; required.")
+    accel: b.Accel | None = Field(
         default=None,
         description="[m/s^2] signed acceleration, != 0: > 0 to speed up, < 0 to slow down. "
         "Default 2 when speeding up, -3 when slowing.",
@@ -393,7 +403,7 @@ class LaneChangeActionModel(FormatModel):
     """Move to another lane at a constant lateral speed."""
 
     to_lane: int = Field(description="Target lane index; required, must exist.")
-    lateral_speed: PosFloat = Field(
+    lateral_speed: b.LateralSpeed = Field(
         default=2.0, description="[m/s] lateral speed, > 0. Default 2.0 (UN R157-like)."
     )
 
@@ -403,17 +413,17 @@ class WalkActionModel(FormatModel):
     speed (reached and left at `world.actors.behaviour.LATERAL_ACCEL`), facing the walking
     direction; then stand."""
 
-    to_offset: float = Field(
+    to_offset: b.Offset = Field(
         description="[m] lateral offset from the actor's lane centre to walk to, left "
         "positive; required."
     )
-    speed_kph: PosFloat = Field(default=5.0, description="[km/h] walking speed, > 0. Default 5.")
+    speed_kph: b.PosSpeed = Field(default=5.0, description="[km/h] walking speed, > 0. Default 5.")
 
 
 class StopActionModel(FormatModel):
     """Brake to a standstill, written `stop: {}`."""
 
-    decel: PosFloat = Field(
+    decel: b.Decel = Field(
         default=6.0, description="[m/s^2] braking deceleration, > 0. Default 6."
     )
 
@@ -465,7 +475,7 @@ class AcceleratorOverrideModel(FormatModel):
     reads and arbitrates (its speed limiter); the world adds no torque for it."""
 
     pedal: Fraction = Field(description="[-] pedal position 0..1; required.")
-    duration: PosFloat = Field(description="[s] how long, > 0; required.")
+    duration: b.Duration = Field(description="[s] how long, > 0; required.")
 
 
 class FlatTireModel(FormatModel):
@@ -518,11 +528,11 @@ class EventModel(FormatModel):
 class EgoModel(FormatModel):
     """The car under test. On a road: `lane` and `s`; in a town: `start` and `route`."""
 
-    lane: NonNegInt | None = Field(
+    lane: Annotated[int, Field(ge=0, le=b.MAX_LANES)] | None = Field(
         default=None,
         description="(road) starting lane, 0 = rightmost; must exist at `s`. Default 0.",
     )
-    s: NonNegFloat | None = Field(
+    s: b.Station | None = Field(
         default=None,
         description="[m] (road) station of the car's centre, on the route; required on a road.",
     )
@@ -531,18 +541,18 @@ class EgoModel(FormatModel):
         description="(town) `[ix, iy, heading]`: junction indices and east | north | west | "
         "south; required in a town.",
     )
-    route: list[Turn] | None = Field(
+    route: Annotated[list[Turn], Field(max_length=b.MAX_ROUTE_TURNS)] | None = Field(
         default=None,
         description="(town) what to do at each junction met: straight | left | right | u_turn; "
         "required in a town.",
     )
-    speed_kph: NonNegFloat = Field(
+    speed_kph: b.Speed = Field(
         default=0.0, description="[km/h] initial speed, >= 0, <= max_speed_kph. Default 0."
     )
-    set_speed_kph: NonNegFloat = Field(
+    set_speed_kph: b.Speed = Field(
         description="[km/h] the driver's desired (cruise) speed, >= 0, <= max_speed_kph; required."
     )
-    max_speed_kph: PosFloat = Field(
+    max_speed_kph: b.PosSpeed = Field(
         default=54.0,
         description="[km/h] vehicle speed limit, > 0. Default 54 (15 m/s, the ICCAS car).",
     )
@@ -572,24 +582,25 @@ class ActorModel(FormatModel):
         description="(road) lane index: 0 = rightmost of the ego's direction; -1, -2, ... "
         "oncoming lanes from the centre line out. Must exist at `s`. Default 0.",
     )
-    s: NonNegFloat | None = Field(
+    s: b.Station | None = Field(
         default=None,
         description="[m] (road) station of the actor's centre, on the route; required on a road.",
     )
-    offset: float = Field(
+    offset: b.Offset = Field(
         default=0.0,
         description="[m] lateral offset from the lane centre, left positive. Default 0.",
     )
     start: TownStart | None = Field(
         default=None, description="(town) `[ix, iy, heading]` as for the ego."
     )
-    route: list[Turn] | None = Field(default=None, description="(town) turns as for the ego.")
-    speed_kph: NonNegFloat = Field(
+    route: Annotated[list[Turn], Field(max_length=b.MAX_ROUTE_TURNS)] | None = Field(
+        default=None, description="(town) turns as for the ego.")
+    speed_kph: b.Speed = Field(
         default=0.0,
         description="[km/h] initial speed, >= 0; an obstacle must not move. Default 0.",
     )
     actions: list[ActionModel] = Field(
-        default_factory=list,
+        default_factory=list, max_length=b.MAX_ACTIONS,
         description="Scripted actions, each fires once when its trigger first holds. "
         "Default none: the actor keeps its lane and speed.",
     )
@@ -626,11 +637,11 @@ class GnssModel(FormatModel):
         "heading from motion, outages) or `degraded` (3 m, 30 s, 0.8 m, frequent "
         "outages). Default: `rtk` when knobs are given, else `consumer`.",
     )
-    sigma: NonNegFloat | None = Field(
+    sigma: Annotated[float, Field(ge=0, le=MAX_GNSS_BIAS)] | None = Field(
         default=None, description="[m] 1-sigma white position noise per axis, >= 0. "
         "Default: the preset's (rtk 0.05, consumer 0.3, degraded 0.8)."
     )
-    heading_sigma_deg: NonNegFloat | None = Field(
+    heading_sigma_deg: b.HeadingSigma | None = Field(
         default=None, description="[deg] 1-sigma heading noise, >= 0. Default: the "
         "preset's (rtk 0.2, consumer 0.3, degraded 1.0)."
     )
@@ -644,20 +655,20 @@ class GnssModel(FormatModel):
         default=None, description="[m] stationary 1-sigma of the wandering (Gauss-Markov) "
         "bias per axis, 0..50. Default: the preset's (rtk 0, consumer 1.2, degraded 3)."
     )
-    bias_tau: PosFloat | None = Field(
+    bias_tau: b.Duration | None = Field(
         default=None, description="[s] correlation time of the wandering bias, > 0. "
         "Default: the preset's (60, degraded 30)."
     )
-    velocity_sigma: NonNegFloat | None = Field(
+    velocity_sigma: b.VelocitySigma | None = Field(
         default=None, description="[m/s] 1-sigma velocity noise; > 0: the heading is the "
         "course over ground, noisier at low speed, none at a standstill. Default: the "
         "preset's (rtk 0, consumer 0.15, degraded 0.3)."
     )
-    dropout_rate: NonNegFloat | None = Field(
+    dropout_rate: b.DropoutRate | None = Field(
         default=None, description="[1/s] outages started per second, >= 0. Default: the "
         "preset's (rtk 0, consumer 1/300, degraded 1/30)."
     )
-    dropout_duration: PosFloat | None = Field(
+    dropout_duration: b.Duration | None = Field(
         default=None, description="[s] mean length of an outage, > 0. Default: the "
         "preset's (2, degraded 3)."
     )
@@ -667,7 +678,7 @@ class LidarModel(FormatModel):
     """LiDAR noise (the beam layout comes from `--profile`); keys left out take their
     defaults."""
 
-    range_sigma: NonNegFloat = Field(
+    range_sigma: b.RangeSigma = Field(
         default=0.02, description="[m] 1-sigma range noise, >= 0. Default 0.02."
     )
     dropout: Fraction = Field(
@@ -733,8 +744,8 @@ class ScenarioModel(FormatModel):
         description="normal_driving | lane_change | cut_in_out | traffic_jam | sudden_stop | "
         "external_disturbance | decs_route | town | other. Default other.",
     )
-    duration: PosFloat = Field(description="[s] simulated time limit, > 0; required.")
-    seed: NonNegInt = Field(default=0, description="Random seed, >= 0. Default 0.")
+    duration: b.Duration = Field(description="[s] simulated time limit, > 0; required.")
+    seed: b.Seed = Field(default=0, description="Random seed, >= 0. Default 0.")
     road: RoadModel | None = Field(
         default=None, description="Map kind 1, a route road; give this or `town`."
     )
@@ -744,14 +755,14 @@ class ScenarioModel(FormatModel):
     )
     ego: EgoModel = Field(description="The car under test; required.")
     actors: list[ActorModel] = Field(
-        default_factory=list, description="Other road users. Default none."
+        default_factory=list, max_length=b.MAX_ACTORS, description="Other road users. Default none."
     )
     sensors: SensorsModel = Field(
         default_factory=SensorsModel,
         description="Sensor noise; keys left out come from `--profile`. Default: the profile's.",
     )
     events: list[EventModel] = Field(
-        default_factory=list,
+        default_factory=list, max_length=b.MAX_EVENTS,
         description="What happens to the ego car. Default none. `flat_tire` is not supported "
         "yet.",
     )

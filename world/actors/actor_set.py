@@ -4,7 +4,8 @@ NPCs are kinematic: static (mass 0) boxes, placed at `ACTOR_RATE`
 (`world.core.rates`) from their `NpcMotion` in route coordinates. The ego collides with them
 like with a wall, and contact queries see them. (Only the ego must drive through its joints;
 NPCs are scripted traffic.) A vehicle's box is its catalogue model's (`world.actors.catalogue`:
-the actor's `model`, else its type's default); a pedestrian's and an obstacle's are `SIZES`.
+the actor's `model`, else its type's default); a pedestrian's and an obstacle's are
+`world.actors.bodies.SIZES`.
 Pedestrians are boxes too, placed by station and offset from
 their lane's centre like any actor; their speed is a walking speed along the lane, and the
 `walk` action moves them across the road, facing where they walk.
@@ -27,46 +28,14 @@ from numpy.typing import NDArray
 from pybullet_utils.bullet_client import BulletClient
 
 from world.actors.behaviour import NpcMotion, TriggerContext
-from world.actors.catalogue import CATALOGUE, DEFAULT_MODEL, VehicleClass, VehicleModel
+from world.actors.bodies import VEHICLES, BoxSize, body_size, vehicle_of
+from world.actors.catalogue import CATALOGUE, DEFAULT_MODEL, VehicleClass
 from world.actors.town_traffic import TownDriver
 from world.hdmap import RoadMap
 from world.map.road import build_road_map
 from world.map.signals import route_signals
 from world.scene.collision import Box, CollisionShapes, Part
 from world.spec import ActorSpec, ActorType
-
-
-@dataclass(frozen=True, slots=True)
-class BoxSize:
-    """An actor's box."""
-
-    length: float  # [m]
-    width: float  # [m]
-    height: float  # [m]
-
-
-SIZES = {  # the bodies that are not vehicles (those are catalogue models)
-    ActorType.OBSTACLE: BoxSize(1.0, 1.0, 1.0),  # [m] length, width, height: a crate / block
-    ActorType.PEDESTRIAN: BoxSize(0.5, 0.6, 1.75),
-}
-VEHICLES = (ActorType.CAR, ActorType.TRUCK)
-
-
-def vehicle_of(spec: ActorSpec) -> VehicleModel | None:
-    """The catalogue model of a vehicle actor (its own, else its type's default); None for a
-    pedestrian or an obstacle."""
-    if spec.type not in VEHICLES:
-        return None
-    return spec.model if spec.model is not None else CATALOGUE[DEFAULT_MODEL[spec.type.value]]
-
-
-def body_size(spec: ActorSpec) -> BoxSize:
-    """[m] the box of an actor's body."""
-    model = vehicle_of(spec)
-    if model is None:
-        return SIZES[spec.type] if spec.size is None else BoxSize(*spec.size)
-    return BoxSize(model.length, model.width, model.height)
-
 
 COLOURS = {  # [-] RGBA
     ActorType.CAR: (0.85, 0.20, 0.15, 1.0),

@@ -204,6 +204,11 @@ BAD: dict[str, tuple[str, str]] = {
     ),
     "model_on_pedestrian": ("actors.0.model", "only a car or truck takes a model"),
     "model_type_mismatch": ("actors.0.model", "a semi_trailer needs type: truck, not car"),
+    "actor_overlaps_ego": ("actors.1", "overlaps the ego at s = 22 m"),
+    "actors_overlap": ("actors.1", "overlaps actors.0 (lead) at s = 63 m"),
+    "too_many_lanes": ("road.lanes", "must be <= 6, got 500"),
+    "route_too_long": ("road.segments", "the route is 22854 m long: at most 20000 m"),
+    "duration_too_long": ("duration", "must be <= 7200"),
     "grid_too_big": ("grid", "1089 points: at most 1000"),
     "grid_varies_grid": ("grid", "'grid.x': a grid cannot vary this key"),
     "grid_empty_values": ("grid.ego.speed_kph", "must have at least 1 item(s), got 0"),
@@ -542,3 +547,13 @@ def test_plain_numbers_read_by_yaml_1_2(tmp_path: Path) -> None:
 ])
 def test_a_value_reads_by_the_core_schema(text: str, value: object) -> None:
     assert parse_value(text) == value
+
+
+def test_doc_gives_every_bound() -> None:
+    """Every size a file can ask for has its bound in the docs (issue L)."""
+    from avsim.scenario import bounds
+
+    doc = DOC.read_text(encoding="utf-8")
+    for name in dir(bounds):
+        if name.startswith("MAX_"):
+            assert f"`{name}`" in doc, name

@@ -12,7 +12,7 @@ import pytest
 from avsim.scenario.load import load_scenario
 from perception.messages import ObjectClass
 from perception.objects import DetectorParams, ObjectDetector, SizePrior
-from world.actors.actor_set import SIZES
+from world.actors.bodies import SIZES
 from world.actors.catalogue import (
     CATALOGUE,
     DEFAULT_MODEL,
