@@ -19,6 +19,7 @@ from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.table import Table
 
 from avsim.files import write_atomic
+from avsim.run.interrupts import Interrupts
 from avsim.run.result import dumps, result_json
 from avsim.scenario.load import ScenarioError, bundled_scenarios, load_scenario
 from avsim.scenario.profile_fit import check_profile
@@ -117,16 +118,21 @@ def run(scenario: str, out: Path | None, json_path: Path | None, profile: str, s
 
     out.parent.mkdir(parents=True, exist_ok=True)
     partial = out.with_name(f".{out.name}.partial")
-    runner = Runner(loaded, partial, None if profile == "none" else Profile(profile), sensing)
-    result = _run_with_progress(runner, loaded.duration, not no_progress)
-    partial.replace(out)
-    payload = result_json(result, scenario, out, profile)
-    write_atomic(json_path, dumps(payload))
-    if plot_path is not None:
-        from avsim.report.speed_plot import plot_speed_profile
+    with Interrupts() as stop:  # Ctrl-C / SIGTERM end the run at its tick, files kept
+        runner = Runner(loaded, partial, None if profile == "none" else Profile(profile),
+                        sensing)
+        stop.on_signal(runner.interrupt)
+        result = _run_with_progress(runner, loaded.duration, not no_progress)
+        partial.replace(out)
+        payload = result_json(result, scenario, out, profile)
+        write_atomic(json_path, dumps(payload))
+        if plot_path is not None:
+            from avsim.report.speed_plot import plot_speed_profile
 
-        plot_speed_profile(result, plot_path)
-    _print_verdict(payload)
+            plot_speed_profile(result, plot_path)
+        _print_verdict(payload)
+    if stop.exit_status is not None:
+        sys.exit(stop.exit_status)
     sys.exit(0 if result.passed else EXIT_FAILED)
 
 
@@ -145,7 +151,10 @@ def _run_with_progress(runner: Runner, duration: float, show: bool) -> RunResult
 def _print_verdict(payload: dict[str, object]) -> None:
     """The result file's verdict as a table of criteria, then the run's times and files."""
     console = Console()
-    table = Table(title=f"{payload['scenario']}: {'PASS' if payload['passed'] else 'FAIL'}")
+    verdict = "PASS" if payload["passed"] else "FAIL"
+    if payload.get("interrupted"):
+        verdict += f" so far (interrupted at {payload['sim_time']:.1f} s)"
+    table = Table(title=f"{payload['scenario']}: {verdict}")
     for column in ("criterion", "verdict", "value", "threshold", "unit"):
         table.add_column(column)
     criteria = payload["criteria"]

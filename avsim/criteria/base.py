@@ -158,6 +158,19 @@ class CriterionResult:
         return out
 
 
+def judged_so_far(results: list[CriterionResult], t: float) -> list[CriterionResult]:
+    """The results of a run interrupted at `t` [s]: what was judged so far stands (a pass
+    so far, a failure seen happen, which has its `first_failure`); a failure that only the
+    run's end would have settled (the goal not reached yet, an action not fired yet, no
+    standstill yet: no `first_failure`) could not be judged, and is not applicable."""
+    return [r if r.passed is not False or r.first_failure is not None else
+            CriterionResult.not_applicable(
+                r.name, r.threshold, r.unit,
+                f"not judged: the run was interrupted at {t:.2f} s"
+                + (f" ({r.note})" if r.note else ""))
+            for r in results]
+
+
 def _round(x: float | None) -> float | None:
     """x to 4 decimals (no -0.0); None as it is."""
     return None if x is None else round(x, 4) + 0.0

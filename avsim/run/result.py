@@ -28,6 +28,7 @@ def result_json(result: RunResult, file: str | Path, recording: Path, profile: s
         "profile": profile,
         "renderer": result.renderer,
         "passed": result.passed,
+        "interrupted": result.interrupted,
         "sim_time": round(result.sim_time, 4),
         "wall_time": round(result.wall_time, 3),
         "criteria": [c.as_json() for c in result.criteria],

@@ -37,6 +37,7 @@ from avsim.criteria.base import (
     Need,
     TruthSample,
     Verdict,
+    judged_so_far,
 )
 from avsim.criteria.collision import NoCollision
 from avsim.criteria.declaration import RunInputs
@@ -138,6 +139,8 @@ class RunResult:
     stage_times: dict[str, float] = field(default_factory=dict)  # [s] wall time per stage
     #   (`world.core.stopwatch`: where the run's time went; not part of the result file)
     story: tuple[StoryEntry, ...] = ()  # each scripted action and event, and when it fired
+    interrupted: bool = False  # stopped early by `Runner.interrupt` (a signal): the criteria
+    #   are those judged so far (`avsim.criteria.base.judged_so_far`)
 
     @property
     def passed(self) -> bool:
@@ -210,6 +213,12 @@ class Runner:
         self.state_changes: list[StateChange] = []
         self._touching: frozenset[int] = frozenset()
         self._last: StackOutput | None = None
+        self._interrupted = False
+
+    def interrupt(self) -> None:
+        """End the run at the current tick (safe from a signal handler): `run` closes the
+        recording and returns what was judged so far, marked interrupted."""
+        self._interrupted = True
 
     # -- the loop ------------------------------------------------------------------------------
 
@@ -224,7 +233,7 @@ class Runner:
         try:
             # one control period per pass: decide on this snapshot, then hold the command
             # on the joints for the period's physics steps (contacts watched at their rate)
-            while w.clock.step < steps:
+            while w.clock.step < steps and not self._interrupted:
                 self._tick()
                 self._period(steps)
                 if done_at is None and self._may_end():
@@ -242,14 +251,18 @@ class Runner:
             sim_time = w.t
             w.close()
         renderer = self.sensors.sensing.renderer
+        criteria = self.criteria.results()
+        if self._interrupted:
+            criteria = judged_so_far(criteria, sim_time)
         return RunResult(
-            scenario=self.scenario, criteria=self.criteria.results(), metrics=self._metrics(),
+            scenario=self.scenario, criteria=criteria, metrics=self._metrics(),
             sim_time=sim_time, wall_time=time.perf_counter() - start, log=self.log,
             recording=self.recorder.path if self.recorder else None,
             state_changes=tuple(self.state_changes), infractions=tuple(self.infractions),
             profile=self.setup.profile.value if self.setup is not None else None,
             renderer=renderer.value if renderer is not None else None,
             stage_times=dict(watch.seconds), story=self.story.now(),
+            interrupted=self._interrupted,
         )
 
     def _period(self, steps: int) -> None:

@@ -13,6 +13,7 @@ llvmpipe splits the frame into tiles, not the work on a pixel.
 from __future__ import annotations
 
 import os
+import signal
 from multiprocessing.connection import Connection
 from typing import Any
 
@@ -22,6 +23,8 @@ def main(conn: Connection, spec: Any, setup: Any, slots_file: Any, render_thread
     """Serve `conn` (`world.sensors.pipeline.serve`) in the environment `environ` and the
     directory `cwd` of the process that started the worker (a forked worker has its
     forkserver's otherwise)."""
+    for sig in (signal.SIGINT, signal.SIGTERM):  # the main process ends the run and then
+        signal.signal(sig, signal.SIG_IGN)  # the worker (Ctrl-C reaches the whole group)
     os.environ.clear()
     os.environ.update(environ)
     os.chdir(cwd)

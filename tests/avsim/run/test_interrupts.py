@@ -1,0 +1,99 @@
+"""Interrupted runs keep what they recorded (issue L 1): SIGINT / SIGTERM end `avsim run` at
+its tick with a valid recording at the path asked for, a result that says it was
+interrupted and holds what was judged so far, exit 130 / 143, and no temporary file left."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from avsim.criteria.base import CriterionResult, judged_so_far
+from avsim.run.interrupts import Interrupts
+
+REPO = Path(__file__).resolve().parents[3]
+RERUN = Path(sys.executable).parent / "rerun"
+
+
+def test_what_was_judged_stands_and_what_the_end_would_settle_is_not_applicable() -> None:
+    results = [
+        CriterionResult("no_collision", True, 0.0, 0.0, "contacts"),
+        CriterionResult("speed_limit", False, 3.0, 1.0, "km/h", first_failure=4.5),
+        CriterionResult("completes", False, 120.0, 500.0, "m"),
+        CriterionResult("story", False, 1.0, 0.0, "actions", note="never fired: events.0"),
+        CriterionResult.not_applicable("stop_signs", 1.0, "s", "no stop line on the route"),
+    ]
+    judged = judged_so_far(results, 12.345)
+    assert judged[:2] == results[:2]
+    assert judged[4] == results[4]
+    assert [(r.passed, r.value, r.note) for r in judged[2:4]] == [
+        (None, None, "not judged: the run was interrupted at 12.35 s"),
+        (None, None, "not judged: the run was interrupted at 12.35 s (never fired: events.0)")]
+
+
+def test_a_signal_is_recorded_and_calls_back_and_the_handlers_come_back() -> None:
+    before = signal.getsignal(signal.SIGTERM)
+    calls: list[str] = []
+    with Interrupts() as stop:
+        stop.on_signal(lambda: calls.append("first"))
+        os.kill(os.getpid(), signal.SIGTERM)
+        stop.on_signal(lambda: calls.append("late"))  # registered after: called at once
+        assert stop.exit_status == 143
+    assert calls == ["first", "late"]
+    assert signal.getsignal(signal.SIGTERM) is before
+
+
+def _interrupted_run(tmp_path: Path, profile: str, sig: signal.Signals,
+                     group: bool) -> tuple[subprocess.CompletedProcess[str], Path]:
+    """`avsim run normal_driving` into tmp_path, sent `sig` 3 s after its recording opened
+    (to its process group when `group`, as Ctrl-C at a terminal is)."""
+    out = tmp_path / "run" / "nd.rrd"
+    env = {**os.environ, "PYTHONPATH": str(REPO)}
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "avsim.cli", "run", "normal_driving", "--out", str(out),
+         "--profile", profile, "--plot", "--no-progress"],
+        cwd=tmp_path, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        start_new_session=True)
+    partial = out.with_name(f".{out.name}.partial")
+    deadline = time.monotonic() + 120
+    while not partial.exists() and proc.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.2)
+    time.sleep(3.0)
+    if group:
+        os.killpg(proc.pid, sig)
+    else:
+        proc.send_signal(sig)
+    stdout, stderr = proc.communicate(timeout=120)
+    return subprocess.CompletedProcess(proc.args, proc.returncode, stdout, stderr), out
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(("profile", "sig", "group", "status"), [
+    ("fast", signal.SIGINT, True, 130),  # Ctrl-C: the sensing worker gets it too
+    ("none", signal.SIGTERM, False, 143),
+])
+def test_an_interrupted_run_keeps_its_recording_and_result(
+        tmp_path: Path, profile: str, sig: signal.Signals, group: bool, status: int) -> None:
+    done, out = _interrupted_run(tmp_path, profile, sig, group)
+    assert done.returncode == status, done.stderr
+    assert "Traceback" not in done.stderr
+    result = json.loads(out.with_suffix(".json").read_text(encoding="utf-8"))
+    assert result["interrupted"] is True
+    assert 0.0 < result["sim_time"] < 100.0  # normal_driving runs 110 s
+    verdicts = {c["name"]: c for c in result["criteria"]}
+    assert verdicts["no_collision"]["verdict"] == "pass"  # judged so far
+    completes = verdicts["completes"]  # the goal was not reached: the end would settle it
+    assert completes["verdict"] == "not_applicable"
+    assert completes["note"].startswith("not judged: the run was interrupted at")
+    assert "so far (interrupted at" in done.stdout
+    assert out.with_suffix(".png").is_file()
+    check = subprocess.run([str(RERUN), "rrd", "verify", str(out)], capture_output=True,
+                           text=True, check=False)
+    assert check.returncode == 0, check.stderr
+    assert sorted(p.name for p in out.parent.iterdir()) == ["nd.json", "nd.png", "nd.rrd"]
