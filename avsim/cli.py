@@ -230,9 +230,10 @@ def suite(paths: tuple[str, ...], out: Path, jobs: int | None, executor: str,
         planned = batch.plan(entries, out, profile)
     except (ScenarioError, batch.BatchError) as exc:
         _bad_input(str(exc))
-    outcomes = _execute(planned, executor, jobs, address)
-    _report(outcomes, out, f"avsim suite ({len(outcomes)} runs)", snapshots)
-    sys.exit(batch.exit_status(outcomes))
+    with Interrupts() as stop:  # Ctrl-C / SIGTERM: finished runs and reports are kept
+        outcomes = _execute(planned, executor, jobs, address, stop)
+        _report(outcomes, out, f"avsim suite ({len(outcomes)} runs)", snapshots)
+    sys.exit(stop.exit_status or batch.exit_status(outcomes))
 
 
 @main.command()
@@ -270,15 +271,16 @@ def sweep(scenario: str, sets: tuple[str, ...], params: tuple[str, ...], out: Pa
         planned = batch.plan(entries, out, profile)
     except (ScenarioError, SweepError, batch.BatchError) as exc:
         _bad_input(str(exc))
-    outcomes = _execute(planned, executor, jobs, address)
-    _report(outcomes, out, f"avsim sweep {name} ({len(outcomes)} runs)", snapshots)
-    _sweep_report(outcomes, out, [a.path for a in axes if len(a.values) > 1],
-                  [a.path for a in axes], metric, name)
-    sys.exit(batch.exit_status(outcomes))
+    with Interrupts() as stop:  # Ctrl-C / SIGTERM: finished runs and reports are kept
+        outcomes = _execute(planned, executor, jobs, address, stop)
+        _report(outcomes, out, f"avsim sweep {name} ({len(outcomes)} runs)", snapshots)
+        _sweep_report(outcomes, out, [a.path for a in axes if len(a.values) > 1],
+                      [a.path for a in axes], metric, name)
+    sys.exit(stop.exit_status or batch.exit_status(outcomes))
 
 
 def _execute(planned: Sequence[RunJob], executor: str, jobs: int | None,
-             address: str | None) -> list[RunOutcome]:
+             address: str | None, stop: Interrupts) -> list[RunOutcome]:
     """Run the planned jobs on the chosen executor (`--jobs` default: this machine's cores)."""
     from avsim.batch import suite as batch
     from avsim.batch.executors import ExecutorError, LocalExecutor, RayExecutor
@@ -287,7 +289,7 @@ def _execute(planned: Sequence[RunJob], executor: str, jobs: int | None,
     runner: LocalExecutor | RayExecutor = (
         LocalExecutor(workers) if executor == "local" else RayExecutor(address, jobs))
     try:
-        return batch.execute(planned, runner)
+        return batch.execute(planned, runner, stop)
     except ExecutorError as exc:
         _bad_input(str(exc))
 

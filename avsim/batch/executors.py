@@ -24,9 +24,11 @@ from starting a long run while the others idle.
 
 from __future__ import annotations
 
+import contextlib
 import multiprocessing as mp
 import os
 import queue
+import signal
 import tempfile
 from collections.abc import Callable, Sequence
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
@@ -34,8 +36,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Protocol
 
-from avsim.batch.jobs import RunJob, RunOutcome, Status, run_job
+from avsim.batch.jobs import RunJob, RunOutcome, Status, not_run, run_job
 from avsim.files import write_atomic
+from avsim.run.interrupts import Interrupts
 
 POLL = 0.2  # [s] how often the display is refreshed while runs are under way
 PROGRESS_EVERY = 1.0  # [s] of simulated time between a worker's progress messages
@@ -71,8 +74,10 @@ class Executor(Protocol):
 
     name: str  # as `--executor` names it
 
-    def run(self, jobs: Sequence[RunJob], sink: ProgressSink | None = None) -> list[RunOutcome]:
-        """Run every job; the outcomes in job order."""
+    def run(self, jobs: Sequence[RunJob], sink: ProgressSink | None = None,
+            stop: Interrupts | None = None) -> list[RunOutcome]:
+        """Run every job; the outcomes in job order (after a signal caught by `stop`: the
+        finished runs', the interrupted ones' and `not_run` for the rest)."""
         ...
 
 
@@ -102,10 +107,30 @@ class _QueueProgress:
             self.sink.put(Progress(self.name, t, duration))
 
 
-def _local_task(job: RunJob, messages: Any) -> RunOutcome:
-    """A worker's task: say the job started (its name on the queue), then run it."""
-    messages.put(job.name)  # started
-    return run_job(job, progress=_QueueProgress(job.name, messages))
+def _ignore_sigint() -> None:
+    """A pool worker's initializer: Ctrl-C (which reaches the whole process group) is for
+    the main process to handle; a worker running a job catches it itself (`_local_task`)."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+@dataclass(frozen=True)
+class Channel:
+    """What a local worker's task shares with the batch (manager proxies: picklable)."""
+
+    messages: Any  # a queue: (job name, worker process id) when a run starts, `Progress`
+    stopping: Any  # an event: set once the batch stops (a task taken after it does not run)
+
+
+def _local_task(job: RunJob, channel: Channel) -> RunOutcome:
+    """A worker's task: unless the batch is stopping, say the job started (its name and
+    this process's id on the queue), then run it; SIGINT or SIGTERM meanwhile end the run at
+    its tick, files kept."""
+    if channel.stopping.is_set():
+        return not_run(job)
+    with Interrupts() as stop:
+        channel.messages.put((job.name, os.getpid()))  # started
+        return run_job(job, progress=_QueueProgress(job.name, channel.messages),
+                       interrupts=stop)
 
 
 def died(job: RunJob, exc: BaseException) -> RunOutcome:
@@ -127,82 +152,116 @@ class LocalExecutor:
 
     jobs: int = 1  # worker processes
     name: str = "local"
-    task: Callable[[RunJob, Any], RunOutcome] = _local_task  # what a worker runs (tests)
+    task: Callable[[RunJob, Channel], RunOutcome] = _local_task  # what a worker runs (tests)
 
-    def run(self, jobs: Sequence[RunJob], sink: ProgressSink | None = None) -> list[RunOutcome]:
+    def run(self, jobs: Sequence[RunJob], sink: ProgressSink | None = None,
+            stop: Interrupts | None = None) -> list[RunOutcome]:
         """Run every job, longest first, in rounds of pools (class doc); outcomes in job
-        order."""
+        order. Once `stop` has caught a signal, no run starts, the runs under way end at
+        their tick (their workers get SIGINT; their files are written) and the rest are
+        `not_run`."""
         ctx = mp.get_context("forkserver")
         ctx.set_forkserver_preload(PRELOAD)
         outcomes: list[RunOutcome] = []
         todo = longest_first(jobs)
         with ctx.Manager() as manager:
-            messages = manager.Queue()
-            while todo:
-                started: set[str] = set()
-                done, lost = self._pool(ctx, todo, self.jobs, messages, started, sink)
+            messages = Channel(manager.Queue(), manager.Event())
+            while todo and not _stopped(stop):
+                started: dict[str, int] = {}
+                done, lost = self._pool(ctx, todo, self.jobs, messages, started, sink, stop)
                 outcomes += done
+                if _stopped(stop):  # a pool broken while stopping: its runs are not rerun
+                    outcomes += [_tell(sink, not_run(j)) for j, _ in lost]
+                    todo = []
+                    break
                 suspects = [j for j, _ in lost if j.name in started] or [j for j, _ in lost]
                 todo = [j for j, _ in lost if j not in suspects]
                 for job in suspects:
-                    outcomes.append(self._alone(ctx, job, messages, sink))
+                    outcomes.append(self._alone(ctx, job, messages, sink, stop))
+            outcomes += [_tell(sink, not_run(j)) for j in todo]
         return _in_job_order(jobs, outcomes)
 
-    def _alone(self, ctx: Any, job: RunJob, messages: Any,
-               sink: ProgressSink | None) -> RunOutcome:
+    def _alone(self, ctx: Any, job: RunJob, messages: Channel, sink: ProgressSink | None,
+               stop: Interrupts | None) -> RunOutcome:
         """Run `job` in a pool of its own: its outcome, or `died` if it breaks this one too."""
-        done, lost = self._pool(ctx, [job], 1, messages, set(), sink)
+        if _stopped(stop):
+            return _tell(sink, not_run(job))
+        done, lost = self._pool(ctx, [job], 1, messages, {}, sink, stop)
         if done:
             return done[0]
-        outcome = died(job, lost[0][1])
-        if sink is not None:
-            sink.finished(outcome)
-        return outcome
+        return _tell(sink, not_run(job) if _stopped(stop) else died(job, lost[0][1]))
 
-    def _pool(self, ctx: Any, jobs: Sequence[RunJob], workers: int, messages: Any,
-              started: set[str], sink: ProgressSink | None,
+    def _pool(self, ctx: Any, jobs: Sequence[RunJob], workers: int, messages: Channel,
+              started: dict[str, int], sink: ProgressSink | None, stop: Interrupts | None,
               ) -> tuple[list[RunOutcome], list[tuple[RunJob, BaseException]]]:
         """Run `jobs` in one pool: the outcomes, and the jobs lost when a worker died (with
-        the error). `started` collects the names of the runs that began."""
+        the error). `started` collects the runs that began: name -> worker process id."""
         outcomes: list[RunOutcome] = []
         lost: list[tuple[RunJob, BaseException]] = []
         by_name = {j.name: j for j in jobs}
+        signalled: set[str] = set()  # the runs told to end (stopping)
         with ProcessPoolExecutor(max_workers=min(workers, len(jobs)), mp_context=ctx,
-                                 max_tasks_per_child=1) as pool:
+                                 max_tasks_per_child=1, initializer=_ignore_sigint) as pool:
             futures = {pool.submit(self.task, job, messages): job for job in jobs}
             pending: set[Future[RunOutcome]] = set(futures)
             while pending:
                 done, pending = wait(pending, timeout=POLL, return_when=FIRST_COMPLETED)
-                _drain(messages, by_name, sink, started)
+                _drain(messages.messages, by_name, sink, started)
+                if _stopped(stop):
+                    messages.stopping.set()  # the tasks already queued to workers
+                    for future in pending:
+                        future.cancel()  # those not yet under way
+                    _end_runs(started, signalled)
                 for future in done:
-                    exc = future.exception()
-                    if exc is not None:
-                        lost.append((futures[future], exc))
-                        continue
-                    outcomes.append(future.result())
-                    if sink is not None:
-                        sink.finished(outcomes[-1])
-        _drain(messages, by_name, sink, started)
+                    job = futures[future]
+                    if future.cancelled():
+                        outcomes.append(_tell(sink, not_run(job)))
+                    elif (exc := future.exception()) is not None:
+                        lost.append((job, exc))
+                    else:
+                        outcomes.append(_tell(sink, future.result()))
+        _drain(messages.messages, by_name, sink, started)
         return outcomes, lost
 
 
+def _stopped(stop: Interrupts | None) -> bool:
+    """A signal has asked the batch to stop."""
+    return stop is not None and stop.received is not None
+
+
+def _end_runs(started: dict[str, int], signalled: set[str]) -> None:
+    """SIGINT to the worker of each run under way not yet told: it ends at its tick."""
+    for name, pid in started.items():
+        if name not in signalled:
+            signalled.add(name)
+            with contextlib.suppress(ProcessLookupError):
+                os.kill(pid, signal.SIGINT)
+
+
+def _tell(sink: ProgressSink | None, outcome: RunOutcome) -> RunOutcome:
+    """Report a finished outcome to the sink; the outcome."""
+    if sink is not None:
+        sink.finished(outcome)
+    return outcome
+
+
 def _drain(messages: Any, jobs: dict[str, RunJob], sink: ProgressSink | None,
-           started: set[str]) -> None:
-    """Pass the queued messages on to the sink: a job name is a start (also noted in
-    `started`), a `Progress` an advance."""
+           started: dict[str, int]) -> None:
+    """Pass the queued messages on to the sink: a (job name, worker process id) is a start
+    (also noted in `started`), a `Progress` an advance."""
     while True:
         try:
             message = messages.get_nowait()
         except queue.Empty:
             return
-        if not isinstance(message, Progress):
-            started.add(message)
-        if sink is None:
-            continue
         if isinstance(message, Progress):
-            sink.advanced(message)
-        else:
-            sink.started(jobs[message])
+            if sink is not None:
+                sink.advanced(message)
+            continue
+        name, pid = message
+        started[name] = pid
+        if sink is not None:
+            sink.started(jobs[name])
 
 
 # ---- Ray -----------------------------------------------------------------------------------
@@ -226,22 +285,24 @@ class RayExecutor:
     jobs: int | None = None  # CPUs of the local instance (None: all of this machine's)
     name: str = "ray"
 
-    def run(self, jobs: Sequence[RunJob], sink: ProgressSink | None = None) -> list[RunOutcome]:
+    def run(self, jobs: Sequence[RunJob], sink: ProgressSink | None = None,
+            stop: Interrupts | None = None) -> list[RunOutcome]:
         """Run every job as a Ray task (starting and stopping Ray if it is not running);
-        outcomes in job order."""
+        outcomes in job order. Once `stop` has caught a signal the tasks not finished are
+        cancelled (`not_run`; a task's files come back only when it finishes)."""
         ray = _import_ray()
         address = self.address or os.environ.get("RAY_ADDRESS") or None
         started_here = not ray.is_initialized()
         if started_here:
             _ray_init(ray, address, self.jobs)
         try:
-            return self._run(ray, jobs, sink)
+            return self._run(ray, jobs, sink, stop)
         finally:
             if started_here:
                 ray.shutdown()
 
-    def _run(self, ray: Any, jobs: Sequence[RunJob],
-             sink: ProgressSink | None) -> list[RunOutcome]:
+    def _run(self, ray: Any, jobs: Sequence[RunJob], sink: ProgressSink | None,
+             stop: Interrupts | None) -> list[RunOutcome]:
         """Submit every task, longest first; write each one's files here as it returns."""
         task = ray.remote(num_cpus=1, max_retries=0)(_ray_task)
         order = longest_first(jobs)
@@ -251,17 +312,24 @@ class RayExecutor:
                 sink.started(job)
         outcomes: list[RunOutcome] = []
         pending = list(refs)
+        cancelled = False
         while pending:
-            done, pending = ray.wait(pending, num_returns=1)
+            if _stopped(stop) and not cancelled:
+                cancelled = True
+                for ref in pending:
+                    ray.cancel(ref, force=True)
+            done, pending = ray.wait(pending, num_returns=1, timeout=POLL)
+            if not done:
+                continue
             job = refs[done[0]]
             try:
                 outcome, files = ray.get(done[0])
+            except ray.exceptions.TaskCancelledError:
+                outcome, files = not_run(job), {}
             except ray.exceptions.RayError as exc:  # the task's worker or node died
-                outcome, files = died(job, exc), {}
+                outcome, files = (not_run(job) if cancelled else died(job, exc)), {}
             _write_files(job.out_dir, files)
-            outcomes.append(outcome)
-            if sink is not None:
-                sink.finished(outcome)
+            outcomes.append(_tell(sink, outcome))
         return _in_job_order(jobs, outcomes)
 
 

@@ -23,6 +23,7 @@ from avsim.scenario.load import ScenarioError, load_scenario
 from avsim.scenario.profile_fit import check_profile
 
 if TYPE_CHECKING:
+    from avsim.run.interrupts import Interrupts
     from avsim.scenario.scenario import Scenario
 
 
@@ -33,6 +34,8 @@ class Status(Enum):
     FAILED = "failed"  # a criterion failed (exit 1)
     BAD_INPUT = "bad_input"  # the scenario or an override is invalid (exit 2)
     ERROR = "error"  # the run crashed (a bug): the message is the exception's last line
+    INTERRUPTED = "interrupted"  # the batch was interrupted (SIGINT / SIGTERM): the run
+    #   ended at its tick, its result judged so far, or it never started (no result)
 
 
 @dataclass(frozen=True, slots=True)
@@ -131,13 +134,22 @@ class RunOutcome:
 ProgressCallback = Callable[[float, float], None]  # (sim time, duration) [s]
 
 
+def not_run(job: RunJob) -> RunOutcome:
+    """The outcome of a job the batch's interruption kept from starting."""
+    return RunOutcome(job, Status.INTERRUPTED,
+                      error=f"{job.name}: not run (the batch was interrupted)")
+
+
 def run_job(job: RunJob, into: Path | None = None,
-            progress: ProgressCallback | None = None) -> RunOutcome:
+            progress: ProgressCallback | None = None,
+            interrupts: Interrupts | None = None) -> RunOutcome:
     """Run one job in this process (the worker's entry point); never raises.
 
     The files go to `into` when given (a worker's scratch folder on a cluster node, whose
     files the caller moves to ``job.out_dir``), else to ``job.out_dir``; the result names
-    the job's own paths either way. `progress` is called as the simulation advances."""
+    the job's own paths either way. `progress` is called as the simulation advances; a
+    signal caught by `interrupts` ends the run at its tick (`Status.INTERRUPTED`, its files
+    written)."""
     start = time.perf_counter()
     try:
         scenario = load_scenario(job.scenario, dict(job.overrides))
@@ -146,17 +158,18 @@ def run_job(job: RunJob, into: Path | None = None,
         return RunOutcome(job, Status.BAD_INPUT, error=str(exc),
                           wall_time=time.perf_counter() - start)
     try:
-        result = _simulate(job, scenario, into or job.out_dir, progress)
+        result = _simulate(job, scenario, into or job.out_dir, progress, interrupts)
     except Exception as exc:  # a crash is this run's outcome, not the batch's
         last = traceback.format_exception_only(exc)[-1].strip()
         return RunOutcome(job, Status.ERROR, error=f"{job.name}: {last}",
                           wall_time=time.perf_counter() - start)
-    status = Status.PASSED if result["passed"] else Status.FAILED
+    status = (Status.INTERRUPTED if result.get("interrupted") else
+              Status.PASSED if result["passed"] else Status.FAILED)
     return RunOutcome(job, status, result, wall_time=time.perf_counter() - start)
 
 
-def _simulate(job: RunJob, scenario: Scenario, into: Path,
-              progress: ProgressCallback | None) -> dict[str, object]:
+def _simulate(job: RunJob, scenario: Scenario, into: Path, progress: ProgressCallback | None,
+              interrupts: Interrupts | None) -> dict[str, object]:
     """Run the loaded scenario into `into`: the recording (renamed whole at the end), the
     result JSON and the plot; returns the result JSON."""
     from world.core.quiet import quiet_c_output
@@ -171,7 +184,10 @@ def _simulate(job: RunJob, scenario: Scenario, into: Path,
     recording = into / job.recording.name
     partial = into / f".{recording.name}.partial"
     profile = None if job.profile == "none" else Profile(job.profile)
-    result = Runner(scenario, partial, profile, job.sensing).run(progress)
+    runner = Runner(scenario, partial, profile, job.sensing)
+    if interrupts is not None:
+        interrupts.on_signal(runner.interrupt)
+    result = runner.run(progress)
     partial.replace(recording)
     payload = result_json(result, job.scenario, job.recording, job.profile)
     write_atomic(into / job.result_file.name, dumps(payload))

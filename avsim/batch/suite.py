@@ -24,6 +24,7 @@ from rich.progress import Progress as RichProgress
 from avsim.batch.executors import Executor, Progress
 from avsim.batch.jobs import RunJob, RunOutcome, Status
 from avsim.files import write_atomic
+from avsim.run.interrupts import Interrupts
 from avsim.run.result import dumps
 from avsim.scenario.load import bundled_scenarios, load_scenario
 from avsim.scenario.model import grid_paths
@@ -177,10 +178,12 @@ class LiveDisplay:
         self._bar.update(self._batch, advance=1, detail=f"{self._failed} not passed")
 
 
-def execute(jobs: Sequence[RunJob], executor: Executor) -> list[RunOutcome]:
-    """Run the jobs (longest first) with the live display; outcomes in job order."""
+def execute(jobs: Sequence[RunJob], executor: Executor,
+            stop: Interrupts | None = None) -> list[RunOutcome]:
+    """Run the jobs (longest first) with the live display; outcomes in job order (`stop`:
+    see `Executor.run`)."""
     with LiveDisplay(len(jobs)) as display:
-        return executor.run(jobs, display)
+        return executor.run(jobs, display, stop)
 
 
 # ---- reports -------------------------------------------------------------------------------

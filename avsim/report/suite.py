@@ -38,6 +38,7 @@ VERDICTS: dict[Status, tuple[str, str]] = {  # status -> (word, rich style)
     Status.FAILED: ("FAIL", "bold red"),
     Status.BAD_INPUT: ("BAD INPUT", "bold yellow"),
     Status.ERROR: ("ERROR", "bold magenta"),
+    Status.INTERRUPTED: ("INTERRUPTED", "bold yellow"),
 }
 _NO_SNAPSHOTS: Mapping[str, Path] = MappingProxyType({})  # an immutable empty default
 _MD_SPECIAL = re.compile(r"([\\`*_{}\[\]<>|])")  # escaped in free text of a table cell
@@ -259,10 +260,14 @@ def _header(outcomes: Sequence[RunOutcome], title: str) -> list[str]:
     passed, failed, errors = _counts(outcomes)
     sim = sum(_sim_time(o) for o in outcomes)
     wall = sum(o.wall_time for o in outcomes)
+    interrupted = sum(o.status is Status.INTERRUPTED for o in outcomes)
+    stopped = (f" · **interrupted**: {interrupted} runs ended early or never started"
+               if interrupted else "")
     return [
         f"# {title}", "",
         f"**{len(outcomes)} runs**: {passed} passed, {failed} failed, {errors} errors "
-        f"(did not finish) · sim time {format_value(sim)} s · wall time {format_value(wall)} s",
+        f"(did not finish) · sim time {format_value(sim)} s · wall time {format_value(wall)} s"
+        + stopped,
         "",
     ]
 

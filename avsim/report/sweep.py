@@ -192,7 +192,8 @@ def _annotation(outcome: RunOutcome | None, value: float) -> str:
     if outcome is None:
         return "no run"
     if outcome.result is None:
-        return "error" if outcome.status is Status.ERROR else "bad input"
+        return {Status.ERROR: "error", Status.INTERRUPTED: "not run"}.get(outcome.status,
+                                                                          "bad input")
     text = format_value(value)
     if outcome.status is Status.FAILED:
         contact = outcome.metric(CONTACT_METRIC) > 0  # NaN > 0 is False

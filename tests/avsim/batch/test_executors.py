@@ -3,15 +3,25 @@
 from __future__ import annotations
 
 import os
+import signal
 import sys
+import threading
+import time
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any
 
 import pytest
 
-from avsim.batch.executors import ExecutorError, LocalExecutor, RayExecutor, longest_first
-from avsim.batch.jobs import RunJob, RunOutcome, Status
+from avsim.batch.executors import (
+    Channel,
+    ExecutorError,
+    LocalExecutor,
+    Progress,
+    RayExecutor,
+    longest_first,
+)
+from avsim.batch.jobs import RunJob, RunOutcome, Status, not_run
+from avsim.run.interrupts import Interrupts
 
 
 def job(name: str, duration: float) -> RunJob:
@@ -33,26 +43,26 @@ def test_without_ray_the_ray_executor_says_how_to_get_it(
                               "(pip install 'avsim[ray]')")
 
 
-def _dies(job: RunJob, messages: Any) -> RunOutcome:
+def _dies(job: RunJob, channel: Channel) -> RunOutcome:
     """A worker task that says it started (as the real one does), then, for the job named
     `crashes`, ends its process as a crash in native code would."""
-    messages.put(job.name)
+    channel.messages.put((job.name, os.getpid()))
     if job.name == "crashes":
         os._exit(3)
     return RunOutcome(job, Status.PASSED, {"criteria": [], "metrics": {}, "sim_time": 1.0})
 
 
-def _dies_at_once(job: RunJob, messages: Any) -> RunOutcome:
+def _dies_at_once(job: RunJob, channel: Channel) -> RunOutcome:
     """As `_dies`, but the crash comes before the worker could say it started."""
     if job.name == "crashes":
         os._exit(3)
-    return _dies(job, messages)
+    return _dies(job, channel)
 
 
 @pytest.mark.parametrize("task", [_dies, _dies_at_once])
 @pytest.mark.parametrize("workers", [1, 2])
 def test_a_worker_that_dies_is_that_runs_error_not_the_batchs(
-    task: Callable[[RunJob, Any], RunOutcome], workers: int,
+    task: Callable[[RunJob, Channel], RunOutcome], workers: int,
 ) -> None:
     """The crashing run is the longest: it starts first and breaks the pool while the others
     wait or run; they finish all the same."""
@@ -65,3 +75,50 @@ def test_a_worker_that_dies_is_that_runs_error_not_the_batchs(
     assert crashed.result is None and crashed.error is not None
     assert crashed.error.startswith("crashes: the worker died")
     assert "\n" not in crashed.error
+
+
+def _slow(job: RunJob, channel: Channel) -> RunOutcome:
+    """A worker task that says it started, then "runs" for up to 30 s, ending early (at its
+    tick, as a run does) when its worker is told to stop; `quick` ends at once."""
+    if channel.stopping.is_set():
+        return not_run(job)
+    with Interrupts() as stop:
+        channel.messages.put((job.name, os.getpid()))
+        end = time.monotonic() + (0.0 if job.name == "quick" else 30.0)
+        while time.monotonic() < end and stop.received is None:
+            time.sleep(0.02)
+        interrupted = stop.received is not None
+        return RunOutcome(job, Status.INTERRUPTED if interrupted else Status.PASSED,
+                          {"criteria": [], "metrics": {}, "sim_time": 1.0,
+                           "interrupted": interrupted})
+
+
+def test_a_stopped_batch_ends_its_runs_at_their_tick_and_starts_no_more() -> None:
+    """A signal caught by the batch's `Interrupts` (set here from a timer, as its handler
+    would): the runs under way end early with their results, the waiting ones never start,
+    the finished one stands."""
+    jobs = [job("quick", 3.0), job("slow", 2.0), job("slower", 1.0), job("never", 0.5),
+            job("nor", 0.4)]
+    stop = Interrupts()
+
+    class StopOnceSlowStarts:  # the batch's sink: the signal comes 1 s after `slow` began
+        def started(self, job: RunJob) -> None:
+            if job.name == "slow":
+                threading.Timer(1.0, setattr, (stop, "received", signal.SIGTERM)).start()
+
+        def advanced(self, progress: Progress) -> None:
+            pass
+
+        def finished(self, outcome: RunOutcome) -> None:
+            pass
+
+    start = time.monotonic()
+    outcomes = LocalExecutor(2, task=_slow).run(jobs, StopOnceSlowStarts(), stop)
+    assert time.monotonic() - start < 25.0  # no run went its 30 s
+    assert [o.job.name for o in outcomes] == [j.name for j in jobs]
+    assert outcomes[0].status is Status.PASSED
+    assert all(o.status is Status.INTERRUPTED for o in outcomes[1:])
+    assert outcomes[1].result is not None and outcomes[1].result["interrupted"] is True
+    not_started = [o for o in outcomes[1:] if o.result is None]
+    assert not_started and all(o.error is not None and o.error.endswith(
+        "not run (the batch was interrupted)") for o in not_started)

@@ -97,3 +97,40 @@ def test_an_interrupted_run_keeps_its_recording_and_result(
                            text=True, check=False)
     assert check.returncode == 0, check.stderr
     assert sorted(p.name for p in out.parent.iterdir()) == ["nd.json", "nd.png", "nd.rrd"]
+
+
+@pytest.mark.slow
+def test_an_interrupted_sweep_keeps_its_finished_runs_and_reports(tmp_path: Path) -> None:
+    """Ctrl-C (SIGINT to the process group) once the first of three runs has finished: the
+    second ends at its tick with its files, the third never starts; the reports cover all
+    three; exit 130; no temporary file is left."""
+    out = tmp_path / "sweep"
+    env = {**os.environ, "PYTHONPATH": str(REPO)}
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "avsim.cli", "sweep", "normal_driving", "--set",
+         "seed=1,2,3", "--jobs", "1", "--profile", "none", "--out", str(out)],
+        cwd=tmp_path, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        start_new_session=True)
+    first = out / "normal_driving_000.json"
+    deadline = time.monotonic() + 300
+    while not first.exists() and proc.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.2)
+    time.sleep(4.0)  # the second run is under way
+    os.killpg(proc.pid, signal.SIGINT)
+    _, stderr = proc.communicate(timeout=300)
+    assert proc.returncode == 130, stderr
+    assert "Traceback" not in stderr
+    runs = json.loads((out / "results.json").read_text(encoding="utf-8"))
+    assert [r["status"] for r in runs][1:] == ["interrupted", "interrupted"]
+    assert runs[0]["status"] in ("passed", "failed") and not runs[0]["result"]["interrupted"]
+    assert runs[1]["result"]["interrupted"] is True  # ended at its tick, files written
+    assert runs[2]["result"] is None and runs[2]["error"].endswith("not run (the batch was "
+                                                                   "interrupted)")
+    assert (out / "junit.xml").is_file() and (out / "sweep.csv").is_file()
+    assert "**interrupted**: 2 runs" in (out / "summary.md").read_text(encoding="utf-8")
+    for name in ("normal_driving_000", "normal_driving_001"):
+        check = subprocess.run([str(RERUN), "rrd", "verify", str(out / f"{name}.rrd")],
+                               capture_output=True, text=True, check=False)
+        assert check.returncode == 0, check.stderr
+    assert not (out / "normal_driving_002.rrd").exists()
+    assert not [p for p in out.rglob(".*")], "a temporary file was left behind"
