@@ -333,6 +333,9 @@ class FakeRunner:
     def run(self, _progress: object = None) -> RunResult:
         return synthetic_result()
 
+    def interrupt(self) -> None:
+        raise AssertionError("no signal was sent")
+
 
 @pytest.fixture
 def fake_runner(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> Path:
