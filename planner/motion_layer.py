@@ -27,7 +27,8 @@ until its end. While a path is followed, the vehicle ahead in the lane kept (the
 lane) is the ACC's lead; the vehicle ahead in the origin lane is a lead too while the car's
 body (mirrors included) still overlaps that lane (`leads`): the car does not run into the
 vehicle it is leaving. On a pass (a change taken to pass a slower vehicle), the vehicle
-passed counts only while the path does not clear it (`clears`, below): the car does not
+passed counts only once the path does not clear it by ``pass_margin_keep`` (`clears`,
+below; a hysteresis below the margin a pass starts with): the car does not
 trail it through the pass (issue K, item 6), yet stops behind it rather than run into it if
 it does not get past. A change the route or a flat tyre asks for keeps trailing it (the car
 may be moving into that vehicle's path).
@@ -38,13 +39,16 @@ and the speed it wants), the path's centre is at least half the car's width + ha
 vehicle's width (across the road, from its track) + ``pass_margin`` from the vehicle's
 centre. (The front corners are then farther out still: the car heads away from it.) From a
 standstill the path is ``min_length`` long (`planner.lane_change_path`), which clears a car
-only from about 10 m behind; so with overtaking on, behind a (nearly) stationary vehicle that
+only from about 9 m behind; so with overtaking on, behind a (nearly) stationary vehicle that
 blocks the lane the car stops ``pass_gap`` back instead of at the ACC's standstill gap d0: the
 manoeuvre asks the ACC to keep ``room`` = ``pass_gap`` - d0 more (the room to pull out, as a
-driver leaves to see the tyres of the car ahead). Without overtaking, the ACC's d0 holds (UN
-R157 4.2.1: 2 to 6 m). Keeping right
-after a pass waits for a car behind in the right lane to be ``keep_right_gap`` back (a
-margin over the gap that aborts).
+driver leaves to see the tyres of the car ahead), as much of it as a stop at
+``room_decel`` still leaves. Without overtaking, the ACC's d0 holds (UN R157
+4.2.1: 2 to 6 m). From 2 to 6 m behind a car of the same width no forward path clears it
+(the turning circle): a pass from there waits for good.
+
+Keeping right after a pass waits for a car behind in the right lane to be
+``keep_right_gap`` back (a margin over the gap that aborts).
 
 At a town junction where the route turns, the turn is entered when the car's centre passes
 the stop line and done at the junction's exit (`RoadMap.junctions`); its path is the map's
@@ -95,9 +99,15 @@ class MotionLayerParams:
     mirrors: float = 0.1  # [m] how far each mirror stands out beyond the body's side
     prepare_distance: float = 150.0  # [m] a lane ending this near ahead is left ...
     prepare_time: float = 12.0  # [s] ... or this many seconds ahead at the present speed
-    pass_margin: float = 0.4  # [m] a pass path clears a vehicle by this, side to side
-    pass_gap: float = 10.0  # [m] with overtaking on, the gap kept behind a stationary vehicle
-    #   that blocks the lane: room for a pass path from a standstill to clear it
+    pass_margin: float = 0.4  # [m] a pass starts on a path that clears a vehicle by this,
+    #   side to side ...
+    pass_margin_keep: float = 0.2  # [m] ... and once under way, the vehicle passed is in
+    #   the way (a lead) only when the path clears it by less than this (hysteresis: the
+    #   track's box and gap wobble by tenths of a metre as the car moves past it)
+    pass_gap: float = 12.0  # [m] with overtaking on, the gap kept behind a stationary vehicle
+    #   that blocks the lane: room for a pass path from a standstill to clear it (by ~0.9 m)
+    room_decel: float = 2.5  # [m/s^2] the room is kept only as far as a stop at this
+    #   leaves it (below ISO 15622's 3.5 m/s^2: never a hard stop for it)
     stationary: float = 0.5  # [m/s] a vehicle slower than this is stationary
     keep_right_gap: float = 2.0  # [s] keeping right waits for this time gap to a car behind
     #   in the right lane (UN R157's t_G of 1 s aborts a change: the margin between the two
@@ -163,12 +173,9 @@ class MotionLayer:
             self.path = None  # the way back after an abort is done
             self.origin = self.lane
         changes = self.machine.apply(ego.t, change)
-        room_for = self._room_for(traffic, ego.speed, v_want)
+        room_for, room = self._room(traffic, ego.speed, v_want)
         return Manoeuvre(self.motion, self.lane, self.origin, self.path,
-                         self._leads(traffic, s, d, ego.speed),
-                         room=0.0 if room_for is None else
-                         max(self.params.pass_gap - self.acc.d0, 0.0),
-                         room_for=room_for), changes
+                         self._leads(traffic, s, d, ego.speed), room, room_for), changes
 
     @property
     def motion(self) -> Motion:
@@ -268,42 +275,46 @@ class MotionLayer:
             self.path = None
 
     def _plan_into(self, lane: int, ego: EgoState) -> LaneChangePath:
+        # the estimate of a standing car's speed may be a hair below 0
         return start_lane_change(self.road.lane(lane), lane, ego.x, ego.y, ego.heading,
-                                 ego.speed, self.params.lane_change)
+                                 max(ego.speed, 0.0), self.params.lane_change)
 
     def _leads(self, traffic: dict[int, LaneTraffic], s: float, d: float,
                v: float) -> tuple[Neighbour, ...]:
         """On a path: the vehicle ahead in the target lane, and the one ahead in the origin
         lane while the car's body still overlaps that lane; on a pass, only from the moment
-        the path does not clear it (`clears`) on (so that braking for it does not release
-        it: no chatter)."""
+        the path does not clear it by ``pass_margin_keep`` (`clears`) on (so that braking for
+        it does not release it: no chatter)."""
         if self.path is None:
             return ()
         leads = [n for n in (traffic[self.lane].ahead,) if n is not None] \
             if self.lane in traffic else []
+        p = self.params
         origin = self.road.lane(self.origin)
-        clear = 0.5 * float(origin.width_at(s)) + 0.5 * self.vehicle.width + self.params.mirrors
+        clear = 0.5 * float(origin.width_at(s)) + 0.5 * self.vehicle.width + p.mirrors
         left_behind = traffic[self.origin].ahead if self.origin in traffic else None
         if left_behind is not None and abs(d - float(origin.offset_at(s))) < clear and (
                 not self._passing or left_behind.track_id in self._near
-                or not self.clears(self.path, left_behind, s, v)):
+                or not self.clears(self.path, left_behind, s, v, p.pass_margin_keep)):
             self._near.add(left_behind.track_id)  # near once: a lead until the body is out
             leads.append(left_behind)
         return tuple(leads)
 
-    def clears(self, path: LaneChangePath, n: Neighbour, s: float, v: float) -> bool:
+    def clears(self, path: LaneChangePath, n: Neighbour, s: float, v: float,
+               margin: float | None = None) -> bool:
         """Whether the car, on `path` from its centre's station `s` [m] at speed `v` [m/s],
         clears vehicle `n` ahead in the lane it leaves: at the station where its front bumper
         reaches n's rear (n at its speed, the car at max(v, the speed it wants)), the path's
-        centre is half the car's width + n's half width + ``pass_margin`` from n's centre
-        (module doc)."""
+        centre is half the car's width + n's half width + `margin` (``pass_margin``) [m]
+        from n's centre (module doc)."""
         v_car = max(v, self._v_want)
         if v_car <= n.speed:
             return True  # it never reaches it
         meet = s + n.gap * v_car / (v_car - n.speed)
         target = self.road.lane(path.target_index)
         y = float(target.offset_at(meet)) + float(path.offset_at(meet))
-        need = 0.5 * self.vehicle.width + n.half_width + self.params.pass_margin
+        need = 0.5 * self.vehicle.width + n.half_width + (
+            self.params.pass_margin if margin is None else margin)
         return abs(y - n.offset) >= need
 
     def _pass_clears(self, ego: EgoState, s: float, lane: int,
@@ -314,17 +325,23 @@ class MotionLayer:
             return True
         return self.clears(self._plan_into(lane, ego), ahead, s, ego.speed)
 
-    def _room_for(self, traffic: dict[int, LaneTraffic], v: float,
-                  v_want: float) -> int | None:
+    def _room(self, traffic: dict[int, LaneTraffic], v: float,
+              v_want: float) -> tuple[int | None, float]:
         """The track id of a stationary vehicle blocking the lane kept, which the car may
-        pass (overtaking on, keeping its lane): the ACC keeps ``room`` more behind it."""
+        pass (overtaking on, keeping its lane), and the room [m] the ACC is to keep behind
+        it beyond d0: ``pass_gap`` - d0, or as much of it as a stop at ``room_decel`` from
+        speed `v` [m/s] still leaves (never a hard stop for it). As the car slows on a
+        gentler stop the room left grows, up to ``pass_gap`` - d0: the car stops as far back
+        as it comfortably can."""
+        p = self.params
         ahead = traffic[self.lane].ahead if self.lane in traffic else None
-        if (not self.params.overtake or self.motion is not Motion.LANE_KEEP or ahead is None
-                or ahead.speed >= self.params.stationary
-                or not is_blocked(traffic[self.lane], v, v_want, self.params.occupancy,
-                                  self.acc)):
-            return None
-        return ahead.track_id
+        if (not p.overtake or self.motion is not Motion.LANE_KEEP or ahead is None
+                or ahead.speed >= p.stationary
+                or not is_blocked(traffic[self.lane], v, v_want, p.occupancy, self.acc)):
+            return None, 0.0
+        comfortable = ahead.gap - self.acc.d0 - v * v / (2.0 * p.room_decel)
+        room = min(max(p.pass_gap - self.acc.d0, 0.0), max(comfortable, 0.0))
+        return ahead.track_id, room
 
 
 def _turn(junction: Junction | None) -> Turn | None:

@@ -231,13 +231,13 @@ def stopped_car(t: float, gap: float) -> Track:
     return car(t, 100.0 + VEHICLE.front_overhang + gap + 2.3, 0.0, 0.0, 7)
 
 
-@pytest.mark.parametrize(("gap", "passes"), [(10.0, True), (9.0, True), (6.0, False),
+@pytest.mark.parametrize(("gap", "passes"), [(12.0, True), (9.0, True), (6.0, False),
                                              (4.0, False)])
 def test_passes_a_stopped_car_from_a_standstill_only_with_room_to_pull_out(
         gap: float, passes: bool) -> None:
     """Standing behind a stopped car, the left lane free: the pass (a path of `min_length`)
     starts once `blocked_time` has passed if it clears the car, from the `pass_gap` the ACC
-    keeps behind it (10 m) but not from the ACC's d0 (4 m)."""
+    keeps behind it (12 m) and a little nearer, but not from the ACC's d0 (4 m)."""
     m = layer()
     motions = [m.update(standing(t, 100.0), V, [stopped_car(t, gap)])[0].motion
                for t in np.arange(0.0, 2.0, 0.025)]
@@ -260,11 +260,11 @@ def test_a_pass_from_a_standstill_waits_for_a_car_coming_up_behind() -> None:
 
 
 def test_keeps_room_behind_a_stationary_car_it_may_pass() -> None:
-    """Overtaking on, a stationary car blocking the lane: the ACC is to keep `pass_gap` (10
+    """Overtaking on, a stationary car blocking the lane: the ACC is to keep `pass_gap` (12
     m) instead of d0 (4 m) behind it; not without overtaking, nor behind a moving car."""
     acc = AccParams()
     man = layer().update(standing(0.0, 100.0), V, [stopped_car(0.0, 12.0)])[0]
-    assert man.room_for == 7 and man.room == pytest.approx(10.0 - acc.d0)
+    assert man.room_for == 7 and man.room == pytest.approx(12.0 - acc.d0)
     off = layer(overtake=False).update(standing(0.0, 100.0), V, [stopped_car(0.0, 12.0)])[0]
     assert off.room_for is None and off.room == 0.0
     moving = layer().update(ego(0.0, 100.0), V, [car(0.0, 140.0, 0.0, 5.56, 1)])[0]
