@@ -284,3 +284,16 @@ def test_a_flat_tyre_waits_for_the_car_behind_judged_at_the_speed_it_slows_to() 
     m = MotionLayer(ROAD, 1, AccParams(), VEHICLE, MotionLayerParams())
     man = m.update(fast_now, V, [rear], pull_over=True, v_rear=6.4)[0]
     assert man.motion is Motion.LANE_KEEP
+
+
+def test_keeping_right_yields_to_a_faster_car_behind_in_the_right_lane() -> None:
+    """In lane 1 with nothing ahead, the car keeps right at once; not while a car at 90 km/h
+    is 30 m behind in lane 0: it would have to brake at 5.3 m/s^2 (UN R157's rule, binding
+    here: the `keep_right_gap` of 2 s, 27.8 m, alone would let it go)."""
+    def first(tracks: list[Track]) -> Motion:
+        m = MotionLayer(ROAD, 1, AccParams(), VEHICLE, MotionLayerParams(overtake=True))
+        return m.update(ego(0.0, 100.0, W), V, tracks)[0].motion
+
+    assert first([]) is Motion.LANE_CHANGE_RIGHT
+    fast = car(0.0, 100.0 - VEHICLE.rear_overhang - 30.0 - 2.3, 0.0, 25.0, 3)
+    assert first([fast]) is Motion.LANE_KEEP
