@@ -20,14 +20,15 @@ A lane is *free* for the ego to move into when nothing is alongside and
 
       a = dv^2 / (2 (gap - dv t_B - v t_G)),   dv = max(V_behind - v, 0),
 
-  <= a_rear, i.e. gap >= dv t_B + dv^2 / (2 a_rear) + v t_G. This is the lane-change rule of
-  UN R157 (ALKS, 01 series: a lane change starts only if an approaching vehicle in the
+  <= a_rear, i.e. gap >= dv t_B + dv^2 / (2 a_rear) + v t_G. This is the lane-change rule
+  of UN R157 (ALKS, 01 series: a lane change starts only if an approaching vehicle in the
   target lane need not decelerate harder than 3 m/s^2, 0.4 s after the change starts, to
   keep the distance the ALKS vehicle travels in 1 s) and the critical distance S_rear of UN
   R79 5.6.4.8.3 (ACSF of category C), with the regulations' values as defaults. Here it
   guards every lateral move (`planner.motion_layer`). v is the *lowest* speed the ego plans
   during the move (`v_rear`; its speed now unless it is slowing, as after a flat tyre): a car
-  that brakes while it moves over lets the one behind close faster.
+  that brakes while it moves over lets the one behind close faster. A change under way goes
+  on (the lane stays free for it) up to ``rear_decel_abort`` (hysteresis).
 
 The ego's own lane is *blocked* when the vehicle ahead in it moves slower than the speed
 the ego wants by more than ``block_margin`` and is within the ACC's d_max (the gap inside
@@ -53,7 +54,10 @@ class OccupancyParams:
     overlap: float = 0.3  # [m] a box overlapping a lane this much across is in it
     front_time: float = 2.0  # [s] closing time allowed for a slower vehicle ahead
     rear_reaction: float = 0.4  # [s] t_B, UN R157
-    rear_decel: float = 3.0  # [m/s^2] a_rear, UN R157
+    rear_decel: float = 3.0  # [m/s^2] a_rear, UN R157: a move starts only below it ...
+    rear_decel_abort: float = 4.0  # [m/s^2] ... and a change under way is given up (before
+    #   its commit point) only above this (hysteresis: a car still slowing as it starts, or a
+    #   track's speed wobble, does not start and abort a change within a second)
     rear_time_gap: float = 1.0  # [s] t_G, UN R157
     block_margin: float = kph(10.0)  # [m/s] slower than wanted by this blocks the lane
 
@@ -139,9 +143,10 @@ def rear_decel_needed(gap: float, v_behind: float, v: float, p: OccupancyParams)
 
 
 def is_free(lt: LaneTraffic, v: float, p: OccupancyParams, v_rear: float | None = None,
-            ) -> bool:
+            under_way: bool = False) -> bool:
     """The ego at speed `v` [m/s] may move into this lane now (see the module doc); the rear
-    rule is judged at `v_rear` [m/s], the lowest speed it plans during the move (`v`)."""
+    rule is judged at `v_rear` [m/s], the lowest speed it plans during the move (`v`), and
+    against ``rear_decel_abort`` instead of ``rear_decel`` for a move `under_way`."""
     if lt.alongside:
         return False
     if lt.ahead is not None:
@@ -150,7 +155,8 @@ def is_free(lt: LaneTraffic, v: float, p: OccupancyParams, v_rear: float | None 
             return False
     if lt.behind is not None:
         v_low = v if v_rear is None else min(v, v_rear)
-        if rear_decel_needed(lt.behind.gap, lt.behind.speed, v_low, p) > p.rear_decel:
+        limit = p.rear_decel_abort if under_way else p.rear_decel
+        if rear_decel_needed(lt.behind.gap, lt.behind.speed, v_low, p) > limit:
             return False
     return True
 

@@ -241,7 +241,8 @@ class MotionLayer:
             return x
         target = self.road.lane(self.lane)
         centre, width = float(target.offset_at(s)), float(target.width_at(s))
-        return replace(x, target_free=is_free(traffic[self.lane], v, p.occupancy, v_low),
+        return replace(x, target_free=is_free(traffic[self.lane], v, p.occupancy, v_low,
+                                              under_way=True),
                        committed=abs(d - centre) < 0.5 * width, change_done=s >= self.path.end)
 
     def _junction_at(self, s: float) -> Junction | None:

@@ -121,3 +121,18 @@ def test_blocked_by_a_slower_lead_within_d_max() -> None:
     nearly = LaneTraffic(0, ahead=Neighbour(1, 1.0, 20.0, V - 2.0))  # within the margin
     assert not is_blocked(nearly, V, V, P, acc)
     assert not is_blocked(LaneTraffic(0), V, V, P, acc)
+
+
+def test_a_change_under_way_goes_on_up_to_the_abort_deceleration() -> None:
+    """Started only if the car behind need not brake over 3 m/s^2; given up only once it
+    would have to brake over 4 m/s^2 (hysteresis)."""
+    def behind(gap: float) -> LaneTraffic:
+        return LaneTraffic(1, behind=Neighbour(1, 1.0, gap, 25.0))
+
+    gap = next(g / 10 for g in range(1, 2000)
+               if rear_decel_needed(g / 10, 25.0, V, P) <= 3.5)  # needs 3.5 m/s^2
+    assert not is_free(behind(gap), V, P)
+    assert is_free(behind(gap), V, P, under_way=True)
+    worse = next(g / 10 for g in range(2000, 1, -1)
+                 if rear_decel_needed(g / 10, 25.0, V, P) > 4.0)
+    assert not is_free(behind(worse), V, P, under_way=True)
