@@ -329,14 +329,15 @@ class MotionLayer:
     def _room(self, traffic: dict[int, LaneTraffic], v: float,
               v_want: float) -> tuple[int | None, float]:
         """The track id of a stationary vehicle blocking the lane kept, which the car may
-        pass (overtaking on, keeping its lane), and the room [m] the ACC is to keep behind
-        it beyond d0: ``pass_gap`` - d0, or as much of it as a stop at ``room_decel`` from
-        speed `v` [m/s] still leaves (never a hard stop for it). As the car slows on a
-        gentler stop the room left grows, up to ``pass_gap`` - d0: the car stops as far back
-        as it comfortably can."""
+        pass (overtaking on, keeping its lane, a lane beside it), and the room [m] the ACC
+        is to keep behind it beyond d0: ``pass_gap`` - d0, or as much of it as a stop at
+        ``room_decel`` from speed `v` [m/s] still leaves (never a hard stop for it). As the
+        car slows on a gentler stop the room left grows, up to ``pass_gap`` - d0: the car
+        stops as far back as it comfortably can."""
         p = self.params
         ahead = traffic[self.lane].ahead if self.lane in traffic else None
-        if (not p.overtake or self.motion is not Motion.LANE_KEEP or ahead is None
+        side = any(k in traffic for k in (self.lane - 1, self.lane + 1) if k >= 0)
+        if (not p.overtake or not side or self.motion is not Motion.LANE_KEEP or ahead is None
                 or ahead.speed >= p.stationary
                 or not is_blocked(traffic[self.lane], v, v_want, p.occupancy, self.acc)):
             return None, 0.0

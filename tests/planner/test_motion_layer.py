@@ -269,6 +269,17 @@ def test_keeps_room_behind_a_stationary_car_it_may_pass() -> None:
     assert off.room_for is None and off.room == 0.0
     moving = layer().update(ego(0.0, 100.0), V, [car(0.0, 140.0, 0.0, 5.56, 1)])[0]
     assert moving.room_for is None
+    one_lane = make_map(seg(1000.0, lanes=1, oncoming=0))
+    alone = MotionLayer(one_lane, 0, acc, VEHICLE, MotionLayerParams(overtake=True)).update(
+        standing(0.0, 100.0), V, [stopped_car(0.0, 12.0)])[0]
+    assert alone.room_for is None  # no lane to pass in
+
+
+def test_the_room_is_what_a_gentle_stop_leaves() -> None:
+    """Coming up at 13.9 m/s, 50 m behind the stopped car: a stop at `room_decel` (2.5
+    m/s^2) takes 38.6 m, so 50 - 4 - 38.6 = 7.4 m of room (not the 8 m of `pass_gap`)."""
+    man = layer().update(ego(0.0, 100.0), V, [stopped_car(0.0, 50.0)])[0]
+    assert man.room == pytest.approx(50.0 - 4.0 - V**2 / 5.0, abs=0.05)
 
 
 def test_a_flat_tyre_waits_for_the_car_behind_judged_at_the_speed_it_slows_to() -> None:
