@@ -11,7 +11,10 @@ shoulder). Per tick:
    slower vehicle has blocked it for ``blocked_time``; the lanes left and right are free or
    not (by the tracks, rear traffic included: `planner.lane_occupancy.is_free`, UN R157's
    rule that a vehicle approaching from behind need not brake harder than 3 m/s^2, judged at
-   the lowest speed the car plans during the move, e.g. a flat tyre's slowing); a pass
+   the lowest speed the car plans during the move, e.g. a flat tyre's slowing; the tracks
+   reach 60 m behind, less past a vehicle alongside in the lane, which hides what follows
+   it: the lane is free only ``rear_view_time`` after such a vehicle was last alongside,
+   time for the tracks of what it hid to be confirmed); a pass
    would clear the blocking vehicle (below); the route needs the car to move right when
    the lane kept does not go on to max(``prepare_distance``, ``prepare_time`` v) ahead (a
    lane that ends at an exit or a lane drop is left in time); the route's turn at a
@@ -106,6 +109,9 @@ class MotionLayerParams:
     #   track's box and gap wobble by tenths of a metre as the car moves past it)
     pass_gap: float = 12.0  # [m] with overtaking on, the gap kept behind a stationary vehicle
     #   that blocks the lane: room for a pass path from a standstill to clear it (by ~0.9 m)
+    rear_view_time: float = 0.5  # [s] after a vehicle alongside in a lane (which hides the
+    #   lane behind it), its rear counts as seen again only after this: the tracks of what
+    #   it hid need 3 of 5 scans at 10 Hz to be confirmed (`perception.tracking`)
     room_decel: float = 2.5  # [m/s^2] the room is kept only as far as a stop at this
     #   leaves it (below ISO 15622's 3.5 m/s^2: never a hard stop for it)
     stationary: float = 0.5  # [m/s] a vehicle slower than this is stationary
@@ -143,6 +149,7 @@ class MotionLayer:
         self.lane = self.origin = lane
         self.path: LaneChangePath | None = None
         self._v_want = 0.0  # [m/s] the speed the car wants, this tick
+        self._hidden_until: dict[int, float] = {}  # [s] lane -> its rear view is whole again
         self._blocked_since: float | None = None
         self._turn_end = math.inf  # [m] where the turn in hand ends (its junction's exit)
         self._near: set[int] = set()  # tracks of the lane being left found in the way
@@ -160,6 +167,9 @@ class MotionLayer:
         lanes = self._lanes_around(s, ego.speed, pull_over)
         traffic = lane_traffic(self.road, tracks, ego.t, s, ego.speed, lanes,
                                self.params.occupancy, self.vehicle)
+        for k, lt in traffic.items():
+            if lt.alongside:  # it hides the lane behind it from the LiDAR
+                self._hidden_until[k] = ego.t + self.params.rear_view_time
         self._v_want = v_want
         v_low = ego.speed if v_rear is None else min(ego.speed, v_rear)
         x = self._input(ego, s, d, v_want, v_low, traffic, pull_over)
@@ -223,8 +233,10 @@ class MotionLayer:
             if self.lane != SHOULDER else None
         x = MotionInput(
             t=t, since=self.machine.since, overtake=p.overtake, blocked=blocked,
-            left_free=left is not None and is_free(left, v, p.occupancy, v_low),
-            right_free=right is not None and is_free(right, v, p.occupancy, v_low),
+            left_free=left is not None and self._seen(left, t)
+            and is_free(left, v, p.occupancy, v_low),
+            right_free=right is not None and self._seen(right, t)
+            and is_free(right, v, p.occupancy, v_low),
             clears_left=not blocked_now or left is None
             or self._pass_clears(ego, s, self.lane + 1, traffic),
             clears_right=not blocked_now or right is None or right.lane == SHOULDER
@@ -317,6 +329,11 @@ class MotionLayer:
         need = 0.5 * self.vehicle.width + n.half_width + (
             self.params.pass_margin if margin is None else margin)
         return abs(y - n.offset) >= need
+
+    def _seen(self, lt: LaneTraffic, t: float) -> bool:
+        """Whether the lane's rear has been in the LiDAR's view for ``rear_view_time`` since
+        a vehicle alongside in it last hid what comes behind it."""
+        return t >= self._hidden_until.get(lt.lane, -math.inf)
 
     def _pass_clears(self, ego: EgoState, s: float, lane: int,
                      traffic: dict[int, LaneTraffic]) -> bool:

@@ -308,3 +308,22 @@ def test_keeping_right_yields_to_a_faster_car_behind_in_the_right_lane() -> None
     assert first([]) is Motion.LANE_CHANGE_RIGHT
     fast = car(0.0, 100.0 - VEHICLE.rear_overhang - 30.0 - 2.3, 0.0, 25.0, 3)
     assert first([fast]) is Motion.LANE_KEEP
+
+
+def test_a_lane_counts_as_seen_behind_only_a_while_after_a_car_alongside_in_it() -> None:
+    """Standing behind a stopped car, a car passes in the left lane at 60 km/h: it hides the
+    lane behind it while alongside; the pass starts no sooner than `rear_view_time` (0.5
+    s) after it was last alongside (at a standstill the gap ahead it needs is only 2 m)."""
+    m = layer()
+    last_alongside, start = -1.0, None
+    for t in np.arange(0.0, 6.0, 0.025):
+        passing = car(t, 100.0 - 40.0 + 16.7 * t, W, 16.7, 8)
+        tracks = [stopped_car(t, 12.0), passing]
+        if lane_traffic(ROAD, tracks, t, 100.0, 0.0, (0, 1), m.params.occupancy,
+                        VEHICLE)[1].alongside:
+            last_alongside = t
+        if m.update(standing(t, 100.0), V, tracks)[0].motion is Motion.LANE_CHANGE_LEFT:
+            start = t
+            break
+    assert last_alongside > 0.0 and start is not None
+    assert start - last_alongside == pytest.approx(0.5, abs=0.03)
