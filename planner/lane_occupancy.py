@@ -4,17 +4,31 @@ Each confirmed track (map frame) is placed on the map (its box centre projected 
 route's reference line: station [m], offset [m], left +) and counted in every lane its box
 overlaps by at least ``overlap`` across. Per lane, the nearest vehicle ahead of the ego and
 the nearest behind it give bumper gaps [m] along the route (stations, carried from the
-track's time to now at the relative speed) and speeds [m/s] along the route; a box that
-overlaps the ego's along the route is alongside.
+track's time to now at the relative speed), speeds [m/s] along the route, and where the box
+lies across (its centre's offset and half its width across the road); a box that overlaps
+the ego's along the route is alongside. The tracks see all round the car (the LiDAR's 360
+deg, `perception.objects`' region of interest reaches 60 m behind as ahead), so a vehicle
+coming up from behind in a lane is its `behind`.
 
 A lane is *free* for the ego to move into when nothing is alongside and
 
 - ahead: gap >= d_min(v) + max(v - V_ahead, 0) * ``front_time`` (UN R157's minimum gap, plus
   the closing during the change);
-- behind: gap >= dv * t_B + dv^2 / (2 a_rear) + v * t_G with dv = max(V_behind - v, 0): UN
-  R157 (5.2.5) asks that an approaching vehicle need not brake harder than a_rear after a
-  reaction time t_B, and keep a time gap t_G behind the ego at the end (the parameters'
-  defaults are R157's values).
+- behind: the vehicle approaching from behind need not brake harder than a_rear =
+  ``rear_decel`` (3 m/s^2) after a reaction time t_B = ``rear_reaction`` (0.4 s) to stay a
+  time gap t_G = ``rear_time_gap`` (1 s) behind the ego: `rear_decel_needed`,
+
+      a = dv^2 / (2 (gap - dv t_B - v t_G)),   dv = max(V_behind - v, 0),
+
+  <= a_rear, i.e. gap >= dv t_B + dv^2 / (2 a_rear) + v t_G. This is the lane-change rule
+  of UN R157 (ALKS, 01 series: a lane change starts only if an approaching vehicle in the
+  target lane need not decelerate harder than 3 m/s^2, 0.4 s after the change starts, to
+  keep the distance the ALKS vehicle travels in 1 s) and the critical distance S_rear of UN
+  R79 5.6.4.8.3 (ACSF of category C), with the regulations' values as defaults. Here it
+  guards every lateral move (`planner.motion_layer`). v is the *lowest* speed the ego plans
+  during the move (`v_rear`; its speed now unless it is slowing, as after a flat tyre): a car
+  that brakes while it moves over lets the one behind close faster. A change under way goes
+  on (the lane stays free for it) up to ``rear_decel_abort`` (hysteresis).
 
 The ego's own lane is *blocked* when the vehicle ahead in it moves slower than the speed
 the ego wants by more than ``block_margin`` and is within the ACC's d_max (the gap inside
@@ -25,7 +39,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -40,7 +54,10 @@ class OccupancyParams:
     overlap: float = 0.3  # [m] a box overlapping a lane this much across is in it
     front_time: float = 2.0  # [s] closing time allowed for a slower vehicle ahead
     rear_reaction: float = 0.4  # [s] t_B, UN R157
-    rear_decel: float = 3.0  # [m/s^2] a_rear, UN R157
+    rear_decel: float = 3.0  # [m/s^2] a_rear, UN R157: a move starts only below it ...
+    rear_decel_abort: float = 4.0  # [m/s^2] ... and a change under way is given up (before
+    #   its commit point) only above this (hysteresis: a car still slowing as it starts, or a
+    #   track's speed wobble, does not start and abort a change within a second)
     rear_time_gap: float = 1.0  # [s] t_G, UN R157
     block_margin: float = kph(10.0)  # [m/s] slower than wanted by this blocks the lane
 
@@ -53,6 +70,8 @@ class Neighbour:
     t: float  # [s] the track's time
     gap: float  # [m] bumper to bumper along the route, now
     speed: float  # [m/s] along the route
+    offset: float = 0.0  # [m] its centre's offset from the route's reference line, left +
+    half_width: float = 0.0  # [m] half its box's extent across the road
 
 
 @dataclass(frozen=True, slots=True)
@@ -85,8 +104,8 @@ def lane_traffic(road: RoadMap, tracks: Sequence[Track], t: float, station: floa
             centre, width = float(lane.offset_at(s)), float(lane.width_at(s))
             if abs(d - centre) > 0.5 * width + half_wid - p.overlap:
                 continue
-            out[k] = _add(out[k], Neighbour(tr.id, tr.t, 0.0, speed), ahead, half_len,
-                          vehicle)
+            out[k] = _add(out[k], Neighbour(tr.id, tr.t, 0.0, speed, d, half_wid), ahead,
+                          half_len, vehicle)
     return out
 
 
@@ -102,20 +121,32 @@ def _add(lt: LaneTraffic, n: Neighbour, ahead: float, half_len: float,
     if ahead - half_len >= vehicle.front_overhang:
         gap = ahead - half_len - vehicle.front_overhang
         if lt.ahead is None or gap < lt.ahead.gap:
-            return LaneTraffic(lt.lane, Neighbour(n.track_id, n.t, gap, n.speed), lt.behind,
-                               lt.alongside)
+            return LaneTraffic(lt.lane, replace(n, gap=gap), lt.behind, lt.alongside)
         return lt
     if -ahead - half_len >= vehicle.rear_overhang:
         gap = -ahead - half_len - vehicle.rear_overhang
         if lt.behind is None or gap < lt.behind.gap:
-            return LaneTraffic(lt.lane, lt.ahead, Neighbour(n.track_id, n.t, gap, n.speed),
-                               lt.alongside)
+            return LaneTraffic(lt.lane, lt.ahead, replace(n, gap=gap), lt.alongside)
         return lt
     return LaneTraffic(lt.lane, lt.ahead, lt.behind, True)
 
 
-def is_free(lt: LaneTraffic, v: float, p: OccupancyParams) -> bool:
-    """The ego at speed `v` [m/s] may move into this lane now (see the module doc)."""
+def rear_decel_needed(gap: float, v_behind: float, v: float, p: OccupancyParams) -> float:
+    """[m/s^2] how hard a vehicle `gap` [m] behind at `v_behind` [m/s] must brake, after
+    ``rear_reaction``, to stay ``rear_time_gap`` behind the ego at `v` [m/s] (module doc);
+    +inf when even braking at once cannot."""
+    dv = max(v_behind - v, 0.0)
+    room = gap - dv * p.rear_reaction - v * p.rear_time_gap
+    if room <= 0.0:
+        return 0.0 if dv == 0.0 and room == 0.0 else math.inf
+    return dv * dv / (2.0 * room)
+
+
+def is_free(lt: LaneTraffic, v: float, p: OccupancyParams, v_rear: float | None = None,
+            under_way: bool = False) -> bool:
+    """The ego at speed `v` [m/s] may move into this lane now (see the module doc); the rear
+    rule is judged at `v_rear` [m/s], the lowest speed it plans during the move (`v`), and
+    against ``rear_decel_abort`` instead of ``rear_decel`` for a move `under_way`."""
     if lt.alongside:
         return False
     if lt.ahead is not None:
@@ -123,9 +154,9 @@ def is_free(lt: LaneTraffic, v: float, p: OccupancyParams) -> bool:
         if lt.ahead.gap < need:
             return False
     if lt.behind is not None:
-        dv = max(lt.behind.speed - v, 0.0)
-        need = dv * p.rear_reaction + dv * dv / (2.0 * p.rear_decel) + v * p.rear_time_gap
-        if lt.behind.gap < need:
+        v_low = v if v_rear is None else min(v, v_rear)
+        limit = p.rear_decel_abort if under_way else p.rear_decel
+        if rear_decel_needed(lt.behind.gap, lt.behind.speed, v_low, p) > limit:
             return False
     return True
 

@@ -9,11 +9,17 @@ shoulder). Per tick:
    the car over from lane 0;
 2. the inputs of the motion FSM (`planner.fsm.motion`): the lane kept is *blocked* once a
    slower vehicle has blocked it for ``blocked_time``; the lanes left and right are free or
-   not; the route needs the car to move right when the lane kept does not go on to
-   max(``prepare_distance``, ``prepare_time`` v) ahead (a lane that ends at an exit or a
-   lane drop is left in time); the route's turn at a junction; during a change, whether
-   the target lane is still free, whether the car's centre is inside it (committed) and
-   whether the path is done;
+   not (by the tracks, rear traffic included: `planner.lane_occupancy.is_free`, UN R157's
+   rule that a vehicle approaching from behind need not brake harder than 3 m/s^2, judged at
+   the lowest speed the car plans during the move, e.g. a flat tyre's slowing; the tracks
+   reach 60 m behind, less past a vehicle alongside in the lane, which hides what follows
+   it: the lane is free only ``rear_view_time`` after such a vehicle was last alongside,
+   time for the tracks of what it hid to be confirmed); a pass
+   would clear the blocking vehicle (below); the route needs the car to move right when
+   the lane kept does not go on to max(``prepare_distance``, ``prepare_time`` v) ahead (a
+   lane that ends at an exit or a lane drop is left in time); the route's turn at a
+   junction; during a change, whether the target lane is still free, whether the car's
+   centre is inside it (committed) and whether the path is done;
 3. the motion FSM steps once.
 
 Entering a lane change makes the target lane the lane kept (its speed plan and, once done,
@@ -24,11 +30,28 @@ until its end. While a path is followed, the vehicle ahead in the lane kept (the
 lane) is the ACC's lead; the vehicle ahead in the origin lane is a lead too while the car's
 body (mirrors included) still overlaps that lane (`leads`): the car does not run into the
 vehicle it is leaving. On a pass (a change taken to pass a slower vehicle), the vehicle
-passed counts only once it is near, within UN R157's d_min or under ``pass_ttc`` to
-collision: the car does not trail it through the pass. A change the route or a flat tyre
-asks for keeps trailing it (the car may be moving into that vehicle's path). Keeping right
-after a pass waits for a car behind in the right lane to be ``keep_right_gap`` back (a
-margin over the gap that aborts).
+passed counts only once the path does not clear it by ``pass_margin_keep`` (`clears`,
+below; a hysteresis below the margin a pass starts with): the car does not
+trail it through the pass (issue K, item 6), yet stops behind it rather than run into it if
+it does not get past. A change the route or a flat tyre asks for keeps trailing it (the car
+may be moving into that vehicle's path).
+
+A pass starts only if its path *clears* the vehicle ahead: at the station where the car's
+front bumper reaches that vehicle's rear (it at its speed, the car at the higher of its speed
+and the speed it wants), the path's centre is at least half the car's width + half the
+vehicle's width (across the road, from its track) + ``pass_margin`` from the vehicle's
+centre. (The front corners are then farther out still: the car heads away from it.) From a
+standstill the path is ``min_length`` long (`planner.lane_change_path`), which clears a car
+only from about 9 m behind; so with overtaking on, behind a (nearly) stationary vehicle that
+blocks the lane the car stops ``pass_gap`` back instead of at the ACC's standstill gap d0: the
+manoeuvre asks the ACC to keep ``room`` = ``pass_gap`` - d0 more (the room to pull out, as a
+driver leaves to see the tyres of the car ahead), as much of it as a stop at
+``room_decel`` still leaves. Without overtaking, the ACC's d0 holds (UN R157
+4.2.1: 2 to 6 m). From 2 to 6 m behind a car of the same width no forward path clears it
+(the turning circle): a pass from there waits for good.
+
+Keeping right after a pass waits for a car behind in the right lane to be
+``keep_right_gap`` back (a margin over the gap that aborts).
 
 At a town junction where the route turns, the turn is entered when the car's centre passes
 the stop line and done at the junction's exit (`RoadMap.junctions`); its path is the map's
@@ -46,7 +69,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from perception.messages import EgoState, Track
-from planner.fsm.acc import AccParams, r157_min_gap
+from planner.fsm.acc import AccParams
 from planner.fsm.machine import Machine, StateChange
 from planner.fsm.motion import (
     LANE_CHANGES,
@@ -79,8 +102,19 @@ class MotionLayerParams:
     mirrors: float = 0.1  # [m] how far each mirror stands out beyond the body's side
     prepare_distance: float = 150.0  # [m] a lane ending this near ahead is left ...
     prepare_time: float = 12.0  # [s] ... or this many seconds ahead at the present speed
-    pass_ttc: float = 4.0  # [s] during a change, the car being left is a lead once closer
-    #   in time than this (or within d_min)
+    pass_margin: float = 0.4  # [m] a pass starts on a path that clears a vehicle by this,
+    #   side to side ...
+    pass_margin_keep: float = 0.2  # [m] ... and once under way, the vehicle passed is in
+    #   the way (a lead) only when the path clears it by less than this (hysteresis: the
+    #   track's box and gap wobble by tenths of a metre as the car moves past it)
+    pass_gap: float = 12.0  # [m] with overtaking on, the gap kept behind a stationary vehicle
+    #   that blocks the lane: room for a pass path from a standstill to clear it (by ~0.9 m)
+    rear_view_time: float = 0.5  # [s] after a vehicle alongside in a lane (which hides the
+    #   lane behind it), its rear counts as seen again only after this: the tracks of what
+    #   it hid need 3 of 5 scans at 10 Hz to be confirmed (`perception.tracking`)
+    room_decel: float = 2.5  # [m/s^2] the room is kept only as far as a stop at this
+    #   leaves it (below ISO 15622's 3.5 m/s^2: never a hard stop for it)
+    stationary: float = 0.5  # [m/s] a vehicle slower than this is stationary
     keep_right_gap: float = 2.0  # [s] keeping right waits for this time gap to a car behind
     #   in the right lane (UN R157's t_G of 1 s aborts a change: the margin between the two
     #   keeps a gap that hovers near t_G from starting and aborting changes)
@@ -98,6 +132,9 @@ class Manoeuvre:
     origin: int  # [-] the lane left by a lane change in hand (== lane otherwise)
     path: LaneChangePath | None  # the lane-change (or abort) path being followed
     leads: tuple[Neighbour, ...] = ()  # on a path: the vehicles ahead in the lanes occupied
+    room: float = 0.0  # [m] more gap for the ACC to keep behind track `room_for` (the room
+    #   to pull out around a stationary vehicle it may pass)
+    room_for: int | None = None  # the track id of that vehicle
 
 
 class MotionLayer:
@@ -111,20 +148,31 @@ class MotionLayer:
         self.machine = Machine("motion", Motion.LANE_KEEP)
         self.lane = self.origin = lane
         self.path: LaneChangePath | None = None
+        self._v_want = 0.0  # [m/s] the speed the car wants, this tick
+        self._hidden_until: dict[int, float] = {}  # [s] lane -> its rear view is whole again
         self._blocked_since: float | None = None
         self._turn_end = math.inf  # [m] where the turn in hand ends (its junction's exit)
-        self._near: set[int] = set()  # tracks of the lane being left found near (`_leads`)
+        self._near: set[int] = set()  # tracks of the lane being left found in the way
+        #   (`_leads`)
         self._passing = False  # the change in hand is one to pass a slower vehicle
 
     def update(self, ego: EgoState, v_want: float, tracks: Sequence[Track],
-               pull_over: bool = False) -> tuple[Manoeuvre, tuple[StateChange, ...]]:
-        """Step with the ego estimate, the speed it wants [m/s], the confirmed tracks and
-        whether to pull over onto the shoulder (a flat tyre)."""
+               pull_over: bool = False, v_rear: float | None = None,
+               ) -> tuple[Manoeuvre, tuple[StateChange, ...]]:
+        """Step with the ego estimate, the speed it wants [m/s], the confirmed tracks,
+        whether to pull over onto the shoulder (a flat tyre) and the lowest speed [m/s] the
+        car plans during a lane change (the rear traffic is judged at it; default: its
+        speed now)."""
         s, d = (float(a) for a in self.road.local_coordinates((ego.x, ego.y)))
         lanes = self._lanes_around(s, ego.speed, pull_over)
         traffic = lane_traffic(self.road, tracks, ego.t, s, ego.speed, lanes,
                                self.params.occupancy, self.vehicle)
-        x = self._input(ego, s, d, v_want, traffic, pull_over)
+        for k, lt in traffic.items():
+            if lt.alongside:  # it hides the lane behind it from the LiDAR
+                self._hidden_until[k] = ego.t + self.params.rear_view_time
+        self._v_want = v_want
+        v_low = ego.speed if v_rear is None else min(ego.speed, v_rear)
+        x = self._input(ego, s, d, v_want, v_low, traffic, pull_over)
         change = transition(self.machine.state, x, self.params.motion)
         if change is not None:
             self._passing = is_pass(self.machine.state, x, self.params.motion)
@@ -135,8 +183,9 @@ class MotionLayer:
             self.path = None  # the way back after an abort is done
             self.origin = self.lane
         changes = self.machine.apply(ego.t, change)
+        room_for, room = self._room(traffic, ego.speed, v_want)
         return Manoeuvre(self.motion, self.lane, self.origin, self.path,
-                         self._leads(traffic, s, d, ego.speed)), changes
+                         self._leads(traffic, s, d, ego.speed), room, room_for), changes
 
     @property
     def motion(self) -> Motion:
@@ -170,7 +219,7 @@ class MotionLayer:
         first, last = (int(i) for i in line.segment_index(np.array([s, min(end, line.length)])))
         return min(self.road.sections[i].lanes for i in range(first, last + 1))
 
-    def _input(self, ego: EgoState, s: float, d: float, v_want: float,
+    def _input(self, ego: EgoState, s: float, d: float, v_want: float, v_low: float,
                traffic: dict[int, LaneTraffic], pull_over: bool) -> MotionInput:
         p, v, t = self.params, ego.speed, ego.t
         blocked_now = is_blocked(traffic[self.lane], v, v_want, p.occupancy, self.acc)
@@ -184,8 +233,14 @@ class MotionLayer:
             if self.lane != SHOULDER else None
         x = MotionInput(
             t=t, since=self.machine.since, overtake=p.overtake, blocked=blocked,
-            left_free=left is not None and is_free(left, v, p.occupancy),
-            right_free=right is not None and is_free(right, v, p.occupancy),
+            left_free=left is not None and self._seen(left, t)
+            and is_free(left, v, p.occupancy, v_low),
+            right_free=right is not None and self._seen(right, t)
+            and is_free(right, v, p.occupancy, v_low),
+            clears_left=not blocked_now or left is None
+            or self._pass_clears(ego, s, self.lane + 1, traffic),
+            clears_right=not blocked_now or right is None or right.lane == SHOULDER
+            or self._pass_clears(ego, s, self.lane - 1, traffic),
             right_clear=right is not None and right.lane != SHOULDER
             and not is_blocked(right, v, v_want, p.occupancy, self.acc)
             and (right.behind is None or right.behind.gap >= v * p.keep_right_gap),
@@ -198,7 +253,8 @@ class MotionLayer:
             return x
         target = self.road.lane(self.lane)
         centre, width = float(target.offset_at(s)), float(target.width_at(s))
-        return replace(x, target_free=is_free(traffic[self.lane], v, p.occupancy),
+        return replace(x, target_free=is_free(traffic[self.lane], v, p.occupancy, v_low,
+                                              under_way=True),
                        committed=abs(d - centre) < 0.5 * width, change_done=s >= self.path.end)
 
     def _junction_at(self, s: float) -> Junction | None:
@@ -232,37 +288,79 @@ class MotionLayer:
             self.path = None
 
     def _plan_into(self, lane: int, ego: EgoState) -> LaneChangePath:
+        # the estimate of a standing car's speed may be a hair below 0
         return start_lane_change(self.road.lane(lane), lane, ego.x, ego.y, ego.heading,
-                                 ego.speed, self.params.lane_change)
+                                 max(ego.speed, 0.0), self.params.lane_change)
 
     def _leads(self, traffic: dict[int, LaneTraffic], s: float, d: float,
                v: float) -> tuple[Neighbour, ...]:
         """On a path: the vehicle ahead in the target lane, and the one ahead in the origin
         lane while the car's body still overlaps that lane; on a pass, only from the moment
-        it is near enough to matter (`_still_near`) on (so that braking for it does not make
-        it far again and release it: no chatter)."""
+        the path does not clear it by ``pass_margin_keep`` (`clears`) on (so that braking for
+        it does not release it: no chatter)."""
         if self.path is None:
             return ()
         leads = [n for n in (traffic[self.lane].ahead,) if n is not None] \
             if self.lane in traffic else []
+        p = self.params
         origin = self.road.lane(self.origin)
-        clear = 0.5 * float(origin.width_at(s)) + 0.5 * self.vehicle.width + self.params.mirrors
+        clear = 0.5 * float(origin.width_at(s)) + 0.5 * self.vehicle.width + p.mirrors
         left_behind = traffic[self.origin].ahead if self.origin in traffic else None
         if left_behind is not None and abs(d - float(origin.offset_at(s))) < clear and (
                 not self._passing or left_behind.track_id in self._near
-                or self._still_near(left_behind, v)):
+                or not self.clears(self.path, left_behind, s, v, p.pass_margin_keep)):
             self._near.add(left_behind.track_id)  # near once: a lead until the body is out
             leads.append(left_behind)
         return tuple(leads)
 
-    def _still_near(self, n: Neighbour, v: float) -> bool:
-        """The vehicle ahead in the lane being left still constrains the car's speed: within
-        UN R157's d_min at speed `v` [m/s], or closing with under ``pass_ttc`` to collision.
-        Farther, the target lane's vehicle is the lead: a pass does not trail the car it
-        passes."""
-        closing = v - n.speed
-        return n.gap < r157_min_gap(v) or (closing > 0.0 and
-                                           n.gap < self.params.pass_ttc * closing)
+    def clears(self, path: LaneChangePath, n: Neighbour, s: float, v: float,
+               margin: float | None = None) -> bool:
+        """Whether the car, on `path` from its centre's station `s` [m] at speed `v` [m/s],
+        clears vehicle `n` ahead in the lane it leaves: at the station where its front bumper
+        reaches n's rear (n at its speed, the car at max(v, the speed it wants)), the path's
+        centre is half the car's width + n's half width + `margin` (``pass_margin``) [m]
+        from n's centre (module doc)."""
+        v_car = max(v, self._v_want)
+        if v_car <= n.speed:
+            return True  # it never reaches it
+        meet = s + n.gap * v_car / (v_car - n.speed)
+        target = self.road.lane(path.target_index)
+        y = float(target.offset_at(meet)) + float(path.offset_at(meet))
+        need = 0.5 * self.vehicle.width + n.half_width + (
+            self.params.pass_margin if margin is None else margin)
+        return abs(y - n.offset) >= need
+
+    def _seen(self, lt: LaneTraffic, t: float) -> bool:
+        """Whether the lane's rear has been in the LiDAR's view for ``rear_view_time`` since
+        a vehicle alongside in it last hid what comes behind it."""
+        return t >= self._hidden_until.get(lt.lane, -math.inf)
+
+    def _pass_clears(self, ego: EgoState, s: float, lane: int,
+                     traffic: dict[int, LaneTraffic]) -> bool:
+        """Whether a pass into `lane` started now would clear the vehicle ahead (`clears`)."""
+        ahead = traffic[self.lane].ahead
+        if ahead is None or not 0 <= lane < self.road.lanes_at(s):
+            return True
+        return self.clears(self._plan_into(lane, ego), ahead, s, ego.speed)
+
+    def _room(self, traffic: dict[int, LaneTraffic], v: float,
+              v_want: float) -> tuple[int | None, float]:
+        """The track id of a stationary vehicle blocking the lane kept, which the car may
+        pass (overtaking on, keeping its lane, a lane beside it), and the room [m] the ACC
+        is to keep behind it beyond d0: ``pass_gap`` - d0, or as much of it as a stop at
+        ``room_decel`` from speed `v` [m/s] still leaves (never a hard stop for it). As the
+        car slows on a gentler stop the room left grows, up to ``pass_gap`` - d0: the car
+        stops as far back as it comfortably can."""
+        p = self.params
+        ahead = traffic[self.lane].ahead if self.lane in traffic else None
+        side = any(k in traffic for k in (self.lane - 1, self.lane + 1) if k >= 0)
+        if (not p.overtake or not side or self.motion is not Motion.LANE_KEEP or ahead is None
+                or ahead.speed >= p.stationary
+                or not is_blocked(traffic[self.lane], v, v_want, p.occupancy, self.acc)):
+            return None, 0.0
+        comfortable = ahead.gap - self.acc.d0 - v * v / (2.0 * p.room_decel)
+        room = min(max(p.pass_gap - self.acc.d0, 0.0), max(comfortable, 0.0))
+        return ahead.track_id, room
 
 
 def _turn(junction: Junction | None) -> Turn | None:

@@ -29,9 +29,11 @@ Positions are in the map frame, stations [m] along the route's reference line, s
    unless it lowers it: the map's plan (`planner.speed_planning`: set speed, the lane kept's
    limits and curves), the driver's pedal (`planner.driver_override`: it raises the plan up
    to the limit), the ACC / event law (`planner.acc_layer`: cruise, trail or brake behind
-   the lead; a stop, a bump's pass speed, a flat tyre's crawl), the degraded lane's cap
-   (ramped down at ``a_comf`` to the hold speed in MAP_HOLD, to a stop in STOP_IN_LANE) and
-   the emergency stop; the plan's `speed_source` is the link that set the speed;
+   the lead, which is nearer by the motion layer's room to pull out when it is a stationary
+   vehicle the car may pass; a stop, a bump's pass speed, a flat tyre's crawl), the
+   degraded lane's cap (ramped down at ``a_comf`` to the hold speed in MAP_HOLD, to a stop
+   in STOP_IN_LANE) and the emergency stop; the plan's `speed_source` is the link that set
+   the speed;
 6. the control FSM (`planner.control_layer`) names the control action and, in an
    emergency, asks for the emergency stop's deceleration instead; the hazard lights go on
    with a flat tyre (`planner.fsm.hazard`).
@@ -182,7 +184,9 @@ class Planner:
         target = self.speed_for(station)
         want = min(self.params.set_speed, target.limit_at_front)
         manoeuvre, motion_changes = self.motion.update(ego, want, tracks,
-                                                       pull_over=inp.flat_tyre)
+                                                       pull_over=inp.flat_tyre,
+                                                       v_rear=self._lowest_speed(ego.speed,
+                                                                                 inp.flat_tyre))
         if manoeuvre.lane != self.lane_index:  # a lane change began, ended or was aborted
             self._keep(manoeuvre.lane)
             station, lateral = self.localise(ego)
@@ -205,13 +209,15 @@ class Planner:
         events = replace(events, active=events.active | junction.active,
                          stop_distance=min(events.stop_distance, junction.stop_distance))
         acc, acc_changes = self.acc.update(ego.t, dt, ego.speed, self.params.set_speed,
-                                           target.limit_at_front, planned, lead,
+                                           target.limit_at_front, planned,
+                                           _with_room(lead, manoeuvre),
                                            driver_gap=self.params.override.gap_margin
                                            if driver else None, events=events)
         speed = self._degraded_cap(acc.speed, ego.speed, dt)
         control, control_changes = self.control.update(
-            ego.t, ego.speed, speed.ref.speed, speed.ref.accel, acc.lead_gap, lead,
-            self.lead_accel.update(lead))
+            ego.t, ego.speed, speed.ref.speed, speed.ref.accel,
+            acc.lead_gap + (manoeuvre.room if _with_room(lead, manoeuvre) is not lead else 0.0),
+            lead, self.lead_accel.update(lead))
         if control.emergency:
             speed = PlannedSpeed(SpeedRef(0.0, -self.control.decel), SpeedSource.EMERGENCY)
         hazard_changes = self.hazard.apply(ego.t, hazard.transition(self.hazard.state,
@@ -236,6 +242,15 @@ class Planner:
             speed_source=speed.source,
             changes=changes + motion_changes + acc_changes + control_changes + hazard_changes,
         )
+
+    def _lowest_speed(self, v: float, flat: bool) -> float:
+        """[m/s] the lowest speed the car plans during a lane change started now: with a
+        flat tyre, FLAT's slowing at ``a_flat_plan`` over the longest change, not below its
+        crawl (`planner.acc_layer`); otherwise its speed `v` [m/s]."""
+        if not flat:
+            return v
+        c, lc = self.params.acc.control, self.params.motion.lane_change
+        return max(v - c.a_flat_plan * lc.t_max, min(c.v_pull_over, v))
 
     def _path(self, ego: EgoState, station: float, view: LaneView | None,
               manoeuvre: Manoeuvre) -> LateralChoice:
@@ -335,6 +350,15 @@ class Planner:
             accel = -a_comf if self._cap > wanted else 0.0
             return PlannedSpeed(SpeedRef(self._cap, accel), SpeedSource.DEGRADED)
         return planned
+
+
+def _with_room(lead: Lead | None, manoeuvre: Manoeuvre) -> Lead | None:
+    """The lead as the ACC is to see it: nearer by the manoeuvre's room when it is the
+    stationary vehicle the car may pass (it stops that much farther back: room to pull
+    out, `planner.motion_layer`)."""
+    if lead is None or lead.track_id != manoeuvre.room_for:
+        return lead
+    return replace(lead, gap=lead.gap - manoeuvre.room)
 
 
 def _straight_ahead(_x: float) -> float:

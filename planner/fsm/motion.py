@@ -6,9 +6,12 @@ turns are entered from the route's command at a town junction (`planner.motion_l
 Inputs (`MotionInput`) are decided upstream from the tracks and the map
 (`planner.lane_occupancy`, `planner.motion_layer`): whether a slower vehicle blocks the lane
 ahead, whether the lanes to the left and right are free ("according to the presence or
-absence of obstacles in the side", ICCAS 2020), the lanes the route needs the car to move,
-the route's turn at a junction, a flat tyre's pull-over, and the progress of the manoeuvre
-in hand.
+absence of obstacles in the side", ICCAS 2020; rear traffic included: UN R157's rule that a
+vehicle approaching from behind in the target lane need not brake harder than 3 m/s^2, which
+so guards every lateral move: a pass, a flat tyre's pull-over, a route change before an exit,
+keeping right), whether a pass path to either side would clear the vehicle ahead, the
+lanes the route needs the car to move, the route's turn at a junction, a flat tyre's
+pull-over, and the progress of the manoeuvre in hand.
 
 A lane change is *committed* once the car's centre is inside the target lane: before that,
 a target lane that stops being free aborts the change (a change to LANE_KEEP before the
@@ -24,10 +27,11 @@ tried in this order and the first that holds is taken:
 4. lane_keep -> u_turn: the route turns back there
 5. lane_keep -> lane_change_right: the route needs a lane to the right and it is free
 6. lane_keep -> lane_change_left: the route needs a lane to the left and it is free
-7. lane_keep -> lane_change_left: overtaking allowed, the lane blocked, the left free,
-   `keep_time` since the last change, and the route needs no other lane
+7. lane_keep -> lane_change_left: overtaking allowed, the lane blocked, the left free and a
+   pass path into it clears the vehicle ahead, `keep_time` since the last change, and the
+   route needs no other lane
 8. lane_keep -> lane_change_right: overtaking allowed, the lane blocked, only the right free
-   (as above)
+   and clearing (as above)
 9. lane_keep -> lane_change_right: keep right: overtaking allowed, the lane not blocked, the
    right free and clear (nothing slower ahead in it to block it), `keep_time` since the last
    change, and the route needs no other lane
@@ -42,8 +46,12 @@ lane by lane (`right_free` then means the next lane, or the paved shoulder from 
 stays on the shoulder. Then the route's turns, then its lane needs, then overtaking, then
 keeping right: where the driver lets the car change lanes to pass, it goes back to the
 right once that lane is free and clear (no slower vehicle ahead in it within the ACC's
-d_max, which would make it pass again). Overtaking and keeping right wait `keep_time` after
-the last change (no weaving); a route lane change waits `route_keep_time` only.
+d_max, which would make it pass again). A blocked lane is passed also from a standstill
+behind a stopped vehicle: `blocked` does not ask that the vehicle ahead moves, only that it
+is slower than wanted; while no side is free, or a pass path would not clear it, the car
+waits in its lane (the ACC stops it behind that vehicle) and goes once both hold.
+Overtaking and keeping right wait `keep_time` after the last change (no weaving); a route
+lane change waits `route_keep_time` only.
 """
 
 from __future__ import annotations
@@ -92,6 +100,8 @@ class MotionInput:
     left_free: bool = False  # a lane to the left exists and is free by the tracks
     right_free: bool = False  # a lane to the right exists and is free by the tracks
     right_clear: bool = False  # ... and nothing slower ahead in it would block it
+    clears_left: bool = True  # a pass path into the left lane clears the vehicle ahead
+    clears_right: bool = True  # ... into the right lane
     route_lane: int = 0  # [lanes] the route needs the car to move: > 0 left, < 0 right
     target_free: bool = True  # the target lane of the change in hand is still free
     committed: bool = False  # the car's centre is in the target lane of the change
@@ -142,11 +152,11 @@ def _may_overtake(x: MotionInput, p: MotionParams) -> bool:
 
 
 def _overtake_left(_m: Motion, x: MotionInput, p: MotionParams) -> bool:
-    return _may_overtake(x, p) and x.left_free
+    return _may_overtake(x, p) and x.left_free and x.clears_left
 
 
 def _overtake_right(_m: Motion, x: MotionInput, p: MotionParams) -> bool:
-    return _may_overtake(x, p) and x.right_free
+    return _may_overtake(x, p) and x.right_free and x.clears_right
 
 
 def _keep_right(_m: Motion, x: MotionInput, p: MotionParams) -> bool:
@@ -186,11 +196,12 @@ TABLE: Table[Motion, MotionInput, MotionParams] = Table(Motion, (
         "the route needs a lane to the left and it is free",
         "the route needs a lane to the left"),
     Row(_KEEP, M.LANE_CHANGE_LEFT, _overtake_left,
-        "overtaking allowed, the lane blocked, the left free, `keep_time` since the last "
-        "change, and the route needs no other lane",
+        "overtaking allowed, the lane blocked, the left free and a pass path into it clears "
+        "the vehicle ahead, `keep_time` since the last change, and the route needs no other "
+        "lane",
         "a slower vehicle ahead, the left lane free"),
     Row(_KEEP, M.LANE_CHANGE_RIGHT, _overtake_right,
-        "overtaking allowed, the lane blocked, only the right free (as above)",
+        "overtaking allowed, the lane blocked, only the right free and clearing (as above)",
         "a slower vehicle ahead, only the right lane free"),
     Row(_KEEP, M.LANE_CHANGE_RIGHT, _keep_right,
         "keep right: overtaking allowed, the lane not blocked, the right free and clear "

@@ -13,6 +13,7 @@ from planner.lane_occupancy import (
     is_blocked,
     is_free,
     lane_traffic,
+    rear_decel_needed,
 )
 from tests.roads import W, make_map, seg
 from tests.vehicle import VEHICLE
@@ -36,9 +37,10 @@ def traffic(*tracks: Track, t: float = 1.0) -> dict[int, LaneTraffic]:
 def test_neighbours_ahead_behind_and_alongside() -> None:
     lt = traffic(car(150.0, 0.1, 8.0, 1), car(130.0, 0.0, 9.0, 2), car(60.0, W, 20.0, 3),
                  car(102.0, W + 0.2, 14.0, 4))
-    assert lt[0].ahead == Neighbour(2, 1.0, pytest.approx(30.0 - 2.3 - 2.4), 9.0)
+    assert lt[0].ahead == Neighbour(2, 1.0, pytest.approx(30.0 - 2.3 - 2.4), 9.0, 0.0, 0.9)
     assert lt[0].behind is None and not lt[0].alongside
-    assert lt[1].behind == Neighbour(3, 1.0, pytest.approx(40.0 - 2.3 - 2.4), 20.0)
+    assert lt[1].behind == Neighbour(3, 1.0, pytest.approx(40.0 - 2.3 - 2.4), 20.0,
+                                     pytest.approx(W), 0.9)
     assert lt[1].alongside and lt[1].ahead is None
 
 
@@ -73,6 +75,43 @@ def test_free_behind_is_r157s_approaching_vehicle_rule() -> None:
     assert is_free(slower, V, P)
 
 
+@pytest.mark.parametrize(
+    ("gap", "v_behind", "v", "decel"),
+    [
+        # UN R157's rule as the rear vehicle's need: dv^2 / (2 (gap - dv t_B - v t_G))
+        (40.0, 25.0, V, (25.0 - V) ** 2 / (2.0 * (40.0 - (25.0 - V) * 0.4 - V))),
+        (20.0, 16.7, 0.0, 16.7**2 / (2.0 * (20.0 - 16.7 * 0.4))),  # past a standing car
+        (V + 1.0, 10.0, V, 0.0),  # slower behind, beyond t_G: nothing to brake for
+        (V, V, V, 0.0),  # just t_G behind at the same speed
+        (V - 0.1, V, V, float("inf")),  # inside t_G: no braking keeps it
+        (5.0, 25.0, V, float("inf")),  # too near to brake at all
+    ],
+)
+def test_the_rear_vehicles_needed_deceleration(gap: float, v_behind: float, v: float,
+                                               decel: float) -> None:
+    assert rear_decel_needed(gap, v_behind, v, P) == pytest.approx(decel)
+
+
+def test_free_behind_means_the_rear_car_brakes_at_most_3_m_s2() -> None:
+    def behind(gap: float) -> LaneTraffic:
+        return LaneTraffic(1, behind=Neighbour(1, 1.0, gap, 25.0))
+
+    limit = next(g / 10 for g in range(1, 2000) if rear_decel_needed(g / 10, 25.0, V, P) <= 3.0)
+    assert is_free(behind(limit), V, P) and not is_free(behind(limit - 0.1), V, P)
+
+
+def test_the_rear_rule_is_judged_at_the_lowest_speed_planned() -> None:
+    """A car slowing while it moves over (a flat tyre) lets the one behind close faster: a
+    gap free at its speed now is not at the speed it slows to."""
+    lt = LaneTraffic(0, behind=Neighbour(1, 1.0, 30.0, 18.1))
+    assert is_free(lt, 16.4, P)  # dv = 1.7 m/s: 18 m would do
+    assert not is_free(lt, 16.4, P, v_rear=6.4)  # dv = 11.7 m/s: 34 m needed
+    assert is_free(lt, 16.4, P, v_rear=20.0)  # never above the speed now
+    # the front rule stays at the speed now
+    ahead = LaneTraffic(0, ahead=Neighbour(1, 1.0, r157_min_gap(16.4) + 0.1, 16.4))
+    assert is_free(ahead, 16.4, P, v_rear=0.0)
+
+
 def test_blocked_by_a_slower_lead_within_d_max() -> None:
     acc = AccParams()
     d_max = gaps(V, 5.5, acc).d_max
@@ -82,3 +121,18 @@ def test_blocked_by_a_slower_lead_within_d_max() -> None:
     nearly = LaneTraffic(0, ahead=Neighbour(1, 1.0, 20.0, V - 2.0))  # within the margin
     assert not is_blocked(nearly, V, V, P, acc)
     assert not is_blocked(LaneTraffic(0), V, V, P, acc)
+
+
+def test_a_change_under_way_goes_on_up_to_the_abort_deceleration() -> None:
+    """Started only if the car behind need not brake over 3 m/s^2; given up only once it
+    would have to brake over 4 m/s^2 (hysteresis)."""
+    def behind(gap: float) -> LaneTraffic:
+        return LaneTraffic(1, behind=Neighbour(1, 1.0, gap, 25.0))
+
+    gap = next(g / 10 for g in range(1, 2000)
+               if rear_decel_needed(g / 10, 25.0, V, P) <= 3.5)  # needs 3.5 m/s^2
+    assert not is_free(behind(gap), V, P)
+    assert is_free(behind(gap), V, P, under_way=True)
+    worse = next(g / 10 for g in range(2000, 1, -1)
+                 if rear_decel_needed(g / 10, 25.0, V, P) > 4.0)
+    assert not is_free(behind(worse), V, P, under_way=True)

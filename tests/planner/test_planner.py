@@ -8,8 +8,10 @@ import numpy as np
 import pytest
 
 from perception.messages import EgoState, PlannerInput
-from planner.messages import SpeedSource
-from planner.planner import Planner, PlannerParams
+from planner.fsm.motion import Motion
+from planner.messages import Lead, SpeedSource
+from planner.motion_layer import Manoeuvre
+from planner.planner import Planner, PlannerParams, _with_room
 from planner.speed_planning import Binding, SpeedPlanner
 from tests.planner.maps import KPH, real_map, road_spec, segment, straight_road
 from tests.vehicle import VEHICLE
@@ -101,3 +103,23 @@ def test_rejects_oncoming_lane() -> None:
     road = straight_road("real", 100.0, 50.0)
     with pytest.raises(ValueError, match="ego-direction"):
         Planner(road, PlannerParams(10.0, 20.0, VEHICLE, lane=-1))
+
+
+def test_with_a_flat_tyre_rear_traffic_is_judged_at_the_speed_flat_slows_to() -> None:
+    """FLAT slows at ``a_flat_plan`` (2 m/s^2) to its crawl (6 m/s): over the longest lane
+    change (5 s) from 16 m/s the car ends at 6 m/s, from 25 m/s at 15 m/s."""
+    p = planner(straight_road("real", 500.0, 90.0), lane=0)
+    assert p._lowest_speed(16.0, flat=False) == 16.0
+    assert p._lowest_speed(16.0, flat=True) == pytest.approx(6.0)
+    assert p._lowest_speed(25.0, flat=True) == pytest.approx(15.0)
+    assert p._lowest_speed(4.0, flat=True) == pytest.approx(4.0)
+
+
+def test_the_acc_sees_a_stationary_car_it_may_pass_nearer_by_the_room() -> None:
+
+    lead = Lead(7, 1.0, 20.0, 0.0)
+    room = Manoeuvre(Motion.LANE_KEEP, 0, 0, None, room=8.0, room_for=7)
+    assert _with_room(lead, room) == Lead(7, 1.0, 12.0, 0.0)
+    other = Manoeuvre(Motion.LANE_KEEP, 0, 0, None, room=8.0, room_for=3)
+    assert _with_room(lead, other) is lead
+    assert _with_room(None, room) is None

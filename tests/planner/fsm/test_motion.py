@@ -64,6 +64,17 @@ TABLE_CASES = [
     ("keep_overtake_right", M.LANE_KEEP, x(blocked=True, right_free=True), M.LANE_CHANGE_RIGHT,
      False),
     ("keep_blocked_nothing_free", M.LANE_KEEP, x(blocked=True), None, False),
+    # a pass starts only if its path clears the vehicle ahead (e.g. from too near behind a
+    # stopped car: the car waits in its lane); the other side may still do
+    ("keep_overtake_left_waits_until_it_clears", M.LANE_KEEP,
+     x(blocked=True, left_free=True, clears_left=False), None, False),
+    ("keep_overtake_right_when_only_it_clears", M.LANE_KEEP,
+     x(blocked=True, left_free=True, right_free=True, clears_left=False), M.LANE_CHANGE_RIGHT,
+     False),
+    ("keep_overtake_right_waits_until_it_clears", M.LANE_KEEP,
+     x(blocked=True, right_free=True, clears_right=False), None, False),
+    ("keep_route_change_needs_no_pass_clearance", M.LANE_KEEP,
+     x(route_lane=-1, right_free=True, clears_right=False), M.LANE_CHANGE_RIGHT, False),
     ("keep_free_not_blocked", M.LANE_KEEP, x(left_free=True, right_free=True), None, False),
     ("keep_overtake_not_allowed", M.LANE_KEEP, x(overtake=False, blocked=True, left_free=True),
      None, False),
