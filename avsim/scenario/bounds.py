@@ -14,6 +14,8 @@ from typing import Annotated
 
 from pydantic import Field
 
+MAX_FILE_BYTES = 512 * 1024  # a scenario file's size (the bundled ones are about 2 kB)
+MAX_VALUES = 100_000  # the values (scalars, lists, mappings) a file holds, anchors expanded
 MAX_DURATION = 7200.0  # [s] `duration`, and every time in the file (triggers, delays, lights)
 MAX_SEED = 2**32 - 1  # `seed` (numpy's seed range)
 MAX_LANES = 6  # driving lanes per direction on a road, oncoming lanes

@@ -2,8 +2,9 @@
 
 A scenario argument is a file path, or the name of a bundled scenario in `<repo>/scenarios/`
 (`SCENARIO_DIR`). The YAML is read with a strict safe loader: a key written twice in one
-mapping is an error (PyYAML would keep the last), and plain scalars are read by the YAML
-1.2 core schema (``1e9`` is a number, ``yes`` is text). Problems are `LocatedError`s keyed
+mapping is an error (PyYAML would keep the last), plain scalars are read by the YAML 1.2
+core schema (``1e9`` is a number, ``yes`` is text), and a file over `MAX_FILE_BYTES` or
+holding over `MAX_VALUES` values (anchors expanded) is refused. Problems are `LocatedError`s keyed
 `(file)` or `line N`.
 """
 
@@ -13,10 +14,11 @@ import os
 import re
 from collections.abc import Hashable
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import yaml
 
+from avsim.scenario.bounds import MAX_FILE_BYTES, MAX_VALUES
 from avsim.scenario.errors import FILE_KEY, LocatedError, show
 
 REPO_ROOT = Path(__file__).resolve().parents[2]  # the repository this package sits in
@@ -58,7 +60,13 @@ def shown_name(path_or_name: str | Path, path: Path) -> str:
 _MERGE_TAG = "tag:yaml.org,2002:merge"
 
 
-class _StrictLoader(yaml.SafeLoader):
+if TYPE_CHECKING:
+    _Base = yaml.SafeLoader
+else:  # libyaml's parser where PyYAML has it (its wheels do): 30 times the pure Python one's
+    _Base = yaml.CSafeLoader if yaml.__with_libyaml__ else yaml.SafeLoader
+
+
+class _StrictLoader(_Base):
     """A safe YAML loader that refuses duplicate keys instead of keeping the last one, and
     reads plain scalars by the YAML 1.2 core schema (`_core_schema`) instead of PyYAML's YAML
     1.1 rules: ``1e9`` and ``.5`` are numbers, ``yes`` / ``on`` and ``2024-01-01`` are text,
@@ -81,7 +89,7 @@ class _StrictLoader(yaml.SafeLoader):
                 )
             if isinstance(key, Hashable):
                 seen[key] = key_node
-        return super().construct_mapping(node, deep=deep)
+        return yaml.constructor.SafeConstructor.construct_mapping(self, node, deep=deep)
 
 
 def _core_schema(loader: type[yaml.SafeLoader]) -> None:
@@ -124,6 +132,9 @@ def parse_value(text: str) -> Any:
 def read_raw(path: Path) -> dict[str, Any]:
     """The file's YAML as a mapping, or a `LocatedError` keyed `(file)` or `line N`."""
     try:
+        size = path.stat().st_size
+        if size > MAX_FILE_BYTES and path.is_file():
+            raise LocatedError(FILE_KEY, f"{size} bytes: at most {MAX_FILE_BYTES}")
         text = path.read_text(encoding="utf-8")
     except FileNotFoundError:
         raise LocatedError(FILE_KEY, "no such file") from None
@@ -141,11 +152,28 @@ def read_raw(path: Path) -> dict[str, Any]:
         raise LocatedError(FILE_KEY, f"YAML error: {exc}") from None
     if data is None:
         raise LocatedError(FILE_KEY, "empty file")
+    _check_values(data)
     if not isinstance(data, dict):
         raise LocatedError(
             FILE_KEY, f"must be a mapping of keys (format, name, ...), got {show(data)}"
         )
     return data
+
+
+def _check_values(data: object) -> None:
+    """At most `MAX_VALUES` values in the document, counting every use of an anchor (YAML
+    aliases share one value, but everything after the loader walks each use: a few nested
+    anchors would otherwise ask for billions). The count stops at the bound."""
+    count, todo = 0, [data]
+    while todo:
+        node = todo.pop()
+        count += 1
+        if count > MAX_VALUES:
+            raise LocatedError(FILE_KEY, f"more than {MAX_VALUES} values (anchors expanded)")
+        if isinstance(node, dict):
+            todo.extend(node.values())
+        elif isinstance(node, list):
+            todo.extend(node)
 
 
 def _yaml_problem(exc: yaml.MarkedYAMLError) -> LocatedError:
