@@ -39,6 +39,7 @@ from avsim.criteria.base import (
     Verdict,
 )
 from avsim.criteria.collision import NoCollision
+from avsim.criteria.comfort import peaks
 from avsim.criteria.declaration import RunInputs
 from avsim.criteria.lane import TyresInLane
 from avsim.criteria.registry import build_criteria
@@ -415,7 +416,8 @@ class Runner:
             "distance": float(self.log.station[-1] - self.log.station[0]) if xte.size else 0.0,
             "collisions": float(self.collisions.count),
             "acc_shortest_mode": shortest_hold(self.state_changes, "acc"),
-        } | (self.sensors.metrics() if self.setup is not None else {})
+        } | peaks(self.log.array("t"), speed) \
+            | (self.sensors.metrics() if self.setup is not None else {})
 
     # -- recording -----------------------------------------------------------------------------
 
