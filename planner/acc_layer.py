@@ -7,7 +7,10 @@ Per tick:
 1. the lead's bumper gap is carried from its track's time t_track to now with the relative
    speed, ``d_now = d + (V_l - v) (t - t_track)`` (tracks are one sensor period old);
    V_GPS is the posted limit at the front bumper, V_s the set speed (ACC is on while
-   V_s > 0);
+   V_s > 0); the least deceleration that still stops the closing on the lead
+   (`planner.acc_control.need`, from the deceleration the car brakes at now), whether it
+   leaves a comfortable stop (and with the FSM's hysteresis to spare), the time to
+   collision, and whether a lead was lost within the FSM's ``lead_hold``;
 2. the FSM steps once;
 3. the mode's law gives the reference: ACC_OFF 0; CRUISE and SPEED_LIMIT the speed plan;
    TRAIL and BRAKE their laws behind the lead; OFF_RAMP the speed plan (the ramp's limit
@@ -19,7 +22,9 @@ Per tick:
    where the car is faster than the law). A vehicle ahead still counts in an event mode:
    the reference is the lower of the event's law and the trail law behind it. The plan's
    `SpeedSource` is the law's where it lowers the speed plan (FLAT's always), the plan's
-   own otherwise.
+   own otherwise;
+4. the deceleration the car brakes at is carried on from the reference's feed-forward
+   (`planner.acc_control.BrakeModel`: it rises at the speed loop's comfort jerk).
 """
 
 from __future__ import annotations
@@ -149,8 +154,8 @@ class AccLayer:
         law = trail(plan.speed, x.d, d_des, x.v_l, m.d0, c)
         stopped = x.v_l < c.v_standstill
         end = m.d0 + c.stop_band if stopped else gaps(x.v_l, x.v_l, m).d_des
-        if driver_gap is not None and not stopped:
-            end = min(end, r157_min_gap(x.v_l) + driver_gap)
+        if driver_gap is not None and not stopped:  # d_min at the faster of the two: a
+            end = min(end, r157_min_gap(max(x.v, x.v_l)) + driver_gap)  # closing car's
         return follow(x.v, law, x.d, x.v_l, end, dt, c, a_min, self._braking.a)
 
     def _control(self, x: AccInput, dt: float, planned: PlannedSpeed,
