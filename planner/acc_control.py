@@ -46,8 +46,9 @@ pedal). `planner.acc_layer` picks the law for the mode.
   behind a stopped car ends with a short one) and the cap is a_hard, the feed-forward beyond
   a_comf_max telling the speed loop the plan is urgent. The stops and the bump use the same
   approach with room = the distance to their point less the margin (need = a_plan: a point
-  on the map has no floor short of it). Of the laws that bind (an event's and the trail law
-  behind a vehicle ahead), the lower reference is taken, the minimum of the laws' outputs.
+  on the map has no floor short of it). Of the laws that bind (the speed plan, an event's, the
+  trail law behind a vehicle ahead), the one the speed loop would ask least of the car on
+  is taken, the minimum of the laws' outputs (`planner.acc_layer`).
 - BRAKE (gap at or below d_min, or no comfortable stop): the approach behind the lead on
   the trail law, with the gap opened at no more than ``a_open`` while it is under d_min
   and the lead is not closing, and the cap a_comf_max, or a_hard when no comfortable stop
@@ -158,10 +159,13 @@ def approach(v: float, law: SpeedRef, a_plan: float, a_need: float, dt: float,
              p: AccControlParams) -> SpeedRef:
     """The law's reference `law`, or, where the car at speed v [m/s] is faster than it and
     the planned deceleration `a_plan` [m/s^2] is gentler than the speed loop's reaction,
-    that deceleration from the car's speed over dt [s]; never gentler than `a_need`, capped
-    at a_comf_max (a_hard when a_need exceeds it)."""
+    that deceleration from the car's speed over dt [s]; never gentler than `a_need` (below
+    the law: only when that leaves no comfortable stop), capped at a_comf_max (a_hard when
+    a_need exceeds it)."""
     loop = max(-law.accel, 0.0) + max(v - law.speed, 0.0) / p.tau_loop
-    if v <= law.speed:  # not faster than the law: nothing to plan
+    if v <= law.speed:  # not faster than the law: the law, unless no comfortable stop
+        if comfortable(a_need, p):
+            return law
         a_plan = loop
     a = max(a_need, min(loop, a_plan))
     if a <= loop and a_plan >= loop:

@@ -20,9 +20,12 @@ Per tick:
    behind a lead and each stop or pass point goes through the approach
    (`planner.acc_control`: a planned constant deceleration within ISO 15622's comfort
    where the car is faster than the law). A vehicle ahead still counts in an event mode:
-   the reference is the lower of the event's law and the trail law behind it. The plan's
-   `SpeedSource` is the law's where it lowers the speed plan (FLAT's always), the plan's
-   own otherwise;
+   the reference is the lower of the event's law and the trail law behind it. Lower is
+   what the speed loop would ask less of the car on, ``a_ff + (v_ref - v) / tau_loop``
+   (the minimum of the laws' outputs: a planned deceleration from the car's speed counts
+   by its feed-forward, and binds even while the car is a ripple above the plan). The
+   plan's `SpeedSource` is the law's where it lowers the speed plan (FLAT's always), the
+   plan's own otherwise;
 4. the deceleration the car brakes at is carried on from the reference's feed-forward
    (`planner.acc_control.BrakeModel`: it rises at the speed loop's comfort jerk).
 """
@@ -124,25 +127,28 @@ class AccLayer:
                                         else 0.0), SpeedSource.EVENT)
         elif self.mode is AccMode.SPEED_BUMP:
             ref = bump(events.bump_distance, events.bump_speed, x.v, plan.speed, dt, c)
-            out = self._lower(planned, ref, SpeedSource.EVENT)
+            out = self._lower(planned, PlannedSpeed(ref, SpeedSource.EVENT), x.v)
         elif self.mode in STOP_LAWS:
             ref = stop(events.stop_distance, x.v, plan.speed, dt, c)
-            out = self._lower(planned, ref, SpeedSource.EVENT)
+            out = self._lower(planned, PlannedSpeed(ref, SpeedSource.EVENT), x.v)
         else:
             out = planned
         if math.isfinite(x.d):
             following = self._following(x, dt, plan, None)
-            if following.speed < out.ref.speed:
-                return PlannedSpeed(following, SpeedSource.FOLLOWING)
+            return self._lower(out, PlannedSpeed(following, SpeedSource.FOLLOWING), x.v)
         return out
 
-    @staticmethod
-    def _lower(planned: PlannedSpeed, ref: SpeedRef, source: SpeedSource) -> PlannedSpeed:
-        """`ref` from `source` where it is below the plan, else the plan (with `ref`'s
-        feed-forward where it brakes)."""
-        if ref.speed < planned.ref.speed:
-            return PlannedSpeed(ref, source)
-        return planned
+    def _lower(self, planned: PlannedSpeed, law: PlannedSpeed, v: float) -> PlannedSpeed:
+        """The minimum of two laws' outputs: `law` where the speed loop would ask less of
+        the car on it than on `planned` at the speed v [m/s] (its request, feed-forward +
+        (speed - v) / tau_loop: a planned deceleration from the speed counts by its
+        feed-forward), else `planned`."""
+        tau = self.params.control.tau_loop
+
+        def request(ref: SpeedRef) -> float:
+            return ref.accel + (ref.speed - v) / tau
+
+        return law if request(law.ref) < request(planned.ref) else planned
 
     def _following(self, x: AccInput, dt: float, plan: SpeedRef,
                    driver_gap: float | None, a_min: float = 0.0) -> SpeedRef:
@@ -165,8 +171,7 @@ class AccLayer:
         if self.mode is AccMode.BRAKE:  # open a gap under d_min at up to a_open
             opening = c.a_open if x.d <= gaps(x.v, x.v_l, m).d_min else 0.0
             ref = self._following(x, dt, plan, driver_gap, opening)
-            return PlannedSpeed(ref, SpeedSource.FOLLOWING) if ref.speed < plan.speed \
-                else planned
+            return self._lower(planned, PlannedSpeed(ref, SpeedSource.FOLLOWING), x.v)
         if self.mode is AccMode.TRAIL:
             following = self._following(x, dt, plan, driver_gap)
             source = SpeedSource.FOLLOWING if following.speed < plan.speed else planned.source

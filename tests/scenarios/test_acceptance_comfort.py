@@ -1,7 +1,7 @@
 """ACC comfort within ISO 15622 / ISO 22179 (issue K, items 1, 3 and 5), on the acceptance
 scenarios that reproduced its failures: (a) closing at 15 km/h on a slower lead from 25 m
 (braked at 4.4 m/s^2, where about 1 m/s^2 does); (b) a stopped car revealed by the lead's
-cut-out about 45 m ahead (braked at 5.9 m/s^2); (c) a stop line, a crossing a pedestrian
+cut-out about 50 m ahead (braked at 5.9 m/s^2); (c) a stop line, a crossing a pedestrian
 walks onto and a speed bump, met at 40 km/h (the crossing braked at 5.9 m/s^2: a pedestrian
 is tracked from about 24 m); and pedal pushes while following (never nearer the lead than
 UN R157's d_min).
@@ -77,7 +77,7 @@ def test_a_stopped_car_revealed_by_a_cut_out_is_stopped_for_comfortably(
     log = revealed.log
     t, gap, lead_v = log.array("t"), log.array("lead_gap"), log.array("lead_speed")
     jump = int(np.argmax(np.diff(gap) > 10.0)) + 1  # the lead left: the stopped car ahead
-    assert lead_v[jump] == 0.0 and 40.0 < gap[jump] < 50.0
+    assert lead_v[jump] == 0.0 and 40.0 < gap[jump] < 55.0
     assert log.speed[jump] == pytest.approx(50 * KPH, abs=0.3)
     # comfortable by the truth: stopping 2 m short needs under 3.5 m/s^2
     assert log.speed[jump] ** 2 / (2.0 * (gap[jump] - 2.0)) < 3.5
@@ -119,7 +119,9 @@ def test_pedal_pushes_while_following_keep_d_min(pedal: RunResult) -> None:
     margin = gap - np.array([r157_min_gap(x) for x in v])
     start = int(np.argmax(pushed))
     end = len(pushed) - 1 - int(np.argmax(pushed[::-1]))
-    assert v[start:end].max() > v[start] + 0.5  # the push did speed the car up
+    lead_v = log.array("lead_speed")
+    assert v[start:end].max() > lead_v[start] + 0.3  # the push sped it up, closing in ...
+    assert gap[start:end].min() < gap[start] - 1.0  # ... on the lead
     around = (t > t[start] - 1.0) & (t < t[end] + 5.0)  # the push, its start and its end
     assert float(margin[around].min()) > 0.0
     assert float(margin[t > 2.0].min()) > 0.0
