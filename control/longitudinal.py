@@ -85,7 +85,7 @@ class SpeedParams:
     #   (`planner.limits.A_COMF_MAX`)
     comfort_decel: float = 3.2  # [m/s^2] in a comfortable plan, the request's floor (under
     #   ISO 15622's 3.5 m/s^2)
-    comfort_jerk: float = 2.3  # [m/s^3] in a comfortable plan, the most the deceleration
+    comfort_jerk: float = 2.0  # [m/s^3] in a comfortable plan, the most the deceleration
     #   rises per second (under ISO 15622's 2.5 m/s^3; `planner.limits.J_COMF`)
 
     @property

@@ -29,8 +29,10 @@ pedal). `planner.acc_layer` picks the law for the mode.
   deceleration, the one that brings the closing speed to zero at the law's end point,
   ``a_plan = (v^2 - v_end^2) / (2 room)`` (a stop or pass point; behind a lead ``(v - v_l)^2
   / (2 (d - d_end))``, d_end = d_des(v_l) or, behind a stopped lead, d0 + stop_band),
-  whenever it is gentler than the speed loop's reaction; the reference then follows it from
-  the car's speed (``v - a dt``, feed-forward -a) and the speed loop's jerk limit
+  whenever it is gentler than the speed loop's reaction and that reaction exceeds a_gentle
+  (1 m/s^2: below it the law itself acts, so a lead that slows down is followed as it slows,
+  not by a plan that assumes its speed now); the reference then follows it from the car's
+  speed (``v - a dt``, feed-forward -a) and the speed loop's jerk limit
   (`control.longitudinal`: comfort_jerk) eases it in. It is never gentler than ``need``, the
   least deceleration that still stops the closing at d_floor (2.5 m: UN R157 4.2.1's least
   standstill gap of 2 m and a margin; once the car is inside d_end, it keeps to the law, or,
@@ -45,10 +47,11 @@ pedal). `planner.acc_layer` picks the law for the mode.
   needs 3.9 m/s^2, ttc 2.1 s"; the time to collision is reported, not judged: a planned stop
   behind a stopped car ends with a short one) and the cap is a_hard, the feed-forward beyond
   a_comf_max telling the speed loop the plan is urgent. The stops and the bump use the same
-  approach with room = the distance to their point less the margin (need = a_plan: a point
-  on the map has no floor short of it). Of the laws that bind (the speed plan, an event's, the
-  trail law behind a vehicle ahead), the one the speed loop would ask least of the car on
-  is taken, the minimum of the laws' outputs (`planner.acc_layer`).
+  approach with room = the distance to their point less the margin and the ramp-in from the
+  deceleration the car brakes at (`ramped`; need = a_plan: a point on the map has no floor
+  short of it). Of the laws that bind (the speed plan, an event's, the trail law behind a
+  vehicle ahead), the one the speed loop would ask least of the car on is taken, the minimum
+  of the laws' outputs (`planner.acc_layer`).
 - BRAKE (gap at or below d_min, or no comfortable stop): the approach behind the lead on
   the trail law, with the gap opened at no more than ``a_open`` while it is under d_min
   and the lead is not closing, and the cap a_comf_max, or a_hard when no comfortable stop
@@ -89,6 +92,8 @@ class AccControlParams:
     a_comf_max: float = A_COMF_MAX  # [m/s^2] the most a comfortable approach plans
     a_hard: float = A_HARD  # [m/s^2] the most BRAKE plans when no comfortable stop is left
     a_open: float = A_COMF  # [m/s^2] BRAKE opens a gap under d_min at no more than this
+    a_gentle: float = 1.0  # [m/s^2] the approach keeps to the law while the speed loop's
+    #   reaction to it is no harder than this (a lead slowing down is followed as it slows)
     tau_loop: float = 0.8  # [s] the speed loop's time constant (`control.longitudinal`):
     #   it brakes at (v - v_ref) / tau_loop on a reference below the speed
     j_comf: float = J_COMF  # [m/s^3] the speed loop eases a comfortable plan in at this
@@ -167,6 +172,7 @@ def approach(v: float, law: SpeedRef, a_plan: float, a_need: float, dt: float,
         if comfortable(a_need, p):
             return law
         a_plan = loop
+    a_plan = max(a_plan, p.a_gentle)  # the law's own reaction is kept up to a_gentle
     a = max(a_need, min(loop, a_plan))
     if a <= loop and a_plan >= loop:
         return law
@@ -192,24 +198,35 @@ def follow(v: float, law: SpeedRef, d: float, v_l: float, d_end: float, dt: floa
     return approach(v, law, a_plan, need(v, v_l, d, p, a_now), dt, p)
 
 
-def stop(distance: float, v: float, v_plan: float, dt: float, p: AccControlParams) -> SpeedRef:
+def ramped(v: float, v_end: float, room: float, a_now: float, p: AccControlParams) -> float:
+    """[m/s^2] the constant deceleration from v to v_end [m/s] within `room` [m] after the
+    ramp-in from `a_now` [m/s^2] at j_comf (the room shortened by v (a - a_now) / (2 j_comf),
+    a first estimated without it); inf with no room."""
+    if room <= p.arrived:
+        return math.inf
+    first = max(v * v - v_end * v_end, 0.0) / (2.0 * room)
+    left = room - v * max(first - a_now, 0.0) / (2.0 * p.j_comf)
+    return max(v * v - v_end * v_end, 0.0) / (2.0 * left) if left > 0.0 else math.inf
+
+
+def stop(distance: float, v: float, v_plan: float, dt: float, p: AccControlParams,
+         a_now: float = 0.0) -> SpeedRef:
     """The stop `margin` before `distance` [m] (`stop_speed`) through the approach from the
-    speed v [m/s]."""
+    speed v [m/s], braking at `a_now` [m/s^2] now (`ramped`)."""
     speed = stop_speed(distance, v_plan, p)
     law = SpeedRef(speed, -p.a_comf if 0.0 < speed < v_plan else 0.0)
-    room = distance - p.margin
-    a_plan = v * v / (2.0 * room) if room > p.arrived else math.inf
+    a_plan = ramped(v, 0.0, distance - p.margin, a_now, p)
     return approach(v, law, a_plan, a_plan if v > speed else 0.0, dt, p) if speed > 0.0 \
         else law
 
 
 def bump(distance: float, v_pass: float, v: float, v_plan: float, dt: float,
-         p: AccControlParams) -> SpeedRef:
-    """The bump's pass speed (`pass_speed`) through the approach from the speed v [m/s]."""
+         p: AccControlParams, a_now: float = 0.0) -> SpeedRef:
+    """The bump's pass speed (`pass_speed`) through the approach from the speed v [m/s],
+    braking at `a_now` [m/s^2] now (`ramped`)."""
     speed = pass_speed(distance, v_pass, v_plan, p)
     law = SpeedRef(speed, -p.a_comf if v_pass < speed < v_plan else 0.0)
-    room = distance - p.margin
-    a_plan = max(v * v - v_pass * v_pass, 0.0) / (2.0 * room) if room > p.arrived else 0.0
+    a_plan = ramped(v, v_pass, distance - p.margin, a_now, p) if v > v_pass else 0.0
     return approach(v, law, a_plan, a_plan if v > speed else 0.0, dt, p)
 
 

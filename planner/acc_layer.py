@@ -126,10 +126,11 @@ class AccLayer:
             out = PlannedSpeed(SpeedRef(self._flat, -c.a_flat_plan if self._flat > floor
                                         else 0.0), SpeedSource.EVENT)
         elif self.mode is AccMode.SPEED_BUMP:
-            ref = bump(events.bump_distance, events.bump_speed, x.v, plan.speed, dt, c)
+            ref = bump(events.bump_distance, events.bump_speed, x.v, plan.speed, dt, c,
+                       self._braking.a)
             out = self._lower(planned, PlannedSpeed(ref, SpeedSource.EVENT), x.v)
         elif self.mode in STOP_LAWS:
-            ref = stop(events.stop_distance, x.v, plan.speed, dt, c)
+            ref = stop(events.stop_distance, x.v, plan.speed, dt, c, self._braking.a)
             out = self._lower(planned, PlannedSpeed(ref, SpeedSource.EVENT), x.v)
         else:
             out = planned

@@ -28,7 +28,7 @@ A_ISO = 3.5  # [m/s^2] ISO 15622 / 22179 (above 20 m/s): an ACC's deceleration, 
 J_ISO = 2.5  # [m/s^3] ISO 15622 / 22179 (above 20 m/s): the rise of its deceleration, 1 s
 #   average
 A_COMF_MAX = 3.0  # [m/s^2] the most a comfortable law plans (under A_ISO)
-J_COMF = 2.3  # [m/s^3] the rise of a comfortable plan's deceleration (under J_ISO)
+J_COMF = 2.0  # [m/s^3] the rise of a comfortable plan's deceleration (under J_ISO)
 A_HARD = 5.0  # [m/s^2] hard
 A_FLAT = 4.0  # [m/s^2] DECS's acceptance for a flat tyre (UN R157's bound on a minimum-risk
 #   manoeuvre is the same)

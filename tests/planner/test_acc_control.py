@@ -58,9 +58,12 @@ def test_need_stops_the_closing_at_the_floor_after_a_ramp_in() -> None:
 def test_approach_plans_the_gentler_of_the_law_and_the_constant_deceleration() -> None:
     dt, v = 0.025, 11.1
     law = SpeedRef(8.0, 0.0)  # the loop would brake at (11.1 - 8) / 0.8 = 3.9 m/s^2
-    ref = approach(v, law, 0.8, 0.5, dt, P)
-    assert ref.accel == pytest.approx(-0.8)  # the planned deceleration, not the jolt
-    assert ref.speed == pytest.approx(v - 0.8 * dt)  # followed from the car's speed
+    ref = approach(v, law, 1.2, 0.5, dt, P)
+    assert ref.accel == pytest.approx(-1.2)  # the planned deceleration, not the jolt
+    assert ref.speed == pytest.approx(v - 1.2 * dt)  # followed from the car's speed
+    # a plan gentler than a_gentle: a_gentle (the law's own reaction is kept up to it)
+    assert approach(v, law, 0.8, 0.5, dt, P).accel == pytest.approx(-P.a_gentle)
+    assert approach(v, SpeedRef(10.5, 0.0), 0.3, 0.0, dt, P) == SpeedRef(10.5, 0.0)
     assert approach(v, law, 5.0, 0.5, dt, P) == law  # the law is gentler: the law
     assert approach(7.0, law, 0.8, 0.0, dt, P) == law  # slower than the law: the law
     # never gentler than the need; capped at a_comf_max while that is comfortable ...
@@ -73,15 +76,16 @@ def test_approach_plans_the_gentler_of_the_law_and_the_constant_deceleration() -
 
 def test_follow_approaches_a_slower_lead_at_about_1_m_s2() -> None:
     """Issue K (a): 40 km/h closing at 15 km/h from 25 m: the constant deceleration that
-    ends the closing at d_des(v_l) (14.4 m), about 0.8 m/s^2, not the speed loop's 3.9."""
+    ends the closing at d_des(v_l) (14.4 m) is 0.8 m/s^2; the law's own reaction kept to
+    a_gentle, 1 m/s^2, not the speed loop's 3.9."""
     v, v_l, d, d_end = 40 / 3.6, 25 / 3.6, 25.0, 4.0 + 1.5 * 25 / 3.6
     law = trail(v, d, 4.0 + 1.5 * v, v_l, 4.0, P)
     ref = follow(v, law, d, v_l, d_end, 0.025, P)
-    assert -ref.accel == pytest.approx((v - v_l) ** 2 / (2.0 * (d - d_end)))
-    assert -ref.accel < 1.0
-    # a stopped car revealed 45 m ahead at 50 km/h: a comfortable stop 5 m behind it
+    assert (v - v_l) ** 2 / (2.0 * (d - d_end)) < P.a_gentle  # the plan: 0.8 m/s^2 ...
+    assert -ref.accel == pytest.approx(P.a_gentle)  # ... so a_gentle, 1 m/s^2
+    # a stopped car revealed 50 m ahead at 50 km/h: a comfortable stop 5 m behind it
     v = 50 / 3.6
-    stopped = follow(v, trail(v, 45.0, 25.0, 0.0, 4.0, P), 45.0, 0.0, 5.0, 0.025, P)
+    stopped = follow(v, trail(v, 50.0, 25.0, 0.0, 4.0, P), 50.0, 0.0, 5.0, 0.025, P)
     assert 2.4 < -stopped.accel <= P.a_comf_max
     # 25 m ahead: no comfortable stop, up to a_hard
     late = follow(v, trail(v, 25.0, 25.0, 0.0, 4.0, P), 25.0, 0.0, 5.0, 0.025, P)
@@ -99,15 +103,21 @@ def test_stops_and_bumps_met_late_plan_a_constant_deceleration() -> None:
     # on the curve (far enough): the law, with its comfortable feed-forward
     far = stop(200.0, v, v, dt, P)
     assert far == SpeedRef(v, 0.0)
-    # met at 30 m: v^2 / (2 (30 - margin)) = 2.1 m/s^2, planned, not the loop's jolt
+    # met at 30 m: v^2 / (2 (30 - margin)) = 2.1 m/s^2, with the room the ramp-in takes
+    # (v 2.1 / (2 j_comf)) 2.7 m/s^2, planned, not the loop's jolt
     late = stop(30.0, v, v, dt, P)
-    assert -late.accel == pytest.approx(v * v / (2.0 * (30.0 - P.margin)))
+    first = v * v / (2.0 * (30.0 - P.margin))
+    room = 30.0 - P.margin - v * first / (2.0 * P.j_comf)
+    assert -late.accel == pytest.approx(v * v / (2.0 * room))
+    assert -late.accel <= P.a_comf_max
     # met at 12 m: no comfortable stop, harder (at most a_hard)
     assert -stop(12.0, v, v, dt, P).accel == P.a_hard
     assert stop(P.margin + 0.1, v, v, dt, P).speed == 0.0  # arrived
     v_pass = 15 / 3.6
     slow = bump(20.0, v_pass, v, v, dt, P)
-    assert -slow.accel == pytest.approx((v * v - v_pass**2) / (2.0 * (20.0 - P.margin)))
+    first = (v * v - v_pass**2) / (2.0 * (20.0 - P.margin))
+    room = 20.0 - P.margin - v * first / (2.0 * P.j_comf)
+    assert -slow.accel == pytest.approx(min((v * v - v_pass**2) / (2.0 * room), P.a_hard))
     assert bump(200.0, v_pass, v, v, dt, P).speed == pytest.approx(v)
 
 
