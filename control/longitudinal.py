@@ -6,10 +6,10 @@ measured forward speed [m/s] and dt [s]. Output: a `SpeedCommand`, the accelerat
 
 Steps of `SpeedController.update`:
 
-1. Hold guard: when the target speed is at most ``stop_target_speed`` and the car is slower
-   than ``standstill_speed``, the car holds at a stop: the PID is reset (no windup while
-   parked) and the desired request is -``hold_decel``, flagged ``hold`` so that actuation
-   applies brake only.
+1. Hold guard: when the target speed is at most ``stop_target_speed``, the plan asks for
+   no acceleration and the car is slower than ``standstill_speed``, the car holds at a
+   stop: the PID is reset (no windup while parked) and the desired request is
+   -``hold_decel``, flagged ``hold`` so that actuation applies brake only.
 2. Otherwise desired = target_accel (the planner's feed-forward) + PID(target_speed - speed).
    Conditional integration (anti-windup on top of the PID's clamp): the integrator runs only
    within |error| <= ``integration_band`` (a large speed step would charge it on the way up
@@ -21,10 +21,21 @@ Steps of `SpeedController.update`:
    ``stall_delay``. The stall test reads the request and the time, not the rise of the
    estimated speed, which lags and is noisy and would take a pull-away for a stall.
 3. Clamp to [-``max_decel``, ``max_accel``] (ICCAS 2020 drives with at most 5 m/s^2).
-4. Jerk limit: the request moves by at most ``max_jerk`` dt per step. ``max_jerk`` is an
-   actuator guard, not a comfort setting (ride comfort is the planner's job, through
-   target_accel): it keeps torque steps and PID noise off the drivetrain while letting hard
-   braking reach ``max_decel`` within a fraction of a second.
+   Comfort envelope (ISO 15622 / ISO 22179: an ACC decelerates at most 3.5 m/s^2 over 2 s,
+   and its deceleration rises at most at 2.5 m/s^3 over 1 s): while the plan is
+   comfortable, its feed-forward no harder than -``comfort_plan``, the request is also
+   kept above -``comfort_decel`` and its deceleration rises at most at ``comfort_jerk``.
+   The plan's deceleration is the planner's to choose (its laws plan at most
+   ``comfort_plan`` unless no comfortable stop is left, `planner.acc_control`); the
+   envelope keeps the PID's share within comfort too, so that a step in the target speed
+   does not become a jolt. A car holding at a stop is at rest: no envelope. A plan asking
+   for more braking than ``comfort_plan`` is urgent: the envelope is off and the actuator
+   limits below apply.
+4. Jerk limit: the request moves by at most ``max_jerk`` dt per step (in a comfortable
+   plan, a request at or below 0 falls by at most ``comfort_jerk`` dt: the deceleration
+   rises at the comfort jerk, while an acceleration is still taken back at once). ``max_jerk`` is an
+   actuator guard: it keeps torque steps and PID noise off the drivetrain while letting
+   hard braking reach ``max_decel`` within a fraction of a second.
 
 The first step after `reset()` ramps from 0 m/s^2.
 
@@ -70,6 +81,12 @@ class SpeedParams:
     standstill_speed: float = 0.3  # [m/s] below this (with a stop target) the car holds
     hold_decel: float = 3.0  # [m/s^2] positive, the request while holding (brake only)
     emergency_jerk: float = 40.0  # [m/s^3] the emergency request's rise rate (the brake's)
+    comfort_plan: float = 3.0  # [m/s^2] a plan braking no harder than this is comfortable
+    #   (`planner.limits.A_COMF_MAX`)
+    comfort_decel: float = 3.2  # [m/s^2] in a comfortable plan, the request's floor (under
+    #   ISO 15622's 3.5 m/s^2)
+    comfort_jerk: float = 2.0  # [m/s^3] in a comfortable plan, the most the deceleration
+    #   rises per second (under ISO 15622's 2.5 m/s^3; `planner.limits.J_COMF`)
 
     @property
     def pid(self) -> PidParams:
@@ -117,7 +134,7 @@ class SpeedController:
             accel = max(self._accel - step, target_accel)
             self._accel, self._excess = accel, 0.0
             return SpeedCommand(accel=accel, hold=speed < p.standstill_speed)
-        stop_requested = target_speed <= p.stop_target_speed
+        stop_requested = target_speed <= p.stop_target_speed and target_accel <= 0.0
         at_standstill = speed < p.standstill_speed
         hold = stop_requested and at_standstill
         if hold:
@@ -129,9 +146,14 @@ class SpeedController:
             integrate = self._excess * error <= 0.0 and (abs(error) <= p.integration_band
                                                          or stalled)
             desired = target_accel + self._pid.update(error, dt, integrate=integrate)
-        clamped = min(max(desired, -p.max_decel), p.max_accel)
+        comfortable = target_accel >= -p.comfort_plan and not hold  # (a hold: at rest)
+        floor = p.comfort_decel if comfortable else p.max_decel
+        clamped = min(max(desired, -floor), p.max_accel)
         max_step = p.max_jerk * dt
-        accel = self._accel + min(max(clamped - self._accel, -max_step), max_step)
+        low = self._accel - max_step  # the braking part of a drop, at the comfort jerk:
+        if comfortable:
+            low = max(low, min(self._accel, 0.0) - p.comfort_jerk * dt)
+        accel = min(max(clamped, low), self._accel + max_step)
         self._excess = desired - accel
         pressing = accel >= p.stall_rise and speed < p.stall_speed and not hold
         self._pressing = self._pressing + dt if pressing else 0.0

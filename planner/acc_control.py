@@ -17,27 +17,55 @@ pedal). `planner.acc_layer` picks the law for the mode.
   which braking at a_comf still stops d0 behind a lead that stops. Stop-and-go: behind a
   lead slower than ``v_standstill`` the gap law would creep up on it for several of its time
   constants, so the reference is the braking curve ``sqrt(2 a_final max(d - d0 - stop_band,
-  0))`` alone: the car comes to rest ``stop_band`` beyond d0 in finite time, the speed loop
-  holds it, and it moves off as soon as the lead does.
-- BRAKE (gap at or below d_min), hard braking that eases in: the deceleration that brings
-  the speed down to the trail law's v_trail (below the lead's while the gap is short, so the
-  gap opens again) before the gap shrinks to d_stop, ``a_need = max(v^2 - v_trail^2, 0) /
-  (2 max(d - d_stop, 0.5 m))`` (`braking_need`), at most a_firm (enough for a cut-in at UN
-  R157's distances), or a_hard when the time to collision ``d / (v - v_l)`` is under
-  ``ttc_hard`` (`brake_cap`). The command rises towards it at no more than the jerk j_in
-  ("the throttle is held momentarily, then gradually eased"), so a cut-in does not jolt the
-  car (or the one behind it), and drops at once when less is needed (`EasedBrake`). The
-  speed reference follows the planned deceleration, ``v - a_cmd dt``, so that the speed loop
-  adds little of its own.
+  0))`` alone: the car comes to rest ``stop_band`` beyond d0 in finite time (a bumper gap
+  of d0 + stop_band = 5 m, inside UN R157 4.2.1's 2 to 6 m), the speed loop holds it, and
+  it moves off as soon as the lead does.
+- The approach (`approach`, every law behind a lead and every stop or pass point; ISO 15622
+  / ISO 22179 comfort: at most 3.5 m/s^2 over 2 s, its rise at most 2.5 m/s^3 over 1 s). A
+  speed law's reference below the car's speed would make the speed loop brake at ``(v -
+  v_ref) / tau_loop`` at once: a car that meets a slower lead, a stopped car revealed by a
+  cut-out or a stop line in its law's reach faster than the law's curve would be jolted.
+  Where the car is faster than the law, the reference is instead a planned constant
+  deceleration, the one that brings the closing speed to zero at the law's end point,
+  ``a_plan = (v^2 - v_end^2) / (2 room)`` (a stop or pass point; behind a lead ``(v - v_l)^2
+  / (2 (d - d_end))``, d_end = d_des(v_l) or, behind a stopped lead, d0 + stop_band),
+  whenever it is gentler than the speed loop's reaction and that reaction exceeds a_gentle
+  (1 m/s^2: below it the law itself acts, so a lead that slows down is followed as it slows,
+  not by a plan that assumes its speed now); the reference then follows it from the car's
+  speed (``v - a dt``, feed-forward -a) and the speed loop's jerk limit
+  (`control.longitudinal`: comfort_jerk) eases it in. It is never gentler than ``need``, the
+  least deceleration that still stops the closing at d_floor (2.5 m: UN R157 4.2.1's least
+  standstill gap of 2 m and a margin; once the car is inside d_end, it keeps to the law, or,
+  where the law would brake harder than a_open, stops the closing at the floor at a_open or
+  more), the room shortened by the closing speed times ``t_ramp = (a_comf_max - a_now) / (2
+  j_comf)``, what the ramp-in at the speed loop's comfort jerk from the deceleration the car
+  already brakes at (a_now, `BrakeModel`) costs: ``need = (v - v_l)^2 / (2 (d - d_floor - (v
+  - v_l) t_ramp))``. The planned deceleration is capped at a_comf_max
+  (`planner.limits.A_COMF_MAX`, under ISO's 3.5 m/s^2), so that a car short of room stops a
+  little nearer rather than harder; only when even ``need`` exceeds a_comf_max is there no
+  comfortable stop: the ACC enters BRAKE saying so (`planner.fsm.acc`: "no comfortable stop:
+  needs 3.9 m/s^2, ttc 2.1 s"; the time to collision is reported, not judged: a planned stop
+  behind a stopped car ends with a short one) and the cap is a_hard, the feed-forward beyond
+  a_comf_max telling the speed loop the plan is urgent. The stops and the bump use the same
+  approach with room = the distance to their point less the margin and the ramp-in from the
+  deceleration the car brakes at (`ramped`; need = a_plan: a point on the map has no floor
+  short of it). Of the laws that bind (the speed plan, an event's, the trail law behind a
+  vehicle ahead), the one the speed loop would ask least of the car on is taken, the minimum
+  of the laws' outputs (`planner.acc_layer`).
+- BRAKE (gap at or below d_min, or no comfortable stop): the approach behind the lead on
+  the trail law, with the gap opened at no more than ``a_open`` while it is under d_min
+  and the lead is not closing, and the cap a_comf_max, or a_hard when no comfortable stop
+  is left. Harder still is the control FSM's emergency stop.
 - PEDESTRIAN, STOP_SIGN, RED_LIGHT, YIELD: stop ``margin`` before a point ``s_stop`` ahead
   of the front bumper (`stop_speed`): ``v_ref = sqrt(2 a_comf (s_stop - margin))``, and 0
-  once ``s_stop - margin <= arrived``. The cut-off is there because the speed loop cannot
-  follow the curve's vertical end: the car comes to rest a little short, where the curve
-  still asks for a speed the drive cannot break away at, and the speed loop's integrator
-  would wind up for as long as the car waits and overshoot when it moves off.
+  once ``s_stop - margin <= arrived``, through the approach (`stop`). The cut-off is
+  there because the speed loop cannot follow the curve's vertical end: the car comes to
+  rest a little short, where the curve still asks for a speed the drive cannot break away
+  at, and the speed loop's integrator would wind up for as long as the car waits and
+  overshoot when it moves off.
 - SPEED_BUMP: cross at the bump's pass speed v_pass (`pass_speed`): ``v_ref = sqrt(v_pass^2
   + 2 a_comf max(d_bump - margin, 0))``, d_bump the front axle's distance to the point where
-  it must be at v_pass (`planner.events`).
+  it must be at v_pass (`planner.events`), through the approach.
 - FLAT: the reference falls at ``a_flat_plan`` (gentler than the DECS bound a_flat) from
   the plan's speed at the tick FLAT is entered, never above the car's own speed, down to a
   crawl, ``v_pull_over`` (or the plan's speed if lower), while the motion FSM pulls the car
@@ -53,7 +81,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from planner.limits import A_COMF, A_FIRM, A_FLAT, A_HARD
+from planner.limits import A_COMF, A_COMF_MAX, A_FLAT, A_HARD, J_COMF
 from planner.speed import SpeedRef
 
 
@@ -61,15 +89,21 @@ from planner.speed import SpeedRef
 class AccControlParams:
     k_gap: float = 0.25  # [1/s] trail: gap error to speed (1 / the gap's time constant)
     a_comf: float = A_COMF  # [m/s^2] comfortable deceleration (stops, bumps)
-    a_firm: float = A_FIRM  # [m/s^2] the most BRAKE plans unless a collision is imminent
-    a_hard: float = A_HARD  # [m/s^2] the most BRAKE plans when it is
-    ttc_hard: float = 2.5  # [s] time to collision below which a_hard is allowed
+    a_comf_max: float = A_COMF_MAX  # [m/s^2] the most a comfortable approach plans
+    a_hard: float = A_HARD  # [m/s^2] the most BRAKE plans when no comfortable stop is left
+    a_open: float = A_COMF  # [m/s^2] BRAKE opens a gap under d_min at no more than this
+    a_gentle: float = 1.0  # [m/s^2] the approach keeps to the law while the speed loop's
+    #   reaction to it is no harder than this (a lead slowing down is followed as it slows)
+    tau_loop: float = 0.8  # [s] the speed loop's time constant (`control.longitudinal`):
+    #   it brakes at (v - v_ref) / tau_loop on a reference below the speed
+    j_comf: float = J_COMF  # [m/s^3] the speed loop eases a comfortable plan in at this
+    #   (`control.longitudinal`: comfort_jerk): the ramp-in `need` allows for
+    d_floor: float = 2.5  # [m] `need` stops the closing this far behind the lead (UN R157
+    #   4.2.1's least standstill gap, 2 m, and a margin)
     a_flat: float = A_FLAT  # [m/s^2] DECS's bound on FLAT's deceleration (no law reads it)
     a_flat_plan: float = 2.0  # [m/s^2] the deceleration FLAT plans: a gentle stop
     v_pull_over: float = 6.0  # [m/s] FLAT's crawl while the car pulls onto the shoulder (slow
     #   enough to stop short, quick enough to cross onto it within the 8 s a lane change has)
-    j_in: float = 4.0  # [m/s^3] how fast BRAKE's deceleration eases in
-    d_stop: float = 2.0  # [m] gap BRAKE aims to keep at the lead's speed
     margin: float = 1.0  # [m] stop / pass points are aimed this far before the point
     arrived: float = 0.3  # [m] this near its stop point, a car stopping has arrived
     v_standstill: float = 0.5  # [m/s] a lead slower than this counts as stopped (trail)
@@ -89,20 +123,6 @@ def trail(v_plan: float, d: float, d_des: float, v_l: float, d0: float,
     return SpeedRef(min(max(min(gap_law, stop_law), 0.0), v_plan), 0.0)
 
 
-def braking_need(v: float, v_l: float, d: float, p: AccControlParams) -> float:
-    """[m/s^2] >= 0: the deceleration that slows from v to v_l [m/s] before the gap d [m]
-    shrinks to d_stop, at most a_hard."""
-    room = max(d - p.d_stop, 0.5)
-    return min(max(v * v - max(v_l, 0.0) ** 2, 0.0) / (2.0 * room), p.a_hard)
-
-
-def brake_cap(v: float, v_lead: float, d: float, p: AccControlParams) -> float:
-    """[m/s^2] the most BRAKE may plan: a_firm, or a_hard when the time to collision at the
-    present closing speed v - v_lead is under ttc_hard."""
-    closing = v - v_lead
-    return p.a_hard if closing > 0.0 and d / closing < p.ttc_hard else p.a_firm
-
-
 def stop_speed(distance: float, v_plan: float, p: AccControlParams) -> float:
     """[m/s] the speed from which braking at a_comf stops `margin` before `distance` [m],
     at most v_plan [m/s]; 0 within `arrived` of that point (or past it)."""
@@ -116,19 +136,113 @@ def pass_speed(distance: float, v_pass: float, v_plan: float, p: AccControlParam
     return min(math.sqrt(v_pass**2 + 2.0 * p.a_comf * max(distance - p.margin, 0.0)), v_plan)
 
 
-class EasedBrake:
-    """A deceleration command that rises at most at the jerk j_in and falls at once."""
+def need(v: float, v_l: float, d: float, p: AccControlParams, a_now: float = 0.0) -> float:
+    """[m/s^2] >= 0: the least deceleration that still stops the closing speed v - v_l [m/s]
+    at d_floor (module doc) from the gap d [m], after the ramp-in from the deceleration
+    `a_now` [m/s^2] the car brakes at (`BrakeModel`); +inf with no room left."""
+    closing = v - max(v_l, 0.0)
+    if closing <= 0.0:
+        return 0.0
+    t_ramp = max(p.a_comf_max - a_now, 0.0) / (2.0 * p.j_comf)
+    room = d - p.d_floor - closing * t_ramp
+    return closing * closing / (2.0 * room) if room > 0.0 else math.inf
+
+
+def comfortable(a_need: float, p: AccControlParams) -> bool:
+    """Whether a comfortable stop is left when `a_need` [m/s^2] is needed."""
+    return a_need <= p.a_comf_max
+
+
+def ttc(v: float, v_l: float, d: float) -> float:
+    """[s] the time to collision with a lead at gap d [m] and speed v_l at the closing speed
+    now (ego speed v [m/s]); inf when not closing."""
+    closing = v - v_l
+    return d / closing if closing > 0.0 and math.isfinite(d) else math.inf
+
+
+def approach(v: float, law: SpeedRef, a_plan: float, a_need: float, dt: float,
+             p: AccControlParams) -> SpeedRef:
+    """The law's reference `law`, or, where the car at speed v [m/s] is faster than it and
+    the planned deceleration `a_plan` [m/s^2] is gentler than the speed loop's reaction,
+    that deceleration from the car's speed over dt [s]; never gentler than `a_need` (below
+    the law: only when that leaves no comfortable stop), capped at a_comf_max (a_hard when
+    a_need exceeds it)."""
+    loop = max(-law.accel, 0.0) + max(v - law.speed, 0.0) / p.tau_loop
+    if v <= law.speed:  # not faster than the law: the law, unless no comfortable stop
+        if comfortable(a_need, p):
+            return law
+        a_plan = loop
+    a_plan = max(a_plan, p.a_gentle)  # the law's own reaction is kept up to a_gentle
+    a = max(a_need, min(loop, a_plan))
+    if a <= loop and a_plan >= loop:
+        return law
+    a = min(a, p.a_comf_max if comfortable(a_need, p) else p.a_hard)
+    return SpeedRef(max(v - a * dt, 0.0), -a)
+
+
+def follow(v: float, law: SpeedRef, d: float, v_l: float, d_end: float, dt: float,
+           p: AccControlParams, a_min: float = 0.0, a_now: float = 0.0) -> SpeedRef:
+    """The approach behind a lead at gap d [m] and speed v_l [m/s] on the trail law `law`:
+    the constant deceleration that ends the closing at d_end [m], at least `a_min` [m/s^2]
+    while the car is faster than the law; `a_now` [m/s^2] the deceleration the car brakes
+    at (`need`)."""
+    closing = v - max(v_l, 0.0)
+    if closing > 0.0 and d - d_end > p.arrived:  # the approach to d_end
+        a_plan = max(closing * closing / (2.0 * (d - d_end)), a_min)
+    elif closing > 0.0:  # inside d_end: the law, or stopping the closing at the floor at
+        room = d - p.d_floor  # no more than a_open where the law would brake harder
+        a_plan = max(closing * closing / (2.0 * room) if room > 0.0 else math.inf, a_min,
+                     p.a_open)
+    else:  # not closing: the law, or opening the gap at a_min
+        a_plan = a_min if a_min > 0.0 else math.inf
+    return approach(v, law, a_plan, need(v, v_l, d, p, a_now), dt, p)
+
+
+def ramped(v: float, v_end: float, room: float, a_now: float, p: AccControlParams) -> float:
+    """[m/s^2] the constant deceleration from v to v_end [m/s] within `room` [m] after the
+    ramp-in from `a_now` [m/s^2] at j_comf (the room shortened by v (a - a_now) / (2 j_comf),
+    a first estimated without it); inf with no room."""
+    if room <= p.arrived:
+        return math.inf
+    first = max(v * v - v_end * v_end, 0.0) / (2.0 * room)
+    left = room - v * max(first - a_now, 0.0) / (2.0 * p.j_comf)
+    return max(v * v - v_end * v_end, 0.0) / (2.0 * left) if left > 0.0 else math.inf
+
+
+def stop(distance: float, v: float, v_plan: float, dt: float, p: AccControlParams,
+         a_now: float = 0.0) -> SpeedRef:
+    """The stop `margin` before `distance` [m] (`stop_speed`) through the approach from the
+    speed v [m/s], braking at `a_now` [m/s^2] now (`ramped`)."""
+    speed = stop_speed(distance, v_plan, p)
+    law = SpeedRef(speed, -p.a_comf if 0.0 < speed < v_plan else 0.0)
+    a_plan = ramped(v, 0.0, distance - p.margin, a_now, p)
+    return approach(v, law, a_plan, a_plan if v > speed else 0.0, dt, p) if speed > 0.0 \
+        else law
+
+
+def bump(distance: float, v_pass: float, v: float, v_plan: float, dt: float,
+         p: AccControlParams, a_now: float = 0.0) -> SpeedRef:
+    """The bump's pass speed (`pass_speed`) through the approach from the speed v [m/s],
+    braking at `a_now` [m/s^2] now (`ramped`)."""
+    speed = pass_speed(distance, v_pass, v_plan, p)
+    law = SpeedRef(speed, -p.a_comf if v_pass < speed < v_plan else 0.0)
+    a_plan = ramped(v, v_pass, distance - p.margin, a_now, p) if v > v_pass else 0.0
+    return approach(v, law, a_plan, a_plan if v > speed else 0.0, dt, p)
+
+
+class BrakeModel:
+    """The deceleration the car brakes at, as the speed loop builds it from the plan's
+    feed-forward: it rises at most at j_comf and falls at once (`control.longitudinal`'s
+    comfort envelope); `need` allows for the ramp-in still to come."""
 
     def __init__(self) -> None:
-        self.a = 0.0  # [m/s^2] >= 0, the deceleration commanded last
+        self.a = 0.0  # [m/s^2] >= 0
 
     def reset(self) -> None:
         self.a = 0.0
 
-    def step(self, v: float, a_need: float, dt: float, p: AccControlParams,
-             cap: float | None = None) -> SpeedRef:
-        """Move the command towards `a_need` (capped at `cap`, default a_hard) and give the
-        speed reference that follows it from the current speed v over dt [s]."""
-        target = min(a_need, p.a_hard if cap is None else cap)
-        self.a = min(target, self.a + p.j_in * dt)
-        return SpeedRef(max(v - self.a * dt, 0.0), -self.a)
+    def step(self, accel: float, dt: float, p: AccControlParams) -> float:
+        """Follow the plan's feed-forward `accel` [m/s^2] (signed) over dt [s]; the
+        deceleration now [m/s^2]."""
+        self.a = min(max(-accel, 0.0), self.a + p.j_comf * dt)
+        return self.a

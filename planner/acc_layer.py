@@ -7,16 +7,27 @@ Per tick:
 1. the lead's bumper gap is carried from its track's time t_track to now with the relative
    speed, ``d_now = d + (V_l - v) (t - t_track)`` (tracks are one sensor period old);
    V_GPS is the posted limit at the front bumper, V_s the set speed (ACC is on while
-   V_s > 0);
+   V_s > 0); the least deceleration that still stops the closing on the lead
+   (`planner.acc_control.need`, from the deceleration the car brakes at now), whether it
+   leaves a comfortable stop (and with the FSM's hysteresis to spare), the time to
+   collision, and whether a lead was lost within the FSM's ``lead_hold``;
 2. the FSM steps once;
 3. the mode's law gives the reference: ACC_OFF 0; CRUISE and SPEED_LIMIT the speed plan;
    TRAIL and BRAKE their laws behind the lead; OFF_RAMP the speed plan (the ramp's limit
    is a posting); STOP_SIGN, PEDESTRIAN, RED_LIGHT and YIELD a stop at the events' stop
    point; SPEED_BUMP the pass speed at the bump; FLAT down at ``a_flat_plan`` to
-   ``v_pull_over`` while the car pulls over, then to a stop on the shoulder. A vehicle
-   ahead still counts in an event mode: the reference is the lower of the event's law and
-   the trail law behind it. The plan's `SpeedSource` is the law's where it lowers the
-   speed plan (FLAT's always), the plan's own otherwise.
+   ``v_pull_over`` while the car pulls over, then to a stop on the shoulder. Each law
+   behind a lead and each stop or pass point goes through the approach
+   (`planner.acc_control`: a planned constant deceleration within ISO 15622's comfort
+   where the car is faster than the law). A vehicle ahead still counts in an event mode:
+   the reference is the lower of the event's law and the trail law behind it. Lower is
+   what the speed loop would ask less of the car on, ``a_ff + (v_ref - v) / tau_loop``
+   (the minimum of the laws' outputs: a planned deceleration from the car's speed counts
+   by its feed-forward, and binds even while the car is a ripple above the plan). The
+   plan's `SpeedSource` is the law's where it lowers the speed plan (FLAT's always), the
+   plan's own otherwise;
+4. the deceleration the car brakes at is carried on from the reference's feed-forward
+   (`planner.acc_control.BrakeModel`: it rises at the speed loop's comfort jerk).
 """
 
 from __future__ import annotations
@@ -26,15 +37,17 @@ from dataclasses import dataclass, field
 
 from planner.acc_control import (
     AccControlParams,
-    EasedBrake,
-    brake_cap,
-    braking_need,
-    pass_speed,
-    stop_speed,
+    BrakeModel,
+    bump,
+    comfortable,
+    follow,
+    need,
+    stop,
     trail,
+    ttc,
 )
 from planner.events import Events
-from planner.fsm.acc import AccInput, AccMode, AccParams, gaps, transition
+from planner.fsm.acc import AccInput, AccMode, AccParams, gaps, r157_min_gap, transition
 from planner.fsm.machine import Machine, StateChange
 from planner.messages import Lead, SpeedSource
 from planner.speed import PlannedSpeed, SpeedRef
@@ -65,8 +78,9 @@ class AccLayer:
     def __init__(self, params: AccLayerParams | None = None) -> None:
         self.params = params if params is not None else AccLayerParams()
         self.machine = Machine("acc", AccMode.ACC_OFF)
-        self._brake = EasedBrake()
         self._flat: float | None = None  # [m/s] FLAT's ramped reference
+        self._braking = BrakeModel()  # the deceleration the car brakes at (`need`)
+        self._lead_seen = -math.inf  # [s] when a lead was last seen
 
     @property
     def mode(self) -> AccMode:
@@ -84,21 +98,27 @@ class AccLayer:
         may close up to d_min + this instead of d_des."""
         d, v_l = (lead.gap + (lead.speed - v) * max(t - lead.t, 0.0), lead.speed) \
             if lead is not None else (math.inf, math.inf)
+        c = self.params.control
+        a_need, time_to_collision = need(v, v_l, d, c, self._braking.a), ttc(v, v_l, d)
+        self._lead_seen = t if lead is not None else self._lead_seen
         x = AccInput(acc_on=set_speed > 0.0, v=v, v_s=set_speed, v_gps=limit, d=d, v_l=v_l,
-                     events=events.active)
+                     events=events.active, a_need=a_need, ttc=time_to_collision,
+                     comfortable=comfortable(a_need, c),
+                     relaxed=comfortable(a_need + self.params.modes.a_hysteresis, c),
+                     lead_lost=lead is None and t - self._lead_seen <= self.params.modes.lead_hold)
         changes = self.machine.apply(t, transition(self.mode, x, self.params.modes))
         if self.mode in EVENT_LAWS:
             speed = self._event(x, dt, plan, events)
         else:
             speed = self._control(x, dt, plan, driver_gap)
+        self._braking.step(speed.ref.accel, dt, c)
         return AccOutput(speed, d), changes
 
     def _event(self, x: AccInput, dt: float, planned: PlannedSpeed,
                events: Events) -> PlannedSpeed:
         """The event mode's law, never above the trail law behind a vehicle ahead."""
-        c, m = self.params.control, self.params.modes
+        c = self.params.control
         plan = planned.ref
-        self._brake.reset()
         if self.mode is AccMode.FLAT:  # down to a crawl until on the shoulder, then a stop
             floor = 0.0 if events.pulled_over else min(c.v_pull_over, plan.speed)
             self._flat = plan.speed if self._flat is None else self._flat
@@ -106,37 +126,55 @@ class AccLayer:
             out = PlannedSpeed(SpeedRef(self._flat, -c.a_flat_plan if self._flat > floor
                                         else 0.0), SpeedSource.EVENT)
         elif self.mode is AccMode.SPEED_BUMP:
-            v = pass_speed(events.bump_distance, events.bump_speed, plan.speed, c)
-            braking = events.bump_speed < v < plan.speed  # on the braking curve
-            ref = SpeedRef(v, -c.a_comf if braking else 0.0 if v < plan.speed else plan.accel)
-            out = PlannedSpeed(ref, SpeedSource.EVENT if v < plan.speed else planned.source)
+            ref = bump(events.bump_distance, events.bump_speed, x.v, plan.speed, dt, c,
+                       self._braking.a)
+            out = self._lower(planned, PlannedSpeed(ref, SpeedSource.EVENT), x.v)
         elif self.mode in STOP_LAWS:
-            v = stop_speed(events.stop_distance, plan.speed, c)
-            ref = SpeedRef(v, -c.a_comf if 0.0 < v < plan.speed else 0.0)
-            out = PlannedSpeed(ref, SpeedSource.EVENT if v < plan.speed else planned.source)
+            ref = stop(events.stop_distance, x.v, plan.speed, dt, c, self._braking.a)
+            out = self._lower(planned, PlannedSpeed(ref, SpeedSource.EVENT), x.v)
         else:
             out = planned
         if math.isfinite(x.d):
-            following = trail(plan.speed, x.d, gaps(x.v, x.v_l, m).d_des, x.v_l, m.d0, c)
-            if following.speed < out.ref.speed:
-                return PlannedSpeed(following, SpeedSource.FOLLOWING)
+            following = self._following(x, dt, plan, None)
+            return self._lower(out, PlannedSpeed(following, SpeedSource.FOLLOWING), x.v)
         return out
+
+    def _lower(self, planned: PlannedSpeed, law: PlannedSpeed, v: float) -> PlannedSpeed:
+        """The minimum of two laws' outputs: `law` where the speed loop would ask less of
+        the car on it than on `planned` at the speed v [m/s] (its request, feed-forward +
+        (speed - v) / tau_loop: a planned deceleration from the speed counts by its
+        feed-forward), else `planned`."""
+        tau = self.params.control.tau_loop
+
+        def request(ref: SpeedRef) -> float:
+            return ref.accel + (ref.speed - v) / tau
+
+        return law if request(law.ref) < request(planned.ref) else planned
+
+    def _following(self, x: AccInput, dt: float, plan: SpeedRef,
+                   driver_gap: float | None, a_min: float = 0.0) -> SpeedRef:
+        """The trail law behind the lead (at d_min + `driver_gap` at most, while the driver
+        overrides) through the approach (`planner.acc_control.follow`)."""
+        c, m = self.params.control, self.params.modes
+        g = gaps(x.v, x.v_l, m)
+        d_des = g.d_des if driver_gap is None else min(g.d_des, g.d_min + driver_gap)
+        law = trail(plan.speed, x.d, d_des, x.v_l, m.d0, c)
+        stopped = x.v_l < c.v_standstill
+        end = m.d0 + c.stop_band if stopped else gaps(x.v_l, x.v_l, m).d_des
+        if driver_gap is not None and not stopped:  # d_min at the faster of the two: a
+            end = min(end, r157_min_gap(max(x.v, x.v_l)) + driver_gap)  # closing car's
+        return follow(x.v, law, x.d, x.v_l, end, dt, c, a_min, self._braking.a)
 
     def _control(self, x: AccInput, dt: float, planned: PlannedSpeed,
                  driver_gap: float | None) -> PlannedSpeed:
         c, m = self.params.control, self.params.modes
         plan = planned.ref
-        if self.mode in (AccMode.BRAKE, AccMode.TRAIL):
-            g = gaps(x.v, x.v_l, m)
-            d_des = g.d_des if driver_gap is None else min(g.d_des, g.d_min + driver_gap)
-            following = trail(plan.speed, x.d, d_des, x.v_l, m.d0, c)
-        if self.mode is AccMode.BRAKE:
-            need = braking_need(x.v, following.speed, x.d, c)
-            ref = self._brake.step(x.v, need, dt, c, cap=brake_cap(x.v, x.v_l, x.d, c))
-            return PlannedSpeed(ref, SpeedSource.FOLLOWING) if ref.speed < plan.speed \
-                else planned
-        self._brake.reset()
+        if self.mode is AccMode.BRAKE:  # open a gap under d_min at up to a_open
+            opening = c.a_open if x.d <= gaps(x.v, x.v_l, m).d_min else 0.0
+            ref = self._following(x, dt, plan, driver_gap, opening)
+            return self._lower(planned, PlannedSpeed(ref, SpeedSource.FOLLOWING), x.v)
         if self.mode is AccMode.TRAIL:
+            following = self._following(x, dt, plan, driver_gap)
             source = SpeedSource.FOLLOWING if following.speed < plan.speed else planned.source
             return PlannedSpeed(following, source)
         if self.mode is AccMode.ACC_OFF:

@@ -14,7 +14,9 @@ where v_cap is the map's speed envelope with the set speed raised to the vehicle
 the speed up to the limit and never past it, and the feed-forward fades over the last
 ``tau * a_drv`` m/s so that the car reaches the limit without overshoot. The ACC layer keeps
 its modes and laws on top of this reference, with the driver's shorter gap: it lets the
-pedal close up on a lead to ``d_min + gap_margin``, never to d_min (`planner.acc_layer`).
+pedal close up on a lead to ``d_min + gap_margin``, never to d_min (`planner.acc_layer`;
+while the car closes, its approach ends at d_min of the car's own speed + gap_margin, so
+that braking to the lead's speed never takes the gap under d_min on the way).
 When the pedal is released above the plan's speed, the reference comes back down to the
 plan at ``a_release``, not in a step.
 """

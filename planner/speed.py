@@ -36,4 +36,5 @@ BINDING_SOURCE = {  # the map plan's binding constraint, as a source of the plan
     Binding.LIMIT_AHEAD: SpeedSource.LIMIT,
     Binding.CURVE: SpeedSource.CURVE,
     Binding.CURVE_AHEAD: SpeedSource.CURVE,
+    Binding.CROSSING: SpeedSource.LIMIT,  # a crossing's speed, like a posted limit
 }

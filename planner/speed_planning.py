@@ -7,11 +7,18 @@ the target is the minimum of
 * the posted limit in force at the FRONT BUMPER, less ``limit_margin``,
 * the curvature speed ``sqrt(a_lat_max / |kappa|)`` of the lane between the car's centre and
   its front axle,
+* the crossing speed ``crossing_speed`` while the front bumper is within ``crossing_sight``
+  of a marked crossing it has not reached: a pedestrian who steps out is tracked from about
+  that range, and from this speed the car still stops before the crossing within ISO 15622's
+  comfort (about 2.5 m/s^2 with the ramp-in; `planner.acc_control`), where at the posted
+  40 km/h of a town it would need 5 m/s^2 (issue K);
 * for every constraint ahead, the speed from which the car can reach it by braking at
   ``a_comf``: ``sqrt(v_c^2 + 2 a_comf max(d - brake_margin, 0))``. Constraints ahead are the
   speed-limit postings beyond the front bumper (``v_c`` = limit less ``limit_margin``, ``d``
-  from the front bumper, so the limit already holds when the bumper reaches the sign) and the
-  curvature-speed samples beyond the front axle (``d`` from the front axle).
+  from the front bumper, so the limit already holds when the bumper reaches the sign), the
+  crossings (``v_c`` = crossing_speed, ``d`` from the front bumper to ``crossing_sight``
+  before the crossing) and the curvature-speed samples beyond the front axle (``d`` from the
+  front axle).
 
 ``brake_margin`` makes the braking curve reach ``v_c`` that many metres before the
 constraint: room for the speed loop's lag behind a falling target. ``limit_margin`` keeps
@@ -47,7 +54,7 @@ import numpy as np
 
 from planner.limits import A_COMF
 from world.frames import VehicleInfo, kph
-from world.hdmap import FloatArray, IntArray, Lane, RoadMap
+from world.hdmap import Crosswalk, FloatArray, IntArray, Lane, RoadMap
 
 
 class Binding(enum.Enum):
@@ -59,9 +66,10 @@ class Binding(enum.Enum):
     LIMIT_AHEAD = "limit_ahead"  # braking towards a lower posting ahead
     CURVE = "curve"  # the curvature speed between the car's centre and front axle
     CURVE_AHEAD = "curve_ahead"  # braking towards a curve ahead
+    CROSSING = "crossing"  # the crossing speed near a marked crossing, or braking towards it
 
 
-_AHEAD = (Binding.LIMIT_AHEAD, Binding.CURVE_AHEAD)
+_AHEAD = (Binding.LIMIT_AHEAD, Binding.CURVE_AHEAD, Binding.CROSSING)
 
 
 @dataclass(frozen=True, slots=True)
@@ -72,6 +80,8 @@ class SpeedPlanningParams:
     brake_margin: float = 3.0  # [m] the braking curve reaches v_c this far before d = 0
     sample_spacing: float = 0.5  # [m] station step of the curvature samples (map-fixed grid)
     min_curvature: float = 1e-6  # [1/m] below this |kappa| the lane is straight (no limit)
+    crossing_speed: float = kph(30.0)  # [m/s] near a marked crossing (module doc)
+    crossing_sight: float = 20.0  # [m] ... within this of it (a pedestrian's tracking range)
 
 
 @dataclass(frozen=True, slots=True)
@@ -142,6 +152,7 @@ class SpeedPlanner:
         self._best_ahead: list[int] = _suffix_argmin(key).tolist()
         self._post_s = [p.s for p in road.speed_limits]
         self._post_v = [p.limit for p in road.speed_limits]
+        self._crossings = sorted(f.s for f in road.features if isinstance(f, Crosswalk))
 
     # -- lane geometry on the grid --------------------------------------------------------------
 
@@ -178,6 +189,7 @@ class SpeedPlanner:
             (limit_at_front - p.limit_margin, Binding.LIMIT, 0.0),
             *self._curve_constraints(s, s_axle),
             *self._limit_constraints(s_front),
+            *self._crossing_constraints(s_front),
         ]
         v, binding, d = min(candidates, key=lambda c: c[0])  # the first of equal minima
         braking = binding in _AHEAD and d > p.brake_margin
@@ -222,4 +234,18 @@ class SpeedPlanner:
                 v = math.sqrt((v_p - p.limit_margin) ** 2
                               + 2.0 * p.a_comf * max(d - p.brake_margin, 0.0))
                 out.append((v, Binding.LIMIT_AHEAD, d))
+        return out
+
+    def _crossing_constraints(self, s_front: float) -> list[tuple[float, Binding, float]]:
+        """(speed, binding, distance) per marked crossing the front bumper has not reached:
+        the crossing speed within crossing_sight of it, the braking curve to it beyond."""
+        p = self.params
+        d_front = self._distance_at(s_front)
+        out = []
+        for s_c in self._crossings:
+            if s_front < s_c <= self.road.length:
+                d = max(self._distance_at(s_c) - d_front - p.crossing_sight, 0.0)
+                v = math.sqrt(p.crossing_speed**2 + 2.0 * p.a_comf
+                              * max(d - p.brake_margin, 0.0))
+                out.append((v, Binding.CROSSING, d))
         return out

@@ -19,6 +19,7 @@ from typing import Any
 
 from avsim.criteria.base import CriteriaSet, Criterion, Need
 from avsim.criteria.collision import NO_COLLISION
+from avsim.criteria.comfort import COMFORT
 from avsim.criteria.declaration import Declaration, RunInputs
 from avsim.criteria.following import FOLLOWING_GAP, MIN_GAP, RESUME_WITHIN, STANDSTILL_GAP
 from avsim.criteria.jerk import MAX_JERK
@@ -48,6 +49,7 @@ DECLARATIONS: tuple[Declaration[Any], ...] = (
     STANDSTILL_GAP,  # `standstill_gap`
     RESUME_WITHIN,  # `resume_within`
     MAX_JERK,  # `max_jerk`
+    COMFORT,  # `comfort`
 )
 
 

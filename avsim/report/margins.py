@@ -8,8 +8,9 @@ collision to the lead, the lateral offset in the lane, and the motion FSM's mano
   d_min (a far lead leaves the top).
 - Time to collision [s] (`world.truth.time_to_collision`): gap / closing speed where the
   ego closes on its lead (ego speed - lead speed > 0), nothing where there is no lead or it
-  pulls away; shown from 0 to `TTC_VIEW` (longer ones leave the top), with the stack's `ttc_hard`
-  (`planner.acc_control.AccControlParams`: below it BRAKE may brake hard) as a dashed line.
+  pulls away; shown from 0 to `TTC_VIEW` (longer ones leave the top), with `TTC_HARD` (2.5
+  s: a lead closer than this in time seldom leaves a comfortable stop; the stack decides on
+  the deceleration it needs, `planner.acc_control.need`) as a dashed line.
 - Lateral offset [m]: the ego centre's true offset from the centre of the lane the stack
   keeps (the log's `cross_track`, left +), with +-(lane width - car width) / 2 as the bound
   where the body is still inside that lane (`lane_margin`: the lane width of the route's
@@ -31,14 +32,13 @@ import numpy as np
 from matplotlib.axes import Axes
 
 from avsim.report.bands import FloatArray, Run, mode_runs
-from planner.acc_control import AccControlParams
 from planner.fsm.acc import r157_min_gap
 from planner.fsm.machine import StateChange
 from planner.fsm.motion import LANE_CHANGES, Motion
 from world.spec import RoadSpec
 
 TTC_VIEW = 10.0  # [s] the time-to-collision axis' top
-TTC_HARD = AccControlParams().ttc_hard  # [s] below it BRAKE may brake hard
+TTC_HARD = 2.5  # [s] a time to collision marked as short (module doc)
 GAP_VIEW = 4.0  # [-] the gap axis' top: at most this many times the run's largest d_min
 MOTION_MACHINE = "motion"  # the motion FSM's name in the state changes (`planner.motion_layer`)
 ABORTED = "lane_change_aborted"  # a lane change that ended by an abort

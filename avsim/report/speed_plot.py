@@ -13,7 +13,7 @@ below it (`avsim run --plot`). Panels, top to bottom, on one time axis [s]:
 4. The bumper gap to the lead [m] with UN R157's d_min at the ego's speed, shaded where the
    gap is under it.
 5. The time to collision to the lead [s] (gap / closing speed while the ego closes on it),
-   0-10 s, with the stack's `ttc_hard` (2.5 s) dashed.
+   0-10 s, with `ttc_hard` (2.5 s, `avsim.report.margins.TTC_HARD`) dashed.
 6. The ego's true lateral offset [m] from the centre of the lane the stack keeps, with
    +-(lane width - car width) / 2, where the body touches the lane's edge.
 

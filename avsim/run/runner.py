@@ -40,6 +40,7 @@ from avsim.criteria.base import (
     judged_so_far,
 )
 from avsim.criteria.collision import NoCollision
+from avsim.criteria.comfort import peaks
 from avsim.criteria.declaration import RunInputs
 from avsim.criteria.lane import TyresInLane
 from avsim.criteria.registry import build_criteria
@@ -429,7 +430,8 @@ class Runner:
             "distance": float(self.log.station[-1] - self.log.station[0]) if xte.size else 0.0,
             "collisions": float(self.collisions.count),
             "acc_shortest_mode": shortest_hold(self.state_changes, "acc"),
-        } | self._lead_margins() | (self.sensors.metrics() if self.setup is not None else {})
+        } | self._lead_margins() | peaks(self.log.array("t"), speed) \
+            | (self.sensors.metrics() if self.setup is not None else {})
 
     def _lead_margins(self) -> dict[str, float]:
         """The closest the ego came to the vehicle ahead in its lane, from the truth

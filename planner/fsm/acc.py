@@ -5,8 +5,10 @@ States (the paper's Stateflow chart, Fig. 2): ACC_OFF, and inside ACC_ON either 
 FLAT}, plus two modes of our own for town junctions, RED_LIGHT and YIELD. Inputs
 (`AccInput`, speeds [m/s], gaps [m]): the bumper gap d to the vehicle ahead in the lane and
 its speed V_l (+inf when there is none), the set speed V_s, the posted limit V_GPS (the
-paper reads it from the map by GPS; here at the front bumper), the ego speed v and the set
-of discrete events. The events are decided upstream (`planner.events`,
+paper reads it from the map by GPS; here at the front bumper), the ego speed v, the
+deceleration a_need that still stops the closing on the lead and the time to collision ttc
+with it (both from `planner.acc_control`: `need`, `ttc`) and the set of discrete events.
+The events are decided upstream (`planner.events`,
 `planner.junctions`); this module only says which mode holds.
 
 Gaps (the paper gives none; designed here, `gaps`, parameters `AccParams`):
@@ -19,6 +21,13 @@ Gaps (the paper gives none; designed here, `gaps`, parameters `AccParams`):
   the lead matters. Beyond it, braking at a_comf from v to V_l still ends at or beyond
   d_des; d_reach is hysteresis.
 
+Comfort (ISO 15622 / ISO 22179): a comfortable stop is left while a_need <= a_comf_max
+(`planner.limits.A_COMF_MAX`; `planner.acc_control.comfortable` decides, the input says).
+When it is not, the ACC enters BRAKE at once, saying so ("no comfortable stop: needs 4.2
+m/s^2, ttc 2.1 s"), and BRAKE is left only once a_need is back at or below
+a_comf_max - a_hysteresis (`relaxed`), so that a need hovering at the bound does not
+flip the mode.
+
 Transitions (`TABLE`, as data): every row of the paper's Table 2, plus the rows a sound
 chart needs that the table's "sample" leaves out, and the town modes' rows; rows and parts
 of rows the paper has no counterpart for are marked *. For the state the car is in, the rows
@@ -29,6 +38,12 @@ its own event does, unless a row leaves it for another event's mode (only where 
 has one: a stop sign does not interrupt a speed bump); when its event is over the car
 cruises (the chart's default ACC_ACTIVE state), and CRUISE's rows settle the mode on the same
 input (`transition`: one change, from the event's mode to the mode they reach).
+The rows that leave a lead because it is as fast as the set speed or the limit (V_s <= V_l,
+V_GPS <= V_l in Table 2) ask it to be v_band faster (*): a lead driving at the set speed
+would otherwise flip TRAIL and CRUISE with every wobble of its measured speed (issue K).
+And a lead lost leaves TRAIL only after lead_hold (`lead_lost`: no lead now, one within
+lead_hold; *): when the lead cuts out, the vehicle it hid becomes the lead once its track
+is confirmed, and the mode goes on as TRAIL instead of flipping to CRUISE and back.
 Table 2's conditions overlap: out of BRAKE with the lead beyond d_max, Trail's row also
 holds, so Cruise and SpeedLimit are tried first.
 
@@ -53,15 +68,21 @@ holds, so Cruise and SpeedLimit are tried first.
 16. yield -> cruise: the gap has come *
 17. cruise, trail, speed_limit -> brake: d <= d_min (Table 2: Cruise -> Brake; Trail,
     SpeedLimit *)
-18. cruise -> trail: d_des < d < d_max and V_l < V_s
-19. trail -> cruise: V_GPS >= V_s and (d >= d_max or (V_s <= V_l and d > d_min))
-20. brake -> cruise: V_GPS >= V_s and (d >= d_max or V_s <= V_l) and d > d_min
-21. brake -> speed_limit: V_GPS < V_s and (d >= d_max or V_s <= V_l) and d > d_min
-22. brake -> trail: d > d_des and (V_l < V_s or V_l < V_GPS) and d > d_min
-23. speed_limit -> cruise: V_GPS >= V_s and (d >= d_max or (V_GPS <= V_l and d > d_min))
-24. speed_limit -> trail: (V_GPS < V_s or V_l < V_GPS) and d_des < d < d_max
-25. cruise, trail -> speed_limit: V_GPS < V_s and (d >= d_max or (V_GPS <= V_l and d >
-    d_min)) (Trail *)
+18. cruise, trail, speed_limit -> brake: no comfortable stop (a_need > a_comf_max) *
+19. cruise -> trail: d_des < d < d_max and V_l < V_s
+20. trail -> cruise: V_GPS >= V_s and ((d >= d_max and not lead_lost) or (V_s + v_band <=
+    V_l and d_min < d < inf))
+21. brake -> cruise: V_GPS >= V_s and (d >= d_max or V_s + v_band <= V_l) and d > d_min and
+    a_need relaxed *
+22. brake -> speed_limit: V_GPS < V_s and (d >= d_max or V_s + v_band <= V_l) and d > d_min
+    and a_need relaxed *
+23. brake -> trail: d > d_des and (V_l < V_s or V_l < V_GPS) and d > d_min and a_need
+    relaxed *
+24. speed_limit -> cruise: V_GPS >= V_s and (d >= d_max or (V_GPS + v_band <= V_l and d >
+    d_min))
+25. speed_limit -> trail: (V_GPS < V_s or V_l < V_GPS) and d_des < d < d_max
+26. cruise, trail -> speed_limit: V_GPS < V_s and ((d >= d_max and not lead_lost) or (V_GPS
+    + v_band <= V_l and d_min < d < inf)) (Trail *; v_band, lead_lost *)
 
 FLAT has no row out: the car stops on the shoulder ("Simulation Stops").
 """
@@ -127,6 +148,9 @@ class AccParams:
     tau: float = 1.5  # [s] time gap of d_des
     a_comf: float = A_COMF  # [m/s^2] comfortable deceleration (d_max)
     d_reach: float = 10.0  # [m] hysteresis beyond the braking distance (d_max)
+    a_hysteresis: float = 0.5  # [m/s^2] BRAKE is left with a_need this far under a_comf_max
+    v_band: float = 0.5  # [m/s] a lead counts as faster than a speed once this much faster
+    lead_hold: float = 0.5  # [s] TRAIL outlives a lost lead this long (lead_lost)
 
 
 @dataclass(frozen=True, slots=True)
@@ -138,6 +162,12 @@ class AccInput:
     d: float = math.inf  # [m] gap to the vehicle ahead in the lane (+inf: none)
     v_l: float = math.inf  # [m/s] its speed over ground (+inf: none)
     events: frozenset[AccEvent] = NO_EVENTS  # the events that hold now
+    a_need: float = 0.0  # [m/s^2] the least deceleration that still stops the closing on
+    #   the lead (`planner.acc_control.need`; 0: not closing)
+    ttc: float = math.inf  # [s] time to collision with the lead at the closing speed now
+    comfortable: bool = True  # a comfortable stop is left (`planner.acc_control.comfortable`)
+    relaxed: bool = True  # ... with a_hysteresis to spare (module doc)
+    lead_lost: bool = False  # no lead now, but one within lead_hold (module doc)
 
 
 @dataclass(frozen=True, slots=True)
@@ -145,6 +175,8 @@ class Gaps:
     d_min: float  # [m] UN R157 minimum following distance
     d_des: float  # [m] desired gap
     d_max: float  # [m] gap inside which the lead matters
+    v_band: float = 0.5  # [m/s] the speed hysteresis of the rows that leave a lead
+    #   (`AccParams.v_band`)
 
 
 def r157_min_gap(v: float) -> float:
@@ -158,7 +190,7 @@ def gaps(v: float, v_l: float, p: AccParams) -> Gaps:
     d_min = r157_min_gap(v)
     d_des = max(p.d0 + p.tau * v, d_min)
     closing = max(v * v - min(v_l, v) ** 2, 0.0) / (2.0 * p.a_comf)
-    return Gaps(d_min, d_des, d_des + closing + p.d_reach)
+    return Gaps(d_min, d_des, d_des + closing + p.d_reach, p.v_band)
 
 
 # -- the guards: (mode now, input, gaps) -> the row holds --------------------------------------
@@ -190,8 +222,22 @@ def _too_close(_m: AccMode, x: AccInput, g: Gaps) -> bool:
     return x.d <= g.d_min
 
 
+def _comfortable(x: AccInput, _g: Gaps) -> bool:
+    """A comfortable stop is left, with the hysteresis to spare (module doc)."""
+    return x.comfortable and x.relaxed
+
+
+def _no_comfortable_stop(_m: AccMode, x: AccInput, _g: Gaps) -> bool:
+    return not x.comfortable
+
+
+def _why_hard(x: AccInput, _g: Gaps) -> str:
+    return f"no comfortable stop: needs {min(x.a_need, 99.0):.1f} m/s^2, ttc {x.ttc:.1f} s"
+
+
 def _to_limit(_m: AccMode, x: AccInput, g: Gaps) -> bool:
-    return x.v_gps < x.v_s and (x.d >= g.d_max or (x.v_gps <= x.v_l and x.d > g.d_min))
+    return x.v_gps < x.v_s and ((x.d >= g.d_max and not x.lead_lost)
+                                or (x.v_gps + g.v_band <= x.v_l and g.d_min < x.d < math.inf))
 
 
 def _cruise_to_trail(_m: AccMode, x: AccInput, g: Gaps) -> bool:
@@ -199,23 +245,27 @@ def _cruise_to_trail(_m: AccMode, x: AccInput, g: Gaps) -> bool:
 
 
 def _trail_to_cruise(_m: AccMode, x: AccInput, g: Gaps) -> bool:
-    return x.v_gps >= x.v_s and (x.d >= g.d_max or (x.v_s <= x.v_l and x.d > g.d_min))
+    return x.v_gps >= x.v_s and ((x.d >= g.d_max and not x.lead_lost)
+                                 or (x.v_s + g.v_band <= x.v_l and g.d_min < x.d < math.inf))
 
 
 def _brake_to_cruise(_m: AccMode, x: AccInput, g: Gaps) -> bool:
-    return x.v_gps >= x.v_s and (x.d >= g.d_max or x.v_s <= x.v_l) and x.d > g.d_min
+    return (x.v_gps >= x.v_s and (x.d >= g.d_max or x.v_s + g.v_band <= x.v_l) and x.d > g.d_min
+            and _comfortable(x, g))
 
 
 def _brake_to_limit(_m: AccMode, x: AccInput, g: Gaps) -> bool:
-    return x.v_gps < x.v_s and (x.d >= g.d_max or x.v_s <= x.v_l) and x.d > g.d_min
+    return (x.v_gps < x.v_s and (x.d >= g.d_max or x.v_s + g.v_band <= x.v_l) and x.d > g.d_min
+            and _comfortable(x, g))
 
 
 def _brake_to_trail(_m: AccMode, x: AccInput, g: Gaps) -> bool:
-    return x.d > g.d_des and (x.v_l < x.v_s or x.v_l < x.v_gps) and x.d > g.d_min
+    return (x.d > g.d_des and (x.v_l < x.v_s or x.v_l < x.v_gps) and x.d > g.d_min
+            and _comfortable(x, g))
 
 
 def _limit_to_cruise(_m: AccMode, x: AccInput, g: Gaps) -> bool:
-    return x.v_gps >= x.v_s and (x.d >= g.d_max or (x.v_gps <= x.v_l and x.d > g.d_min))
+    return x.v_gps >= x.v_s and (x.d >= g.d_max or (x.v_gps + g.v_band <= x.v_l and x.d > g.d_min))
 
 
 def _limit_to_trail(_m: AccMode, x: AccInput, g: Gaps) -> bool:
@@ -266,27 +316,33 @@ TABLE: Table[AccMode, AccInput, Gaps] = Table(AccMode, (
     Row(frozenset({M.CRUISE, M.TRAIL, M.SPEED_LIMIT}), M.BRAKE, _too_close,
         "d <= d_min (Table 2: Cruise -> Brake; Trail, SpeedLimit *)",
         "gap at or below d_min"),
+    Row(frozenset({M.CRUISE, M.TRAIL, M.SPEED_LIMIT}), M.BRAKE, _no_comfortable_stop,
+        "no comfortable stop (a_need > a_comf_max) *", _why_hard),
     Row(frozenset({M.CRUISE}), M.TRAIL, _cruise_to_trail,
         "d_des < d < d_max and V_l < V_s", "a slower vehicle ahead within d_max"),
     Row(frozenset({M.TRAIL}), M.CRUISE, _trail_to_cruise,
-        "V_GPS >= V_s and (d >= d_max or (V_s <= V_l and d > d_min))",
+        "V_GPS >= V_s and ((d >= d_max and not lead_lost) or (V_s + v_band <= V_l and d_min "
+        "< d < inf))",
         "the lead is gone or faster than the set speed"),
     Row(frozenset({M.BRAKE}), M.CRUISE, _brake_to_cruise,
-        "V_GPS >= V_s and (d >= d_max or V_s <= V_l) and d > d_min",
+        "V_GPS >= V_s and (d >= d_max or V_s + v_band <= V_l) and d > d_min and a_need "
+        "relaxed *",
         "gap recovered, nothing slower ahead"),
     Row(frozenset({M.BRAKE}), M.SPEED_LIMIT, _brake_to_limit,
-        "V_GPS < V_s and (d >= d_max or V_s <= V_l) and d > d_min",
+        "V_GPS < V_s and (d >= d_max or V_s + v_band <= V_l) and d > d_min and a_need "
+        "relaxed *",
         "gap recovered, the posted limit binds"),
     Row(frozenset({M.BRAKE}), M.TRAIL, _brake_to_trail,
-        "d > d_des and (V_l < V_s or V_l < V_GPS) and d > d_min",
+        "d > d_des and (V_l < V_s or V_l < V_GPS) and d > d_min and a_need relaxed *",
         "gap recovered beyond d_des behind a slower vehicle"),
     Row(frozenset({M.SPEED_LIMIT}), M.CRUISE, _limit_to_cruise,
-        "V_GPS >= V_s and (d >= d_max or (V_GPS <= V_l and d > d_min))",
+        "V_GPS >= V_s and (d >= d_max or (V_GPS + v_band <= V_l and d > d_min))",
         "the posted limit is no longer below the set speed"),
     Row(frozenset({M.SPEED_LIMIT}), M.TRAIL, _limit_to_trail,
         "(V_GPS < V_s or V_l < V_GPS) and d_des < d < d_max", "a vehicle ahead within d_max"),
     Row(frozenset({M.CRUISE, M.TRAIL}), M.SPEED_LIMIT, _to_limit,
-        "V_GPS < V_s and (d >= d_max or (V_GPS <= V_l and d > d_min)) (Trail *)",
+        "V_GPS < V_s and ((d >= d_max and not lead_lost) or (V_GPS + v_band <= V_l and d_min "
+        "< d < inf)) (Trail *; v_band, lead_lost *)",
         "the posted limit is below the set speed"),
 ))
 

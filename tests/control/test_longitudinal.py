@@ -76,8 +76,25 @@ def test_pulling_away_from_a_hold_does_not_overshoot() -> None:
 
 
 def test_braking_respects_decel_limit_and_stops_into_a_hold() -> None:
-    speeds, commands = simulate(SpeedController(), 15.0, 0.0, 12.0)
+    # an urgent plan (its feed-forward beyond comfort_plan): the actuator limit
+    speeds, commands = simulate(SpeedController(), 15.0, 0.0, 12.0, target_accel=-5.0)
     assert min(c.accel for c in commands) == pytest.approx(-6.0)
+    assert speeds[-1] == 0.0
+    assert commands[-1].hold
+    assert commands[-1].accel == pytest.approx(-SpeedParams().hold_decel)
+
+
+def test_a_comfortable_plan_brakes_within_iso_15622() -> None:
+    """A step of the target speed to 0 with no feed-forward (a comfortable plan): the PID
+    alone would ask for 6 m/s^2 at once; the envelope keeps the request above
+    -comfort_decel and lets its deceleration rise at comfort_jerk (ISO 15622: 3.5 m/s^2,
+    2.5 m/s^3), and the car still stops into a hold."""
+    p = SpeedParams()
+    speeds, commands = simulate(SpeedController(), 15.0, 0.0, 12.0)
+    accel = [c.accel for c in commands if not c.hold]
+    assert min(accel) == pytest.approx(-p.comfort_decel)
+    drops = -np.diff([0.0, *accel])
+    assert drops.max() <= p.comfort_jerk * CONTROL_DT + 1e-9
     assert speeds[-1] == 0.0
     assert commands[-1].hold
     assert commands[-1].accel == pytest.approx(-SpeedParams().hold_decel)
@@ -125,7 +142,10 @@ def test_reset_restarts_the_jerk_ramp_from_zero() -> None:
     for _ in range(100):
         controller.update(13.9, 0.0, 0.0, CONTROL_DT)
     controller.reset()
-    command = controller.update(0.0, 0.0, 10.0, CONTROL_DT)
+    command = controller.update(0.0, 0.0, 10.0, CONTROL_DT)  # braking: at comfort_jerk
+    assert command.accel == pytest.approx(-SpeedParams().comfort_jerk * CONTROL_DT)
+    controller.reset()
+    command = controller.update(0.0, -5.0, 10.0, CONTROL_DT)  # an urgent plan: max_jerk
     assert command.accel == pytest.approx(-10.0 * CONTROL_DT)
 
 

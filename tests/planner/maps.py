@@ -83,6 +83,7 @@ class StraightRoad:
         postings = [(0.0, limit_kph), *sorted(signs)]
         self.speed_limits = tuple(SpeedLimitPosting(s, v * KPH) for s, v in postings)
         self.lanes = (StraightLane(0, 0.0), StraightLane(1, LANE_WIDTH))
+        self.features: tuple[object, ...] = ()  # no stop lines, crossings or bumps
 
     def lane(self, index: int) -> StraightLane:
         return self.lanes[index]

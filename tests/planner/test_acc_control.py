@@ -1,20 +1,25 @@
-"""The ACC / event controllers: following, eased hard braking, stopping and passing."""
+"""The ACC / event controllers: following, the comfortable approach, stopping and passing."""
 
 from __future__ import annotations
 
-import itertools
 import math
 
 import pytest
 
 from planner.acc_control import (
     AccControlParams,
-    EasedBrake,
-    braking_need,
+    approach,
+    bump,
+    comfortable,
+    follow,
+    need,
     pass_speed,
+    stop,
     stop_speed,
     trail,
+    ttc,
 )
+from planner.speed import SpeedRef
 
 P = AccControlParams()
 
@@ -36,25 +41,84 @@ def test_trail_closes_the_gap_error_and_never_exceeds_the_plan() -> None:
     assert trail(30.0, d0 + 1.0, d0, 1.0, d0, P).speed > 0.0  # it moves off with the lead
 
 
-def test_braking_need() -> None:
-    # 20 -> 10 m/s with 30 m to go to d_stop: (400 - 100) / 60 = 5 m/s^2 (the cap)
-    assert braking_need(20.0, 10.0, 32.0, P) == pytest.approx(5.0)
-    assert braking_need(15.0, 10.0, 27.0, P) == pytest.approx(125.0 / 50.0)
-    assert braking_need(10.0, 12.0, 20.0, P) == 0.0  # the lead is faster: nothing needed
-    assert braking_need(30.0, 0.0, 1.0, P) == P.a_hard  # the cap
+def test_need_stops_the_closing_at_the_floor_after_a_ramp_in() -> None:
+    # closing at 5 m/s from 30 m: room 30 - 2.5 - 5 t_ramp, 25 / (2 room)
+    room = 30.0 - P.d_floor - 5.0 * P.a_comf_max / (2.0 * P.j_comf)  # ramp-in from 0
+    assert need(15.0, 10.0, 30.0, P) == pytest.approx(25.0 / (2.0 * room))
+    braking = 30.0 - P.d_floor - 5.0 * (P.a_comf_max - 1.0) / (2.0 * P.j_comf)  # from 1
+    assert need(15.0, 10.0, 30.0, P, a_now=1.0) == pytest.approx(25.0 / (2.0 * braking))
+    assert need(10.0, 12.0, 20.0, P) == 0.0  # the lead is faster: nothing needed
+    assert need(10.0, math.inf, math.inf, P) == 0.0  # no lead
+    assert need(30.0, 0.0, 5.0, P) == math.inf  # no room left
+    assert comfortable(P.a_comf_max, P) and not comfortable(P.a_comf_max + 0.01, P)
+    assert ttc(15.0, 10.0, 30.0) == pytest.approx(6.0)
+    assert ttc(10.0, 12.0, 30.0) == math.inf
 
 
-def test_hard_braking_eases_in_and_releases_at_once() -> None:
-    brake, dt, v = EasedBrake(), 0.025, 20.0
-    refs = [brake.step(v, 4.0, dt, P) for _ in range(60)]
-    decel = [-r.accel for r in refs]
-    assert decel[0] == pytest.approx(P.j_in * dt)  # no step: it starts small
-    assert all(b - a <= P.j_in * dt + 1e-12 for a, b in itertools.pairwise(decel))
-    assert decel[-1] == pytest.approx(4.0)  # and reaches the need within a second
-    assert decel.index(4.0) * dt == pytest.approx(4.0 / P.j_in, abs=dt)
-    assert refs[-1].speed == pytest.approx(v - 4.0 * dt)  # the reference follows the plan
-    assert -brake.step(v, 1.0, dt, P).accel == 1.0  # less needed: at once
-    assert -brake.step(v, 9.0, dt, P, cap=3.5).accel <= 3.5  # a mode's own cap
+def test_approach_plans_the_gentler_of_the_law_and_the_constant_deceleration() -> None:
+    dt, v = 0.025, 11.1
+    law = SpeedRef(8.0, 0.0)  # the loop would brake at (11.1 - 8) / 0.8 = 3.9 m/s^2
+    ref = approach(v, law, 1.2, 0.5, dt, P)
+    assert ref.accel == pytest.approx(-1.2)  # the planned deceleration, not the jolt
+    assert ref.speed == pytest.approx(v - 1.2 * dt)  # followed from the car's speed
+    # a plan gentler than a_gentle: a_gentle (the law's own reaction is kept up to it)
+    assert approach(v, law, 0.8, 0.5, dt, P).accel == pytest.approx(-P.a_gentle)
+    assert approach(v, SpeedRef(10.5, 0.0), 0.3, 0.0, dt, P) == SpeedRef(10.5, 0.0)
+    assert approach(v, law, 5.0, 0.5, dt, P) == law  # the law is gentler: the law
+    assert approach(7.0, law, 0.8, 0.0, dt, P) == law  # slower than the law: the law
+    # never gentler than the need; capped at a_comf_max while that is comfortable ...
+    assert approach(v, law, 0.8, 2.0, dt, P).accel == pytest.approx(-2.0)
+    assert approach(v, SpeedRef(0.0, 0.0), 4.5, 2.0, dt, P).accel == -P.a_comf_max
+    # ... and at a_hard when no comfortable stop is left
+    assert approach(v, SpeedRef(0.0, 0.0), 4.0, 4.0, dt, P).accel == pytest.approx(-4.0)
+    assert approach(v, SpeedRef(0.0, 0.0), 9.0, 9.0, dt, P).accel == -P.a_hard
+
+
+def test_follow_approaches_a_slower_lead_at_about_1_m_s2() -> None:
+    """Issue K (a): 40 km/h closing at 15 km/h from 25 m: the constant deceleration that
+    ends the closing at d_des(v_l) (14.4 m) is 0.8 m/s^2; the law's own reaction kept to
+    a_gentle, 1 m/s^2, not the speed loop's 3.9."""
+    v, v_l, d, d_end = 40 / 3.6, 25 / 3.6, 25.0, 4.0 + 1.5 * 25 / 3.6
+    law = trail(v, d, 4.0 + 1.5 * v, v_l, 4.0, P)
+    ref = follow(v, law, d, v_l, d_end, 0.025, P)
+    assert (v - v_l) ** 2 / (2.0 * (d - d_end)) < P.a_gentle  # the plan: 0.8 m/s^2 ...
+    assert -ref.accel == pytest.approx(P.a_gentle)  # ... so a_gentle, 1 m/s^2
+    # a stopped car revealed 50 m ahead at 50 km/h: a comfortable stop 5 m behind it
+    v = 50 / 3.6
+    stopped = follow(v, trail(v, 50.0, 25.0, 0.0, 4.0, P), 50.0, 0.0, 5.0, 0.025, P)
+    assert 2.4 < -stopped.accel <= P.a_comf_max
+    # 25 m ahead: no comfortable stop, up to a_hard
+    late = follow(v, trail(v, 25.0, 25.0, 0.0, 4.0, P), 25.0, 0.0, 5.0, 0.025, P)
+    assert -late.accel == P.a_hard
+    # inside d_end but closing: the closing is stopped before the floor, not at once
+    inside = follow(v, trail(v, 15.0, 25.0, v - 2.0, 4.0, P), 15.0, v - 2.0, 20.0, 0.025, P)
+    assert 0.0 < -inside.accel <= P.a_comf_max
+    # a lead pulling away: the law
+    law = trail(v, 30.0, 25.0, v + 1.0, 4.0, P)
+    assert follow(v, law, 30.0, v + 1.0, 25.0, 0.025, P) == law
+
+
+def test_stops_and_bumps_met_late_plan_a_constant_deceleration() -> None:
+    v, dt = 40 / 3.6, 0.025
+    # on the curve (far enough): the law, with its comfortable feed-forward
+    far = stop(200.0, v, v, dt, P)
+    assert far == SpeedRef(v, 0.0)
+    # met at 30 m: v^2 / (2 (30 - margin)) = 2.1 m/s^2, with the room the ramp-in takes
+    # (v 2.1 / (2 j_comf)) 2.7 m/s^2, planned, not the loop's jolt
+    late = stop(30.0, v, v, dt, P)
+    first = v * v / (2.0 * (30.0 - P.margin))
+    room = 30.0 - P.margin - v * first / (2.0 * P.j_comf)
+    assert -late.accel == pytest.approx(v * v / (2.0 * room))
+    assert -late.accel <= P.a_comf_max
+    # met at 12 m: no comfortable stop, harder (at most a_hard)
+    assert -stop(12.0, v, v, dt, P).accel == P.a_hard
+    assert stop(P.margin + 0.1, v, v, dt, P).speed == 0.0  # arrived
+    v_pass = 15 / 3.6
+    slow = bump(20.0, v_pass, v, v, dt, P)
+    first = (v * v - v_pass**2) / (2.0 * (20.0 - P.margin))
+    room = 20.0 - P.margin - v * first / (2.0 * P.j_comf)
+    assert -slow.accel == pytest.approx(min((v * v - v_pass**2) / (2.0 * room), P.a_hard))
+    assert bump(200.0, v_pass, v, v, dt, P).speed == pytest.approx(v)
 
 
 def test_stop_and_pass_speeds() -> None:

@@ -76,15 +76,17 @@ def test_lead_brakes_to_a_stop_waits_and_drives_off() -> None:
     assert v[-1] == pytest.approx(12.0, abs=0.1)
 
 
-def test_cut_in_close_ahead_brakes_eased_then_recovers() -> None:
-    """A car 20 km/h slower appears 15 m ahead (inside d_min): BRAKE eases in, never
-    above the hard limit, and the gap is back above d_min."""
+def test_cut_in_close_ahead_brakes_comfortably_then_recovers() -> None:
+    """A car 20 km/h slower appears 15 m ahead (inside d_min): BRAKE plans the comfortable
+    stop of the closing (a comfortable stop is left: 1.7 m/s^2 would stop it 2.5 m short
+    after the ramp-in that the speed loop's comfort jerk gives), and the gap is back above
+    d_min."""
     v0 = 60 / 3.6
-    run = drive([v0 - 20 / 3.6] * 800, v0=v0, gap0=15.0, set_speed=v0)
+    run = drive([v0 - 20 / 3.6] * 1200, v0=v0, gap0=15.0, set_speed=v0)
     assert run["modes"][0] == "brake"  # engaged with it inside d_min: braking at once
     decel = -run["a"]
-    assert float(decel.max()) <= 5.0 + 1e-9
-    assert float(decel[0]) < 1.0  # eased in: no step at the cut-in
+    assert float(decel.max()) <= 3.0 + 1e-9  # within comfort (planner.limits.A_COMF_MAX)
+    assert float(run["gap"].min()) > 4.0  # the closing stopped short of the floor
     late = run["t"] > 10.0
     v, gap = run["v"][late], run["gap"][late]
     assert np.all(gap >= np.array([r157_min_gap(x) for x in v]) - 0.5)

@@ -8,7 +8,7 @@ from dataclasses import replace
 import pytest
 
 from perception.messages import ObjectClass, Track
-from planner.acc_control import AccControlParams, pass_speed, stop_speed
+from planner.acc_control import AccControlParams, bump, stop, stop_speed
 from planner.acc_layer import AccLayer
 from planner.events import EventMonitor, EventParams, Events
 from planner.fsm.acc import AccEvent, AccMode
@@ -83,20 +83,24 @@ C = AccControlParams()
 PLAN = PlannedSpeed(SpeedRef(12.0, 0.0), SpeedSource.LIMIT)  # the map's plan
 
 
-@pytest.mark.parametrize(("events", "mode", "speed"), [
-    (Events(active=frozenset({STOP_SIGN}), stop_distance=20.0), AccMode.STOP_SIGN,
-     stop_speed(20.0, 12.0, C)),
-    (Events(active=frozenset({PEDESTRIAN}), stop_distance=8.0), AccMode.PEDESTRIAN,
-     stop_speed(8.0, 12.0, C)),
+@pytest.mark.parametrize(("events", "mode", "v", "speed"), [
+    # met faster than their laws (at 10 m/s): the planned deceleration from the speed
+    (Events(active=frozenset({STOP_SIGN}), stop_distance=20.0), AccMode.STOP_SIGN, 10.0,
+     stop(20.0, 10.0, 12.0, 0.025, C).speed),
+    (Events(active=frozenset({PEDESTRIAN}), stop_distance=8.0), AccMode.PEDESTRIAN, 10.0,
+     stop(8.0, 10.0, 12.0, 0.025, C).speed),
     (Events(active=frozenset({SPEED_BUMP}), bump_distance=15.0, bump_speed=1.3),
-     AccMode.SPEED_BUMP, pass_speed(15.0, 1.3, 12.0, C)),
-    (Events(active=frozenset({OFF_RAMP})), AccMode.OFF_RAMP, 12.0),
+     AccMode.SPEED_BUMP, 10.0, bump(15.0, 1.3, 10.0, 12.0, 0.025, C).speed),
+    # on its curve: the law itself
+    (Events(active=frozenset({STOP_SIGN}), stop_distance=30.0), AccMode.STOP_SIGN,
+     stop_speed(30.0, 12.0, C), stop_speed(30.0, 12.0, C)),
+    (Events(active=frozenset({OFF_RAMP})), AccMode.OFF_RAMP, 10.0, 12.0),
 ])
-def test_the_event_modes_and_their_laws(events: Events, mode: AccMode, speed: float) -> None:
+def test_the_event_modes_and_their_laws(events: Events, mode: AccMode, v: float,
+                                        speed: float) -> None:
     layer = AccLayer()
-    layer.update(0.0, 0.025, 10.0, 15.0, 20.0, PLAN, None)  # on: cruise
-    out, changes = layer.update(0.025, 0.025, 10.0, 15.0, 20.0, PLAN, None,
-                                events=events)
+    layer.update(0.0, 0.025, v, 15.0, 20.0, PLAN, None)  # on: cruise
+    out, changes = layer.update(0.025, 0.025, v, 15.0, 20.0, PLAN, None, events=events)
     assert layer.mode is mode and changes[0].target == mode.value
     assert out.speed.ref.speed == pytest.approx(speed)
     # the event's law set the speed where it is below the plan's (the ramp: the plan's)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -18,7 +19,7 @@ from planner.speed_planning import (
 )
 from tests.planner.maps import KPH, real_map, road_spec, segment, straight_road
 from tests.vehicle import VEHICLE
-from world.hdmap import RoadMap
+from world.hdmap import Crosswalk, RoadMap
 
 P = SpeedPlanningParams()
 A = P.a_comf
@@ -306,3 +307,23 @@ def test_planner_equals_brute_force_over_every_sample() -> None:
             assert got.speed == pytest.approx(best, rel=1e-9, abs=1e-9), (lane_index, s)
     # every kind of map constraint was exercised
     assert {Binding.CURVE, Binding.CURVE_AHEAD, Binding.LIMIT, Binding.LIMIT_AHEAD} <= seen
+
+
+# ---- marked crossings (issue K: a pedestrian tracked from ~20 m is stopped for within comfort)
+
+
+def test_a_crossing_caps_the_speed_within_its_sight_and_brakes_towards_it() -> None:
+    crossing = 400.0
+    spec = road_spec([segment(1000.0)], 40.0)
+    road = real_map(replace(spec, features=(*spec.features, Crosswalk(s=crossing, width=4.0))))
+    far = target(road, 100.0, 40.0)  # 300 m before: the posted limit
+    assert far.binding is Binding.LIMIT
+    d_sight = crossing - P.crossing_sight  # the cap holds from here (front bumper)
+    near = target(road, d_sight - FRONT + 5.0, 40.0)
+    assert near.binding is Binding.CROSSING and near.speed == pytest.approx(P.crossing_speed)
+    ahead = target(road, d_sight - FRONT - 10.0, 40.0)  # 10 m before the cap: its curve
+    assert ahead.binding is Binding.CROSSING and ahead.accel == -A
+    assert ahead.speed == pytest.approx(math.sqrt(P.crossing_speed**2 + 2 * A * (10 - MARGIN)),
+                                        rel=1e-3)
+    past = target(road, crossing - FRONT + 0.5, 40.0)  # the bumper on the crossing: free
+    assert past.binding is Binding.LIMIT

@@ -90,6 +90,25 @@ TABLE_CASES = [
     ("trail_pedestrian", M.TRAIL, x(d=BETWEEN, v_l=VL, pedestrian=True), M.PEDESTRIAN),
     ("trail_speed_bump", M.TRAIL, x(d=BETWEEN, v_l=VL, speed_bump=True), M.SPEED_BUMP),
     ("trail_brake", M.TRAIL, x(d=CLOSE, v_l=VL), M.BRAKE),
+    # no comfortable stop (ISO 15622; *): BRAKE at once, saying so; left once relaxed
+    ("trail_brake_no_comfortable_stop", M.TRAIL,
+     x(d=BETWEEN, v_l=0.0, a_need=4.2, ttc=2.1, comfortable=False, relaxed=False), M.BRAKE),
+    ("cruise_brake_no_comfortable_stop", M.CRUISE,
+     x(d=FAR, v_l=0.0, a_need=3.6, ttc=3.0, comfortable=False, relaxed=False), M.BRAKE),
+    ("limit_brake_no_comfortable_stop", M.SPEED_LIMIT,
+     x(v_gps=13.0, d=FAR, v_l=0.0, a_need=3.6, comfortable=False, relaxed=False), M.BRAKE),
+    ("brake_stays_until_relaxed", M.BRAKE,
+     x(d=BETWEEN, v_l=VL, a_need=2.8, comfortable=True, relaxed=False), None),
+    ("brake_cruise_stays_until_relaxed", M.BRAKE,
+     x(d=FAR, v_l=VL, a_need=2.8, comfortable=True, relaxed=False), None),
+    # a lead at the set speed or the limit: no flip on its speed's wobble (v_band *)
+    ("trail_stays_lead_at_set_speed", M.TRAIL, x(d=G.d_des + 2.0, v_l=15.2), None),
+    # a lead just lost: TRAIL holds for lead_hold (the car it hid may become the lead; *)
+    ("trail_stays_lead_just_lost", M.TRAIL, x(lead_lost=True), None),
+    ("trail_limit_waits_lead_just_lost", M.TRAIL, x(v_gps=13.0, lead_lost=True), None),
+    ("brake_stays_lead_at_set_speed", M.BRAKE, x(d=G.d_min + 1.0, v_l=15.2), None),
+    ("limit_stays_lead_at_limit", M.SPEED_LIMIT,
+     x(v_s=13.0, v_gps=13.0, d=G.d_des + 2.0, v_l=13.2), None),
     ("trail_limit", M.TRAIL, x(v_gps=13.0), M.SPEED_LIMIT),
     # Brake (3 to 1, 3 to 2, 3 to 4, 3 to 9)
     ("brake_cruise", M.BRAKE, x(d=FAR, v_l=VL), M.CRUISE),

@@ -1,0 +1,210 @@
+"""`comfort`: the ego's automatic braking stays within ISO 15622 / ISO 22179's comfort limits
+whenever the truth shows a comfortable solution existed (`criteria: {comfort: iso15622}`;
+off unless set). Two criteria, on the ego's true forward speed at the criteria rate:
+
+- `comfort_decel` [m/s^2]: the deceleration averaged over `DECEL_WINDOW` (2 s, ISO's
+  measure), ``(v(t - 2 s) - v(t)) / 2 s``, is at most `A_ISO` (3.5 m/s^2);
+- `comfort_jerk` [m/s^3]: the rate at which the deceleration rises, ISO's "average rate of
+  change of deceleration over 1 s": the deceleration averaged over `ACCEL_WINDOW` (0.5 s,
+  which filters the drivetrain's and the suspension's ripple), ``D(t) = (v(t - 0.5 s) -
+  v(t)) / 0.5 s``, and the rise of its braking part over `JERK_WINDOW` (1 s), ``(D+(t) -
+  D+(t - 1 s)) / 1 s`` with ``D+ = max(D, 0)``, is at most `J_ISO` (2.5 m/s^3). A
+  deceleration that falls (brakes released, the car coming to rest) and an acceleration
+  that tapers off (the end of a pull-away) are not judged: ISO limits the onset of
+  braking.
+
+Each window uses the newest sample at least its span back, so an extra sample (the runner
+samples at each contact onset too) does not bend it.
+
+Excused (the truth shows no comfortable solution): from the first sample at which the
+deceleration needed to stop closing on the vehicle ahead in the ego's lane before a bumper
+gap of `D_STOP` exceeds `A_ISO` -- ``(v - v_l)^2 / (2 (d - D_STOP))`` against its speed
+now, or, while it brakes, ``v^2 / (2 (d + v_l^2 / (2 b_l) - D_STOP))`` to stop behind
+where it stops (b_l its deceleration) -- such as a cut-in close ahead or a lead braking
+hard, until `EXCUSE_AFTER` (2 s, the longest window) after the ego's braking has ended
+(its 0.5 s deceleration under `BRAKING`). The criterion cannot tell whether the stack
+itself let the need grow (braking late); `min_gap` and `no_collision` judge that.
+
+Value: the peak judged (0 before a window first fills). Not applicable when the ego never
+braked outside the excused windows (its 0.5 s deceleration never reached `BRAKING`). The
+run's metrics carry the unexcused peaks of the whole run too (`peaks`: `peak_decel_2s`,
+`peak_braking_jerk`), whatever the scenario's criteria.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+from typing import Literal
+
+import numpy as np
+from numpy.typing import NDArray
+
+from avsim.criteria.base import Criterion, CriterionResult, Need, TruthSample
+from avsim.criteria.declaration import Declaration
+from avsim.criteria.following import ahead_of
+from world.hdmap import RoadMap
+
+A_ISO = 3.5  # [m/s^2] ISO 15622 / 22179 (above 20 m/s): deceleration, 2 s average
+J_ISO = 2.5  # [m/s^3] ISO 15622 / 22179 (above 20 m/s): rise of deceleration, 1 s average
+DECEL_WINDOW = 2.0  # [s] of the deceleration's average (ISO)
+ACCEL_WINDOW = 0.5  # [s] of the deceleration's average the jerk is taken from
+JERK_WINDOW = 1.0  # [s] of the jerk's average (ISO)
+D_STOP = 2.0  # [m] the bumper gap a comfortable solution must keep (UN R157 4.2.1)
+BRAKING = 0.5  # [m/s^2] a 0.5 s deceleration at least this is braking
+LEAD_BRAKING = 0.5  # [m/s^2] a vehicle ahead decelerating more brakes
+EXCUSE_AFTER = DECEL_WINDOW  # [s] an excused window lasts this long after braking ends
+SPAN_TOLERANCE = 1e-9  # [s] in comparing spans of sample times (sums of float steps)
+ISO15622 = "iso15622"  # the setting
+
+
+def required_decel(speed: float, gap: float, lead_speed: float, lead_accel: float) -> float:
+    """[m/s^2] >= 0: the deceleration that stops the ego (speed [m/s]) closing on a vehicle
+    ahead at bumper gap `gap` [m] with speed `lead_speed` [m/s] and acceleration `lead_accel`
+    [m/s^2] before the gap falls to `D_STOP` (module doc); inf with no room left."""
+    closing = speed - lead_speed
+    room = gap - D_STOP
+    need = closing * closing / (2.0 * room) if closing > 0.0 and room > 0.0 else \
+        (math.inf if closing > 0.0 else 0.0)
+    if lead_accel < -LEAD_BRAKING:
+        stop_room = room + lead_speed * lead_speed / (2.0 * -lead_accel)
+        need = max(need, speed * speed / (2.0 * stop_room) if stop_room > 0.0 else math.inf)
+    return need
+
+
+class _Window:
+    """The newest (t, value) at least `span` [s] before the latest one."""
+
+    def __init__(self, span: float) -> None:
+        self.span = span
+        self.items: deque[tuple[float, float]] = deque()
+
+    def push(self, t: float, value: float) -> tuple[float, float] | None:
+        """Add (t, value); the sample `span` back, or None until the window has filled."""
+        self.items.append((t, value))
+        while len(self.items) > 1 and t - self.items[1][0] >= self.span - SPAN_TOLERANCE:
+            self.items.popleft()
+        t0, v0 = self.items[0]
+        return (t0, v0) if t - t0 >= self.span - SPAN_TOLERANCE else None
+
+
+class ComfortSignals:
+    """The 2 s deceleration and the braking jerk of a speed trace, sample by sample."""
+
+    def __init__(self) -> None:
+        self._decel = _Window(DECEL_WINDOW)
+        self._short = _Window(ACCEL_WINDOW)
+        self._jerk = _Window(JERK_WINDOW)
+
+    def push(self, t: float, speed: float) -> tuple[float | None, float | None, float | None]:
+        """([m/s^2] 2 s deceleration, [m/s^2] 0.5 s deceleration, [m/s^3] the rise of the
+        latter's braking part over 1 s) at time t [s] and speed [m/s]; None until each
+        window has filled."""
+        back = self._decel.push(t, speed)
+        decel = (back[1] - speed) / (t - back[0]) if back is not None and t > back[0] else None
+        short_back = self._short.push(t, speed)
+        if short_back is None or t <= short_back[0]:
+            return decel, None, None
+        short = (short_back[1] - speed) / (t - short_back[0])
+        jerk_back = self._jerk.push(t, short)
+        jerk = (max(short, 0.0) - max(jerk_back[1], 0.0)) / (t - jerk_back[0]) \
+            if jerk_back is not None and t > jerk_back[0] else None
+        return decel, short, jerk
+
+
+def peaks(t: NDArray[np.float64], speed: NDArray[np.float64]) -> dict[str, float]:
+    """The run's metrics: the peak 2 s deceleration `peak_decel_2s` [m/s^2] and the peak
+    braking jerk `peak_braking_jerk` [m/s^3] of the speed trace (module doc), nothing
+    excused; 0 before a window fills."""
+    signals = ComfortSignals()
+    decel_peak = jerk_peak = 0.0
+    for ti, vi in zip(t.tolist(), speed.tolist(), strict=True):
+        decel, _, jerk = signals.push(ti, vi)
+        decel_peak = max(decel_peak, decel or 0.0)
+        jerk_peak = max(jerk_peak, jerk or 0.0)
+    return {"peak_decel_2s": decel_peak, "peak_braking_jerk": jerk_peak}
+
+
+class _Comfort(Criterion):
+    """A comfort limit judged outside the excused windows (module doc)."""
+
+    unit = ""
+    limit = 0.0
+
+    def __init__(self, road: RoadMap, ego_length: float) -> None:
+        super().__init__()
+        self.road, self.ego_length = road, ego_length
+        self.signals = ComfortSignals()
+        self.peak = 0.0  # [unit] the largest judged
+        self.braked = False  # the ego braked outside the excused windows
+        self.excused = 0  # how many excused windows there were
+        self._in_window = False  # in an excused window
+        self._excused_until = math.inf  # [s] its end, once the braking in it has ended
+
+    def _measure(self, decel: float | None, jerk: float | None) -> float | None:
+        raise NotImplementedError
+
+    def update(self, sample: TruthSample) -> None:
+        decel, short, jerk = self.signals.push(sample.t, sample.speed)
+        braking = short is not None and short >= BRAKING
+        ahead = ahead_of(sample, self.road, self.ego_length)
+        need = required_decel(sample.speed, ahead[0].gap, ahead[0].speed, ahead[0].accel) \
+            if ahead else 0.0
+        if need > A_ISO:  # no comfortable solution: a window opens (or goes on)
+            self.excused += 0 if self._in_window else 1
+            self._in_window, self._excused_until = True, math.inf
+        elif self._in_window:  # it lasts until EXCUSE_AFTER after the braking has ended
+            if braking:
+                self._excused_until = math.inf
+            elif self._excused_until == math.inf:
+                self._excused_until = sample.t + EXCUSE_AFTER
+            self._in_window = sample.t <= self._excused_until
+        if self._in_window:
+            return
+        self.braked = self.braked or braking
+        value = self._measure(decel, jerk)
+        if value is None:
+            return
+        self.peak = max(self.peak, value)
+        if value > self.limit:
+            self._fail(sample, f"{self.name} {value:.2f} {self.unit} beyond {self.limit:g} "
+                               f"{self.unit} with a comfortable solution at hand")
+
+    def result(self) -> CriterionResult:
+        if not self.braked:
+            why = f" ({self.excused} braking(s) excused: no comfortable solution by the " \
+                  f"truth)" if self.excused else ""
+            return CriterionResult.not_applicable(self.name, self.limit, self.unit,
+                                                  f"the ego never braked{why}")
+        return CriterionResult(self.name, self.first_failure is None, self.peak, self.limit,
+                               self.unit, self.first_failure)
+
+
+class ComfortDecel(_Comfort):
+    """ISO 15622's deceleration bound: the 2 s deceleration at most `A_ISO`."""
+
+    name, unit, limit = "comfort_decel", "m/s^2", A_ISO
+
+    def _measure(self, decel: float | None, jerk: float | None) -> float | None:
+        return decel
+
+
+class ComfortJerk(_Comfort):
+    """ISO 15622's jerk bound: the deceleration rises at most at `J_ISO`."""
+
+    name, unit, limit = "comfort_jerk", "m/s^3", J_ISO
+
+    def _measure(self, decel: float | None, jerk: float | None) -> float | None:
+        return jerk
+
+
+COMFORT: Declaration[str] = Declaration(
+    build=lambda _, run: [ComfortDecel(run.road, run.car.body_length),
+                          ComfortJerk(run.road, run.car.body_length)],
+    needs=frozenset({Need.MAP, Need.CAR, Need.ACTORS}), key="comfort",
+    setting=Literal["iso15622"],
+    doc="`iso15622`: the ego's deceleration (2 s average) stays at most 3.5 m/s^2 and its "
+    "rise (the 0.5 s deceleration's change over 1 s) at most 2.5 m/s^3, except where the "
+    "truth shows no comfortable solution (stopping the closing on the vehicle ahead 2 m "
+    "short of it needs more than 3.5 m/s^2); criteria `comfort_decel` and `comfort_jerk`, "
+    "not applicable when the ego never braked. Default: off.", example=ISO15622)
