@@ -185,8 +185,12 @@ def mutate_xml(tree: ET.ElementTree, index: int, attribute: str, value: str | No
 
 def road_of(xosc: Path) -> Path | None:
     """The OpenDRIVE file an OpenSCENARIO file names (its `LogicFile`), if any."""
-    found = re.search(r'LogicFile filepath="([^"]+)"', xosc.read_text(encoding="utf-8"))
-    return (xosc.parent / found.group(1)).resolve() if found else None
+    text = xosc.read_text(encoding="utf-8")
+    found = re.search(r'LogicFile filepath="([^"$]+)"', text)
+    if found is None:  # given by a parameter: its default value
+        found = re.search(r'ParameterDeclaration name="Road"[^>]*value="([^"]+)"', text)
+    road = (xosc.parent / found.group(1)).resolve() if found else None
+    return road if road is not None and road.is_file() else None
 
 
 @FUZZ
