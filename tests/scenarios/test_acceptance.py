@@ -5,7 +5,8 @@ cameras and the LiDAR in the loop).
 Each test first shows from the truth that its situation happened (the stationary car stood
 in the ego's lane and the ego came up behind it; the lead braked to a stop; the cutter
 entered the ego's lane ahead of it; the lead left the lane and revealed the stopped car;
-the lead stopped and drove off again), then that every criterion passed (a collision UN
+the lead stopped and drove off again), then that every criterion passed (ISO 15622 comfort
+included, `comfort: iso15622`; a collision UN
 R157 deems unavoidable is reported by `no_collision`, not failed). The set is too long for
 `make test` (113 runs of the grids): `make acceptance` runs it.
 """
