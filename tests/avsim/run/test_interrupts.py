@@ -101,21 +101,22 @@ def test_an_interrupted_run_keeps_its_recording_and_result(
 
 @pytest.mark.slow
 def test_an_interrupted_sweep_keeps_its_finished_runs_and_reports(tmp_path: Path) -> None:
-    """Ctrl-C (SIGINT to the process group) once the first of three runs has finished: the
-    second ends at its tick with its files, the third never starts; the reports cover all
+    """Ctrl-C (SIGINT to the process group) once the second of three runs is under way: it
+    ends at its tick with its files, the third never starts; the reports cover all
     three; exit 130; no temporary file is left."""
     out = tmp_path / "sweep"
     env = {**os.environ, "PYTHONPATH": str(REPO)}
     proc = subprocess.Popen(
         [sys.executable, "-m", "avsim.cli", "sweep", "normal_driving", "--set",
-         "seed=1,2,3", "--jobs", "1", "--profile", "none", "--out", str(out)],
+         "seed=1,2,3", "--set", "duration=60", "--jobs", "1", "--profile", "none", "--out",
+         str(out)],
         cwd=tmp_path, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
         start_new_session=True)
-    first = out / "normal_driving_000.json"
+    second = out / ".normal_driving_001.rrd.partial"  # its recording is open: under way
     deadline = time.monotonic() + 300
-    while not first.exists() and proc.poll() is None and time.monotonic() < deadline:
-        time.sleep(0.2)
-    time.sleep(4.0)  # the second run is under way
+    while not second.exists() and proc.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.05)
+    time.sleep(1.0)  # well inside its 60 s simulated (6 s or more of wall time)
     os.killpg(proc.pid, signal.SIGINT)
     _, stderr = proc.communicate(timeout=300)
     assert proc.returncode == 130, stderr
