@@ -8,7 +8,9 @@ from __future__ import annotations
 
 import json
 import os
+import subprocess
 import sys
+import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, NoReturn
@@ -137,15 +139,31 @@ def run(scenario: str, out: Path | None, json_path: Path | None, profile: str, s
 
 
 def _run_with_progress(runner: Runner, duration: float, show: bool) -> RunResult:
-    """Run, with a progress bar in sim seconds on stderr when `show` and it is a terminal."""
+    """Run, with a progress line on stderr when `show` and it is a terminal (quiet when
+    piped): simulated time, the real-time factor so far and the wall time to go."""
     console = Console(stderr=True)
     if not show or not console.is_terminal:
         return runner.run()
     columns = (TextColumn("[bold]{task.description}"), BarColumn(),
-               TextColumn("{task.completed:.0f}/{task.total:.0f} s sim"), TimeElapsedColumn())
+               TextColumn("{task.completed:.0f}/{task.total:.0f} s sim"),
+               TextColumn("{task.fields[pace]}"), TimeElapsedColumn())
     with Progress(*columns, console=console, transient=True) as bar:
-        task = bar.add_task(runner.scenario.name, total=duration)
-        return runner.run(lambda t, _d: bar.update(task, completed=t))
+        task = bar.add_task(runner.scenario.name, total=duration, pace="")
+        start = time.perf_counter()
+
+        def advance(t: float, _duration: float) -> None:
+            bar.update(task, completed=t, pace=pace(t, duration, time.perf_counter() - start))
+
+        return runner.run(advance)
+
+
+def pace(sim: float, duration: float, wall: float) -> str:
+    """`RTF x.xx, n s to go`: the real-time factor so far (simulated over wall time) and
+    the wall time the rest of the run takes at it; empty before there is a rate."""
+    if sim <= 0.0 or wall <= 0.0:
+        return ""
+    rtf = sim / wall
+    return f"RTF {rtf:.2f}, {max(duration - sim, 0.0) / rtf:.0f} s to go"
 
 
 def _print_verdict(payload: dict[str, object]) -> None:
@@ -169,6 +187,21 @@ def _print_verdict(payload: dict[str, object]) -> None:
     renderer = f", cameras by {payload['renderer']}" if payload.get("renderer") else ""
     console.print(f"sim {payload['sim_time']:.1f} s in {payload['wall_time']:.1f} s wall "
                   f"(profile {payload['profile']}{renderer}); recording {payload['recording']}")
+
+
+@main.command()
+@click.argument("recording", type=click.Path(path_type=Path))
+@click.option("--web", is_flag=True, help="Open the web viewer (served on port 9090) instead "
+              "of the native one.")
+def view(recording: Path, web: bool) -> None:
+    """Open a run's recording (.rrd) in the Rerun viewer (the one that came with avsim)."""
+    if not recording.is_file():
+        _bad_input(f"{recording}: (file): no such recording")
+    viewer = Path(sys.executable).parent / "rerun"
+    if not viewer.is_file():
+        _bad_input(f"{recording}: (file): the Rerun viewer is not installed ({viewer})")
+    command = [str(viewer), *(["--web-viewer"] if web else []), str(recording)]
+    sys.exit(subprocess.call(command))
 
 
 @main.command(name="list")

@@ -329,3 +329,35 @@ def test_run_set_overrides_a_key_and_the_result_is_strict_json(tmp_path: Path) -
                if c["verdict"] == "not_applicable")
     with pytest.raises(ValueError, match="not strict JSON"):
         strict_json('{"value": Infinity}')
+
+
+def test_view_opens_the_recording_in_the_rerun_viewer(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """`avsim view RUN.rrd` starts the viewer that came with avsim on the file; `--web`
+    the web viewer (the viewer itself is not started here: there is no display)."""
+    calls: list[list[str]] = []
+    monkeypatch.setattr(subprocess, "call", lambda command: calls.append(command) or 0)
+    recording = tmp_path / "run.rrd"
+    recording.write_bytes(b"")
+    viewer = str(Path(sys.executable).parent / "rerun")
+    for args, command in ((["view", str(recording)], [viewer, str(recording)]),
+                          (["view", "--web", str(recording)],
+                           [viewer, "--web-viewer", str(recording)])):
+        result = CliRunner().invoke(main, args)
+        assert result.exit_code == 0, result.output
+        assert calls.pop() == command
+    result = CliRunner().invoke(main, ["view", str(tmp_path / "none.rrd")])
+    assert result.exit_code == 2
+    missing = tmp_path / "none.rrd"
+    assert result.output.strip() == f"avsim: error: {missing}: (file): no such recording"
+
+
+@pytest.mark.parametrize(("sim", "duration", "wall", "text"), [
+    (0.0, 60.0, 1.0, ""), (10.0, 60.0, 5.0, "RTF 2.00, 25 s to go"),
+    (30.0, 30.0, 40.0, "RTF 0.75, 0 s to go"),
+])
+def test_the_progress_line_gives_the_pace(sim: float, duration: float, wall: float,
+                                          text: str) -> None:
+    from avsim.cli import pace
+
+    assert pace(sim, duration, wall) == text
