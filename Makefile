@@ -6,7 +6,7 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 PYTEST_ARGS ?=
 
-.PHONY: setup demo test test-quick acceptance lint golden bench clean
+.PHONY: setup demo test test-quick acceptance lint golden bench soak clean
 
 # The virtual environment with the pinned dependencies (pyproject.toml), installed once.
 $(STAMP): pyproject.toml
@@ -56,6 +56,11 @@ bench: $(STAMP)
 	$(BIN)/python -m bench.bench_sensing
 	$(BIN)/python -m bench.bench_stages
 	$(BIN)/python -m bench.bench_batch
+
+# An hour of simulated time on a town loop per profile (none, fast): memory, recording size
+# and real-time factor over time (about 50 minutes here).
+soak: $(STAMP)
+	$(BIN)/python -m bench.bench_soak
 
 clean:
 	rm -rf runs .pytest_cache .mypy_cache .ruff_cache
