@@ -313,6 +313,21 @@ class Localizer:
         ahead = min(mouths, key=lambda d: abs(d - x_end))
         return self._along(ahead - x_end, p.line_end_sigma)
 
+    def lane_width(self, pose: EgoState) -> float | None:
+        """[m] the HD map's width of the ego-direction lane the car's centre is nearest at
+        ``pose`` (the lane a camera frame taken there sees), None without a map or a lane
+        there: the width the camera's lane keeps when one of its lines is hidden."""
+        road = self.road
+        if road is None:
+            return None
+        s_arr, d_arr = road.local_coordinates(np.array([pose.x, pose.y]))
+        s, d = float(s_arr), float(d_arr)
+        lanes = [lane for lane in road.lanes if bool(lane.exists_at(s))]
+        if not lanes:
+            return None
+        nearest = min(lanes, key=lambda lane: abs(float(lane.offset_at(s)) - d))
+        return float(nearest.width_at(s))
+
     def stop_lines_ahead(self, pose: EgoState, near: float, far: float) -> list[float]:
         """[m] distances from ``pose`` to the map's painted stop lines (a stop sign's, a town
         junction's) between ``near`` and ``far`` ahead along the route."""
