@@ -82,6 +82,7 @@ class ObjectClass(enum.Enum):
 
     CAR = "car"
     TRUCK = "truck"
+    MOTORCYCLE = "motorcycle"  # a powered two-wheeler and its rider
     PEDESTRIAN = "pedestrian"
     OTHER = "other"
 

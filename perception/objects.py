@@ -45,30 +45,35 @@ named below are fields of `DetectorParams`.
    squared distances have the normal n = the eigenvector of the smallest eigenvalue of S_1 -
    S_2 (the scatter matrices of the two point sets; closed form).
 6. **Candidate classes** from the observed extents a >= b and the highest point h (lower
-   bounds: a LiDAR sees only the near faces and, far away, one or two rings): none (not an
+   bounds: a LiDAR sees only the near faces and, far away, one or two rings) and the height
+   the ring above passes over the cluster (`ring_gap_top`: an upper bound): none (not an
    object) if a > ``max_length`` or h > ``max_height``; if a <= ``small_footprint``,
    PEDESTRIAN when a <= ``pedestrian_footprint``, h <= ``pedestrian_max_height`` and h >=
    ``pedestrian_min_height`` or, where only the cluster's top ring could reach it (the ring
    below meets the ground first), the ring above passes over it at ``pedestrian_adult_height``
-   or higher (`ring_gap_top`: beyond 30 m one ring crosses a walker, at knee height), else
-   OTHER (obstacles, poles); TRUCK alone if h > ``car.height``
-   + ``height_margin``, a > ``truck_min_length`` or b > ``truck_min_width``; otherwise CAR or
-   TRUCK.
+   or higher (beyond 30 m one ring crosses a walker, at knee height), else OTHER (obstacles,
+   poles); TRUCK alone if h > ``car.height`` + ``height_margin``, a > ``truck_min_length``
+   or b > ``truck_min_width``; otherwise CAR, then MOTORCYCLE if ``car.width`` < a <=
+   ``motorcycle_max_length``, b <= ``motorcycle_max_width`` and h <=
+   ``motorcycle_max_height`` (a side longer than a car's rear is wide: a car's side or a
+   motorcycle's), then TRUCK unless the ring above passes over it lower than ``car.height``
+   + ``height_margin`` (no truck's rear is that low). Of equal costs (step 7) the first
+   wins: a car's rear is no motorcycle's side.
 7. **Box completion**: each candidate class's box is grown to its size prior (``car``,
-   ``truck``, ``pedestrian``; never shrunk below what was seen; OTHER: a square of the longer
-   observed side), with either rectangle axis as the length. A pedestrian's rectangle is
-   taken along the line of sight instead of the L-shape fit (see `along_sight`). Each axis
-   grows away from the sensor, so that the faces seen stay where they were seen: if the
-   sensor projects onto the axis outside the observed interval, the interval's end nearer
-   the sensor is kept; if inside (a face seen head-on, both its ends visible), the interval
-   grows symmetrically. The
-   hypothesis of least cost = silhouette growth + ``overshoot_weight`` x overshoot (+
-   ``truck_bias`` for trucks) wins: the silhouette growth [m] is how far the box sticks out
-   sideways beyond the seen points as viewed from the sensor (azimuth growth x mean range; a
-   rightly completed box hides behind its visible faces), the overshoot [m] how much the seen
-   extents exceed the prior's. This decides, e.g., whether a lone face a car wide is a car's
-   rear (grown away: no growth) or part of its side (grown sideways). Height: the prior's, or
-   the observed one if larger; z is half the height.
+   ``truck``, ``motorcycle``, ``pedestrian``; never shrunk below what was seen; OTHER: a
+   square of the longer observed side), with either rectangle axis as the length. A
+   pedestrian's rectangle is taken along the line of sight instead of the L-shape fit (see
+   `along_sight`). Each axis grows away from the sensor, so that the faces seen stay where
+   they were seen: if the sensor projects onto the axis outside the observed interval, the
+   interval's end nearer the sensor is kept; if inside (a face seen head-on, both its ends
+   visible), the interval grows symmetrically. The hypothesis of least cost = silhouette
+   growth + ``overshoot_weight`` x overshoot (+ ``truck_bias`` for trucks) wins: the
+   silhouette growth [m] is how far the box sticks out sideways beyond the seen points as
+   viewed from the sensor (azimuth growth x mean range; a rightly completed box hides behind
+   its visible faces), the overshoot [m] how much the seen extents exceed the prior's. This
+   decides, e.g., whether a lone face a car wide is a car's rear (grown away: no growth) or
+   part of its side (grown sideways). Height: the prior's, or the observed one if larger; z
+   is half the height.
 8. **Fragments**: a surface seen at grazing incidence breaks into clusters of one azimuth
    column each (a truck's side seen from just behind it). Walking the detections from the
    most points down, one whose points lie mostly (>= 50 %) inside a kept box grown by
@@ -142,6 +147,11 @@ class DetectorParams:
     height_margin: float = 0.4  # [m] a vehicle higher than the car prior + this is a truck
     truck_min_length: float = 5.6  # [m] a longer one too
     truck_min_width: float = 2.2  # [m] a wider one too
+    motorcycle_max_length: float = 2.7  # [m] a motorcycle's longest seen side, at most (the
+    #   longest series machines, touring bikes, are about 2.6 m: Honda's Gold Wing 2.575 m)
+    motorcycle_max_width: float = 1.2  # [m] its shortest seen side, at most (handlebars and
+    #   mirrors about 0.8 - 1.0 m wide; EU category L3e, Regulation (EU) No 168/2013)
+    motorcycle_max_height: float = 1.9  # [m] its highest point with a seated rider, at most
     overshoot_weight: float = 2.0  # [-] cost per metre seen beyond a prior's size
     truck_bias: float = 0.1  # [m] cost added to truck boxes (a car when equally likely)
     coarse_step: float = 3.0 * DEG  # [rad] L-shape heading search, coarse
@@ -161,9 +171,14 @@ class DetectorParams:
     # [m] nuScenes' mean pedestrian box (not the simulated walker's 0.5 x 0.6 x 1.75)
     pedestrian: SizePrior = field(default_factory=lambda: SizePrior(0.73, 0.66, 1.76))
 
+    # [m] nuScenes' mean motorcycle box (the anchor of mmdetection3d's nuScenes SSN config,
+    #   configs/ssn: 2.10 x 0.76 x 1.44), its rider included
+    motorcycle: SizePrior = field(default_factory=lambda: SizePrior(2.10, 0.76, 1.44))
+
     def prior(self, cls: ObjectClass) -> SizePrior | None:
         """The size prior of ``cls`` (None for `ObjectClass.OTHER`)."""
         return {ObjectClass.CAR: self.car, ObjectClass.TRUCK: self.truck,
+                ObjectClass.MOTORCYCLE: self.motorcycle,
                 ObjectClass.PEDESTRIAN: self.pedestrian}.get(cls)
 
 
@@ -353,22 +368,29 @@ def refine_heading(xy: FloatArray, theta: float) -> float:
 
 
 def candidate_classes(long_side: float, short_side: float, top: float,
-                      p: DetectorParams, top_bound: float | None = None
+                      p: DetectorParams, gap: RingGap | None = None
                       ) -> tuple[ObjectClass, ...]:
     """The classes observed extents [m] and highest point [m] allow (module doc, step 6);
-    empty: not an object. ``top_bound`` [m]: the height the next ring up passed at, over the
-    object (it may be that tall; None: ``top``)."""
+    empty: not an object. ``gap``: how tall the object may be (`ring_gap_top`; None:
+    unknown)."""
     if long_side > p.max_length or top > p.max_height:
         return ()
     if long_side <= p.small_footprint:
-        bound = top if top_bound is None else max(top, top_bound)
+        hidden = gap is not None and gap.alone and gap.above >= p.pedestrian_adult_height
         is_ped = (long_side <= p.pedestrian_footprint and top <= p.pedestrian_max_height
-                  and (top >= p.pedestrian_min_height or bound >= p.pedestrian_adult_height))
+                  and (top >= p.pedestrian_min_height or hidden))
         return (ObjectClass.PEDESTRIAN,) if is_ped else (ObjectClass.OTHER,)
-    if (top > p.car.height + p.height_margin or long_side > p.truck_min_length
-            or short_side > p.truck_min_width):
+    truck_height = p.car.height + p.height_margin
+    if top > truck_height or long_side > p.truck_min_length or short_side > p.truck_min_width:
         return (ObjectClass.TRUCK,)
-    return (ObjectClass.CAR, ObjectClass.TRUCK)
+    classes = [ObjectClass.CAR]
+    if (p.car.width < long_side <= p.motorcycle_max_length  # longer than a car's rear:
+            and short_side <= p.motorcycle_max_width  # a side, of a car or of a motorcycle
+            and top <= p.motorcycle_max_height):
+        classes.append(ObjectClass.MOTORCYCLE)
+    if gap is None or gap.above >= truck_height:  # the ring above may pass over a truck's
+        classes.append(ObjectClass.TRUCK)  # rear only if it is that high
+    return tuple(classes)
 
 
 def grow_interval(lo: float, hi: float, size: float, sensor: float) -> tuple[float, float]:
@@ -493,12 +515,11 @@ def wrap_half_pi(a: float) -> float:
 
 def box_from_points(xy: FloatArray, top: float, sensor_xy: tuple[float, float],
                     p: DetectorParams, heights: FloatArray | None = None,
-                    top_bound: float | None = None) -> Detection | None:
+                    gap: RingGap | None = None) -> Detection | None:
     """The completed box of one cluster: (N, 2) vehicle-frame points [m], highest point
     ``top`` [m] above the ground, sensor position [m], the points' (N,) heights [m] above
-    the ground (given: the heading is fitted below the roof band), the height [m] the next
-    ring up passed over it at (`ring_gap_top`; None: unknown); None if it is not an
-    object."""
+    the ground (given: the heading is fitted below the roof band), how tall it may be
+    (`ring_gap_top`; None: unknown); None if it is not an object."""
     fit = None
     if heights is not None:
         below = heights < top - p.roof_band
@@ -506,7 +527,7 @@ def box_from_points(xy: FloatArray, top: float, sensor_xy: tuple[float, float],
     fp = footprint(xy, sensor_xy, p, fit)
     ext = fp.extents
     longer_first = ext[0] >= ext[1]
-    classes = candidate_classes(max(ext), min(ext), top, p, top_bound)
+    classes = candidate_classes(max(ext), min(ext), top, p, gap)
     sight = along_sight(fp, xy, p.pedestrian) if ObjectClass.PEDESTRIAN in classes else fp
     hyps = [hypothesis(sight if cls is ObjectClass.PEDESTRIAN else fp, cls, axis1_length, p)
             for cls in classes
@@ -552,17 +573,25 @@ def suppress_fragments(found: list[tuple[Detection, FloatArray]],
     return kept
 
 
+@dataclass(frozen=True, slots=True)
+class RingGap:
+    """How tall a cluster may be, from the LiDAR's rings (`ring_gap_top`)."""
+
+    above: float  # [m] the ring above its highest-hit ring passes over it this high (inf:
+    #   none above): the object is lower
+    alone: bool  # only its highest-hit ring could reach it: the ring below meets the ground
+    #   before it, so more of it may be hidden below that ring's hit too
+
+
 def ring_gap_top(info: LidarInfo, xy: FloatArray, heights: FloatArray, rings: IntArray,
-                 p: DetectorParams) -> float:
-    """[m] how tall a cluster may be ((N, 2) vehicle-frame points [m], their (N,) heights
-    [m] above the ground and ring indices): where only its highest-hit ring could reach it
-    (the ring below meets the ground, ``ground_clearance`` high, before the cluster's nearest
-    point), the height at which the ring above passes over it there (inf: no ring above);
-    else its highest point. A 16-channel LiDAR's rings are 2 deg apart: beyond 30 m one ring
-    crosses a walker, at knee height, and the next passes 1 - 2 m higher; the walker's top
-    lies between. Nearer, the ring below sees a low object's foot, and a low object stays
-    low. The rings are taken as level cones from the sensor's mount height (the body's pitch
-    is small)."""
+                 p: DetectorParams) -> RingGap:
+    """How tall a cluster may be ((N, 2) vehicle-frame points [m], their (N,) heights [m]
+    above the ground and ring indices), at its nearest point. A 16-channel LiDAR's rings are
+    2 deg apart: beyond 30 m one ring crosses a walker, at knee height, and the next passes
+    1 - 2 m higher; the walker's top lies between. Beside the car the ring above passes a
+    few centimetres over a motorcycle's top: it is no truck's rear. The rings are taken as
+    level cones from the sensor's mount height (the body's pitch is small); the ring below
+    reaches the object if it is still ``ground_clearance`` high there."""
     k = int(np.argmax(heights))
     top = float(heights[k])
     elevations = info.elevations
@@ -570,12 +599,10 @@ def ring_gap_top(info: LidarInfo, xy: FloatArray, heights: FloatArray, rings: In
     sensor = np.array([info.mount.x, info.mount.y])
     d = float(np.min(np.hypot(*(xy - sensor).T)))
     below = [e for e in elevations if e < own]
-    if below and info.mount.z + d * math.tan(max(below)) > p.ground_clearance:
-        return top  # the ring below reaches it: what was seen is what there is
+    alone = not below or info.mount.z + d * math.tan(max(below)) <= p.ground_clearance
     above = [e for e in elevations if e > own]
-    if not above:
-        return math.inf
-    return top + d * (math.tan(min(above)) - math.tan(own))
+    bound = top + d * (math.tan(min(above)) - math.tan(own)) if above else math.inf
+    return RingGap(bound, alone)
 
 
 class ObjectDetector:
@@ -614,8 +641,8 @@ class ObjectDetector:
         found: list[tuple[Detection, FloatArray]] = []
         for idx in gated_clusters(cluster_labels(xy, p), xy, heights, p, columns):
             top = float(heights[idx].max())
-            bound = ring_gap_top(scan.info, xy[idx], heights[idx], rings[idx], p)
-            det = box_from_points(xy[idx], top, sensor, p, heights[idx], bound)
+            gap = ring_gap_top(scan.info, xy[idx], heights[idx], rings[idx], p)
+            det = box_from_points(xy[idx], top, sensor, p, heights[idx], gap)
             if det is not None:
                 found.append((det, xy[idx]))
         kept = suppress_fragments(found, p.fragment_margin)
