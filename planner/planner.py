@@ -72,6 +72,9 @@ from planner.speed_planning import SpeedPlanner, SpeedPlanningParams, SpeedTarge
 from world.frames import VehicleInfo
 from world.hdmap import SHOULDER, RoadMap
 
+_CAMERA_LANE = frozenset({LaneSource.CAMERA, LaneSource.ONE_LINE})  # the camera's lane is the
+#   path (the lane kept, on both lines or on one)
+
 
 @dataclass(frozen=True, slots=True)
 class PlannerParams:
@@ -338,10 +341,6 @@ class Planner:
             accel = -a_comf if self._cap > wanted else 0.0
             return PlannedSpeed(SpeedRef(self._cap, accel), SpeedSource.DEGRADED)
         return planned
-
-
-_CAMERA_LANE = frozenset({LaneSource.CAMERA, LaneSource.ONE_LINE})  # the camera's lane is the
-#   path (the lane kept, on both lines or on one)
 
 
 def _straight_ahead(_x: float) -> float:
