@@ -108,8 +108,10 @@ class LocalizerParams:
     #   correlated: about 4 x the 0.04 m RMS error measured on normal_driving)
     lane_heading_sigma: float = 1.0 * DEG  # [rad] camera heading-to-lane noise (0.66 deg RMS)
     lane_confidence: float = 0.5  # [-] a lane estimate this confident is a measurement
-    wheel_lock_ratio: float = 0.2  # [-] a wheel spinning this much slower than the fastest
-    #   is locking (braking): the speed is then the fastest wheel's (`wheel_speed`)
+    wheel_lock_ratio: float = 0.5  # [-] a wheel spinning this much slower than the fastest
+    #   is locking (braking): the speed is then the fastest wheel's (`wheel_speed`); in the
+    #   tightest turn a car makes (5 m at the rear axle) the inner rear wheel turns 35 %
+    #   slower than the outer front one, and that is no lock
     lane_gate: float = 13.8  # [-] Mahalanobis distance^2 gate (chi^2, 2 dof, 99.9 %)
     line_end_sigma: float = 1.0  # [m] where the camera sees the painted lines end
     line_end_range: tuple[float, float] = (10.0, 28.0)  # [m] ahead of the car's centre where
@@ -136,8 +138,8 @@ def wheel_speed(odo: Odometry, lock_ratio: float) -> float:
     """[m/s] the car's speed from its wheels: the mean rear-wheel spin (`Odometry.speed`),
     unless a wheel spins ``lock_ratio`` or more slower than the fastest (a locking wheel
     under hard braking reads far below the ground speed, a locked one 0): then the fastest
-    wheel's, the one slipping least (an ABS's reference speed). The small spin differences
-    of a curve or a flat tyre's smaller radius stay below the ratio."""
+    wheel's, the one slipping least (an ABS's reference speed). The spin differences of a
+    turn (inner wheels slower) or a flat tyre's smaller radius stay below the ratio."""
     spins = odo.wheel_speeds
     fastest = max(spins)
     if fastest > 0.0 and min(spins) < (1.0 - lock_ratio) * fastest:
