@@ -55,7 +55,8 @@ left, origin on the ground), in m, rad and 1/m.
    -atan(a1), curvature = 2 a2 (left turn +), width = (c0_left - c0_right) cos(atan(a1)); the
    pair is trusted if the width is within [``min_width``, ``max_width``] and the pair
    straddles the car (c0_left > 0 > c0_right). Otherwise, or with one boundary, the other is
-   searched again (steps 3-4) a lane width (the prior's, else ``default_width``) across from
+   searched again (steps 3-4) a lane width (the HD map's at the car when the caller gives
+   it, else the prior's, else ``default_width``) across from
    the one first seen nearest the car (of equals, the better-seen): on a tight curve a dashed
    line whose first dash is far may have crossed the car's axis, where step 3 misses it.
    Failing that, the centre is that line shifted half a width across.
@@ -444,7 +445,8 @@ def _estimate(t: float, centre: Coefficients, width: float, confidence: float,
               left: LaneBoundary | None, right: LaneBoundary | None) -> LaneEstimate:
     a0, a1, a2 = centre
     return LaneEstimate(t=t, offset=-a0, heading_error=-math.atan(a1), curvature=2.0 * a2,
-                        width=width, confidence=confidence, left=left, right=right)
+                        width=width, confidence=confidence, left=left, right=right,
+                        lines=(left is not None) + (right is not None))
 
 
 def _one_sided(t: float, boundary: LaneBoundary, sign: int, score: float, width: float
@@ -494,16 +496,19 @@ class LaneDetector:
         return narrow_only(warped, p.mask_min_coverage,
                            max(2, round(p.max_paint_width / p.grid.resolution)))
 
-    def detect(self, frame: CameraFrame, prior: LaneEstimate | None = None) -> LaneEstimate:
+    def detect(self, frame: CameraFrame, prior: LaneEstimate | None = None,
+               map_width: float | None = None) -> LaneEstimate:
         """The ego lane in ``frame``; ``prior`` (e.g. the filter's last output) guides the
-        base search and gives the width when one boundary is seen."""
+        base search; with one boundary seen the lane is ``map_width`` [m] wide (the HD
+        map's lane at the car), else the prior's width, else ``default_width``."""
         p = self.params
         if prior is not None and prior.confidence < p.prior_min_confidence:
             prior = None
         x, y = paint_cells(self.birdseye_mask(frame), p.grid, p.mask_min_coverage)
         win = _Windows.make(x, y, p.grid, p.window_length, self.camera.mount.x, p.weight_power)
         fits = _fit_sides(win, _search_sides(win, p.grid, prior, p), p)
-        width = prior.width if prior is not None else p.default_width
+        width = map_width if map_width is not None else prior.width if prior is not None \
+            else p.default_width
         estimate = self._two_sided(frame.t, win, fits)
         if estimate is None and fits:
             estimate = self._with_the_other_side(frame.t, win, fits, width)
@@ -599,6 +604,10 @@ class LaneFilter:
        as the new lane's other boundary.
     5. The confidence moves by ``confidence_gain`` towards each accepted detection's and
        decays as exp(-dt / ``confidence_tau``) while predicting.
+    6. The output says what it rests on: ``lines``, the boundaries the detection saw (taken
+       or not: 1, a line and the lane's width; 0, nothing), and ``age`` [s], the time since
+       the last detection taken, over which the lane was dead-reckoned on the car's speed
+       and yaw rate (odometry; the consumer decides how long that may last).
     """
 
     def __init__(self, params: LaneFilterParams | None = None) -> None:
@@ -615,6 +624,7 @@ class LaneFilter:
         self.initialised = False
         self.rejections = 0  # [-] consecutive gated-out measurements
         self._rejected: list[LaneEstimate] = []  # the last of them
+        self._measured: float | None = None  # [s] time of the last detection taken
 
     def reset(self) -> None:
         """Forget everything; the next confident measurement initialises again."""
@@ -625,6 +635,7 @@ class LaneFilter:
         self.initialised = False
         self.rejections = 0
         self._rejected = []
+        self._measured = None
 
     def update(self, estimate: LaneEstimate, speed: float = 0.0,
                yaw_rate: float | None = None) -> LaneEstimate:
@@ -644,6 +655,7 @@ class LaneFilter:
             self.confidence *= math.exp(-dt / p.confidence_tau)
             return self._output(replace(estimate, left=None, right=None))
         self.confidence += p.confidence_gain * (estimate.confidence - self.confidence)
+        self._measured = estimate.t
         if self._reassign():  # this frame's lines belong to the lane left behind
             return self._output(replace(estimate, left=None, right=None))
         return self._output(estimate)
@@ -672,6 +684,7 @@ class LaneFilter:
         self.initialised = True
         self.rejections = 0
         self._rejected = []
+        self._measured = z.t
 
     def _predict(self, dt: float, speed: float, yaw_rate: float | None) -> None:
         if dt <= 0.0:
@@ -720,9 +733,12 @@ class LaneFilter:
                 and max(headings) - min(headings) <= p.agree_heading)
 
     def _output(self, z: LaneEstimate) -> LaneEstimate:
-        """The state as an estimate at ``z.t`` with ``z``'s boundaries."""
+        """The state as an estimate at ``z.t`` with ``z``'s boundaries and lines, and the
+        age of the last detection taken."""
+        m = self._measured
         return LaneEstimate(
             t=z.t, offset=float(self.x[I_OFFSET]), heading_error=float(self.x[I_HEADING]),
             curvature=float(self.x[I_CURVATURE]), width=float(self.x[I_WIDTH]),
             confidence=float(self.confidence), left=z.left, right=z.right,
+            lines=z.lines, age=max(0.0, z.t - m) if m is not None else 0.0,
         )

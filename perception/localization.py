@@ -23,8 +23,10 @@ Steps:
    carrier-phase (RTK) accuracy (``rtk_sigma`` or better) is taken at its word: the camera's
    lane errors would otherwise pass into the bias estimate and move the car's pose where
    nothing corrects it (through a town junction's turn, out of its corridor by 0.35 m).
-3. Update at every odometry sample with its speed (mean rear wheel spin x nominal radius)
-   and the gyro yaw rate, and at every valid GNSS fix with position + bias and heading (the
+3. Update at every odometry sample with its speed (mean rear wheel spin x nominal radius;
+   while a wheel locks under hard braking, reading ``wheel_lock_ratio`` or more below the
+   fastest one, the fastest wheel's: the reference speed of an ABS, `wheel_speed`) and the
+   gyro yaw rate, and at every valid GNSS fix with position + bias and heading (the
    white noise ``gnss_white`` x the fix's stated sigma, at least ``gnss_sigma``; the heading
    noise the larger of the fix's own and ``gnss_heading_sigma``); an invalid fix (an
    outage) is skipped. The heading innovation is wrapped to (-pi, pi].
@@ -106,6 +108,10 @@ class LocalizerParams:
     #   correlated: about 4 x the 0.04 m RMS error measured on normal_driving)
     lane_heading_sigma: float = 1.0 * DEG  # [rad] camera heading-to-lane noise (0.66 deg RMS)
     lane_confidence: float = 0.5  # [-] a lane estimate this confident is a measurement
+    wheel_lock_ratio: float = 0.5  # [-] a wheel spinning this much slower than the fastest
+    #   is locking (braking): the speed is then the fastest wheel's (`wheel_speed`); in the
+    #   tightest turn a car makes (5 m at the rear axle) the inner rear wheel turns 35 %
+    #   slower than the outer front one, and that is no lock
     lane_gate: float = 13.8  # [-] Mahalanobis distance^2 gate (chi^2, 2 dof, 99.9 %)
     line_end_sigma: float = 1.0  # [m] where the camera sees the painted lines end
     line_end_range: tuple[float, float] = (10.0, 28.0)  # [m] ahead of the car's centre where
@@ -126,6 +132,19 @@ class LaneMatch:
     distance2: float  # [-] its squared Mahalanobis distance
     accepted: bool  # within the gate, applied
     correction: tuple[float, float, float]  # [m, m, rad] x, y, heading added to the state
+
+
+def wheel_speed(odo: Odometry, lock_ratio: float) -> float:
+    """[m/s] the car's speed from its wheels: the mean rear-wheel spin (`Odometry.speed`),
+    unless a wheel spins ``lock_ratio`` or more slower than the fastest (a locking wheel
+    under hard braking reads far below the ground speed, a locked one 0): then the fastest
+    wheel's, the one slipping least (an ABS's reference speed). The spin differences of a
+    turn (inner wheels slower) or a flat tyre's smaller radius stay below the ratio."""
+    spins = odo.wheel_speeds
+    fastest = max(spins)
+    if fastest > 0.0 and min(spins) < (1.0 - lock_ratio) * fastest:
+        return fastest * odo.wheel_radius
+    return odo.speed
 
 
 def motion(x: FloatArray, dt: float) -> tuple[FloatArray, FloatArray]:
@@ -240,7 +259,8 @@ class Localizer:
         if not self._initialised:
             return
         self._predict_to(odo.t)
-        self._ekf.update(np.array([odo.speed, odo.yaw_rate]), _h_odo, _hx_odo, R=self._r_odo)
+        speed = wheel_speed(odo, self.params.wheel_lock_ratio)
+        self._ekf.update(np.array([speed, odo.yaw_rate]), _h_odo, _hx_odo, R=self._r_odo)
 
     def on_gnss(self, fix: GnssFix) -> None:
         """Initialise from the first valid fix; later, predict to ``fix.t`` and update with
@@ -312,6 +332,21 @@ class Localizer:
             return None
         ahead = min(mouths, key=lambda d: abs(d - x_end))
         return self._along(ahead - x_end, p.line_end_sigma)
+
+    def lane_width(self, pose: EgoState) -> float | None:
+        """[m] the HD map's width of the ego-direction lane the car's centre is nearest at
+        ``pose`` (the lane a camera frame taken there sees), None without a map or a lane
+        there: the width the camera's lane keeps when one of its lines is hidden."""
+        road = self.road
+        if road is None:
+            return None
+        s_arr, d_arr = road.local_coordinates(np.array([pose.x, pose.y]))
+        s, d = float(s_arr), float(d_arr)
+        lanes = [lane for lane in road.lanes if bool(lane.exists_at(s))]
+        if not lanes:
+            return None
+        nearest = min(lanes, key=lambda lane: abs(float(lane.offset_at(s)) - d))
+        return float(nearest.width_at(s))
 
     def stop_lines_ahead(self, pose: EgoState, near: float, far: float) -> list[float]:
         """[m] distances from ``pose`` to the map's painted stop lines (a stop sign's, a town

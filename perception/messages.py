@@ -51,7 +51,10 @@ class LaneEstimate:
     centre is relative to that centre line (left +: the car is left of the lane centre),
     ``heading_error`` the car's heading minus the lane's (left +), ``curvature`` the lane's
     (left turn +). With ``confidence`` below the consumer's threshold the numbers are the
-    filter's prediction, not a measurement.
+    filter's prediction, not a measurement. ``lines`` counts the boundaries the frame's
+    detection saw; ``age`` is 0 for a detection, and for the filter's output the time since
+    the last detection it took, over which it dead-reckoned the lane on odometry
+    (`perception.lanes.LaneFilter`).
     """
 
     t: float  # [s] sim time of the camera frame
@@ -62,6 +65,8 @@ class LaneEstimate:
     confidence: float  # [0, 1] how much of the lane was seen (both lines, windows, length)
     left: LaneBoundary | None  # the left boundary fit, if found in this frame
     right: LaneBoundary | None  # the right boundary fit, if found in this frame
+    lines: int = 2  # [-] boundaries (0, 1, 2) the frame's detection saw
+    age: float = 0.0  # [s] since the lane was last measured (the filter's prediction since)
 
     def centre_y(self, x: float) -> float:
         """[m] lateral position (left +) of the lane centre at forward distance x [m], from
@@ -77,6 +82,7 @@ class ObjectClass(enum.Enum):
 
     CAR = "car"
     TRUCK = "truck"
+    MOTORCYCLE = "motorcycle"  # a powered two-wheeler and its rider
     PEDESTRIAN = "pedestrian"
     OTHER = "other"
 

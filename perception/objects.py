@@ -23,7 +23,11 @@ named below are fields of `DetectorParams`.
    the points are averaged per ``voxel`` x ``voxel`` grid cell (each point's cell kept), the
    centroids clustered by Open3D's ``cluster_dbscan`` (eps ``cluster_eps``, ``min_points =
    1``: single-linkage Euclidean clustering), and the labels go back to the points.
-4. **Cluster gate**: clusters with fewer than ``min_points`` returns, whose highest point is
+4. **Cluster gate**: clusters with fewer than `fewest_points` returns (``min_points`` up to
+   ``min_points_range``, then falling as 1 / range^2, the solid angle an object fills, to
+   ``min_points_far``: a 16-channel LiDAR's single ring crosses a walker at 50 m on two or
+   three columns; the tracker's M-of-N confirmation over consecutive scans is what rejects
+   lone returns), whose highest point is
    below ``min_top`` or above ``max_height`` (buildings), or whose axis-aligned extent exceeds
    ``max_length`` sqrt(2) are dropped before fitting.
 5. **Oriented rectangle (L-shape fitting)**: the heading in [0, pi/2) that maximises the
@@ -41,35 +45,44 @@ named below are fields of `DetectorParams`.
    squared distances have the normal n = the eigenvector of the smallest eigenvalue of S_1 -
    S_2 (the scatter matrices of the two point sets; closed form).
 6. **Candidate classes** from the observed extents a >= b and the highest point h (lower
-   bounds: a LiDAR sees only the near faces and, far away, one or two rings): none (not an
+   bounds: a LiDAR sees only the near faces and, far away, one or two rings) and the height
+   the ring above passes over the cluster (`ring_gap_top`: an upper bound): none (not an
    object) if a > ``max_length`` or h > ``max_height``; if a <= ``small_footprint``,
-   PEDESTRIAN when a <= ``pedestrian_footprint`` and ``pedestrian_min_height`` <= h <=
-   ``pedestrian_max_height``, else OTHER (obstacles, poles); TRUCK alone if h > ``car.height``
-   + ``height_margin``, a > ``truck_min_length`` or b > ``truck_min_width``; otherwise CAR or
-   TRUCK.
+   PEDESTRIAN when a <= ``pedestrian_footprint``, h <= ``pedestrian_max_height`` and h >=
+   ``pedestrian_min_height`` or, where only the cluster's top ring could reach it (the ring
+   below meets the ground first), the ring above passes over it at ``pedestrian_adult_height``
+   or higher (beyond 30 m one ring crosses a walker, at knee height), else OTHER (obstacles,
+   poles); TRUCK alone if h > ``car.height`` + ``height_margin``, a > ``truck_min_length``
+   or b > ``truck_min_width``; otherwise CAR, then MOTORCYCLE if ``car.width`` < a <=
+   ``motorcycle_max_length``, b <= ``motorcycle_max_width`` and h <=
+   ``motorcycle_max_height`` (a side longer than a car's rear is wide: a car's side or a
+   motorcycle's), then TRUCK unless the ring above passes over it lower than ``car.height``
+   + ``height_margin`` (no truck's rear is that low). Of equal costs (step 7) the first
+   wins: a car's rear is no motorcycle's side.
 7. **Box completion**: each candidate class's box is grown to its size prior (``car``,
-   ``truck``, ``pedestrian``; never shrunk below what was seen; OTHER: a square of the longer
-   observed side), with either rectangle axis as the length. A pedestrian's rectangle is
-   taken along the line of sight instead of the L-shape fit (see `along_sight`). Each axis
-   grows away from the sensor, so that the faces seen stay where they were seen: if the
-   sensor projects onto the axis outside the observed interval, the interval's end nearer
-   the sensor is kept; if inside (a face seen head-on, both its ends visible), the interval
-   grows symmetrically. The
-   hypothesis of least cost = silhouette growth + ``overshoot_weight`` x overshoot (+
-   ``truck_bias`` for trucks) wins: the silhouette growth [m] is how far the box sticks out
-   sideways beyond the seen points as viewed from the sensor (azimuth growth x mean range; a
-   rightly completed box hides behind its visible faces), the overshoot [m] how much the seen
-   extents exceed the prior's. This decides, e.g., whether a lone face a car wide is a car's
-   rear (grown away: no growth) or part of its side (grown sideways). Height: the prior's, or
-   the observed one if larger; z is half the height.
+   ``truck``, ``motorcycle``, ``pedestrian``; never shrunk below what was seen; OTHER: a
+   square of the longer observed side), with either rectangle axis as the length. A
+   pedestrian's rectangle is taken along the line of sight instead of the L-shape fit (see
+   `along_sight`). Each axis grows away from the sensor, so that the faces seen stay where
+   they were seen: if the sensor projects onto the axis outside the observed interval, the
+   interval's end nearer the sensor is kept; if inside (a face seen head-on, both its ends
+   visible), the interval grows symmetrically. The hypothesis of least cost = silhouette
+   growth + ``overshoot_weight`` x overshoot (+ ``truck_bias`` for trucks) wins: the
+   silhouette growth [m] is how far the box sticks out sideways beyond the seen points as
+   viewed from the sensor (azimuth growth x mean range; a rightly completed box hides behind
+   its visible faces), the overshoot [m] how much the seen extents exceed the prior's. This
+   decides, e.g., whether a lone face a car wide is a car's rear (grown away: no growth) or
+   part of its side (grown sideways). Height: the prior's, or the observed one if larger; z
+   is half the height.
 8. **Fragments**: a surface seen at grazing incidence breaks into clusters of one azimuth
    column each (a truck's side seen from just behind it). Walking the detections from the
    most points down, one whose points lie mostly (>= 50 %) inside a kept box grown by
    ``fragment_margin`` is dropped (two objects cannot overlap).
 
 The yaw is the length axis's heading, wrapped to (-pi/2, pi/2] (front and back are not told
-apart). Limits: a distant pedestrian hit by one ring only, below ``pedestrian_min_height``,
-comes out as OTHER, and one with fewer than ``min_points`` returns is not seen at all.
+apart). Limits: a walker shorter than ``pedestrian_adult_height`` hit by one ring only, below
+``pedestrian_min_height``, comes out as OTHER (it cannot be told from a bollard), and one
+with fewer returns than `fewest_points` is not seen at all.
 
 Open3D is imported lazily, on the first scan, by `world.frames.import_open3d`.
 """
@@ -83,7 +96,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from perception.messages import Detection, ObjectClass
-from world.frames import LidarScan, import_open3d
+from world.frames import LidarInfo, LidarScan, import_open3d
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -117,7 +130,9 @@ class DetectorParams:
     voxel: float = 0.15  # [m] horizontal grid cell of the downsampling before clustering
     cluster_eps: float = 0.6  # [m] DBSCAN neighbourhood radius (horizontal): wider than the
     #   column spacing of a 0.4 deg LiDAR at roi range, narrower than two cars a lane apart
-    min_points: int = 4  # [-] fewest returns in a detected cluster
+    min_points: int = 4  # [-] fewest returns in a detected cluster, up to min_points_range
+    min_points_range: float = 20.0  # [m] beyond it the fewest returns fall as 1 / range^2 ...
+    min_points_far: int = 2  # [-] ... down to this
     min_top: float = 0.3  # [m] a cluster's highest point must be at least this high
     max_length: float = 18.75  # [m] longer clusters are structures, not objects (the EU's
     #   longest vehicle, a road train, Directive 96/53/EC; an articulated one is 16.5 m)
@@ -126,9 +141,17 @@ class DetectorParams:
     pedestrian_footprint: float = 0.85  # [m] longest side of a pedestrian, at most
     pedestrian_min_height: float = 0.9  # [m] highest point of a pedestrian, at least
     pedestrian_max_height: float = 2.2  # [m] and at most
+    pedestrian_adult_height: float = 1.5  # [m] a lower top is a walker's if an adult this
+    #   tall would be crossed by no other ring (the 5th-percentile woman's stature, about
+    #   1.5 m: Pheasant and Haslegrave, "Bodyspace", 3rd ed., table 2.1)
     height_margin: float = 0.4  # [m] a vehicle higher than the car prior + this is a truck
     truck_min_length: float = 5.6  # [m] a longer one too
     truck_min_width: float = 2.2  # [m] a wider one too
+    motorcycle_max_length: float = 2.7  # [m] a motorcycle's longest seen side, at most (the
+    #   longest series machines, touring bikes, are about 2.6 m: Honda's Gold Wing 2.575 m)
+    motorcycle_max_width: float = 1.2  # [m] its shortest seen side, at most (handlebars and
+    #   mirrors about 0.8 - 1.0 m wide; EU category L3e, Regulation (EU) No 168/2013)
+    motorcycle_max_height: float = 1.9  # [m] its highest point with a seated rider, at most
     overshoot_weight: float = 2.0  # [-] cost per metre seen beyond a prior's size
     truck_bias: float = 0.1  # [m] cost added to truck boxes (a car when equally likely)
     coarse_step: float = 3.0 * DEG  # [rad] L-shape heading search, coarse
@@ -148,9 +171,14 @@ class DetectorParams:
     # [m] nuScenes' mean pedestrian box (not the simulated walker's 0.5 x 0.6 x 1.75)
     pedestrian: SizePrior = field(default_factory=lambda: SizePrior(0.73, 0.66, 1.76))
 
+    # [m] nuScenes' mean motorcycle box (the anchor of mmdetection3d's nuScenes SSN config,
+    #   configs/ssn: 2.10 x 0.76 x 1.44), its rider included
+    motorcycle: SizePrior = field(default_factory=lambda: SizePrior(2.10, 0.76, 1.44))
+
     def prior(self, cls: ObjectClass) -> SizePrior | None:
         """The size prior of ``cls`` (None for `ObjectClass.OTHER`)."""
         return {ObjectClass.CAR: self.car, ObjectClass.TRUCK: self.truck,
+                ObjectClass.MOTORCYCLE: self.motorcycle,
                 ObjectClass.PEDESTRIAN: self.pedestrian}.get(cls)
 
 
@@ -248,10 +276,19 @@ def cluster_labels(xy: FloatArray, p: DetectorParams) -> IntArray:
     return out
 
 
+def fewest_points(distance: FloatArray, p: DetectorParams) -> FloatArray:
+    """(N,) the fewest returns a cluster needs whose nearest point lies ``distance`` (N,)
+    [m] from the car's centre, horizontally (module doc, step 4)."""
+    scaled = np.ceil(p.min_points * (p.min_points_range / np.maximum(distance, 1e-3)) ** 2)
+    out: FloatArray = np.clip(scaled, p.min_points_far, p.min_points)
+    return out
+
+
 def gated_clusters(labels: IntArray, xy: FloatArray, heights: FloatArray,
-                   p: DetectorParams) -> list[IntArray]:
+                   p: DetectorParams, columns: IntArray | None = None) -> list[IntArray]:
     """Point indices of each cluster (label >= 0) that passes the gate of step 4, in label
-    order; ``xy`` (N, 2) [m] and ``heights`` (N,) [m] are the labelled points."""
+    order; ``xy`` (N, 2) [m], ``heights`` (N,) [m] and ``columns`` (N,) (the LiDAR's
+    azimuth steps; None: not checked) are the labelled points."""
     if len(labels) == 0:
         return []
     order = np.argsort(labels, kind="stable")
@@ -261,8 +298,13 @@ def gated_clusters(labels: IntArray, xy: FloatArray, heights: FloatArray,
     top = np.maximum.reduceat(heights[order], starts)
     sxy = xy[order]
     extent = np.max(np.maximum.reduceat(sxy, starts) - np.minimum.reduceat(sxy, starts), axis=1)
-    ok = ((sorted_labels[starts] >= 0) & (counts >= p.min_points) & (top >= p.min_top)
+    nearest = np.minimum.reduceat(np.hypot(sxy[:, 0], sxy[:, 1]), starts)  # [m]
+    ok = ((sorted_labels[starts] >= 0) & (counts >= fewest_points(nearest, p))
+          & (top >= p.min_top)
           & (top <= p.max_height) & (extent <= p.max_length * math.sqrt(2.0)))
+    if columns is not None:  # fewer than min_points: across two columns at least
+        for i in np.flatnonzero(ok & (counts < p.min_points)):
+            ok[i] = len(np.unique(columns[order[starts[i]:starts[i] + counts[i]]])) >= 2
     return [order[i:i + n] for i, n in zip(starts[ok], counts[ok], strict=True)]
 
 
@@ -326,19 +368,29 @@ def refine_heading(xy: FloatArray, theta: float) -> float:
 
 
 def candidate_classes(long_side: float, short_side: float, top: float,
-                      p: DetectorParams) -> tuple[ObjectClass, ...]:
+                      p: DetectorParams, gap: RingGap | None = None
+                      ) -> tuple[ObjectClass, ...]:
     """The classes observed extents [m] and highest point [m] allow (module doc, step 6);
-    empty: not an object."""
+    empty: not an object. ``gap``: how tall the object may be (`ring_gap_top`; None:
+    unknown)."""
     if long_side > p.max_length or top > p.max_height:
         return ()
     if long_side <= p.small_footprint:
-        is_ped = (long_side <= p.pedestrian_footprint
-                  and p.pedestrian_min_height <= top <= p.pedestrian_max_height)
+        hidden = gap is not None and gap.alone and gap.above >= p.pedestrian_adult_height
+        is_ped = (long_side <= p.pedestrian_footprint and top <= p.pedestrian_max_height
+                  and (top >= p.pedestrian_min_height or hidden))
         return (ObjectClass.PEDESTRIAN,) if is_ped else (ObjectClass.OTHER,)
-    if (top > p.car.height + p.height_margin or long_side > p.truck_min_length
-            or short_side > p.truck_min_width):
+    truck_height = p.car.height + p.height_margin
+    if top > truck_height or long_side > p.truck_min_length or short_side > p.truck_min_width:
         return (ObjectClass.TRUCK,)
-    return (ObjectClass.CAR, ObjectClass.TRUCK)
+    classes = [ObjectClass.CAR]
+    if (p.car.width < long_side <= p.motorcycle_max_length  # longer than a car's rear:
+            and short_side <= p.motorcycle_max_width  # a side, of a car or of a motorcycle
+            and top <= p.motorcycle_max_height):
+        classes.append(ObjectClass.MOTORCYCLE)
+    if gap is None or gap.above >= truck_height:  # the ring above may pass over a truck's
+        classes.append(ObjectClass.TRUCK)  # rear only if it is that high
+    return tuple(classes)
 
 
 def grow_interval(lo: float, hi: float, size: float, sensor: float) -> tuple[float, float]:
@@ -462,11 +514,12 @@ def wrap_half_pi(a: float) -> float:
 
 
 def box_from_points(xy: FloatArray, top: float, sensor_xy: tuple[float, float],
-                    p: DetectorParams, heights: FloatArray | None = None) -> Detection | None:
+                    p: DetectorParams, heights: FloatArray | None = None,
+                    gap: RingGap | None = None) -> Detection | None:
     """The completed box of one cluster: (N, 2) vehicle-frame points [m], highest point
     ``top`` [m] above the ground, sensor position [m], the points' (N,) heights [m] above
-    the ground (given: the heading is fitted below the roof band); None if it is not an
-    object."""
+    the ground (given: the heading is fitted below the roof band), how tall it may be
+    (`ring_gap_top`; None: unknown); None if it is not an object."""
     fit = None
     if heights is not None:
         below = heights < top - p.roof_band
@@ -474,7 +527,7 @@ def box_from_points(xy: FloatArray, top: float, sensor_xy: tuple[float, float],
     fp = footprint(xy, sensor_xy, p, fit)
     ext = fp.extents
     longer_first = ext[0] >= ext[1]
-    classes = candidate_classes(max(ext), min(ext), top, p)
+    classes = candidate_classes(max(ext), min(ext), top, p, gap)
     sight = along_sight(fp, xy, p.pedestrian) if ObjectClass.PEDESTRIAN in classes else fp
     hyps = [hypothesis(sight if cls is ObjectClass.PEDESTRIAN else fp, cls, axis1_length, p)
             for cls in classes
@@ -520,6 +573,38 @@ def suppress_fragments(found: list[tuple[Detection, FloatArray]],
     return kept
 
 
+@dataclass(frozen=True, slots=True)
+class RingGap:
+    """How tall a cluster may be, from the LiDAR's rings (`ring_gap_top`)."""
+
+    above: float  # [m] the ring above its highest-hit ring passes over it this high (inf:
+    #   none above): the object is lower
+    alone: bool  # only its highest-hit ring could reach it: the ring below meets the ground
+    #   before it, so more of it may be hidden below that ring's hit too
+
+
+def ring_gap_top(info: LidarInfo, xy: FloatArray, heights: FloatArray, rings: IntArray,
+                 p: DetectorParams) -> RingGap:
+    """How tall a cluster may be ((N, 2) vehicle-frame points [m], their (N,) heights [m]
+    above the ground and ring indices), at its nearest point. A 16-channel LiDAR's rings are
+    2 deg apart: beyond 30 m one ring crosses a walker, at knee height, and the next passes
+    1 - 2 m higher; the walker's top lies between. Beside the car the ring above passes a
+    few centimetres over a motorcycle's top: it is no truck's rear. The rings are taken as
+    level cones from the sensor's mount height (the body's pitch is small); the ring below
+    reaches the object if it is still ``ground_clearance`` high there."""
+    k = int(np.argmax(heights))
+    top = float(heights[k])
+    elevations = info.elevations
+    own = elevations[int(rings[k])]
+    sensor = np.array([info.mount.x, info.mount.y])
+    d = float(np.min(np.hypot(*(xy - sensor).T)))
+    below = [e for e in elevations if e < own]
+    alone = not below or info.mount.z + d * math.tan(max(below)) <= p.ground_clearance
+    above = [e for e in elevations if e > own]
+    bound = top + d * (math.tan(min(above)) - math.tan(own)) if above else math.inf
+    return RingGap(bound, alone)
+
+
 class ObjectDetector:
     """LiDAR object detector; see the module docstring for the method."""
 
@@ -530,23 +615,34 @@ class ObjectDetector:
     def obstacle_points(self, scan: LidarScan) -> tuple[FloatArray, FloatArray]:
         """(N, 3) vehicle-frame points [m] in the ROI above the ground, and their (N,)
         heights [m] above the fitted ground plane (steps 1-2)."""
+        pts, h, _, _ = self._obstacles(scan)
+        return pts, h
+
+    def _obstacles(self, scan: LidarScan
+                   ) -> tuple[FloatArray, FloatArray, IntArray, IntArray]:
+        """`obstacle_points` and each point's (N,) ring and column index."""
         p = self.params
         pts = scan.info.mount.to_vehicle(np.asarray(scan.points, dtype=np.float64))
-        pts = pts[(np.abs(pts[:, 0]) <= p.roi_x) & (np.abs(pts[:, 1]) <= p.roi_y)]
+        roi = (np.abs(pts[:, 0]) <= p.roi_x) & (np.abs(pts[:, 1]) <= p.roi_y)
+        pts = pts[roi]
+        ring = np.asarray(scan.ring, dtype=np.int64)[roi]
+        column = np.asarray(scan.column, dtype=np.int64)[roi]
         self.ground = fit_ground(pts, p)
         h = self.ground.height(pts)
         keep = (h >= p.ground_clearance) & (h <= p.roi_height)
-        return pts[keep], h[keep]
+        return pts[keep], h[keep], ring[keep], column[keep]
 
     def detect(self, scan: LidarScan) -> tuple[Detection, ...]:
         """Boxes of the objects in ``scan``, vehicle frame, nearest first."""
         p = self.params
-        pts, heights = self.obstacle_points(scan)
+        pts, heights, rings, columns = self._obstacles(scan)
         xy = pts[:, :2]
         sensor = (scan.info.mount.x, scan.info.mount.y)
         found: list[tuple[Detection, FloatArray]] = []
-        for idx in gated_clusters(cluster_labels(xy, p), xy, heights, p):
-            det = box_from_points(xy[idx], float(heights[idx].max()), sensor, p, heights[idx])
+        for idx in gated_clusters(cluster_labels(xy, p), xy, heights, p, columns):
+            top = float(heights[idx].max())
+            gap = ring_gap_top(scan.info, xy[idx], heights[idx], rings[idx], p)
+            det = box_from_points(xy[idx], top, sensor, p, heights[idx], gap)
             if det is not None:
                 found.append((det, xy[idx]))
         kept = suppress_fragments(found, p.fragment_margin)

@@ -16,6 +16,15 @@ Model (one linear Kalman filter per track, filterpy's `KalmanFilter`):
 
 Steps of `MultiObjectTracker.update`:
 
+0. Follow the ego pose's corrections: the tracks are measured relative to the car, so when
+   the localiser moves its pose estimate (a GNSS fix, the camera's lane matched on the map:
+   metres at once when a GNSS bias is found) the tracks move with it. The pose at t is
+   compared with the last scan's pose dead-reckoned to t on its own speed and yaw rate
+   (`pose_jump`); the difference, a rotation about the car and a shift, is applied to every
+   track's position, velocity and covariance. So the tracks live in the car's odometry frame
+   (smooth, like a ROS `odom` frame) and are reported in the map frame; without this, a
+   pose jump leaves a track where the car thought it was and starts a second one for the
+   same object, the first coasting (a truck beside the car coasting into its lane).
 1. Predict every track to t.
 2. Associate: the cost is the squared Mahalanobis distance of each detection's centre to
    each track's predicted centre (S = H P H^T + R); pairs beyond the chi-square gate
@@ -119,6 +128,17 @@ def to_map(det: Detection, ego: EgoState) -> MapDetection:
                         height=det.height, cls=det.cls)
 
 
+def pose_jump(prev: EgoState, now: EgoState) -> tuple[float, float, float]:
+    """(dx [m], dy [m], dpsi [rad]), map frame: how far the pose estimate ``now`` lies from
+    ``prev`` dead-reckoned to ``now.t`` on its speed and yaw rate (unicycle at the midpoint
+    heading): the localiser's corrections in between."""
+    dt = now.t - prev.t
+    mid = prev.heading + 0.5 * prev.yaw_rate * dt
+    x = prev.x + prev.speed * dt * math.cos(mid)
+    y = prev.y + prev.speed * dt * math.sin(mid)
+    return now.x - x, now.y - y, wrap_angle(now.heading - prev.heading - prev.yaw_rate * dt)
+
+
 class _TrackState:
     """One track's filter and bookkeeping (mutable, private to the tracker)."""
 
@@ -152,6 +172,22 @@ class _TrackState:
         if dt > 0.0:
             self.kf.predict(F=transition(dt), Q=process_noise(dt, p.accel_psd))
             self.t = t
+
+    def move(self, pivot: tuple[float, float], jump: tuple[float, float, float]) -> None:
+        """Rotate the track by jump[2] [rad] about ``pivot`` (x, y) [m], then shift it by
+        (jump[0], jump[1]) [m] (step 0)."""
+        dx, dy, dpsi = jump
+        c, s = math.cos(dpsi), math.sin(dpsi)
+        rot = np.array([[c, -s], [s, c]])
+        x = self.state
+        centre = np.asarray(pivot)
+        pos = centre + rot @ (x[:2] - centre) + np.array([dx, dy])
+        vel = rot @ x[2:]
+        self.kf.x = np.concatenate([pos, vel]).reshape(DIM_X, 1)
+        big = np.kron(np.eye(2), rot)  # on (x, y) and on (vx, vy)
+        self.kf.P = big @ self.kf.P @ big.T
+        self.axis = np.array([[math.cos(2 * dpsi), -math.sin(2 * dpsi)],
+                              [math.sin(2 * dpsi), math.cos(2 * dpsi)]]) @ self.axis
 
     def mahalanobis2(self, z: FloatArray) -> FloatArray:
         """(D,) squared Mahalanobis distance of (D, 2) map-frame centres [m]."""
@@ -223,6 +259,7 @@ class MultiObjectTracker:
         self.params = params if params is not None else TrackerParams()
         self._tracks: list[_TrackState] = []
         self._next_id = 1
+        self._last_ego: EgoState | None = None  # the pose of the last scan
 
     def update(self, t: float, ego: EgoState,
                detections: tuple[Detection, ...]) -> tuple[Track, ...]:
@@ -230,6 +267,11 @@ class MultiObjectTracker:
         of ``ego``) and return the confirmed tracks, by id."""
         p = self.params
         dets = [to_map(d, ego) for d in detections]
+        if self._last_ego is not None and ego.t >= self._last_ego.t:
+            jump = pose_jump(self._last_ego, ego)
+            for tr in self._tracks:
+                tr.move((ego.x - jump[0], ego.y - jump[1]), jump)
+        self._last_ego = ego
         for tr in self._tracks:
             tr.predict(t, p)
         pairs = associate(self._tracks, dets, p.gate)

@@ -6,7 +6,10 @@ with its gap, speed and lateral offset from the lane's centre line.
 - `lane_candidates`: in the vehicle frame of the track's time (x forward, y left), the
   offset from the ego lane's centre line (the camera's lane when it is the path, else
   straight ahead); the gap [m] is bumper to bumper along the ego's heading, the speed [m/s]
-  the track's over ground along the ego's heading (>= 0), both at the track's time;
+  the track's over ground along the ego's heading (>= 0), both at the track's time; a
+  pedestrian's offset is the one nearest the centre line on its way until the car reaches
+  it (at the closing speed, at most ``CROSSING_HORIZON`` ahead; `crossing_lateral`): a
+  walker crossing the road is in the car's path before it steps into the lane;
 - `route_candidates`, through a town junction, where the lane is the map's turn path: the
   tracks (map frame) up to ``path_reach`` ahead along the map lane kept; the gap is along the
   lane, the speed along the lane's heading where the track is.
@@ -39,6 +42,9 @@ from perception.messages import ObjectClass, Track
 from planner.messages import Lead
 from world.hdmap import Lane
 
+CROSSING_HORIZON = 3.0  # [s] a pedestrian's walk is predicted this far ahead at most (the
+#   time to collision at which AEB pedestrian systems brake; 50 m at 60 km/h)
+
 
 @dataclass(frozen=True, slots=True)
 class LeadParams:
@@ -57,18 +63,35 @@ class Candidate:
     lateral: float  # [m] its centre's offset from the lane's centre line, left +
 
 
+def crossing_lateral(lateral: float, lateral_speed: float, gap: float,
+                     closing_speed: float, horizon: float = CROSSING_HORIZON) -> float:
+    """[m] the offset from the lane's centre line nearest it that a walker at ``lateral``
+    [m], moving across at ``lateral_speed`` [m/s], takes before the car closing in at
+    ``closing_speed`` [m/s] covers the ``gap`` [m] (at most ``horizon`` [s]): 0 if it
+    crosses the centre line by then."""
+    if closing_speed <= 0.0:
+        return lateral
+    later = lateral + lateral_speed * min(horizon, max(gap, 0.0) / closing_speed)
+    if lateral * later <= 0.0:
+        return 0.0
+    return min(lateral, later, key=abs)
+
+
 def lane_candidates(tracks: Sequence[Track], centre_y: Callable[[float], float],
                     ego_heading: float, front_overhang: float) -> list[Candidate]:
-    """The vehicles ahead; `centre_y(x)` is the lane centre's lateral position [m] at x [m]
-    ahead, in the vehicle frame of the tracks' time; `front_overhang` [m] the ego's centre
-    to its front bumper."""
+    """The vehicles and pedestrians ahead; `centre_y(x)` is the lane centre's lateral
+    position [m] at x [m] ahead, in the vehicle frame of the tracks' time; `front_overhang`
+    [m] the ego's centre to its front bumper."""
     out: list[Candidate] = []
     for tr in tracks:
         if tr.cls is ObjectClass.OTHER or tr.rel_x <= 0.0:
             continue
         gap = tr.rel_x - front_overhang - 0.5 * tr.length
         speed = max(0.0, tr.vx * math.cos(ego_heading) + tr.vy * math.sin(ego_heading))
-        out.append(Candidate(Lead(tr.id, tr.t, gap, speed), tr.rel_y - centre_y(tr.rel_x)))
+        lateral = tr.rel_y - centre_y(tr.rel_x)
+        if tr.cls is ObjectClass.PEDESTRIAN:
+            lateral = crossing_lateral(lateral, tr.rel_vy, gap, -tr.rel_vx)
+        out.append(Candidate(Lead(tr.id, tr.t, gap, speed), lateral))
     return out
 
 

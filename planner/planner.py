@@ -11,13 +11,14 @@ Positions are in the map frame, stations [m] along the route's reference line, s
    (`planner.events`, `planner.junctions`);
 2. the car is placed on the lane kept (station, lateral offset); the lane-source FSM
    (`planner.fsm.lane_source`) says where the lateral reference comes from: the camera's
-   lane, or the map lane (`planner.route.lane_path`, placed by the pose estimate) while the
-   camera's is acquired, lost or another lane than the one kept, or near a town junction;
+   lane (on both its lines, or on one: ONE_LINE), or the map lane
+   (`planner.route.lane_path`, placed by the pose estimate) while the camera's is acquired,
+   lost or another lane than the one kept, or near a town junction;
 3. the motion FSM (`planner.motion_layer`) keeps the lane, changes lanes from the lane
    occupancy of the tracks, turns at a junction or pulls over; a lane change (or its
    abort) makes its target lane the lane kept and its Hermite path
    (`planner.lane_change_path`) the path. Otherwise the path is the camera's lane
-   (`planner.camera_lane`) when the source is CAMERA (the camera sees the lane kept: its
+   (`planner.camera_lane`) when the source is CAMERA or ONE_LINE (the camera sees the lane kept: its
    offset agrees with the map's within ``camera_agree`` at the frame's pose, which the
    camera's lane itself corrects across the lane) and the lane is not the shoulder, else
    the map lane (ACQUIRING at the start, before the camera's lane has corrected the pose
@@ -72,6 +73,9 @@ from planner.speed import BINDING_SOURCE, PlannedSpeed, SpeedRef
 from planner.speed_planning import SpeedPlanner, SpeedPlanningParams, SpeedTarget
 from world.frames import VehicleInfo
 from world.hdmap import SHOULDER, RoadMap
+
+_CAMERA_LANE = frozenset({LaneSource.CAMERA, LaneSource.ONE_LINE})  # the camera's lane is the
+#   path (the lane kept, on both lines or on one)
 
 
 @dataclass(frozen=True, slots=True)
@@ -265,7 +269,7 @@ class Planner:
                 camera=False)
         # the camera's lane lies between painted lines: not the shoulder (no outer line);
         # in CAMERA it is the lane kept (`_other_lane`, the lane source's input)
-        if self.source.state is LaneSource.CAMERA and view is not None and \
+        if self.source.state in _CAMERA_LANE and view is not None and \
                 self.lane_index != SHOULDER:
             return LateralChoice(self._camera_path(view), camera=True)
         if self.source.state is LaneSource.ACQUIRING and not self._lane_seen:
@@ -290,7 +294,9 @@ class Planner:
             self._start = t
         confidence = view.estimate.confidence if view is not None else 0.0
         since = max(self.source.since, self._start)  # ACQUIRING counts from the start
-        x = LaneSourceInput(t, confidence, since, junction, other_lane)
+        lines, age = (view.estimate.lines, view.estimate.age + max(0.0, t - view.estimate.t)) \
+            if view is not None else (0, math.inf)  # the lane dead-reckoned until now
+        x = LaneSourceInput(t, confidence, since, junction, other_lane, lines, age)
         changes = self.source.apply(t, lane_source.transition(self.source.state, x,
                                                               self.params.source))
         self._lane_seen = self._lane_seen or self.source.state is LaneSource.CAMERA

@@ -86,6 +86,7 @@ ACTOR_CLASSES: dict[str, tuple[int, Rgb]] = {  # kind -> (class id, colour)
     "pedestrian": (3, (245, 180, 30)),
     "cyclist": (4, (240, 120, 40)),
     "obstacle": (5, (200, 60, 60)),
+    "motorcycle": (6, (120, 200, 250)),
 }
 SERIES_STYLES: dict[str, tuple[str, Rgb]] = {  # metric -> (label with unit, colour)
     "speed": ("speed [m/s]", (31, 119, 180)),
@@ -116,6 +117,7 @@ TRACK_CLASSES: dict[str, tuple[int, Rgb]] = {  # kind -> (class id as ACTOR_CLAS
     "pedestrian": (3, (0, 230, 230)),
     "cyclist": (4, (0, 200, 130)),
     "obstacle": (5, (255, 240, 0)),
+    "motorcycle": (6, (255, 120, 220)),
 }
 DETECTION_RGB: Rgb = (255, 200, 0)  # every raw detection, whatever its kind
 VELOCITY_HORIZON = 1.0  # [s] a track's velocity arrow shows this much motion

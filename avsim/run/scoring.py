@@ -25,8 +25,8 @@ knew of it (the detection-range scenarios of UN R157's ALKS set).
 Per class: the same recall, track recall, track errors and id switches for each true vehicle
 class (its catalogue model's: car, truck, bus, motorbike; `world.actors.catalogue`), keyed
 `<metric>_<class>` (`detection_recall_truck`), for the classes seen in the run; precision for
-each class the detector gave (car, truck: `detection_precision_car` is the share of the
-detections called cars that lie on a true vehicle of any class).
+each vehicle class the detector gave (car, truck, motorcycle: `detection_precision_car` is
+the share of the detections called cars that lie on a true vehicle of any class).
 """
 
 from __future__ import annotations
@@ -46,7 +46,7 @@ from world.sensors.lidar import LidarTruth
 from world.spec import ActorType
 
 VEHICLES = (ActorType.CAR, ActorType.TRUCK)
-VEHICLE_CLASSES = (ObjectClass.CAR, ObjectClass.TRUCK)
+VEHICLE_CLASSES = (ObjectClass.CAR, ObjectClass.TRUCK, ObjectClass.MOTORCYCLE)
 
 
 @dataclass(frozen=True, slots=True, eq=False)

@@ -180,7 +180,8 @@ class Stack:
         if front is not None and self.lane_detector is not None:
             prior = self._view.estimate if self._view is not None else None
             with watch("perception lanes"):
-                lane_raw = self.lane_detector.detect(front, prior)
+                lane_raw = self.lane_detector.detect(front, prior,
+                                                     self.localizer.lane_width(pose))
             with watch("perception lane filter"):
                 lane = self.lane_filter.update(lane_raw, pose.speed, pose.yaw_rate)
             with watch("localisation"):

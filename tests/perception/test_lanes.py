@@ -259,11 +259,12 @@ def measurement(t: float, offset: float = 0.2, heading: float = 0.01, curvature:
                 width: float = 3.5, confidence: float = 0.9) -> LaneEstimate:
     both = confidence > 0.0
     return LaneEstimate(t, offset, heading, curvature, width, confidence,
-                        BOUNDARY if both else None, BOUNDARY if both else None)
+                        BOUNDARY if both else None, BOUNDARY if both else None,
+                        lines=2 if both else 0)
 
 
 def black(t: float) -> LaneEstimate:
-    return LaneEstimate(t, 0.0, 0.0, 0.0, 3.5, 0.0, None, None)
+    return LaneEstimate(t, 0.0, 0.0, 0.0, 3.5, 0.0, None, None, lines=0)
 
 
 def run_steady(f: LaneFilter, n: int, t0: float = 0.0, seed: int = 0) -> list[LaneEstimate]:
@@ -426,3 +427,52 @@ def test_a_yellow_truck_beside_is_not_a_line(detector: LaneDetector) -> None:
             assert est.width == pytest.approx(truth.width, abs=0.2)
     finally:
         world.close()
+
+
+# ---- one-line lane keeping -----------------------------------------------------------------
+
+
+def test_one_boundary_takes_the_maps_width(detector: LaneDetector) -> None:
+    """With the map's lane width given, one line places the centre half that width across,
+    whatever the prior's width; the estimate says it saw one line."""
+    scene = render(normal_driving_road(), 100.0, 0.3, 1.0 * DEG)
+    rgb = scene.frame.rgb.copy()
+    rgb[:, : scene.frame.info.width // 2] = ASPHALT
+    frame = CameraFrame(scene.frame.t, scene.frame.info, rgb)
+    full = detector.detect(scene.frame)
+    assert full.lines == 2
+    est = detector.detect(frame, prior=replace(full, width=3.3), map_width=3.6)
+    assert est.lines == 1 and est.left is None and est.right is not None
+    assert est.width == 3.6
+    alone = detector.detect(frame, map_width=3.6)
+    assert alone.width == 3.6
+    assert est.offset == pytest.approx(alone.offset, abs=0.02)  # the map's width, not 3.3
+    no_map = detector.detect(frame)
+    assert alone.offset == pytest.approx(no_map.offset - 0.05, abs=0.01)  # -c0 + w / 2
+    assert detector.detect(CameraFrame(0.0, frame.info, np.zeros_like(rgb))).lines == 0
+
+
+def one_line(t: float, confidence: float, offset: float = 0.2) -> LaneEstimate:
+    """A detection on the right line alone (the left hidden)."""
+    return LaneEstimate(t, offset, 0.01, 0.002, 3.5, confidence, None, BOUNDARY, lines=1)
+
+
+def test_filter_dead_reckons_the_lane_between_one_line_measurements() -> None:
+    """A dashed right line with its left line hidden: a dash well seen (confidence 0.45)
+    measures the lane, a lone far dash (0.06) does not; in between the filter predicts on
+    the car's speed and yaw rate and says since when (`age`), and which lines the frame saw."""
+    f = LaneFilter()
+    run_steady(f, 10)
+    seen = f.update(one_line(1.0, 0.45), speed=16.7, yaw_rate=0.0)
+    assert (seen.lines, seen.age) == (1, 0.0) and seen.right is BOUNDARY
+    turn = 16.7 * seen.curvature  # [rad/s] the car follows the lane's curve
+    gap = [f.update(one_line(1.1 + 0.1 * i, 0.06, offset=0.9), speed=16.7, yaw_rate=turn)
+           for i in range(4)]
+    assert [g.age for g in gap] == pytest.approx([0.1, 0.2, 0.3, 0.4])
+    assert all(g.lines == 1 and g.right is None for g in gap)  # seen, not taken
+    heading = seen.heading_error
+    assert gap[-1].offset == pytest.approx(seen.offset + 16.7 * 0.4 * heading, abs=1e-6)
+    again = f.update(one_line(1.5, 0.45), speed=16.7, yaw_rate=0.0)
+    assert again.age == 0.0
+    dark = f.update(black(1.6))
+    assert (dark.lines, dark.age) == (0, pytest.approx(0.1))

@@ -13,6 +13,7 @@ from perception.localization import (
     LocalizerParams,
     NotInitialisedError,
     motion,
+    wheel_speed,
 )
 from world.frames import GnssFix, Odometry, wrap_angle
 
@@ -176,3 +177,24 @@ def test_motion_jacobian_matches_finite_differences() -> None:
         dx[j] = eps
         num = (motion(x + dx, dt)[0] - motion(x - dx, dt)[0]) / (2 * eps)
         np.testing.assert_allclose(f[:, j], num, atol=1e-7)
+
+
+@pytest.mark.parametrize(("spins", "expected"), [
+    ((50.0, 50.0, 50.0, 50.0), 50.0),  # rolling
+    ((50.5, 49.5, 50.5, 49.5), 50.0),  # a curve: the rear mean
+    ((50.0, 50.0, 52.0, 50.0), 51.0),  # a flat rear tyre spins 4 % faster: still the mean
+    ((58.0, 45.0, 50.0, 38.0), 44.0),  # a 5 m right turn: the inner rear 35 % slower
+    ((41.2, 41.3, 0.0, 0.0), 41.3),  # ALKS 4.2.3's emergency stop: the rear wheels locked
+    ((42.4, 42.4, 1.9, 3.2), 42.4),  # locking
+    ((46.8, 46.8, 34.9, 36.9), 35.9),  # beginning to lock: 25 % slower, not yet taken
+    ((0.0, 0.0, 0.0, 0.0), 0.0),  # standing
+])
+def test_a_locking_wheel_does_not_stop_the_car_in_the_estimate(
+        spins: tuple[float, float, float, float], expected: float) -> None:
+    """Under hard braking a locked wheel reads 0 while the car slides on: the speed is the
+    fastest wheel's (an ABS's reference speed), not the rear mean (which said 0.1 m/s at
+    13.6 m/s, and the control FSM took the car for stopped)."""
+    odo = Odometry(t=0.0, wheel_speeds=spins, wheel_radius=0.33, yaw_rate=0.0,
+                   steering_angle=0.0)
+    assert wheel_speed(odo, LocalizerParams().wheel_lock_ratio) == pytest.approx(
+        expected * 0.33)

@@ -284,3 +284,28 @@ def test_process_noise_is_white_acceleration() -> None:
     assert q[2, 2] == pytest.approx(2.0 * 0.1)
     assert q[0, 1] == 0.0 and q[0, 3] == 0.0
     np.testing.assert_allclose(q, q.T)
+
+
+@pytest.mark.parametrize("turn", [0.0, 3.0 * DEG])
+def test_tracks_follow_a_jump_of_the_ego_pose(turn: float) -> None:
+    """The localiser finds a 2.2 m GNSS bias (the camera's lane matched on the map) and moves
+    the pose estimate across the road at once, and turns it by ``turn``: a truck driving
+    beside the car stays one track, beside the car, at its speed (not left coasting into the
+    car's lane with a second track for the same truck: ALKS 4.1.3)."""
+    ego, truck = Mover(0.0, 0.0, 0.0, 16.7), Mover(5.0, 3.0, 0.0, 16.7)
+    tracker = MultiObjectTracker()
+    out = []
+    for k in range(15):
+        t = k * DT
+        true_ego = ego_state(t, ego)
+        det = observe(true_ego, truck, t, size=TRUCK, cls=ObjectClass.TRUCK)
+        belief = true_ego if k >= 5 else EgoState(  # before the correction: off by the bias
+            t=t, x=true_ego.x, y=true_ego.y - 2.2, heading=true_ego.heading - turn,
+            speed=true_ego.speed, yaw_rate=0.0, steering_angle=0.0, position_sigma=2.0)
+        out.append(tracker.update(t, belief, (det,)))
+    for tracks in out[5:]:
+        (only,) = tracks
+        assert only.id == 1
+        assert only.rel_y == pytest.approx(3.0, abs=0.1)
+        assert only.rel_vx == pytest.approx(0.0, abs=0.3)
+    assert out[-1][0].misses == 0

@@ -5,10 +5,12 @@ nearest qualified vehicle wins. Table tests on `Candidate`s (gaps and offsets gi
 from __future__ import annotations
 
 import itertools
+from dataclasses import replace
 
 import pytest
 
-from planner.lead import Candidate, LeadParams, LeadSelector
+from perception.messages import ObjectClass, Track
+from planner.lead import Candidate, LeadParams, LeadSelector, crossing_lateral, lane_candidates
 from planner.messages import Lead
 
 P = LeadParams()  # half_width 1.6 m, keep_width 2.0 m, confirm 0.3 s, urgent_ttc 2.5 s
@@ -85,3 +87,36 @@ def test_a_lead_taken_during_a_lane_change_is_held_after_it() -> None:
     selector.take(Lead(9, 0.0, 20.0, 15.0))
     lead = selector.select(0.0, 20.0, [car(9, 20.0, 1.8, 15.0)])
     assert lead is not None and lead.track_id == 9  # held (keep band), not re-confirmed
+
+
+# ---- a pedestrian crossing the road ---------------------------------------------------------
+
+
+@pytest.mark.parametrize(("lateral", "lateral_speed", "gap", "closing", "expected"), [
+    (-4.2, 1.5, 50.0, 16.7, 0.0),  # ALKS 4.2.3 at 55 m: it crosses the centre line by then
+    (-4.2, 1.4, 10.0, 16.7, -4.2 + 1.4 * 10.0 / 16.7),  # reached before it gets there
+    (-4.2, 1.4, 200.0, 16.7, -4.2 + 1.4 * 3.0),  # far: the horizon bounds the walk
+    (-4.2, -1.4, 50.0, 16.7, -4.2),  # walking away: where it is
+    (-4.2, 0.0, 50.0, 16.7, -4.2),  # on the pavement
+    (-4.2, 1.4, 50.0, -2.0, -4.2),  # not closing in: where it is
+    (0.5, 1.4, 50.0, 16.7, 0.5),  # in the lane, leaving it: where it is
+])
+def test_a_crossing_walker_is_placed_nearest_the_path_on_its_way(
+        lateral: float, lateral_speed: float, gap: float, closing: float,
+        expected: float) -> None:
+    assert crossing_lateral(lateral, lateral_speed, gap, closing) == pytest.approx(expected)
+
+
+def walker(rel_y: float, rel_vy: float) -> Track:
+    return Track(id=7, t=1.0, x=55.0, y=rel_y, vx=0.0, vy=rel_vy, rel_x=55.0, rel_y=rel_y,
+                 rel_vx=-16.7, rel_vy=rel_vy, length=0.7, width=0.7, height=1.8, yaw=0.0,
+                 cls=ObjectClass.PEDESTRIAN, hits=5, misses=0, position_sigma=0.1)
+
+
+def test_a_walker_heading_into_the_lane_is_in_it_and_one_on_the_pavement_is_not() -> None:
+    """The car brakes for a pedestrian about to cross its path, not for one walking by."""
+    (crossing,) = lane_candidates([walker(-4.2, 1.5)], lambda x: 0.0, 0.0, 2.4)
+    (strolling,) = lane_candidates([walker(-4.2, 0.0)], lambda x: 0.0, 0.0, 2.4)
+    assert crossing.lateral == pytest.approx(0.0) and strolling.lateral == pytest.approx(-4.2)
+    car = replace(walker(-4.2, 1.4), cls=ObjectClass.CAR)  # a car's drift is no crossing
+    assert lane_candidates([car], lambda x: 0.0, 0.0, 2.4)[0].lateral == pytest.approx(-4.2)

@@ -46,11 +46,30 @@ TABLE_CASES = [
 OTHER_LANE_TABLE = [
     (S.CAMERA, 0.9, True, S.ACQUIRING),  # the path is the map's: the source says so
     (S.CAMERA, P.lose - 0.01, True, S.MAP_HOLD),  # lost first
+    (S.ONE_LINE, 0.2, True, S.ACQUIRING),
     (S.ACQUIRING, 0.9, True, None),  # a good estimate, but of another lane
     (S.MAP_HOLD, 0.9, True, None),
     (S.STOP_IN_LANE, 0.9, True, None),
     (S.JUNCTION, 0.9, True, S.ACQUIRING),
     (S.MAP, 0.9, True, None),
+]
+
+
+# (state, confidence, lines seen, age of the last measurement) -> next state: one-line lane
+# keeping (a line hidden, a dashed line's gaps), and a camera that sees no line at all
+ONE_LINE_TABLE = [
+    (S.CAMERA, P.lose - 0.01, 1, 0.0, S.ONE_LINE),  # a truck hides the left line
+    (S.CAMERA, P.lose - 0.01, 2, 0.4, S.ONE_LINE),  # two lines, too little of them to measure
+    (S.CAMERA, P.lose - 0.01, 1, P.dead_reckon_time, S.MAP_HOLD),  # not measured for too long
+    (S.CAMERA, P.lose - 0.01, 0, 0.3, S.MAP_HOLD),  # no line at all (a black camera)
+    (S.CAMERA, P.lose, 1, 0.0, None),
+    (S.ONE_LINE, 0.1, 1, P.dead_reckon_time - 0.01, None),  # dead-reckoning a dash's gap
+    (S.ONE_LINE, 0.0, 0, 0.5, None),  # a frame without a line, within the dead reckoning
+    (S.ONE_LINE, 0.45, 1, 0.0, None),  # one line well seen: still one line
+    (S.ONE_LINE, 0.1, 1, P.dead_reckon_time, S.MAP_HOLD),
+    (S.ONE_LINE, P.acquire, 2, 0.0, S.CAMERA),
+    (S.ACQUIRING, 0.45, 1, 0.0, None),  # a lane is acquired on both lines only
+    (S.MAP_HOLD, 0.45, 1, 0.0, None),
 ]
 
 
@@ -60,6 +79,7 @@ JUNCTION_TABLE = [
     (S.MAP_HOLD, 0.0, True, S.JUNCTION),
     (S.STOP_IN_LANE, 0.0, True, S.JUNCTION),
     (S.ACQUIRING, 0.9, True, S.JUNCTION),
+    (S.ONE_LINE, 0.2, True, S.JUNCTION),
     (S.MAP, 0.0, True, None),  # no camera: the map anyway
     (S.JUNCTION, 0.0, True, None),
     (S.JUNCTION, 0.9, True, None),  # lines seen inside: still the map's turn path
@@ -72,6 +92,15 @@ JUNCTION_TABLE = [
 def test_transition_table(state: LaneSource, t: float, confidence: float, since: float,
                           expected: LaneSource | None) -> None:
     change = transition(state, LaneSourceInput(t, confidence, since), P)
+    assert (change.to if change else None) is expected
+    if change is not None:
+        assert change.reason
+
+
+@pytest.mark.parametrize(("state", "confidence", "lines", "age", "expected"), ONE_LINE_TABLE)
+def test_one_line_table(state: LaneSource, confidence: float, lines: int, age: float,
+                        expected: LaneSource | None) -> None:
+    change = transition(state, LaneSourceInput(100.0, confidence, 99.5, lines=lines, age=age), P)
     assert (change.to if change else None) is expected
     if change is not None:
         assert change.reason
@@ -95,13 +124,17 @@ def test_every_state_and_edge_of_the_table_is_covered() -> None:
     edges = {(row[0], row[4]) for row in TABLE_CASES if row[4] is not None}
     edges |= {(row[0], row[3]) for row in JUNCTION_TABLE if row[3] is not None}
     edges |= {(row[0], row[3]) for row in OTHER_LANE_TABLE if row[3] is not None}
+    edges |= {(row[0], row[4]) for row in ONE_LINE_TABLE if row[4] is not None}
     assert edges == {(S.ACQUIRING, S.CAMERA), (S.ACQUIRING, S.MAP_HOLD),
                      (S.CAMERA, S.MAP_HOLD), (S.CAMERA, S.ACQUIRING), (S.MAP_HOLD, S.CAMERA),
+                     (S.CAMERA, S.ONE_LINE), (S.ONE_LINE, S.CAMERA), (S.ONE_LINE, S.MAP_HOLD),
+                     (S.ONE_LINE, S.ACQUIRING),
                      (S.MAP_HOLD, S.STOP_IN_LANE), (S.STOP_IN_LANE, S.CAMERA),
                      *((s, S.JUNCTION) for s in (S.CAMERA, S.MAP_HOLD, S.STOP_IN_LANE,
-                                                 S.ACQUIRING)),
+                                                 S.ACQUIRING, S.ONE_LINE)),
                      (S.JUNCTION, S.CAMERA), (S.JUNCTION, S.ACQUIRING)}
-    assert {row[0] for row in TABLE_CASES} | {row[0] for row in JUNCTION_TABLE} == set(LaneSource)
+    assert {row[0] for row in TABLE_CASES} | {row[0] for row in JUNCTION_TABLE} | {
+        row[0] for row in ONE_LINE_TABLE} == set(LaneSource)
 
 
 def test_the_cases_walk_every_row_of_the_data() -> None:
@@ -111,6 +144,8 @@ def test_the_cases_walk_every_row_of_the_data() -> None:
               for state, confidence, junction, expected in JUNCTION_TABLE]
     cases += [(state, LaneSourceInput(100.0, confidence, 99.5, other_lane=other), expected)
               for state, confidence, other, expected in OTHER_LANE_TABLE]
+    cases += [(state, LaneSourceInput(100.0, confidence, 99.5, lines=lines, age=age), expected)
+              for state, confidence, lines, age, expected in ONE_LINE_TABLE]
     assert unwalked_rows(TABLE, cases, lambda _: P) == []
 
 
