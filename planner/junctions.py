@@ -53,7 +53,8 @@ the line:
   that arrived after it, nor for one queued behind another.
 
 Like the yellow rule, the decision to give way is taken only while the car can still stop
-before the line at ``commit_decel``: once it is moving (faster than ``moving``) and cannot
+before the line at ``commit_decel`` (at an all-way stop, where it stops at the line
+anyway, not before it has arrived there): once it is moving (faster than ``moving``) and cannot
 (v^2 > 2 commit_decel (L - f - stop_margin)) without already waiting, or once its front is
 over the line, it is committed to the junction and goes on (the control FSM's emergency
 stop still covers a vehicle in its path). A gap that closes after that point is not chased
@@ -225,7 +226,8 @@ class JunctionMonitor:
                 self._order, self._order_at = ArrivalOrder(p), k
             standing = v < p.stopped and 0.0 <= j.s_stop - front <= p.arrival_zone
             wait = self._order.update(t, j, self._line_out[k], standing, tracks) or wait
-        if k not in self._waiting and v > p.moving and \
+        stops_first = j.control is Control.STOP_SIGNS and self._order.arrived is None
+        if k not in self._waiting and v > p.moving and not stops_first and \
                 v * v > 2.0 * p.commit_decel * max(room, 0.0):
             self._committed.add(k)  # past the last point it could stop comfortably: go on
             return None
