@@ -29,7 +29,7 @@ from pybullet_utils.bullet_client import BulletClient
 from world.actors.all_way_stop import AllWayStop
 from world.actors.behaviour import NpcMotion, TriggerContext
 from world.actors.catalogue import CATALOGUE, DEFAULT_MODEL, VehicleClass, VehicleModel
-from world.actors.town_traffic import Others, StopZones, TownDriver
+from world.actors.town_traffic import STOP_SPEED, Others, StopZones, TownDriver
 from world.hdmap import RoadMap
 from world.map.road import build_road_map
 from world.map.signals import route_signals
@@ -254,17 +254,20 @@ class ActorSet:
                 self._leave(i)
 
     def _ego_order(self, t: float, ego: tuple[float, float, float], speed: float) -> None:
-        """The ego arrives at an all-way stop when it stands at its line, and leaves the
-        order when it no longer does (the NPCs mind its turn as any other's)."""
+        """The ego arrives at an all-way stop when it stands at its line (slower than the
+        stack's stood speed), and leaves the order when it moves off (faster than an NPC's
+        stopped speed) or is no longer at the line: the NPCs mind its turn as any other's."""
         assert self._ego_zones is not None
-        at = self._ego_zones.at_line(ego[:2], ego[2], speed)
-        key = at.index if at is not None else None
-        if self._ego_at is not None and key != self._ego_at and speed >= 0.1:
-            self.order.leave(self._ego_at, EGO)
-            self._ego_at = None
-        if at is not None and self._ego_at is None:
-            self.order.arrive(at.index, EGO, at.heading, t)
-            self._ego_at = at.index
+        if self._ego_at is not None:
+            still = self._ego_zones.at_line(ego[:2], ego[2], speed, STOP_SPEED)
+            if still is None or still.index != self._ego_at:
+                self.order.leave(self._ego_at, EGO)
+                self._ego_at = None
+        if self._ego_at is None:
+            at = self._ego_zones.at_line(ego[:2], ego[2], speed)
+            if at is not None:
+                self.order.arrive(at.index, EGO, at.heading, t)
+                self._ego_at = at.index
 
     def _leave(self, i: int) -> None:
         """Take actor i out of the world: it has arrived at its route's end."""

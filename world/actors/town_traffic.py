@@ -52,6 +52,8 @@ STOP_MARGIN = 0.5  # [m] front bumper short of the stop line
 STOP_DWELL = 1.5  # [s] standing at a stop sign
 STOP_SPEED = 0.3  # [m/s] below this at the line counts as stopped
 STOP_ZONE = 4.0  # [m] the ego stands at its line with its front bumper this near it
+EGO_STOPPED = 0.1  # [m/s] ... and slower than this (the stack's own "stood" speed, so that
+#   the world does not see it arrive before it knows it has)
 TURN_LATERAL_ACCEL = 2.0  # [m/s^2] on a turn's arc
 FOLLOW_GAP = 4.0  # [m] bumper to bumper at a standstill
 FOLLOW_HEADWAY = 1.2  # [s] of its own speed, added to the standstill gap
@@ -230,7 +232,7 @@ class TownDriver:
 class StopZones:
     """Where a vehicle on route `road` (the ego's) stands at an all-way stop's line: its
     front bumper 0 to ``STOP_ZONE`` before the line (``STOP_MARGIN`` over it at most),
-    within ``FOLLOW_LANE_HALF`` of its lane's centre, slower than ``STOP_SPEED``."""
+    within ``FOLLOW_LANE_HALF`` of its lane's centre, slower than ``EGO_STOPPED``."""
 
     def __init__(self, road: RoadMap) -> None:
         self.junctions = [j for j in road.junctions if j.control is Control.STOP_SIGNS]
@@ -239,11 +241,12 @@ class StopZones:
         h = np.array([j.heading for j in self.junctions])
         self._forward = np.column_stack([np.cos(h), np.sin(h)])
 
-    def at_line(self, xy: tuple[float, float], half_length: float,
-                speed: float) -> Junction | None:
+    def at_line(self, xy: tuple[float, float], half_length: float, speed: float,
+                stopped: float = EGO_STOPPED) -> Junction | None:
         """The all-way stop whose line the vehicle with centre `xy` [m], `half_length` [m]
-        and `speed` [m/s] stands at; None if it stands at none (or moves)."""
-        if speed >= STOP_SPEED or not self.junctions:
+        and `speed` [m/s] stands at (slower than `stopped` [m/s]); None if it stands at
+        none (or moves)."""
+        if speed >= stopped or not self.junctions:
             return None
         rel = np.asarray(xy) - self._xy
         along = (rel * self._forward).sum(axis=1)

@@ -199,3 +199,21 @@ def test_at_its_route_end_an_npc_arrives() -> None:
     assert not d.arrived
     d.speed_cap(1.0, end, 0.0, town_traffic.no_others())
     assert d.arrived
+
+
+@pytest.mark.parametrize(("back", "speed", "stopped", "at"), [
+    (0.0, 0.0, town_traffic.EGO_STOPPED, True),  # standing at its line
+    (3.0, 0.05, town_traffic.EGO_STOPPED, True),  # within the zone
+    (0.0, 0.2, town_traffic.EGO_STOPPED, False),  # still rolling: not arrived yet ...
+    (0.0, 0.2, town_traffic.STOP_SPEED, True),  # ... but once arrived, not left either
+    (9.0, 0.0, town_traffic.EGO_STOPPED, False),  # queued behind a car at the line
+])
+def test_where_the_ego_stands_at_an_all_way_stop(back: float, speed: float, stopped: float,
+                                                 at: bool) -> None:
+    layout = town("stop_signs")
+    road = build_road_map(compile_route(layout, (0, 1, "east"), [Manoeuvre.STRAIGHT], "ego"))
+    zones = town_traffic.StopZones(road)
+    j = road.junctions[0]
+    x, y, _ = road.line.pose_one(j.s_stop - 0.5 - HALF - back, 0.0)
+    found = zones.at_line((x, y), HALF, speed, stopped)
+    assert (found is not None and found.index == (1, 1)) is at
