@@ -14,6 +14,12 @@ that starts before the fork keeps the road the route leaves (`RoadMap.through_li
 other, the route. Bodies are placed with one scalar map lookup per moving actor; `poses`
 (all of them, for criteria, scoring and the recording) is one vectorised map call, when
 asked, with every station and offset taken on the ego's route.
+
+In a town, each NPC car has a town driver (`world.actors.town_traffic`); the drivers share
+one all-way-stop order (`world.actors.all_way_stop`), which the ego joins when it stands at
+its line (`StopZones`). A driver that has arrived at its route's end is taken out of the
+world (`gone`): its body and its pose far away below the ground (`GONE_XY`), no longer
+minded by the others.
 """
 
 from __future__ import annotations
