@@ -279,3 +279,11 @@ def test_a_car_that_moves_off_its_line_is_no_longer_waited_for() -> None:
     m = stop_monitor()
     assert at_stop(m, 0.0, [at_arm("south", 4)])
     assert not at_stop(m, 1.0, [at_arm("south", 4, back=-3.0, moving=3.0)])  # on its way
+
+
+def test_at_an_all_way_stop_the_car_does_not_commit_before_it_has_stood() -> None:
+    """Too fast to stop at commit_decel 10 m before the line (where the stop sign's own
+    event brakes it anyway): still not committed, so its turn is judged once it stands."""
+    m = stop_monitor()
+    assert m.update(0.0, front_at(m, 10.0), 9.0, []).active == frozenset()
+    assert at_stop(m, 3.0, [at_arm("south", 4)])  # it stood: the earlier car goes first
