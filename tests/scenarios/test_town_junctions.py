@@ -85,9 +85,6 @@ def test_the_queued_ego_moves_up_and_goes_after_the_npc_ahead(stop_queue: RunRes
     assert c["no_collision"].passed and c["completes"].passed
 
 
-@pytest.mark.xfail(strict=True, reason="the ACC stop law (planner.acc_control.stop_speed, "
-                   "not this work's) lets the car, moving up from 1 m/s 4 m before the line, "
-                   "speed up towards sqrt(2 a_comf d) and stand 0.5 m over the line")
 def test_the_queued_ego_makes_its_own_stop_at_the_line(stop_queue: RunResult) -> None:
     c = {r.name: r for r in stop_queue.criteria}
     assert c["stop_signs"].passed, c["stop_signs"]
