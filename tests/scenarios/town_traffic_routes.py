@@ -27,6 +27,32 @@ def route(rng: random.Random, start: tuple[int, int, str], n: int) -> list[str]:
         out.append(m)
     return out
 
+def trail(rng: random.Random, start: tuple[int, int, str], tries: int = 2000) -> list[str]:
+    """The longest of `tries` random walks from `start` that use no street twice (either
+    way): a route that passes a street again would make the ego's station along it
+    ambiguous there (the map projects onto the nearest pass)."""
+    best: list[str] = []
+    for _ in range(tries):
+        j, h = (start[0], start[1]), start[2]
+        used = {frozenset({j, (j[0] + STEPS[h][0], j[1] + STEPS[h][1])})}
+        out: list[str] = []
+        while True:
+            j = (j[0] + STEPS[h][0], j[1] + STEPS[h][1])
+            opts = []
+            for m, nh in (("straight", h), ("left", LEFT[h]), ("right", RIGHT[h])):
+                nxt = (j[0] + STEPS[nh][0], j[1] + STEPS[nh][1])
+                if exists(nxt) and frozenset({j, nxt}) not in used:
+                    opts.append((m, nh, nxt))
+            if not opts:
+                break
+            m, h, nxt = rng.choice(opts)
+            used.add(frozenset({j, nxt}))
+            out.append(m)
+        if len(out) > len(best):
+            best = out
+    return best
+
+
 def main() -> None:
     rng = random.Random(7)
     starts = []
@@ -45,7 +71,7 @@ def main() -> None:
         s = rng.choice([10, 25, 40])
         lines.append(f"  - {{id: car_{k:02d}, type: car, start: [{st[0]}, {st[1]}, {st[2]}], "
                      f"s: {s},\n     speed_kph: {speed}, route: [{', '.join(r)}]}}")
-    ego_route = route(rng, ego_start, 50)
+    ego_route = trail(rng, ego_start)
     print(f"""format: avsim/1
 name: town_traffic
 description: >-
