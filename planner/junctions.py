@@ -37,10 +37,24 @@ the line:
   when the light turns green, as the car's does), or for any vehicle track inside the box
   that is not moving the car's way;
 - at a stop-sign junction, also going straight or turning right: for a vehicle track inside
-  the box that is not moving the car's way.
+  the box that is not moving the car's way;
+- at a stop-sign junction (an all-way stop), in order of arrival (`ArrivalOrder`): first to
+  stop, first to go; ties to the right. The car *arrives* when it stands (below
+  ``stopped``) with its front 0 to ``arrival_zone`` before its line. A vehicle track
+  *waits at a line* of the junction when it stands (below ``moving``) in the inbound lane
+  of an arm (right of the arm's axis, within the street's half width), its centre
+  ``line_zone_near`` to ``line_zone_far`` beyond the line's distance from the centre (the
+  other approaches' lines are as far out as the car's own: the town is symmetric): the
+  first car of its queue, not one queued behind it. It arrived when first seen waiting
+  there; one first seen already waiting counts as there before the car. The car waits
+  for every vehicle that arrived before it (by more than ``tie``), or within ``tie`` of
+  it and on its right (coming from the right: travelling 90 deg left of the car's
+  heading), until that vehicle no longer waits at its line. It never waits for a vehicle
+  that arrived after it, nor for one queued behind another.
 
 Like the yellow rule, the decision to give way is taken only while the car can still stop
-before the line at ``commit_decel``: once it is moving (faster than ``moving``) and cannot
+before the line at ``commit_decel`` (at an all-way stop, where it stops at the line
+anyway, not before it has arrived there): once it is moving (faster than ``moving``) and cannot
 (v^2 > 2 commit_decel (L - f - stop_margin)) without already waiting, or once its front is
 over the line, it is committed to the junction and goes on (the control FSM's emergency
 stop still covers a vehicle in its path). A gap that closes after that point is not chased
@@ -84,6 +98,11 @@ class JunctionParams:
     moving: float = 0.5  # [m/s] slower than this, a track (or the ego) is not moving
     near_box: float = 12.0  # [m] an oncoming track this near the box counts, moving or not
     same_way: float = 0.7  # [-] cos of the angle within which a track moves the car's way
+    stopped: float = 0.1  # [m/s] the car stands below this (its arrival at an all-way stop)
+    arrival_zone: float = 4.0  # [m] front bumper this near its line: the car has arrived
+    line_zone_near: float = -1.0  # [m] a track's centre this far beyond a line (from the
+    line_zone_far: float = 8.0  # [m] ... centre outwards) to this far waits at that line
+    tie: float = 1.0  # [s] arrivals this close in time are a tie (the right goes first)
 
 
 @dataclass(frozen=True, slots=True)
@@ -118,6 +137,10 @@ class JunctionMonitor:
         self._stopping: set[int] = set()  # lights the car stops for until seen green
         self._waiting: set[int] = set()  # junctions (route order) the car gives way at
         self._committed: set[int] = set()  # junctions the car goes on through, come what may
+        self._order = ArrivalOrder(self.params)  # at the all-way stop ahead
+        self._order_at: int | None = None  # the junction (route order) `_order` is for
+        # [m] each junction's centre to its stop line (the car's approach; every arm's)
+        self._line_out = [self._line_distance(j) for j in road.junctions]
 
     def see_lights(self, detections: Sequence[LightDetection]) -> None:
         """Take the camera's colours: red or yellow at once; green, which lets the car go,
@@ -141,7 +164,7 @@ class JunctionMonitor:
         front = station + self.vehicle.front_overhang
         approach = v * v / (2.0 * p.a_comf) + p.approach_extra
         light_stop, colour = self._light(t, front, v, approach)
-        way_stop = self._give_way(front, v, approach, tracks)
+        way_stop = self._give_way(t, front, v, approach, tracks)
         stops = [d for d in (light_stop, way_stop) if d is not None]
         happening = {AccEvent.RED_LIGHT: light_stop is not None,
                      AccEvent.GIVE_WAY: way_stop is not None}
@@ -182,7 +205,12 @@ class JunctionMonitor:
 
     # -- giving way ------------------------------------------------------------------------
 
-    def _give_way(self, front: float, v: float, approach: float,
+    def _line_distance(self, j: Junction) -> float:
+        """[m] from `j`'s centre back to the car's stop line, along its approach."""
+        x, y = (float(a) for a in self.road.line.point(np.array(j.s_stop), np.array(0.0)))
+        return -((x - j.x) * math.cos(j.heading) + (y - j.y) * math.sin(j.heading))
+
+    def _give_way(self, t: float, front: float, v: float, approach: float,
                   tracks: Sequence[Track]) -> float | None:
         p = self.params
         k = next((k for k, j in enumerate(self.road.junctions) if j.s_stop > front - 0.5), None)
@@ -193,7 +221,13 @@ class JunctionMonitor:
             return None
         room = j.s_stop - front - p.stop_margin
         wait = self._must_wait(j, tracks)
-        if k not in self._waiting and v > p.moving and \
+        if j.control is Control.STOP_SIGNS:
+            if self._order_at != k:
+                self._order, self._order_at = ArrivalOrder(p), k
+            standing = v < p.stopped and 0.0 <= j.s_stop - front <= p.arrival_zone
+            wait = self._order.update(t, j, self._line_out[k], standing, tracks) or wait
+        stops_first = j.control is Control.STOP_SIGNS and self._order.arrived is None
+        if k not in self._waiting and v > p.moving and not stops_first and \
                 v * v > 2.0 * p.commit_decel * max(room, 0.0):
             self._committed.add(k)  # past the last point it could stop comfortably: go on
             return None
@@ -243,3 +277,79 @@ class JunctionMonitor:
         about_to = along - j.half_width < p.near_box
         out: np.ndarray = on_far_arm & (coming | about_to)
         return out
+
+
+class ArrivalOrder:
+    """Who came first at one all-way stop, from the tracks (module doc, giving way)."""
+
+    def __init__(self, params: JunctionParams) -> None:
+        self.params = params
+        self.arrived: float | None = None  # [s] when the car stood at its line
+        self.first_seen: dict[int, float] = {}  # track id -> [s] first seen (any place)
+        self.waiting_since: dict[int, float] = {}  # track id -> [s] arrival at its line
+
+    def update(self, t: float, j: Junction, line_out: float, standing: bool,
+               tracks: Sequence[Track]) -> bool:
+        """Whether the car must wait for a vehicle that arrived before it, at time `t` [s];
+        `line_out` [m] from the centre to a line, `standing` the car stands at its own."""
+        p = self.params
+        if standing and self.arrived is None:
+            self.arrived = t
+        waiting = {tr.id: tr for tr in tracks
+                   if tr.cls in (ObjectClass.CAR, ObjectClass.TRUCK) and
+                   waits_at_line(j, line_out, tr, p)}
+        for tr in tracks:
+            self.first_seen.setdefault(tr.id, t)
+        for tid in list(self.waiting_since):
+            if tid not in waiting:
+                del self.waiting_since[tid]  # gone from its line: into the junction
+        for tid in waiting:
+            if tid not in self.waiting_since:
+                already = self.first_seen[tid] == t  # first seen waiting: there before
+                self.waiting_since[tid] = -math.inf if already else t
+        if self.arrived is None:
+            return False
+        return any(self._before(waiting[tid], since, j) for tid, since in
+                   self.waiting_since.items())
+
+    def _before(self, tr: Track, since: float, j: Junction) -> bool:
+        """Whether the vehicle of track `tr`, waiting at its line since `since` [s], goes
+        before the car."""
+        assert self.arrived is not None
+        if since < self.arrived - self.params.tie:
+            return True
+        if since > self.arrived + self.params.tie:
+            return False
+        return _on_right(j.heading, _arm_heading(j, tr))
+
+
+def waits_at_line(j: Junction, line_out: float, tr: Track, p: JunctionParams) -> bool:
+    """Whether track `tr` stands at the stop line of one of `j`'s arms, first of its queue:
+    in the arm's inbound lane, its centre `line_zone_near` to `line_zone_far` beyond the
+    line, `line_out` [m] from the centre (module doc)."""
+    if math.hypot(tr.vx, tr.vy) >= p.moving:
+        return False
+    rel_x, rel_y = tr.x - j.x, tr.y - j.y
+    for k in range(4):
+        out = j.heading + math.pi + 0.5 * math.pi * k  # the arm's outward direction
+        c, s = math.cos(out), math.sin(out)
+        along = rel_x * c + rel_y * s  # [m] out from the centre
+        left_of_inbound = rel_x * s - rel_y * c  # [m] inbound travel is -out; its lane: right
+        beyond = along - line_out
+        if p.line_zone_near <= beyond <= p.line_zone_far and \
+                0.0 < -left_of_inbound < j.half_width:
+            return True
+    return False
+
+
+def _arm_heading(j: Junction, tr: Track) -> float:
+    """[rad] the inbound direction of travel of the arm the track stands on."""
+    out = math.atan2(tr.y - j.y, tr.x - j.x)
+    k = round(math.remainder(out - j.heading - math.pi, 2.0 * math.pi) / (0.5 * math.pi))
+    return j.heading + math.pi + 0.5 * math.pi * k + math.pi
+
+
+def _on_right(heading: float, other: float) -> bool:
+    """Whether a vehicle travelling `other` [rad] comes from the right of one travelling
+    `heading` [rad]: it travels 90 deg to the left of it."""
+    return abs(math.remainder(other - heading - 0.5 * math.pi, 2.0 * math.pi)) < 0.5

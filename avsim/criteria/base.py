@@ -46,6 +46,7 @@ class Need(enum.Enum):
     LANE_CHANGE = "lane_change_max"  # [s] how long a lane change may take
     STORY = "story"  # the scenario's required actions and events (`story_label`s)
     ACTOR_BODIES = "actor_bodies"  # which actor each NPC body is (body id -> actor id)
+    TOWN = "town"  # the town's layout (`world.spec.TownSpec`; None on a road)
 
 
 @dataclass(frozen=True, slots=True, eq=False)

@@ -22,7 +22,7 @@ from typing import Any, Generic, TypeVar
 from avsim.criteria.base import MAX_LANE_CHANGE, Criterion, Need
 from vehicle_urdf import CarGeometry
 from world.hdmap import RoadMap
-from world.spec import TrafficLightSpec
+from world.spec import TownSpec, TrafficLightSpec
 
 S = TypeVar("S")  # a declaration's setting, as validated
 
@@ -45,6 +45,7 @@ class RunInputs:
     #   (`avsim.criteria.story.story_label`)
     actor_bodies: Mapping[int, str] = field(default_factory=dict)  # NPC body id -> its
     #   actor's id
+    town: TownSpec | None = None  # the town's layout and signal timing (None: a road)
 
 
 @dataclass(frozen=True, slots=True)

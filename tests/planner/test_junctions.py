@@ -4,6 +4,7 @@ giving way before a left turn or U-turn, on routes compiled from a grid town."""
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import pytest
 
@@ -209,3 +210,80 @@ def test_one_green_frame_does_not_let_the_car_go_through_a_red() -> None:
     m.see_lights([seen(LightColour.GREEN, 0.3)])
     m.see_lights([seen(LightColour.GREEN, 0.4)])  # it did turn green
     assert not m.update(0.45, front_at(m, 30.0), 8.0).holds(RED_LIGHT)
+
+
+# ---- the all-way stop's order of arrival, from the tracks -----------------------------------
+
+LINE_OUT = STOPS.mouth + 1.0  # [m] from a junction's centre to each stop line
+LANE = STOPS.kerb_lane  # [m] lane 0's centre from the street's centre line
+
+
+def at_arm(arm: str, track_id: int, back: float = 2.9, moving: float = 0.0) -> Track:
+    """A car on `arm` of junction (1, 1) (`south`: coming from the south, heading north),
+    in its inbound lane, its centre `back` [m] behind that arm's stop line, at speed
+    `moving` [m/s] towards the junction."""
+    cx, cy = STOPS.centre((1, 1))
+    out = {"south": (0.0, -1.0), "north": (0.0, 1.0), "east": (1.0, 0.0),
+           "west": (-1.0, 0.0)}[arm]
+    right = (-out[1], out[0])  # right of the inbound direction (-out)
+    d = LINE_OUT + back
+    x, y = cx + d * out[0] + LANE * right[0], cy + d * out[1] + LANE * right[1]
+    return replace(car(x, y, -moving * out[0], -moving * out[1]), id=track_id)
+
+
+def at_stop(m: JunctionMonitor, t: float, tracks: list[Track]) -> bool:
+    """Whether the car, standing at its line at time t, gives way."""
+    return m.update(t, front_at(m, 1.0), 0.0, tracks).holds(GIVE_WAY)
+
+
+def stop_monitor() -> JunctionMonitor:
+    return JunctionMonitor(route(STOPS, Manoeuvre.STRAIGHT), VEHICLE, P)
+
+
+# (arm, seen there from [s], the car stands at its line from t = 2 s: waits for it)
+ARRIVAL_TABLE = [
+    ("south", 0.0, True),  # first seen waiting there: there before the car
+    ("north", 0.0, True),  # on the left, but earlier: first to stop, first to go
+    ("east", 0.0, True),  # oncoming, earlier
+    ("south", 2.5, True),  # a tie, on the car's right: it goes first
+    ("north", 2.5, False),  # a tie, on the car's left: the car goes first
+    ("east", 2.5, False),  # a tie, oncoming: nobody on the car's right, it goes first
+    ("south", 3.5, False),  # after the car: the car goes first
+]
+
+
+@pytest.mark.parametrize(("arm", "since", "waits"), ARRIVAL_TABLE)
+def test_an_all_way_stop_goes_in_order_of_arrival(arm: str, since: float, waits: bool) -> None:
+    m = stop_monitor()
+    approaching = at_arm(arm, 7, back=30.0, moving=5.0)
+    waiting = at_arm(arm, 7)
+    for t in (0.0, 0.5, 1.0, 1.5):
+        m.update(t, front_at(m, 1.0 + (2.0 - t)), 1.0, [waiting if since <= t else approaching])
+    for t in (2.0, 2.5, 3.0, 3.5, 4.0, 6.0):
+        tracks = [waiting if since <= t else approaching]
+        at_stop(m, t, tracks)
+    assert at_stop(m, 6.5, [waiting]) is waits
+    # it has gone into the junction: the car's turn
+    assert not at_stop(m, 7.0, [])
+
+
+def test_a_car_queued_on_another_arm_or_behind_the_car_is_not_waited_for() -> None:
+    m = stop_monitor()
+    queued = at_arm("south", 4, back=2.9 + 4.8 + 3.0)  # behind the first of its queue
+    behind = at_arm("west", 5, back=2.9 + 4.8 + 3.0)  # behind the car, on its own arm
+    assert not at_stop(m, 0.0, [queued, behind])
+    assert not at_stop(m, 3.0, [queued, behind])
+
+
+def test_a_car_that_moves_off_its_line_is_no_longer_waited_for() -> None:
+    m = stop_monitor()
+    assert at_stop(m, 0.0, [at_arm("south", 4)])
+    assert not at_stop(m, 1.0, [at_arm("south", 4, back=-3.0, moving=3.0)])  # on its way
+
+
+def test_at_an_all_way_stop_the_car_does_not_commit_before_it_has_stood() -> None:
+    """Too fast to stop at commit_decel 10 m before the line (where the stop sign's own
+    event brakes it anyway): still not committed, so its turn is judged once it stands."""
+    m = stop_monitor()
+    assert m.update(0.0, front_at(m, 10.0), 9.0, []).active == frozenset()
+    assert at_stop(m, 3.0, [at_arm("south", 4)])  # it stood: the earlier car goes first

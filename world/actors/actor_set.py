@@ -15,6 +15,12 @@ that starts before the fork keeps the road the route leaves (`RoadMap.through_li
 other, the route. Bodies are placed with one scalar map lookup per moving actor; `poses`
 (all of them, for criteria, scoring and the recording) is one vectorised map call, when
 asked, with every station and offset taken on the ego's route.
+
+In a town, each NPC car has a town driver (`world.actors.town_traffic`); the drivers share
+one all-way-stop order (`world.actors.all_way_stop`), which the ego joins when it stands at
+its line (`StopZones`). A driver that has arrived at its route's end is taken out of the
+world (`gone`): its body and its pose far away below the ground (`GONE_XY`), no longer
+minded by the others.
 """
 
 from __future__ import annotations
@@ -27,15 +33,20 @@ import pybullet
 from numpy.typing import NDArray
 from pybullet_utils.bullet_client import BulletClient
 
+from world.actors.all_way_stop import AllWayStop
 from world.actors.behaviour import NpcMotion, TriggerContext
 from world.actors.bodies import VEHICLES, BoxSize, body_size, vehicle_of
 from world.actors.catalogue import CATALOGUE, DEFAULT_MODEL, VehicleClass
-from world.actors.town_traffic import TownDriver
+from world.actors.town_traffic import STOP_SPEED, Others, StopZones, TownDriver
 from world.hdmap import RoadMap
 from world.map.road import build_road_map
 from world.map.signals import route_signals
 from world.scene.collision import Box, CollisionShapes, Part
 from world.spec import ActorSpec, ActorType
+
+EGO = "ego"  # the ego's key in the all-way-stop order
+GONE_XY = (1.0e5, 1.0e5)  # [m] where an NPC that has left the town is (below the ground)
+
 
 COLOURS = {  # [-] RGBA
     ActorType.CAR: (0.85, 0.20, 0.15, 1.0),
@@ -101,11 +112,17 @@ class ActorSet:
         self.half_sizes = np.array(
             [[size.length / 2, size.width / 2, size.height / 2] for size in sizes]
         ).reshape(-1, 3)
+        self.order = AllWayStop()  # whose turn at the town's all-way stops (the truth)
         self._drivers = [
-            TownDriver(own_map, route_signals(a.road, own_map), size.length / 2)
+            TownDriver(own_map, route_signals(a.road, own_map), size.length / 2, a.id,
+                       self.order)
             if a.road is not None and a.type in VEHICLES else None
             for a, own_map, size in zip(specs, self._maps, sizes, strict=True)
         ]
+        self._ego_zones = StopZones(road) if any(d is not None for d in self._drivers) else None
+        self._ego_at: tuple[int, int] | None = None  # the all-way stop the ego stands at
+        self._ego_prev: tuple[float, float] | None = None  # [m] its centre a step ago
+        self.gone = np.zeros(len(specs), dtype=bool)  # arrived town drivers, out of the world
         self._last_speed = self._speeds()  # [m/s] before the last step
         self._dt = 1.0  # [s] the last step
         self._ids = tuple(a.id for a in specs)
@@ -126,6 +143,7 @@ class ActorSet:
                                                    strict=True)]
         self.town_drivers = any(d is not None for d in self._drivers)
         self._xy = np.zeros((len(specs), 2))  # [m] each body's centre as last placed
+        self._xy_prev = self._xy  # [m] ... a step before (velocities over ground)
         self._poses: ActorPoses | None = None
         self._place(force=True)
 
@@ -177,28 +195,64 @@ class ActorSet:
         `ego`: (x, y, half length) of the ego, for town drivers to keep their distance."""
         self._last_speed = self._speeds()
         self._dt = dt
-        self._cap_town_drivers(t, ego)
+        self._cap_town_drivers(t, dt, ego)
         for motion, line in zip(self.motions, self._lines, strict=True):
             motion.step(t, dt, line.curvature_one(motion.s))
         self._poses = None
         self._place(force=False)
 
-    def _cap_town_drivers(self, t: float, ego: tuple[float, float, float] | None) -> None:
-        """Each town driver's speed cap from its rules and the other vehicles' centres."""
+    def _cap_town_drivers(self, t: float, dt: float,
+                          ego: tuple[float, float, float] | None) -> None:
+        """Each town driver's speed cap from its rules and the other vehicles' centres and
+        velocities (those over the last step); the ego's place in the all-way-stop order."""
         if not self._own.any():
             return
-        vehicles = np.array([k in VEHICLES for k in self._kinds])
+        vehicles = np.array([k in VEHICLES for k in self._kinds]) & ~self.gone
         xy, half = self._xy[vehicles], self.half_sizes[vehicles, 0]
+        velocity = (self._xy - self._xy_prev)[vehicles] / dt
+        self._xy_prev = self._xy.copy()
         if ego is not None:
+            prev = self._ego_prev if self._ego_prev is not None else ego[:2]
+            ego_v = ((ego[0] - prev[0]) / dt, (ego[1] - prev[1]) / dt)
+            self._ego_prev = (ego[0], ego[1])
+            self._ego_order(t, ego, math.hypot(*ego_v))
             xy = np.vstack([xy, [ego[:2]]])
+            velocity = np.vstack([velocity, [ego_v]])
             half = np.append(half, ego[2])
         index = np.cumsum(vehicles) - 1  # row of each vehicle actor in xy
         for i, (driver, motion) in enumerate(zip(self._drivers, self.motions, strict=True)):
-            if driver is None:
+            if driver is None or self.gone[i]:
                 continue
             others = np.ones(len(xy), dtype=bool)
             others[index[i]] = False
-            motion.cap = driver.speed_cap(t, motion.s, motion.speed, xy[others], half[others])
+            motion.cap = driver.speed_cap(
+                t, motion.s, motion.speed, Others(xy[others], velocity[others], half[others]))
+            if driver.arrived:
+                self._leave(i)
+
+    def _ego_order(self, t: float, ego: tuple[float, float, float], speed: float) -> None:
+        """The ego arrives at an all-way stop when it stands at its line (slower than the
+        stack's stood speed), and leaves the order when it moves off (faster than an NPC's
+        stopped speed) or is no longer at the line: the NPCs mind its turn as any other's."""
+        assert self._ego_zones is not None
+        if self._ego_at is not None:
+            still = self._ego_zones.at_line(ego[:2], ego[2], speed, STOP_SPEED)
+            if still is None or still.index != self._ego_at:
+                self.order.leave(self._ego_at, EGO)
+                self._ego_at = None
+        if self._ego_at is None:
+            at = self._ego_zones.at_line(ego[:2], ego[2], speed)
+            if at is not None:
+                self.order.arrive(at.index, EGO, at.heading, t)
+                self._ego_at = at.index
+
+    def _leave(self, i: int) -> None:
+        """Take actor i out of the world: it has arrived at its route's end."""
+        self.gone[i] = True
+        self.motions[i].speed = 0.0
+        self.motions[i].cap = 0.0
+        self._xy[i] = GONE_XY
+        self._reset_pose(self.bodies[i], (*GONE_XY, -10.0), (0.0, 0.0, 0.0, 1.0))
 
     def _speeds(self) -> NDArray[np.float64]:
         """[m/s] (N,) `ActorPoses.speeds` now."""
@@ -237,6 +291,10 @@ class ActorSet:
                 np.column_stack([x[through], y[through]]))
         yaws = heading + self._flip + np.array([x.heading_offset for x in m])
         centres = np.column_stack([x, y, self.half_sizes[:, 2]]) if m else np.zeros((0, 3))
+        if self.gone.any():  # left the town: far away, below the ground
+            centres[self.gone] = (*GONE_XY, -10.0)
+            s[self.gone], offsets[self.gone] = self._road.local_coordinates(
+                np.array([GONE_XY]))
         return ActorPoses(
             ids=self._ids,
             kinds=self._kinds,
