@@ -22,7 +22,7 @@ from avsim.run.runner import RunResult
 from planner.fsm.acc import r157_min_gap
 from world.sensors.setup import Profile
 
-pytestmark = pytest.mark.slow
+pytestmark = [pytest.mark.slow, pytest.mark.acceptance]  # the acceptance set: `make acceptance`
 KPH = 1 / 3.6
 DIR = "scenarios/acceptance"
 

@@ -24,7 +24,7 @@ from world.actors.catalogue import CATALOGUE, DEFAULT_MODEL
 from world.hdmap import SHOULDER
 from world.sensors.setup import Profile
 
-pytestmark = pytest.mark.slow
+pytestmark = [pytest.mark.slow, pytest.mark.acceptance]  # the acceptance set: `make acceptance`
 CAR = CATALOGUE[DEFAULT_MODEL["car"]].length  # [m] a `type: car` actor's body
 EGO = 4.8  # [m] the ego's body
 W = 3.5  # [m] lane width of both scenarios

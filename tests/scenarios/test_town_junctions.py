@@ -24,7 +24,7 @@ from avsim.run.runner import RunResult
 from world.map.road import build_road_map
 from world.sensors.setup import Profile
 
-pytestmark = pytest.mark.slow
+pytestmark = [pytest.mark.slow, pytest.mark.acceptance]  # the acceptance set: `make acceptance`
 HERE = Path(__file__).parents[2] / "scenarios" / "acceptance"
 FRONT = 2.4  # [m] the ego's centre -> front bumper
 TIE = 1.0  # [s] arrivals this close are a tie (`world.actors.all_way_stop.TIE`)

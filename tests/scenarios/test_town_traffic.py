@@ -21,7 +21,7 @@ from world.hdmap import Control
 from world.map.road import build_road_map
 from world.sensors.setup import Profile
 
-pytestmark = pytest.mark.slow
+pytestmark = [pytest.mark.slow, pytest.mark.acceptance]  # the acceptance set: `make acceptance`
 SCENARIO = str(Path(__file__).parents[2] / "scenarios" / "acceptance" / "town_traffic.yaml")
 FRONT = 2.4  # [m] the ego's centre -> front bumper
 
