@@ -21,6 +21,10 @@ Gaps (the paper gives none; designed here, `gaps`, parameters `AccParams`):
   the lead matters. Beyond it, braking at a_comf from v to V_l still ends at or beyond
   d_des; d_reach is hysteresis.
 
+BRAKE is left for TRAIL once the gap is back above d_min and the car no longer closes on
+the lead (row 23's ``v <= V_l + v_band``): from there the gap is TRAIL's to open to d_des,
+which its law approaches from below and would never pass.
+
 Comfort (ISO 15622 / ISO 22179): a comfortable stop is left while a_need <= a_comf_max
 (`planner.limits.A_COMF_MAX`; `planner.acc_control.comfortable` decides, the input says).
 When it is not, the ACC enters BRAKE at once, saying so ("no comfortable stop: needs 4.2
@@ -76,8 +80,8 @@ holds, so Cruise and SpeedLimit are tried first.
     a_need relaxed *
 22. brake -> speed_limit: V_GPS < V_s and (d >= d_max or V_s + v_band <= V_l) and d > d_min
     and a_need relaxed *
-23. brake -> trail: d > d_des and (V_l < V_s or V_l < V_GPS) and d > d_min and a_need
-    relaxed *
+23. brake -> trail: (d > d_des or v <= V_l + v_band) and (V_l < V_s or V_l < V_GPS) and d >
+    d_min and a_need relaxed *
 24. speed_limit -> cruise: V_GPS >= V_s and (d >= d_max or (V_GPS + v_band <= V_l and d >
     d_min))
 25. speed_limit -> trail: (V_GPS < V_s or V_l < V_GPS) and d_des < d < d_max
@@ -260,7 +264,8 @@ def _brake_to_limit(_m: AccMode, x: AccInput, g: Gaps) -> bool:
 
 
 def _brake_to_trail(_m: AccMode, x: AccInput, g: Gaps) -> bool:
-    return (x.d > g.d_des and (x.v_l < x.v_s or x.v_l < x.v_gps) and x.d > g.d_min
+    recovered = x.d > g.d_des or x.v <= x.v_l + g.v_band  # or no longer closing on it
+    return (recovered and (x.v_l < x.v_s or x.v_l < x.v_gps) and x.d > g.d_min
             and _comfortable(x, g))
 
 
@@ -333,8 +338,9 @@ TABLE: Table[AccMode, AccInput, Gaps] = Table(AccMode, (
         "relaxed *",
         "gap recovered, the posted limit binds"),
     Row(frozenset({M.BRAKE}), M.TRAIL, _brake_to_trail,
-        "d > d_des and (V_l < V_s or V_l < V_GPS) and d > d_min and a_need relaxed *",
-        "gap recovered beyond d_des behind a slower vehicle"),
+        "(d > d_des or v <= V_l + v_band) and (V_l < V_s or V_l < V_GPS) and d > d_min and "
+        "a_need relaxed *",
+        "gap recovered above d_min, no longer closing on the vehicle ahead"),
     Row(frozenset({M.SPEED_LIMIT}), M.CRUISE, _limit_to_cruise,
         "V_GPS >= V_s and (d >= d_max or (V_GPS + v_band <= V_l and d > d_min))",
         "the posted limit is no longer below the set speed"),
