@@ -21,9 +21,10 @@ Gaps (the paper gives none; designed here, `gaps`, parameters `AccParams`):
   the lead matters. Beyond it, braking at a_comf from v to V_l still ends at or beyond
   d_des; d_reach is hysteresis.
 
-BRAKE is left for TRAIL once the gap is back above d_min and the car no longer closes on
-the lead (row 23's ``v <= V_l + v_band``): from there the gap is TRAIL's to open to d_des,
-which its law approaches from below and would never pass.
+BRAKE is left for TRAIL once the gap is back ``d_band`` above d_min (hysteresis against the
+entry at d_min) and the car no longer closes on the lead (row 23's ``v <= V_l + v_band``):
+from there the gap is TRAIL's to open to d_des, which its law approaches from below and
+would never pass.
 
 Comfort (ISO 15622 / ISO 22179): a comfortable stop is left while a_need <= a_comf_max
 (`planner.limits.A_COMF_MAX`; `planner.acc_control.comfortable` decides, the input says).
@@ -80,8 +81,8 @@ holds, so Cruise and SpeedLimit are tried first.
     a_need relaxed *
 22. brake -> speed_limit: V_GPS < V_s and (d >= d_max or V_s + v_band <= V_l) and d > d_min
     and a_need relaxed *
-23. brake -> trail: (d > d_des or v <= V_l + v_band) and (V_l < V_s or V_l < V_GPS) and d >
-    d_min and a_need relaxed *
+23. brake -> trail: (d > d_des or (v <= V_l + v_band and d > d_min + d_band)) and (V_l < V_s
+    or V_l < V_GPS) and d > d_min and a_need relaxed *
 24. speed_limit -> cruise: V_GPS >= V_s and (d >= d_max or (V_GPS + v_band <= V_l and d >
     d_min))
 25. speed_limit -> trail: (V_GPS < V_s or V_l < V_GPS) and d_des < d < d_max
@@ -153,6 +154,7 @@ class AccParams:
     a_comf: float = A_COMF  # [m/s^2] comfortable deceleration (d_max)
     d_reach: float = 10.0  # [m] hysteresis beyond the braking distance (d_max)
     a_hysteresis: float = 0.5  # [m/s^2] BRAKE is left with a_need this far under a_comf_max
+    d_band: float = 1.0  # [m] BRAKE is left for TRAIL without closing this far above d_min
     v_band: float = 0.5  # [m/s] a lead counts as faster than a speed once this much faster
     lead_hold: float = 0.5  # [s] TRAIL outlives a lost lead this long (lead_lost)
 
@@ -181,6 +183,7 @@ class Gaps:
     d_max: float  # [m] gap inside which the lead matters
     v_band: float = 0.5  # [m/s] the speed hysteresis of the rows that leave a lead
     #   (`AccParams.v_band`)
+    d_band: float = 1.0  # [m] the gap hysteresis of BRAKE's way out to TRAIL (`AccParams`)
 
 
 def r157_min_gap(v: float) -> float:
@@ -194,7 +197,7 @@ def gaps(v: float, v_l: float, p: AccParams) -> Gaps:
     d_min = r157_min_gap(v)
     d_des = max(p.d0 + p.tau * v, d_min)
     closing = max(v * v - min(v_l, v) ** 2, 0.0) / (2.0 * p.a_comf)
-    return Gaps(d_min, d_des, d_des + closing + p.d_reach, p.v_band)
+    return Gaps(d_min, d_des, d_des + closing + p.d_reach, p.v_band, p.d_band)
 
 
 # -- the guards: (mode now, input, gaps) -> the row holds --------------------------------------
@@ -264,7 +267,7 @@ def _brake_to_limit(_m: AccMode, x: AccInput, g: Gaps) -> bool:
 
 
 def _brake_to_trail(_m: AccMode, x: AccInput, g: Gaps) -> bool:
-    recovered = x.d > g.d_des or x.v <= x.v_l + g.v_band  # or no longer closing on it
+    recovered = x.d > g.d_des or (x.v <= x.v_l + g.v_band and x.d > g.d_min + g.d_band)
     return (recovered and (x.v_l < x.v_s or x.v_l < x.v_gps) and x.d > g.d_min
             and _comfortable(x, g))
 
@@ -338,8 +341,8 @@ TABLE: Table[AccMode, AccInput, Gaps] = Table(AccMode, (
         "relaxed *",
         "gap recovered, the posted limit binds"),
     Row(frozenset({M.BRAKE}), M.TRAIL, _brake_to_trail,
-        "(d > d_des or v <= V_l + v_band) and (V_l < V_s or V_l < V_GPS) and d > d_min and "
-        "a_need relaxed *",
+        "(d > d_des or (v <= V_l + v_band and d > d_min + d_band)) and (V_l < V_s or V_l < "
+        "V_GPS) and d > d_min and a_need relaxed *",
         "gap recovered above d_min, no longer closing on the vehicle ahead"),
     Row(frozenset({M.SPEED_LIMIT}), M.CRUISE, _limit_to_cruise,
         "V_GPS >= V_s and (d >= d_max or (V_GPS + v_band <= V_l and d > d_min))",

@@ -106,7 +106,7 @@ TABLE_CASES = [
     # a lead just lost: TRAIL holds for lead_hold (the car it hid may become the lead; *)
     ("trail_stays_lead_just_lost", M.TRAIL, x(lead_lost=True), None),
     ("trail_limit_waits_lead_just_lost", M.TRAIL, x(v_gps=13.0, lead_lost=True), None),
-    ("brake_trail_lead_at_set_speed", M.BRAKE, x(d=G.d_min + 1.0, v_l=15.2), M.TRAIL),
+    ("brake_trail_lead_at_set_speed", M.BRAKE, x(d=G.d_min + 1.5, v_l=15.2), M.TRAIL),
     ("limit_stays_lead_at_limit", M.SPEED_LIMIT,
      x(v_s=13.0, v_gps=13.0, d=G.d_des + 2.0, v_l=13.2), None),
     ("trail_limit", M.TRAIL, x(v_gps=13.0), M.SPEED_LIMIT),
@@ -121,6 +121,8 @@ TABLE_CASES = [
      x(d=0.5 * (G.d_min + G.d_des), v=VL + 0.3, v_l=VL), M.TRAIL),
     ("brake_stays_slowed_but_close", M.BRAKE,
      x(d=gaps(VL, VL, P).d_min - 0.5, v=VL, v_l=VL), None),
+    ("brake_stays_slowed_just_above_d_min", M.BRAKE,  # d_band: no flip at d_min
+     x(d=gaps(VL, VL, P).d_min + 0.5, v=VL, v_l=VL), None),
     ("brake_speed_bump", M.BRAKE, x(d=CLOSE, v_l=VL, speed_bump=True), M.SPEED_BUMP),
     # SpeedLimit (4 to 1, 4 to 2; * to Brake)
     ("limit_cruise", M.SPEED_LIMIT, x(), M.CRUISE),
