@@ -11,7 +11,6 @@ derandomized: the same mutations on every machine and every run.
 from __future__ import annotations
 
 import copy
-import math
 import re
 import shutil
 import tempfile
@@ -127,7 +126,7 @@ def test_the_mutations_reach_every_file_and_kind() -> None:
     assert mutate(doc, ("a", 0), "remove", None) == {"a": [2], "b": {"c": "x"}}
     assert mutate(doc, ("a", 1), "duplicate", None)["a"] == [1, 2, 2]
     assert len(mutate(doc, ("b", "c"), "huge", None)["b"]["c"]) == 1_000_000
-    assert math.isinf(float("inf")) and len(FILES) >= 20 and len(XOSC) == 15
+    assert len(FILES) >= 20 and len(XOSC) == 15
 
 
 # ---- OpenSCENARIO and OpenDRIVE -----------------------------------------------------------
