@@ -41,6 +41,7 @@ from world.core.rendering import Renderer
 from world.core.stopwatch import Stopwatch
 from world.frames import Frame
 from world.sensors import worker as sensing_worker
+from world.sensors.forkserver import SensingProcess
 from world.sensors.frame_slots import SLOTS, FrameSlots, shared_dir
 from world.sensors.lidar import LidarSensor
 from world.sensors.schedule import Due
@@ -141,36 +142,32 @@ def render_threads(setup: SensorSetup) -> int:
     return 1 if pixels < LIGHT_RENDERING else 0
 
 
-PRELOAD = ("world.sensors.warm",)  # what the workers' forkserver imports once (`SensingWorker`)
-
-
 class SensingWorker:
     """The worker process of a `ProcessSensing`, started on its own: it builds its mirror of
     the scenario's world while the main process builds the simulated one (about 2 s and 1 s
     here, side by side instead of one after the other).
 
-    Workers are forked from multiprocessing's ``forkserver``: a fresh interpreter (no physics
-    or GL state is ever inherited) that has imported `preload` once, so that the second and
-    later workers of a process (a test session's runs) start without the imports and the EGL
-    plugin's symbol scan (about 2 s a run, `world.sensors.warm`); the first costs what a
-    spawned worker did. The forkserver is one per process and keeps the preload of whoever
-    started it (a local batch's is a superset of this one, `avsim.run.warm`). The worker
-    gets this process's environment and directory at its start, as a spawned one would (the
-    forkserver's are those of its own start)."""
+    Workers are forked from a forkserver of their own (`world.sensors.forkserver`): a fresh
+    interpreter (no physics or GL state is ever inherited) that has imported its preload
+    once, so that the second and later workers of a process (a test session's runs) start
+    without the imports and the EGL plugin's symbol scan (about 2 s a run,
+    `world.sensors.warm`); the first costs what a spawned worker did. The server is the
+    same whatever else the starting process has done (a batch's forkserver has another
+    preload), so a worker starts the same everywhere. The worker gets this process's
+    environment and directory at its start, as a spawned one would (the forkserver's are
+    those of its own start)."""
 
-    def __init__(self, spec: WorldSpec, setup: SensorSetup,
-                 preload: tuple[str, ...] = PRELOAD) -> None:
+    def __init__(self, spec: WorldSpec, setup: SensorSetup) -> None:
         self.spec = spec
         fd, name = tempfile.mkstemp(prefix="avsim-frames-", dir=shared_dir())
         os.close(fd)
         self.slots = FrameSlots(Path(name), setup.cameras, create=True)
-        ctx = mp.get_context("forkserver")
-        ctx.set_forkserver_preload(list(preload))  # no effect once the forkserver runs
-        self._conn, child = ctx.Pipe()
-        self._proc = ctx.Process(target=sensing_worker.main,
-                                 args=(child, spec, setup, self.slots.path,
-                                       render_threads(setup), dict(os.environ), os.getcwd()),
-                                 name="avsim-sensing", daemon=True)
+        self._conn, child = mp.Pipe()
+        self._proc = SensingProcess(target=sensing_worker.main,
+                                    args=(child, spec, setup, self.slots.path,
+                                          render_threads(setup), dict(os.environ),
+                                          os.getcwd()),
+                                    name="avsim-sensing", daemon=True)
         self._proc.start()
         child.close()
         self._renderer: Renderer | None = None
@@ -196,6 +193,7 @@ class SensingWorker:
         try:
             kind, payload = self._conn.recv()
         except EOFError as e:
+            self._proc.join(timeout=5)  # reap it, for its exit code (-N: killed by signal N)
             raise SensingError(f"sensing worker exited (code {self._proc.exitcode})") from e
         if kind == "error":
             raise SensingError(f"sensing worker failed:\n{payload}")
