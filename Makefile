@@ -35,10 +35,10 @@ lint: $(STAMP)
 	$(BIN)/mypy
 
 test: lint
-	$(BIN)/pytest -n 2 --dist loadfile -m "not acceptance" $(PYTEST_ARGS)
+	$(BIN)/pytest -n 2 --dist loadfile --no-loadscope-reorder -m "not acceptance" --durations=25 $(PYTEST_ARGS)
 
 test-quick: lint
-	$(BIN)/pytest -n 2 --dist loadfile -m "not slow" $(PYTEST_ARGS)
+	$(BIN)/pytest -n 2 --dist loadfile --no-loadscope-reorder -m "not slow" $(PYTEST_ARGS)
 
 # The acceptance set (scenarios/acceptance: Euro NCAP, UN R157, ISO 22179 grids), one test
 # per run, each asserting its situation happened and its verdicts; too long for `make test`.
