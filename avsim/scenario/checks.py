@@ -2,8 +2,8 @@
 make: a lane exists at its station, stations lie on the route (so does a criteria setting
 declared a station, `reach_s`), `after` names an earlier action, arcs are wider than the
 road, actor ids are unique, speeds fit the car, a speed action's acceleration has the sign
-its change of speed needs, in a town every car starts on its route, and on a road no two
-bodies overlap where they start (`check_spawn`).
+its change of speed needs, in a town every car starts on its route, and no two bodies
+overlap where they start (`check_spawn`).
 
 Each check raises the first problem it finds as a `LocatedError` at its key; the order of
 the checks is the order in which a file's problems are reported. Stations are metres along
@@ -21,6 +21,7 @@ from avsim.scenario.model import ActorModel, RoadModel, ScenarioModel, TriggerMo
 from vehicle_urdf import CarDimensions
 from world import spec
 from world.actors.bodies import body_size
+from world.map.rectangles import Corners, overlap, rectangle
 from world.map.road import build_road_map
 
 DEFAULT_SPEED_UP = 2.0  # [m/s^2] a speed action's accel when it speeds up
@@ -60,12 +61,15 @@ def check_town(model: ScenarioModel, ego_road: spec.RoadSpec,
 
 
 def check_spawn(world: spec.WorldSpec) -> None:
-    """No two bodies overlap where they start (issue L): the ego and each actor on a road,
+    """No two bodies overlap where they start (issue L). On a road: the ego and each actor,
     each a box of its length and width along the lane it starts in (at its offset), the
     ego's `vehicle_urdf.CarDimensions`'; the first overlap found is refused at the later
     body's key: ``actors.2: overlaps the ego at s = 11 m``. Pedestrians and obstacles count
     like vehicles. Along the route the boxes are compared station by station (an arc's
     radius is far larger than a car)."""
+    if world.town is not None:
+        _check_town_spawn(world)
+        return
     road = build_road_map(world.road)
     car = CarDimensions()
     boxes = [("the ego", world.ego.s, road.lane(world.ego.lane).offset_at(world.ego.s),
@@ -82,6 +86,32 @@ def check_spawn(world: spec.WorldSpec) -> None:
                 raise LocatedError(f"actors.{index}",
                                    f"overlaps {name} at s = {fmt(actor.s)} m")
         boxes.append(box)
+
+
+def _check_town_spawn(world: spec.WorldSpec) -> None:
+    """`check_spawn` in a town: each car starts on its own route, so the bodies are placed in
+    the world (the centre at its station and offset on its route, the length along the
+    route's heading there) and compared as rectangles (`world.map.rectangles`)."""
+    car = CarDimensions()
+    placed = [("the ego", _footprint(world.road, world.ego.lane, world.ego.s, 0.0,
+                                     car.body_length, car.body_width))]
+    for index, actor in enumerate(world.actors):
+        size = body_size(actor)
+        here = _footprint(actor.road or world.road, actor.lane, actor.s, actor.offset,
+                          size.length, size.width)
+        for name, other in placed:
+            if overlap(here, other):
+                raise LocatedError(f"actors.{index}",
+                                   f"overlaps {name} at s = {fmt(actor.s)} m of its route")
+        placed.append((f"actors.{index} ({actor.id})", here))
+
+
+def _footprint(road: spec.RoadSpec, lane_index: int, s: float, offset: float, length: float,
+               width: float) -> Corners:
+    """The ground rectangle of a body centred at station s and `offset` on a lane of `road`."""
+    lane = build_road_map(road).lane(lane_index)
+    x, y = (float(v) for v in lane.position(s, offset))
+    return rectangle(x, y, float(lane.heading_at(s)), length, width)
 
 
 def route_length(segments: Sequence[spec.SegmentSpec]) -> float:

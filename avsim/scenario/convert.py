@@ -283,7 +283,9 @@ def _convert_town(model: ScenarioModel) -> Scenario:
     actors = tuple(
         replace(_actor_spec(index, actor), s=given_or(actor.s, TOWN_START_S), road=road)
         for index, (actor, road) in enumerate(zip(model.actors, roads, strict=True)))
-    return _scenario(model, ego_road, actors, town)
+    scenario = _scenario(model, ego_road, actors, town)
+    check_spawn(scenario.world)
+    return scenario
 
 
 def _town_route(layout: TownLayout, key: str, start: tuple[int, int, str] | None,

@@ -19,6 +19,7 @@ from numpy.typing import NDArray
 
 from world.frames import to_kph, wrap_angle
 from world.hdmap import RoadMap, StopSign
+from world.map.rectangles import overlap
 from world.spec import BuildingsSpec
 
 FloatArray = NDArray[np.float64]
@@ -151,11 +152,7 @@ def _overlaps(box: BuildingBox, others: list[BuildingBox]) -> bool:
         gap = math.dist(box.centre[:2], other.centre[:2])
         if gap >= math.hypot(*box.half_extents[:2]) + math.hypot(*other.half_extents[:2]):
             continue
-        b = other.footprint()
-        axes = np.concatenate([a[1:3] - a[0:2], b[1:3] - b[0:2]])
-        proj_a, proj_b = a @ axes.T, b @ axes.T  # (4, 4): corner x axis
-        separated = (proj_a.max(0) <= proj_b.min(0)) | (proj_b.max(0) <= proj_a.min(0))
-        if not bool(np.any(separated)):
+        if overlap(a, other.footprint()):
             return True
     return False
 

@@ -43,6 +43,7 @@ from avsim.scenario.openscenario.conditions import (
 )
 from avsim.scenario.openscenario.parameters import ParamValue
 from avsim.scenario.openscenario.positions import Position
+from world.map.rectangles import rectangle
 
 STANDING = 0.01  # [m/s] below this an entity stands still (as the snapshot's standing_for)
 Resolved = tuple[float, float, float, float]  # x, y [m] map frame; s, offset [m] route
@@ -118,7 +119,7 @@ def _to_position(e: EntityState, p: Resolved, dtype: RelativeDistanceType,
         d = abs(offset - c) - e.width / 2.0 if freespace else abs(offset - e.offset)
         return max(d, 0.0)
     if freespace:
-        point = g.rectangle(x, y, 0.0, 0.0, 0.0)
+        point = rectangle(x, y, 0.0, 0.0, 0.0)
         return g.rectangle_distance(g.corners(e), point)
     return math.hypot(x - e.x, y - e.y)
 

@@ -16,8 +16,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from avsim.run.storyboard.snapshot import EntityState
-
-Corners = NDArray[np.float64]  # (4, 2), in order around the rectangle
+from world.map.rectangles import Corners, overlap, rectangle
 
 
 def centre_station(e: EntityState) -> float:
@@ -56,27 +55,6 @@ def corners(e: EntityState) -> Corners:
     return rectangle(cx, cy, e.heading, e.length, e.width)
 
 
-def rectangle(cx: float, cy: float, heading: float, length: float, width: float) -> Corners:
-    """The corners of a rectangle centred at (cx, cy), its length along `heading`."""
-    c, s = math.cos(heading), math.sin(heading)
-    u = np.array([c, s]) * length / 2.0
-    v = np.array([-s, c]) * width / 2.0
-    centre = np.array([cx, cy])
-    return np.array([centre + u + v, centre - u + v, centre - u - v, centre + u - v])
-
-
-def _separated(a: Corners, b: Corners) -> bool:
-    """Whether an edge normal of `a` or `b` separates them (separating axis theorem)."""
-    for poly in (a, b):
-        for k in range(4):
-            edge = poly[(k + 1) % 4] - poly[k]
-            axis = np.array([-edge[1], edge[0]])
-            pa, pb = a @ axis, b @ axis
-            if pa.max() < pb.min() or pb.max() < pa.min():
-                return True
-    return False
-
-
 def _point_segment(p: NDArray[np.float64], q0: NDArray[np.float64],
                    q1: NDArray[np.float64]) -> float:
     d = q1 - q0
@@ -91,7 +69,7 @@ def _one_way(a: Corners, b: Corners) -> float:
 
 def rectangle_distance(a: Corners, b: Corners) -> float:
     """[m] the distance between two rectangles (0 when they overlap or touch)."""
-    if not _separated(a, b):
+    if overlap(a, b):
         return 0.0
     return min(_one_way(a, b), _one_way(b, a))
 

@@ -206,6 +206,8 @@ BAD: dict[str, tuple[str, str]] = {
     "model_type_mismatch": ("actors.0.model", "a semi_trailer needs type: truck, not car"),
     "actor_overlaps_ego": ("actors.1", "overlaps the ego at s = 22 m"),
     "actors_overlap": ("actors.1", "overlaps actors.0 (lead) at s = 63 m"),
+    "town_actors_overlap": ("actors.1", "overlaps actors.0 (a) at s = 7 m of its route"),
+    "town_actor_overlaps_ego": ("actors.0", "overlaps the ego at s = 8 m of its route"),
     "too_many_lanes": ("road.lanes", "must be <= 6, got 500"),
     "route_too_long": ("road.segments", "the route is 22854 m long: at most 20000 m"),
     "duration_too_long": ("duration", "must be <= 7200"),

@@ -11,11 +11,12 @@ from hypothesis import strategies as st
 
 from avsim.run.storyboard import geometry as g
 from tests.avsim.run.storyboard.helpers import entity
+from world.map.rectangles import rectangle
 
 coord = st.floats(-10.0, 10.0)
 size = st.floats(0.2, 6.0)
 angle = st.floats(-math.pi, math.pi)
-rectangles = st.builds(g.rectangle, coord, coord, angle, size, size)
+rectangles = st.builds(rectangle, coord, coord, angle, size, size)
 
 
 def _sampled_distance(a: np.ndarray, b: np.ndarray, n: int = 60) -> tuple[float, bool]:
@@ -66,12 +67,12 @@ def test_rectangle_distance_matches_a_dense_sampling(a: np.ndarray, b: np.ndarra
 
 
 def test_rectangle_distance_of_rotated_boxes() -> None:
-    square = g.rectangle(0.0, 0.0, 0.0, 2.0, 2.0)
-    diamond = g.rectangle(3.0, 0.0, math.pi / 4, 2.0, 2.0)  # its corner at x = 3 - sqrt 2
+    square = rectangle(0.0, 0.0, 0.0, 2.0, 2.0)
+    diamond = rectangle(3.0, 0.0, math.pi / 4, 2.0, 2.0)  # its corner at x = 3 - sqrt 2
     assert math.isclose(g.rectangle_distance(square, diamond), 2.0 - math.sqrt(2.0))
-    overlapping = g.rectangle(1.5, 0.0, math.pi / 4, 2.0, 2.0)
+    overlapping = rectangle(1.5, 0.0, math.pi / 4, 2.0, 2.0)
     assert g.rectangle_distance(square, overlapping) == 0.0
-    inside = g.rectangle(0.0, 0.0, 0.3, 0.5, 0.5)
+    inside = rectangle(0.0, 0.0, 0.3, 0.5, 0.5)
     assert g.rectangle_distance(square, inside) == 0.0
 
 
