@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import math
 import time
+from array import array
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -46,6 +47,7 @@ from avsim.criteria.lane import TyresInLane
 from avsim.criteria.registry import build_criteria
 from avsim.criteria.route import Completes
 from avsim.record.recorder import Recorder
+from avsim.run.columns import Rows, flags, floats, ints
 from avsim.run.holds import shortest_hold
 from avsim.run.sensor_loop import FrameHook, SensorLoop, sensing_mode
 from avsim.run.stack import Stack, StackOutput
@@ -80,48 +82,53 @@ VERDICT_WORDS = {Verdict.PASS: "pass", Verdict.FAIL: "FAIL", Verdict.NOT_APPLICA
 
 @dataclass
 class TrajectoryLog:
-    """Per control tick: the ego's true and estimated state and what the stack did."""
+    """Per control tick: the ego's true and estimated state and what the stack did.
 
-    t: list[float] = field(default_factory=list)  # [s]
-    x: list[float] = field(default_factory=list)  # [m] true, car centre
-    y: list[float] = field(default_factory=list)  # [m]
-    yaw: list[float] = field(default_factory=list)  # [rad]
-    speed: list[float] = field(default_factory=list)  # [m/s] true forward speed
-    station: list[float] = field(default_factory=list)  # [m] true centre station
-    cross_track: list[float] = field(default_factory=list)  # [m] true centre offset from
+    Stored compactly (an hour's run holds 144,000 ticks): numbers and flags in typed arrays
+    (8 bytes a float, 1 a flag: a list of floats takes 32), rows of numbers in `Rows`, the
+    FSM states as references to their enum members. `array(name)` gives a column as a
+    float64 array (a copy)."""
+
+    t: array[float] = field(default_factory=floats)  # [s]
+    x: array[float] = field(default_factory=floats)  # [m] true, car centre
+    y: array[float] = field(default_factory=floats)  # [m]
+    yaw: array[float] = field(default_factory=floats)  # [rad]
+    speed: array[float] = field(default_factory=floats)  # [m/s] true forward speed
+    station: array[float] = field(default_factory=floats)  # [m] true centre station
+    cross_track: array[float] = field(default_factory=floats)  # [m] true centre offset from
     #   the centre of the lane the stack keeps (its plan's), left +
-    lane_error: list[float] = field(default_factory=list)  # [m] true centre offset from the
+    lane_error: array[float] = field(default_factory=floats)  # [m] true centre offset from the
     #   centre of the lane it is in (the truth and the map: `world.truth.ego_lane_edges`)
-    crossing: list[bool] = field(default_factory=list)  # its tyres are on or over a lane
+    crossing: array[int] = field(default_factory=flags)  # its tyres are on or over a lane
     #   line (a lane change, from the truth: `avsim.criteria.lane.LaneChanges`)
-    front_axle_error: list[float] = field(default_factory=list)  # [m] true, at front axle
-    target_speed: list[float] = field(default_factory=list)  # [m/s]
-    speed_limit: list[float] = field(default_factory=list)  # [m/s] at the front bumper
-    steering: list[float] = field(default_factory=list)  # [rad] commanded
-    drive_torque: list[float] = field(default_factory=list)  # [N m] commanded, total
-    brake_torque: list[float] = field(default_factory=list)  # [N m] commanded, total
-    wheel_spin: list[NDArray[np.float64]] = field(default_factory=list)  # [rad/s] (4,)
+    front_axle_error: array[float] = field(default_factory=floats)  # [m] true, at front axle
+    target_speed: array[float] = field(default_factory=floats)  # [m/s]
+    speed_limit: array[float] = field(default_factory=floats)  # [m/s] at the front bumper
+    steering: array[float] = field(default_factory=floats)  # [rad] commanded
+    drive_torque: array[float] = field(default_factory=floats)  # [N m] commanded, total
+    brake_torque: array[float] = field(default_factory=floats)  # [N m] commanded, total
+    wheel_spin: Rows = field(default_factory=Rows)  # [rad/s] (4,)
     acc_mode: list[AccMode] = field(default_factory=list)  # the ACC / event layer's mode
     motion: list[Motion] = field(default_factory=list)  # the motion FSM's state
-    hazard: list[bool] = field(default_factory=list)  # the stack's hazard lights are on
+    hazard: array[int] = field(default_factory=flags)  # the stack's hazard lights are on
     speed_source: list[SpeedSource] = field(default_factory=list)  # what set the speed
-    lane: list[int] = field(default_factory=list)  # the lane the stack keeps (cross_track's)
-    changing: list[bool] = field(default_factory=list)  # a commanded lane change in hand
-    pedal: list[float] = field(default_factory=list)  # [-] the driver's accelerator pedal
-    pose_error: list[float] = field(default_factory=list)  # [m] the stack's position
+    lane: array[int] = field(default_factory=ints)  # the lane the stack keeps (cross_track's)
+    changing: array[int] = field(default_factory=flags)  # a commanded lane change in hand
+    pedal: array[float] = field(default_factory=floats)  # [-] the driver's accelerator pedal
+    pose_error: array[float] = field(default_factory=floats)  # [m] the stack's position
     #   estimate (the plan's) from the true centre
-    actor_station: list[NDArray[np.float64]] = field(default_factory=list)  # [m] (N,) true,
+    actor_station: Rows = field(default_factory=Rows)  # [m] (N,) true,
     #   along the road each drives on (the route; past an exit's fork, the road the route
     #   left for traffic that kept it; in a town, each actor's own route): not comparable
     #   with the ego's station off the route (the lead is `lead_gap`, `lead_speed`)
-    actor_offset: list[NDArray[np.float64]] = field(default_factory=list)  # [m] (N,) true,
+    actor_offset: Rows = field(default_factory=Rows)  # [m] (N,) true,
     #   from that road's reference line, left +
-    lead_gap: list[float] = field(default_factory=list)  # [m] bumper gap to the vehicle
+    lead_gap: array[float] = field(default_factory=floats)  # [m] bumper gap to the vehicle
     #   ahead in the ego's lane (truth and map: `world.truth.vehicles_ahead`), NaN: none
-    lead_speed: list[float] = field(default_factory=list)  # [m/s] its speed, NaN: none
+    lead_speed: array[float] = field(default_factory=floats)  # [m/s] its speed, NaN: none
 
     def array(self, name: str) -> NDArray[np.float64]:
-        return np.asarray(getattr(self, name), dtype=np.float64)
+        return np.array(getattr(self, name), dtype=np.float64)
 
 
 @dataclass(frozen=True, slots=True, eq=False)
