@@ -252,7 +252,49 @@ class FlatTire:
     wheel: Wheel
 
 
-EgoEvent = AcceleratorOverride | FlatTire
+@dataclass(frozen=True, slots=True)
+class CameraBlackout:
+    """A camera's images go black (a dead sensor or a cut cable: `world.sensors.faults`)."""
+
+    camera: str  # the camera's name ("front", "left", "right")
+    duration: float  # [s] how long
+
+
+@dataclass(frozen=True, slots=True)
+class CameraFreeze:
+    """A camera keeps sending its last image (a hung image pipeline: `world.sensors.faults`)."""
+
+    camera: str  # the camera's name
+    duration: float  # [s] how long
+
+
+@dataclass(frozen=True, slots=True)
+class LidarOutage:
+    """The LiDAR sends no scan (`world.sensors.faults`)."""
+
+    duration: float  # [s] how long
+
+
+@dataclass(frozen=True, slots=True)
+class GnssOutage:
+    """The GNSS receiver has no fix: every epoch is flagged invalid
+    (`world.sensors.faults`)."""
+
+    duration: float  # [s] how long
+
+
+@dataclass(frozen=True, slots=True)
+class GnssJump:
+    """The GNSS fixes jump by a constant offset (a multipath lock or a spoofed signal:
+    `world.sensors.faults`)."""
+
+    offset: tuple[float, float]  # [m] (x, y) added to every fix, map frame
+    duration: float  # [s] how long
+
+
+SensorFault = CameraBlackout | CameraFreeze | LidarOutage | GnssOutage | GnssJump
+SENSOR_FAULTS = (CameraBlackout, CameraFreeze, LidarOutage, GnssOutage, GnssJump)
+EgoEvent = AcceleratorOverride | FlatTire | SensorFault
 
 
 @dataclass(frozen=True, slots=True)
