@@ -45,9 +45,9 @@ lane is taken from it (`acquire` needs a camera without a fault) until its frame
 again; the change's reason says how the fault was noticed. MAP_HOLD follows the map lane
 placed by the localisation estimate (odometry, GNSS and the camera's lane as long as it was
 seen) and slows to `hold_speed`; STOP_IN_LANE brings the car to a stop in its lane (with the
-hazard lights on, `planner.fsm.hazard`), until the lane is found again. JUNCTION follows the map's path through
-a town junction at the planned speed: the painted lines end at the junction's mouth, and
-the path turns where none are painted. Every change carries a reason for the log.
+hazard lights on, `planner.fsm.hazard`), until the lane is found again. JUNCTION follows
+the map's path through a town junction at the planned speed: the painted lines end at the
+junction's mouth, and the path turns where none are painted. Every change carries a reason for the log.
 """
 
 from __future__ import annotations
