@@ -47,7 +47,8 @@ placed by the localisation estimate (odometry, GNSS and the camera's lane as lon
 seen) and slows to `hold_speed`; STOP_IN_LANE brings the car to a stop in its lane (with the
 hazard lights on, `planner.fsm.hazard`), until the lane is found again. JUNCTION follows
 the map's path through a town junction at the planned speed: the painted lines end at the
-junction's mouth, and the path turns where none are painted. Every change carries a reason for the log.
+junction's mouth, and the path turns where none are painted. Every change carries a reason
+for the log.
 """
 
 from __future__ import annotations
