@@ -219,14 +219,17 @@ class SensorHealth:
     (`perception.health`): per sensor None while it is fine, else how the fault was noticed
     (the reason its state changes give)."""
 
-    camera: str | None = None  # the front camera's frames (blank, frozen, missing)
-    lidar: str | None = None  # the LiDAR's scans (missing, empty)
+    camera: str | None = None  # the front camera's frames (blank, frozen, late, missing)
+    lidar: str | None = None  # the LiDAR's scans (late, missing, empty)
     gnss: str | None = None  # the GNSS fixes (missing, inconsistent with the odometry)
+    occlusion: str | None = None  # part of the front camera's view covered (its frames are
+    #   still perceived: the lane on what is seen)
 
     @property
     def ok(self) -> bool:
         """Every sensor is fine."""
-        return self.camera is None and self.lidar is None and self.gnss is None
+        return (self.camera is None and self.lidar is None and self.gnss is None
+                and self.occlusion is None)
 
 
 @dataclass(frozen=True, slots=True, eq=False)

@@ -206,7 +206,8 @@ class Planner:
                                       self._other_lane(view, manoeuvre), inp.health.camera)
         health = inp.health
         changes += self.sensing.apply(ego.t, sensing.transition(
-            self.sensing.state, SensingInput(health.lidar, health.gnss), self.params.sensing))
+            self.sensing.state, SensingInput(health.lidar, health.gnss, health.occlusion),
+            self.params.sensing))
         lateral_choice = self._path(ego, station, view, manoeuvre)
         lead = self._lead(view, tracks, ego, manoeuvre, lateral_choice.camera)
         planned = PlannedSpeed(SpeedRef(target.speed, target.accel),

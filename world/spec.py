@@ -269,6 +269,27 @@ class CameraFreeze:
 
 
 @dataclass(frozen=True, slots=True)
+class CameraOcclusion:
+    """Part of a camera's view is covered by something opaque and dark (mud, a leaf, tape:
+    `world.sensors.faults`): a strip of the image from one side."""
+
+    camera: str  # the camera's name
+    fraction: float  # [-] 0..1, of the image's width covered
+    side: Side  # the side of the image the strip is on (left / right, as the car looks)
+    duration: float  # [s] how long
+
+
+@dataclass(frozen=True, slots=True)
+class SensorDelay:
+    """A sensor's data arrive later than they should (a congested bus, an overloaded
+    driver: `world.sensors.faults`): each delivery carries its capture from `delay` earlier."""
+
+    sensor: str  # a camera's name or "lidar"
+    delay: float  # [s] added to its latency
+    duration: float  # [s] how long
+
+
+@dataclass(frozen=True, slots=True)
 class LidarOutage:
     """The LiDAR sends no scan (`world.sensors.faults`)."""
 
@@ -292,8 +313,10 @@ class GnssJump:
     duration: float  # [s] how long
 
 
-SensorFault = CameraBlackout | CameraFreeze | LidarOutage | GnssOutage | GnssJump
-SENSOR_FAULTS = (CameraBlackout, CameraFreeze, LidarOutage, GnssOutage, GnssJump)
+SensorFault = (CameraBlackout | CameraFreeze | CameraOcclusion | LidarOutage | GnssOutage
+               | GnssJump | SensorDelay)
+SENSOR_FAULTS = (CameraBlackout, CameraFreeze, CameraOcclusion, LidarOutage, GnssOutage, GnssJump,
+                 SensorDelay)
 EgoEvent = AcceleratorOverride | FlatTire | SensorFault
 
 

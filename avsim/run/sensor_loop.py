@@ -35,7 +35,7 @@ from perception.messages import Detection
 from world.core.rates import CONTROL_RATE, SensorTiming
 from world.core.stopwatch import Stopwatch
 from world.frames import CameraFrame, Frame, LidarScan, wrap_angle
-from world.sensors.faults import FaultySensing
+from world.sensors.faults import FaultySensing, sensor_delays
 from world.sensors.lidar import LidarTruth
 from world.sensors.pipeline import (
     Capture,
@@ -92,7 +92,9 @@ class SensorLoop:
         pipeline: Sensing = (ProcessSensing(world, setup, self.watch, worker)
                              if mode == "process" and setup is not None and setup.cameras
                              else InlineSensing(world, self.watch))
-        self.sensing: Sensing = FaultySensing(pipeline, lambda: world.sensor_faults)
+        self.sensing: Sensing = FaultySensing(
+            pipeline, lambda: world.sensor_faults,
+            sensor_delays(e.event for e in world.spec.events))
         self.mode = mode
         self.recorder = recorder
         self.frame_hook = frame_hook

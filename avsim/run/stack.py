@@ -182,11 +182,12 @@ class Stack:
             return None
         front = next((f for f in frames if f.info.name == "front"), None)
         watch = self.watch
-        if scan is not None:
-            self.health.scan(scan)
+        now = self._times[-1] if self._times else t  # [s] the stack's clock: its last tick
+        if scan is not None and self.health.scan(scan, now) is not None:
+            scan = None  # late or empty: nothing to perceive in it
         if front is not None and self.lane_detector is not None:
             with watch("perception health"):
-                fault = self.health.camera(front, pose.speed)
+                fault = self.health.camera(front, pose.speed, now)
             if fault is not None:  # nothing to perceive in it: the lane is found anew after
                 front, self._view = None, None
                 self.lane_filter.reset()

@@ -45,6 +45,7 @@ MAX_DROPOUT_RATE = 10.0  # [1/s] GNSS outages started per second
 MAX_RANGE_SIGMA = 1.0  # [m] LiDAR range noise
 MAX_FAULT_DURATION = MAX_DURATION  # [s] a sensor fault's duration
 MAX_GNSS_JUMP = 1000.0  # [m] a GNSS jump's offset, per axis
+MAX_SENSOR_DELAY = 1.0  # [s] a sensor delay's added latency (the stack keeps 2 s of poses)
 
 Duration = Annotated[float, Field(gt=0, le=MAX_DURATION)]
 Time = Annotated[float, Field(ge=0, le=MAX_DURATION)]
@@ -74,3 +75,4 @@ VelocitySigma = Annotated[float, Field(ge=0, le=MAX_VELOCITY_SIGMA)]
 DropoutRate = Annotated[float, Field(ge=0, le=MAX_DROPOUT_RATE)]
 RangeSigma = Annotated[float, Field(ge=0, le=MAX_RANGE_SIGMA)]
 FaultDuration = Annotated[float, Field(gt=0, le=MAX_FAULT_DURATION)]
+SensorDelay = Annotated[float, Field(gt=0, le=MAX_SENSOR_DELAY)]

@@ -208,6 +208,13 @@ def _fault_spec(event: EventModel) -> spec.SensorFault:
         return spec.CameraBlackout(event.camera_blackout.camera, event.camera_blackout.duration)
     if event.camera_freeze is not None:
         return spec.CameraFreeze(event.camera_freeze.camera, event.camera_freeze.duration)
+    if event.camera_occlusion is not None:
+        occlusion = event.camera_occlusion
+        return spec.CameraOcclusion(occlusion.camera, occlusion.fraction,
+                                    hdmap.Side(occlusion.side), occlusion.duration)
+    if event.sensor_delay is not None:
+        delay = event.sensor_delay
+        return spec.SensorDelay(delay.sensor, delay.delay, delay.duration)
     if event.lidar_outage is not None:
         return spec.LidarOutage(event.lidar_outage.duration)
     if event.gnss_outage is not None:

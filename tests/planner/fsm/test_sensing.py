@@ -13,17 +13,21 @@ P = SensingParams()
 S = Sensing
 LIDAR = "no LiDAR scan for 0.6 s"
 GNSS = "no valid GNSS fix for 3.1 s"
+OCCLUDED = "45% of the camera frame dark and featureless (partly occluded)"
 CASES = [
     (S.NOMINAL, SensingInput(), None),
     (S.NOMINAL, SensingInput(lidar=LIDAR), S.MINIMUM_RISK),
     (S.NOMINAL, SensingInput(lidar=LIDAR, gnss=GNSS), S.MINIMUM_RISK),  # the stop first
     (S.NOMINAL, SensingInput(gnss=GNSS), S.DEGRADED),
+    (S.NOMINAL, SensingInput(occlusion=OCCLUDED), S.DEGRADED),
     (S.DEGRADED, SensingInput(gnss=GNSS), None),
+    (S.DEGRADED, SensingInput(occlusion=OCCLUDED), None),
     (S.DEGRADED, SensingInput(lidar=LIDAR, gnss=GNSS), S.MINIMUM_RISK),
     (S.DEGRADED, SensingInput(), S.NOMINAL),
     (S.MINIMUM_RISK, SensingInput(lidar=LIDAR), None),
     (S.MINIMUM_RISK, SensingInput(lidar=LIDAR, gnss=GNSS), None),
     (S.MINIMUM_RISK, SensingInput(gnss=GNSS), S.DEGRADED),
+    (S.MINIMUM_RISK, SensingInput(occlusion=OCCLUDED), S.DEGRADED),
     (S.MINIMUM_RISK, SensingInput(), S.NOMINAL),
 ]
 
@@ -41,6 +45,8 @@ def test_each_change_says_how_the_fault_was_noticed() -> None:
     assert change is not None and change.reason.startswith(LIDAR)
     change = transition(S.NOMINAL, SensingInput(gnss=GNSS), P)
     assert change is not None and change.reason.startswith(GNSS)
+    change = transition(S.NOMINAL, SensingInput(occlusion=OCCLUDED), P)
+    assert change is not None and change.reason.startswith(OCCLUDED)
 
 
 def test_the_cases_walk_every_row_of_the_data() -> None:

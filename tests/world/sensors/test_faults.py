@@ -10,15 +10,18 @@ import numpy as np
 
 from tests.world.sensors.test_pipeline import assert_same, drive
 from world.frames import CameraFrame, CameraInfo, GnssFix, LidarInfo, LidarScan, SensorMount
+from world.hdmap import Side
 from world.sensors.faults import FaultInjector
 from world.sensors.sensor import Reading
 from world.spec import (
     CameraBlackout,
     CameraFreeze,
+    CameraOcclusion,
     EventSpec,
     GnssJump,
     GnssOutage,
     LidarOutage,
+    SensorDelay,
     TimeTrigger,
 )
 
@@ -71,6 +74,30 @@ def test_a_frozen_camera_repeats_the_image_delivered_before_the_fault() -> None:
     assert got == [10, 20, 20, 20, 50, 50]  # a new freeze holds the last image again
 
 
+def test_an_occlusion_blacks_out_a_strip_from_its_side() -> None:
+    injector = FaultInjector()
+    out = injector.apply((camera(0.1, 80),), (CameraOcclusion("front", 0.25, Side.RIGHT, 1.0),))
+    frame = frame_of(out, "front")
+    assert isinstance(frame, CameraFrame)
+    assert not frame.rgb[:, 6:].any() and (frame.rgb[:, :6] == 80).all()
+    out = injector.apply((camera(0.2, 80),), (CameraOcclusion("front", 0.5, Side.LEFT, 1.0),))
+    frame = frame_of(out, "front")
+    assert isinstance(frame, CameraFrame)
+    assert not frame.rgb[:, :4].any() and (frame.rgb[:, 4:] == 80).all()
+
+
+def test_a_delayed_sensor_delivers_its_capture_from_the_delay_before() -> None:
+    injector = FaultInjector({"lidar": 0.3})
+    delay = (SensorDelay("lidar", 0.3, 1.0),)
+    got = []
+    for k in range(8):
+        faults = delay if 2 <= k < 6 else ()
+        out = injector.apply((scan(0.1 * k),), faults)
+        got.append(round(out[0].frame.t, 3) if out else None)
+    # none 0.3 s older at 0.2 s; then the captures 0.3 s old; on time when it is over
+    assert got == [0.0, 0.1, None, 0.0, 0.1, 0.2, 0.6, 0.7]
+
+
 def test_a_lidar_outage_drops_the_scan_and_a_gnss_outage_invalidates_the_fix() -> None:
     injector = FaultInjector()
     out = injector.apply((camera(0.1, 80), scan(0.1)), (LidarOutage(1.0),))
@@ -93,7 +120,9 @@ def test_inline_and_process_sensing_give_bitwise_the_same_faulty_data() -> None:
               EventSpec(TimeTrigger(0.9), CameraBlackout("front", 0.3)),
               EventSpec(TimeTrigger(0.5), LidarOutage(0.5)),
               EventSpec(TimeTrigger(0.3), GnssJump((20.0, 0.0), 0.4)),
-              EventSpec(TimeTrigger(1.2), GnssOutage(0.3)))
+              EventSpec(TimeTrigger(1.2), GnssOutage(0.3)),
+              EventSpec(TimeTrigger(1.3), SensorDelay("front", 0.2, 0.2)),
+              EventSpec(TimeTrigger(1.5), CameraOcclusion("front", 0.5, Side.LEFT, 0.3)))
     inline, process = drive("inline", events=events), drive("process", events=events)
     assert len(inline) == len(process)
     for (at_a, a), (at_b, b) in zip(inline, process, strict=True):
@@ -102,7 +131,8 @@ def test_inline_and_process_sensing_give_bitwise_the_same_faulty_data() -> None:
         for ra, rb in zip(a.readings, b.readings, strict=True):
             assert_same(ra.frame, rb.frame)
             assert_same(ra.truth, rb.truth)
-    # and the faults are in it: frozen, then black fronts; scans missing; fixes off
+    # and the faults are in it: frozen, black, then occluded fronts; scans missing; fixes
+    # off
     fronts = {round(c.t, 3): r.frame.rgb for _, c in inline for r in c.readings
               if isinstance(r.frame, CameraFrame) and r.sensor == "front"}
     for t, rgb in fronts.items():
@@ -110,6 +140,8 @@ def test_inline_and_process_sensing_give_bitwise_the_same_faulty_data() -> None:
             assert np.array_equal(rgb, fronts[0.3]), t
         elif 0.9 <= t < 1.2:
             assert not rgb.any(), t
+        elif 1.5 <= t < 1.8:
+            assert not rgb[:, :320].any() and rgb[:, 320:].any(), t
         else:
             assert (rgb.any() and not np.array_equal(rgb, fronts[0.3])) or t == 0.3, t
     scans = [round(c.t, 3) for _, c in inline if "lidar" in c.due.sensors]
