@@ -60,8 +60,8 @@ def _slow_fault(x: SensingInput) -> str | None:
 
 
 def _slowing(x: SensingInput, p: SensingParams) -> str:
-    what = ("lane on camera and odometry" if x.gnss is not None
-            else "lane on what the camera sees")
+    what = ("the lane kept without GNSS" if x.gnss is not None
+            else "the lane on what the camera sees")
     return f"{_slow_fault(x)}: {what}, slowing to {p.slow_speed:.1f} m/s"
 
 

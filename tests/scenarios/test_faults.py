@@ -230,7 +230,7 @@ def test_camera_occlusion_keeps_the_lane_on_what_is_seen_and_slows_down(
     noticed, resumed = sensing
     assert start < noticed.t < start + 0.3
     assert noticed.reason.endswith("of the camera frame dark and featureless (partly "
-                                   "occluded): lane on what the camera sees, slowing to "
+                                   "occluded): the lane on what the camera sees, slowing to "
                                    "8.3 m/s")
     assert end < resumed.t < end + 0.3
     # the lane was kept on the camera (the right line), the car slowed, no stop, no hazard
