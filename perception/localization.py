@@ -464,6 +464,21 @@ class Localizer:
             position_sigma=math.sqrt(max(pos_var, 0.0)),
         )
 
+    def predicted_fix(self, t: float) -> tuple[float, float, float] | None:
+        """What a fix at time ``t`` [s] should read, from the estimate extrapolated (not
+        committed) to it: (x, y) [m] of position + bias, and the 1-sigma [m] of that
+        prediction in its worst direction. None before the first fix. A fix farther from
+        it than its gate allows is inconsistent with the odometry (`perception.health`)."""
+        if not self._initialised:
+            return None
+        x0 = self.state
+        x, f = motion(x0, t - self._t)
+        cov = f @ self._ekf.P @ f.T + process_noise(x0, abs(t - self._t), self.params)
+        h = _H_GNSS[:2]
+        c = h @ cov @ h.T
+        var = _largest_eigenvalue(c[0, 0], c[0, 1], c[1, 1])
+        return (float(x[IX] + x[IBX]), float(x[IY] + x[IBY]), math.sqrt(max(var, 0.0)))
+
     def _bias_sigma_of(self, fix: GnssFix) -> float:
         """[m] 1-sigma of the bias assumed of a fix: its stated sigma, at least the floor
         when the camera's lane can be matched on a map (else nothing could correct it)."""

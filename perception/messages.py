@@ -213,6 +213,25 @@ class SignView:
     pose: EgoState  # map frame, at the camera frame's time
 
 
+@dataclass(frozen=True, slots=True)
+class SensorHealth:
+    """What the stack noticed wrong with its sensors, from their data alone
+    (`perception.health`): per sensor None while it is fine, else how the fault was noticed
+    (the reason its state changes give)."""
+
+    camera: str | None = None  # the front camera's frames (blank, frozen, late, missing)
+    lidar: str | None = None  # the LiDAR's scans (late, missing, empty)
+    gnss: str | None = None  # the GNSS fixes (missing, inconsistent with the odometry)
+    occlusion: str | None = None  # part of the front camera's view covered (its frames are
+    #   still perceived: the lane on what is seen)
+
+    @property
+    def ok(self) -> bool:
+        """Every sensor is fine."""
+        return (self.camera is None and self.lidar is None and self.gnss is None
+                and self.occlusion is None)
+
+
 @dataclass(frozen=True, slots=True, eq=False)
 class PlannerInput:
     """What perception hands the planner each control tick.
@@ -229,3 +248,4 @@ class PlannerInput:
     lights: tuple[LightDetection, ...] = ()  # the lights of a frame delivered this tick
     pedal: float = 0.0  # [-] 0..1, the driver's accelerator pedal position
     flat_tyre: bool = False  # a flat tyre is detected (from the wheel speeds)
+    health: SensorHealth = SensorHealth()  # the sensor faults noticed now

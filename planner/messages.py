@@ -21,6 +21,7 @@ from planner.fsm.hazard import HazardLights
 from planner.fsm.lane_source import LaneSource
 from planner.fsm.machine import StateChange
 from planner.fsm.motion import Motion
+from planner.fsm.sensing import Sensing
 
 __all__ = ["MACHINES", "AccMode", "ControlState", "EgoState", "HazardLights", "LaneSource",
            "Lead", "Motion", "Plan", "ReferencePath", "SpeedSource", "StateChange"]
@@ -77,7 +78,9 @@ class Plan:
     lane: int = 0  # [-] the lane kept, or moved into by a lane change (ego-direction index)
     origin_lane: int = 0  # [-] the lane a lane change in hand leaves (== lane otherwise)
     control: ControlState = ControlState.SPEED_KEEPING  # the control FSM's state
-    hazard: HazardLights = HazardLights.OFF  # on from a flat tyre's detection
+    hazard: HazardLights = HazardLights.OFF  # on from a flat tyre's detection, and during
+    #   a minimum-risk stop in lane after a sensor fault
+    sensing: Sensing = Sensing.NOMINAL  # the answer to the LiDAR's and GNSS's health
     speed_source: SpeedSource = SpeedSource.SET_SPEED  # what set `target_speed`
     changes: tuple[StateChange, ...] = ()  # state changes made in this tick
 
@@ -85,10 +88,10 @@ class Plan:
     def states(self) -> dict[str, enum.Enum]:
         """Every state of the plan by its machine's name (`MACHINES`)."""
         return {"lane_source": self.lane_source, "motion": self.motion, "acc": self.acc_mode,
-                "control": self.control, "hazard": self.hazard,
+                "control": self.control, "hazard": self.hazard, "sensing": self.sensing,
                 "speed_source": self.speed_source}
 
 
 MACHINES: dict[str, type[enum.Enum]] = {  # the plan's states: machine name -> its states
     "lane_source": LaneSource, "motion": Motion, "acc": AccMode, "control": ControlState,
-    "hazard": HazardLights, "speed_source": SpeedSource}
+    "hazard": HazardLights, "sensing": Sensing, "speed_source": SpeedSource}

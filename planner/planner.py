@@ -2,10 +2,10 @@
 
 `Planner.update` takes the one message perception hands it each control tick
 (`perception.messages.PlannerInput`: the ego estimate, the camera's lane, the confirmed
-tracks, the signs and light colours of a frame, the driver's accelerator pedal and the
-flat-tyre flag) and returns the `Plan` (`planner.messages`). Nothing else calls into it.
-Positions are in the map frame, stations [m] along the route's reference line, speeds
-[m/s]. Steps:
+tracks, the signs and light colours of a frame, the driver's accelerator pedal, the
+flat-tyre flag and the sensors' health) and returns the `Plan` (`planner.messages`).
+Nothing else calls into it. Positions are in the map frame, stations [m] along the route's
+reference line, speeds [m/s]. Steps:
 
 1. the signs and light colours of a frame are matched with the map's stop lines and lights
    (`planner.events`, `planner.junctions`);
@@ -32,12 +32,16 @@ Positions are in the map frame, stations [m] along the route's reference line, s
    to the limit), the ACC / event law (`planner.acc_layer`: cruise, trail or brake behind
    the lead, which is nearer by the motion layer's room to pull out when it is a stationary
    vehicle the car may pass; a stop, a bump's pass speed, a flat tyre's crawl), the
-   degraded lane's cap (ramped down at ``a_comf`` to the hold speed in MAP_HOLD, to a stop
-   in STOP_IN_LANE) and the emergency stop; the plan's `speed_source` is the link that set
+   degraded modes' cap (ramped down at ``a_comf`` to the hold speed in MAP_HOLD, to a stop
+   in STOP_IN_LANE; to the slow speed when the sensing machine, `planner.fsm.sensing`,
+   answers a faulty GNSS with DEGRADED, to a stop in lane when it answers a lost LiDAR with
+   MINIMUM_RISK: the sensors' health as `perception.health` noticed it) and the emergency
+   stop; the plan's `speed_source` is the link that set
    the speed;
 6. the control FSM (`planner.control_layer`) names the control action and, in an
    emergency, asks for the emergency stop's deceleration instead; the hazard lights go on
-   with a flat tyre (`planner.fsm.hazard`).
+   with a flat tyre, and during a minimum-risk stop in lane after a sensor fault (off again
+   when it is over: `planner.fsm.hazard`).
 """
 
 from __future__ import annotations
@@ -54,10 +58,11 @@ from planner.camera_lane import camera_lane_path
 from planner.control_layer import ControlLayer
 from planner.driver_override import DriverOverride, OverrideParams
 from planner.events import EventMonitor, EventParams
-from planner.fsm import hazard, lane_source
-from planner.fsm.hazard import HazardLights
+from planner.fsm import hazard, lane_source, sensing
+from planner.fsm.hazard import HazardInput, HazardLights
 from planner.fsm.lane_source import LaneSource, LaneSourceInput, LaneSourceParams
 from planner.fsm.machine import Machine, StateChange
+from planner.fsm.sensing import Sensing, SensingInput, SensingParams
 from planner.junctions import JunctionMonitor, JunctionParams
 from planner.lead import (
     LeadAccel,
@@ -92,6 +97,7 @@ class PlannerParams:
     camera_ahead: float = 30.0  # [m] the camera's lane is used this far ahead of its frame
     speed: SpeedPlanningParams = field(default_factory=SpeedPlanningParams)
     source: LaneSourceParams = field(default_factory=LaneSourceParams)
+    sensing: SensingParams = field(default_factory=SensingParams)
     lead: LeadParams = field(default_factory=LeadParams)
     acc: AccLayerParams = field(default_factory=AccLayerParams)
     motion: MotionLayerParams = field(default_factory=MotionLayerParams)
@@ -143,6 +149,7 @@ class Planner:
         self.events = EventMonitor(self.road, p.vehicle, p.events)
         self.junctions = JunctionMonitor(self.road, p.vehicle, p.junctions)
         self.hazard = Machine("hazard", HazardLights.OFF)
+        self.sensing = Machine("sensing", Sensing.NOMINAL)
 
     def _keep(self, lane: int) -> None:
         """Make `lane` the lane whose stations, speed plan and map path are used."""
@@ -196,7 +203,11 @@ class Planner:
             station, lateral = self.localise(ego)
             target = self.speed_for(station)
         changes = self._update_source(ego.t, view, self.near_junction(station),
-                                      self._other_lane(view, manoeuvre))
+                                      self._other_lane(view, manoeuvre), inp.health.camera)
+        health = inp.health
+        changes += self.sensing.apply(ego.t, sensing.transition(
+            self.sensing.state, SensingInput(health.lidar, health.gnss, health.occlusion),
+            self.params.sensing))
         lateral_choice = self._path(ego, station, view, manoeuvre)
         lead = self._lead(view, tracks, ego, manoeuvre, lateral_choice.camera)
         planned = PlannedSpeed(SpeedRef(target.speed, target.accel),
@@ -224,8 +235,8 @@ class Planner:
             lead, self.lead_accel.update(lead))
         if control.emergency:
             speed = PlannedSpeed(SpeedRef(0.0, -self.control.decel), SpeedSource.EMERGENCY)
-        hazard_changes = self.hazard.apply(ego.t, hazard.transition(self.hazard.state,
-                                                                    inp.flat_tyre))
+        hazard_changes = self.hazard.apply(ego.t, hazard.transition(
+            self.hazard.state, HazardInput(inp.flat_tyre, self._stopping(health.lidar))))
         return Plan(
             t=ego.t,
             ego=ego,
@@ -243,6 +254,7 @@ class Planner:
             origin_lane=manoeuvre.origin,
             control=control.state,
             hazard=self.hazard.state,
+            sensing=self.sensing.state,
             speed_source=speed.source,
             changes=changes + motion_changes + acc_changes + control_changes + hazard_changes,
         )
@@ -288,15 +300,25 @@ class Planner:
         _, r = self.localise(view.pose)
         return abs(view.estimate.offset - r) > self.params.camera_agree
 
+    def _stopping(self, lidar: str | None) -> str | None:
+        """Why a minimum-risk stop in lane is under way (the lane lost, the LiDAR lost), or
+        None."""
+        if self.sensing.state is Sensing.MINIMUM_RISK:
+            return lidar if lidar is not None else "the LiDAR's scans were faulty"
+        if self.source.state is LaneSource.STOP_IN_LANE:
+            return "the lane is lost"
+        return None
+
     def _update_source(self, t: float, view: LaneView | None, junction: bool,
-                       other_lane: bool) -> tuple[StateChange, ...]:
+                       other_lane: bool, camera_fault: str | None) -> tuple[StateChange, ...]:
         if self._start is None:
             self._start = t
         confidence = view.estimate.confidence if view is not None else 0.0
         since = max(self.source.since, self._start)  # ACQUIRING counts from the start
         lines, age = (view.estimate.lines, view.estimate.age + max(0.0, t - view.estimate.t)) \
             if view is not None else (0, math.inf)  # the lane dead-reckoned until now
-        x = LaneSourceInput(t, confidence, since, junction, other_lane, lines, age)
+        x = LaneSourceInput(t, confidence, since, junction, other_lane, lines, age,
+                            camera_fault)
         changes = self.source.apply(t, lane_source.transition(self.source.state, x,
                                                               self.params.source))
         self._lane_seen = self._lane_seen or self.source.state is LaneSource.CAMERA
@@ -342,9 +364,13 @@ class Planner:
 
     def _degraded_cap(self, planned: PlannedSpeed, ego_speed: float,
                       dt: float) -> PlannedSpeed:
-        """With the lane lost, ramp the target down at a_comf to the hold speed / to 0."""
-        wanted = {LaneSource.MAP_HOLD: self.params.source.hold_speed,
-                  LaneSource.STOP_IN_LANE: 0.0}.get(self.source.state, math.inf)
+        """With the lane lost (`planner.fsm.lane_source`) or a sensor faulty
+        (`planner.fsm.sensing`), ramp the target down at a_comf to the hold / slow speed, or
+        to 0 for a minimum-risk stop in lane."""
+        wanted = min({LaneSource.MAP_HOLD: self.params.source.hold_speed,
+                      LaneSource.STOP_IN_LANE: 0.0}.get(self.source.state, math.inf),
+                     {Sensing.DEGRADED: self.params.sensing.slow_speed,
+                      Sensing.MINIMUM_RISK: 0.0}.get(self.sensing.state, math.inf))
         speed = planned.ref.speed
         if math.isinf(wanted):
             self._cap = math.inf

@@ -252,7 +252,72 @@ class FlatTire:
     wheel: Wheel
 
 
-EgoEvent = AcceleratorOverride | FlatTire
+@dataclass(frozen=True, slots=True)
+class CameraBlackout:
+    """A camera's images go black (a dead sensor or a cut cable: `world.sensors.faults`)."""
+
+    camera: str  # the camera's name ("front", "left", "right")
+    duration: float  # [s] how long
+
+
+@dataclass(frozen=True, slots=True)
+class CameraFreeze:
+    """A camera keeps sending its last image (a hung image pipeline: `world.sensors.faults`)."""
+
+    camera: str  # the camera's name
+    duration: float  # [s] how long
+
+
+@dataclass(frozen=True, slots=True)
+class CameraOcclusion:
+    """Part of a camera's view is covered by something opaque and dark (mud, a leaf, tape:
+    `world.sensors.faults`): a strip of the image from one side."""
+
+    camera: str  # the camera's name
+    fraction: float  # [-] 0..1, of the image's width covered
+    side: Side  # the side of the image the strip is on (left / right, as the car looks)
+    duration: float  # [s] how long
+
+
+@dataclass(frozen=True, slots=True)
+class SensorDelay:
+    """A sensor's data arrive later than they should (a congested bus, an overloaded
+    driver: `world.sensors.faults`): each delivery carries its capture from `delay` earlier."""
+
+    sensor: str  # a camera's name or "lidar"
+    delay: float  # [s] added to its latency
+    duration: float  # [s] how long
+
+
+@dataclass(frozen=True, slots=True)
+class LidarOutage:
+    """The LiDAR sends no scan (`world.sensors.faults`)."""
+
+    duration: float  # [s] how long
+
+
+@dataclass(frozen=True, slots=True)
+class GnssOutage:
+    """The GNSS receiver has no fix: every epoch is flagged invalid
+    (`world.sensors.faults`)."""
+
+    duration: float  # [s] how long
+
+
+@dataclass(frozen=True, slots=True)
+class GnssJump:
+    """The GNSS fixes jump by a constant offset (a multipath lock or a spoofed signal:
+    `world.sensors.faults`)."""
+
+    offset: tuple[float, float]  # [m] (x, y) added to every fix, map frame
+    duration: float  # [s] how long
+
+
+SensorFault = (CameraBlackout | CameraFreeze | CameraOcclusion | LidarOutage | GnssOutage
+               | GnssJump | SensorDelay)
+SENSOR_FAULTS = (CameraBlackout, CameraFreeze, CameraOcclusion, LidarOutage, GnssOutage, GnssJump,
+                 SensorDelay)
+EgoEvent = AcceleratorOverride | FlatTire | SensorFault
 
 
 @dataclass(frozen=True, slots=True)

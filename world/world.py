@@ -61,7 +61,7 @@ from world.sensors.odometry import OdometrySensor
 from world.sensors.rig import SensorRig
 from world.sensors.sensor import Sensor
 from world.sensors.setup import LIDAR, SensorSetup
-from world.spec import TownSpec, TrafficLightSpec, WorldSpec
+from world.spec import SensorFault, TownSpec, TrafficLightSpec, WorldSpec
 from world.truth import RouteTruth, route_truth
 
 SIGN_POLE_RADIUS = 0.04  # [m]
@@ -413,8 +413,15 @@ class World:
 
     @property
     def event_ended_at(self) -> tuple[float | None, ...]:
-        """[s] per ego event: when it ended (an override: the pedal released), None while not."""
+        """[s] per ego event: when it ended (an override: the pedal released; a sensor
+        fault: its duration over), None while not."""
         return self._events.ended_at
+
+    @property
+    def sensor_faults(self) -> tuple[SensorFault, ...]:
+        """The sensor faults running now (as of the last trigger check), in the order they
+        fired: what the sensing pipeline does to the data (`world.sensors.faults`)."""
+        return self._events.faults
 
     @property
     def started_events(self) -> tuple[int, ...]:

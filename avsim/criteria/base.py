@@ -68,6 +68,7 @@ class TruthSample:
     road_curvature: float = 0.0  # [1/m] the route's curvature at the ego's station
     flat: bool = False  # a flat tyre event has happened to the ego
     hazard_lights: bool = False  # the ego's hazard lights are flashing (its lamps' state)
+    sensor_fault: bool = False  # a scenario's sensor fault is running now (the event's truth)
     fired: frozenset[str] = frozenset()  # the scripted actions and events fired so far
     #   (`avsim.criteria.story.story_label`)
     rear_station: float | None = None  # [m] rear bumper station; None: as far behind the

@@ -1,5 +1,6 @@
 """The route: the ego gets where it goes (`completes`), or after a flat tyre comes to a
-minimum-risk stop (`minimum_risk_stop`). Both always apply; the scenario's `reach_s` sets
+minimum-risk stop (`minimum_risk_stop`, which also judges the stops in lane after sensor
+faults). Both always apply; the scenario's `reach_s` sets
 the station to reach (default: the route's end less `END_MARGIN`), and `completes: false`
 turns route completion off (a test of a behaviour that need not get anywhere)."""
 
@@ -26,34 +27,47 @@ STOPPED, STOPPED_FOR = 0.1, 2.0  # [m/s], [s] the ego stands: below this speed f
 
 
 class StopAfterFlat:
-    """The watch of a minimum-risk stop after a flat tyre (truth and map): from the flat
-    on, the deceleration's peak (`DECEL_WINDOW` moving average over the samples), and the
-    first standstill (below `STOPPED` for `STOPPED_FOR`): where it stands and whether the
-    hazard lights flash then."""
+    """The watch of a minimum-risk stop (truth and map) after a flat tyre, or
+    (``after_fault``) after a sensor fault: from the first sample with one on, the
+    deceleration's peak (`DECEL_WINDOW` moving average over the samples), and the first
+    standstill (below `STOPPED` for `STOPPED_FOR`; after a sensor fault, one that began while
+    a fault was running): where it stands and whether the hazard lights flash then. After a
+    flat tyre the car stands on the shoulder where the road has one; after a sensor fault it
+    stops in its lane (the stack keeps its lane while it stops)."""
 
-    def __init__(self, road: RoadMap, half_tread: float, rate: float) -> None:
+    def __init__(self, road: RoadMap, half_tread: float, rate: float,
+                 after_fault: bool = False) -> None:
         self.road, self.half_tread = road, half_tread
-        self.flat_at: float | None = None  # [s] the flat tyre happened (first sample with it)
+        self.after_fault = after_fault
+        self.flat_at: float | None = None  # [s] the flat tyre (or the first sensor fault)
+        #   happened (first sample with it)
         self.peak = 0.0  # [m/s^2] the largest deceleration since the flat
         self.stop: tuple[float, str | None] | None = None  # ([s] the standstill's start, what
         #   is wrong with it: None when it is a minimum-risk stop)
         self._speeds: deque[float] = deque(maxlen=max(2, round(DECEL_WINDOW * rate) + 1))
         self._rate = rate
         self._since: float | None = None  # [s] standing since
+        self._in_fault = False  # the standstill began while a sensor fault was running
+
+    def _started(self, sample: TruthSample) -> bool:
+        return self.flat_at is not None or (sample.sensor_fault if self.after_fault
+                                             else sample.flat)
 
     def update(self, sample: TruthSample) -> float | None:
         """Watch `sample`; the deceleration [m/s^2] over the window ending now, once the flat
         has happened and the window is full (else None)."""
         self._speeds.append(sample.speed)
-        if not sample.flat or self.stop is not None:
+        if not self._started(sample) or self.stop is not None:
             return None
         if self.flat_at is None:
             self.flat_at = sample.t
         if sample.speed >= STOPPED:
             self._since = None
         else:
-            self._since = sample.t if self._since is None else self._since
-            if sample.t - self._since >= STOPPED_FOR:
+            if self._since is None:
+                self._since, self._in_fault = sample.t, sample.sensor_fault
+            if sample.t - self._since >= STOPPED_FOR and (self._in_fault or
+                                                          not self.after_fault):
                 self.stop = (self._since, self._wrong(sample))
         if len(self._speeds) < (self._speeds.maxlen or 2):
             return None
@@ -65,8 +79,10 @@ class StopAfterFlat:
         """What keeps the standstill at `sample` from being a minimum-risk stop, or None."""
         place = footprint(self.road, sample, self.half_tread)
         shoulder = self.road.cross_section_at(sample.station).shoulder > 0.0
-        if shoulder and place.lane != SHOULDER:
+        if not self.after_fault and shoulder and place.lane != SHOULDER:
             return "stood off the shoulder, which the road has there"
+        if self.after_fault and (place.lane is None or place.lane < 0):
+            return "stood outside a lane of its direction"
         if not shoulder and (place.lane is None or place.lane < 0):
             return "stood outside a lane (the road has no shoulder there)"
         if not sample.hazard_lights:
@@ -84,34 +100,48 @@ class MinimumRiskStop(Criterion):
     for `STOPPED_FOR`) with every tyre on the paved shoulder where the road has one there,
     else wholly inside a lane of its direction, with its hazard lights flashing, and never
     decelerates harder than `MRM_DECEL` on the way (0.2 s average; UN R157's bound for a
-    minimum-risk manoeuvre). Value: the peak deceleration [m/s^2] from the flat to the
-    stop. Not applicable without a flat tyre."""
+    minimum-risk manoeuvre). After a sensor fault (a scenario's fault event running) the ego
+    may drive on (slowed, on the sensors left), but never decelerates harder than
+    `MRM_DECEL` from the fault on, and where it stands still during the fault it stands
+    wholly inside a lane of its direction with its hazard lights flashing. Value: the peak
+    deceleration [m/s^2] from the flat (or the first fault) on. Not applicable without a
+    flat tyre or a sensor fault."""
 
     name, unit = "minimum_risk_stop", "m/s^2"
 
     def __init__(self, road: RoadMap, half_tread: float, rate: float) -> None:
         super().__init__()
         self.watch = StopAfterFlat(road, half_tread, rate)
+        self.fault = StopAfterFlat(road, half_tread, rate, after_fault=True)
 
     def update(self, sample: TruthSample) -> None:
-        stopped = self.watch.stop is not None
-        decel = self.watch.update(sample)
-        if decel is not None and decel > MRM_DECEL:
-            self._fail(sample, f"deceleration {decel:.2f} m/s^2 after the flat tyre, over "
-                               f"{MRM_DECEL:g} m/s^2")
-        stop = self.watch.stop
-        if not stopped and stop is not None and stop[1] is not None:
-            self._fail(sample, f"after the flat tyre it {stop[1]}", at=stop[0])
+        for watch, what in ((self.watch, "the flat tyre"), (self.fault, "the sensor fault")):
+            stopped = watch.stop is not None
+            decel = watch.update(sample)
+            if decel is not None and decel > MRM_DECEL:
+                self._fail(sample, f"deceleration {decel:.2f} m/s^2 after {what}, over "
+                                   f"{MRM_DECEL:g} m/s^2")
+            stop = watch.stop
+            if not stopped and stop is not None and stop[1] is not None:
+                self._fail(sample, f"after {what} it {stop[1]}", at=stop[0])
 
     def result(self) -> CriterionResult:
-        w = self.watch
-        if w.flat_at is None:
+        w, f = self.watch, self.fault
+        if w.flat_at is None and f.flat_at is None:
             return CriterionResult.not_applicable(self.name, MRM_DECEL, self.unit,
-                                                  "no flat tyre")
-        note = ("no standstill after the flat tyre" if w.stop is None
-                else None if w.stop[1] is None else f"it {w.stop[1]}")
-        return CriterionResult(self.name, self.first_failure is None and w.done, w.peak,
-                               MRM_DECEL, self.unit, self.first_failure, note)
+                                                  "no flat tyre, no sensor fault")
+        if w.flat_at is not None:
+            note = ("no standstill after the flat tyre" if w.stop is None
+                    else None if w.stop[1] is None else f"it {w.stop[1]}")
+            passed = w.done
+        else:
+            note = ("it drove on through the sensor fault" if f.stop is None
+                    else "a minimum-risk stop in lane during the sensor fault"
+                    if f.stop[1] is None else f"it {f.stop[1]}")
+            passed = f.stop is None or f.done
+        return CriterionResult(self.name, self.first_failure is None and passed,
+                               max(w.peak, f.peak), MRM_DECEL, self.unit, self.first_failure,
+                               note)
 
 
 class Completes(Criterion):

@@ -402,6 +402,7 @@ class Runner:
             axle_stations=(float(route.stations[1]),
                            float(np.mean(route.stations[4:6]))),
             flat=self._flat_fired(), hazard_lights=w.ego.hazard_lights, fired=self.story.fired,
+            sensor_fault=bool(w.sensor_faults),
             xy=(float(truth.position[0]), float(truth.position[1])),
         ))
         self.infractions += infractions

@@ -12,6 +12,10 @@ instant whose data arrives late is kept until its delivery, to score perception
 `record_every`-th frame of each sensor (its entry in the rates table), by frame type: camera
 images, LiDAR points.
 
+The scenario's sensor faults (`world.sensors.faults`) are applied to every capture, in
+either pipeline, before anything else sees it: the stack, the scoring and the recording get
+the faulty data (the recording shows what the stack was given).
+
 `frame_hook` lets a test (or a fault-injection study) alter the camera frames the stack
 receives, e.g. a blinded camera; the scoring and the recording keep the true frames.
 """
@@ -31,6 +35,7 @@ from perception.messages import Detection
 from world.core.rates import CONTROL_RATE, SensorTiming
 from world.core.stopwatch import Stopwatch
 from world.frames import CameraFrame, Frame, LidarScan, wrap_angle
+from world.sensors.faults import FaultySensing, sensor_delays
 from world.sensors.lidar import LidarTruth
 from world.sensors.pipeline import (
     Capture,
@@ -84,9 +89,12 @@ class SensorLoop:
         self.schedule = SensorSchedule(timings, CONTROL_RATE,
                                        frames_read(timings, stack.reads, recorder is not None))
         self.watch = watch if watch is not None else Stopwatch()
-        self.sensing: Sensing = (ProcessSensing(world, setup, self.watch, worker)
-                                 if mode == "process" and setup is not None and setup.cameras
-                                 else InlineSensing(world, self.watch))
+        pipeline: Sensing = (ProcessSensing(world, setup, self.watch, worker)
+                             if mode == "process" and setup is not None and setup.cameras
+                             else InlineSensing(world, self.watch))
+        self.sensing: Sensing = FaultySensing(
+            pipeline, lambda: world.sensor_faults,
+            sensor_delays(e.event for e in world.spec.events))
         self.mode = mode
         self.recorder = recorder
         self.frame_hook = frame_hook

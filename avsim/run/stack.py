@@ -23,6 +23,7 @@ from control.command import VehicleCommand
 from control.stanley import MAX_STEER, StanleyParams
 from control.vehicle_controller import VehicleController, VehicleControllerParams
 from perception.flat_tyre import FlatTyreDetector
+from perception.health import HealthMonitor
 from perception.lanes import LaneDetector, LaneFilter
 from perception.lights import TrafficLightDetector
 from perception.localization import LaneMatch, Localizer
@@ -128,6 +129,7 @@ class Stack:
         self.lane_filter = LaneFilter()
         self.object_detector = ObjectDetector()
         self.flat_detector = FlatTyreDetector(vehicle)
+        self.health = HealthMonitor()
         self.tracker = MultiObjectTracker()
         self._times: list[float] = []  # [s] of the poses below, increasing
         self._poses: list[EgoState] = []
@@ -157,8 +159,12 @@ class Stack:
         return self.on_sensors(t, tuple(cameras), scan)
 
     def on_gnss(self, fix: GnssFix) -> None:
+        """A fix inconsistent with the odometry's prediction is not fused
+        (`perception.health`)."""
         with self.watch("localisation"):
-            self.localizer.on_gnss(fix)
+            predicted = self.localizer.predicted_fix(fix.t) if fix.valid else None
+            if self.health.fix(fix, predicted).accepted:
+                self.localizer.on_gnss(fix)
 
     def on_odometry(self, odo: Odometry) -> None:
         with self.watch("localisation"):
@@ -176,6 +182,15 @@ class Stack:
             return None
         front = next((f for f in frames if f.info.name == "front"), None)
         watch = self.watch
+        now = self._times[-1] if self._times else t  # [s] the stack's clock: its last tick
+        if scan is not None and self.health.scan(scan, now) is not None:
+            scan = None  # late or empty: nothing to perceive in it
+        if front is not None and self.lane_detector is not None:
+            with watch("perception health"):
+                fault = self.health.camera(front, pose.speed, now)
+            if fault is not None:  # nothing to perceive in it: the lane is found anew after
+                front, self._view = None, None
+                self.lane_filter.reset()
         lane_raw = lane = None
         if front is not None and self.lane_detector is not None:
             prior = self._view.estimate if self._view is not None else None
@@ -230,7 +245,7 @@ class Stack:
             plan = self.planner.update(PlannerInput(
                 ego=ego, lane=self._view, tracks=self._tracks, signs=self._signs,
                 lights=self._lights, pedal=self._pedal,
-                flat_tyre=self.flat_detector.state is not None))
+                flat_tyre=self.flat_detector.state is not None, health=self.health.health(t)))
         self._signs, self._lights = None, ()
         with self.watch("control"):
             command = self.controller.update(plan, dt)

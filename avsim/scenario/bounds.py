@@ -43,6 +43,9 @@ MAX_HEADING_SIGMA = 180.0  # [deg] GNSS heading noise
 MAX_VELOCITY_SIGMA = 50.0  # [m/s] GNSS velocity noise
 MAX_DROPOUT_RATE = 10.0  # [1/s] GNSS outages started per second
 MAX_RANGE_SIGMA = 1.0  # [m] LiDAR range noise
+MAX_FAULT_DURATION = MAX_DURATION  # [s] a sensor fault's duration
+MAX_GNSS_JUMP = 1000.0  # [m] a GNSS jump's offset, per axis
+MAX_SENSOR_DELAY = 1.0  # [s] a sensor delay's added latency (the stack keeps 2 s of poses)
 
 Duration = Annotated[float, Field(gt=0, le=MAX_DURATION)]
 Time = Annotated[float, Field(ge=0, le=MAX_DURATION)]
@@ -71,3 +74,5 @@ HeadingSigma = Annotated[float, Field(ge=0, le=MAX_HEADING_SIGMA)]
 VelocitySigma = Annotated[float, Field(ge=0, le=MAX_VELOCITY_SIGMA)]
 DropoutRate = Annotated[float, Field(ge=0, le=MAX_DROPOUT_RATE)]
 RangeSigma = Annotated[float, Field(ge=0, le=MAX_RANGE_SIGMA)]
+FaultDuration = Annotated[float, Field(gt=0, le=MAX_FAULT_DURATION)]
+SensorDelay = Annotated[float, Field(gt=0, le=MAX_SENSOR_DELAY)]

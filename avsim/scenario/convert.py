@@ -196,9 +196,32 @@ def _event_spec(event: EventModel) -> spec.EventSpec:
             trigger, spec.AcceleratorOverride(pedal=override.pedal, duration=override.duration),
             event.optional,
         )
-    assert event.flat_tire is not None
-    return spec.EventSpec(trigger, spec.FlatTire(wheel=frames.Wheel(event.flat_tire.wheel)),
-                          event.optional)
+    if event.flat_tire is not None:
+        return spec.EventSpec(trigger, spec.FlatTire(wheel=frames.Wheel(event.flat_tire.wheel)),
+                              event.optional)
+    return spec.EventSpec(trigger, _fault_spec(event), event.optional)
+
+
+def _fault_spec(event: EventModel) -> spec.SensorFault:
+    """A sensor fault event's fault."""
+    if event.camera_blackout is not None:
+        return spec.CameraBlackout(event.camera_blackout.camera, event.camera_blackout.duration)
+    if event.camera_freeze is not None:
+        return spec.CameraFreeze(event.camera_freeze.camera, event.camera_freeze.duration)
+    if event.camera_occlusion is not None:
+        occlusion = event.camera_occlusion
+        return spec.CameraOcclusion(occlusion.camera, occlusion.fraction,
+                                    hdmap.Side(occlusion.side), occlusion.duration)
+    if event.sensor_delay is not None:
+        delay = event.sensor_delay
+        return spec.SensorDelay(delay.sensor, delay.delay, delay.duration)
+    if event.lidar_outage is not None:
+        return spec.LidarOutage(event.lidar_outage.duration)
+    if event.gnss_outage is not None:
+        return spec.GnssOutage(event.gnss_outage.duration)
+    assert event.gnss_jump is not None
+    offset = event.gnss_jump.offset
+    return spec.GnssJump((float(offset[0]), float(offset[1])), event.gnss_jump.duration)
 
 
 def _gnss_spec(gnss: GnssModel | None) -> spec.GnssSpec:

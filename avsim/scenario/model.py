@@ -69,7 +69,11 @@ WheelName = Literal["front_left", "front_right", "rear_left", "rear_right"]
 
 TRIGGER_KINDS = ("time", "ego_s", "gap", "after")
 ACTION_KINDS = ("speed", "lane_change", "walk", "stop")
-EVENT_KINDS = ("accelerator_override", "flat_tire")
+FAULT_KINDS = ("camera_blackout", "camera_freeze", "camera_occlusion", "lidar_outage",
+               "gnss_outage", "gnss_jump", "sensor_delay")
+EVENT_KINDS = ("accelerator_override", "flat_tire", *FAULT_KINDS)
+CameraName = Literal["front", "left", "right"]
+DelayedSensor = Literal["front", "left", "right", "lidar"]
 
 Identifier = Annotated[str, Field(pattern=NAME_PATTERN)]
 MAX_GRID_POINTS = 1000  # runs a file's `grid` may ask for
@@ -486,9 +490,57 @@ class FlatTireModel(FormatModel):
     )
 
 
+class CameraFaultModel(FormatModel):
+    """A camera's fault for `duration` seconds (a camera the profile lacks: nothing happens)."""
+
+    camera: CameraName = Field(description="front | left | right; required.")
+    duration: b.FaultDuration = Field(description="[s] how long, > 0; required.")
+
+
+class CameraOcclusionModel(FormatModel):
+    """An opaque dark strip over `fraction` of a camera's image width, from `side`, for
+    `duration` seconds (a camera the profile lacks: nothing happens)."""
+
+    camera: CameraName = Field(description="front | left | right; required.")
+    fraction: Annotated[float, Field(gt=0, le=1)] = Field(
+        default=0.5, description="[-] of the image's width covered, > 0, <= 1. Default 0.5.")
+    side: SideName = Field(default="left", description="left | right, as the car looks. "
+                           "Default left.")
+    duration: b.FaultDuration = Field(description="[s] how long, > 0; required.")
+
+
+class SensorDelayModel(FormatModel):
+    """A sensor's data arrive `delay` seconds later than its latency, for `duration` seconds
+    (a camera the profile lacks: nothing happens)."""
+
+    sensor: DelayedSensor = Field(description="front | left | right | lidar; required.")
+    delay: b.SensorDelay = Field(description="[s] added to its latency, > 0, <= 1; required.")
+    duration: b.FaultDuration = Field(description="[s] how long, > 0; required.")
+
+
+class OutageModel(FormatModel):
+    """A sensor sends nothing usable for `duration` seconds."""
+
+    duration: b.FaultDuration = Field(description="[s] how long, > 0; required.")
+
+
+class GnssJumpModel(FormatModel):
+    """The GNSS fixes jump by `offset` for `duration` seconds."""
+
+    offset: Annotated[
+        tuple[Annotated[float, Field(strict=True, ge=-b.MAX_GNSS_JUMP, le=b.MAX_GNSS_JUMP)],
+              Annotated[float, Field(strict=True, ge=-b.MAX_GNSS_JUMP, le=b.MAX_GNSS_JUMP)]],
+        Field(strict=False),
+    ] = Field(description="[m] (x, y) added to every fix, map frame, each within +-1000; "
+              "required.")
+    duration: b.FaultDuration = Field(description="[s] how long, > 0; required.")
+
+
 class EventModel(FormatModel):
     """Something that happens to the ego car: a `trigger` (not `gap`: there is no actor)
-    and exactly one event key, `accelerator_override` or `flat_tire`."""
+    and exactly one event key: `accelerator_override`, `flat_tire`, or a sensor fault
+    (`camera_blackout`, `camera_freeze`, `camera_occlusion`, `lidar_outage`, `gnss_outage`,
+    `gnss_jump`, `sensor_delay`)."""
 
     model_config = ConfigDict(json_schema_extra=_one_of(EVENT_KINDS))
 
@@ -497,6 +549,21 @@ class EventModel(FormatModel):
         default=None, description="Hold the accelerator: `{pedal, duration}`."
     )
     flat_tire: FlatTireModel | None = Field(default=None, description="A flat tyre: `{wheel}`.")
+    camera_blackout: CameraFaultModel | None = Field(
+        default=None, description="A camera's images go black: `{camera, duration}`.")
+    camera_freeze: CameraFaultModel | None = Field(
+        default=None, description="A camera repeats its last image: `{camera, duration}`.")
+    camera_occlusion: CameraOcclusionModel | None = Field(
+        default=None, description="A dark strip covers part of a camera's image: "
+        "`{camera, fraction, side, duration}`.")
+    lidar_outage: OutageModel | None = Field(
+        default=None, description="The LiDAR sends no scan: `{duration}`.")
+    gnss_outage: OutageModel | None = Field(
+        default=None, description="The GNSS receiver has no fix: `{duration}`.")
+    gnss_jump: GnssJumpModel | None = Field(
+        default=None, description="The GNSS fixes jump by an offset: `{offset, duration}`.")
+    sensor_delay: SensorDelayModel | None = Field(
+        default=None, description="A sensor's data arrive late: `{sensor, delay, duration}`.")
     optional: StrictBool = Field(
         default=False, description="true: the run may end without it having fired; else it "
         "must fire before the run ends early, and one that never fires fails `story`. "
@@ -763,8 +830,8 @@ class ScenarioModel(FormatModel):
     )
     events: list[EventModel] = Field(
         default_factory=list, max_length=b.MAX_EVENTS,
-        description="What happens to the ego car. Default none. `flat_tire` is not supported "
-        "yet.",
+        description="What happens to the ego car: an accelerator override, a flat tyre, "
+        "sensor faults. Default none.",
     )
     criteria: CriteriaModel = Field(
         default_factory=CriteriaModel,

@@ -15,16 +15,18 @@ and the first that holds is taken:
 2. junction -> acquiring: past the junction, no good estimate yet
 3. acquiring, camera, one_line, map_hold, stop_in_lane -> junction: near a town junction (no
    lines inside; the map's turn path)
-4. camera -> one_line: confidence < `lose`, a line still seen, the last measurement younger
+4. acquiring, camera, one_line -> map_hold: the camera's frames are faulty
+   (`perception.health`)
+5. camera -> one_line: confidence < `lose`, a line still seen, the last measurement younger
    than `dead_reckon_time`
-5. camera -> map_hold: confidence < `lose` (hysteresis: `lose` < `acquire`)
-6. camera, one_line -> acquiring: the camera's lane is not the lane kept
-7. one_line -> camera: confidence >= `acquire` of the lane kept
-8. one_line -> map_hold: the lane not measured for `dead_reckon_time`
-9. acquiring, map_hold, stop_in_lane -> camera: confidence >= `acquire` (a good lane
-   estimate) of the lane kept
-10. acquiring -> map_hold: no good estimate of the lane kept for `acquire_time`
-11. map_hold -> stop_in_lane: lost for `stop_after` seconds
+6. camera -> map_hold: confidence < `lose` (hysteresis: `lose` < `acquire`)
+7. camera, one_line -> acquiring: the camera's lane is not the lane kept
+8. one_line -> camera: confidence >= `acquire` of the lane kept
+9. one_line -> map_hold: the lane not measured for `dead_reckon_time`
+10. acquiring, map_hold, stop_in_lane -> camera: confidence >= `acquire` (a good lane
+    estimate) of the lane kept
+11. acquiring -> map_hold: no good estimate of the lane kept for `acquire_time`
+12. map_hold -> stop_in_lane: lost for `stop_after` seconds
 
 What each state follows (`planner.planner`): MAP is the state of a stack built without a
 camera (GNSS + odometry on the HD map only); no row leaves it. ACQUIRING follows the map
@@ -37,11 +39,16 @@ the car, worn paint, a dashed line's one dash in view): the lane is the seen lin
 lane's width (the HD map's, `perception.lanes.LaneDetector.detect`), and between
 measurements the filter dead-reckons its last fitted lane on odometry, for at most
 `dead_reckon_time`. A camera that sees no line at all (black frames) goes from CAMERA
-straight to MAP_HOLD. MAP_HOLD follows the map lane placed by the localisation estimate
-(odometry, GNSS and the camera's lane as long as it was seen) and slows to `hold_speed`;
-STOP_IN_LANE brings the car to a stop in its lane. JUNCTION follows the map's path through
-a town junction at the planned speed: the painted lines end at the junction's mouth, and
-the path turns where none are painted. Every change carries a reason for the log.
+straight to MAP_HOLD. So does a camera whose frames the sensor-health monitor finds faulty
+(`perception.health`: a blank, frozen or missing frame, which is then not perceived), and no
+lane is taken from it (`acquire` needs a camera without a fault) until its frames are sound
+again; the change's reason says how the fault was noticed. MAP_HOLD follows the map lane
+placed by the localisation estimate (odometry, GNSS and the camera's lane as long as it was
+seen) and slows to `hold_speed`; STOP_IN_LANE brings the car to a stop in its lane (with the
+hazard lights on, `planner.fsm.hazard`), until the lane is found again. JUNCTION follows
+the map's path through a town junction at the planned speed: the painted lines end at the
+junction's mouth, and the path turns where none are painted. Every change carries a reason
+for the log.
 """
 
 from __future__ import annotations
@@ -84,10 +91,16 @@ class LaneSourceInput:
     other_lane: bool = False  # the camera's lane is not the lane kept (module doc)
     lines: int = 0  # [-] boundaries the latest frame saw (0, 1, 2)
     age: float = math.inf  # [s] since the lane was last measured (dead-reckoned since)
+    camera_fault: str | None = None  # how a fault of the camera was noticed in its frames
+    #   (`perception.health`: blank, frozen, missing); None while it is fine
 
 
 def _good(x: LaneSourceInput, p: LaneSourceParams) -> bool:
-    return x.confidence >= p.acquire
+    return x.confidence >= p.acquire and x.camera_fault is None
+
+
+def _camera_fault(_s: LaneSource, x: LaneSourceInput, _p: LaneSourceParams) -> bool:
+    return x.camera_fault is not None
 
 
 def _past_found(_s: LaneSource, x: LaneSourceInput, p: LaneSourceParams) -> bool:
@@ -142,6 +155,9 @@ TABLE: Table[LaneSource, LaneSourceInput, LaneSourceParams] = Table(LaneSource, 
     Row(_SEEKING | {L.CAMERA, L.ONE_LINE}, L.JUNCTION, _at_junction,
         "near a town junction (no lines inside; the map's turn path)",
         "at a junction: the map's path"),
+    Row(frozenset({L.ACQUIRING, L.CAMERA, L.ONE_LINE}), L.MAP_HOLD, _camera_fault,
+        "the camera's frames are faulty (`perception.health`)",
+        lambda x, p: f"{x.camera_fault}: holding on the map"),
     Row(frozenset({L.CAMERA}), L.ONE_LINE, _one_line,
         "confidence < `lose`, a line still seen, the last measurement younger than "
         "`dead_reckon_time`",

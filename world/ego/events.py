@@ -21,6 +21,12 @@ over, or when a later override replaces it). `gap` needs an actor: the loader re
 events, and so does this class. Each event fires once, at the first check where its trigger
 holds.
 
+A sensor fault (`camera_blackout`, `camera_freeze`, `lidar_outage`, `gnss_outage`,
+`gnss_jump`: `world.spec.SensorFault`) runs from the check it fires at for its `duration`,
+alongside any other event (faults do not replace each other); the sensing pipeline applies
+the faults running at each capture's instant to the data it hands the stack
+(`world.sensors.faults`). Nothing tells the stack: it must notice from its data.
+
 Pure (no PyBullet) and deterministic: the state is a function of the checks' (t, ego_s).
 """
 
@@ -30,7 +36,15 @@ import math
 
 from world.actors.behaviour import TriggerContext, trigger_holds
 from world.frames import Wheel
-from world.spec import AcceleratorOverride, AfterTrigger, EventSpec, FlatTire, GapTrigger
+from world.spec import (
+    SENSOR_FAULTS,
+    AcceleratorOverride,
+    AfterTrigger,
+    EventSpec,
+    FlatTire,
+    GapTrigger,
+    SensorFault,
+)
 
 RELEASE_TOLERANCE = 1e-9  # [s] so that fired + duration summed in floats lands on its check
 
@@ -45,7 +59,7 @@ class EgoEvents:
                 raise ValueError(f"{key}.trigger.gap: only for actors (the gap to the ego)")
             if isinstance(event.trigger, AfterTrigger) and not 0 <= event.trigger.index < i:
                 raise ValueError(f"{key}.trigger.after: must refer to an earlier event")
-            if not isinstance(event.event, AcceleratorOverride | FlatTire):
+            if not isinstance(event.event, (AcceleratorOverride, FlatTire, *SENSOR_FAULTS)):
                 raise ValueError(f"{key}: {type(event.event).__name__} is not simulated yet")
         self.events = events
         self._fired_at: list[float | None] = [None] * len(events)  # [s]
@@ -53,6 +67,7 @@ class EgoEvents:
         self._override: int | None = None  # the override holding the pedal now
         self._started: tuple[int, ...] = ()
         self._flats: list[Wheel] = []  # punctured tyres, in the order they fired
+        self._faults: list[int] = []  # the sensor faults running now, in the order they fired
 
     def update(self, t: float, ego_s: float) -> tuple[int, ...]:
         """One check at sim time `t` [s], the ego's centre at station `ego_s` [m].
@@ -69,6 +84,7 @@ class EgoEvents:
             if t >= fired + override.duration - RELEASE_TOLERANCE:
                 self._ended_at[running] = t
                 self._override = None
+        self._end_faults(t)
         ctx = TriggerContext(t=t, ego_s=ego_s, gap=math.inf)  # no actor: no gap
         started = []
         for i, event in enumerate(self.events):
@@ -79,11 +95,36 @@ class EgoEvents:
                     self._ended_at[i] = t
                     self._flats.append(event.event.wheel)
                     continue
+                if isinstance(event.event, SENSOR_FAULTS):  # runs beside everything else
+                    self._faults.append(i)
+                    continue
                 if self._override is not None:  # replaced, as a running NPC action is
                     self._ended_at[self._override] = t
                 self._override = i
         self._started = tuple(started)
         return self._started
+
+    def _end_faults(self, t: float) -> None:
+        """End the running sensor faults whose duration is over at `t` [s]."""
+        running = []
+        for i in self._faults:
+            fired = self._fired_at[i]
+            assert fired is not None
+            if t >= fired + self._fault(i).duration - RELEASE_TOLERANCE:
+                self._ended_at[i] = t
+            else:
+                running.append(i)
+        self._faults = running
+
+    def _fault(self, index: int) -> SensorFault:
+        event = self.events[index].event
+        assert isinstance(event, SENSOR_FAULTS)
+        return event
+
+    @property
+    def faults(self) -> tuple[SensorFault, ...]:
+        """The sensor faults running now, in the order they fired."""
+        return tuple(self._fault(i) for i in self._faults)
 
     def _accelerator(self, index: int) -> AcceleratorOverride:
         event = self.events[index].event
@@ -103,7 +144,7 @@ class EgoEvents:
     @property
     def ended_at(self) -> tuple[float | None, ...]:
         """[s] per event: when it ended (an override: the pedal released; a flat tyre: as it
-        fired), None while not."""
+        fired; a sensor fault: its duration over), None while not."""
         return tuple(self._ended_at)
 
     @property

@@ -215,6 +215,12 @@ BAD: dict[str, tuple[str, str]] = {
     "grid_too_big": ("grid", "1089 points: at most 1000"),
     "grid_varies_grid": ("grid", "'grid.x': a grid cannot vary this key"),
     "grid_empty_values": ("grid.ego.speed_kph", "must have at least 1 item(s), got 0"),
+    "fault_unknown_camera": ("events.0.camera_blackout.camera",
+                             "must be one of front, left, right, got 'rear'"),
+    "fault_zero_duration": ("events.0.lidar_outage.duration", "must be > 0, got 0"),
+    "fault_jump_too_far": ("events.0.gnss_jump.offset.0", "must be <= 1000, got 5000"),
+    "fault_delay_too_long": ("events.0.sensor_delay.delay", "must be <= 1, got 5"),
+    "fault_occlusion_fraction": ("events.0.camera_occlusion.fraction", "must be <= 1, got 1.5"),
 }
 
 

@@ -73,6 +73,21 @@ ONE_LINE_TABLE = [
 ]
 
 
+# (state, confidence, how a camera fault was noticed) -> next state: a faulty camera's lane
+# is not kept, nor taken back, until its frames are sound
+FAULT = "camera frame carries no information (grey spread 0.0 < 2)"
+CAMERA_FAULT_TABLE = [
+    (S.CAMERA, 0.9, FAULT, S.MAP_HOLD),
+    (S.ONE_LINE, 0.2, FAULT, S.MAP_HOLD),
+    (S.ACQUIRING, 0.9, FAULT, S.MAP_HOLD),
+    (S.MAP_HOLD, 0.9, FAULT, None),  # a stale good estimate: not taken back
+    (S.STOP_IN_LANE, 0.9, FAULT, None),
+    (S.JUNCTION, 0.9, FAULT, S.ACQUIRING),  # past the junction: looking, not on the camera
+    (S.MAP, 0.9, FAULT, None),
+    (S.MAP_HOLD, 0.9, None, S.CAMERA),  # sound again: the lane is found
+]
+
+
 # (state, confidence, near a junction) -> next state
 JUNCTION_TABLE = [
     (S.CAMERA, 0.9, True, S.JUNCTION),
@@ -120,6 +135,15 @@ def test_other_lane_table(state: LaneSource, confidence: float, other: bool,
     assert (change.to if change else None) is expected
 
 
+@pytest.mark.parametrize(("state", "confidence", "fault", "expected"), CAMERA_FAULT_TABLE)
+def test_camera_fault_table(state: LaneSource, confidence: float, fault: str | None,
+                            expected: LaneSource | None) -> None:
+    change = transition(state, LaneSourceInput(100.0, confidence, 99.5, camera_fault=fault), P)
+    assert (change.to if change else None) is expected
+    if change is not None and expected is S.MAP_HOLD:
+        assert change.reason == f"{FAULT}: holding on the map"
+
+
 def test_every_state_and_edge_of_the_table_is_covered() -> None:
     edges = {(row[0], row[4]) for row in TABLE_CASES if row[4] is not None}
     edges |= {(row[0], row[3]) for row in JUNCTION_TABLE if row[3] is not None}
@@ -146,6 +170,8 @@ def test_the_cases_walk_every_row_of_the_data() -> None:
               for state, confidence, other, expected in OTHER_LANE_TABLE]
     cases += [(state, LaneSourceInput(100.0, confidence, 99.5, lines=lines, age=age), expected)
               for state, confidence, lines, age, expected in ONE_LINE_TABLE]
+    cases += [(state, LaneSourceInput(100.0, confidence, 99.5, camera_fault=fault), expected)
+              for state, confidence, fault, expected in CAMERA_FAULT_TABLE]
     assert unwalked_rows(TABLE, cases, lambda _: P) == []
 
 

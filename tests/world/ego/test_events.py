@@ -22,9 +22,12 @@ from world.ego.events import EgoEvents
 from world.spec import (
     AcceleratorOverride,
     AfterTrigger,
+    CameraBlackout,
     EgoStationTrigger,
     EventSpec,
     GapTrigger,
+    GnssJump,
+    LidarOutage,
     TimeTrigger,
     Trigger,
     WorldSpec,
@@ -135,6 +138,28 @@ def test_a_later_override_replaces_a_running_one_which_ends() -> None:
     got = pedals(events, times)
     assert got == [0.5 if t < 1.0 else 1.0 if t < 2.0 else 0.0 for t in times]
     assert events.ended_at == (1.0, 2.0)  # the first one does not come back
+
+
+def test_sensor_faults_run_for_their_duration_beside_an_override() -> None:
+    events = EgoEvents((
+        EventSpec(TimeTrigger(0.5), CameraBlackout("front", 1.0)),
+        EventSpec(TimeTrigger(1.0), LidarOutage(0.5)),
+        override(TimeTrigger(1.0), 0.4, 2.0),
+        EventSpec(AfterTrigger(1, 0.0), GnssJump((5.0, 0.0), 0.25)),
+    ))
+    running = {}
+    for t in check_times(3.0):
+        events.update(t, 0.0)
+        running[t] = events.faults
+    assert running[0.475] == ()
+    assert running[0.5] == (CameraBlackout("front", 1.0),)
+    assert running[1.0] == (CameraBlackout("front", 1.0), LidarOutage(0.5))
+    assert events.pedal == 0.0  # released at 3.0
+    assert running[1.475] == (CameraBlackout("front", 1.0), LidarOutage(0.5))
+    assert running[1.5] == (GnssJump((5.0, 0.0), 0.25),)  # after the outage ended
+    assert running[1.75] == ()
+    assert events.fired_at == (0.5, 1.0, 1.0, 1.5)
+    assert events.ended_at == (1.5, 1.5, 3.0, 1.75)
 
 
 @pytest.mark.parametrize(

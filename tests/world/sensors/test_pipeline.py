@@ -14,30 +14,41 @@ import pytest
 from avsim.scenario.load import load_scenario
 from world.core.rates import CONTROL_RATE, FRAME_LATENCY, PHYSICS_RATE
 from world.frames import CameraFrame, GnssFix, LidarScan, Odometry
+from world.sensors.faults import FaultySensing
 from world.sensors.frame_slots import SLOTS, shared_dir
 from world.sensors.lidar import LidarTruth
 from world.sensors.pipeline import (
     Capture,
     InlineSensing,
     ProcessSensing,
+    Sensing,
     SensingError,
     SensingWorker,
     render_threads,
 )
 from world.sensors.schedule import SensorSchedule
 from world.sensors.setup import Profile, sensor_setup, sensor_timings
+from world.spec import EventSpec
 from world.world import World
 
 LATE = round(FRAME_LATENCY * PHYSICS_RATE)  # [steps]
 
 
-def drive(mode: str, seconds: float = 2.0) -> list[tuple[int, Capture]]:
+def drive(mode: str, seconds: float = 2.0,
+          events: tuple[EventSpec, ...] | None = None) -> list[tuple[int, Capture]]:
     """(delivery step, capture) of a car accelerating on normal_driving for `seconds`, the
-    pipeline asked at every control tick as the sensor loop asks it."""
+    pipeline asked at every control tick as the sensor loop asks it; with `events` (sensor
+    faults), those are the scenario's events and the pipeline applies them
+    (`world.sensors.faults.FaultySensing`, as the sensor loop does)."""
     spec = load_scenario("normal_driving").world
+    if events is not None:
+        spec = replace(spec, events=events)
     setup = sensor_setup(Profile.DEFAULT)
     world = World(spec, setup, cameras=mode == "inline")
-    sensing = InlineSensing(world) if mode == "inline" else ProcessSensing(world, setup)
+    sensing: Sensing = InlineSensing(world) if mode == "inline" \
+        else ProcessSensing(world, setup)
+    if events is not None:
+        sensing = FaultySensing(sensing, lambda: world.sensor_faults)
     schedule = SensorSchedule(sensor_timings(setup), CONTROL_RATE)
     out = []
     try:
