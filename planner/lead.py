@@ -21,7 +21,11 @@ little off far ahead, does not make the car brake and release:
 - a vehicle enters the lane within ``half_width`` of its centre line and must stay there
   for ``confirm`` before it can become the lead (a new track or one that swerved in),
   unless it is urgent: closing with a time to collision under ``urgent_ttc`` (a cut-in
-  close ahead is taken at once);
+  close ahead is taken at once), or closing so fast for its gap that waiting out the
+  confirmation would cost the comfortable stop that is left now (`costly_wait`: the least
+  deceleration that stops the closing, `planner.acc_control.need`, is within a_comf_max at
+  the gap now and beyond it at the gap the wait leaves; a stopped car first found 60 m
+  ahead at 60 km/h: the wait is 5 m of a room the stop needs all of);
 - the lead stays the lead while it is within ``keep_width`` (hysteresis: a lead swerving
   within its lane, or seen through a curve, is not dropped and taken again);
 - the lead is the nearest of the vehicles that qualify.
@@ -39,6 +43,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from perception.messages import ObjectClass, Track
+from planner.acc_control import AccControlParams, comfortable, need
 from planner.messages import Lead
 from world.hdmap import Lane
 
@@ -136,11 +141,25 @@ def route_lead(tracks: Sequence[Track], lane: Lane, station: float, p: LeadParam
                      if abs(c.lateral) <= p.half_width])
 
 
+def costly_wait(v: float, lead: Lead, age: float, wait: float,
+                acc: AccControlParams) -> bool:
+    """Whether waiting `wait` [s] before taking `lead` (its track `age` [s] old) as the
+    lead, the ego at `v` [m/s], would cost the comfortable stop left now (module doc;
+    `need` from no braking yet)."""
+    closing = v - lead.speed
+    if closing <= 0.0:
+        return False
+    now = lead.gap - closing * age  # [m] the gap carried to now
+    return (comfortable(need(v, lead.speed, now, acc), acc)
+            and not comfortable(need(v, lead.speed, now - closing * wait, acc), acc))
+
+
 class LeadSelector:
     """The lead over time: confirmation and hysteresis (module doc)."""
 
-    def __init__(self, p: LeadParams) -> None:
+    def __init__(self, p: LeadParams, acc: AccControlParams | None = None) -> None:
         self.p = p
+        self.acc = acc if acc is not None else AccControlParams()  # `costly_wait`'s laws
         self.lead_id: int | None = None  # the lead's track id
         self._since: dict[int, float] = {}  # [s] track id -> when it entered the lane
 
@@ -166,10 +185,12 @@ class LeadSelector:
             return True
         if i not in self._since:
             return False
-        if t - self._since[i] >= p.confirm - 1e-9:
+        waited = t - self._since[i]
+        if waited >= p.confirm - 1e-9:
             return True
         closing = ego_speed - c.lead.speed
-        return closing > 0.0 and c.lead.gap < p.urgent_ttc * closing
+        return closing > 0.0 and (c.lead.gap < p.urgent_ttc * closing or costly_wait(
+            ego_speed, c.lead, max(t - c.lead.t, 0.0), p.confirm - waited, self.acc))
 
 
 class LeadAccel:

@@ -138,7 +138,7 @@ class Planner:
         self.motion = MotionLayer(self.road, p.lane, p.acc.modes, p.vehicle, p.motion)
         self.control = ControlLayer()
         self.lead_accel = LeadAccel()
-        self.leads = LeadSelector(self.params.lead)
+        self.leads = LeadSelector(self.params.lead, self.params.acc.control)
         self.driver = DriverOverride(p.override)
         self.events = EventMonitor(self.road, p.vehicle, p.events)
         self.junctions = JunctionMonitor(self.road, p.vehicle, p.junctions)

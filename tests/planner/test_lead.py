@@ -10,7 +10,15 @@ from dataclasses import replace
 import pytest
 
 from perception.messages import ObjectClass, Track
-from planner.lead import Candidate, LeadParams, LeadSelector, crossing_lateral, lane_candidates
+from planner.acc_control import AccControlParams
+from planner.lead import (
+    Candidate,
+    LeadParams,
+    LeadSelector,
+    costly_wait,
+    crossing_lateral,
+    lane_candidates,
+)
 from planner.messages import Lead
 
 P = LeadParams()  # half_width 1.6 m, keep_width 2.0 m, confirm 0.3 s, urgent_ttc 2.5 s
@@ -55,6 +63,34 @@ def test_an_urgent_cut_in_is_the_lead_at_once(gap: float, lead_speed: float,
     ids = run([[car(3, gap, 0.5, lead_speed)]] * 8, ego_speed=20.0)
     assert (ids[0] == 3) is urgent
     assert ids[-1] == 3
+
+
+V60 = 60.0 / 3.6  # [m/s]
+
+
+@pytest.mark.parametrize(("gap", "lead_speed", "at_once"), [
+    # a stopped car first found ahead at 60 km/h; need = the least deceleration that stops
+    # the closing (ramp-in included), now -> after the 0.3 s wait (`costly_wait`)
+    (64.0, 0.0, True),  # 2.83 -> 3.16 m/s^2: the wait would cost the comfortable stop
+    (62.0, 0.0, True),  # 2.96 -> 3.31
+    (67.0, 0.0, False),  # 2.67 -> 2.96: still within a_comf_max (3.0) after it
+    (80.0, 0.0, False),  # 2.14 -> 2.32: the wait costs nothing, confirmed first
+    (50.0, 0.0, False),  # 3.97 -> 4.63: no comfortable stop left to keep; ttc 3.0 s
+    (64.0, 14.0, False),  # a slower car: closing at 2.7 m/s, 0.06 m/s^2, no hurry
+])
+def test_a_stopped_car_found_far_ahead_is_the_lead_at_once_when_waiting_costs_the_comfortable_stop(
+        gap: float, lead_speed: float, at_once: bool) -> None:
+    ids = run([[car(4, gap, 0.2, lead_speed)]] * 8, ego_speed=V60)
+    assert (ids[0] == 4) is at_once
+    assert ids[-1] == 4
+
+
+def test_a_costly_wait_reads_the_gap_the_track_has_now() -> None:
+    """A track 0.1 s old (one LiDAR period): its gap is 1.7 m shorter now at 60 km/h."""
+    fresh, late = Lead(4, 0.0, 67.0, 0.0), Lead(4, -0.1, 67.0, 0.0)
+    acc = AccControlParams()
+    assert not costly_wait(V60, fresh, 0.0, 0.3, acc)
+    assert costly_wait(V60, late, 0.1, 0.3, acc)
 
 
 def test_the_lead_is_held_within_the_keep_band_and_dropped_beyond_it() -> None:
