@@ -5,6 +5,7 @@ nearest qualified vehicle wins. Table tests on `Candidate`s (gaps and offsets gi
 from __future__ import annotations
 
 import itertools
+import math
 from dataclasses import replace
 
 import pytest
@@ -17,6 +18,7 @@ from planner.lead import (
     LeadSelector,
     costly_wait,
     crossing_lateral,
+    far_centre,
     lane_candidates,
 )
 from planner.messages import Lead
@@ -156,3 +158,27 @@ def test_a_walker_heading_into_the_lane_is_in_it_and_one_on_the_pavement_is_not(
     assert crossing.lateral == pytest.approx(0.0) and strolling.lateral == pytest.approx(-4.2)
     car = replace(walker(-4.2, 1.4), cls=ObjectClass.CAR)  # a car's drift is no crossing
     assert lane_candidates([car], lambda x: 0.0, 0.0, 2.4)[0].lateral == pytest.approx(-4.2)
+
+
+# ---- the lane centre beyond the camera's reach ------------------------------------------
+
+
+def test_beyond_the_camera_the_lane_bends_as_the_map_says_not_as_the_paint_fit_guessed() -> None:
+    """A straight road, the camera's fit with a spurious 7e-4 1/m (issue K: 1.4 m at 65 m):
+    beyond its 30 m reach the centre runs on along the car's heading to the lane; on a
+    200 m radius the map's bend is kept. Up to the reach it is the camera's."""
+    heading_error, kappa = 0.007, 7e-4
+
+    def camera(x: float) -> float:
+        return -0.05 - math.tan(heading_error) * x + 0.5 * kappa * x * x
+
+    straight = far_centre(camera, heading_error, 30.0, lambda x: 0.0)
+    assert straight(20.0) == camera(20.0) and straight(30.0) == pytest.approx(camera(30.0))
+    assert straight(65.0) == pytest.approx(camera(30.0) - math.tan(heading_error) * 35.0)
+    assert abs(straight(65.0)) < 0.3 and camera(65.0) > 0.9  # the fit: 1 m off
+
+    def arc(x: float) -> float:  # a left curve of 200 m radius
+        return 200.0 - math.sqrt(200.0**2 - x * x)
+
+    bent = far_centre(camera, heading_error, 30.0, arc)
+    assert bent(65.0) - straight(65.0) == pytest.approx(arc(65.0) - arc(30.0))
