@@ -116,7 +116,10 @@ class SizePrior:
 class DetectorParams:
     """Thresholds of the detector, by step of the module docstring."""
 
-    roi_x: float = 60.0  # [m] keep |x| <= roi_x (vehicle frame)
+    roi_x: float = 100.0  # [m] keep |x| <= roi_x (vehicle frame): the LiDAR's range, so
+    #   that a car ahead is found as far as a ring still crosses it above min_top (a
+    #   VLP-16-like sensor on the roof: its -1 deg ring, the lowest that still clears the
+    #   ground that far, meets a car's rear under min_top beyond about 72 m)
     roi_y: float = 60.0  # [m] keep |y| <= roi_y
     roi_height: float = 8.0  # [m] drop points higher than this above the ground (well above
     #   max_height: a wall stays whole, too tall to be an object)

@@ -84,7 +84,8 @@ class TrackerParams:
     confirm_hits: int = 3  # [-] M: matched scans needed for confirmation ...
     confirm_window: int = 5  # [-] N: ... within the track's first N scans
     max_coast: float = 0.5  # [s] a track unmatched for longer is deleted
-    max_distance: float = 80.0  # [m] a track farther from the ego is deleted
+    max_distance: float = 100.0  # [m] a track farther from the ego is deleted (the LiDAR's
+    #   range: a car found far ahead is tracked from its first detection)
     size_alpha: float = 0.3  # [-] smoothing weight of a new box size / heading
     heading_min_speed: float = 1.0  # [m/s] faster tracks take the yaw closer to the velocity
 

@@ -5,11 +5,14 @@ with its gap, speed and lateral offset from the lane's centre line.
 
 - `lane_candidates`: in the vehicle frame of the track's time (x forward, y left), the
   offset from the ego lane's centre line (the camera's lane when it is the path, else
-  straight ahead); the gap [m] is bumper to bumper along the ego's heading, the speed [m/s]
-  the track's over ground along the ego's heading (>= 0), both at the track's time; a
-  pedestrian's offset is the one nearest the centre line on its way until the car reaches
-  it (at the closing speed, at most ``CROSSING_HORIZON`` ahead; `crossing_lateral`): a
-  walker crossing the road is in the car's path before it steps into the lane;
+  straight ahead; beyond the camera's reach, `far_centre`: the camera's lane continued along
+  the car's heading to it and bent as the map's lane bends: the camera's curvature, fitted
+  on 30 m of paint, was 7e-4 1/m on a straight road in issue K: 1.4 m at 65 m); the gap [m]
+  is bumper to bumper along the ego's heading, the speed [m/s] the track's over ground along
+  the ego's heading (>= 0), both at the track's time; a pedestrian's offset is the one
+  nearest the centre line on its way until the car reaches it (at the closing speed, at most
+  ``CROSSING_HORIZON`` ahead; `crossing_lateral`): a walker crossing the road is in the
+  car's path before it steps into the lane;
 - `route_candidates`, through a town junction, where the lane is the map's turn path: the
   tracks (map frame) up to ``path_reach`` ahead along the map lane kept; the gap is along the
   lane, the speed along the lane's heading where the track is.
@@ -21,7 +24,11 @@ little off far ahead, does not make the car brake and release:
 - a vehicle enters the lane within ``half_width`` of its centre line and must stay there
   for ``confirm`` before it can become the lead (a new track or one that swerved in),
   unless it is urgent: closing with a time to collision under ``urgent_ttc`` (a cut-in
-  close ahead is taken at once);
+  close ahead is taken at once), or closing so fast for its gap that waiting out the
+  confirmation would cost the comfortable stop that is left now (`costly_wait`: the least
+  deceleration that stops the closing, `planner.acc_control.need`, is within a_comf_max at
+  the gap now and beyond it at the gap the wait leaves; a stopped car first found 60 m
+  ahead at 60 km/h: the wait is 5 m of a room the stop needs all of);
 - the lead stays the lead while it is within ``keep_width`` (hysteresis: a lead swerving
   within its lane, or seen through a curve, is not dropped and taken again);
 - the lead is the nearest of the vehicles that qualify.
@@ -39,6 +46,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from perception.messages import ObjectClass, Track
+from planner.acc_control import AccControlParams, comfortable, need
 from planner.messages import Lead
 from world.hdmap import Lane
 
@@ -61,6 +69,22 @@ class Candidate:
 
     lead: Lead
     lateral: float  # [m] its centre's offset from the lane's centre line, left +
+
+
+def far_centre(centre_y: Callable[[float], float], heading_error: float, reach: float,
+               bend: Callable[[float], float]) -> Callable[[float], float]:
+    """x [m] ahead -> the lane centre's lateral position [m] (vehicle frame, left +): the
+    camera's `centre_y` up to `reach` [m]; beyond, its value there continued along the car's
+    `heading_error` [rad] to the lane, plus how the map's lane bends from there (`bend(x)`
+    [m]: the map lane centre's offset from its tangent at the car, x ahead)."""
+    near, tan = centre_y(reach), math.tan(heading_error)
+
+    def centre(x: float) -> float:
+        if x <= reach:
+            return centre_y(x)
+        return near - tan * (x - reach) + bend(x) - bend(reach)
+
+    return centre
 
 
 def crossing_lateral(lateral: float, lateral_speed: float, gap: float,
@@ -136,11 +160,25 @@ def route_lead(tracks: Sequence[Track], lane: Lane, station: float, p: LeadParam
                      if abs(c.lateral) <= p.half_width])
 
 
+def costly_wait(v: float, lead: Lead, age: float, wait: float,
+                acc: AccControlParams) -> bool:
+    """Whether waiting `wait` [s] before taking `lead` (its track `age` [s] old) as the
+    lead, the ego at `v` [m/s], would cost the comfortable stop left now (module doc;
+    `need` from no braking yet)."""
+    closing = v - lead.speed
+    if closing <= 0.0:
+        return False
+    now = lead.gap - closing * age  # [m] the gap carried to now
+    return (comfortable(need(v, lead.speed, now, acc), acc)
+            and not comfortable(need(v, lead.speed, now - closing * wait, acc), acc))
+
+
 class LeadSelector:
     """The lead over time: confirmation and hysteresis (module doc)."""
 
-    def __init__(self, p: LeadParams) -> None:
+    def __init__(self, p: LeadParams, acc: AccControlParams | None = None) -> None:
         self.p = p
+        self.acc = acc if acc is not None else AccControlParams()  # `costly_wait`'s laws
         self.lead_id: int | None = None  # the lead's track id
         self._since: dict[int, float] = {}  # [s] track id -> when it entered the lane
 
@@ -166,10 +204,12 @@ class LeadSelector:
             return True
         if i not in self._since:
             return False
-        if t - self._since[i] >= p.confirm - 1e-9:
+        waited = t - self._since[i]
+        if waited >= p.confirm - 1e-9:
             return True
         closing = ego_speed - c.lead.speed
-        return closing > 0.0 and c.lead.gap < p.urgent_ttc * closing
+        return closing > 0.0 and (c.lead.gap < p.urgent_ttc * closing or costly_wait(
+            ego_speed, c.lead, max(t - c.lead.t, 0.0), p.confirm - waited, self.acc))
 
 
 class LeadAccel:

@@ -68,6 +68,7 @@ from planner.lead import (
     LeadAccel,
     LeadParams,
     LeadSelector,
+    far_centre,
     lane_candidates,
     route_candidates,
 )
@@ -144,7 +145,7 @@ class Planner:
         self.motion = MotionLayer(self.road, p.lane, p.acc.modes, p.vehicle, p.motion)
         self.control = ControlLayer()
         self.lead_accel = LeadAccel()
-        self.leads = LeadSelector(self.params.lead)
+        self.leads = LeadSelector(self.params.lead, self.params.acc.control)
         self.driver = DriverOverride(p.override)
         self.events = EventMonitor(self.road, p.vehicle, p.events)
         self.junctions = JunctionMonitor(self.road, p.vehicle, p.junctions)
@@ -351,9 +352,25 @@ class Planner:
         else:
             centre: Callable[[float], float] = _straight_ahead
             if view is not None and camera:
-                centre = view.estimate.centre_y
+                centre = far_centre(view.estimate.centre_y, view.estimate.heading_error,
+                                    p.camera_ahead, self._bend(ego))
             candidates = lane_candidates(tracks, centre, ego.heading, p.vehicle.front_overhang)
         return self.leads.select(ego.t, ego.speed, candidates)
+
+    def _bend(self, ego: EgoState) -> Callable[[float], float]:
+        """x [m] ahead -> [m] the offset (left +) of the kept map lane's centre from its
+        tangent at the car's station, for the direction the car drives (`far_centre`)."""
+        s0 = self.localise(ego)[0]
+        h0 = float(self.lane.heading_at(s0))
+        ahead = 1.0 if math.cos(h0 - ego.heading) >= 0.0 else -1.0
+        x0, y0 = (float(v) for v in self.lane.position(s0, 0.0))
+        c, s = math.cos(h0), math.sin(h0)
+
+        def bend(x: float) -> float:
+            px, py = (float(v) for v in self.lane.position(s0 + ahead * x, 0.0))
+            return ahead * (c * (py - y0) - s * (px - x0))
+
+        return bend
 
     def near_junction(self, station: float) -> bool:
         """Whether the car's centre is near or in a town junction, where the map's path is

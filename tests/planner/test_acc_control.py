@@ -41,12 +41,30 @@ def test_trail_closes_the_gap_error_and_never_exceeds_the_plan() -> None:
     assert trail(30.0, d0 + 1.0, d0, 1.0, d0, P).speed > 0.0  # it moves off with the lead
 
 
+def test_need_does_not_rise_while_the_car_ramps_in_as_planned() -> None:
+    """A stopped car 63.3 m ahead at 60 km/h: the car brakes at the need, its deceleration
+    rising at j_comf; the need stays at its first value until the ramp is done (it rose by a
+    twentieth, over a_comf_max, when the ramp's cost left out what braking already gives)."""
+    v, d, a, dt = 16.6, 63.3, 0.0, 0.01
+    first = need(v, 0.0, d, P)
+    assert first < P.a_comf_max
+    for _ in range(round(first / P.j_comf / dt)):  # the ramp's time
+        a = min(a + P.j_comf * dt, need(v, 0.0, d, P, a))
+        v, d = v - a * dt, d - (v - a * dt) * dt
+        assert need(v, 0.0, d, P, a) <= first + 0.01
+
+
 def test_need_stops_the_closing_at_the_floor_after_a_ramp_in() -> None:
     # closing at 5 m/s from 30 m: room 30 - 2.5 - 5 t_ramp, 25 / (2 room)
     room = 30.0 - P.d_floor - 5.0 * P.a_comf_max / (2.0 * P.j_comf)  # ramp-in from 0
     assert need(15.0, 10.0, 30.0, P) == pytest.approx(25.0 / (2.0 * room))
-    braking = 30.0 - P.d_floor - 5.0 * (P.a_comf_max - 1.0) / (2.0 * P.j_comf)  # from 1
+    # from 1 m/s^2: the ramp's 1 s costs 5 m/s x 1 s / 2 and braking at 1 gives 1 / 3 of
+    # that back
+    braking = 30.0 - P.d_floor - 5.0 * (P.a_comf_max - 1.0) ** 2 / (
+        2.0 * P.j_comf * P.a_comf_max)
     assert need(15.0, 10.0, 30.0, P, a_now=1.0) == pytest.approx(25.0 / (2.0 * braking))
+    assert need(15.0, 10.0, 30.0, P, a_now=P.a_comf_max) == pytest.approx(
+        25.0 / (2.0 * (30.0 - P.d_floor)))  # no ramp left
     assert need(10.0, 12.0, 20.0, P) == 0.0  # the lead is faster: nothing needed
     assert need(10.0, math.inf, math.inf, P) == 0.0  # no lead
     assert need(30.0, 0.0, 5.0, P) == math.inf  # no room left

@@ -5,12 +5,22 @@ nearest qualified vehicle wins. Table tests on `Candidate`s (gaps and offsets gi
 from __future__ import annotations
 
 import itertools
+import math
 from dataclasses import replace
 
 import pytest
 
 from perception.messages import ObjectClass, Track
-from planner.lead import Candidate, LeadParams, LeadSelector, crossing_lateral, lane_candidates
+from planner.acc_control import AccControlParams
+from planner.lead import (
+    Candidate,
+    LeadParams,
+    LeadSelector,
+    costly_wait,
+    crossing_lateral,
+    far_centre,
+    lane_candidates,
+)
 from planner.messages import Lead
 
 P = LeadParams()  # half_width 1.6 m, keep_width 2.0 m, confirm 0.3 s, urgent_ttc 2.5 s
@@ -55,6 +65,34 @@ def test_an_urgent_cut_in_is_the_lead_at_once(gap: float, lead_speed: float,
     ids = run([[car(3, gap, 0.5, lead_speed)]] * 8, ego_speed=20.0)
     assert (ids[0] == 3) is urgent
     assert ids[-1] == 3
+
+
+V60 = 60.0 / 3.6  # [m/s]
+
+
+@pytest.mark.parametrize(("gap", "lead_speed", "at_once"), [
+    # a stopped car first found ahead at 60 km/h; need = the least deceleration that stops
+    # the closing (ramp-in included), now -> after the 0.3 s wait (`costly_wait`)
+    (64.0, 0.0, True),  # 2.83 -> 3.16 m/s^2: the wait would cost the comfortable stop
+    (62.0, 0.0, True),  # 2.96 -> 3.31
+    (67.0, 0.0, False),  # 2.67 -> 2.96: still within a_comf_max (3.0) after it
+    (80.0, 0.0, False),  # 2.14 -> 2.32: the wait costs nothing, confirmed first
+    (50.0, 0.0, False),  # 3.97 -> 4.63: no comfortable stop left to keep; ttc 3.0 s
+    (64.0, 14.0, False),  # a slower car: closing at 2.7 m/s, 0.06 m/s^2, no hurry
+])
+def test_a_stopped_car_found_far_ahead_is_the_lead_at_once_when_waiting_costs_the_comfortable_stop(
+        gap: float, lead_speed: float, at_once: bool) -> None:
+    ids = run([[car(4, gap, 0.2, lead_speed)]] * 8, ego_speed=V60)
+    assert (ids[0] == 4) is at_once
+    assert ids[-1] == 4
+
+
+def test_a_costly_wait_reads_the_gap_the_track_has_now() -> None:
+    """A track 0.1 s old (one LiDAR period): its gap is 1.7 m shorter now at 60 km/h."""
+    fresh, late = Lead(4, 0.0, 67.0, 0.0), Lead(4, -0.1, 67.0, 0.0)
+    acc = AccControlParams()
+    assert not costly_wait(V60, fresh, 0.0, 0.3, acc)
+    assert costly_wait(V60, late, 0.1, 0.3, acc)
 
 
 def test_the_lead_is_held_within_the_keep_band_and_dropped_beyond_it() -> None:
@@ -120,3 +158,27 @@ def test_a_walker_heading_into_the_lane_is_in_it_and_one_on_the_pavement_is_not(
     assert crossing.lateral == pytest.approx(0.0) and strolling.lateral == pytest.approx(-4.2)
     car = replace(walker(-4.2, 1.4), cls=ObjectClass.CAR)  # a car's drift is no crossing
     assert lane_candidates([car], lambda x: 0.0, 0.0, 2.4)[0].lateral == pytest.approx(-4.2)
+
+
+# ---- the lane centre beyond the camera's reach ------------------------------------------
+
+
+def test_beyond_the_camera_the_lane_bends_as_the_map_says_not_as_the_paint_fit_guessed() -> None:
+    """A straight road, the camera's fit with a spurious 7e-4 1/m (issue K: 1.4 m at 65 m):
+    beyond its 30 m reach the centre runs on along the car's heading to the lane; on a
+    200 m radius the map's bend is kept. Up to the reach it is the camera's."""
+    heading_error, kappa = 0.007, 7e-4
+
+    def camera(x: float) -> float:
+        return -0.05 - math.tan(heading_error) * x + 0.5 * kappa * x * x
+
+    straight = far_centre(camera, heading_error, 30.0, lambda x: 0.0)
+    assert straight(20.0) == camera(20.0) and straight(30.0) == pytest.approx(camera(30.0))
+    assert straight(65.0) == pytest.approx(camera(30.0) - math.tan(heading_error) * 35.0)
+    assert abs(straight(65.0)) < 0.3 and camera(65.0) > 0.9  # the fit: 1 m off
+
+    def arc(x: float) -> float:  # a left curve of 200 m radius
+        return 200.0 - math.sqrt(200.0**2 - x * x)
+
+    bent = far_centre(camera, heading_error, 30.0, arc)
+    assert bent(65.0) - straight(65.0) == pytest.approx(arc(65.0) - arc(30.0))
