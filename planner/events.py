@@ -5,7 +5,12 @@ Positions are stations [m] along the route's reference line (the car's centre s,
 bumper f, its axles); tracks are in the map frame. Each tick
 (`EventMonitor.update`, parameters `EventParams`):
 
-- off_ramp: the car's centre is on a segment of zone `ramp` (the paper's [Off_Ramp]).
+- off_ramp: the segment where the posted limit in force is read is of zone `ramp` (the
+  paper's [Off_Ramp]): the front bumper as the speed plan places it
+  (`planner.speed_planning.SpeedPlanner.front_station`, passed as ``limit_station``), so
+  that the ramp's event and its lower limit begin (and end) on the same tick, and the ACC
+  goes from its mode before the ramp straight into OFF_RAMP (issue K: no SPEED_LIMIT for
+  the time the bumper takes to the centre).
 - stop_sign: the next stop line L of the map ahead, once perception has confirmed its sign
   (`see_signs`: a camera stop sign, placed on the map, near the line and right of the
   route), from ``approach(v)`` before it until the car has stood (below ``stopped_speed``)
@@ -113,18 +118,21 @@ class EventMonitor:
 
     def update(self, t: float, station: float, v: float, lane_offset: float, lane_width: float,
                tracks: Sequence[Track] = (), flat: bool = False,
-               pulled_over: bool = False) -> Events:
+               pulled_over: bool = False, limit_station: float | None = None) -> Events:
         """The events at time `t` [s] for the car's centre at `station` [m] with speed `v`
         [m/s]; `lane_offset` [m] of the lane kept's centre from the reference line there
         (left +) and its `lane_width` [m]; `tracks` the confirmed tracks (map frame); `flat`
-        a flat tyre detected, `pulled_over` the car on the shoulder."""
+        a flat tyre detected, `pulled_over` the car on the shoulder; `limit_station` [m]
+        where the speed plan reads the posted limit (its front bumper; by default `station`
+        + the front overhang)."""
         p = self.params
         front = station + self.vehicle.front_overhang
+        limit_station = front if limit_station is None else limit_station
         approach = v * v / (2.0 * p.a_comf) + p.approach_extra
         stop = self._stop_sign(t, front, v, approach)
         crossing = self._crossing(front, approach, lane_offset, lane_width, tracks)
         bump = self._bump(station, approach)
-        zone = self.road.cross_section_at(station).zone
+        zone = self.road.cross_section_at(limit_station).zone
         happening = {AccEvent.OFF_RAMP: zone is Zone.RAMP, AccEvent.STOP_SIGN: stop is not None,
                      AccEvent.PEDESTRIAN: crossing is not None,
                      AccEvent.SPEED_BUMP: bump is not None, AccEvent.FLAT: flat}

@@ -59,6 +59,18 @@ anyway, not before it has arrived there): once it is moving (faster than ``movin
 over the line, it is committed to the junction and goes on (the control FSM's emergency
 stop still covers a vehicle in its path). A gap that closes after that point is not chased
 with a stop the car cannot make.
+
+**Taking a gap** (hysteresis, then commitment; issue K: a gap taken and given up 0.1 s
+later, for an oncoming car the one just gone by had hidden). Once giving way, the car gives
+way until it has had nothing to wait for during ``gap_confirm`` in a row: a vehicle that
+comes out from behind another, or into the LiDAR's reach, is a confirmed track only after
+the tracker's M-of-N confirmation (up to 5 scans at 10 Hz), so a gap is taken once what it
+may hide has had the time to show. Then the gap is taken: the car goes and is committed to
+the junction (as above), the way production stacks commit to a gap: it gives way there
+again only for a safety reason, a vehicle inside the box that is not moving its way (at a
+junction whose rules look at the box) while it can still stop before the line at
+``commit_decel``; never because an oncoming vehicle closes the gap. So the give-way event
+holds at least ``gap_confirm`` each time, and is not taken up again for the gap it left.
 """
 
 from __future__ import annotations
@@ -103,6 +115,8 @@ class JunctionParams:
     line_zone_near: float = -1.0  # [m] a track's centre this far beyond a line (from the
     line_zone_far: float = 8.0  # [m] ... centre outwards) to this far waits at that line
     tie: float = 1.0  # [s] arrivals this close in time are a tie (the right goes first)
+    gap_confirm: float = 0.6  # [s] a gap is taken once nothing was waited for this long: the
+    #   tracker's confirmation window (5 LiDAR scans at 10 Hz) and one scan more
 
 
 @dataclass(frozen=True, slots=True)
@@ -136,7 +150,10 @@ class JunctionMonitor:
         self._yellow_go: set[int] = set()  # lights whose yellow the car decided to go on
         self._stopping: set[int] = set()  # lights the car stops for until seen green
         self._waiting: set[int] = set()  # junctions (route order) the car gives way at
-        self._committed: set[int] = set()  # junctions the car goes on through, come what may
+        self._committed: set[int] = set()  # junctions the car goes on through (a gap taken,
+        #   or past where it could stop): given up only for a safety reason (module doc)
+        self._clear_since: dict[int, float] = {}  # [s] junctions waited at: nothing to wait
+        #   for since then
         self._order = ArrivalOrder(self.params)  # at the all-way stop ahead
         self._order_at: int | None = None  # the junction (route order) `_order` is for
         # [m] each junction's centre to its stop line (the car's approach; every arm's)
@@ -214,12 +231,17 @@ class JunctionMonitor:
                   tracks: Sequence[Track]) -> float | None:
         p = self.params
         k = next((k for k, j in enumerate(self.road.junctions) if j.s_stop > front - 0.5), None)
-        if k is None or k in self._committed:
+        if k is None:
             return None
         j = self.road.junctions[k]
         if j.s_stop - front > approach:
             return None
         room = j.s_stop - front - p.stop_margin
+        can_stop = v * v <= 2.0 * p.commit_decel * max(room, 0.0)
+        if k in self._committed:
+            if not (can_stop and self._box_taken(j, tracks)):
+                return None
+            self._committed.discard(k)  # a safety reason: a vehicle in its path in the box
         wait = self._must_wait(j, tracks)
         if j.control is Control.STOP_SIGNS:
             if self._order_at != k:
@@ -227,25 +249,47 @@ class JunctionMonitor:
             standing = v < p.stopped and 0.0 <= j.s_stop - front <= p.arrival_zone
             wait = self._order.update(t, j, self._line_out[k], standing, tracks) or wait
         stops_first = j.control is Control.STOP_SIGNS and self._order.arrived is None
-        if k not in self._waiting and v > p.moving and not stops_first and \
-                v * v > 2.0 * p.commit_decel * max(room, 0.0):
+        if k not in self._waiting and v > p.moving and not stops_first and not can_stop:
             self._committed.add(k)  # past the last point it could stop comfortably: go on
             return None
+        return room if self._gives_way(t, k, wait) else None
+
+    def _gives_way(self, t: float, k: int, wait: bool) -> bool:
+        """Whether the car gives way at junction `k` at time `t` [s], `wait` whether it must
+        now: while it must, and then until it need not for ``gap_confirm``; the gap is then
+        taken and the junction committed (module doc)."""
         if wait:
             self._waiting.add(k)
-            return room
+            self._clear_since.pop(k, None)
+            return True
+        if k not in self._waiting:
+            return False
+        since = self._clear_since.setdefault(k, t)
+        if t - since < self.params.gap_confirm - 1e-9:  # (ticks' float times)
+            return True  # not yet taken: what the gap may hide has not had the time to show
         self._waiting.discard(k)
-        return None
+        del self._clear_since[k]
+        self._committed.add(k)  # the gap is taken: the car goes, committed
+        return False
+
+    def _box_rules(self, j: Junction) -> bool:
+        """Whether the car looks at `j`'s box and oncoming traffic at all: before a left
+        turn or a U-turn, or at a stop-sign junction."""
+        return j.manoeuvre in (Manoeuvre.LEFT, Manoeuvre.U_TURN) or \
+            j.control is Control.STOP_SIGNS
+
+    def _box_taken(self, j: Junction, tracks: Sequence[Track]) -> bool:
+        """Whether a vehicle track inside `j`'s box is not moving the car's way, where the
+        car looks at the box (`_box_rules`)."""
+        xy, vel = _vehicles(tracks)
+        return self._box_rules(j) and len(xy) > 0 and bool(np.any(self._in_box(j, xy, vel)))
 
     def _must_wait(self, j: Junction, tracks: Sequence[Track]) -> bool:
-        vehicles = [tr for tr in tracks if tr.cls in (ObjectClass.CAR, ObjectClass.TRUCK)]
-        turning_across = j.manoeuvre in (Manoeuvre.LEFT, Manoeuvre.U_TURN)
-        if not vehicles or not (turning_across or j.control is Control.STOP_SIGNS):
+        xy, vel = _vehicles(tracks)
+        if not len(xy) or not self._box_rules(j):
             return False
-        xy = np.array([[tr.x, tr.y] for tr in vehicles])
-        vel = np.array([[tr.vx, tr.vy] for tr in vehicles])
         wait = bool(np.any(self._in_box(j, xy, vel)))
-        if turning_across:
+        if j.manoeuvre in (Manoeuvre.LEFT, Manoeuvre.U_TURN):
             wait = wait or bool(np.any(self._oncoming_soon(j, xy, vel)))
         return wait
 
@@ -321,6 +365,13 @@ class ArrivalOrder:
         if since > self.arrived + self.params.tie:
             return False
         return _on_right(j.heading, _arm_heading(j, tr))
+
+
+def _vehicles(tracks: Sequence[Track]) -> tuple[np.ndarray, np.ndarray]:
+    """(positions (N, 2) [m], velocities (N, 2) [m/s]) of the vehicle tracks (map frame)."""
+    vehicles = [tr for tr in tracks if tr.cls in (ObjectClass.CAR, ObjectClass.TRUCK)]
+    return (np.array([[tr.x, tr.y] for tr in vehicles]).reshape(-1, 2),
+            np.array([[tr.vx, tr.vy] for tr in vehicles]).reshape(-1, 2))
 
 
 def waits_at_line(j: Junction, line_out: float, tr: Track, p: JunctionParams) -> bool:

@@ -220,7 +220,8 @@ class Planner:
                                     float(self.lane.offset_at(station)),
                                     float(self.lane.width_at(station)), tracks, inp.flat_tyre,
                                     pulled_over=manoeuvre.lane == SHOULDER
-                                    and manoeuvre.path is None)
+                                    and manoeuvre.path is None,
+                                    limit_station=self.speed_planner.front_station(station))
         junction = self.junctions.update(ego.t, station, ego.speed, tracks)
         events = replace(events, active=events.active | junction.active,
                          stop_distance=min(events.stop_distance, junction.stop_distance))

@@ -171,6 +171,11 @@ class SpeedPlanner:
         """[m] station ``metres`` [m] ahead of station ``s`` along the lane (local metric)."""
         return s + metres / self._metric[self._index(s)]
 
+    def front_station(self, s: float) -> float:
+        """[m] the station of the front bumper of a car whose centre is at station ``s``
+        [m]: where the posted limit in force is read (`target`)."""
+        return self._station_ahead(s, self.vehicle.front_overhang)
+
     # -- the target -----------------------------------------------------------------------------
 
     def target(self, s: float, *, set_speed: float, max_speed: float) -> SpeedTarget:
@@ -180,7 +185,7 @@ class SpeedPlanner:
         speed, limit, curve now, curve ahead, limit ahead.
         """
         p = self.params
-        s_front = self._station_ahead(s, self.vehicle.front_overhang)
+        s_front = self.front_station(s)
         s_axle = self._station_ahead(s, self.vehicle.front_axle)
         limit_at_front = float(self.road.speed_limit_at(s_front))
         candidates = [

@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 from dataclasses import replace
 
+import numpy as np
 import pytest
 
 from perception.messages import ObjectClass, Track
@@ -14,6 +15,7 @@ from planner.events import EventMonitor, EventParams, Events
 from planner.fsm.acc import AccEvent, AccMode
 from planner.messages import SpeedSource
 from planner.speed import PlannedSpeed, SpeedRef
+from planner.speed_planning import SpeedPlanner, SpeedPlanningParams
 from tests.roads import KPH, W, make_map, seg
 from tests.vehicle import VEHICLE
 from world.hdmap import Crosswalk, SpeedBump, StopSign, Zone
@@ -77,6 +79,25 @@ def test_a_pedestrian_on_or_walking_into_the_crossing_in_the_lane() -> None:
 def test_the_ramp_zone_is_the_off_ramp() -> None:
     m = EventMonitor(ROAD, VEHICLE, P)
     assert not at(m, 490.0).holds(OFF_RAMP) and at(m, 510.0).holds(OFF_RAMP)
+    # from the front bumper on, where the ramp's limit applies (not from the car's centre)
+    front = 500.0 - VEHICLE.front_overhang
+    assert not at(m, front - 0.01).holds(OFF_RAMP) and at(m, front + 0.01).holds(OFF_RAMP)
+
+
+@pytest.mark.parametrize("lane", [0, 1])
+def test_the_off_ramp_holds_exactly_while_the_ramps_limit_is_in_force(lane: int) -> None:
+    """The event and the ramp's lower limit start and end on the same tick (issue K: no
+    SPEED_LIMIT between CRUISE and OFF_RAMP), also after a curve, where the speed plan's
+    front bumper is the lane's length ahead of the centre, not the reference line's."""
+    road = make_map(seg(100.0, 60.0), seg(50.0, speed_kph=25.0, zone=Zone.RAMP),
+                    seg(100.0, -60.0, speed_kph=40.0, zone=Zone.CITY))
+    plan = SpeedPlanner(road, road.lane(lane), SpeedPlanningParams(), VEHICLE)
+    m = EventMonitor(road, VEHICLE, P)
+    ramp = 25.0 * KPH
+    for s in np.arange(90.0, 160.0, 0.01):
+        target = plan.target(float(s), set_speed=20.0, max_speed=30.0)
+        e = m.update(0.0, float(s), 5.0, 0.0, W, limit_station=plan.front_station(float(s)))
+        assert e.holds(OFF_RAMP) is (target.limit_at_front == ramp), s
 
 
 C = AccControlParams()

@@ -172,6 +172,61 @@ def test_a_car_already_waiting_goes_on_waiting_however_close_to_the_line() -> No
     assert m.update(0.1, front_at(m, 1.0), 2.0, car_coming).holds(GIVE_WAY)
 
 
+def standing_left_turn() -> JunctionMonitor:
+    """A left turn at a green light, the car standing at its line."""
+    m = JunctionMonitor(route(LIGHTS, Manoeuvre.LEFT), VEHICLE, P)
+    green(m)
+    return m
+
+
+def at_line(m: JunctionMonitor, t: float, tracks: list[Track], v: float = 0.0,
+            before_line: float = 1.0) -> bool:
+    """Whether the car, `before_line` [m] before its line at `v` [m/s], gives way at t [s]."""
+    return m.update(t, front_at(m, before_line), v, tracks).holds(GIVE_WAY)
+
+
+def test_a_gap_is_taken_only_once_it_has_been_clear_for_gap_confirm() -> None:
+    """The town_route case (issue K): the car that hid the next one goes by, the gap
+    looks clear, and the next one's track comes 0.1 s later: the car has not taken the gap
+    yet, so it waits on, once; the gap it takes is one clear for gap_confirm."""
+    m = standing_left_turn()
+    assert at_line(m, 0.0, [oncoming(m, 20.0, 10.0)])
+    assert at_line(m, 2.0, [])  # clear since 2 s: not yet taken
+    assert at_line(m, 2.1, [oncoming(m, 43.0, 9.6)])  # 4.5 s away: still waiting
+    assert at_line(m, 2.2, [])  # clear again from 2.2 s
+    assert at_line(m, 2.0 + P.gap_confirm, [])
+    assert at_line(m, 2.19 + P.gap_confirm, [])
+    assert not at_line(m, 2.2 + P.gap_confirm, [])  # taken
+
+
+@pytest.mark.parametrize("v", [0.0, 0.4, 2.0])  # still standing, creeping off, moving
+def test_a_taken_gap_is_not_given_up_when_an_oncoming_car_closes_it(v: float) -> None:
+    m = standing_left_turn()
+    assert at_line(m, 0.0, [oncoming(m, 20.0, 10.0)])
+    assert at_line(m, 1.0, [])
+    assert not at_line(m, 1.0 + P.gap_confirm, [])  # taken: committed
+    late = [oncoming(m, 30.0, 10.0)]  # 3 s away: would have been waited for before
+    assert not at_line(m, 1.1 + P.gap_confirm, late, v=v, before_line=0.9)
+    assert not at_line(m, 1.5 + P.gap_confirm, late, v=v, before_line=0.5)
+
+
+def test_a_taken_gap_is_given_up_for_a_vehicle_in_the_box_while_the_car_can_stop() -> None:
+    """The safety reason: a vehicle stands (or crosses) in the box in the car's path."""
+    m = standing_left_turn()
+    j = m.road.junctions[0]
+    in_box = [car(j.x + 1.0, j.y + 1.0, vx=0.0, vy=3.0)]
+    assert at_line(m, 0.0, [oncoming(m, 20.0, 10.0)])
+    assert at_line(m, 1.0, [])
+    assert not at_line(m, 1.0 + P.gap_confirm, [])  # taken
+    assert at_line(m, 1.7, in_box, v=1.0, before_line=0.9)  # 1 m/s: it can still stop
+    # too fast to stop at commit_decel before its line: committed, the emergency stop's
+    m = standing_left_turn()
+    assert at_line(m, 0.0, [oncoming(m, 20.0, 10.0)])
+    assert at_line(m, 1.0, [])
+    assert not at_line(m, 1.0 + P.gap_confirm, [])
+    assert not at_line(m, 1.7, in_box, v=3.0, before_line=0.9)
+
+
 @pytest.mark.parametrize(
     ("vx", "vy", "waits"),
     [(0.0, 5.0, True), (0.0, 0.0, True), (5.0, 0.0, False)],  # across, standing, my way
@@ -182,8 +237,11 @@ def test_at_a_stop_sign_the_car_waits_for_the_box_to_clear(vx: float, vy: float,
     j = m.road.junctions[0]
     e = m.update(0.0, front_at(m, 1.0), 0.0, [car(j.x + 1.0, j.y - 2.0, vx, vy)])
     assert e.holds(GIVE_WAY) is waits
-    assert not m.update(0.0, front_at(m, 1.0), 0.0, []).holds(GIVE_WAY)
-    assert math.isinf(m.update(0.0, front_at(m, 1.0), 0.0, []).stop_distance)
+    # the box clear from t = 1 s: the gap is taken once it has been so for gap_confirm
+    assert m.update(1.0, front_at(m, 1.0), 0.0, []).holds(GIVE_WAY) is waits
+    assert m.update(0.99 + P.gap_confirm, front_at(m, 1.0), 0.0, []).holds(GIVE_WAY) is waits
+    gone = m.update(1.0 + P.gap_confirm, front_at(m, 1.0), 0.0, [])
+    assert not gone.holds(GIVE_WAY) and math.isinf(gone.stop_distance)
 
 
 def test_an_unread_light_once_stopped_for_stays_so_until_read() -> None:
@@ -263,8 +321,9 @@ def test_an_all_way_stop_goes_in_order_of_arrival(arm: str, since: float, waits:
         tracks = [waiting if since <= t else approaching]
         at_stop(m, t, tracks)
     assert at_stop(m, 6.5, [waiting]) is waits
-    # it has gone into the junction: the car's turn
-    assert not at_stop(m, 7.0, [])
+    # it has gone into the junction: the car's turn, once that has held for gap_confirm
+    assert at_stop(m, 7.0, []) is waits
+    assert not at_stop(m, 7.0 + P.gap_confirm, [])
 
 
 def test_a_car_queued_on_another_arm_or_behind_the_car_is_not_waited_for() -> None:
@@ -278,7 +337,9 @@ def test_a_car_queued_on_another_arm_or_behind_the_car_is_not_waited_for() -> No
 def test_a_car_that_moves_off_its_line_is_no_longer_waited_for() -> None:
     m = stop_monitor()
     assert at_stop(m, 0.0, [at_arm("south", 4)])
-    assert not at_stop(m, 1.0, [at_arm("south", 4, back=-3.0, moving=3.0)])  # on its way
+    on_its_way = [at_arm("south", 4, back=-3.0, moving=3.0)]
+    assert at_stop(m, 1.0, on_its_way)  # the gap not yet taken (gap_confirm)
+    assert not at_stop(m, 1.0 + P.gap_confirm, on_its_way)
 
 
 def test_at_an_all_way_stop_the_car_does_not_commit_before_it_has_stood() -> None:

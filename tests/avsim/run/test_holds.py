@@ -6,7 +6,7 @@ import math
 
 import pytest
 
-from avsim.run.holds import shortest_hold
+from avsim.run.holds import holds, shortest_hold
 from planner.fsm.machine import StateChange
 
 
@@ -33,3 +33,14 @@ def change(t: float, source: str, target: str, machine: str = "acc") -> StateCha
 ])
 def test_shortest_hold(changes: list[StateChange], expected: object) -> None:
     assert shortest_hold(changes, "acc") == expected
+
+
+def test_holds_lists_what_shortest_hold_counts() -> None:
+    changes = [change(0.0, "acc_off", "cruise"), change(5.0, "cruise", "brake"),
+               change(5.1, "brake", "trail"), change(8.0, "trail", "cruise"),
+               change(8.2, "cruise", "yield"), change(9.0, "yield", "cruise")]
+    got = holds(changes, "acc")
+    assert [(h.mode, h.then) for h in got] == [("trail", "cruise"), ("cruise", "yield"),
+                                               ("yield", "cruise")]
+    assert got[1].t == 8.0 and got[1].duration == pytest.approx(0.2)
+    assert shortest_hold(changes, "acc") == min(h.duration for h in got)

@@ -131,6 +131,9 @@ TABLE_CASES = [
     ("limit_brake", M.SPEED_LIMIT, x(v_gps=13.0, d=CLOSE, v_l=VL), M.BRAKE),
     # events from ACC_ACTIVE (* generalised from Table 2's rows)
     ("cruise_off_ramp", M.CRUISE, x(off_ramp=True), M.OFF_RAMP),
+    ("cruise_off_ramp_with_its_limit", M.CRUISE, x(off_ramp=True, v_gps=7.0), M.OFF_RAMP),
+    #   the ramp's lower limit in force on the tick its event starts (`planner.events`):
+    #   one change, straight into OFF_RAMP, not through SPEED_LIMIT (issue K)
     ("limit_stop_sign", M.SPEED_LIMIT, x(v_gps=13.0, stop_sign=True), M.STOP_SIGN),
     ("cruise_pedestrian_first", M.CRUISE, x(pedestrian=True, speed_bump=True), M.PEDESTRIAN),
     # OffRamp (6 to 1, 6 to 7)
