@@ -70,6 +70,7 @@ from planner.lead import (
     LeadSelector,
     far_centre,
     lane_candidates,
+    map_bend,
     route_candidates,
 )
 from planner.messages import Lead, Plan, ReferencePath, SpeedSource
@@ -360,18 +361,11 @@ class Planner:
 
     def _bend(self, ego: EgoState) -> Callable[[float], float]:
         """x [m] ahead -> [m] the offset (left +) of the kept map lane's centre from its
-        tangent at the car's station, for the direction the car drives (`far_centre`)."""
+        tangent at the car's station, for the direction the car drives (`far_centre`,
+        `map_bend`)."""
         s0 = self.localise(ego)[0]
-        h0 = float(self.lane.heading_at(s0))
-        ahead = 1.0 if math.cos(h0 - ego.heading) >= 0.0 else -1.0
-        x0, y0 = (float(v) for v in self.lane.position(s0, 0.0))
-        c, s = math.cos(h0), math.sin(h0)
-
-        def bend(x: float) -> float:
-            px, py = (float(v) for v in self.lane.position(s0 + ahead * x, 0.0))
-            return ahead * (c * (py - y0) - s * (px - x0))
-
-        return bend
+        ahead = 1.0 if math.cos(float(self.lane.heading_at(s0)) - ego.heading) >= 0.0 else -1.0
+        return map_bend(self.lane, s0, ahead)
 
     def near_junction(self, station: float) -> bool:
         """Whether the car's centre is near or in a town junction, where the map's path is

@@ -20,8 +20,10 @@ from planner.lead import (
     crossing_lateral,
     far_centre,
     lane_candidates,
+    map_bend,
 )
 from planner.messages import Lead
+from tests.roads import arc, make_map, seg
 
 P = LeadParams()  # half_width 1.6 m, keep_width 2.0 m, confirm 0.3 s, urgent_ttc 2.5 s
 DT = 0.05  # [s] the planner's tick
@@ -182,3 +184,22 @@ def test_beyond_the_camera_the_lane_bends_as_the_map_says_not_as_the_paint_fit_g
 
     bent = far_centre(camera, heading_error, 30.0, arc)
     assert bent(65.0) - straight(65.0) == pytest.approx(arc(65.0) - arc(30.0))
+
+
+def test_map_bend_is_the_lane_at_a_distance_ahead_not_along_the_lane() -> None:
+    """The last 26 degrees of a right bend of R 50 m, then a straight: 62 m of lane reach
+    57 m ahead; the offset at 57 m ahead is the lane's there (exact geometry), 2.4 m from
+    the offset of the point 62 m along the lane; a bend turned past 90 degrees has no lane
+    ahead beyond its furthest point."""
+    road = make_map(arc(50.0, -26.0, lanes=1, oncoming=0), seg(100.0, lanes=1, oncoming=0))
+    bend = map_bend(road.lane(0), 0.0, 1.0)
+    turn = math.radians(26.0)
+    x_arc, y_arc = 50.0 * math.sin(turn), -50.0 * (1.0 - math.cos(turn))
+    for along in (10.0, 39.0):  # metres of straight after the bend
+        x = x_arc + along * math.cos(turn)
+        y = y_arc - along * math.sin(turn)
+        assert bend(x) == pytest.approx(y, abs=0.02)
+    assert bend(57.0) - bend(62.0) == pytest.approx(2.4, abs=0.15)
+    hairpin = map_bend(make_map(arc(50.0, -150.0, lanes=1, oncoming=0)).lane(0), 0.0, 1.0)
+    assert hairpin(45.0) == pytest.approx(-50.0 * (1.0 - math.cos(math.asin(0.9))), abs=0.05)
+    assert math.isnan(hairpin(55.0))  # the bend never reaches 50 m ahead

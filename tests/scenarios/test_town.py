@@ -34,7 +34,10 @@ def close_car(run_scenario: Callable[..., RunResult]) -> RunResult:
 
 @pytest.fixture(scope="module")
 def far_car(run_scenario: Callable[..., RunResult]) -> RunResult:
-    return run_scenario("town_left_turn", record=False, **{"actors.0.start": [3, 1, "west"]})
+    # two blocks off and at 20 km/h: at green it is still beyond the 6 s gap a left turn
+    # waits for (at 30 km/h it came within it, seen since the LiDAR's tracks reach 100 m)
+    return run_scenario("town_left_turn", record=False,
+                        **{"actors.0.start": [3, 1, "west"], "actors.0.speed_kph": 20})
 
 
 def _actor_xy(r: RunResult, actor_id: str) -> np.ndarray:
