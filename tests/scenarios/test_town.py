@@ -166,10 +166,10 @@ def test_with_the_oncoming_car_far_the_left_turn_goes_at_once(far_car: RunResult
     xy = _actor_xy(far_car, "oncoming")
     entered = _entered(far_car, j)
     k = int(np.searchsorted(t, entered))
-    assert np.hypot(xy[k, 0] - j.x, xy[k, 1] - j.y) > 30.0  # it was coming, but far
-    # the oncoming car did come through the junction, well after the ego went (the gap)
-    inside = _in_box(xy, j)
-    assert inside.any() and t[inside].min() > entered + 4.0
+    distance = np.hypot(xy[:, 0] - j.x, xy[:, 1] - j.y)
+    assert distance[k] > 30.0  # far when the ego went in
+    assert distance[k] < distance[0] - 30.0  # and coming (it drove 30 m towards the box)
+    assert not _in_box(xy[:k + 1], j).any()  # it had not been through yet
     assert "yield" not in _states(far_car, "acc")
     assert entered < _entered(close_car, j) - 2.0  # sooner than with the close car
     assert "turn_left" in _states(far_car, "motion")
