@@ -55,7 +55,6 @@ from avsim.run.story import ScriptedStory, StoryboardStory, StoryEntry
 from avsim.run.storyboard.director import Director
 from avsim.scenario.scenario import Scenario
 from planner.messages import MACHINES, AccMode, HazardLights, Motion, Plan, SpeedSource, StateChange
-from world.core.memory import release_memory
 from world.core.rates import (
     ACTOR_RECORD_RATE,
     CONTACT_RATE,
@@ -74,8 +73,6 @@ from world.truth import ego_lane_edges, time_to_collision, touching, vehicles_ah
 from world.world import World
 
 MOVING = 2.0  # [m/s] the ego moves (`min_lead_gap`; `min_gap` judges from the same speed)
-RELEASE_EVERY = 60.0  # [s] of simulated time between giving freed memory back
-#   (`world.core.memory`)
 SETTLE_AFTER_DONE = 1.0  # [s] the run goes on this long after it may end: `completes`
 #   reached and every required action and event fired
 
@@ -254,8 +251,6 @@ class Runner:
                     break
                 if progress is not None and w.clock.step % PHYSICS_RATE == 0:
                     progress(w.t, self.scenario.duration)
-                if w.clock.step % round(RELEASE_EVERY * PHYSICS_RATE) == 0:
-                    release_memory()
         finally:
             self.sensors.close()
             if self.recorder is not None:

@@ -37,7 +37,6 @@ from multiprocessing.connection import Connection
 from pathlib import Path
 from typing import Any, Protocol
 
-from world.core.memory import release_memory
 from world.core.rendering import Renderer
 from world.core.stopwatch import Stopwatch
 from world.frames import Frame
@@ -130,8 +129,6 @@ class _Pending:
     received: tuple[Reading, ...] | None = None
 
 
-RELEASE_EVERY = 600  # [requests] the worker gives freed memory back this often (a minute of
-#   10 Hz captures; `world.core.memory`)
 LIGHT_RENDERING = 10e6  # [px/s] below this the worker renders on one llvmpipe thread
 
 
@@ -327,8 +324,6 @@ def serve(conn: Connection, spec: WorldSpec, setup: SensorSetup, slots_file: Pat
             conn.send(("data", (readings, watch.seconds)))
             sent = time.perf_counter() - start
             request += 1
-            if request % RELEASE_EVERY == 0:
-                release_memory()
         slots.close()
         world.close()
     except Exception:  # report any failure to the main process, which raises it
