@@ -1,7 +1,7 @@
 """Rectangles on the ground plane (a body's or a building's footprint) and whether two
 overlap: the separating-axis test, whose candidate axes for two rectangles are their four
 edge normals; two rectangles overlap where their projections overlap on all four. Touching
-edges do not overlap (no area is shared)."""
+edges do not overlap (no area is shared) unless asked (`touching`: a distance of 0)."""
 
 from __future__ import annotations
 
@@ -22,13 +22,15 @@ def rectangle(cx: float, cy: float, heading: float, length: float, width: float)
     return np.array([centre + u + v, centre - u + v, centre - u - v, centre + u - v])
 
 
-def overlap(a: Corners, b: Corners) -> bool:
-    """Whether rectangles `a` and `b` share area (no edge normal of either separates them)."""
+def overlap(a: Corners, b: Corners, *, touching: bool = False) -> bool:
+    """Whether rectangles `a` and `b` share area (no edge normal of either separates them);
+    with `touching`, also whether they only touch (a distance of exactly 0)."""
     for poly in (a, b):
         for k in range(4):
             edge = poly[(k + 1) % 4] - poly[k]
             axis = np.array([-edge[1], edge[0]])
             pa, pb = a @ axis, b @ axis
-            if pa.max() <= pb.min() or pb.max() <= pa.min():
+            gap = max(pb.min() - pa.max(), pa.min() - pb.max())
+            if gap > 0.0 or (gap == 0.0 and not touching):
                 return False
     return True

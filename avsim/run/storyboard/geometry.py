@@ -69,7 +69,7 @@ def _one_way(a: Corners, b: Corners) -> float:
 
 def rectangle_distance(a: Corners, b: Corners) -> float:
     """[m] the distance between two rectangles (0 when they overlap or touch)."""
-    if overlap(a, b):
+    if overlap(a, b, touching=True):
         return 0.0
     return min(_one_way(a, b), _one_way(b, a))
 
