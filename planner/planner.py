@@ -138,6 +138,8 @@ class Planner:
         self.source = Machine("lane_source",
                               LaneSource.ACQUIRING if p.camera else LaneSource.MAP)
         self._start: float | None = None  # [s] time of the first tick
+        self._standing = 0.0  # [s] the car has stood since the lane source's state was
+        #   entered (`LaneSourceInput.standing`)
         self._lane_seen = False  # the camera's lane has been the path (the pose is matched)
         self._cap = math.inf  # [m/s] the ramped speed cap of the degraded modes
         self._last_t: float | None = None
@@ -204,7 +206,7 @@ class Planner:
             self._keep(manoeuvre.lane)
             station, lateral = self.localise(ego)
             target = self.speed_for(station)
-        changes = self._update_source(ego.t, view, self.near_junction(station),
+        changes = self._update_source(ego, dt, view, self.near_junction(station),
                                       self._other_lane(view, manoeuvre), inp.health.camera)
         health = inp.health
         changes += self.sensing.apply(ego.t, sensing.transition(
@@ -312,18 +314,23 @@ class Planner:
             return "the lane is lost"
         return None
 
-    def _update_source(self, t: float, view: LaneView | None, junction: bool,
+    def _update_source(self, ego: EgoState, dt: float, view: LaneView | None, junction: bool,
                        other_lane: bool, camera_fault: str | None) -> tuple[StateChange, ...]:
+        t = ego.t
         if self._start is None:
             self._start = t
+        if ego.speed < self.params.source.standing_speed:
+            self._standing += dt  # stood through the last tick, in this state
         confidence = view.estimate.confidence if view is not None else 0.0
         since = max(self.source.since, self._start)  # ACQUIRING counts from the start
         lines, age = (view.estimate.lines, view.estimate.age + max(0.0, t - view.estimate.t)) \
             if view is not None else (0, math.inf)  # the lane dead-reckoned until now
         x = LaneSourceInput(t, confidence, since, junction, other_lane, lines, age,
-                            camera_fault)
+                            camera_fault, self._standing)
         changes = self.source.apply(t, lane_source.transition(self.source.state, x,
                                                               self.params.source))
+        if changes:
+            self._standing = 0.0
         self._lane_seen = self._lane_seen or self.source.state is LaneSource.CAMERA
         return changes
 

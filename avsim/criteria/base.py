@@ -160,15 +160,17 @@ class CriterionResult:
         return out
 
 
-def judged_so_far(results: list[CriterionResult], t: float) -> list[CriterionResult]:
-    """The results of a run interrupted at `t` [s]: what was judged so far stands (a pass
-    so far, a failure seen happen, which has its `first_failure`); a failure that only the
-    run's end would have settled (the goal not reached yet, an action not fired yet, no
-    standstill yet: no `first_failure`) could not be judged, and is not applicable."""
+def judged_so_far(results: list[CriterionResult], t: float,
+                  why: str = "the run was interrupted") -> list[CriterionResult]:
+    """The results of a run whose judging stopped at `t` [s] (`why`: interrupted, or an
+    unavoidable collision): what was judged so far stands (a pass so far, a failure seen
+    happen, which has its `first_failure`); a failure that only the run's end would have
+    settled (the goal not reached yet, an action not fired yet, no standstill yet: no
+    `first_failure`) could not be judged, and is not applicable."""
     return [r if r.passed is not False or r.first_failure is not None else
             CriterionResult.not_applicable(
                 r.name, r.threshold, r.unit,
-                f"not judged: the run was interrupted at {t:.2f} s"
+                f"not judged: {why} at {t:.2f} s"
                 + (f" ({r.note})" if r.note else ""))
             for r in results]
 
@@ -189,6 +191,8 @@ class Criterion:
         self.first_failure: float | None = None  # [s] sim time of the first failure
         self.idle = False  # this run gives it nothing to watch (no such feature on the map):
         #   the samples need not carry what only it needs
+        self.ends_judging: str | None = None  # set when what it saw ends the judging of the
+        #   whole run (an unavoidable collision): what happened, for the other results' notes
         self._new: list[Infraction] = []  # not yet taken by the run
 
     def update(self, sample: TruthSample) -> None:
@@ -222,20 +226,34 @@ C = TypeVar("C", bound=Criterion)
 
 @dataclass
 class CriteriaSet:
-    """All criteria of a run; `verdict` is their conjunction."""
+    """All criteria of a run; `verdict` is their conjunction. A criterion may end the
+    judging (`Criterion.ends_judging`: a collision UN R157 labels unavoidable, whose
+    aftermath, the car pushed across the lane, is no behaviour of the stack's): from then
+    on no criterion sees a sample, and the results are those judged until then."""
 
     items: list[Criterion] = field(default_factory=list)
     needs: frozenset[Need] = frozenset()  # what the samples must carry for them
+    ended: tuple[float, str] | None = None  # ([s], why) the judging ended, None: it goes on
 
     def update(self, sample: TruthSample) -> list[Infraction]:
         """Every criterion sees the sample; the infractions it brought, in criteria order."""
+        if self.ended is not None:
+            return []
         for c in self.items:
             c.update(sample)
+        for c in self.items:
+            if c.ends_judging is not None:
+                self.ended = (sample.t, c.ends_judging)
+                break
         return [i for c in self.items for i in c.take_infractions()]
 
     def results(self) -> list[CriterionResult]:
         """Every criterion's result, in the set's order."""
-        return [c.result() for c in self.items]
+        results = [c.result() for c in self.items]
+        if self.ended is not None:
+            t, why = self.ended
+            return judged_so_far(results, t, f"judging ended with {why}")
+        return results
 
     def find(self, kind: type[C]) -> C:
         """The set's criterion of class `kind` (the first, if there are several)."""

@@ -3,7 +3,10 @@
 With `unavoidable: r157` a collision with a vehicle that cut in where UN R157 5.2.5.2 does
 not require the ALKS to avoid it (`avsim.criteria.cut_in`) is reported, not failed: the
 verdict is not applicable when every collision was such, with a note giving the
-regulation's figures.
+regulation's figures. Such a collision, when it is the first, ends the judging of the run
+(`CriteriaSet`): what follows it (the car pushed out of its lane, the gap never restored)
+is the crash's doing, not the stack's, so the other criteria keep what they judged before
+it, and one only the run's end would have settled is not applicable.
 """
 
 from __future__ import annotations
@@ -49,6 +52,8 @@ class NoCollision(Criterion):
             if exempt is not None:
                 self.unavoidable.append(f"{what} at {sample.t:.2f} s: unavoidable under "
                                         f"UN R157 5.2.5.2 ({exempt})")
+                if self.count == 0:
+                    self.ends_judging = f"the unavoidable collision with {what}"
                 continue
             self.count += 1
             self._contacts.append((sample.t, what))

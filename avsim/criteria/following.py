@@ -127,8 +127,11 @@ def ahead_of(sample: TruthSample, road: RoadMap,
 
 class StandstillGap(Criterion):
     """Each time the ego stands (below `STOPPED` for `HOLD`) behind a vehicle in its lane
-    within `REACH`, the bumper gap is within [low, high]. Value: the standstill gap farthest
-    from the band's middle [m], against the bound on its side; fails if it never stood."""
+    within `REACH` that stands too, the bumper gap is within [low, high] (UN R157 4.2.1:
+    the gap to a vehicle at rest; once it drives off the gap opens until the ego follows).
+    Value: the standstill gap farthest from the band's middle [m], against the bound on its
+    side; not applicable if it never stood behind a standing vehicle (the vehicle ahead
+    drove off before the ego came to rest behind it)."""
 
     name, unit = "standstill_gap", "m"
     STOPPED, HOLD, REACH = 0.1, 1.0, 15.0  # [m/s], [s], [m]
@@ -146,7 +149,8 @@ class StandstillGap(Criterion):
         self._since = sample.t if self._since is None else self._since
         ahead = ahead_of(sample, self.road, self.ego_length)
         gap = ahead[0].gap if ahead else math.inf
-        if sample.t - self._since < self.HOLD or gap > self.REACH:
+        if sample.t - self._since < self.HOLD or gap > self.REACH or \
+                ahead[0].speed >= self.STOPPED:
             return
         self.gaps.append(gap)
         if not self.low <= gap <= self.high:
@@ -155,8 +159,8 @@ class StandstillGap(Criterion):
 
     def result(self) -> CriterionResult:
         if not self.gaps:
-            return CriterionResult(self.name, False, None, self.low, self.unit, None,
-                                   "the ego never stood behind a vehicle")
+            return CriterionResult.not_applicable(
+                self.name, self.low, self.unit, "the ego never stood behind a standing vehicle")
         mid = 0.5 * (self.low + self.high)
         worst = max(self.gaps, key=lambda g: abs(g - mid))
         bound = self.low if worst < mid else self.high
@@ -258,7 +262,8 @@ STANDSTILL_GAP: Declaration[tuple[float, float]] = Declaration(
     needs=frozenset({Need.MAP, Need.CAR, Need.ACTORS}), key="standstill_gap",
     setting=StandstillGapSetting,
     doc="[m] `[low, high]`: the bumper gap to the vehicle ahead each time the ego stands "
-    "behind it; it must stand at least once. Default: off.", example=[2.0, 6.0])
+    "behind it while it stands too; not applicable if that never happens. Default: off.",
+    example=[2.0, 6.0])
 
 RESUME_WITHIN: Declaration[float] = Declaration(
     build=lambda threshold, run: [TimeToResume(threshold, run.set_speed, run.road,

@@ -49,6 +49,10 @@ would otherwise flip TRAIL and CRUISE with every wobble of its measured speed (i
 And a lead lost leaves TRAIL only after lead_hold (`lead_lost`: no lead now, one within
 lead_hold; *): when the lead cuts out, the vehicle it hid becomes the lead once its track
 is confirmed, and the mode goes on as TRAIL instead of flipping to CRUISE and back.
+Table 2 enters TRAIL from CRUISE and SPEED_LIMIT only beyond d_des: a lead inside d_des but
+beyond d_min (the car stood behind it at a red light, or it cut in close but not under
+d_min) would leave the car cruising on the speed plan, up into it until a comfortable stop
+is gone; those rows start at d_min (*), and TRAIL's law opens the gap to d_des.
 Table 2's conditions overlap: out of BRAKE with the lead beyond d_max, Trail's row also
 holds, so Cruise and SpeedLimit are tried first.
 
@@ -74,7 +78,8 @@ holds, so Cruise and SpeedLimit are tried first.
 17. cruise, trail, speed_limit -> brake: d <= d_min (Table 2: Cruise -> Brake; Trail,
     SpeedLimit *)
 18. cruise, trail, speed_limit -> brake: no comfortable stop (a_need > a_comf_max) *
-19. cruise -> trail: d_des < d < d_max and V_l < V_s
+19. cruise -> trail: d_min < d < d_max and V_l < V_s (Table 2: d_des < d; inside d_des too
+    *)
 20. trail -> cruise: V_GPS >= V_s and ((d >= d_max and not lead_lost) or (V_s + v_band <=
     V_l and d_min < d < inf))
 21. brake -> cruise: V_GPS >= V_s and (d >= d_max or V_s + v_band <= V_l) and d > d_min and
@@ -85,7 +90,8 @@ holds, so Cruise and SpeedLimit are tried first.
     or V_l < V_GPS) and d > d_min and a_need relaxed *
 24. speed_limit -> cruise: V_GPS >= V_s and (d >= d_max or (V_GPS + v_band <= V_l and d >
     d_min))
-25. speed_limit -> trail: (V_GPS < V_s or V_l < V_GPS) and d_des < d < d_max
+25. speed_limit -> trail: (V_GPS < V_s or V_l < V_GPS) and d_min < d < d_max (d_des < d:
+    inside d_des too *)
 26. cruise, trail -> speed_limit: V_GPS < V_s and ((d >= d_max and not lead_lost) or (V_GPS
     + v_band <= V_l and d_min < d < inf)) (Trail *; v_band, lead_lost *)
 
@@ -248,7 +254,7 @@ def _to_limit(_m: AccMode, x: AccInput, g: Gaps) -> bool:
 
 
 def _cruise_to_trail(_m: AccMode, x: AccInput, g: Gaps) -> bool:
-    return g.d_des < x.d < g.d_max and x.v_l < x.v_s
+    return g.d_min < x.d < g.d_max and x.v_l < x.v_s
 
 
 def _trail_to_cruise(_m: AccMode, x: AccInput, g: Gaps) -> bool:
@@ -277,7 +283,7 @@ def _limit_to_cruise(_m: AccMode, x: AccInput, g: Gaps) -> bool:
 
 
 def _limit_to_trail(_m: AccMode, x: AccInput, g: Gaps) -> bool:
-    return (x.v_gps < x.v_s or x.v_l < x.v_gps) and g.d_des < x.d < g.d_max
+    return (x.v_gps < x.v_s or x.v_l < x.v_gps) and g.d_min < x.d < g.d_max
 
 
 # -- the table --------------------------------------------------------------------------------
@@ -327,7 +333,8 @@ TABLE: Table[AccMode, AccInput, Gaps] = Table(AccMode, (
     Row(frozenset({M.CRUISE, M.TRAIL, M.SPEED_LIMIT}), M.BRAKE, _no_comfortable_stop,
         "no comfortable stop (a_need > a_comf_max) *", _why_hard),
     Row(frozenset({M.CRUISE}), M.TRAIL, _cruise_to_trail,
-        "d_des < d < d_max and V_l < V_s", "a slower vehicle ahead within d_max"),
+        "d_min < d < d_max and V_l < V_s (Table 2: d_des < d; inside d_des too *)",
+        "a slower vehicle ahead within d_max"),
     Row(frozenset({M.TRAIL}), M.CRUISE, _trail_to_cruise,
         "V_GPS >= V_s and ((d >= d_max and not lead_lost) or (V_s + v_band <= V_l and d_min "
         "< d < inf))",
@@ -348,7 +355,8 @@ TABLE: Table[AccMode, AccInput, Gaps] = Table(AccMode, (
         "V_GPS >= V_s and (d >= d_max or (V_GPS + v_band <= V_l and d > d_min))",
         "the posted limit is no longer below the set speed"),
     Row(frozenset({M.SPEED_LIMIT}), M.TRAIL, _limit_to_trail,
-        "(V_GPS < V_s or V_l < V_GPS) and d_des < d < d_max", "a vehicle ahead within d_max"),
+        "(V_GPS < V_s or V_l < V_GPS) and d_min < d < d_max (d_des < d: inside d_des too *)",
+        "a vehicle ahead within d_max"),
     Row(frozenset({M.CRUISE, M.TRAIL}), M.SPEED_LIMIT, _to_limit,
         "V_GPS < V_s and ((d >= d_max and not lead_lost) or (V_GPS + v_band <= V_l and d_min "
         "< d < inf)) (Trail *; v_band, lead_lost *)",

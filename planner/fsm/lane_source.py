@@ -26,7 +26,8 @@ and the first that holds is taken:
 10. acquiring, map_hold, stop_in_lane -> camera: confidence >= `acquire` (a good lane
     estimate) of the lane kept
 11. acquiring -> map_hold: no good estimate of the lane kept for `acquire_time`
-12. map_hold -> stop_in_lane: lost for `stop_after` seconds
+12. map_hold -> stop_in_lane: lost for `stop_after` seconds of moving (standing, as in a
+    queue, does not count)
 
 What each state follows (`planner.planner`): MAP is the state of a stack built without a
 camera (GNSS + odometry on the HD map only); no row leaves it. ACQUIRING follows the map
@@ -44,8 +45,12 @@ straight to MAP_HOLD. So does a camera whose frames the sensor-health monitor fi
 lane is taken from it (`acquire` needs a camera without a fault) until its frames are sound
 again; the change's reason says how the fault was noticed. MAP_HOLD follows the map lane
 placed by the localisation estimate (odometry, GNSS and the camera's lane as long as it was
-seen) and slows to `hold_speed`; STOP_IN_LANE brings the car to a stop in its lane (with the
-hazard lights on, `planner.fsm.hazard`), until the lane is found again. JUNCTION follows
+seen) and slows to `hold_speed`; the time it has to find the lane again counts only while
+the car moves (`standing`): standing a few metres behind a car in a queue, the camera sees
+no line past it, and the car holds, to follow the queue off on the map until the lines are
+in view again, not to stop in lane with its hazard lights on. STOP_IN_LANE brings the car
+to a stop in its lane (with the hazard lights on, `planner.fsm.hazard`), until the lane is
+found again. JUNCTION follows
 the map's path through a town junction at the planned speed: the painted lines end at the
 junction's mouth, and the path turns where none are painted. Every change carries a reason
 for the log.
@@ -78,6 +83,9 @@ class LaneSourceParams:
     acquire_time: float = 1.0  # [s] ACQUIRING this long without a lane: hold on the map
     stop_after: float = 5.0  # [s] MAP_HOLD this long: stop in lane
     hold_speed: float = kph(20.0)  # [m/s] speed while holding the lane on the map
+    standing_speed: float = 0.1  # [m/s] slower than this the car stands: a lane lost while
+    #   it stands (its view of the lines blocked by the car it queues behind) is no reason
+    #   to stop in lane: MAP_HOLD's `stop_after` counts only the time it moves
     dead_reckon_time: float = 1.0  # [s] ONE_LINE keeps a lane measured no longer ago (60 km/h:
     #   17 m, two 12 m periods of a dashed line; the odometry's heading drifts little in it)
 
@@ -93,6 +101,8 @@ class LaneSourceInput:
     age: float = math.inf  # [s] since the lane was last measured (dead-reckoned since)
     camera_fault: str | None = None  # how a fault of the camera was noticed in its frames
     #   (`perception.health`: blank, frozen, missing); None while it is fine
+    standing: float = 0.0  # [s] the car has stood (odometry below `standing_speed`) since
+    #   the state was entered
 
 
 def _good(x: LaneSourceInput, p: LaneSourceParams) -> bool:
@@ -140,7 +150,7 @@ def _nothing_found(_s: LaneSource, x: LaneSourceInput, p: LaneSourceParams) -> b
 
 
 def _lost_too_long(_s: LaneSource, x: LaneSourceInput, p: LaneSourceParams) -> bool:
-    return x.t - x.since >= p.stop_after
+    return x.t - x.since - x.standing >= p.stop_after
 
 
 L = LaneSource
@@ -182,7 +192,7 @@ TABLE: Table[LaneSource, LaneSourceInput, LaneSourceParams] = Table(LaneSource, 
         "no good estimate of the lane kept for `acquire_time`",
         lambda x, p: f"no lane found in {p.acquire_time:.1f} s"),
     Row(frozenset({L.MAP_HOLD}), L.STOP_IN_LANE, _lost_too_long,
-        "lost for `stop_after` seconds",
+        "lost for `stop_after` seconds of moving (standing, as in a queue, does not count)",
         lambda x, p: f"lane lost for {p.stop_after:.1f} s: stopping in lane"),
 ))
 

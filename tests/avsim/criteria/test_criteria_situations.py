@@ -10,7 +10,7 @@ import dataclasses
 import numpy as np
 import pytest
 
-from avsim.criteria.base import CriterionResult, TruthSample
+from avsim.criteria.base import CriterionResult, TruthSample, Verdict
 from avsim.criteria.following import StandstillGap, TimeToResume
 from avsim.criteria.lane import (
     LINE_HALF_WIDTH,
@@ -262,17 +262,31 @@ def test_standing_too_close_fails_once_it_has_stood_1_s() -> None:
 @pytest.mark.parametrize("stop", [(0.9, 1.5), (3.0, 16.0)])  # short, nothing within 15 m
 def test_a_short_stop_or_one_with_nothing_near_is_no_standstill(stop: tuple[float, float]) -> None:
     r = stood(stop)
-    assert not r.passed and r.first_failure is None
-    assert r.note == "the ego never stood behind a vehicle"
+    assert r.verdict is Verdict.NOT_APPLICABLE and r.first_failure is None
+    assert r.note == "the ego never stood behind a standing vehicle"
 
 
-def test_never_standing_fails_with_a_note_in_the_json() -> None:
+def test_never_standing_is_not_applicable_with_a_note_in_the_json() -> None:
     c = StandstillGap(2.0, 6.0, ROAD, EGO_LENGTH)
     for k in range(100):
         c.update(truth(k * DT, speed=5.0, actors=cars([gap_ahead(4.0)], [0.0], [5.0])))
     assert c.result().as_json() == {
-        "name": "standstill_gap", "verdict": "fail", "passed": False, "value": None,
-        "threshold": 2.0, "unit": "m", "note": "the ego never stood behind a vehicle"}
+        "name": "standstill_gap", "verdict": "not_applicable", "passed": None, "value": None,
+        "threshold": 2.0, "unit": "m", "note": "the ego never stood behind a standing vehicle"}
+
+
+def test_the_gap_opening_as_the_vehicle_ahead_drives_off_is_not_judged() -> None:
+    """The ego stands 2 s 4 m behind a standing car, which then drives off at 2 m/s while
+    the ego still stands 2 s: the gap judged is 4 m, not the 8 m it opens to."""
+    c = StandstillGap(2.0, 6.0, ROAD, EGO_LENGTH)
+    for k in range(round(4.0 * RATE)):
+        t = k * DT
+        moving = t >= 2.0
+        gap = 4.0 + (2.0 * (t - 2.0) if moving else 0.0)
+        c.update(truth(t, speed=0.0, actors=cars([gap_ahead(gap)], [0.1],
+                                                 [2.0 if moving else 0.0])))
+    r = c.result()
+    assert r.passed and r.value == pytest.approx(4.0)
 
 
 def resume(back_at: float, *, leaves: bool = True, fast: float = 12.0, station: float = 100.0,

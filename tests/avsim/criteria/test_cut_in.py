@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from avsim.criteria.base import TruthSample, Verdict
+from avsim.criteria.base import CriteriaSet, Criterion, CriterionResult, TruthSample, Verdict
 from avsim.criteria.collision import NoCollision
 from avsim.criteria.cut_in import INTRUSION, R157_VISIBLE, CutInWatch
 from tests.roads import make_map, seg
@@ -111,3 +111,59 @@ def test_without_the_setting_every_collision_fails() -> None:
     for s in cut_in(7.0):
         criterion.update(s)
     assert criterion.result().verdict is Verdict.FAIL
+
+
+class _Seen(Criterion):
+    """A criterion that counts the samples it saw, and fails at the end unless it saw
+    `settles` of them (a verdict only the run's end settles, as `completes`)."""
+
+    name, unit = "seen", "samples"
+
+    def __init__(self, fail_at: float | None = None, settles: int = 10**6) -> None:
+        super().__init__()
+        self.seen, self.fail_at, self.settles = 0, fail_at, settles
+
+    def update(self, sample: TruthSample) -> None:
+        self.seen += 1
+        if self.fail_at is not None and sample.t >= self.fail_at:
+            self._fail(sample, "failed")
+
+    def result(self) -> CriterionResult:
+        return CriterionResult(self.name, self.first_failure is None and
+                               self.seen >= self.settles, self.seen, None, self.unit,
+                               self.first_failure)
+
+
+def test_an_unavoidable_collision_ends_the_judging() -> None:
+    """After the unavoidable collision no criterion sees a sample; a failure seen before
+    it stands, a verdict only the run's end would settle is not applicable, and the
+    samples after the collision (the car pushed across the lane) change nothing."""
+    samples = cut_in(7.0)
+    crash = samples[-1].t
+    after = [sample(crash + DT * k, 130.0, samples[-1].actors or poses(0, 0, 0), True)
+             for k in range(1, 40)]
+    failed_before, unsettled = _Seen(fail_at=samples[5].t), _Seen()
+    collision = NoCollision({BODY: "actor cutter"}, {BODY: "cutter"},
+                            CutInWatch(ROAD, EGO_LENGTH))
+    criteria = CriteriaSet([collision, failed_before, unsettled])
+    for s in samples + after:
+        criteria.update(s)
+    assert criteria.ended is not None and criteria.ended[0] == crash
+    assert unsettled.seen == len(samples)  # none after the collision
+    results = criteria.results()
+    assert results[0].verdict is Verdict.NOT_APPLICABLE  # the collision: reported
+    assert results[1].verdict is Verdict.FAIL and results[1].first_failure == samples[5].t
+    assert results[2].verdict is Verdict.NOT_APPLICABLE
+    assert "judging ended with the unavoidable collision with actor cutter" in (
+        results[2].note or "")
+
+
+def test_a_collision_to_avoid_does_not_end_the_judging() -> None:
+    unsettled = _Seen()
+    criteria = CriteriaSet([NoCollision({BODY: "actor cutter"}, {BODY: "cutter"},
+                                        CutInWatch(ROAD, EGO_LENGTH)), unsettled])
+    samples = cut_in(30.0)
+    for s in samples + samples[-1:] * 5:
+        criteria.update(s)
+    assert criteria.ended is None and unsettled.seen == len(samples) + 5
+    assert criteria.results()[0].verdict is Verdict.FAIL

@@ -80,6 +80,10 @@ TABLE_CASES = [
     ("cruise_no_trail_lead_faster", M.CRUISE, x(d=BETWEEN, v_l=16.0), None),
     ("cruise_no_trail_far", M.CRUISE, x(d=FAR, v_l=VL), None),
     ("cruise_brake", M.CRUISE, x(d=CLOSE, v_l=VL), M.BRAKE),
+    # inside d_des but beyond d_min: TRAIL's law opens the gap (*: Table 2 starts at d_des)
+    ("cruise_trail_inside_d_des", M.CRUISE, x(d=0.5 * (G.d_min + G.d_des), v_l=VL), M.TRAIL),
+    #   standing 3.3 m behind a standing car when the light turns green (issue K 6)
+    ("cruise_trail_standing_behind_a_car", M.CRUISE, x(v=0.0, d=3.3, v_l=0.0), M.TRAIL),
     ("cruise_limit_no_lead", M.CRUISE, x(v_gps=13.0), M.SPEED_LIMIT),
     ("cruise_limit_lead_faster", M.CRUISE, x(v_gps=13.0, d=BETWEEN, v_l=14.0), M.SPEED_LIMIT),
     ("cruise_stays", M.CRUISE, x(), None),
@@ -127,6 +131,8 @@ TABLE_CASES = [
     # SpeedLimit (4 to 1, 4 to 2; * to Brake)
     ("limit_cruise", M.SPEED_LIMIT, x(), M.CRUISE),
     ("limit_trail", M.SPEED_LIMIT, x(v_gps=13.0, d=BETWEEN, v_l=VL), M.TRAIL),
+    ("limit_trail_inside_d_des", M.SPEED_LIMIT,
+     x(v_gps=13.0, d=0.5 * (G.d_min + G.d_des), v_l=VL), M.TRAIL),
     ("limit_stays", M.SPEED_LIMIT, x(v_gps=13.0), None),
     ("limit_brake", M.SPEED_LIMIT, x(v_gps=13.0, d=CLOSE, v_l=VL), M.BRAKE),
     # events from ACC_ACTIVE (* generalised from Table 2's rows)

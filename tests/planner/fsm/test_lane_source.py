@@ -144,6 +144,26 @@ def test_camera_fault_table(state: LaneSource, confidence: float, fault: str | N
         assert change.reason == f"{FAULT}: holding on the map"
 
 
+# (seconds stood of the time in MAP_HOLD) -> next state: entered at 2 s, now 2 s +
+# stop_after; standing (in a queue, the lines hidden by the car ahead) does not count
+STANDING_TABLE = [
+    (0.0, S.STOP_IN_LANE),
+    (0.01, None),
+    (P.stop_after, None),  # stood the whole time: holds on
+]
+
+
+@pytest.mark.parametrize(("standing", "expected"), STANDING_TABLE)
+def test_standing_time_does_not_count_towards_the_stop_in_lane(
+        standing: float, expected: LaneSource | None) -> None:
+    x = LaneSourceInput(2.0 + P.stop_after, 0.0, 2.0, standing=standing)
+    change = transition(S.MAP_HOLD, x, P)
+    assert (change.to if change else None) is expected
+    moved_on = LaneSourceInput(2.0 + P.stop_after + standing, 0.0, 2.0, standing=standing)
+    again = transition(S.MAP_HOLD, moved_on, P)  # once it has moved stop_after in all
+    assert again is not None and again.to is S.STOP_IN_LANE
+
+
 def test_every_state_and_edge_of_the_table_is_covered() -> None:
     edges = {(row[0], row[4]) for row in TABLE_CASES if row[4] is not None}
     edges |= {(row[0], row[3]) for row in JUNCTION_TABLE if row[3] is not None}
