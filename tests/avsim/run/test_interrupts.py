@@ -135,3 +135,84 @@ def test_an_interrupted_sweep_keeps_its_finished_runs_and_reports(tmp_path: Path
         assert check.returncode == 0, check.stderr
     assert not (out / "normal_driving_002.rrd").exists()
     assert not [p for p in out.rglob(".*")], "a temporary file was left behind"
+
+
+def _processes() -> dict[int, tuple[int, str]]:
+    """pid -> (parent pid, start time) of every live process (zombies aside), from /proc."""
+    out = {}
+    for entry in Path("/proc").iterdir():
+        if not entry.name.isdigit():
+            continue
+        try:
+            fields = (entry / "stat").read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        if fields[0] != "Z":
+            out[int(entry.name)] = (int(fields[1]), fields[19])  # ppid, starttime
+    return out
+
+
+def _descendants(pid: int) -> dict[int, str]:
+    """pid -> start time of every live descendant of `pid` (children of children, ...)."""
+    procs = _processes()
+    found: dict[int, str] = {}
+    grew = True
+    while grew:
+        more = {p: start for p, (parent, start) in procs.items()
+                if (parent == pid or parent in found) and p not in found}
+        found |= more
+        grew = bool(more)
+    return found
+
+
+def _alive(processes: dict[int, str]) -> list[int]:
+    """Those of `processes` (pid -> start time) still alive (the same process: its start
+    time too)."""
+    now = _processes()
+    return [p for p, start in processes.items() if p in now and now[p][1] == start]
+
+
+@pytest.mark.slow
+def test_an_interrupted_sweep_on_ray_cancels_its_tasks_and_keeps_what_finished(
+        tmp_path: Path) -> None:
+    """The same on a local Ray instance, one task at a time: SIGINT once the first run's
+    files are back. The task under way and the one not started are cancelled (a Ray
+    task's files come back only when it finishes: both are not run); the finished run's
+    files and the reports stay; exit 130; Ray and its workers are gone with the sweep."""
+    out = tmp_path / "sweep"
+    env = {**os.environ, "PYTHONPATH": str(REPO)}
+    env.pop("RAY_ADDRESS", None)
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "avsim.cli", "sweep", "normal_driving", "--set",
+         "seed=1,2,3", "--set", "duration=40", "--executor", "ray", "--jobs", "1",
+         "--profile", "none", "--no-snapshots", "--out", str(out)],
+        cwd=tmp_path, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        start_new_session=True)
+    first = out / "normal_driving_000.json"
+    deadline = time.monotonic() + 400
+    while not first.exists() and proc.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert first.exists(), proc.communicate(timeout=60)[1]
+    time.sleep(1.0)  # the second task under way (40 s simulated: several s of wall time)
+    ray = _descendants(proc.pid)  # Ray's processes and workers, started by the sweep
+    assert len(ray) >= 3, ray
+    os.killpg(proc.pid, signal.SIGINT)
+    _, stderr = proc.communicate(timeout=300)
+    assert proc.returncode == 130, stderr
+    assert "Traceback" not in stderr
+    runs = {r["name"]: r for r in json.loads((out / "results.json").read_text(encoding="utf-8"))}
+    assert runs["normal_driving_000"]["status"] in ("passed", "failed")
+    for name in ("normal_driving_001", "normal_driving_002"):
+        assert runs[name]["status"] == "interrupted" and runs[name]["result"] is None
+        assert runs[name]["error"].endswith("not run (the batch was interrupted)")
+        assert not (out / f"{name}.json").exists()
+    assert (out / "junit.xml").is_file() and (out / "sweep.csv").is_file()
+    assert "**interrupted**: 2 runs" in (out / "summary.md").read_text(encoding="utf-8")
+    check = subprocess.run([str(RERUN), "rrd", "verify", str(out / "normal_driving_000.rrd")],
+                           capture_output=True, text=True, check=False)
+    assert check.returncode == 0, check.stderr
+    assert not [p for p in out.rglob(".*")], "a temporary file was left behind"
+    deadline = time.monotonic() + 30  # Ray's processes may take a moment to exit
+    while _alive(ray) and time.monotonic() < deadline:
+        time.sleep(0.2)
+    assert _alive(ray) == [], "Ray processes outlived the sweep"
