@@ -13,11 +13,13 @@ import pytest
 from perception.messages import ObjectClass, Track
 from planner.acc_control import AccControlParams
 from planner.lead import (
+    CUT_IN_HORIZON,
     Candidate,
     LeadParams,
     LeadSelector,
     costly_wait,
     crossing_lateral,
+    cut_in_lateral,
     far_centre,
     lane_candidates,
     map_bend,
@@ -158,8 +160,45 @@ def test_a_walker_heading_into_the_lane_is_in_it_and_one_on_the_pavement_is_not(
     (crossing,) = lane_candidates([walker(-4.2, 1.5)], lambda x: 0.0, 0.0, 2.4)
     (strolling,) = lane_candidates([walker(-4.2, 0.0)], lambda x: 0.0, 0.0, 2.4)
     assert crossing.lateral == pytest.approx(0.0) and strolling.lateral == pytest.approx(-4.2)
-    car = replace(walker(-4.2, 1.4), cls=ObjectClass.CAR)  # a car's drift is no crossing
-    assert lane_candidates([car], lambda x: 0.0, 0.0, 2.4)[0].lateral == pytest.approx(-4.2)
+    car = replace(walker(-4.2, 1.4), cls=ObjectClass.CAR)  # a car moving over: 1 s ahead only
+    assert lane_candidates([car], lambda x: 0.0, 0.0, 2.4)[0].lateral == pytest.approx(
+        -4.2 + 1.4 * CUT_IN_HORIZON)
+
+
+@pytest.mark.parametrize(("lateral", "lateral_speed", "expected"), [
+    (3.5, -1.0, 3.5 - CUT_IN_HORIZON),  # cutting in from the left at 1 m/s
+    (-3.5, 2.0, -3.5 + 2.0 * CUT_IN_HORIZON),  # from the right at 2 m/s
+    (1.0, -1.5, 0.0),  # crosses the centre line within the horizon
+    (3.5, -0.3, 3.5),  # a sway within its lane: where it is
+    (3.5, 1.0, 3.5),  # moving away
+    (0.5, 1.0, 0.5),  # a lead cutting out: where it is (the hold keeps it)
+])
+def test_a_vehicle_moving_into_the_lane_is_taken_where_it_will_be(
+        lateral: float, lateral_speed: float, expected: float) -> None:
+    assert cut_in_lateral(lateral, lateral_speed) == pytest.approx(expected)
+
+
+def test_the_cut_in_speed_is_over_ground_across_the_lane_not_the_egos_yaw() -> None:
+    """A car in the next lane 50 m ahead where the lane bends left (its centre line rises
+    at a slope of 0.025 there), driving along its lane at 20 m/s: its velocity has 0.5 m/s
+    to the left of the ego's heading, but none across its lane, so it is where it is; the
+    same car moving over at 1 m/s towards the centre line is taken 1 s further in."""
+    lane = math.atan(0.025)  # the lane's heading at the car
+    along = (20.0 * math.cos(lane), 20.0 * math.sin(lane))
+    keeping = Track(id=3, t=1.0, x=50.0, y=4.75, vx=along[0], vy=along[1], rel_x=50.0,
+                    rel_y=4.75, rel_vx=0.0, rel_vy=along[1], length=4.5, width=1.8,
+                    height=1.5, yaw=lane, cls=ObjectClass.CAR, hits=5, misses=0,
+                    position_sigma=0.1)
+
+    def centre(x: float) -> float:
+        return 0.025 * x  # 1.25 m left at 50 m: the car 3.5 m left of it
+
+    (c,) = lane_candidates([keeping], centre, 0.0, 2.4)
+    assert c.lateral == pytest.approx(3.5)
+    right = (math.sin(lane), -math.cos(lane))  # 1 m/s to the lane's right
+    moving = replace(keeping, vx=along[0] + right[0], vy=along[1] + right[1])
+    (c,) = lane_candidates([moving], centre, 0.0, 2.4)
+    assert c.lateral == pytest.approx(3.5 - CUT_IN_HORIZON)
 
 
 # ---- the lane centre beyond the camera's reach ------------------------------------------
