@@ -15,7 +15,8 @@ with its gap, speed and lateral offset from the lane's centre line.
   car's path before it steps into the lane; a vehicle moving across the lane towards its
   centre line faster than ``CUT_IN_SPEED`` (its velocity over ground across the lane's
   direction where it is: no yaw of the ego's in it) is taken where it will be
-  ``CUT_IN_HORIZON`` later (`cut_in_lateral`): a car cutting in at 1 m/s has its body
+  ``CUT_IN_HORIZON`` later (`cut_in_lateral`; its lateral speed is the track's, which lags
+  the move by a few tenths of a second): a car cutting in at 1 m/s has its body
   0.2 m inside the lane 0.8 s before its centre is within ``half_width``, and UN R157
   5.2.5.2 counts from that intrusion (issue K: a cut-in 30 m ahead at 20 km/h slower was
   taken as the lead 0.8 s after its intrusion and hit);
@@ -58,7 +59,7 @@ from world.hdmap import Lane
 
 CROSSING_HORIZON = 3.0  # [s] a pedestrian's walk is predicted this far ahead at most (the
 #   time to collision at which AEB pedestrian systems brake; 50 m at 60 km/h)
-CUT_IN_HORIZON = 1.0  # [s] a vehicle moving into the lane is taken where it will be this
+CUT_IN_HORIZON = 1.5  # [s] a vehicle moving into the lane is taken where it will be this
 #   much later (a lane change's lateral move lasts 3 to 6 s)
 CUT_IN_SPEED = 0.4  # [m/s] ... if it moves across faster than this (a car keeping its lane
 #   sways at 0.1 to 0.2 m/s; a lane change moves at 0.5 to 2.5 m/s)

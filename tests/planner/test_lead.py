@@ -182,7 +182,7 @@ def test_the_cut_in_speed_is_over_ground_across_the_lane_not_the_egos_yaw() -> N
     """A car in the next lane 50 m ahead where the lane bends left (its centre line rises
     at a slope of 0.025 there), driving along its lane at 20 m/s: its velocity has 0.5 m/s
     to the left of the ego's heading, but none across its lane, so it is where it is; the
-    same car moving over at 1 m/s towards the centre line is taken 1 s further in."""
+    same car moving over at 1 m/s towards the centre line is taken 1.5 s further in."""
     lane = math.atan(0.025)  # the lane's heading at the car
     along = (20.0 * math.cos(lane), 20.0 * math.sin(lane))
     keeping = Track(id=3, t=1.0, x=50.0, y=4.75, vx=along[0], vy=along[1], rel_x=50.0,
