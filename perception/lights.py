@@ -230,13 +230,17 @@ class TrafficLightDetector:
         self.road = road
         self.vehicle = vehicle
         self.params = params or LightParams()
+        self._station: float | None = None  # [m] the car's station at the last look (a
+        #   town route crossing itself passes a point twice: `ReferenceLine.project`)
 
     def heads_ahead(self, ego: EgoState) -> list[tuple[int, LightHead]]:
         """(id, head) of the map's lights whose stop line is at most ``stop_line_ahead``
         ahead of the front bumper, or less than ``stop_line_behind`` behind it, by station
         along the road (an id indexes `RoadMap.traffic_lights`)."""
         p = self.params
-        station = float(self.road.local_coordinates(np.array([ego.x, ego.y]))[0])
+        station = float(self.road.local_coordinates(np.array([ego.x, ego.y]),
+                                                     self._station)[0])
+        self._station = station
         front = station + self.vehicle.front_overhang
         return [(i, light.head) for i, light in enumerate(self.road.traffic_lights)
                 if -p.stop_line_behind < light.s - front <= p.stop_line_ahead]

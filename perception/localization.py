@@ -236,6 +236,8 @@ class Localizer:
         self._initialised = False
         self._last_odo: Odometry | None = None
         self._bias_sigma = 0.0  # [m] 1-sigma of the GNSS bias (the receiver's stated)
+        self._station: float | None = None  # [m] the estimate's station on the route when
+        #   last placed on it (`_on_route`)
         self.matched = False  # a camera lane has been matched on the map since the start
 
     @property
@@ -295,12 +297,12 @@ class Localizer:
         if found is None:
             return None
         index, map_lane, s = found
-        _, r = map_lane.local_coordinates(np.array([pose.x, pose.y]))
+        _, r = self._on_route(np.array([pose.x, pose.y]), map_lane)
         theta = float(map_lane.heading_at(s))
         nu = np.array([lane.offset - float(r),
                        wrap_angle(lane.heading_error - wrap_angle(pose.heading - theta))])
         now_theta = float(map_lane.heading_at(
-            map_lane.local_coordinates(self.state[[IX, IY]])[0]))
+            self._on_route(self.state[[IX, IY]], map_lane)[0]))
         h = np.zeros((2, DIM_X))
         h[0, IX], h[0, IY] = -math.sin(now_theta), math.cos(now_theta)
         h[1, IPSI] = 1.0
@@ -326,7 +328,7 @@ class Localizer:
         if not ends or not lo <= max(ends) <= hi:
             return None
         x_end = max(ends)  # [m] the farthest line: a car ahead hides the nearer ends
-        s = float(road.local_coordinates(np.array([pose.x, pose.y]))[0])
+        s = self._on_route(np.array([pose.x, pose.y]))[0]
         mouths = [j.s_enter - s for j in road.junctions if lo - 5.0 <= j.s_enter - s <= hi + 5.0]
         if not mouths:
             return None
@@ -340,8 +342,7 @@ class Localizer:
         road = self.road
         if road is None:
             return None
-        s_arr, d_arr = road.local_coordinates(np.array([pose.x, pose.y]))
-        s, d = float(s_arr), float(d_arr)
+        s, d = self._on_route(np.array([pose.x, pose.y]))
         lanes = [lane for lane in road.lanes if bool(lane.exists_at(s))]
         if not lanes:
             return None
@@ -354,7 +355,7 @@ class Localizer:
         if self.road is None:
             return []
         road = self.road
-        s = float(road.local_coordinates(np.array([pose.x, pose.y]))[0])
+        s = self._on_route(np.array([pose.x, pose.y]))[0]
         lines = {f.s for f in road.features if isinstance(f, StopSign)}
         lines |= {j.s_stop for j in road.junctions}
         return sorted(d for d in (line - s for line in lines) if near <= d <= far)
@@ -394,7 +395,7 @@ class Localizer:
         """(1, 7) the position's component along the route at the estimate."""
         assert self.road is not None
         road = self.road
-        theta = float(road.heading_at(float(road.local_coordinates(self.state[[IX, IY]])[0])))
+        theta = float(road.heading_at(self._on_route(self.state[[IX, IY]])[0]))
         h = np.zeros((1, DIM_X))
         h[0, IX], h[0, IY] = math.cos(theta), math.sin(theta)
         return h
@@ -418,14 +419,23 @@ class Localizer:
         return LaneMatch(lane, innovation, d2, True,
                          (float(dx[IX]), float(dx[IY]), float(dx[IPSI])))
 
+    def _on_route(self, xy: FloatArray, lane: Lane | None = None) -> tuple[float, float]:
+        """(station, offset) [m] of the point `xy` on the route (on `lane`: from its centre;
+        else from the reference line), near the station the car was last placed at: a town
+        route that crosses itself passes a point twice (`world.hdmap.ReferenceLine.project`)."""
+        assert self.road is not None
+        on = lane if lane is not None else self.road
+        s_arr, d_arr = on.local_coordinates(xy, self._station)
+        self._station = float(s_arr)
+        return self._station, float(d_arr)
+
     def _match(self, lane: LaneEstimate, pose: EgoState) -> tuple[int, Lane, float] | None:
         """(index, lane, station at the pose) of the ego-direction lane whose centre plus
         the camera's offset is nearest the pose (the start lane before the first match)."""
         assert self.road is not None
         road = self.road
         xy = np.array([pose.x, pose.y])
-        s_arr, d_arr = road.local_coordinates(xy)
-        s, d = float(s_arr), float(d_arr)
+        s, d = self._on_route(xy)
         if self.matched:
             candidates = [i for i in range(len(road.lanes))
                           if bool(road.lanes[i].exists_at(s))]

@@ -45,7 +45,7 @@ from perception.messages import EgoState, ObjectClass, SignDetection, Track
 from planner.fsm.acc import NO_EVENTS, AccEvent
 from planner.limits import A_COMF
 from world.frames import VehicleInfo, kph
-from world.hdmap import Crosswalk, RoadMap, SpeedBump, StopSign, Zone
+from world.hdmap import NEAR_WINDOW, Crosswalk, RoadMap, SpeedBump, StopSign, Zone
 
 
 @dataclass(frozen=True, slots=True)
@@ -95,6 +95,9 @@ class EventMonitor:
         self.confirmed: set[float] = set()  # stop lines whose sign perception saw
         self.done: set[float] = set()  # stop lines stopped at, not yet passed
         self._standing_since: float | None = None
+        self._station: float | None = None  # [m] the car's centre at the last update: the
+        #   signs seen are placed on the stretch ahead of it (a town route crossing itself
+        #   passes a point twice: `world.hdmap.ReferenceLine.project`)
 
     def confirm_sign(self, line_s: float) -> None:
         """Perception found the sign of the stop line at `line_s` [m]."""
@@ -106,11 +109,12 @@ class EventMonitor:
         of ``sign_match`` and 20 % of its range [m] of a stop line confirms that line."""
         p = self.params
         c, s = math.cos(pose.heading), math.sin(pose.heading)
+        near = None if self._station is None else self._station + NEAR_WINDOW  # the 60 m ahead
         for d in signs:
             if d.kind != "stop":
                 continue
             xy = (pose.x + c * d.x - s * d.y, pose.y + s * d.x + c * d.y)
-            station, offset = (float(a) for a in self.road.local_coordinates(xy))
+            station, offset = (float(a) for a in self.road.local_coordinates(xy, near))
             tolerance = max(p.sign_match, 0.2 * d.range)
             for line in self.stop_lines:
                 if abs(station - line) <= tolerance and offset < 0.0:
@@ -127,6 +131,7 @@ class EventMonitor:
         + the front overhang)."""
         p = self.params
         front = station + self.vehicle.front_overhang
+        self._station = station
         limit_station = front if limit_station is None else limit_station
         approach = v * v / (2.0 * p.a_comf) + p.approach_extra
         stop = self._stop_sign(t, front, v, approach)

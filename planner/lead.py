@@ -189,7 +189,10 @@ def route_candidates(tracks: Sequence[Track], lane: Lane, station: float, p: Lea
     vehicles = [tr for tr in tracks if tr.cls is not ObjectClass.OTHER]
     if not vehicles:
         return []
-    s, r = lane.local_coordinates(np.array([[tr.x, tr.y] for tr in vehicles]))
+    # near the stretch ahead of the car: a town route that crosses itself passes a junction
+    # twice, and a track in it must be placed on the pass the car is on
+    s, r = lane.local_coordinates(np.array([[tr.x, tr.y] for tr in vehicles]),
+                                  near=station + 0.5 * p.path_reach)
     out: list[Candidate] = []
     for tr, s_tr, r_tr in zip(vehicles, np.atleast_1d(s), np.atleast_1d(r), strict=True):
         ahead = float(s_tr) - station

@@ -153,6 +153,8 @@ class MotionLayer:
         self._blocked_since: float | None = None
         self._turn_end = math.inf  # [m] where the turn in hand ends (its junction's exit)
         self._near: set[int] = set()  # tracks of the lane being left found in the way
+        self._station: float | None = None  # [m] the car's station last tick (a town route
+        #   crossing itself passes a point twice: `world.hdmap.ReferenceLine.project`)
         #   (`_leads`)
         self._passing = False  # the change in hand is one to pass a slower vehicle
 
@@ -163,7 +165,8 @@ class MotionLayer:
         whether to pull over onto the shoulder (a flat tyre) and the lowest speed [m/s] the
         car plans during a lane change (the rear traffic is judged at it; default: its
         speed now)."""
-        s, d = (float(a) for a in self.road.local_coordinates((ego.x, ego.y)))
+        s, d = (float(a) for a in self.road.local_coordinates((ego.x, ego.y), self._station))
+        self._station = s
         lanes = self._lanes_around(s, ego.speed, pull_over)
         traffic = lane_traffic(self.road, tracks, ego.t, s, ego.speed, lanes,
                                self.params.occupancy, self.vehicle)

@@ -138,6 +138,7 @@ class Planner:
         self.source = Machine("lane_source",
                               LaneSource.ACQUIRING if p.camera else LaneSource.MAP)
         self._start: float | None = None  # [s] time of the first tick
+        self._station: float | None = None  # [m] the car's station when last localised
         self._standing = 0.0  # [s] the car has stood since the lane source's state was
         #   entered (`LaneSourceInput.standing`)
         self._lane_seen = False  # the camera's lane has been the path (the pose is matched)
@@ -165,9 +166,12 @@ class Planner:
         self.speed_planner = self._speed_planners[lane]
 
     def localise(self, ego: EgoState) -> tuple[float, float]:
-        """(station [m], lateral offset [m], left +) of the ego's centre on the lane kept."""
-        s, r = self.lane.local_coordinates(np.array([ego.x, ego.y]))
-        return float(np.asarray(s)), float(np.asarray(r))
+        """(station [m], lateral offset [m], left +) of the ego's centre on the lane kept:
+        near the station it had (a town route through a junction it crossed before passes
+        the same point twice: `world.hdmap.ReferenceLine.project`)."""
+        s, r = self.lane.local_coordinates(np.array([ego.x, ego.y]), self._station)
+        self._station = float(np.asarray(s))
+        return self._station, float(np.asarray(r))
 
     def path_for(self, ego: EgoState, station: float, offset: float = 0.0) -> ReferencePath:
         """The lane kept's centre (or the line `offset` [m] left of it) from ``path_behind``

@@ -58,6 +58,11 @@ SHOULDER = -1000  # the lane index of the paved right shoulder (`RoadMap.lane`)
 
 HALF_PI = 0.5 * np.pi  # [rad]
 TWO_PI = 2.0 * np.pi  # [rad]
+NEAR_WINDOW = 30.0  # [m] a projection near a station looks this far either side of it
+#   (`ReferenceLine.project`): more than a car moves between two looks, or its pose estimate
+#   jumps by, and less than the shortest loop of a town route (a block's four sides)
+HINT_SLACK = 3.0  # [m] the pass near the hint is kept unless the nearest of all is this much
+#   nearer (then the hint is stale: the car has moved on by more than the window)
 
 
 # ---------------------------------------------------------------------------------------
@@ -439,12 +444,20 @@ class ReferenceLine:
         y = self.cy[i] + along * self.sin_h0[i] - radial * np.cos(h)
         return np.stack([x, y], axis=-1)
 
-    def project(self, xy: FloatArray) -> tuple[FloatArray, FloatArray]:
+    def project(self, xy: FloatArray, near: float | None = None,
+                window: float = NEAR_WINDOW) -> tuple[FloatArray, FloatArray]:
         """(s, d) of points xy, shape (N, 2): station and offset from the reference line.
 
         Every piece projects each point in closed form (straights: dot / cross product;
         arcs: the angle around the centre, wrapped about the arc's middle); the station is
-        clipped to the piece, and the piece nearest to the point wins.
+        clipped to the piece, and the piece nearest to the point wins. With `near` [m] (the
+        station the points were at a moment ago, or are known to be near), only the pieces
+        within `window` [m] of it take part: a route that comes back through a junction it
+        crossed before passes the same point twice, and the nearest piece there may be the
+        other pass (the car's station would jump by the loop's length). The pass near the
+        hint is kept unless the nearest of all is more than `HINT_SLACK` nearer (a stale
+        hint: the car has moved on by more than the window since); without a piece in the
+        window (a hint off the route), every piece takes part.
         """
         px = xy[:, 0:1]  # (N, 1) against pieces (1, P + 2)
         py = xy[:, 1:2]
@@ -464,16 +477,31 @@ class ReferenceLine:
         excess = (t - t_clip) * np.abs(1.0 - self.k * d)
         cost = excess * excess + d * d
         rows = np.arange(xy.shape[0])
-        # a point lies beyond the route's start (end) only if its nearest point on the route
-        # is the start (end): on a route that comes back near itself (a loop nearly closed)
-        # the straight extensions must not claim points beside the route
+        best = self._nearest_piece(cost, t_clip, rows)
+        if near is not None:
+            nearby = (self.s0 + self.t_lo <= near + window) & (self.s0 + self.t_hi >= near - window)
+            if nearby[1:-1].any():
+                hinted = self._nearest_piece(np.where(nearby, cost, np.inf), t_clip, rows)
+                # the pass near the hint, unless it is much farther than the nearest of all (a
+                # stale hint: the car has moved on since, by more than the window)
+                off = cost[rows, hinted] - cost[rows, best] > HINT_SLACK**2
+                best = np.where(off, best, hinted)
+        s = self.s0[best] + t_clip[rows, best]
+        return s, d[rows, best]
+
+    def _nearest_piece(self, cost: FloatArray, t_clip: FloatArray,
+                       rows: IntArray) -> IntArray:
+        """Per point, the piece of least `cost` (N, P + 2), where a point lies beyond the
+        route's start (end) only if its nearest point on the route is the start (end): on a
+        route that comes back near itself (a loop nearly closed) the straight extensions
+        must not claim points beside the route."""
+        cost = cost.copy()
         inner = np.argmin(cost[:, 1:-1], axis=1) + 1
         s_inner = self.s0[inner] + t_clip[rows, inner]
         cost[:, 0] = np.where(s_inner <= 0.0, cost[:, 0], np.inf)
         cost[:, -1] = np.where(s_inner >= self.length, cost[:, -1], np.inf)
-        best = np.argmin(cost, axis=1)
-        s = self.s0[best] + t_clip[rows, best]
-        return s, d[rows, best]
+        out: IntArray = np.argmin(cost, axis=1)
+        return out
 
 
 def piece_end(piece: Piece) -> tuple[FloatArray, float]:
@@ -576,12 +604,15 @@ class Lane:
         s_arr, r_arr = np.broadcast_arrays(_as_float(s), _as_float(r))
         return self._line.point(s_arr, self.offset_at(s_arr) + r_arr)
 
-    def local_coordinates(self, xy: ArrayLike) -> tuple[FloatArray, FloatArray]:
+    def local_coordinates(self, xy: ArrayLike,
+                          near: float | None = None) -> tuple[FloatArray, FloatArray]:
         """(s, r) of map-frame point(s) xy, shape (2,) or (N, 2): station and offset from
         this lane's centre (left +). Exact for arcs (closed-form projection per piece, the
-        nearest piece wins). Points beyond the route's ends project onto its extension."""
+        nearest piece wins; with `near` [m], the nearest within `NEAR_WINDOW` of that
+        station, `ReferenceLine.project`). Points beyond the route's ends project onto its
+        extension."""
         pts = _as_float(xy)
-        s, d = self._line.project(pts.reshape(-1, 2))
+        s, d = self._line.project(pts.reshape(-1, 2), near)
         r = d - self.offset_at(s)
         shape = pts.shape[:-1]
         return s.reshape(shape), r.reshape(shape)
@@ -772,11 +803,13 @@ class RoadMap:
         s_arr, d_arr = np.broadcast_arrays(_as_float(s), _as_float(d))
         return self.line.point(s_arr, d_arr)
 
-    def local_coordinates(self, xy: ArrayLike) -> tuple[FloatArray, FloatArray]:
+    def local_coordinates(self, xy: ArrayLike,
+                          near: float | None = None) -> tuple[FloatArray, FloatArray]:
         """(s, d) of point(s) xy, shape (2,) or (N, 2): station and offset from the
-        reference line (lane 0's centre), left +."""
+        reference line (lane 0's centre), left +; with `near` [m], the nearest pass of the
+        route within `NEAR_WINDOW` of that station (`ReferenceLine.project`)."""
         pts = _as_float(xy)
-        s, d = self.line.project(pts.reshape(-1, 2))
+        s, d = self.line.project(pts.reshape(-1, 2), near)
         shape = pts.shape[:-1]
         return s.reshape(shape), d.reshape(shape)
 

@@ -77,13 +77,17 @@ class RouteTruth:
         return self.offsets[2:]
 
 
-def route_truth(truth: EgoTruth, g: CarGeometry, line: ReferenceLine) -> RouteTruth:
-    """Project the ego's centre, front axle and tyre patches onto the route in one call."""
+def route_truth(truth: EgoTruth, g: CarGeometry, line: ReferenceLine,
+                near: float | None = None) -> RouteTruth:
+    """Project the ego's centre, front axle and tyre patches onto the route in one call;
+    `near` [m]: the centre's station a moment ago, so that a route passing the same point
+    twice (a town route through a junction it crossed before) keeps the pass the car is on
+    (`ReferenceLine.project`)."""
     fwd, left = body_axes(truth)
     x = np.array([0.0, g.front_axle, g.front_axle, g.front_axle, -g.rear_axle, -g.rear_axle])
     y = np.array([0.0, 0.0, g.track / 2, -g.track / 2, g.track / 2, -g.track / 2])
     points = truth.position[:2] + x[:, None] * fwd + y[:, None] * left
-    s, d = line.project(points)
+    s, d = line.project(points, near)
     return RouteTruth(points, s, d)
 
 

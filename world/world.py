@@ -141,6 +141,8 @@ class World:
         self.rig = self._build_rig(sensors, lidar, seeds, lidar_backend)
         self._truth: EgoTruth | None = None
         self._route: RouteTruth | None = None
+        self._route_station: float | None = None  # [m] the ego's station when last projected:
+        #   the next projection looks near it (a town route that crosses itself)
         self.ego_s = self.ego_route.station
         self.started_actions: list[tuple[str, int]] = []  # (actor id, action) at the last check
         self.action_fired_at: dict[tuple[str, int], float] = {}  # [s] (actor id, action) ->
@@ -397,7 +399,9 @@ class World:
         """The ego's true centre, front axle and tyres on the route after the last step (one
         projection per step, shared by the NPC triggers, the criteria and the log)."""
         if self._route is None:
-            self._route = route_truth(self.ego_truth, self.ego.geometry, self.road.line)
+            self._route = route_truth(self.ego_truth, self.ego.geometry, self.road.line,
+                                      self._route_station)
+            self._route_station = self._route.station
         return self._route
 
     @property

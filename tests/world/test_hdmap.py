@@ -262,3 +262,30 @@ def test_scalar_pose_and_curvature_equal_the_vectorised(winding: RoadMap) -> Non
         assert line.curvature_one(float(s[i])) == k[i]
     np.testing.assert_allclose(np.column_stack([x, y]), line.point(s, d), atol=1e-9)
     np.testing.assert_allclose(h, line.heading(s), atol=1e-12)
+
+
+def crossing_loop() -> RoadMap:
+    """East 100 m, three left quarter turns of 10 m (via north 50 m and west 30 m), then south
+    100 m: the last straight crosses the first at (60, 0), 60 m and about 287 m along."""
+    return make_map(seg(100.0), arc(10.0, 90.0), seg(50.0), arc(10.0, 90.0), seg(30.0),
+                    arc(10.0, 90.0), seg(100.0))
+
+
+def test_a_route_crossing_itself_keeps_the_pass_near_the_hint() -> None:
+    road = crossing_loop()
+    second = 100.0 + 50.0 + 30.0 + 3 * 5.0 * math.pi + 60.0  # the crossing, second time
+    xy = np.array([[60.0, 0.3]])  # 0.3 m left of the first pass, on the second
+    s, _ = road.local_coordinates(xy)  # the nearest of all: the second pass
+    assert float(s[0]) == pytest.approx(second - 0.3, abs=1e-9)
+    s, d = road.local_coordinates(xy, near=58.0)  # the car on the first pass
+    assert float(s[0]) == pytest.approx(60.0, abs=1e-9) and float(d[0]) == pytest.approx(0.3)
+    s, _ = road.local_coordinates(xy, near=second + 2.0)
+    assert float(s[0]) == pytest.approx(second - 0.3, abs=1e-9)
+
+
+def test_a_stale_hint_gives_way_to_the_nearest_pass() -> None:
+    """A hint 60 m off (the car moved on while nobody looked): the pieces near it are tens
+    of metres from the point, so the nearest of all is taken."""
+    road = crossing_loop()
+    s, d = road.local_coordinates(np.array([[20.0, 0.5]]), near=200.0)
+    assert float(s[0]) == pytest.approx(20.0, abs=1e-9) and float(d[0]) == pytest.approx(0.5)
