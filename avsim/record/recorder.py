@@ -8,6 +8,13 @@ detections, lane lines). Static things (road meshes, buildings, the ego's body, 
 styles, camera intrinsics and mounts) are logged once. Events, FSM state changes, camera
 images and LiDAR scans come at low rates and are logged directly.
 
+The flush interval sets the number of chunks, and the SDK keeps ~2-3 kB of metadata per
+chunk in memory until `close()` (the manifest it writes in the file's footer, which viewers
+need for random access): at a 2 s interval the town loop's ~10 entities made 300 chunks a
+simulated minute, ~1 MB a minute of memory that never came back. Every 30 s it is ~20 chunks
+a minute (~4 MB over an hour's run; issue L 5), and what waits for a flush stays small: 30 s
+of camera images and scans is a few MB at the `fast` profile's rates.
+
 Size is the caller's to choose, by its rates and point counts: camera images are
 JPEG-compressed (`JPEG_QUALITY`), and a LiDAR point costs 12 bytes (float32 x, y, z; 16 with
 a colour).
@@ -68,7 +75,8 @@ from avsim.record.blueprint import default_blueprint
 FloatArray = npt.NDArray[np.float64]
 Rgb = tuple[int, int, int]  # [0..255]
 
-FLUSH_INTERVAL = 2.0  # [s] of sim time between sends of the buffered columns
+FLUSH_INTERVAL = 30.0  # [s] of sim time between sends of the buffered columns (and the
+#   SDK's batched log calls): the chunks' length, their count sets the SDK's memory
 NANOS_PER_SECOND = 1e9  # [ns/s]
 INITIAL_ROWS = 256  # [-] rows a buffer holds before it first grows (it doubles)
 

@@ -23,9 +23,9 @@ from __future__ import annotations
 
 import math
 import time
-from array import array
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -47,9 +47,10 @@ from avsim.criteria.lane import TyresInLane
 from avsim.criteria.registry import build_criteria
 from avsim.criteria.route import Completes
 from avsim.record.recorder import Recorder
-from avsim.run.columns import Rows, flags, floats, ints
+from avsim.run.columns import Column, EnumColumn, Rows, flags, floats, ints
 from avsim.run.holds import shortest_hold
 from avsim.run.sensor_loop import FrameHook, SensorLoop, sensing_mode
+from avsim.run.spill import SpillFile
 from avsim.run.stack import Stack, StackOutput
 from avsim.run.story import ScriptedStory, StoryboardStory, StoryEntry
 from avsim.run.storyboard.director import Director
@@ -84,38 +85,44 @@ VERDICT_WORDS = {Verdict.PASS: "pass", Verdict.FAIL: "FAIL", Verdict.NOT_APPLICA
 class TrajectoryLog:
     """Per control tick: the ego's true and estimated state and what the stack did.
 
-    Stored compactly (an hour's run holds 144,000 ticks): numbers and flags in typed arrays
-    (8 bytes a float, 1 a flag: a list of floats takes 32), rows of numbers in `Rows`, the
-    FSM states as references to their enum members. `array(name)` gives a column as a
-    float64 array (a copy)."""
+    Stored compactly and flat in memory (an hour's run holds 144,000 ticks, ~0.3 kB each):
+    the columns (`avsim.run.columns`: numbers and flags as typed arrays, rows of numbers,
+    the FSM states a byte each) keep their newest `CHUNK` values in memory and move older
+    ones to the log's spill file, an unnamed temporary file that leaves nothing on disk
+    (`avsim.run.spill`); every read sees the whole column. `array(name)` gives a column as a
+    float64 array (a copy); `close()` frees the file (garbage collection does too), after
+    which the spilled values cannot be read."""
 
-    t: array[float] = field(default_factory=floats)  # [s]
-    x: array[float] = field(default_factory=floats)  # [m] true, car centre
-    y: array[float] = field(default_factory=floats)  # [m]
-    yaw: array[float] = field(default_factory=floats)  # [rad]
-    speed: array[float] = field(default_factory=floats)  # [m/s] true forward speed
-    station: array[float] = field(default_factory=floats)  # [m] true centre station
-    cross_track: array[float] = field(default_factory=floats)  # [m] true centre offset from
+    t: Column[float] = field(default_factory=floats)  # [s]
+    x: Column[float] = field(default_factory=floats)  # [m] true, car centre
+    y: Column[float] = field(default_factory=floats)  # [m]
+    yaw: Column[float] = field(default_factory=floats)  # [rad]
+    speed: Column[float] = field(default_factory=floats)  # [m/s] true forward speed
+    station: Column[float] = field(default_factory=floats)  # [m] true centre station
+    cross_track: Column[float] = field(default_factory=floats)  # [m] true centre offset from
     #   the centre of the lane the stack keeps (its plan's), left +
-    lane_error: array[float] = field(default_factory=floats)  # [m] true centre offset from the
+    lane_error: Column[float] = field(default_factory=floats)  # [m] true centre offset from the
     #   centre of the lane it is in (the truth and the map: `world.truth.ego_lane_edges`)
-    crossing: array[int] = field(default_factory=flags)  # its tyres are on or over a lane
+    crossing: Column[int] = field(default_factory=flags)  # its tyres are on or over a lane
     #   line (a lane change, from the truth: `avsim.criteria.lane.LaneChanges`)
-    front_axle_error: array[float] = field(default_factory=floats)  # [m] true, at front axle
-    target_speed: array[float] = field(default_factory=floats)  # [m/s]
-    speed_limit: array[float] = field(default_factory=floats)  # [m/s] at the front bumper
-    steering: array[float] = field(default_factory=floats)  # [rad] commanded
-    drive_torque: array[float] = field(default_factory=floats)  # [N m] commanded, total
-    brake_torque: array[float] = field(default_factory=floats)  # [N m] commanded, total
+    front_axle_error: Column[float] = field(default_factory=floats)  # [m] true, at front axle
+    target_speed: Column[float] = field(default_factory=floats)  # [m/s]
+    speed_limit: Column[float] = field(default_factory=floats)  # [m/s] at the front bumper
+    steering: Column[float] = field(default_factory=floats)  # [rad] commanded
+    drive_torque: Column[float] = field(default_factory=floats)  # [N m] commanded, total
+    brake_torque: Column[float] = field(default_factory=floats)  # [N m] commanded, total
     wheel_spin: Rows = field(default_factory=Rows)  # [rad/s] (4,)
-    acc_mode: list[AccMode] = field(default_factory=list)  # the ACC / event layer's mode
-    motion: list[Motion] = field(default_factory=list)  # the motion FSM's state
-    hazard: array[int] = field(default_factory=flags)  # the stack's hazard lights are on
-    speed_source: list[SpeedSource] = field(default_factory=list)  # what set the speed
-    lane: array[int] = field(default_factory=ints)  # the lane the stack keeps (cross_track's)
-    changing: array[int] = field(default_factory=flags)  # a commanded lane change in hand
-    pedal: array[float] = field(default_factory=floats)  # [-] the driver's accelerator pedal
-    pose_error: array[float] = field(default_factory=floats)  # [m] the stack's position
+    acc_mode: EnumColumn[AccMode] = field(
+        default_factory=partial(EnumColumn, AccMode))  # the ACC / event layer's mode
+    motion: EnumColumn[Motion] = field(
+        default_factory=partial(EnumColumn, Motion))  # the motion FSM's state
+    hazard: Column[int] = field(default_factory=flags)  # the stack's hazard lights are on
+    speed_source: EnumColumn[SpeedSource] = field(
+        default_factory=partial(EnumColumn, SpeedSource))  # what set the speed
+    lane: Column[int] = field(default_factory=ints)  # the lane the stack keeps (cross_track's)
+    changing: Column[int] = field(default_factory=flags)  # a commanded lane change in hand
+    pedal: Column[float] = field(default_factory=floats)  # [-] the driver's accelerator pedal
+    pose_error: Column[float] = field(default_factory=floats)  # [m] the stack's position
     #   estimate (the plan's) from the true centre
     actor_station: Rows = field(default_factory=Rows)  # [m] (N,) true,
     #   along the road each drives on (the route; past an exit's fork, the road the route
@@ -123,12 +130,24 @@ class TrajectoryLog:
     #   with the ego's station off the route (the lead is `lead_gap`, `lead_speed`)
     actor_offset: Rows = field(default_factory=Rows)  # [m] (N,) true,
     #   from that road's reference line, left +
-    lead_gap: array[float] = field(default_factory=floats)  # [m] bumper gap to the vehicle
+    lead_gap: Column[float] = field(default_factory=floats)  # [m] bumper gap to the vehicle
     #   ahead in the ego's lane (truth and map: `world.truth.vehicles_ahead`), NaN: none
-    lead_speed: array[float] = field(default_factory=floats)  # [m/s] its speed, NaN: none
+    lead_speed: Column[float] = field(default_factory=floats)  # [m/s] its speed, NaN: none
+
+    spill: SpillFile = field(default_factory=SpillFile, init=False, repr=False,
+                             compare=False)  # where the columns move their older values
+
+    def __post_init__(self) -> None:
+        for column in vars(self).values():
+            if isinstance(column, Column | Rows | EnumColumn):
+                column.spill_to(self.spill)
 
     def array(self, name: str) -> NDArray[np.float64]:
         return np.array(getattr(self, name), dtype=np.float64)
+
+    def close(self) -> None:
+        """Free the spill file (idempotent)."""
+        self.spill.close()
 
 
 @dataclass(frozen=True, slots=True, eq=False)

@@ -32,6 +32,7 @@ the share of the detections called cars that lie on a true vehicle of any class)
 from __future__ import annotations
 
 import math
+from array import array
 from collections import defaultdict
 from dataclasses import dataclass, field
 
@@ -46,6 +47,12 @@ from world.sensors.lidar import LidarTruth
 from world.spec import ActorType
 
 VEHICLES = (ActorType.CAR, ActorType.TRUCK)
+
+
+def floats() -> array[float]:
+    """Every error sample of a run, 8 bytes each (a list takes 40: a run of an hour scores
+    ~10^5 camera frames and scans); the RMS and max are taken over them all at the end."""
+    return array("d")
 VEHICLE_CLASSES = (ObjectClass.CAR, ObjectClass.TRUCK, ObjectClass.MOTORCYCLE)
 
 
@@ -75,8 +82,8 @@ class ClassScore:
     visible: int = 0  # visible true vehicles of the class in range, summed over scans
     detected: int = 0  # of those, matched to a detection
     tracked: int = 0  # of those, matched to a confirmed track
-    track_pos_err: list[float] = field(default_factory=list)  # [m]
-    track_speed_err: list[float] = field(default_factory=list)  # [m/s]
+    track_pos_err: array[float] = field(default_factory=floats)  # [m]
+    track_speed_err: array[float] = field(default_factory=floats)  # [m/s]
     switches: int = 0  # id switches of the class's vehicles
 
     def metrics(self, suffix: str) -> dict[str, float]:
@@ -90,11 +97,11 @@ class ClassScore:
         }
 
 
-def _rms(x: list[float]) -> float:
+def _rms(x: array[float]) -> float:
     return math.sqrt(float(np.mean(np.square(x)))) if x else math.nan
 
 
-def _max_abs(x: list[float]) -> float:
+def _max_abs(x: array[float]) -> float:
     return float(np.max(np.abs(x))) if x else math.nan
 
 
@@ -113,16 +120,16 @@ class PerceptionScore:
     """Accumulates the scores of one run; `metrics()` gives the result JSON's entries."""
 
     params: ScoringParams = field(default_factory=ScoringParams)
-    offset_err: list[float] = field(default_factory=list)  # [m] filtered lane
-    heading_err: list[float] = field(default_factory=list)  # [rad]
-    raw_offset_err: list[float] = field(default_factory=list)  # [m] raw detection
+    offset_err: array[float] = field(default_factory=floats)  # [m] filtered lane
+    heading_err: array[float] = field(default_factory=floats)  # [rad]
+    raw_offset_err: array[float] = field(default_factory=floats)  # [m] raw detection
     visible: int = 0  # visible true vehicles in range, summed over scans
     detected: int = 0  # of those, matched to a detection
     detections: int = 0  # vehicle detections in range
     true_detections: int = 0  # of those, matched to a true vehicle in range (seen or not)
     tracked: int = 0  # visible true vehicles matched to a confirmed track
-    track_pos_err: list[float] = field(default_factory=list)  # [m]
-    track_speed_err: list[float] = field(default_factory=list)  # [m/s]
+    track_pos_err: array[float] = field(default_factory=floats)  # [m]
+    track_speed_err: array[float] = field(default_factory=floats)  # [m/s]
     switches: dict[str, int] = field(default_factory=lambda: defaultdict(int))
     by_class: dict[str, ClassScore] = field(default_factory=dict)  # by true class
     detections_by_class: dict[str, int] = field(default_factory=dict)  # by detected class

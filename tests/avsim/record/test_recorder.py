@@ -35,6 +35,7 @@ from avsim.record.recorder import (
 )
 
 RATE = 40.0  # [Hz] logging rate of the synthetic run
+FLUSH = 2.0  # [s] the recorder's flush interval here (not its default): several flushes
 N_TICKS = 400  # 10 s at 40 Hz: five 2 s flushes and a final one at close
 EVENT_EVERY = 40  # ticks: two events between two flushes
 ACTOR_IDS = ("npc_0", "npc_1", "ped_0")
@@ -94,7 +95,8 @@ def write_run(
     speed = 12.0 + np.sin(times) / 3.0
     if speed_bump_at is not None:
         speed[speed_bump_at] += 1e-3
-    with Recorder(path, recording_name="test run", recording_id=recording_id) as rec:
+    with Recorder(path, recording_name="test run", recording_id=recording_id,
+                  flush_interval=FLUSH) as rec:
         rec.log_road_meshes([mesh])
         rec.log_static_boxes(
             "/world/buildings",
@@ -309,7 +311,7 @@ def test_close_is_idempotent_and_exceptions_still_give_a_valid_file(tmp_path: Pa
     with pytest.raises(BoomError), Recorder(path, recording_id="crash") as rec:
         for i in range(30):
             rec.log_scalars(i / RATE, {"speed": float(i)})
-        raise BoomError  # buffered samples (all 30: no 2 s flush yet) must still reach the file
+        raise BoomError  # buffered samples (all 30: no flush yet) must still reach the file
     assert rec.closed
     rec.close()  # again: no error
     with pytest.raises(RuntimeError):
