@@ -139,7 +139,8 @@ class StandstillGap(Criterion):
     def __init__(self, low: float, high: float, road: RoadMap, ego_length: float) -> None:
         super().__init__()
         self.low, self.high, self.road, self.ego_length = low, high, road, ego_length
-        self.gaps: list[float] = []  # [m] every standstill gap judged
+        self.worst: float | None = None  # [m] the standstill gap judged farthest from the
+        #   band's middle (None: none judged; one number, not every sample: an hour's run)
         self._since: float | None = None  # [s] since when the ego stands
 
     def update(self, sample: TruthSample) -> None:
@@ -152,17 +153,19 @@ class StandstillGap(Criterion):
         if sample.t - self._since < self.HOLD or gap > self.REACH or \
                 ahead[0].speed >= self.STOPPED:
             return
-        self.gaps.append(gap)
+        mid = 0.5 * (self.low + self.high)
+        if self.worst is None or abs(gap - mid) > abs(self.worst - mid):
+            self.worst = gap
         if not self.low <= gap <= self.high:
             self._fail(sample, f"standing {gap:.1f} m behind the vehicle ahead, outside "
                                f"[{self.low:g}, {self.high:g}] m")
 
     def result(self) -> CriterionResult:
-        if not self.gaps:
+        if self.worst is None:
             return CriterionResult.not_applicable(
                 self.name, self.low, self.unit, "the ego never stood behind a standing vehicle")
         mid = 0.5 * (self.low + self.high)
-        worst = max(self.gaps, key=lambda g: abs(g - mid))
+        worst = self.worst
         bound = self.low if worst < mid else self.high
         return CriterionResult(self.name, self.first_failure is None, worst, bound, self.unit,
                                self.first_failure)
