@@ -10,6 +10,7 @@ STEPS = {"east": (1, 0), "north": (0, 1), "west": (-1, 0), "south": (0, -1)}
 LEFT = {"east": "north", "north": "west", "west": "south", "south": "east"}
 RIGHT = {v: k for k, v in LEFT.items()}
 N = 4
+EGO_TURNS = 50  # [-] junctions on the ego's route (about 4 km)
 
 def exists(j: tuple[int, int]) -> bool:
     return 0 <= j[0] <= N and 0 <= j[1] <= N
@@ -27,10 +28,20 @@ def route(rng: random.Random, start: tuple[int, int, str], n: int) -> list[str]:
         out.append(m)
     return out
 
+def walk_end(start: tuple[int, int, str], moves: list[str]) -> tuple[int, int, str]:
+    """The junction of a walk's last move and the heading it leaves that junction with."""
+    j, h = (start[0], start[1]), start[2]
+    for m in moves:
+        j = (j[0] + STEPS[h][0], j[1] + STEPS[h][1])
+        h = {"straight": h, "left": LEFT[h], "right": RIGHT[h]}[m]
+    return j[0], j[1], h
+
+
 def trail(rng: random.Random, start: tuple[int, int, str], tries: int = 2000) -> list[str]:
     """The longest of `tries` random walks from `start` that use no street twice (either
-    way): a route that passes a street again would make the ego's station along it
-    ambiguous there (the map projects onto the nearest pass)."""
+    way): the ego's route begins so (it crosses junctions it crossed before, which the
+    stations' projection near the car's last station keeps apart,
+    `world.hdmap.ReferenceLine.project`)."""
     best: list[str] = []
     for _ in range(tries):
         j, h = (start[0], start[1]), start[2]
@@ -72,6 +83,10 @@ def main() -> None:
         lines.append(f"  - {{id: car_{k:02d}, type: car, start: [{st[0]}, {st[1]}, {st[2]}], "
                      f"s: {s},\n     speed_kph: {speed}, route: [{', '.join(r)}]}}")
     ego_route = trail(rng, ego_start)
+    # the longest trail (about 2.5 km) is driven within the ten minutes once the junctions
+    # flow: it goes on as a random walk, streets used again, to EGO_TURNS junctions
+    ego_route += route(random.Random(8), walk_end(ego_start, ego_route),
+                       EGO_TURNS - len(ego_route))
     print(f"""format: avsim/1
 name: town_traffic
 description: >-
