@@ -61,8 +61,9 @@ TWO_PI = 2.0 * np.pi  # [rad]
 NEAR_WINDOW = 30.0  # [m] a projection near a station looks this far either side of it
 #   (`ReferenceLine.project`): more than a car moves between two looks, or its pose estimate
 #   jumps by, and less than the shortest loop of a town route (a block's four sides)
-HINT_SLACK = 3.0  # [m] the pass near the hint is kept unless the nearest of all is this much
-#   nearer (then the hint is stale: the car has moved on by more than the window)
+HINT_SLACK = 10.0  # [m] the pass near the hint is kept unless the nearest of all is this
+#   much nearer (then the hint is stale: the car has moved on by more than the window); a car
+#   cutting a junction's corner is a few metres off its own pass, and on the other pass
 
 
 # ---------------------------------------------------------------------------------------
