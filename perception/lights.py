@@ -230,8 +230,9 @@ class TrafficLightDetector:
         self.road = road
         self.vehicle = vehicle
         self.params = params or LightParams()
-        self._station: float | None = None  # [m] the car's station at the last look (a
-        #   town route crossing itself passes a point twice: `ReferenceLine.project`)
+        self._station: float | None = 0.0  # [m] the car's station at the last look (first:
+        #   the route's start; a town route crossing itself passes a point twice:
+        #   `ReferenceLine.project`)
 
     def heads_ahead(self, ego: EgoState) -> list[tuple[int, LightHead]]:
         """(id, head) of the map's lights whose stop line is at most ``stop_line_ahead``

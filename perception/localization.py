@@ -236,8 +236,8 @@ class Localizer:
         self._initialised = False
         self._last_odo: Odometry | None = None
         self._bias_sigma = 0.0  # [m] 1-sigma of the GNSS bias (the receiver's stated)
-        self._station: float | None = None  # [m] the estimate's station on the route when
-        #   last placed on it (`_on_route`)
+        self._station: float | None = 0.0  # [m] the estimate's station on the route when
+        #   last placed on it (`_on_route`; first: the route's start, where the car begins)
         self.matched = False  # a camera lane has been matched on the map since the start
 
     @property

@@ -153,9 +153,10 @@ class MotionLayer:
         self._blocked_since: float | None = None
         self._turn_end = math.inf  # [m] where the turn in hand ends (its junction's exit)
         self._near: set[int] = set()  # tracks of the lane being left found in the way
-        self._station: float | None = None  # [m] the car's station last tick (a town route
-        #   crossing itself passes a point twice: `world.hdmap.ReferenceLine.project`)
         #   (`_leads`)
+        self._station: float | None = 0.0  # [m] the car's station last tick (first: the route's
+        #   start, `Planner.localise`; a town route crossing itself passes a point twice:
+        #   `world.hdmap.ReferenceLine.project`)
         self._passing = False  # the change in hand is one to pass a slower vehicle
 
     def update(self, ego: EgoState, v_want: float, tracks: Sequence[Track],

@@ -138,7 +138,9 @@ class Planner:
         self.source = Machine("lane_source",
                               LaneSource.ACQUIRING if p.camera else LaneSource.MAP)
         self._start: float | None = None  # [s] time of the first tick
-        self._station: float | None = None  # [m] the car's station when last localised
+        self._station: float | None = 0.0  # [m] the car's station when last localised (first:
+        #   the route's start, where its mission begins; a town route may run along its start
+        #   street again later, and the nearest pass there is either)
         self._standing = 0.0  # [s] the car has stood since the lane source's state was
         #   entered (`LaneSourceInput.standing`)
         self._lane_seen = False  # the camera's lane has been the path (the pose is matched)

@@ -141,8 +141,9 @@ class World:
         self.rig = self._build_rig(sensors, lidar, seeds, lidar_backend)
         self._truth: EgoTruth | None = None
         self._route: RouteTruth | None = None
-        self._route_station: float | None = None  # [m] the ego's station when last projected:
-        #   the next projection looks near it (a town route that crosses itself)
+        self._route_station: float | None = spec.ego.s  # [m] the ego's station when last
+        #   projected (first: where it starts): the next projection looks near it (a town
+        #   route that crosses itself, or runs along its own start street again)
         self.ego_s = self.ego_route.station
         self.started_actions: list[tuple[str, int]] = []  # (actor id, action) at the last check
         self.action_fired_at: dict[tuple[str, int], float] = {}  # [s] (actor id, action) ->
