@@ -11,10 +11,16 @@ pedal). `planner.acc_layer` picks the law for the mode.
   V_GPS at the front bumper and the curves, with braking curves at a_comf towards lower
   limits ahead). An exit ramp's limit is a posting of the map.
 - TRAIL, constant time-gap following (`trail`): ``v_ref = min(v_l + k_gap (d - d_des),
-  sqrt(v_l^2 + 2 a_comf max(d - d0, 0)))``, clamped to [0, v_plan], no feed-forward. The
-  first term feeds the lead's speed forward and closes the gap error with the time constant
-  1 / k_gap, slow enough not to chase the lead's speed noise; the second is the speed from
-  which braking at a_comf still stops d0 behind a lead that stops. Stop-and-go: behind a
+  sqrt(v_l^2 + 2 a_comf max(d - d0, 0)))``, clamped to [0, v_plan]. The first term feeds
+  the lead's speed forward and closes the gap error with the time constant 1 / k_gap, slow
+  enough not to chase the lead's speed noise; the second is the speed from which braking at
+  a_comf still stops d0 behind a lead that stops. Where the first binds and the lead brakes
+  (its acceleration from its track, `planner.lead.LeadAccel`, under -`lead_brakes`), its
+  deceleration is the feed-forward, and its speed is taken less what it shed since its
+  track's measurement and over the track's lag (`lead_speed_now`, every law and the
+  mode's inputs): without it the reference fell with the lead's speed
+  and the speed loop followed tau_loop behind, and a car following at 90 km/h behind a lead
+  braking at 2 m/s^2 fell 2 m under UN R157's d_min (issue K). Stop-and-go: behind a
   lead slower than ``v_standstill`` the gap law would creep up on it for several of its time
   constants, so the reference is the braking curve ``sqrt(2 a_final max(d - d0 - stop_band,
   0))`` alone: the car comes to rest ``stop_band`` beyond d0 in finite time (a bumper gap
@@ -28,7 +34,11 @@ pedal). `planner.acc_layer` picks the law for the mode.
   Where the car is faster than the law, the reference is instead a planned constant
   deceleration, the one that brings the closing speed to zero at the law's end point,
   ``a_plan = (v^2 - v_end^2) / (2 room)`` (a stop or pass point; behind a lead ``(v - v_l)^2
-  / (2 (d - d_end))``, d_end = d_des(v_l) or, behind a stopped lead, d0 + stop_band),
+  / (2 (d - d_end))``, d_end = d_des(v_l) or, behind a stopped lead, d0 + stop_band; behind
+  a lead braking at b, ``b + (v - v_l)^2 / (2 (d - d_end))`` if that ends the closing before
+  the lead comes to rest, else the stop d0 + stop_band behind where it rests, ``v^2 / (2 (d
+  + v_l^2 / (2 b) - d0 - stop_band))``: `closing_plan`; a plan that takes the lead's speed
+  now for its speed to come braked at 1 m/s^2 behind a lead braking at 2),
   whenever it is gentler than the speed loop's reaction and that reaction exceeds a_gentle
   (1 m/s^2: below it the law itself acts, so a lead that slows down is followed as it slows,
   not by a plan that assumes its speed now); the reference then follows it from the car's
@@ -44,9 +54,11 @@ pedal). `planner.acc_layer` picks the law for the mode.
   j_comf: the car loses ``(v - v_l) T / 2`` of room to the ramp and gains ``(v - v_l) T a_now
   / (2 a_comf_max)`` back from braking already; the terms in T^2 shorten the stop, so the
   room left out is on the safe side): ``need = (v - v_l)^2 / (2 (d - d_floor - (v - v_l)
-  t_ramp))``. Without the gain, the need of a car that ramps in as planned rose by a
-  twentieth during the ramp (a stopped car found 63 m ahead at 60 km/h: 2.85 to 3.03 m/s^2,
-  over a_comf_max: BRAKE, comfort envelope off, issue K). The planned deceleration is
+  t_ramp))``, and behind a lead braking at b at least the stop d_floor behind where it will
+  rest, ``v^2 / (2 (d - d_floor + v_l^2 / (2 b) - v t_ramp))``. Without the gain, the
+  need of a car that ramps in as planned rose by a twentieth during the ramp (a stopped
+  car found 63 m ahead at 60 km/h: 2.85 to 3.03 m/s^2, over a_comf_max: BRAKE, comfort
+  envelope off, issue K). The planned deceleration is
   capped at a_comf_max (`planner.limits.A_COMF_MAX`, under ISO's 3.5 m/s^2), so that a car
   short of room stops a little nearer rather than harder; only when even ``need`` exceeds
   a_comf_max is there no comfortable stop: the ACC enters BRAKE saying so (`planner.fsm.acc`:
@@ -115,18 +127,39 @@ class AccControlParams:
     v_standstill: float = 0.5  # [m/s] a lead slower than this counts as stopped (trail)
     stop_band: float = 1.0  # [m] behind a stopped lead, stop this far beyond d0 (trail)
     a_final: float = 0.5  # [m/s^2] the last metres' deceleration behind a stopped lead
+    lead_brakes: float = 0.5  # [m/s^2] a lead decelerating more brakes (`lead_braking`)
+    track_lag: float = 0.4  # [s] a lead's track speed lags its true speed by about this
+    #   while it brakes (`perception.tracking`'s constant-velocity filter: 1.7 m/s behind a
+    #   car braking at 4 m/s^2, measured; `lead_speed_now`)
+
+
+def lead_braking(a_lead: float, p: AccControlParams) -> float:
+    """[m/s^2] >= 0: the lead's deceleration, from its signed acceleration `a_lead` [m/s^2]
+    (`planner.lead.LeadAccel`); 0 unless it brakes harder than `lead_brakes` (the estimate's
+    noise while it holds its speed)."""
+    return -a_lead if a_lead < -p.lead_brakes else 0.0
+
+
+def lead_speed_now(v_l: float, a_lead: float, age: float, p: AccControlParams) -> float:
+    """[m/s] the speed of a lead whose track gives v_l [m/s], `age` [s] old, and the
+    acceleration `a_lead` [m/s^2] (signed): while it brakes (`lead_braking`), less what it
+    shed over the age and the track's lag (`track_lag`), at least 0."""
+    return max(v_l - lead_braking(a_lead, p) * (age + p.track_lag), 0.0)
 
 
 def trail(v_plan: float, d: float, d_des: float, v_l: float, d0: float,
-          p: AccControlParams) -> SpeedRef:
+          p: AccControlParams, a_lead: float = 0.0) -> SpeedRef:
     """TRAIL's law (module doc): the reference behind a lead at bumper gap d [m] with speed
-    v_l [m/s], for the desired gap d_des and standstill gap d0 [m], at most v_plan [m/s]."""
+    v_l [m/s] and acceleration `a_lead` [m/s^2] (signed), for the desired gap d_des and
+    standstill gap d0 [m], at most v_plan [m/s]."""
     if v_l < p.v_standstill:
         approach = math.sqrt(2.0 * p.a_final * max(d - d0 - p.stop_band, 0.0))
         return SpeedRef(min(approach, v_plan), 0.0)
     gap_law = v_l + p.k_gap * (d - d_des)
     stop_law = math.sqrt(max(v_l, 0.0) ** 2 + 2.0 * p.a_comf * max(d - d0, 0.0))
-    return SpeedRef(min(max(min(gap_law, stop_law), 0.0), v_plan), 0.0)
+    speed = min(max(min(gap_law, stop_law), 0.0), v_plan)
+    braking = lead_braking(a_lead, p) if 0.0 < speed == gap_law else 0.0
+    return SpeedRef(speed, -braking)
 
 
 def stop_speed(distance: float, v_plan: float, p: AccControlParams) -> float:
@@ -142,16 +175,36 @@ def pass_speed(distance: float, v_pass: float, v_plan: float, p: AccControlParam
     return min(math.sqrt(v_pass**2 + 2.0 * p.a_comf * max(distance - p.margin, 0.0)), v_plan)
 
 
-def need(v: float, v_l: float, d: float, p: AccControlParams, a_now: float = 0.0) -> float:
+def need(v: float, v_l: float, d: float, p: AccControlParams, a_now: float = 0.0,
+         a_lead: float = 0.0) -> float:
     """[m/s^2] >= 0: the least deceleration that still stops the closing speed v - v_l [m/s]
     at d_floor (module doc) from the gap d [m], after the ramp-in from the deceleration
-    `a_now` [m/s^2] the car brakes at (`BrakeModel`); +inf with no room left."""
+    `a_now` [m/s^2] the car brakes at (`BrakeModel`), and, while the lead brakes
+    (`lead_braking` of its acceleration `a_lead` [m/s^2]), that stops the car d_floor behind
+    where the lead will stop; +inf with no room left."""
     closing = v - max(v_l, 0.0)
-    if closing <= 0.0:
-        return 0.0
     t_ramp = max(p.a_comf_max - a_now, 0.0) ** 2 / (2.0 * p.j_comf * p.a_comf_max)
-    room = d - p.d_floor - closing * t_ramp
-    return closing * closing / (2.0 * room) if room > 0.0 else math.inf
+    a = 0.0
+    if closing > 0.0:
+        room = d - p.d_floor - closing * t_ramp
+        a = closing * closing / (2.0 * room) if room > 0.0 else math.inf
+    b = lead_braking(a_lead, p)
+    if b > 0.0:
+        room = d - p.d_floor + max(v_l, 0.0) ** 2 / (2.0 * b) - v * t_ramp
+        a = max(a, v * v / (2.0 * room) if room > 0.0 else math.inf)
+    return a
+
+
+def closing_plan(v: float, v_l: float, b: float, room: float, rest_room: float) -> float:
+    """[m/s^2] the constant deceleration that ends the closing on a lead at speed v_l [m/s]
+    that brakes at b [m/s^2] (>= 0) within `room` [m] of gap, or, where the lead comes to
+    rest first, that stops the car within `rest_room` [m] (the gap to where the lead
+    stops, less the gap to stand at); ego speed v [m/s], room > 0."""
+    closing = max(v - max(v_l, 0.0), 0.0)
+    a = b + closing * closing / (2.0 * room)
+    if b <= 0.0 or closing * max(v_l, 0.0) / b >= 2.0 * room:  # the closing ends first
+        return a
+    return v * v / (2.0 * rest_room) if rest_room > 0.0 else math.inf
 
 
 def comfortable(a_need: float, p: AccControlParams) -> bool:
@@ -187,21 +240,25 @@ def approach(v: float, law: SpeedRef, a_plan: float, a_need: float, dt: float,
 
 
 def follow(v: float, law: SpeedRef, d: float, v_l: float, d_end: float, dt: float,
-           p: AccControlParams, a_min: float = 0.0, a_now: float = 0.0) -> SpeedRef:
-    """The approach behind a lead at gap d [m] and speed v_l [m/s] on the trail law `law`:
-    the constant deceleration that ends the closing at d_end [m], at least `a_min` [m/s^2]
-    while the car is faster than the law; `a_now` [m/s^2] the deceleration the car brakes
-    at (`need`)."""
+           p: AccControlParams, a_min: float = 0.0, a_now: float = 0.0,
+           a_lead: float = 0.0, d_rest: float = 0.0) -> SpeedRef:
+    """The approach behind a lead at gap d [m], speed v_l [m/s] and acceleration `a_lead`
+    [m/s^2] (signed) on the trail law `law`: the constant deceleration that ends the closing
+    at d_end [m] (`closing_plan`; a braking lead that comes to rest first: the car stands
+    d_rest [m] behind it), at least `a_min` [m/s^2] while the car is faster than the law;
+    `a_now` [m/s^2] the deceleration the car brakes at (`need`)."""
     closing = v - max(v_l, 0.0)
-    if closing > 0.0 and d - d_end > p.arrived:  # the approach to d_end
-        a_plan = max(closing * closing / (2.0 * (d - d_end)), a_min)
+    b = lead_braking(a_lead, p)
+    if (closing > 0.0 or b > 0.0) and d - d_end > p.arrived:  # the approach to d_end
+        rest_room = d + max(v_l, 0.0) ** 2 / (2.0 * b) - d_rest if b > 0.0 else math.inf
+        a_plan = max(closing_plan(v, v_l, b, d - d_end, rest_room), a_min)
     elif closing > 0.0:  # inside d_end: the law, or stopping the closing at the floor at
         room = d - p.d_floor  # no more than a_open where the law would brake harder
         a_plan = max(closing * closing / (2.0 * room) if room > 0.0 else math.inf, a_min,
                      p.a_open)
     else:  # not closing: the law, or opening the gap at a_min
         a_plan = a_min if a_min > 0.0 else math.inf
-    return approach(v, law, a_plan, need(v, v_l, d, p, a_now), dt, p)
+    return approach(v, law, a_plan, need(v, v_l, d, p, a_now, a_lead), dt, p)
 
 
 def ramped(v: float, v_end: float, room: float, a_now: float, p: AccControlParams) -> float:

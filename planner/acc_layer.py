@@ -41,6 +41,7 @@ from planner.acc_control import (
     bump,
     comfortable,
     follow,
+    lead_speed_now,
     need,
     stop,
     trail,
@@ -81,6 +82,7 @@ class AccLayer:
         self._flat: float | None = None  # [m/s] FLAT's ramped reference
         self._braking = BrakeModel()  # the deceleration the car brakes at (`need`)
         self._lead_seen = -math.inf  # [s] when a lead was last seen
+        self._a_lead = 0.0  # [m/s^2] the lead's acceleration this tick (signed)
 
     @property
     def mode(self) -> AccMode:
@@ -88,18 +90,25 @@ class AccLayer:
 
     def update(self, t: float, dt: float, v: float, set_speed: float, limit: float,
                plan: PlannedSpeed, lead: Lead | None, driver_gap: float | None = None,
-               events: Events = NO_EVENTS) -> tuple[AccOutput, tuple[StateChange, ...]]:
+               events: Events = NO_EVENTS,
+               lead_accel: float = 0.0) -> tuple[AccOutput, tuple[StateChange, ...]]:
         """The speed reference now and the mode change made, if any.
 
         `t` now and `dt` since the last tick [s]; `v` ego speed, `set_speed` (V_s, 0: ACC
         off), `limit` the posted limit at the front bumper (V_GPS) [m/s]; `plan` the speed
         plan so far (the map's, after the driver's pedal); `lead` from its track; `events`
         the events now. `driver_gap` [m]: the driver's pedal overrides, and TRAIL and BRAKE
-        may close up to d_min + this instead of d_des."""
-        d, v_l = (lead.gap + (lead.speed - v) * max(t - lead.t, 0.0), lead.speed) \
-            if lead is not None else (math.inf, math.inf)
+        may close up to d_min + this instead of d_des. `lead_accel` [m/s^2]: the lead's
+        acceleration, signed (`planner.lead.LeadAccel`)."""
         c = self.params.control
-        a_need, time_to_collision = need(v, v_l, d, c, self._braking.a), ttc(v, v_l, d)
+        self._a_lead = lead_accel if lead is not None else 0.0
+        d, v_l = math.inf, math.inf
+        if lead is not None:
+            age = max(t - lead.t, 0.0)
+            d = lead.gap + (lead.speed - v) * age
+            v_l = lead_speed_now(lead.speed, self._a_lead, age, c)
+        a_need = need(v, v_l, d, c, self._braking.a, self._a_lead)
+        time_to_collision = ttc(v, v_l, d)
         self._lead_seen = t if lead is not None else self._lead_seen
         x = AccInput(acc_on=set_speed > 0.0, v=v, v_s=set_speed, v_gps=limit, d=d, v_l=v_l,
                      events=events.active, a_need=a_need, ttc=time_to_collision,
@@ -158,12 +167,14 @@ class AccLayer:
         c, m = self.params.control, self.params.modes
         g = gaps(x.v, x.v_l, m)
         d_des = g.d_des if driver_gap is None else min(g.d_des, g.d_min + driver_gap)
-        law = trail(plan.speed, x.d, d_des, x.v_l, m.d0, c)
+        law = trail(plan.speed, x.d, d_des, x.v_l, m.d0, c, self._a_lead)
         stopped = x.v_l < c.v_standstill
-        end = m.d0 + c.stop_band if stopped else gaps(x.v_l, x.v_l, m).d_des
+        rest = m.d0 + c.stop_band
+        end = rest if stopped else gaps(x.v_l, x.v_l, m).d_des
         if driver_gap is not None and not stopped:  # d_min at the faster of the two: a
             end = min(end, r157_min_gap(max(x.v, x.v_l)) + driver_gap)  # closing car's
-        return follow(x.v, law, x.d, x.v_l, end, dt, c, a_min, self._braking.a)
+        return follow(x.v, law, x.d, x.v_l, end, dt, c, a_min, self._braking.a,
+                      self._a_lead, rest)
 
     def _control(self, x: AccInput, dt: float, planned: PlannedSpeed,
                  driver_gap: float | None) -> PlannedSpeed:

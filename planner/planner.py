@@ -59,6 +59,7 @@ from planner.control_layer import ControlLayer
 from planner.driver_override import DriverOverride, OverrideParams
 from planner.events import EventMonitor, EventParams
 from planner.fsm import hazard, lane_source, sensing
+from planner.fsm.acc import sight_speed
 from planner.fsm.hazard import HazardInput, HazardLights
 from planner.fsm.lane_source import LaneSource, LaneSourceInput, LaneSourceParams
 from planner.fsm.machine import Machine, StateChange
@@ -73,6 +74,7 @@ from planner.lead import (
     map_bend,
     route_candidates,
 )
+from planner.limits import A_EMERGENCY
 from planner.messages import Lead, Plan, ReferencePath, SpeedSource
 from planner.motion_layer import Manoeuvre, MotionLayer, MotionLayerParams
 from planner.route import lane_path
@@ -109,6 +111,12 @@ class PlannerParams:
     camera_agree: float = 1.0  # [m] the camera's lane is used only within this of the map's
     junction_before: float = 10.0  # [m] before a town junction's stop line ...
     junction_after: float = 15.0  # [m] ... to after its exit, the map's path is followed
+    sight_range: float = 55.0  # [m] the bumper gap at which the forward LiDAR's track of a
+    #   car ahead is confirmed (measured: 53 m; its lowest ring that clears the ground meets
+    #   a car's rear too low beyond about 72 m, `perception.objects.DetectorParams.roi_x`,
+    #   and nearer than that one ring's few returns are found in too few scans); the speed
+    #   plan never exceeds the speed whose desired gap and emergency stop lie within it
+    #   (`planner.fsm.acc.sight_speed`: 91 km/h)
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -129,6 +137,8 @@ class Planner:
         self.road = road
         self.params = params
         self._speed_planners: dict[int, SpeedPlanner] = {}
+        self.max_speed = min(params.max_speed, sight_speed(  # [m/s]
+            params.sight_range, params.acc.modes, A_EMERGENCY))
         self.reset()
 
     def reset(self) -> None:
@@ -190,7 +200,7 @@ class Planner:
         p = self.params
         return self.speed_planner.target(
             station, set_speed=p.set_speed if set_speed is None else set_speed,
-            max_speed=p.max_speed)
+            max_speed=self.max_speed)
 
     def update(self, inp: PlannerInput) -> Plan:
         """The plan for this tick (module doc)."""
@@ -223,7 +233,7 @@ class Planner:
         planned = PlannedSpeed(SpeedRef(target.speed, target.accel),
                                BINDING_SOURCE[target.binding])
         planned, driver = self.driver.update(
-            inp.pedal, ego.speed, planned, lambda: self.speed_for(station, self.params.max_speed),
+            inp.pedal, ego.speed, planned, lambda: self.speed_for(station, self.max_speed),
             dt)
         events = self.events.update(ego.t, station, ego.speed,
                                     float(self.lane.offset_at(station)),
@@ -234,16 +244,18 @@ class Planner:
         junction = self.junctions.update(ego.t, station, ego.speed, tracks)
         events = replace(events, active=events.active | junction.active,
                          stop_distance=min(events.stop_distance, junction.stop_distance))
+        lead_accel = self.lead_accel.update(lead)
         acc, acc_changes = self.acc.update(ego.t, dt, ego.speed, self.params.set_speed,
                                            target.limit_at_front, planned,
                                            _with_room(lead, manoeuvre),
                                            driver_gap=self.params.override.gap_margin
-                                           if driver else None, events=events)
+                                           if driver else None, events=events,
+                                           lead_accel=lead_accel)
         speed = self._degraded_cap(acc.speed, ego.speed, dt)
         control, control_changes = self.control.update(
             ego.t, ego.speed, speed.ref.speed, speed.ref.accel,
             acc.lead_gap + (manoeuvre.room if _with_room(lead, manoeuvre) is not lead else 0.0),
-            lead, self.lead_accel.update(lead))
+            lead, lead_accel)
         if control.emergency:
             speed = PlannedSpeed(SpeedRef(0.0, -self.control.decel), SpeedSource.EMERGENCY)
         hazard_changes = self.hazard.apply(ego.t, hazard.transition(

@@ -15,8 +15,10 @@ Gaps (the paper gives none; designed here, `gaps`, parameters `AccParams`):
 
 - d_min(v): the UN R157 minimum following distance, ``max(v t_front, 2 m)`` with
   ``t_front = 1.0 + v_kph / 100`` s (v_kph taken as at least 10 km/h);
-- d_des(v) = max(d0 + tau v, d_min(v)): the desired gap, a standstill gap d0 plus a time
-  gap tau, never below d_min;
+- d_des(v) = max(d0 + tau v, d_min(v) + tau_margin v): the desired gap, a standstill gap
+  d0 plus a time gap tau, never within tau_margin (0.2 s) of d_min: above 70 km/h R157's
+  d_min (1 + v / 100 km/h s) exceeds d0 + tau v, and a car that followed at d_min itself
+  fell under it with every ripple of its speed or the lead's;
 - d_max(v, V_l) = d_des + max(v^2 - V_l^2, 0) / (2 a_comf) + d_reach: the gap inside which
   the lead matters. Beyond it, braking at a_comf from v to V_l still ends at or beyond
   d_des; d_reach is hysteresis.
@@ -157,6 +159,7 @@ NO_EVENTS: frozenset[AccEvent] = frozenset()
 class AccParams:
     d0: float = 4.0  # [m] standstill gap of d_des
     tau: float = 1.5  # [s] time gap of d_des
+    tau_margin: float = 0.2  # [s] d_des is at least this time gap above d_min
     a_comf: float = A_COMF  # [m/s^2] comfortable deceleration (d_max)
     d_reach: float = 10.0  # [m] hysteresis beyond the braking distance (d_max)
     a_hysteresis: float = 0.5  # [m/s^2] BRAKE is left with a_need this far under a_comf_max
@@ -201,9 +204,25 @@ def r157_min_gap(v: float) -> float:
 def gaps(v: float, v_l: float, p: AccParams) -> Gaps:
     """The three gaps for ego speed v and lead speed v_l [m/s] (see the module doc)."""
     d_min = r157_min_gap(v)
-    d_des = max(p.d0 + p.tau * v, d_min)
+    d_des = max(p.d0 + p.tau * v, d_min + p.tau_margin * v)
     closing = max(v * v - min(v_l, v) ** 2, 0.0) / (2.0 * p.a_comf)
     return Gaps(d_min, d_des, d_des + closing + p.d_reach, p.v_band, p.d_band)
+
+
+def sight_speed(sight: float, p: AccParams, a_stop: float, t_react: float = 0.5,
+                floor: float = 2.5) -> float:
+    """[m/s] the fastest speed at which the car's forward sensing, which finds a vehicle
+    ahead `sight` [m] away, still covers (a) the desired gap d_des(v) (`gaps`): faster, a
+    lead followed at d_des is out of sight, and the car drives on it unseen until it is
+    inside that range and under UN R157's d_min, which grows as v^2 (1 + v / 100 km/h s);
+    and (b) the stop behind a vehicle standing in the lane, found at `sight`: `t_react` [s]
+    to react, then braking at `a_stop` [m/s^2], to rest `floor` [m] short of it."""
+    low, high = 0.0, 100.0
+    for _ in range(60):  # both sides rise with v: bisection
+        mid = 0.5 * (low + high)
+        stop = mid * t_react + mid * mid / (2.0 * a_stop) + floor
+        low, high = (mid, high) if max(gaps(mid, mid, p).d_des, stop) <= sight else (low, mid)
+    return low
 
 
 # -- the guards: (mode now, input, gaps) -> the row holds --------------------------------------

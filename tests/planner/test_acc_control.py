@@ -10,8 +10,10 @@ from planner.acc_control import (
     AccControlParams,
     approach,
     bump,
+    closing_plan,
     comfortable,
     follow,
+    lead_braking,
     need,
     pass_speed,
     stop,
@@ -114,6 +116,62 @@ def test_follow_approaches_a_slower_lead_at_about_1_m_s2() -> None:
     # a lead pulling away: the law
     law = trail(v, 30.0, 25.0, v + 1.0, 4.0, P)
     assert follow(v, law, 30.0, v + 1.0, 25.0, 0.025, P) == law
+
+
+def test_a_braking_lead_is_fed_forward_past_the_estimates_noise() -> None:
+    assert lead_braking(-2.0, P) == 2.0
+    assert lead_braking(-0.4, P) == 0.0  # the estimate's noise while it holds its speed
+    assert lead_braking(1.0, P) == 0.0  # pulling away
+    # the gap law binds: the lead's deceleration is its feed-forward
+    assert trail(30.0, 40.0, 40.0, 20.0, 4.0, P, a_lead=-2.0) == SpeedRef(20.0, -2.0)
+    # the plan binds (the car's own limit): no feed-forward, the plan's speed is followed
+    assert trail(19.0, 48.0, 40.0, 20.0, 4.0, P, a_lead=-2.0).accel == 0.0
+    # behind a stopped lead the final approach has none
+    assert trail(30.0, 7.0, 5.0, 0.0, 4.0, P, a_lead=-2.0).accel == 0.0
+
+
+def test_closing_plan_behind_a_braking_lead() -> None:
+    """The constant deceleration that ends the closing within the room while the lead
+    brakes at b, or stops the car behind where the lead rests if it rests first."""
+    # no braking: (v - v_l)^2 / (2 room)
+    assert closing_plan(20.0, 15.0, 0.0, 25.0, math.inf) == pytest.approx(0.5)
+    # closing 5 m/s in 25 m while the lead brakes at 2 for 7.5 s more: 2 + 0.5; the
+    # closing ends after 2 x 25 / 5 = 10 s, after the lead rests: the stop behind it
+    assert closing_plan(20.0, 15.0, 2.0, 25.0, 50.0) == pytest.approx(400.0 / 100.0)
+    # the lead rests in 15 s: the closing (10 s) ends first
+    assert closing_plan(35.0, 30.0, 2.0, 25.0, 200.0) == pytest.approx(2.5)
+    # level speeds behind a braking lead: the stop behind where it rests (gentler than b
+    # with the room between)
+    v, b, d, rest = 25.0, 2.0, 52.0, 5.0
+    plan = closing_plan(v, v, b, d - 44.0, d + v * v / (2.0 * b) - rest)
+    assert plan == pytest.approx(v * v / (2.0 * (d + v * v / (2.0 * b) - rest)))
+    assert plan < b
+    assert closing_plan(15.0, 10.0, 2.0, 25.0, 0.0) == math.inf  # no room to rest in
+
+
+def test_need_allows_for_a_lead_that_brakes_to_rest() -> None:
+    """Euro NCAP CCRb: 50 km/h, 40 m behind a car braking at 6 m/s^2: it rests 16.1 m on;
+    the need is the stop d_floor behind that point (after the ramp-in), not 0 (level
+    speeds); a noisy estimate under lead_brakes changes nothing."""
+    v = 50 / 3.6
+    t_ramp = P.a_comf_max / (2.0 * P.j_comf)
+    room = 40.0 - P.d_floor + v * v / 12.0 - v * t_ramp
+    assert need(v, v, 40.0, P, a_lead=-6.0) == pytest.approx(v * v / (2.0 * room))
+    assert need(v, v, 40.0, P, a_lead=-0.3) == 0.0
+    assert need(v, v, 12.0, P, a_lead=-6.0) > P.a_comf_max  # 12 m: no comfortable stop
+
+
+def test_following_a_braking_lead_brakes_with_it() -> None:
+    """R157 lead braking, 90 km/h at d_des behind a lead braking at 2 m/s^2: the car
+    brakes at about the lead's rate from the first tick it knows (it braked at 1 m/s^2, the
+    plan taking the lead's speed now for its speed to come, and fell under d_min)."""
+    v, d, dt = 25.0, 52.0, 0.025
+    v_l = v - 0.5  # half a second into the braking
+    law = trail(v, d, d, v_l, 4.0, P, a_lead=-2.0)
+    ref = follow(v, law, d, v_l, 50.0, dt, P, a_lead=-2.0, d_rest=5.0)
+    assert 1.5 < -ref.accel <= 2.5
+    blind = follow(v, trail(v, d, d, v_l, 4.0, P), d, v_l, 50.0, dt, P)
+    assert -blind.accel < -ref.accel
 
 
 def test_stops_and_bumps_met_late_plan_a_constant_deceleration() -> None:

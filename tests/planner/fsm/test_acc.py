@@ -21,6 +21,7 @@ from planner.fsm.acc import (
     AccParams,
     gaps,
     r157_min_gap,
+    sight_speed,
     transition,
 )
 from planner.fsm.machine import fired_row
@@ -54,11 +55,13 @@ def test_r157_minimum_gap() -> None:
 
 def test_gaps() -> None:
     assert G.d_min == pytest.approx(r157_min_gap(V))
-    assert G.d_des == pytest.approx(max(4.0 + 1.5 * V, G.d_min))
+    assert G.d_des == pytest.approx(max(4.0 + 1.5 * V, G.d_min + 0.2 * V))
     assert G.d_max == pytest.approx(G.d_des + (V**2 - VL**2) / 3.0 + 10.0)
     assert G.d_min < G.d_des < G.d_max
-    fast = gaps(20.0, 15.0, P)  # at 72 km/h R157's 1.72 s exceeds tau: d_des = d_min
-    assert fast.d_des == pytest.approx(fast.d_min) == pytest.approx(20.0 * 1.72)
+    # at 72 km/h R157's 1.72 s exceeds tau: d_des keeps tau_margin (0.2 s) above d_min
+    fast = gaps(20.0, 15.0, P)
+    assert fast.d_min == pytest.approx(20.0 * 1.72)
+    assert fast.d_des == pytest.approx(20.0 * (1.72 + 0.2))
     slow = gaps(2.0, INF, P)  # crawling: the desired gap is the standstill gap plus tau v
     assert slow.d_des == pytest.approx(7.0) and slow.d_max == pytest.approx(17.0)
     assert gaps(V, 25.0, P).d_max == pytest.approx(gaps(V, 25.0, P).d_des + 10.0)
@@ -255,3 +258,17 @@ def test_the_default_state_is_settled_at_once(name: str, state: AccMode, inp: Ac
     change = transition(state, inp, P)
     assert change is not None and change.to is expected, name
     assert change.reason == "; ".join(reasons)
+
+
+def test_sight_speed_keeps_the_gap_and_the_stop_within_the_sensing_range() -> None:
+    """Faster than the sight speed, a lead followed at d_des is out of sight, or a car
+    standing in the lane is found too late to stop for at 8 m/s^2."""
+    v = sight_speed(40.0, P, 8.0)  # following binds: d_des (R157 d_min + 0.2 s) = 40 m
+    assert gaps(v, v, P).d_des == pytest.approx(40.0)
+    assert v * 0.5 + v * v / 16.0 + 2.5 < 40.0
+    v = sight_speed(55.0, P, 8.0)  # the stop binds: 0.5 s, then 8 m/s^2, 2.5 m short
+    assert v * 0.5 + v * v / 16.0 + 2.5 == pytest.approx(55.0)
+    assert gaps(v, v, P).d_des < 55.0
+    assert 88.0 < v / KPH < 93.0
+    assert sight_speed(55.0, P, 4.0) < v  # gentler stopping: slower
+    assert sight_speed(300.0, P, 8.0) / KPH > 130.0  # a long-range radar: no cap that matters
