@@ -11,7 +11,7 @@ minute, then the figures that tell a leak or a drift:
 - the recording's size per simulated minute;
 - the real-time factor of the first and the last ten minutes (no drift: their ratio).
 
-`make soak` runs it with profiles `none` and `fast` (an hour each: about 10 and 40 minutes
+`make soak` runs it with profiles `none` and `fast` (an hour each: about 15 and 35 minutes
 here); `python -m bench.bench_soak --minutes 5 --profile fast` for a shorter look.
 """
 
