@@ -18,9 +18,9 @@ pedal). `planner.acc_layer` picks the law for the mode.
   (its acceleration from its track, `planner.lead.LeadAccel`, under -`lead_brakes`), its
   deceleration is the feed-forward, and its speed is taken less what it shed since its
   track's measurement and over the track's lag (`lead_speed_now`, every law and the
-  mode's inputs): without it the reference fell with the lead's speed
-  and the speed loop followed tau_loop behind, and a car following at 90 km/h behind a lead
-  braking at 2 m/s^2 fell 2 m under UN R157's d_min (issue K). Stop-and-go: behind a
+  mode's inputs): without it the reference fell with the lead's speed and the speed loop
+  followed tau_loop behind, and a car following at 90 km/h behind a lead braking at
+  2 m/s^2 fell 2 m under UN R157's d_min (issue K). Stop-and-go: behind a
   lead slower than ``v_standstill`` the gap law would creep up on it for several of its time
   constants, so the reference is the braking curve ``sqrt(2 a_final max(d - d0 - stop_band,
   0))`` alone: the car comes to rest ``stop_band`` beyond d0 in finite time (a bumper gap
