@@ -52,6 +52,7 @@ from world.scene.scenery import (
     stop_sign_image,
 )
 from world.scene.scenery_roads import build_scenery_roads
+from world.scene.texture_rows import aligned_texture
 from world.scene.town_scene import Pavement, build_town_scene
 from world.scene.traffic_light import TrafficLightBody, add_traffic_light
 from world.sensors.camera import Camera, CameraSensor
@@ -314,7 +315,9 @@ class World:
 
         The mesh goes through a Wavefront OBJ file whose material names the texture PNG:
         both renderers load that (the EGL plugin drops meshes given as vertex arrays, and
-        ignores textures attached afterwards with `changeVisualShape`)."""
+        ignores textures attached afterwards with `changeVisualShape`). Its rows are made
+        whole multiples of 4 bytes first (`world.scene.texture_rows`)."""
+        texture, uvs = aligned_texture(texture, uvs)
         folder = Path(self._tmp.name)
         cv2.imwrite(str(folder / f"{name}.png"), cv2.cvtColor(texture, cv2.COLOR_RGB2BGR))
         _write_obj(folder / f"{name}.obj", vertices, indices, uvs, normals, f"{name}.png")
