@@ -247,5 +247,7 @@ class PlannerInput:
     signs: SignView | None = None  # the signs of a frame delivered this tick
     lights: tuple[LightDetection, ...] = ()  # the lights of a frame delivered this tick
     pedal: float = 0.0  # [-] 0..1, the driver's accelerator pedal position
+    engaged: bool = True  # the automated driving function is switched on (off: the driver
+    #   holds the speed, `planner.planner`)
     flat_tyre: bool = False  # a flat tyre is detected (from the wheel speeds)
     health: SensorHealth = SensorHealth()  # the sensor faults noticed now

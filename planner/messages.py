@@ -39,6 +39,7 @@ class SpeedSource(enum.Enum):
     PEDAL = "pedal"  # the driver's accelerator pedal (or the ramp back after it)
     DEGRADED = "degraded"  # the lane lost: the hold speed, then a stop in lane
     EMERGENCY = "emergency"  # the control FSM's emergency stop
+    DRIVER = "driver"  # the driver holds the set speed: the function is not engaged
 
 
 @dataclass(frozen=True, slots=True, eq=False)

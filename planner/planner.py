@@ -38,7 +38,11 @@ reference line, speeds [m/s]. Steps:
    MINIMUM_RISK: the sensors' health as `perception.health` noticed it) and the emergency
    stop; the plan's `speed_source` is the link that set
    the speed;
-6. the control FSM (`planner.control_layer`) names the control action and, in an
+6. while the automated driving function is not engaged (`PlannerInput.engaged`: an
+   OpenSCENARIO file's car under test before its controller is activated) the ACC is off
+   (ACC_OFF) and the driver holds the set speed (`SpeedSource.DRIVER`) in the lane kept,
+   whatever is ahead; the emergency stop below stays on;
+7. the control FSM (`planner.control_layer`) names the control action and, in an
    emergency, asks for the emergency stop's deceleration instead; the hazard lights go on
    with a flat tyre, and during a minimum-risk stop in lane after a sensor fault (off again
    when it is over: `planner.fsm.hazard`).
@@ -245,13 +249,15 @@ class Planner:
         events = replace(events, active=events.active | junction.active,
                          stop_distance=min(events.stop_distance, junction.stop_distance))
         lead_accel = self.lead_accel.update(lead)
-        acc, acc_changes = self.acc.update(ego.t, dt, ego.speed, self.params.set_speed,
+        set_speed = self.params.set_speed if inp.engaged else 0.0  # off: ACC_OFF
+        acc, acc_changes = self.acc.update(ego.t, dt, ego.speed, set_speed,
                                            target.limit_at_front, planned,
                                            _with_room(lead, manoeuvre),
                                            driver_gap=self.params.override.gap_margin
                                            if driver else None, events=events,
                                            lead_accel=lead_accel)
-        speed = self._degraded_cap(acc.speed, ego.speed, dt)
+        speed = self._degraded_cap(acc.speed, ego.speed, dt) if inp.engaged else \
+            PlannedSpeed(SpeedRef(self.params.set_speed, 0.0), SpeedSource.DRIVER)
         control, control_changes = self.control.update(
             ego.t, ego.speed, speed.ref.speed, speed.ref.accel,
             acc.lead_gap + (manoeuvre.room if _with_room(lead, manoeuvre) is not lead else 0.0),

@@ -110,9 +110,10 @@ class GnssFix:
 
 @dataclass(frozen=True, slots=True)
 class Odometry:
-    """The vehicle signals sampled together: wheel encoders, steering encoder, yaw-rate gyro
-    and the accelerator pedal sensor (drive-by-wire: the driver's, or an external control
-    device's, pedal is an input the stack arbitrates, not a torque on the wheels)."""
+    """The vehicle signals sampled together: wheel encoders, steering encoder, yaw-rate
+    gyro, the accelerator pedal sensor (drive-by-wire: the driver's, or an external control
+    device's, pedal is an input the stack arbitrates, not a torque on the wheels) and the
+    switch of the automated driving function."""
 
     t: float  # [s] sim time of the measurement
     wheel_speeds: tuple[float, float, float, float]  # [rad/s] FL, FR, RL, RR spin rates
@@ -120,6 +121,9 @@ class Odometry:
     yaw_rate: float  # [rad/s] gyro z, counter-clockwise positive
     steering_angle: float  # [rad] measured road-wheel angle (bicycle equivalent), left +
     accelerator_pedal: float = 0.0  # [-] 0..1, the driver's accelerator pedal position sensor
+    engaged: bool = True  # the driver's switch of the automated driving function: on, the
+    #   stack drives; off, the driver holds the speed (an OpenSCENARIO file's car under test
+    #   before its ActivateControllerAction)
 
     @property
     def speed(self) -> float:

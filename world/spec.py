@@ -343,6 +343,8 @@ class EgoSpec:
     s: float  # [m] station of the car's centre
     speed: float  # [m/s] initial speed
     max_speed: float  # [m/s] vehicle limit
+    engaged: bool = True  # the automated driving function's switch at the start (off: the
+    #   driver holds the speed until a storyboard activates the car's controller)
 
 
 @dataclass(frozen=True, slots=True)

@@ -139,6 +139,8 @@ class World:
             self.client.setCollisionFilterGroupMask(self.ego.body, link, EGO_RAY_GROUP, 0xFFFF)
         self.actors = ActorSet(self.client, self.road, spec.actors, self.shapes)
         self._events = EgoEvents(spec.events)
+        self.engaged = spec.ego.engaged  # the automated driving function's switch (the
+        #   odometry's `engaged`): a storyboard's ActivateControllerAction turns it on
         self.rig = self._build_rig(sensors, lidar, seeds, lidar_backend)
         self._truth: EgoTruth | None = None
         self._route: RouteTruth | None = None
@@ -171,7 +173,8 @@ class World:
         events = self._events
         sensors += [GnssSensor(self.spec.sensors.gnss, np.random.default_rng(seeds[1])),
                     OdometrySensor(self.ego.geometry.wheel_radius,
-                                   np.random.default_rng(seeds[2]), pedal=lambda: events.pedal)]
+                                   np.random.default_rng(seeds[2]), pedal=lambda: events.pedal,
+                                   engaged=lambda: self.engaged)]
         return SensorRig(sensors)
 
     def _build_scene(self, rng: np.random.Generator) -> StaticScene:

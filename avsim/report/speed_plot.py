@@ -83,6 +83,7 @@ SOURCE_COLOURS: dict[str, str] = {
     SpeedSource.PEDAL.value: "#26c6da",
     SpeedSource.DEGRADED.value: "#ff7043",
     SpeedSource.EMERGENCY.value: "#d50000",
+    SpeedSource.DRIVER.value: "#6d4c41",
 }
 # [-] the panels' heights, relative to the speed panel's
 PANELS = {"speed": 1.0, "motion": 0.07, "source": 0.07, "gap": 0.45, "ttc": 0.35,

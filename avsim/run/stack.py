@@ -138,6 +138,7 @@ class Stack:
         self._signs: SignView | None = None  # the last frame's signs, for the next tick
         self._lights: tuple[LightDetection, ...] = ()  # the last frame's lights, likewise
         self._pedal = 0.0  # [-] the driver's accelerator pedal, from the odometry
+        self._engaged = True  # the function's switch, from the odometry
 
     def on_frames(self, t: float, frames: Sequence[Frame]) -> PerceptionOutput | None:
         """One delivery: the frames captured together at time `t` [s], each to its
@@ -170,6 +171,7 @@ class Stack:
         with self.watch("localisation"):
             self.localizer.on_odometry(odo)
         self._pedal = odo.accelerator_pedal
+        self._engaged = odo.engaged
         with self.watch("perception flat tyre"):
             self.flat_detector.update(odo)
 
@@ -244,7 +246,7 @@ class Stack:
         with self.watch("planner"):
             plan = self.planner.update(PlannerInput(
                 ego=ego, lane=self._view, tracks=self._tracks, signs=self._signs,
-                lights=self._lights, pedal=self._pedal,
+                lights=self._lights, pedal=self._pedal, engaged=self._engaged,
                 flat_tyre=self.flat_detector.state is not None, health=self.health.health(t)))
         self._signs, self._lights = None, ()
         with self.watch("control"):

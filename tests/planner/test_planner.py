@@ -7,9 +7,10 @@ import math
 import numpy as np
 import pytest
 
-from perception.messages import EgoState, PlannerInput
+from perception.messages import EgoState, ObjectClass, PlannerInput, Track
+from planner.fsm.acc import AccMode
 from planner.fsm.motion import Motion
-from planner.messages import Lead, SpeedSource
+from planner.messages import Lead, Plan, SpeedSource
 from planner.motion_layer import Manoeuvre
 from planner.planner import Planner, PlannerParams, _with_room
 from planner.speed_planning import Binding, SpeedPlanner
@@ -123,3 +124,36 @@ def test_the_acc_sees_a_stationary_car_it_may_pass_nearer_by_the_room() -> None:
     other = Manoeuvre(Motion.LANE_KEEP, 0, 0, None, room=8.0, room_for=3)
     assert _with_room(lead, other) is lead
     assert _with_room(None, room) is None
+
+
+def _car_ahead(road: RoadMap, s: float, speed: float, ego: EgoState) -> Track:
+    """A confirmed car track centred at station `s` of lane 1, at `speed` along it (the
+    straight road runs along +x)."""
+    x, y = (float(c) for c in road.lane(1).position(s, 0.0))
+    return Track(id=9, t=ego.t, x=x, y=y, vx=speed, vy=0.0, rel_x=x - ego.x, rel_y=y - ego.y,
+                 rel_vx=speed - ego.speed,
+                 rel_vy=0.0, length=4.6, width=1.8, height=1.5, yaw=0.0, cls=ObjectClass.CAR,
+                 hits=20, misses=0, position_sigma=0.1)
+
+
+def test_not_engaged_the_driver_holds_the_set_speed_whatever_is_ahead() -> None:
+    """Before the function is switched on the ACC is off and the set speed is held, a slower
+    car 40 m ahead notwithstanding; switched on, the ACC takes it as its lead at once."""
+    road = straight_road("real", 1000.0, 100.0)
+    p = planner(road, set_kph=72.0)
+
+    def tick(k: int, engaged: bool) -> Plan:
+        t = 1.0 + 0.1 * k
+        ego = ego_on(road, 1, 100.0 + 20.0 * (t - 1.0), 0.0, 20.0, t)
+        car = _car_ahead(road, 145.0 + 10.0 * (t - 1.0), 10.0, ego)
+        return p.update(PlannerInput(ego, tracks=(car,), engaged=engaged))
+
+    for k in range(8):
+        plan = tick(k, engaged=False)
+        assert plan.acc_mode is AccMode.ACC_OFF and plan.speed_source is SpeedSource.DRIVER
+        assert plan.target_speed == pytest.approx(20.0) and plan.target_accel == 0.0
+    assert plan.lead is not None  # seen all along
+    plan = tick(8, engaged=True)
+    assert plan.acc_mode is not AccMode.ACC_OFF and plan.lead is not None
+    assert plan.speed_source is SpeedSource.FOLLOWING and plan.target_speed < 20.0
+    assert [c.source for c in plan.changes if c.machine == "acc"] == ["acc_off"]

@@ -5,10 +5,13 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
+import numpy as np
 import pytest
 
 from avsim.criteria.base import Verdict
 from avsim.run.runner import RunResult
+from planner.fsm.acc import AccMode
+from planner.messages import SpeedSource
 from tests.scenarios import alks
 
 pytestmark = pytest.mark.slow
@@ -26,6 +29,24 @@ def test_the_car_cuts_in(runs: dict[str, RunResult], number: str) -> None:
     _, offset = alks.actor(result, "CutInVehicle")
     assert not alks.in_ego_lane(offset[:1]).any() and alks.in_ego_lane(offset[-1:]).all()
     assert alks.fired(result, "CutInAction") is not None
+
+
+def test_the_stack_drives_once_the_files_controller_is_activated(
+        runs: dict[str, RunResult]) -> None:
+    """Until the story's ActivateControllerAction (3 s) the driver holds the Init speed
+    with the ACC off; the ACC is switched on at that tick, and never off again."""
+    result = runs["4_4_1"]
+    activated = alks.fired(result, "ActivateALKSControllerAction")
+    assert activated is not None and activated > 1.0
+    t, speed = result.log.array("t"), result.log.array("speed")
+    modes, sources = list(result.log.acc_mode), list(result.log.speed_source)
+    before = t < activated - 1e-9
+    assert {m for m, b in zip(modes, before, strict=True) if b} == {AccMode.ACC_OFF}
+    assert {s for s, b in zip(sources, before, strict=True) if b} == {SpeedSource.DRIVER}
+    assert np.abs(speed[before] - result.scenario.world.ego.speed).max() < 0.2
+    assert AccMode.ACC_OFF not in {m for m, b in zip(modes, before, strict=True) if not b}
+    on = [c for c in result.state_changes if c.machine == "acc" and c.source == "acc_off"]
+    assert [(c.t, c.target) for c in on] == [(pytest.approx(activated, abs=0.05), "cruise")]
 
 
 def test_an_avoidable_cut_in_is_avoided(runs: dict[str, RunResult]) -> None:

@@ -29,11 +29,16 @@ def _released() -> float:
     return 0.0
 
 
+def _on() -> bool:
+    return True
+
+
 @dataclass(frozen=True, slots=True)
 class OdometrySensor:
     wheel_radius: float  # [m]
     rng: np.random.Generator
     pedal: Callable[[], float] = _released  # [-] 0..1, the accelerator pedal position now
+    engaged: Callable[[], bool] = _on  # the automated driving function's switch now
 
     @property
     def name(self) -> str:
@@ -60,4 +65,5 @@ class OdometrySensor:
             yaw_rate=truth.yaw_rate + GYRO_NOISE * float(noise[4]),
             steering_angle=truth.steering_angle + STEERING_NOISE * float(noise[5]),
             accelerator_pedal=self.pedal(),
+            engaged=self.engaged(),
         )

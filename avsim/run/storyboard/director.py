@@ -6,8 +6,9 @@ storyboard (`runtime.StoryRuntime`: which actions start and stop now), and turns
 started action into a command on each of its actors' motions (`commands`). Commands the
 truth must steer every step (a distance to keep, a continuous relative speed) are renewed
 at each check. Actions on the car under test are its controller's (activation,
-assignment): they complete at once and change nothing, since avsim's stack drives it from
-the start (`avsim.scenario.openscenario.convert`).
+assignment): they complete at once and set the switch of its automated driving function
+(`World.engaged`, `engages`): on, the stack drives it; off (before a storyboard activates
+its controller: `avsim.scenario.openscenario.convert`), the driver holds its Init speed.
 """
 
 from __future__ import annotations
@@ -19,6 +20,7 @@ from avsim.run.storyboard.conditions import Resolved
 from avsim.run.storyboard.runtime import StartedAction, StoryRuntime
 from avsim.run.storyboard.snapshot import Snapshot
 from avsim.run.storyboard.truth import TruthTracker
+from avsim.scenario.openscenario.actions import engages
 from avsim.scenario.openscenario.model import (
     ActivateControllerAction,
     AssignControllerAction,
@@ -128,8 +130,10 @@ class Director:
 
     def _start(self, started: StartedAction, snap: Snapshot) -> None:
         action = started.action
-        if isinstance(action, CONTROLLER_ACTIONS):
-            return  # the runtime completes these itself
+        if isinstance(action, CONTROLLER_ACTIONS):  # the runtime completes these itself
+            if any(self._motion(e) is None for e in started.entities):  # the car under test
+                self.world.engaged = engages(action, self.world.engaged)
+            return
         tags = set()
         for entity in started.entities:
             motion = self._motion(entity)

@@ -165,6 +165,21 @@ class AssignControllerAction:
     activate_animation: bool | None  # 1.2
 
 
+def engages(action: ActivateControllerAction | AssignControllerAction, now: bool) -> bool:
+    """The switch of the car under test's automated driving function (`World.engaged`: on,
+    avsim's stack drives it) after its controller `action`, `now` before it: on where it
+    activates the lateral or longitudinal domain, off where it
+    deactivates those it names; an activation that names neither turns it on, an assignment
+    that names neither leaves it as it was (`now`)."""
+    if isinstance(action, ActivateControllerAction):
+        domains, unnamed = (action.lateral, action.longitudinal), True
+    else:
+        domains, unnamed = (action.activate_lateral, action.activate_longitudinal), now
+    if any(domains):
+        return True
+    return unnamed if all(d is None for d in domains) else False
+
+
 PrivateAction = (
     TeleportAction
     | SpeedAction

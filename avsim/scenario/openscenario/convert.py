@@ -6,9 +6,11 @@ the same world spec, driver settings and criteria as a YAML file gives, plus the
   (`world.map.opendrive.route`); positions on any of them are placed on it. A dual
   carriageway's far side is drawn as a scenery road (`WorldSpec.scenery_roads`).
 - The car under test: the entity named `Ego` (any case), else the first vehicle. avsim's
-  stack drives it from the start, its set speed the Init speed (the speed its driver held
-  when the file's controller takes over); avsim's car keeps its own body (4.8 x 1.6 m), not
-  the file's bounding box.
+  stack drives it once its controller is activated (`starts_engaged`: from the start,
+  unless a story activates it later; until then its driver holds its Init speed in its
+  lane), its set speed the Init speed (the speed its driver held when the file's
+  controller takes over); avsim's car keeps its own body (4.8 x 1.6 m), not the file's
+  bounding box.
 - The other entities become the world's actors with the file's bounding boxes: vehicles by
   category (car, van, motorbike, bicycle: a car; truck, bus, trailer, semitrailer: a truck),
   pedestrians, misc objects as obstacles.
@@ -29,6 +31,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 
 from avsim.scenario.errors import ScenarioError
+from avsim.scenario.openscenario.actions import engages
 from avsim.scenario.openscenario.model import (
     AbsoluteTargetSpeed,
     ActivateControllerAction,
@@ -91,7 +94,8 @@ def load_xosc(path: Path, overrides: Mapping[str, object] | None = None,
     ego = _ego(osc)
     placed, deferred = _init(osc, Resolver(route.chain))
     ahead = {e.name: _centre_ahead(e, e.name == ego.name) for e in osc.entities}
-    ego_spec = _ego_spec(path, road_map, ego.name, placed, ahead[ego.name])
+    ego_spec = _ego_spec(path, road_map, ego.name, placed, ahead[ego.name],
+                         starts_engaged(osc, ego.name))
     others = [e for e in osc.entities if e.name != ego.name]
     actors = tuple(_actor_spec(path, road_map, e, placed, ahead[e.name]) for e in others)
     program = StoryProgram(
@@ -211,8 +215,23 @@ def _centre(path: Path, road_map: RoadMap, name: str, placed: Mapping[str, _Plac
     return road_map.lane_at(xy)
 
 
+def starts_engaged(osc: OpenScenario, ego: str) -> bool:
+    """Whether the stack drives the car under test `ego` from the start (module doc): unless
+    a story activates its controller (`engages`) and no Init action has already."""
+    controller = ActivateControllerAction | AssignControllerAction
+    if any(item.entity == ego and isinstance(item.action, controller)
+           and engages(item.action, False) for item in osc.storyboard.init):
+        return True
+    return not any(
+        ego in group.actors.entities and isinstance(a.private_action, controller)
+        and engages(a.private_action, False)
+        for story in osc.storyboard.stories for act in story.acts
+        for group in act.maneuver_groups for maneuver in group.maneuvers
+        for event in maneuver.events for a in event.actions)
+
+
 def _ego_spec(path: Path, road_map: RoadMap, name: str, placed: Mapping[str, _Placed],
-              ahead: float) -> spec.EgoSpec:
+              ahead: float, engaged: bool) -> spec.EgoSpec:
     lane, s, r = _centre(path, road_map, name, placed, ahead)
     if lane is None or lane < 0:
         raise ScenarioError(str(path), f"Storyboard.Init.{name}", "the car under test must "
@@ -221,7 +240,8 @@ def _ego_spec(path: Path, road_map: RoadMap, name: str, placed: Mapping[str, _Pl
         raise ScenarioError(str(path), f"Storyboard.Init.{name}", "not supported yet (the "
                             f"car under test starting {r:+.2f} m off its lane's centre)")
     return spec.EgoSpec(lane=lane, s=s, speed=placed[name].speed,
-                        max_speed=max(placed[name].speed, 180.0 / 3.6))
+                        max_speed=max(placed[name].speed, 180.0 / 3.6),
+                        engaged=engaged)
 
 
 def _actor_spec(path: Path, road_map: RoadMap, entity: Entity,

@@ -11,6 +11,14 @@ import pytest
 
 from avsim.scenario.errors import ScenarioError
 from avsim.scenario.load import load_scenario
+from avsim.scenario.openscenario import load_openscenario
+from avsim.scenario.openscenario.actions import (
+    ActivateControllerAction,
+    AssignControllerAction,
+    engages,
+)
+from avsim.scenario.openscenario.convert import starts_engaged
+from avsim.scenario.openscenario.entities import Controller
 from avsim.scenario.openscenario.sidecar import MAX_DURATION, bundled_sets
 from world.spec import ActorType
 
@@ -18,6 +26,7 @@ ALKS = Path(__file__).parents[3] / "data" / "alks" / "logical_scenarios" / "conc
 FILES = sorted(ALKS.glob("alks_scenario_*.xosc"))
 CUT_IN = ALKS / "alks_scenario_4_4_1_cut_in_no_collision_template.xosc"
 REAR_AXLE = 1.35  # [m] behind avsim's car's centre (vehicle_urdf)
+DATA = Path(__file__).parent / "data"
 
 
 @pytest.mark.parametrize("path", FILES, ids=lambda p: p.stem.removeprefix("alks_scenario_"))
@@ -29,6 +38,39 @@ def test_every_alks_file_loads_as_a_scenario(path: Path) -> None:
     assert scenario.driver.set_speed == scenario.world.ego.speed
     assert scenario.duration == MAX_DURATION
     assert scenario.criteria.get("completes") is False  # the StopTrigger ends the run
+
+
+def _activate(lateral: bool | None, longitudinal: bool | None) -> ActivateControllerAction:
+    return ActivateControllerAction(lateral, longitudinal, None, None)
+
+
+def _assign(lateral: bool | None, longitudinal: bool | None) -> AssignControllerAction:
+    return AssignControllerAction(Controller("c", {}), lateral, longitudinal, None, None)
+
+
+@pytest.mark.parametrize(("action", "before", "after"), [
+    (_activate(True, True), False, True),
+    (_activate(None, True), False, True),  # one domain activated: the stack drives
+    (_activate(True, False), False, True),
+    (_activate(None, None), False, True),  # an activation naming no domain: all of them
+    (_activate(False, False), True, False),  # both deactivated: the driver again
+    (_activate(False, None), True, False),
+    (_assign(None, None), False, False),  # assigned, not activated: as it was
+    (_assign(None, None), True, True),
+    (_assign(None, True), False, True),
+    (_assign(False, None), True, False),
+])
+def test_the_switch_after_a_controller_action(action: ActivateControllerAction
+                                              | AssignControllerAction, before: bool,
+                                              after: bool) -> None:
+    assert engages(action, before) is after
+
+
+def test_the_car_under_test_starts_engaged_unless_a_story_activates_it() -> None:
+    assert all(not load_scenario(path).world.ego.engaged for path in FILES)  # at 3 s
+    assert starts_engaged(load_openscenario(DATA / "everything_1_2.xosc"), "Ego")  # in Init
+    assert starts_engaged(load_openscenario(DATA / "minimal.xosc"), "Ego")  # never: at once
+    assert load_scenario("cut_in_out").world.ego.engaged  # a YAML file: from the start
 
 
 def test_the_cut_in_vehicle_starts_where_the_file_puts_it() -> None:
