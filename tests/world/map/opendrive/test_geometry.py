@@ -3,13 +3,16 @@ integration, continuity across records, projection round trips."""
 
 from __future__ import annotations
 
+import math
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from scipy.integrate import solve_ivp
+from scipy.integrate import quad, solve_ivp
+from scipy.optimize import brentq
 from scipy.special import fresnel
 
 from world.map.opendrive import (
@@ -218,3 +221,57 @@ def test_param_poly3_turning_past_a_quarter_keeps_its_heading_continuous() -> No
     _, _, h = pv.pose_unwrapped(np.linspace(0.0, 30.0, 301))
     assert np.max(np.abs(np.diff(h))) < 0.1
     assert h[-1] == pytest.approx(2.5 + np.pi - np.arctan(0.2))
+
+
+def _arc_length_inverse(speed: Callable[[float], float], end: float, target: float) -> float:
+    """The parameter at which the curve of |dr/dp| `speed` has run `target` [m] of arc
+    length from 0 (`end` bounds the parameter)."""
+    return float(brentq(lambda p: quad(speed, 0.0, p, epsabs=1e-13, epsrel=1e-13)[0] - target,
+                        0.0, end, xtol=1e-14))
+
+
+def _expected_local(g: Geometry, ds: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """u, v [m] of record `g` at stations ds, from closed forms or quadrature written here,
+    independent of `world.map.opendrive.shapes`."""
+    shape = g.shape
+    if isinstance(shape, Line):
+        return ds, np.zeros_like(ds)
+    if isinstance(shape, Arc):
+        k = shape.curvature
+        return np.sin(k * ds) / k, (1.0 - np.cos(k * ds)) / k
+    if isinstance(shape, Spiral):
+        u, v, _ = integrated(shape.curv_start, shape.curv_end, g.length, ds)
+        return u, v
+    if isinstance(shape, Poly3Shape):  # u such that the arc length of (u, v(u)) is ds
+        a, b, c, d = shape.a, shape.b, shape.c, shape.d
+        us = np.array([_arc_length_inverse(lambda t: math.hypot(1.0, b + 2 * c * t + 3 * d * t * t),
+                                           2.0 * g.length, s) for s in ds])
+        return us, a + b * us + c * us**2 + d * us**3
+    assert isinstance(shape, ParamPoly3)
+    p_end = 1.0 if shape.p_range == "normalized" else g.length
+
+    def speed(p: float) -> float:
+        return math.hypot(shape.bu + 2 * shape.cu * p + 3 * shape.du * p * p,
+                          shape.bv + 2 * shape.cv * p + 3 * shape.dv * p * p)
+
+    scale = quad(speed, 0.0, p_end, epsabs=1e-13, epsrel=1e-13)[0] / g.length
+    ps = np.array([_arc_length_inverse(speed, p_end, s * scale) for s in ds])
+    return (shape.au + shape.bu * ps + shape.cu * ps**2 + shape.du * ps**3,
+            shape.av + shape.bv * ps + shape.cv * ps**2 + shape.dv * ps**3)
+
+
+def test_every_record_of_a_file_against_closed_forms_and_quadrature() -> None:
+    """mixed.xodr, read from the file: line, arcs, spirals, a poly3 and both paramPoly3
+    ranges, each within 1e-6 m of its closed form or of quadrature along it."""
+    plan_view = load_opendrive(DATA / "mixed.xodr").road("1").plan_view
+    kinds = set()
+    for g in plan_view.geometries:
+        ds = np.linspace(0.0, g.length, 9)
+        u, v = _expected_local(g, ds)
+        x = g.x + u * math.cos(g.hdg) - v * math.sin(g.hdg)
+        y = g.y + u * math.sin(g.hdg) + v * math.cos(g.hdg)
+        px, py, _ = plan_view.pose(g.s + ds)
+        assert np.hypot(px - x, py - y).max() < 1e-6, type(g.shape).__name__
+        kinds.add(type(g.shape).__name__ + getattr(g.shape, "p_range", ""))
+    assert kinds == {"Line", "Arc", "Spiral", "Poly3Shape", "ParamPoly3normalized",
+                     "ParamPoly3arcLength"}
