@@ -8,7 +8,6 @@ from collections.abc import Callable
 import numpy as np
 import pytest
 
-from avsim.criteria.base import Verdict
 from avsim.run.runner import RunResult
 from planner.fsm.acc import AccMode
 from planner.messages import SpeedSource
@@ -46,7 +45,8 @@ def test_the_stack_drives_once_the_files_controller_is_activated(
     assert np.abs(speed[before] - result.scenario.world.ego.speed).max() < 0.2
     assert AccMode.ACC_OFF not in {m for m, b in zip(modes, before, strict=True) if not b}
     on = [c for c in result.state_changes if c.machine == "acc" and c.source == "acc_off"]
-    assert [(c.t, c.target) for c in on] == [(pytest.approx(activated, abs=0.05), "cruise")]
+    assert [c.target for c in on] == ["cruise"]
+    assert on[0].t == pytest.approx(activated, abs=0.05)
 
 
 def test_an_avoidable_cut_in_is_avoided(runs: dict[str, RunResult]) -> None:
@@ -57,13 +57,12 @@ def test_an_avoidable_cut_in_is_avoided(runs: dict[str, RunResult]) -> None:
 
 def test_a_cut_in_r157_calls_unavoidable_is_not_failed(runs: dict[str, RunResult]) -> None:
     """10 m ahead at 3 m/s across: TTC at the lane intrusion under 20 km/h / 12 m/s^2 +
-    0.35 s; a collision, if any, is reported (not applicable), never failed."""
+    0.35 s, so a collision would be reported (not applicable), never failed
+    (`tests/avsim/criteria/test_cut_in.py`); the stack brakes in time and none happens."""
     result = runs["4_4_2"]
     assert not alks.failed(result), alks.failed(result)
-    collision = alks.verdicts(result)["no_collision"]
-    assert collision.verdict in (Verdict.PASS, Verdict.NOT_APPLICABLE)
-    if collision.verdict is Verdict.NOT_APPLICABLE:
-        assert "unavoidable under UN R157 5.2.5.2" in (collision.note or "")
+    assert alks.passed(result, "no_collision")
+    assert result.metrics["min_lead_gap"] < 5.0  # it came close: the cutter 3.6 m ahead
 
 
 @pytest.mark.parametrize(("number", "entity"), [
@@ -76,6 +75,8 @@ def test_the_detection_range_is_reported(runs: dict[str, RunResult], number: str
     assert alks.ended_by_stop_trigger(result)
     distance = result.metrics[f"first_tracked_distance_{entity.lower()}"]
     assert 0.0 < distance < 100.0  # tracked, within the LiDAR's 100 m
+    if number == "4_6_1":  # the target ahead: UN R157 7.1.1 asks for 46 m at least
+        assert distance >= 46.0
     assert not alks.failed(result), alks.failed(result)
 
 
