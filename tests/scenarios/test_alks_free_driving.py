@@ -69,3 +69,6 @@ def test_the_ego_keeps_its_speed_beside_the_truck(side_seen: RunResult) -> None:
     assert not alks.failed(side_seen, ignore=("story",))  # the run stops before its story
     v = side_seen.log.array("speed")
     assert np.all(np.abs(v - 60 * alks.KPH) < 2 * alks.KPH)
+    # the LiDAR sees the 18.75 m truck as a truck, tracked from the start (6.4 m aside)
+    assert side_seen.metrics["track_recall_truck"] > 0.9
+    assert side_seen.metrics["first_tracked_distance_sidevehicle"] < 10.0
