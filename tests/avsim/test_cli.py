@@ -133,6 +133,8 @@ def _openscenario_inputs(directory: Path) -> dict[str, Case]:
             "<OverrideControllerValueAction/>"), "not supported yet"),
         "xosc_missing_road": (text.replace("alks_road_straight.xodr", "no_road.xodr"),
                               "no_road.xodr"),
+        "xosc_missing_catalog": (text.replace("catalogs/vehicles", "catalogs/no_vehicles"),
+                                 "no_vehicles"),
     }
     for name, (content, key) in bad.items():
         path = directory / f"{name}.xosc"
@@ -175,7 +177,7 @@ BAD_CASE_NAMES = [f"fixture_{stem}" for stem in SUBPROCESS_FIXTURES] + [
     "out_is_a_directory", "out_below_a_file", "run_set_two_values", "run_set_bad_path",
     "run_set_bad_value", "lights_without_a_camera", "xosc_param_breaks_a_constraint",
     "xosc_malformed", "xosc_unresolved_reference", "xosc_unsupported_action",
-    "xosc_missing_road", "xosc_road_with_junction",
+    "xosc_missing_road", "xosc_missing_catalog", "xosc_road_with_junction",
 ]
 
 
@@ -329,6 +331,26 @@ def test_run_set_overrides_a_key_and_the_result_is_strict_json(tmp_path: Path) -
                if c["verdict"] == "not_applicable")
     with pytest.raises(ValueError, match="not strict JSON"):
         strict_json('{"value": Infinity}')
+
+
+def test_an_openscenario_file_runs_to_a_recording_a_result_and_a_plot(tmp_path: Path) -> None:
+    """`avsim run FILE.xosc` writes what a YAML file's run writes: the recording (valid),
+    the result JSON and the PNG."""
+    proc = subprocess.run(
+        [sys.executable, "-m", "avsim.cli", "run", str(CUT_IN), "--profile", "none",
+         "--set", "duration=2.0", "--out", str(tmp_path / "cut_in.rrd"), "--plot",
+         str(tmp_path / "cut_in.png"), "--no-progress"],
+        cwd=tmp_path, capture_output=True, text=True, timeout=180, check=False)
+    assert proc.returncode == 1, proc.stderr  # stopped at 2 s: its story did not finish
+    result = strict_json((tmp_path / "cut_in.json").read_text(encoding="utf-8"))
+    assert isinstance(result, dict) and result["sim_time"] == 2.0
+    assert result["scenario"] == CUT_IN.stem
+    assert {c["name"]: c["verdict"] for c in result["criteria"]}["story"] == "fail"
+    assert (tmp_path / "cut_in.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    verify = subprocess.run([str(Path(sys.executable).parent / "rerun"), "rrd", "verify",
+                             str(tmp_path / "cut_in.rrd")], capture_output=True, text=True,
+                            timeout=120, check=False)
+    assert verify.returncode == 0, verify.stderr
 
 
 def test_view_opens_the_recording_in_the_rerun_viewer(
