@@ -34,10 +34,13 @@ the line:
   track (on the far arm, in the lanes heading towards the car, up to ``oncoming_reach``
   beyond the box) that will reach the box within ``gap_time`` at its speed towards it, or
   is within ``near_box`` of it whatever its speed (e.g. at its own stop line, about to go
-  when the light turns green, as the car's does), or for any vehicle track inside the box
+  when the light turns green, as the car's does), or for any vehicle track in the box
+  (inside it, or past its own stop line and moving towards the centre: on its way in)
   that is not moving the car's way;
-- at a stop-sign junction, also going straight or turning right: for a vehicle track inside
-  the box that is not moving the car's way;
+- at a stop-sign junction, also going straight or turning right: for a vehicle track in
+  the box (the same) that is not moving the car's way: a car that took its turn and moved
+  off its line is waited for until it has crossed (issue K: town_traffic's ego went as
+  soon as the car first to stop left its line, and met it in the box);
 - at a stop-sign junction (an all-way stop), in order of arrival (`ArrivalOrder`): first to
   stop, first to go; ties to the right. The car *arrives* when it stands (below
   ``stopped``) with its front 0 to ``arrival_zone`` before its line. A vehicle track
@@ -65,8 +68,12 @@ later, for an oncoming car the one just gone by had hidden). Once giving way, th
 way until it has had nothing to wait for during ``gap_confirm`` in a row: a vehicle that
 comes out from behind another, or into the LiDAR's reach, is a confirmed track only after
 the tracker's M-of-N confirmation (up to 5 scans at 10 Hz), so a gap is taken once what it
-may hide has had the time to show. Then the gap is taken: the car goes and is committed to
-the junction (as above), the way production stacks commit to a gap: it gives way there
+may hide has had the time to show. Then the gap is taken: the car goes, and if its front is
+within ``arrival_zone`` of its line it is committed to the junction (as above), the way
+production stacks commit to a gap (queued farther back, behind a car that goes first, it
+is not: the gap is judged again on its way up to the line, as it would take seconds more
+to get there; issue K: town_traffic's ego took a gap 15 m back and turned 5 s later into
+the oncoming car): it gives way there
 again only for a safety reason, a vehicle inside the box that is not moving its way (at a
 junction whose rules look at the box) while it can still stop before the line at
 ``commit_decel``; never because an oncoming vehicle closes the gap. So the give-way event
@@ -239,10 +246,10 @@ class JunctionMonitor:
         room = j.s_stop - front - p.stop_margin
         can_stop = v * v <= 2.0 * p.commit_decel * max(room, 0.0)
         if k in self._committed:
-            if not (can_stop and self._box_taken(j, tracks)):
+            if not (can_stop and self._box_taken(k, tracks)):
                 return None
             self._committed.discard(k)  # a safety reason: a vehicle in its path in the box
-        wait = self._must_wait(j, tracks)
+        wait = self._must_wait(k, tracks)
         if j.control is Control.STOP_SIGNS:
             if self._order_at != k:
                 self._order, self._order_at = ArrivalOrder(p), k
@@ -252,12 +259,15 @@ class JunctionMonitor:
         if k not in self._waiting and v > p.moving and not stops_first and not can_stop:
             self._committed.add(k)  # past the last point it could stop comfortably: go on
             return None
-        return room if self._gives_way(t, k, wait) else None
+        at_line = j.s_stop - front <= p.arrival_zone
+        return room if self._gives_way(t, k, wait, at_line) else None
 
-    def _gives_way(self, t: float, k: int, wait: bool) -> bool:
+    def _gives_way(self, t: float, k: int, wait: bool, at_line: bool) -> bool:
         """Whether the car gives way at junction `k` at time `t` [s], `wait` whether it must
         now: while it must, and then until it need not for ``gap_confirm``; the gap is then
-        taken and the junction committed (module doc)."""
+        taken, and the junction committed if the car is `at_line` (its front within
+        ``arrival_zone`` of its stop line); queued farther back, it is taken as it stands
+        and judged again on the way up (module doc)."""
         if wait:
             self._waiting.add(k)
             self._clear_since.pop(k, None)
@@ -269,7 +279,8 @@ class JunctionMonitor:
             return True  # not yet taken: what the gap may hide has not had the time to show
         self._waiting.discard(k)
         del self._clear_since[k]
-        self._committed.add(k)  # the gap is taken: the car goes, committed
+        if at_line:
+            self._committed.add(k)  # the gap is taken: the car goes, committed
         return False
 
     def _box_rules(self, j: Junction) -> bool:
@@ -278,17 +289,20 @@ class JunctionMonitor:
         return j.manoeuvre in (Manoeuvre.LEFT, Manoeuvre.U_TURN) or \
             j.control is Control.STOP_SIGNS
 
-    def _box_taken(self, j: Junction, tracks: Sequence[Track]) -> bool:
-        """Whether a vehicle track inside `j`'s box is not moving the car's way, where the
-        car looks at the box (`_box_rules`)."""
+    def _box_taken(self, k: int, tracks: Sequence[Track]) -> bool:
+        """Whether a vehicle track is in junction `k`'s box, or on its way in, and not
+        moving the car's way (`_in_box`), where the car looks at the box (`_box_rules`)."""
+        j = self.road.junctions[k]
         xy, vel = _vehicles(tracks)
-        return self._box_rules(j) and len(xy) > 0 and bool(np.any(self._in_box(j, xy, vel)))
+        return self._box_rules(j) and len(xy) > 0 and \
+            bool(np.any(self._in_box(j, self._line_out[k], xy, vel)))
 
-    def _must_wait(self, j: Junction, tracks: Sequence[Track]) -> bool:
+    def _must_wait(self, k: int, tracks: Sequence[Track]) -> bool:
+        j = self.road.junctions[k]
         xy, vel = _vehicles(tracks)
         if not len(xy) or not self._box_rules(j):
             return False
-        wait = bool(np.any(self._in_box(j, xy, vel)))
+        wait = bool(np.any(self._in_box(j, self._line_out[k], xy, vel)))
         if j.manoeuvre in (Manoeuvre.LEFT, Manoeuvre.U_TURN):
             wait = wait or bool(np.any(self._oncoming_soon(j, xy, vel)))
         return wait
@@ -302,12 +316,20 @@ class JunctionMonitor:
         rel = xy - np.array([j.x, j.y])
         return rel @ f, rel @ left, vel @ f, vel @ left
 
-    def _in_box(self, j: Junction, xy: np.ndarray, vel: np.ndarray) -> np.ndarray:
+    def _in_box(self, j: Junction, line_out: float, xy: np.ndarray,
+                vel: np.ndarray) -> np.ndarray:
+        """The tracks in the box, or on their way in: past their stop line (within
+        `line_out` [m] of the centre) and moving towards the centre, as a car that took its
+        turn at an all-way stop does; not those moving the car's way."""
+        p = self.params
         along, left, v_along, v_left = self._frame(j, xy, vel)
         inside = (np.abs(along) <= j.half_width) & (np.abs(left) <= j.half_width)
         speed = np.hypot(v_along, v_left)
-        my_way = v_along > self.params.same_way * np.maximum(speed, 1e-9)
-        out: np.ndarray = inside & ~(my_way & (speed > self.params.moving))
+        moving = speed > p.moving
+        past_line = (np.abs(along) <= line_out) & (np.abs(left) <= line_out)
+        inwards = along * v_along + left * v_left < 0.0
+        my_way = v_along > p.same_way * np.maximum(speed, 1e-9)
+        out: np.ndarray = (inside | (past_line & moving & inwards)) & ~(my_way & moving)
         return out
 
     def _oncoming_soon(self, j: Junction, xy: np.ndarray, vel: np.ndarray) -> np.ndarray:

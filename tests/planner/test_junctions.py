@@ -334,12 +334,42 @@ def test_a_car_queued_on_another_arm_or_behind_the_car_is_not_waited_for() -> No
     assert not at_stop(m, 3.0, [queued, behind])
 
 
-def test_a_car_that_moves_off_its_line_is_no_longer_waited_for() -> None:
+def test_a_car_that_moves_off_its_line_is_waited_for_until_it_has_crossed() -> None:
+    """town_traffic's contact at 456 s (issue K): the car first to stop moves off its line;
+    it no longer waits there, but it is taking its turn: the car waits while it is on its
+    way in and across, and goes once it has left (after gap_confirm)."""
     m = stop_monitor()
     assert at_stop(m, 0.0, [at_arm("south", 4)])
-    on_its_way = [at_arm("south", 4, back=-3.0, moving=3.0)]
-    assert at_stop(m, 1.0, on_its_way)  # the gap not yet taken (gap_confirm)
-    assert not at_stop(m, 1.0 + P.gap_confirm, on_its_way)
+    on_its_way = [at_arm("south", 4, back=-3.0, moving=3.0)]  # 3 m past its line
+    assert at_stop(m, 1.0, on_its_way)
+    assert at_stop(m, 1.0 + P.gap_confirm, on_its_way)  # on its way in: still its turn
+    cx, cy = STOPS.centre((1, 1))
+    across = [replace(car(cx + LANE, cy, 0.0, 3.0), id=4)]  # in the box, heading north
+    assert at_stop(m, 2.0, across)
+    gone = [replace(car(cx + LANE, cy + LINE_OUT + 3.0, 0.0, 3.0), id=4)]  # left it
+    assert at_stop(m, 3.0, gone)  # the gap not yet taken (gap_confirm)
+    assert not at_stop(m, 3.0 + P.gap_confirm, gone)
+
+
+def test_a_car_leaving_the_junction_on_the_cars_own_arm_is_not_waited_for() -> None:
+    """Past the car's stop line but moving away from the centre: no conflict."""
+    m = stop_monitor()
+    cx, cy = STOPS.centre((1, 1))
+    leaving = [replace(car(cx - LINE_OUT + 2.0, cy + LANE, -5.0, 0.0), id=6)]  # westbound
+    assert not at_stop(m, 0.0, leaving)
+
+
+def test_a_gap_taken_queued_behind_another_car_is_judged_again_at_the_line() -> None:
+    """town_traffic's contact at 561 s (issue K): second in the queue for a left turn, the
+    car took a gap 15 m before its line and, committed, turned 5 s later, behind the car
+    ahead, into a car that had come near since. A gap taken away from the line does not
+    commit: an oncoming car that comes within gap_time on the way up is waited for."""
+    m = standing_left_turn()
+    assert at_line(m, 0.0, [oncoming(m, 20.0, 10.0)], before_line=15.0)
+    assert at_line(m, 1.0, [], before_line=15.0)
+    assert not at_line(m, 1.0 + P.gap_confirm, [], before_line=15.0)  # taken, not committed
+    assert not at_line(m, 2.0, [oncoming(m, 90.0, 10.0)], v=2.0, before_line=10.0)
+    assert at_line(m, 3.0, [oncoming(m, 40.0, 10.0)], v=2.0, before_line=8.0)  # 4 s away
 
 
 def test_at_an_all_way_stop_the_car_does_not_commit_before_it_has_stood() -> None:
