@@ -72,3 +72,17 @@ def test_the_ego_keeps_its_speed_beside_the_truck(side_seen: RunResult) -> None:
     # the LiDAR sees the 18.75 m truck as a truck, tracked from the start (6.4 m aside)
     assert side_seen.metrics["track_recall_truck"] > 0.9
     assert side_seen.metrics["first_tracked_distance_sidevehicle"] < 10.0
+
+
+@pytest.mark.acceptance  # two 300 s runs with the cameras and LiDAR: `make acceptance`
+@pytest.mark.parametrize("number", ["4_1_1", "4_1_3"])
+def test_with_its_sensors_in_the_loop_it_drives_to_the_stop_trigger(
+        run_scenario: Callable[..., RunResult], number: str) -> None:
+    """The two long files whole with the `default` sensors (the runs above go on the map):
+    the 5 km of curves in lane at the Init speed, and beside the truck."""
+    result = alks.run(run_scenario, number)
+    assert alks.ended_by_stop_trigger(result)
+    assert result.sim_time > 250.0  # minutes of driving, not a cut-short run
+    assert not alks.failed(result), alks.failed(result)
+    v = result.log.array("speed")[result.log.array("t") > 5.0]
+    assert np.all(np.abs(v - 60 * alks.KPH) < 2 * alks.KPH)

@@ -131,7 +131,7 @@ class Director:
     def _start(self, started: StartedAction, snap: Snapshot) -> None:
         action = started.action
         if isinstance(action, CONTROLLER_ACTIONS):  # the runtime completes these itself
-            if any(self._motion(e) is None for e in started.entities):  # the car under test
+            if self.program.ego in started.entities:
                 self.world.engaged = engages(action, self.world.engaged)
             return
         tags = set()

@@ -10,6 +10,9 @@ from __future__ import annotations
 from world.map.opendrive.model import LaneSection, OdrLane, Poly3, RoadMark
 from world.map.opendrive.xmltree import Node
 
+MAX_SIDE_LANES = 32  # lanes on one side of a lane section (every type: driving, shoulder,
+#   border, sidewalk, ...): a bound on the work; real roads have under a dozen
+
 SPEED_UNITS = {"m/s": 1.0, "km/h": 1 / 3.6, "mph": 0.44704}  # [m/s] per unit
 NO_LIMIT = frozenset({"no limit", "undefined"})
 DEFAULT_MARK_WIDTH = 0.12  # [m]
@@ -133,7 +136,10 @@ def lane(node: Node) -> OdrLane:
 def _side(node: Node | None, sign: int) -> tuple[OdrLane, ...]:
     if node is None:
         return ()
-    lanes = sorted((lane(n) for n in node.only("lane")["lane"]), key=lambda ln: abs(ln.id))
+    nodes = node.only("lane")["lane"]
+    if len(nodes) > MAX_SIDE_LANES:
+        raise node.error(f"{len(nodes)} lanes on one side: at most {MAX_SIDE_LANES}")
+    lanes = sorted((lane(n) for n in nodes), key=lambda ln: abs(ln.id))
     ids = [ln.id for ln in lanes]
     want = [sign * (i + 1) for i in range(len(lanes))]
     if ids != want:
