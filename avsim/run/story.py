@@ -85,9 +85,7 @@ class StoryboardStory:
         self.director = director
         board = director.program.scenario.storyboard
         names = [(action.name, kind_of(action.private_action))
-                 for story in board.stories for act in story.acts
-                 for group in act.maneuver_groups for maneuver in group.maneuvers
-                 for event in maneuver.events for action in event.actions]
+                 for _, action in board.story_actions()]
         if board.stop_trigger is not None:
             names.append((STOP_TRIGGER, "stop_trigger"))
         self.entries = tuple(StoryEntry(None, i, kind, False, None, element=name)

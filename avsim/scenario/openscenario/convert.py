@@ -225,9 +225,7 @@ def starts_engaged(osc: OpenScenario, ego: str) -> bool:
     return not any(
         ego in group.actors.entities and isinstance(a.private_action, controller)
         and engages(a.private_action, False)
-        for story in osc.storyboard.stories for act in story.acts
-        for group in act.maneuver_groups for maneuver in group.maneuvers
-        for event in maneuver.events for a in event.actions)
+        for group, a in osc.storyboard.story_actions())
 
 
 def _ego_spec(path: Path, road_map: RoadMap, name: str, placed: Mapping[str, _Placed],

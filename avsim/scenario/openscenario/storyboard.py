@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import Literal
 
@@ -73,3 +74,13 @@ class Storyboard:
     init: tuple[InitAction, ...]
     stories: tuple[Story, ...]
     stop_trigger: Trigger | None
+
+    def story_actions(self) -> Iterator[tuple[ManeuverGroup, Action]]:
+        """Every action of the stories with its maneuver group, in the file's order."""
+        for story in self.stories:
+            for act in story.acts:
+                for group in act.maneuver_groups:
+                    for maneuver in group.maneuvers:
+                        for event in maneuver.events:
+                            for action in event.actions:
+                                yield group, action
