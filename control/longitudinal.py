@@ -29,10 +29,13 @@ Steps of `SpeedController.update`:
    ``comfort_plan`` unless no comfortable stop is left, `planner.acc_control`); the
    envelope keeps the PID's share within comfort too, so that a step in the target speed
    does not become a jolt. A car holding at a stop is at rest: no envelope. A plan asking
-   for more braking than ``comfort_plan`` is urgent: the envelope is off and the actuator
+   for more than ``comfort_plan`` but no more than ``iso_plan`` (no comfortable stop left,
+   but one within ISO's limits) gets ISO's own envelope: floor -``iso_decel``, rise at most
+   ``iso_jerk``. A plan asking for more is urgent: the envelope is off and the actuator
    limits below apply.
 4. Jerk limit: the request moves by at most ``max_jerk`` dt per step (in a comfortable
-   plan, a request at or below 0 falls by at most ``comfort_jerk`` dt: the deceleration
+   plan, a request at or below 0 falls by at most ``comfort_jerk`` dt, ``iso_jerk`` dt in
+   one within ISO's limits: the deceleration
    rises at the comfort jerk, while an acceleration is still taken back at once). ``max_jerk`` is an
    actuator guard: it keeps torque steps and PID noise off the drivetrain while letting
    hard braking reach ``max_decel`` within a fraction of a second.
@@ -87,6 +90,12 @@ class SpeedParams:
     #   ISO 15622's 3.5 m/s^2)
     comfort_jerk: float = 2.0  # [m/s^3] in a comfortable plan, the most the deceleration
     #   rises per second (under ISO 15622's 2.5 m/s^3; `planner.limits.J_COMF`)
+    iso_plan: float = 3.45  # [m/s^2] a plan braking no harder than this is within ISO's
+    #   limits (`planner.limits.A_ISO_MAX`)
+    iso_decel: float = 3.45  # [m/s^2] in such a plan, the request's floor (under ISO 15622's
+    #   3.5 m/s^2)
+    iso_jerk: float = 2.4  # [m/s^3] in such a plan, the most the deceleration rises per
+    #   second (under ISO 15622's 2.5 m/s^3; `planner.limits.J_ISO_PLAN`)
 
     @property
     def pid(self) -> PidParams:
@@ -119,6 +128,17 @@ class SpeedController:
         self._excess = 0.0
         self._pressing = 0.0
 
+    def _envelope(self, target_accel: float, hold: bool) -> tuple[float, float] | None:
+        """(floor [m/s^2], jerk [m/s^3]) of the comfort envelope for a plan whose
+        feed-forward is `target_accel` [m/s^2] (module doc, step 3); None: urgent, or at
+        rest (`hold`)."""
+        p = self.params
+        if hold or target_accel < -p.iso_plan:
+            return None
+        if target_accel >= -p.comfort_plan:
+            return p.comfort_decel, p.comfort_jerk
+        return p.iso_decel, p.iso_jerk
+
     def update(
         self, target_speed: float, target_accel: float, speed: float, dt: float,
         *, emergency: bool = False,
@@ -146,13 +166,13 @@ class SpeedController:
             integrate = self._excess * error <= 0.0 and (abs(error) <= p.integration_band
                                                          or stalled)
             desired = target_accel + self._pid.update(error, dt, integrate=integrate)
-        comfortable = target_accel >= -p.comfort_plan and not hold  # (a hold: at rest)
-        floor = p.comfort_decel if comfortable else p.max_decel
+        envelope = self._envelope(target_accel, hold)
+        floor = p.max_decel if envelope is None else envelope[0]
         clamped = min(max(desired, -floor), p.max_accel)
         max_step = p.max_jerk * dt
-        low = self._accel - max_step  # the braking part of a drop, at the comfort jerk:
-        if comfortable:
-            low = max(low, min(self._accel, 0.0) - p.comfort_jerk * dt)
+        low = self._accel - max_step  # the braking part of a drop, at the envelope's jerk:
+        if envelope is not None:
+            low = max(low, min(self._accel, 0.0) - envelope[1] * dt)
         accel = min(max(clamped, low), self._accel + max_step)
         self._excess = desired - accel
         pressing = accel >= p.stall_rise and speed < p.stall_speed and not hold

@@ -30,8 +30,11 @@ Steps:
    white noise ``gnss_white`` x the fix's stated sigma, at least ``gnss_sigma``; the heading
    noise the larger of the fix's own and ``gnss_heading_sigma``); an invalid fix (an
    outage) is skipped. The heading innovation is wrapped to (-pi, pi].
-4. Map matching (`on_lane`): a confident camera lane estimate gives the car's lateral
-   offset from a lane centre and its heading relative to the lane. The lane is the HD map's
+4. Map matching (`on_lane`): a camera lane estimate gives the car's lateral offset from a
+   lane centre and its heading relative to the lane: a confident one (``lane_confidence``),
+   or a less confident one (down to ``weak_lane_confidence``: one line and the lane's width,
+   a truck beside hiding the other) whose frame's detection the lane filter took, its noise
+   scaled up by ``lane_confidence`` / confidence. The lane is the HD map's
    ego-direction lane that puts the car nearest the estimate (before the first match: the
    lane the car starts in, since a GNSS bias may exceed half a lane). The pseudo-measurement
    is the estimate projected onto that lane (its station kept) with the camera's lateral
@@ -108,6 +111,11 @@ class LocalizerParams:
     #   correlated: about 4 x the 0.04 m RMS error measured on normal_driving)
     lane_heading_sigma: float = 1.0 * DEG  # [rad] camera heading-to-lane noise (0.66 deg RMS)
     lane_confidence: float = 0.5  # [-] a lane estimate this confident is a measurement
+    weak_lane_confidence: float = 0.2  # [-] less confident, down to this, it is one only when
+    #   this frame's detection was taken (`LaneEstimate.age` 0), its noise scaled by
+    #   `lane_confidence` / confidence: a lane kept on one line beside a truck for minutes
+    #   (ALKS 4.1.3) still pins the position across the lane, or a consumer receiver's
+    #   wandering bias carries the pose a metre off the lane the camera keeps
     wheel_lock_ratio: float = 0.5  # [-] a wheel spinning this much slower than the fastest
     #   is locking (braking): the speed is then the fastest wheel's (`wheel_speed`); in the
     #   tightest turn a car makes (5 m at the rear axle) the inner rear wheel turns 35 %
@@ -291,7 +299,7 @@ class Localizer:
         step 4). None when there is nothing to match (no map, no fix yet, not confident,
         no ego-direction lane there); else what was done."""
         p = self.params
-        if self.road is None or not self._initialised or lane.confidence < p.lane_confidence:
+        if self.road is None or not self._initialised or not self._measures(lane):
             return None
         found = self._match(lane, pose)
         if found is None:
@@ -306,9 +314,16 @@ class Localizer:
         h = np.zeros((2, DIM_X))
         h[0, IX], h[0, IY] = -math.sin(now_theta), math.cos(now_theta)
         h[1, IPSI] = 1.0
-        match = self._gated_update(h, nu, self._r_lane, p.lane_gate, index)
+        weight = min(1.0, lane.confidence / p.lane_confidence)
+        match = self._gated_update(h, nu, self._r_lane / weight**2, p.lane_gate, index)
         self.matched = self.matched or match.accepted
         return match
+
+    def _measures(self, lane: LaneEstimate) -> bool:
+        """Whether ``lane`` is a measurement for map matching (`LocalizerParams`)."""
+        p = self.params
+        return lane.confidence >= p.lane_confidence or (
+            lane.age == 0.0 and lane.confidence >= p.weak_lane_confidence)
 
     def on_line_end(self, lane: LaneEstimate, pose: EgoState) -> LaneMatch | None:
         """Along the route: at a town junction the painted lines end at its mouth

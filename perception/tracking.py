@@ -11,7 +11,14 @@ Model (one linear Kalman filter per track, filterpy's `KalmanFilter`):
   on each axis, Q = q [[dt^3/3, dt^2/2], [dt^2/2, dt]] per axis;
 - measurement: the box centre, moved to the map frame with the ego pose, R =
   ``position_sigma``^2 I (the box completion's centre error; the ego pose error is smaller
-  and is not added);
+  and is not added), placed by the box's near faces: the detector keeps a face where it was
+  seen and grows the box away from the sensor to its class's size (`perception.objects`),
+  so along each box axis whose near end the sensor sees, the centre measured is that face
+  plus half the track's own extent, and when the track's smoothed size changes its centre
+  moves with it, the near faces staying (`_away`). A box whose size changes from one scan to
+  the next (a car revealed by a cut-out, its first few returns a pedestrian's box, then a
+  car's) so moves its far end, not its centre: its velocity stays the object's (the box
+  centre moved away at 0.7 m/s from a standing car before, and the ACC's need with it);
 - a new track starts at its detection with zero velocity, ``init_speed_sigma`` per axis.
 
 Steps of `MultiObjectTracker.update`:
@@ -26,8 +33,9 @@ Steps of `MultiObjectTracker.update`:
    pose jump leaves a track where the car thought it was and starts a second one for the
    same object, the first coasting (a truck beside the car coasting into its lane).
 1. Predict every track to t.
-2. Associate: the cost is the squared Mahalanobis distance of each detection's centre to
-   each track's predicted centre (S = H P H^T + R); pairs beyond the chi-square gate
+2. Associate: the cost is the squared Mahalanobis distance of the centre each detection
+   measures for each track (its near faces and the track's extents, as in step 3's update)
+   to the track's predicted centre (S = H P H^T + R); pairs beyond the chi-square gate
    ``gate`` are not allowed; `scipy.optimize.linear_sum_assignment` finds the least summed
    cost.
 3. Update the matched tracks: the filter; the box size (exponential smoothing with weight
@@ -197,12 +205,35 @@ class _TrackState:
         out: FloatArray = np.einsum("ij,jk,ik->i", y, np.linalg.inv(s), y)
         return out
 
-    def update(self, det: MapDetection, t: float, p: TrackerParams) -> None:
-        self.kf.update(np.array([det.x, det.y]))
+    def _axes_along(self, det: MapDetection) -> list[int]:
+        """The indices of the track's size (length 0, width 1) along ``det``'s length and
+        width axes: swapped when its box axis lies nearer ``det``'s width axis."""
+        axis = 0.5 * math.atan2(float(self.axis[1]), float(self.axis[0]))
+        turned = abs(wrap_angle(2.0 * (axis - det.yaw))) > 0.5 * math.pi  # beyond 45 deg
+        return [1, 0] if turned else [0, 1]
+
+    def measured_centre(self, det: MapDetection, away: FloatArray) -> FloatArray:
+        """(2,) [m] the centre ``det`` measures for this track: its near faces (``away``:
+        `_away`) plus half the track's own extents."""
+        seen = np.array([det.length, det.width])  # [m] along the detection's axes
+        held = self.size[self._axes_along(det)]
+        out: FloatArray = np.array([det.x, det.y]) + away.T @ (0.5 * (held - seen))
+        return out
+
+    def update(self, det: MapDetection, t: float, p: TrackerParams,
+               sensor: tuple[float, float]) -> None:
+        """Take ``det``, seen from ``sensor`` (x, y) [m, map frame]: its near faces are the
+        measurement (module doc, step 3)."""
+        away = _away(det, sensor)  # (2, 2) per box axis, the direction away from the sensor
+        order = self._axes_along(det)
+        held = self.size[order]
+        self.kf.update(self.measured_centre(det, away))
         a = p.size_alpha
         self.size = (1.0 - a) * self.size + a * np.array([det.length, det.width, det.height])
         self.axis = (1.0 - a) * self.axis + a * np.array([math.cos(2.0 * det.yaw),
                                                           math.sin(2.0 * det.yaw)])
+        grown = self.size[order] - held  # [m] the new size's change: the centre
+        self.kf.x[:2, 0] += away.T @ (0.5 * grown)  # moves with it, the near faces stay
         self.votes[det.cls] += 1
         self.last_cls = det.cls
         self.hits += 1
@@ -230,6 +261,21 @@ class _TrackState:
             else flipped
 
 
+def _away(det: MapDetection, sensor: tuple[float, float]) -> FloatArray:
+    """(2, 2) [-]: for ``det``'s length axis and its width axis (rows), the unit vector
+    away from ``sensor`` (x, y) [m] along it where the sensor's projection on the axis lies
+    beyond the box (a face seen: the detector keeps it where it was seen and grows the box
+    away from it, `perception.objects`), else zero (both ends of the axis seen)."""
+    c, s = math.cos(det.yaw), math.sin(det.yaw)
+    out = np.array([[c, s], [-s, c]])
+    half = (0.5 * det.length, 0.5 * det.width)
+    rel = np.array([sensor[0] - det.x, sensor[1] - det.y])
+    for k in (0, 1):
+        along = float(out[k] @ rel)
+        out[k] *= 0.0 if abs(along) <= half[k] else -math.copysign(1.0, along)
+    return out
+
+
 def relative(x: float, y: float, vx: float, vy: float,
              ego: EgoState) -> tuple[float, float, float, float]:
     """(rel_x, rel_y, rel_vx, rel_vy) [m, m, m/s, m/s] of a map-frame position and velocity
@@ -240,13 +286,17 @@ def relative(x: float, y: float, vx: float, vy: float,
     return c * dx + s * dy, -s * dx + c * dy, c * dvx + s * dvy, -s * dvx + c * dvy
 
 
-def associate(tracks: list[_TrackState], dets: list[MapDetection],
-              gate: float) -> list[tuple[int, int]]:
-    """(track index, detection index) pairs of the gated minimum-cost assignment."""
+def associate(tracks: list[_TrackState], dets: list[MapDetection], gate: float,
+              sensor: tuple[float, float] = (0.0, 0.0)) -> list[tuple[int, int]]:
+    """(track index, detection index) pairs of the gated minimum-cost assignment; each
+    pair's cost is the distance of the centre the detection measures for that track (its
+    near faces seen from ``sensor`` [m, map frame], `_TrackState.measured_centre`)."""
     if not tracks or not dets:
         return []
-    z = np.array([[d.x, d.y] for d in dets])
-    cost = np.array([tr.mahalanobis2(z) for tr in tracks])  # (T, D)
+    away = [_away(d, sensor) for d in dets]
+    cost = np.array([tr.mahalanobis2(np.array([tr.measured_centre(d, a)
+                                               for d, a in zip(dets, away, strict=True)]))
+                     for tr in tracks])  # (T, D)
     cost = np.where(cost <= gate, cost, INFEASIBLE)
     rows, cols = linear_sum_assignment(cost)
     return [(int(r), int(c)) for r, c in zip(rows, cols, strict=True)
@@ -262,12 +312,15 @@ class MultiObjectTracker:
         self._next_id = 1
         self._last_ego: EgoState | None = None  # the pose of the last scan
 
-    def update(self, t: float, ego: EgoState,
-               detections: tuple[Detection, ...]) -> tuple[Track, ...]:
+    def update(self, t: float, ego: EgoState, detections: tuple[Detection, ...],
+               sensor: tuple[float, float] = (0.0, 0.0)) -> tuple[Track, ...]:
         """Advance to time ``t`` [s] with the detections of the scan at ``t`` (vehicle frame
-        of ``ego``) and return the confirmed tracks, by id."""
+        of ``ego``), taken from the LiDAR at ``sensor`` (x, y) [m] in that frame, and return
+        the confirmed tracks, by id."""
         p = self.params
         dets = [to_map(d, ego) for d in detections]
+        c, s = math.cos(ego.heading), math.sin(ego.heading)
+        seen_from = (ego.x + c * sensor[0] - s * sensor[1], ego.y + s * sensor[0] + c * sensor[1])
         if self._last_ego is not None and ego.t >= self._last_ego.t:
             jump = pose_jump(self._last_ego, ego)
             for tr in self._tracks:
@@ -275,11 +328,11 @@ class MultiObjectTracker:
         self._last_ego = ego
         for tr in self._tracks:
             tr.predict(t, p)
-        pairs = associate(self._tracks, dets, p.gate)
+        pairs = associate(self._tracks, dets, p.gate, seen_from)
         matched_tracks = {i for i, _ in pairs}
         matched_dets = {j for _, j in pairs}
         for i, j in pairs:
-            self._tracks[i].update(dets[j], t, p)
+            self._tracks[i].update(dets[j], t, p, seen_from)
         for i, tr in enumerate(self._tracks):
             tr.scans += 1
             if i not in matched_tracks:

@@ -14,11 +14,17 @@ pedal). `planner.acc_layer` picks the law for the mode.
   sqrt(v_l^2 + 2 a_comf max(d - d0, 0)))``, clamped to [0, v_plan]. The first term feeds
   the lead's speed forward and closes the gap error with the time constant 1 / k_gap, slow
   enough not to chase the lead's speed noise; the second is the speed from which braking at
-  a_comf still stops d0 behind a lead that stops. Where the first binds and the lead brakes
-  (its acceleration from its track, `planner.lead.LeadAccel`, under -`lead_brakes`), its
-  deceleration is the feed-forward, and its speed is taken less what it shed since its
-  track's measurement and over the track's lag (`lead_speed_now`, every law and the
-  mode's inputs): without it the reference fell with the lead's speed and the speed loop
+  a_comf still stops d0 behind a lead that stops. While the lead brakes gently (b up to
+  a_gentle), the car following it brakes as it does and d_des shrinks with the car's speed
+  at d_des'(v) b: the first term gets ``+ d_des'(v) b`` (tapering to 0 at 2 a_gentle: a lead
+  braking harder is not closed in on), else the gap error alone lags the shrinking d_des by
+  d_des' b / k_gap (ISO 22179 stop and go, a lead stopping at 1 m/s^2 from 40 km/h: 13 m
+  behind at 2 m/s when it stopped, and the car crept its last 8 m at a_final and never
+  stood before it drove off again; now it stands 4.8 m behind). Where the first binds and
+  the lead brakes (its acceleration from its track, `planner.lead.LeadAccel`, under
+  -`lead_brakes`), its deceleration is the feed-forward, and its speed is taken less what
+  it shed since its track's measurement and over the track's lag (`lead_speed_now`, every
+  law and the mode's inputs): without it the reference fell with the lead's speed and the speed loop
   followed tau_loop behind, and a car following at 90 km/h behind a lead braking at
   2 m/s^2 fell 2 m under UN R157's d_min (issue K). Stop-and-go: behind a
   lead slower than ``v_standstill`` the gap law would creep up on it for several of its time
@@ -63,17 +69,23 @@ pedal). `planner.acc_layer` picks the law for the mode.
   short of room stops a little nearer rather than harder; only when even ``need`` exceeds
   a_comf_max is there no comfortable stop: the ACC enters BRAKE saying so (`planner.fsm.acc`:
   "no comfortable stop: needs 3.9 m/s^2, ttc 2.1 s"; the time to collision is reported, not
-  judged: a planned stop behind a stopped car ends with a short one) and the cap is a_hard,
-  the feed-forward beyond a_comf_max telling the speed loop the plan is urgent. The stops and
-  the bump use the same approach with room = the distance to their point less the margin and
-  the ramp-in from the deceleration the car brakes at (`ramped`; need = a_plan: a point on the
-  map has no floor short of it). Of the laws that bind (the speed plan, an event's, the trail
+  judged: a planned stop behind a stopped car ends with a short one) and the cap is a_iso,
+  or ``need`` itself up to a_iso_max, while ``need`` is within a_iso_max
+  (`planner.limits.A_ISO_PLAN`, `A_ISO_MAX`: a stop within ISO's own limits is left, and the
+  speed loop builds it at ISO's jerk; the cap follows ``need`` past a_iso, so that a need
+  that wavers about a_iso does not flick the plan to a_hard and back, a jerk of 8 m/s^3;
+  a stopped car revealed by a cut-out 50 m ahead at 60 km/h needs 3.1 m/s^2, and braking
+  at up to a_hard with the envelope off rose at 3.4 m/s^3), else a_hard, the feed-forward
+  beyond a_iso_max telling the speed loop the plan is urgent. The stops and the bump use
+  the same approach with room = the distance to their point less the margin and the ramp-in
+  from the deceleration the car brakes at (`ramped`; need = a_plan: a point on the map has
+  no floor short of it). Of the laws that bind (the speed plan, an event's, the trail
   law behind a vehicle ahead), the one the speed loop would ask least of the car on is taken,
   the minimum of the laws' outputs (`planner.acc_layer`).
 - BRAKE (gap at or below d_min, or no comfortable stop): the approach behind the lead on
   the trail law, with the gap opened at no more than ``a_open`` while it is under d_min
-  and the lead is not closing, and the cap a_comf_max, or a_hard when no comfortable stop
-  is left. Harder still is the control FSM's emergency stop.
+  and the lead is not closing, and the cap a_comf_max, or a_iso or a_hard when no
+  comfortable stop is left (as above). Harder still is the control FSM's emergency stop.
 - PEDESTRIAN, STOP_SIGN, RED_LIGHT, YIELD: stop ``margin`` before a point ``s_stop`` ahead
   of the front bumper (`stop_speed`): ``v_ref = sqrt(2 a_comf (s_stop - margin))``, and 0
   once ``s_stop - margin <= arrived``, through the approach (`stop`). The cut-off is
@@ -99,7 +111,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from planner.limits import A_COMF, A_COMF_MAX, A_FLAT, A_HARD, J_COMF
+from planner.limits import A_COMF, A_COMF_MAX, A_FLAT, A_HARD, A_ISO_MAX, A_ISO_PLAN, J_COMF
 from planner.speed import SpeedRef
 
 
@@ -108,7 +120,10 @@ class AccControlParams:
     k_gap: float = 0.25  # [1/s] trail: gap error to speed (1 / the gap's time constant)
     a_comf: float = A_COMF  # [m/s^2] comfortable deceleration (stops, bumps)
     a_comf_max: float = A_COMF_MAX  # [m/s^2] the most a comfortable approach plans
-    a_hard: float = A_HARD  # [m/s^2] the most BRAKE plans when no comfortable stop is left
+    a_iso: float = A_ISO_PLAN  # [m/s^2] BRAKE plans at most this, or `need` up to a_iso_max,
+    a_iso_max: float = A_ISO_MAX  # when no comfortable stop is left but one within ISO's
+    #   limits is
+    a_hard: float = A_HARD  # [m/s^2] the most BRAKE plans when no stop within ISO's is left
     a_open: float = A_COMF  # [m/s^2] BRAKE opens a gap under d_min at no more than this
     a_gentle: float = 1.0  # [m/s^2] the approach keeps to the law while the speed loop's
     #   reaction to it is no harder than this (a lead slowing down is followed as it slows)
@@ -148,14 +163,17 @@ def lead_speed_now(v_l: float, a_lead: float, age: float, p: AccControlParams) -
 
 
 def trail(v_plan: float, d: float, d_des: float, v_l: float, d0: float,
-          p: AccControlParams, a_lead: float = 0.0) -> SpeedRef:
+          p: AccControlParams, a_lead: float = 0.0, d_des_slope: float = 0.0) -> SpeedRef:
     """TRAIL's law (module doc): the reference behind a lead at bumper gap d [m] with speed
     v_l [m/s] and acceleration `a_lead` [m/s^2] (signed), for the desired gap d_des and
-    standstill gap d0 [m], at most v_plan [m/s]."""
+    standstill gap d0 [m], at most v_plan [m/s]; `d_des_slope` [s] is d(d_des)/dv at the
+    car's speed (the gap law's shrink term)."""
     if v_l < p.v_standstill:
         approach = math.sqrt(2.0 * p.a_final * max(d - d0 - p.stop_band, 0.0))
         return SpeedRef(min(approach, v_plan), 0.0)
-    gap_law = v_l + p.k_gap * (d - d_des)
+    b = lead_braking(a_lead, p)
+    shrink = d_des_slope * (b if b <= p.a_gentle else max(2.0 * p.a_gentle - b, 0.0))
+    gap_law = v_l + shrink + p.k_gap * (d - d_des)
     stop_law = math.sqrt(max(v_l, 0.0) ** 2 + 2.0 * p.a_comf * max(d - d0, 0.0))
     speed = min(max(min(gap_law, stop_law), 0.0), v_plan)
     braking = lead_braking(a_lead, p) if 0.0 < speed == gap_law else 0.0
@@ -222,10 +240,14 @@ def ttc(v: float, v_l: float, d: float) -> float:
 def approach(v: float, law: SpeedRef, a_plan: float, a_need: float, dt: float,
              p: AccControlParams) -> SpeedRef:
     """The law's reference `law`, or, where the car at speed v [m/s] is faster than it and
-    the planned deceleration `a_plan` [m/s^2] is gentler than the speed loop's reaction,
-    that deceleration from the car's speed over dt [s]; never gentler than `a_need` (below
-    the law: only when that leaves no comfortable stop), capped at a_comf_max (a_hard when
-    a_need exceeds it)."""
+    the planned deceleration `a_plan` [m/s^2] is gentler than the speed loop's reaction (or
+    that reaction exceeds the cap), that deceleration from the car's speed over dt [s];
+    never gentler than `a_need` (below the law: only when that leaves no comfortable stop),
+    capped at a_comf_max (when a_need exceeds it: a_iso, or a_need up to a_iso_max; a_hard
+    beyond). A law whose reaction exceeds the cap is not handed on: the speed loop would brake
+    at its comfort envelope's floor on it, while its feed-forward, 0, told `BrakeModel` the
+    car had stopped braking, and `need`, counting a whole ramp-in again, jumped from 2.9 to
+    12 m/s^2 (UN R157 lead braking at 4 m/s^2 from 60 km/h, its last metres)."""
     loop = max(-law.accel, 0.0) + max(v - law.speed, 0.0) / p.tau_loop
     if v <= law.speed:  # not faster than the law: the law, unless no comfortable stop
         if comfortable(a_need, p):
@@ -233,9 +255,11 @@ def approach(v: float, law: SpeedRef, a_plan: float, a_need: float, dt: float,
         a_plan = loop
     a_plan = max(a_plan, p.a_gentle)  # the law's own reaction is kept up to a_gentle
     a = max(a_need, min(loop, a_plan))
-    if a <= loop and a_plan >= loop:
+    cap = p.a_comf_max if comfortable(a_need, p) else max(p.a_iso, a_need) \
+        if a_need <= p.a_iso_max else p.a_hard
+    if a <= loop <= cap and a_plan >= loop:
         return law
-    a = min(a, p.a_comf_max if comfortable(a_need, p) else p.a_hard)
+    a = min(a, cap)
     return SpeedRef(max(v - a * dt, 0.0), -a)
 
 

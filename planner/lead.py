@@ -35,9 +35,19 @@ little off far ahead, does not make the car brake and release:
   confirmation would cost the comfortable stop that is left now (`costly_wait`: the least
   deceleration that stops the closing, `planner.acc_control.need`, is within a_comf_max at
   the gap now and beyond it at the gap the wait leaves; a stopped car first found 60 m
-  ahead at 60 km/h: the wait is 5 m of a room the stop needs all of);
+  ahead at 60 km/h: the wait is 5 m of a room the stop needs all of), or the stop within
+  ISO's limits left now (a_iso likewise: a stopped car revealed by a cut-out 59 m ahead at
+  60 km/h needs 3.16 m/s^2 now and 3.56 after the wait);
+- a cut-in is taken on the track's velocity across the lane only where the vehicle's
+  offset from the lane's centre line over the last ``rate_window`` moves the same way (the
+  slower of the two is taken; a new track's velocity alone): a constant-velocity track's
+  velocity lags a bend, and a truck keeping the next lane beside the car crossed it by its
+  velocity at 0.7 m/s (`LeadSelector._confirmed_cut_in`);
 - the lead stays the lead while it is within ``keep_width`` (hysteresis: a lead swerving
-  within its lane, or seen through a curve, is not dropped and taken again);
+  within its lane, or seen through a curve, is not dropped and taken again), unless another
+  vehicle that qualifies is within ``half_width``: a lead leaving the lane reveals a car
+  standing in it, which is the lead as soon as it qualifies (a cut-out at 1.5 m/s: 0.2 s
+  earlier, 3 m of a stop from 60 km/h);
 - the lead is the nearest of the vehicles that qualify.
 
 `select_lead` and `route_lead` are the one-shot forms (no memory: every in-lane vehicle
@@ -48,12 +58,12 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from perception.messages import ObjectClass, Track
-from planner.acc_control import AccControlParams, comfortable, need
+from planner.acc_control import AccControlParams, need
 from planner.messages import Lead
 from world.hdmap import Lane
 
@@ -72,6 +82,8 @@ class LeadParams:
     confirm: float = 0.3  # [s] a vehicle is in the lane this long before it can be the lead
     urgent_ttc: float = 2.5  # [s] ... unless it closes in faster than this
     path_reach: float = 60.0  # [m] along a map path, tracks farther ahead are not looked at
+    rate_window: float = 0.5  # [s] a vehicle's offsets from the lane's centre line this far
+    #   back measure its move across the lane (`LeadSelector`: a cut-in is confirmed by it)
 
 
 @dataclass(frozen=True, slots=True)
@@ -79,7 +91,10 @@ class Candidate:
     """A vehicle ahead: the lead it would be, and where it is across the lane."""
 
     lead: Lead
-    lateral: float  # [m] its centre's offset from the lane's centre line, left +
+    lateral: float  # [m] its centre's offset from the lane's centre line, left + (a vehicle
+    #   moving into the lane: where it will be, `cut_in_lateral`)
+    now: float = math.nan  # [m] a vehicle's offset where it is (NaN: as `lateral`)
+    across: float = 0.0  # [m/s] its velocity across the lane towards the left, from its track
 
 
 def far_centre(centre_y: Callable[[float], float], heading_error: float, reach: float,
@@ -177,7 +192,9 @@ def lane_candidates(tracks: Sequence[Track], centre_y: Callable[[float], float],
             slope = 0.5 * (centre_y(tr.rel_x + 1.0) - centre_y(tr.rel_x - 1.0))
             lane = ego_heading + math.atan(slope)  # the lane's heading where the track is
             across = tr.vy * math.cos(lane) - tr.vx * math.sin(lane)  # over ground, left +
-            lateral = cut_in_lateral(lateral, across)
+            out.append(Candidate(Lead(tr.id, tr.t, gap, speed),
+                                 cut_in_lateral(lateral, across), lateral, across))
+            continue
         out.append(Candidate(Lead(tr.id, tr.t, gap, speed), lateral))
     return out
 
@@ -229,14 +246,16 @@ def route_lead(tracks: Sequence[Track], lane: Lane, station: float, p: LeadParam
 def costly_wait(v: float, lead: Lead, age: float, wait: float,
                 acc: AccControlParams) -> bool:
     """Whether waiting `wait` [s] before taking `lead` (its track `age` [s] old) as the
-    lead, the ego at `v` [m/s], would cost the comfortable stop left now (module doc;
-    `need` from no braking yet)."""
+    lead, the ego at `v` [m/s], would cost the comfortable stop left now, or the stop within
+    ISO's limits (`AccControlParams.a_iso`) left now (module doc; `need` from no braking
+    yet)."""
     closing = v - lead.speed
     if closing <= 0.0:
         return False
     now = lead.gap - closing * age  # [m] the gap carried to now
-    return (comfortable(need(v, lead.speed, now, acc), acc)
-            and not comfortable(need(v, lead.speed, now - closing * wait, acc), acc))
+    before = need(v, lead.speed, now, acc)
+    after = need(v, lead.speed, now - closing * wait, acc)
+    return any(before <= limit < after for limit in (acc.a_comf_max, acc.a_iso))
 
 
 class LeadSelector:
@@ -247,18 +266,50 @@ class LeadSelector:
         self.acc = acc if acc is not None else AccControlParams()  # `costly_wait`'s laws
         self.lead_id: int | None = None  # the lead's track id
         self._since: dict[int, float] = {}  # [s] track id -> when it entered the lane
+        self._offsets: dict[int, dict[float, float]] = {}  # track id -> {track time [s]:
+        #   its offset from the lane's centre line [m]} over the last `rate_window`
 
     def select(self, t: float, ego_speed: float, candidates: Sequence[Candidate],
                ) -> Lead | None:
         """The lead at time `t` [s] from this tick's `candidates`, the ego at `ego_speed`
         [m/s]."""
         p = self.p
+        candidates = [self._confirmed_cut_in(c) for c in candidates]
+        self._offsets = {c.lead.track_id: self._offsets.get(c.lead.track_id, {})
+                         for c in candidates if not math.isnan(c.now)}
         inside = {c.lead.track_id for c in candidates if abs(c.lateral) <= p.half_width}
         self._since = {i: self._since.get(i, t) for i in inside}
         qualified = [c for c in candidates if self._qualifies(c, t, ego_speed)]
+        if any(abs(c.lateral) <= p.half_width for c in qualified):  # a lead held by the keep
+            qualified = [c for c in qualified if abs(c.lateral) <= p.half_width]  # band alone
+            #   yields to a vehicle in the lane: the lead leaving it reveals another
         lead = _nearest(qualified)
         self.lead_id = None if lead is None else lead.track_id
         return lead
+
+    def _confirmed_cut_in(self, c: Candidate) -> Candidate:
+        """`c` with its offset history updated, and its cut-in (`cut_in_lateral`) kept only
+        where that history agrees: the track's velocity across the lane lags its turns
+        (`perception.tracking`: a constant-velocity filter), so a truck keeping the next
+        lane through a 250 m bend at 60 km/h crosses it at 0.6 m/s by its velocity (ALKS
+        4.1.3: taken as a cut-in alongside, emergency braking). Its offset from the lane's
+        centre line over the last `rate_window`, a least-squares slope, is the second
+        measure: the cut-in is taken at the slower of the two when they agree, else not;
+        with too little history (a new track), at the velocity's."""
+        if math.isnan(c.now):
+            return c
+        p, i = self.p, c.lead.track_id
+        history = self._offsets.setdefault(i, {})
+        history[c.lead.t] = c.now
+        for old in [k for k in history if k < c.lead.t - p.rate_window]:
+            del history[old]
+        if len(history) < 3 or max(history) - min(history) < 0.5 * p.rate_window:
+            return c
+        times = np.fromiter(history, float)
+        slope = float(np.polyfit(times - times[-1], np.fromiter(history.values(), float),
+                                 1)[0])
+        rate = min(c.across, slope, key=abs) if c.across * slope > 0.0 else 0.0
+        return replace(c, lateral=cut_in_lateral(c.now, rate))
 
     def take(self, lead: Lead | None) -> None:
         """`lead` is the lead by another rule (during a lane change): keep it as the lead."""

@@ -217,7 +217,8 @@ class Stack:
             with watch("perception objects"):
                 detections = self.object_detector.detect(scan)
             with watch("perception tracking"):
-                tracks = self.tracker.update(t, pose, detections)
+                mount = scan.info.mount
+                tracks = self.tracker.update(t, pose, detections, (mount.x, mount.y))
             self._tracks = tracks
         return PerceptionOutput(t, pose, lane_raw, lane, detections, tracks)
 

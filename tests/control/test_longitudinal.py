@@ -100,6 +100,24 @@ def test_a_comfortable_plan_brakes_within_iso_15622() -> None:
     assert commands[-1].accel == pytest.approx(-SpeedParams().hold_decel)
 
 
+@pytest.mark.parametrize(("plan", "floor", "jerk"), [
+    (-2.0, 3.2, 2.0),  # comfortable: comfort_decel, comfort_jerk
+    (-3.0, 3.2, 2.0),  # ... up to comfort_plan
+    (-3.2, 3.45, 2.4),  # no comfortable stop, one within ISO's limits: iso_decel, iso_jerk
+    (-3.45, 3.45, 2.4),  # ... up to iso_plan
+    (-3.6, 6.0, 10.0),  # urgent: the actuator's limits
+])
+def test_the_envelope_follows_how_hard_the_plan_brakes(plan: float, floor: float,
+                                                       jerk: float) -> None:
+    """A step of the target speed to 0 with the plan's feed-forward `plan`: the request's
+    floor and the rise of its deceleration are the envelope's of that plan."""
+    _, commands = simulate(SpeedController(), 15.0, 0.0, 3.0, target_accel=plan)
+    accel = [c.accel for c in commands if not c.hold]
+    assert min(accel) == pytest.approx(-floor)
+    drops = -np.diff([0.0, *accel])
+    assert drops.max() == pytest.approx(jerk * CONTROL_DT)
+
+
 def test_holds_standstill_and_does_not_wind_up() -> None:
     controller = SpeedController()
     # pushed by a small forward disturbance while parked: the hold brake keeps it still

@@ -309,3 +309,31 @@ def test_tracks_follow_a_jump_of_the_ego_pose(turn: float) -> None:
         assert only.rel_y == pytest.approx(3.0, abs=0.1)
         assert only.rel_vx == pytest.approx(0.0, abs=0.3)
     assert out[-1][0].misses == 0
+
+
+def test_a_box_that_grows_moves_its_far_end_not_its_velocity() -> None:
+    """A car standing 60 m ahead, revealed by a cut-out: its first returns make a
+    pedestrian's box (0.73 m), then a car's (4.61 m), each grown away from the sensor from
+    the rear face seen (`perception.objects`). The track measures that face: its velocity
+    stays the car's (0), its rear where it is, its centre moving away with its length (the
+    box centre had moved 1.9 m away in 0.3 s: a car driving off at 0.7 m/s, to the ACC)."""
+    ego = Mover(0.0, 0.0, 0.0, 16.7)
+    rear = 60.0  # [m] the standing car's rear face, map frame
+    tracker = MultiObjectTracker()
+    tracks: tuple[Track, ...] = ()
+    for k in range(12):
+        t = k * DT
+        state = ego_state(t, ego)
+        cls, size = (ObjectClass.PEDESTRIAN, (0.73, 0.66, 1.76)) if k < 3 else \
+            (ObjectClass.CAR, CAR)
+        x, y = in_vehicle_frame(state, rear + 0.5 * size[0], 0.0)
+        det = Detection(x=x, y=y, z=0.5 * size[2], length=size[0], width=size[1],
+                        height=size[2], yaw=0.0, cls=cls, points=8)
+        tracks = tracker.update(t, state, (det,))
+        if k >= 3:
+            (track,) = tracks
+            assert abs(track.vx) < 0.2, (k, track.vx)
+            assert track.x - 0.5 * track.length == pytest.approx(rear, abs=0.1)
+    (track,) = tracks
+    assert track.cls is ObjectClass.CAR
+    assert track.length > 3.5  # smoothed towards the car's

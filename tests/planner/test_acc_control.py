@@ -84,12 +84,21 @@ def test_approach_plans_the_gentler_of_the_law_and_the_constant_deceleration() -
     # a plan gentler than a_gentle: a_gentle (the law's own reaction is kept up to it)
     assert approach(v, law, 0.8, 0.5, dt, P).accel == pytest.approx(-P.a_gentle)
     assert approach(v, SpeedRef(10.5, 0.0), 0.3, 0.0, dt, P) == SpeedRef(10.5, 0.0)
-    assert approach(v, law, 5.0, 0.5, dt, P) == law  # the law is gentler: the law
+    gentle = SpeedRef(9.0, 0.0)  # the loop would brake at 2.6 m/s^2
+    assert approach(v, gentle, 5.0, 0.5, dt, P) == gentle  # the law is gentler: the law
+    # ... but not a law the loop would brake harder on than the cap: the cap, planned (the
+    # law's feed-forward, 0, would tell `BrakeModel` the car had stopped braking)
+    assert approach(v, law, 5.0, 0.5, dt, P) == SpeedRef(v - P.a_comf_max * dt, -P.a_comf_max)
     assert approach(7.0, law, 0.8, 0.0, dt, P) == law  # slower than the law: the law
     # never gentler than the need; capped at a_comf_max while that is comfortable ...
     assert approach(v, law, 0.8, 2.0, dt, P).accel == pytest.approx(-2.0)
     assert approach(v, SpeedRef(0.0, 0.0), 4.5, 2.0, dt, P).accel == -P.a_comf_max
-    # ... and at a_hard when no comfortable stop is left
+    # ... at a_iso when no comfortable stop is left but one within ISO's limits is ...
+    assert approach(v, SpeedRef(0.0, 0.0), 3.2, 3.2, dt, P).accel == pytest.approx(-3.2)
+    assert approach(v, SpeedRef(0.0, 0.0), 9.0, 3.2, dt, P).accel == -P.a_iso
+    assert approach(v, SpeedRef(0.0, 0.0), 9.0, 3.4, dt, P).accel == -3.4  # need itself
+    assert approach(v, SpeedRef(0.0, 0.0), 9.0, 3.5, dt, P).accel == -P.a_hard  # beyond
+    # ... and at a_hard when neither is left
     assert approach(v, SpeedRef(0.0, 0.0), 4.0, 4.0, dt, P).accel == pytest.approx(-4.0)
     assert approach(v, SpeedRef(0.0, 0.0), 9.0, 9.0, dt, P).accel == -P.a_hard
 
@@ -128,6 +137,24 @@ def test_a_braking_lead_is_fed_forward_past_the_estimates_noise() -> None:
     assert trail(19.0, 48.0, 40.0, 20.0, 4.0, P, a_lead=-2.0).accel == 0.0
     # behind a stopped lead the final approach has none
     assert trail(30.0, 7.0, 5.0, 0.0, 4.0, P, a_lead=-2.0).accel == 0.0
+
+
+@pytest.mark.parametrize(("a_lead", "shrink"), [
+    (0.0, 0.0),  # holding its speed: no term
+    (-0.4, 0.0),  # the estimate's noise
+    (-1.0, 1.5),  # braking gently (a_gentle): d_des' b, the car's time gap 1.5 s x 1 m/s^2
+    (-1.5, 0.75),  # tapering ...
+    (-2.0, 0.0),  # ... to none at 2 a_gentle
+    (-6.0, 0.0),  # braking hard: the lead is not closed in on
+])
+def test_the_gap_law_follows_the_shrinking_desired_gap_behind_a_gently_braking_lead(
+        a_lead: float, shrink: float) -> None:
+    """ISO 22179 stop and go: d_des = d0 + 1.5 s v shrinks at 1.5 m/s behind a lead braking
+    at 1 m/s^2 (the car braking with it); the gap law's reference is that much above the
+    lead's speed, so the gap follows d_des down instead of lagging it by 6 m."""
+    ref = trail(30.0, 40.0, 40.0, 20.0, 4.0, P, a_lead=a_lead, d_des_slope=1.5)
+    assert ref.speed == pytest.approx(20.0 + shrink)
+    assert ref.accel == pytest.approx(a_lead if a_lead < -P.lead_brakes else 0.0)
 
 
 def test_closing_plan_behind_a_braking_lead() -> None:

@@ -61,7 +61,9 @@ def test_a_car_in_the_next_lane_straying_near_the_line_for_a_moment_is_no_lead()
 @pytest.mark.parametrize(("gap", "lead_speed", "urgent"), [
     (10.0, 10.0, True),  # closing at 10 m/s, 1 s to collision: taken at once
     (24.0, 10.0, True),  # 2.4 s
-    (26.0, 10.0, False),  # 2.6 s: confirmed first
+    (26.0, 10.0, True),  # 2.6 s, not urgent, but the wait would cost the stop within
+    #   ISO's limits (`costly_wait`: 3.13 -> 3.85 m/s^2)
+    (30.0, 10.0, False),  # 3.0 s (2.50 -> 2.94 m/s^2): confirmed first
     (10.0, 20.0, False),  # not closing
 ])
 def test_an_urgent_cut_in_is_the_lead_at_once(gap: float, lead_speed: float,
@@ -79,9 +81,10 @@ V60 = 60.0 / 3.6  # [m/s]
     # the closing (ramp-in included), now -> after the 0.3 s wait (`costly_wait`)
     (64.0, 0.0, True),  # 2.83 -> 3.16 m/s^2: the wait would cost the comfortable stop
     (62.0, 0.0, True),  # 2.96 -> 3.31
+    (59.0, 0.0, True),  # 3.16 -> 3.56: it would cost the stop within ISO's limits (3.3)
     (67.0, 0.0, False),  # 2.67 -> 2.96: still within a_comf_max (3.0) after it
     (80.0, 0.0, False),  # 2.14 -> 2.32: the wait costs nothing, confirmed first
-    (50.0, 0.0, False),  # 3.97 -> 4.63: no comfortable stop left to keep; ttc 3.0 s
+    (50.0, 0.0, False),  # 3.97 -> 4.63: no stop within ISO's limits left to keep; ttc 3.0 s
     (64.0, 14.0, False),  # a slower car: closing at 2.7 m/s, 0.06 m/s^2, no hurry
 ])
 def test_a_stopped_car_found_far_ahead_is_the_lead_at_once_when_waiting_costs_the_comfortable_stop(
@@ -111,12 +114,14 @@ def test_the_lead_is_held_within_the_keep_band_and_dropped_beyond_it() -> None:
 
 def test_a_cut_out_reveals_the_stopped_car_ahead_in_one_transition() -> None:
     """The lead (1) leaves the lane; the stopped car (2) 60 m ahead, in the lane all along
-    and confirmed, is the lead as soon as the first is out: one change of lead, no gap."""
+    and confirmed, is the lead as soon as the first is out of `half_width`, held by the
+    keep band alone: one change of lead, no gap."""
     frames = ([[car(1, 25.0, 0.1 * k), car(2, 60.0, 0.0, 0.0)] for k in range(25)])
     ids = run(frames)
     changes = [(a, b) for a, b in itertools.pairwise(ids) if a != b]
     assert changes == [(None, 1), (1, 2)]
-    assert ids.index(2) == 21  # the first tick the cut-out car is beyond keep_width (2.1 m)
+    assert ids.index(2) == 17  # the first tick the cut-out car is beyond half_width (1.7 m)
+    #   (it was 21, beyond keep_width, before: 0.2 s and 3 m of the stop later)
 
 
 def test_the_nearest_qualified_vehicle_wins() -> None:
@@ -242,3 +247,49 @@ def test_map_bend_is_the_lane_at_a_distance_ahead_not_along_the_lane() -> None:
     hairpin = map_bend(make_map(arc(50.0, -150.0, lanes=1, oncoming=0)).lane(0), 0.0, 1.0)
     assert hairpin(45.0) == pytest.approx(-50.0 * (1.0 - math.cos(math.asin(0.9))), abs=0.05)
     assert math.isnan(hairpin(55.0))  # the bend never reaches 50 m ahead
+
+
+def _moving(ident: int, t: float, gap: float, offset: float, across: float) -> Candidate:
+    """A vehicle `offset` [m] from the centre line, its track's velocity across the lane
+    `across` [m/s] (left +), as `lane_candidates` gives it at the track's time t [s]."""
+    return Candidate(Lead(ident, t, gap, 16.0), cut_in_lateral(offset, across), offset, across)
+
+
+def _frames(offsets: list[float], across: float, gap: float = -3.5) -> list[list[Candidate]]:
+    """One candidate per tick, its track updated every other tick (DT 0.05 s: 10 Hz)."""
+    return [[_moving(1, round(k / 2) * 2 * DT, gap, offsets[k], across)]
+            for k in range(len(offsets))]
+
+
+def test_a_cut_in_by_the_tracks_velocity_alone_is_not_taken_while_its_offset_holds() -> None:
+    """ALKS 4.1.3: the truck alongside in the next lane, 3.0 m from the centre line, through
+    a 250 m bend at 60 km/h; its constant-velocity track's velocity lags the bend and
+    crosses the lane at 0.7 m/s towards the ego (1.5 s later: 1.95 m, under `half_width`
+    with the noise), while its offset from the centre line holds. It is not taken: without
+    the history check it was, at once (gap -3.5 m: urgent), and the car braked hard."""
+    holding = [3.0 + 0.02 * (-1) ** k for k in range(40)]
+    steady = _frames(holding, -0.95)  # 3.0 - 0.95 x 1.5 = 1.58 m by the velocity alone
+    assert steady[0][0].lateral < P.half_width  # the velocity's prediction: inside
+    assert run(steady, ego_speed=16.7)[8:] == [None] * 32  # history after 0.5 s: never
+
+
+def test_a_cut_in_that_its_offset_confirms_is_taken() -> None:
+    """A car 20 m ahead moving in at 1 m/s (its offset falls as its velocity says): taken
+    where it will be, as the velocity's prediction, once confirmed."""
+    offsets = [3.5 - 1.0 * round(k / 2) * 2 * DT for k in range(30)]
+    ids = run(_frames(offsets, -1.0, gap=20.0), ego_speed=20.0)
+    assert ids[-1] == 1
+    first = ids.index(1)
+    offset_then = offsets[first]
+    assert offset_then > P.half_width + 0.5  # taken while its centre is still 2.1 m out,
+    #   as the velocity's prediction of 1.5 s later says: the history did not delay it
+    assert first * DT == pytest.approx(P.confirm + 0.5, abs=0.2)  # the velocity's
+    #   prediction crosses half_width at 0.5 s; confirmed 0.3 s later
+
+
+def test_a_new_track_moving_in_is_taken_on_its_velocity() -> None:
+    """Too little history (under half of `rate_window`): the velocity's prediction."""
+    selector = LeadSelector(P)
+    c = _moving(1, 0.0, 5.0, 2.5, -1.0)  # 1.5 s later: 1.0 m, closing fast: urgent
+    lead = selector.select(0.0, 20.0, [c])
+    assert lead is not None and lead.track_id == 1

@@ -63,6 +63,9 @@ def test_embree_and_bullet_lidar_drive_alike(name: str) -> None:
         [(c.name, c.passed) for c in bullet.criteria]
     apart = np.hypot(np.subtract(embree.log.x, bullet.log.x),
                      np.subtract(embree.log.y, bullet.log.y))
-    assert apart.max() < 0.01  # [m] over the run
+    assert apart.max() < 0.05  # [m] over the run: the hard stop's plan follows the lead's
+    #   estimated gap and deceleration in proportion (the trail law's shrink term, a plan
+    #   that is `need` itself), 4.3 cm apart at the end of its 3 s; it was within 1 cm while
+    #   the plan sat at a fixed cap
     assert embree.metrics["track_recall"] == pytest.approx(bullet.metrics["track_recall"],
                                                            abs=0.02)
