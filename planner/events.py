@@ -23,9 +23,10 @@ bumper f, its axles); tracks are in the map frame. Each tick
   side, now or ``look_ahead`` ahead at its velocity, or crosses the lane's centre line in
   between; the car stops ``crossing_stop`` before the crosswalk and waits until it is clear.
 - speed_bump: from ``approach(v)`` before a bump's near edge (front axle) until the rear
-  axle is ``bump_margin`` past its far edge; the speed at the bump is its pass speed less
-  ``bump_undershoot`` (at least 0.5 m/s), to be reached by the front axle ``bump_margin``
-  before the near edge.
+  axle is ``bump_margin`` past its far edge (held once entered: braking for it shrinks
+  ``approach(v)``, and the event ended and began again for a tick); the speed at the bump
+  is its pass speed less ``bump_undershoot`` (at least 0.5 m/s), to be reached by the front
+  axle ``bump_margin`` before the near edge.
 - flat: a flat tyre detected from the car's own signals; pulled_over once the motion layer
   has brought the car onto the shoulder.
 
@@ -95,6 +96,8 @@ class EventMonitor:
         self.confirmed: set[float] = set()  # stop lines whose sign perception saw
         self.done: set[float] = set()  # stop lines stopped at, not yet passed
         self._standing_since: float | None = None
+        self._bump_at: float | None = None  # [m] the station of the bump approached: held
+        #   until it is passed, the approach shrinking with the speed it sheds
         self._station: float | None = None  # [m] the car's centre at the last update: the
         #   signs seen are placed on the stretch ahead of it (a town route crossing itself
         #   passes a point twice: `world.hdmap.ReferenceLine.project`)
@@ -194,7 +197,10 @@ class EventMonitor:
             near, far = b.s - 0.5 * b.length, b.s + 0.5 * b.length
             if rear_axle > far + p.bump_margin:
                 continue
-            if near - front_axle > approach:
+            if near - front_axle > approach and b.s != self._bump_at:
+                self._bump_at = None
                 return None
+            self._bump_at = b.s
             return near - p.bump_margin - front_axle, max(b.pass_speed - p.bump_undershoot, 0.5)
+        self._bump_at = None
         return None

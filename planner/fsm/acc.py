@@ -82,8 +82,8 @@ holds, so Cruise and SpeedLimit are tried first.
 18. cruise, trail, speed_limit -> brake: no comfortable stop (a_need > a_comf_max) *
 19. cruise -> trail: d_min < d < d_max and V_l < V_s (Table 2: d_des < d; inside d_des too
     *)
-20. trail -> cruise: V_GPS >= V_s and ((d >= d_max and not lead_lost) or (V_s + v_band <=
-    V_l and d_min < d < inf))
+20. trail -> cruise: V_GPS >= V_s and ((d >= d_max + d_let_go and not lead_lost) or (V_s +
+    v_band <= V_l and d_min < d < inf)) (d_let_go *)
 21. brake -> cruise: V_GPS >= V_s and (d >= d_max or V_s + v_band <= V_l) and d > d_min and
     a_need relaxed *
 22. brake -> speed_limit: V_GPS < V_s and (d >= d_max or V_s + v_band <= V_l) and d > d_min
@@ -94,8 +94,9 @@ holds, so Cruise and SpeedLimit are tried first.
     d_min))
 25. speed_limit -> trail: (V_GPS < V_s or V_l < V_GPS) and d_min < d < d_max (d_des < d:
     inside d_des too *)
-26. cruise, trail -> speed_limit: V_GPS < V_s and ((d >= d_max and not lead_lost) or (V_GPS
-    + v_band <= V_l and d_min < d < inf)) (Trail *; v_band, lead_lost *)
+26. cruise, trail -> speed_limit: V_GPS < V_s and ((d >= d_max (trail: + d_let_go) and not
+    lead_lost) or (V_GPS + v_band <= V_l and d_min < d < inf)) (Trail *; v_band, lead_lost,
+    d_let_go *)
 
 FLAT has no row out: the car stops on the shoulder ("Simulation Stops").
 """
@@ -166,6 +167,8 @@ class AccParams:
     d_band: float = 1.0  # [m] BRAKE is left for TRAIL without closing this far above d_min
     v_band: float = 0.5  # [m/s] a lead counts as faster than a speed once this much faster
     lead_hold: float = 0.5  # [s] TRAIL outlives a lost lead this long (lead_lost)
+    d_let_go: float = 2.0  # [m] TRAIL lets a lead go this far beyond d_max (hysteresis
+    #   against the entry within d_max: a gap about d_max flicked TRAIL and CRUISE a tick)
 
 
 @dataclass(frozen=True, slots=True)
@@ -193,6 +196,7 @@ class Gaps:
     v_band: float = 0.5  # [m/s] the speed hysteresis of the rows that leave a lead
     #   (`AccParams.v_band`)
     d_band: float = 1.0  # [m] the gap hysteresis of BRAKE's way out to TRAIL (`AccParams`)
+    d_let_go: float = 2.0  # [m] the gap hysteresis of TRAIL's way out (`AccParams`)
 
 
 def r157_min_gap(v: float) -> float:
@@ -206,7 +210,7 @@ def gaps(v: float, v_l: float, p: AccParams) -> Gaps:
     d_min = r157_min_gap(v)
     d_des = max(p.d0 + p.tau * v, d_min + p.tau_margin * v)
     closing = max(v * v - min(v_l, v) ** 2, 0.0) / (2.0 * p.a_comf)
-    return Gaps(d_min, d_des, d_des + closing + p.d_reach, p.v_band, p.d_band)
+    return Gaps(d_min, d_des, d_des + closing + p.d_reach, p.v_band, p.d_band, p.d_let_go)
 
 
 def sight_speed(sight: float, p: AccParams, a_stop: float, t_react: float = 0.5,
@@ -267,8 +271,14 @@ def _why_hard(x: AccInput, _g: Gaps) -> str:
     return f"no comfortable stop: needs {min(x.a_need, 99.0):.1f} m/s^2, ttc {x.ttc:.1f} s"
 
 
-def _to_limit(_m: AccMode, x: AccInput, g: Gaps) -> bool:
-    return x.v_gps < x.v_s and ((x.d >= g.d_max and not x.lead_lost)
+def _beyond(m: AccMode, x: AccInput, g: Gaps) -> bool:
+    """The lead is beyond d_max (TRAIL: by d_let_go) and not just lost."""
+    reach = g.d_max + (g.d_let_go if m is AccMode.TRAIL else 0.0)
+    return x.d >= reach and not x.lead_lost
+
+
+def _to_limit(m: AccMode, x: AccInput, g: Gaps) -> bool:
+    return x.v_gps < x.v_s and (_beyond(m, x, g)
                                 or (x.v_gps + g.v_band <= x.v_l and g.d_min < x.d < math.inf))
 
 
@@ -276,8 +286,8 @@ def _cruise_to_trail(_m: AccMode, x: AccInput, g: Gaps) -> bool:
     return g.d_min < x.d < g.d_max and x.v_l < x.v_s
 
 
-def _trail_to_cruise(_m: AccMode, x: AccInput, g: Gaps) -> bool:
-    return x.v_gps >= x.v_s and ((x.d >= g.d_max and not x.lead_lost)
+def _trail_to_cruise(m: AccMode, x: AccInput, g: Gaps) -> bool:
+    return x.v_gps >= x.v_s and (_beyond(m, x, g)
                                  or (x.v_s + g.v_band <= x.v_l and g.d_min < x.d < math.inf))
 
 
@@ -355,8 +365,8 @@ TABLE: Table[AccMode, AccInput, Gaps] = Table(AccMode, (
         "d_min < d < d_max and V_l < V_s (Table 2: d_des < d; inside d_des too *)",
         "a slower vehicle ahead within d_max"),
     Row(frozenset({M.TRAIL}), M.CRUISE, _trail_to_cruise,
-        "V_GPS >= V_s and ((d >= d_max and not lead_lost) or (V_s + v_band <= V_l and d_min "
-        "< d < inf))",
+        "V_GPS >= V_s and ((d >= d_max + d_let_go and not lead_lost) or (V_s + v_band <= "
+        "V_l and d_min < d < inf)) (d_let_go *)",
         "the lead is gone or faster than the set speed"),
     Row(frozenset({M.BRAKE}), M.CRUISE, _brake_to_cruise,
         "V_GPS >= V_s and (d >= d_max or V_s + v_band <= V_l) and d > d_min and a_need "
@@ -377,8 +387,8 @@ TABLE: Table[AccMode, AccInput, Gaps] = Table(AccMode, (
         "(V_GPS < V_s or V_l < V_GPS) and d_min < d < d_max (d_des < d: inside d_des too *)",
         "a vehicle ahead within d_max"),
     Row(frozenset({M.CRUISE, M.TRAIL}), M.SPEED_LIMIT, _to_limit,
-        "V_GPS < V_s and ((d >= d_max and not lead_lost) or (V_GPS + v_band <= V_l and d_min "
-        "< d < inf)) (Trail *; v_band, lead_lost *)",
+        "V_GPS < V_s and ((d >= d_max (trail: + d_let_go) and not lead_lost) or (V_GPS + "
+        "v_band <= V_l and d_min < d < inf)) (Trail *; v_band, lead_lost, d_let_go *)",
         "the posted limit is below the set speed"),
 ))
 

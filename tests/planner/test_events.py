@@ -63,6 +63,19 @@ def test_a_bump_from_its_approach_until_the_rear_axle_is_past() -> None:
     assert not at(m, 300.0 + 0.45 + 1.0 + 1.35 + 0.01, v=1.4).holds(SPEED_BUMP)
 
 
+def test_a_bump_once_approached_holds_while_braking_for_it_shrinks_the_approach() -> None:
+    """Entered 62.2 m before the bump at 10 m/s (approach 63.3 m); 0.5 m on at 9 m/s the
+    approach is 57 m, short of the bump, but the event holds until the bump is passed (it
+    ended and began again for a tick: a SPEED_BUMP mode held 0.025 s in city_stop_40)."""
+    m = EventMonitor(ROAD, VEHICLE, P)
+    assert at(m, 236.0, v=10.0).holds(SPEED_BUMP)
+    assert at(m, 236.5, v=9.0).holds(SPEED_BUMP)
+    assert not at(EventMonitor(ROAD, VEHICLE, P), 236.5, v=9.0).holds(SPEED_BUMP)  # never
+    #   entered: not yet
+    assert not at(m, 300.0 + 0.45 + 1.0 + 1.35 + 0.01, v=1.4).holds(SPEED_BUMP)  # passed
+    assert not at(m, 236.5, v=9.0).holds(SPEED_BUMP)  # forgotten once passed
+
+
 def test_a_pedestrian_on_or_walking_into_the_crossing_in_the_lane() -> None:
     m = EventMonitor(ROAD, VEHICLE, P)
     on = at(m, 370.0, tracks=(walker(402.0, 0.5),))

