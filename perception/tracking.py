@@ -129,12 +129,17 @@ class MapDetection:
     cls: ObjectClass  # the detection's class
 
 
+def in_map(ego: EgoState, x: float, y: float) -> tuple[float, float]:
+    """The point (x, y) [m] of ``ego``'s vehicle frame in the map frame."""
+    c, s = math.cos(ego.heading), math.sin(ego.heading)
+    return ego.x + c * x - s * y, ego.y + s * x + c * y
+
+
 def to_map(det: Detection, ego: EgoState) -> MapDetection:
     """``det`` (vehicle frame of ``ego``) in the map frame."""
-    c, s = math.cos(ego.heading), math.sin(ego.heading)
-    return MapDetection(x=ego.x + c * det.x - s * det.y, y=ego.y + s * det.x + c * det.y,
-                        yaw=det.yaw + ego.heading, length=det.length, width=det.width,
-                        height=det.height, cls=det.cls)
+    x, y = in_map(ego, det.x, det.y)
+    return MapDetection(x=x, y=y, yaw=det.yaw + ego.heading, length=det.length,
+                        width=det.width, height=det.height, cls=det.cls)
 
 
 def pose_jump(prev: EgoState, now: EgoState) -> tuple[float, float, float]:
@@ -212,11 +217,14 @@ class _TrackState:
         turned = abs(wrap_angle(2.0 * (axis - det.yaw))) > 0.5 * math.pi  # beyond 45 deg
         return [1, 0] if turned else [0, 1]
 
-    def measured_centre(self, det: MapDetection, away: FloatArray) -> FloatArray:
+    def measured_centre(self, det: MapDetection, away: FloatArray,
+                        held: FloatArray | None = None) -> FloatArray:
         """(2,) [m] the centre ``det`` measures for this track: its near faces (``away``:
-        `_away`) plus half the track's own extents."""
+        `_away`) plus half the track's own extents (``held``: along ``det``'s axes, by
+        default the track's size there)."""
         seen = np.array([det.length, det.width])  # [m] along the detection's axes
-        held = self.size[self._axes_along(det)]
+        if held is None:
+            held = self.size[self._axes_along(det)]
         out: FloatArray = np.array([det.x, det.y]) + away.T @ (0.5 * (held - seen))
         return out
 
@@ -227,7 +235,7 @@ class _TrackState:
         away = _away(det, sensor)  # (2, 2) per box axis, the direction away from the sensor
         order = self._axes_along(det)
         held = self.size[order]
-        self.kf.update(self.measured_centre(det, away))
+        self.kf.update(self.measured_centre(det, away, held))
         a = p.size_alpha
         self.size = (1.0 - a) * self.size + a * np.array([det.length, det.width, det.height])
         self.axis = (1.0 - a) * self.axis + a * np.array([math.cos(2.0 * det.yaw),
@@ -319,8 +327,7 @@ class MultiObjectTracker:
         the confirmed tracks, by id."""
         p = self.params
         dets = [to_map(d, ego) for d in detections]
-        c, s = math.cos(ego.heading), math.sin(ego.heading)
-        seen_from = (ego.x + c * sensor[0] - s * sensor[1], ego.y + s * sensor[0] + c * sensor[1])
+        seen_from = in_map(ego, *sensor)
         if self._last_ego is not None and ego.t >= self._last_ego.t:
             jump = pose_jump(self._last_ego, ego)
             for tr in self._tracks:
