@@ -56,6 +56,7 @@ bench: $(STAMP)
 	$(BIN)/python -m bench.bench_sensing
 	$(BIN)/python -m bench.bench_stages
 	$(BIN)/python -m bench.bench_batch
+	$(BIN)/python -m bench.bench_load
 
 # An hour of simulated time on a town loop per profile (none, fast): memory, recording size
 # and real-time factor over time (about 50 minutes here).

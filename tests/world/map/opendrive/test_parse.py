@@ -3,6 +3,7 @@ one-line error naming file, line and element)."""
 
 from __future__ import annotations
 
+import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import numpy as np
@@ -17,6 +18,7 @@ from world.map.opendrive import (
     Poly3Shape,
     Spiral,
     load_opendrive,
+    xmltree,
 )
 from world.map.opendrive.parse import MAX_FILE_BYTES
 from world.map.opendrive.parse_lanes import MAX_SIDE_LANES
@@ -221,6 +223,17 @@ def test_file_size_limit(tmp_path: Path) -> None:
     with path.open("wb") as f:
         f.truncate(MAX_FILE_BYTES + 1)
     assert f"over the {MAX_FILE_BYTES} limit" in error_of(path)
+
+
+def test_a_file_of_more_elements_than_the_bound_is_refused_while_it_is_parsed(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The element bound stops the parse at the bound (the worst such load is timed in
+    bench/bench_load.py); a smaller bound here keeps the test quick."""
+    count = sum(1 for _ in ET.parse(MIXED).getroot().iter())
+    monkeypatch.setattr(xmltree, "MAX_ELEMENTS", count - 1)
+    assert f"more than {count - 1} elements" in error_of(MIXED)
+    monkeypatch.setattr(xmltree, "MAX_ELEMENTS", count)
+    load_opendrive(MIXED)
 
 
 def test_a_newline_in_an_id_keeps_the_message_on_one_line(tmp_path: Path) -> None:

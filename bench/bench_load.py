@@ -1,0 +1,106 @@
+"""The worst a scenario file can cost to load: seconds from a path to a scenario or its
+one-line error, for files built up to the loader's bounds.
+
+The fuzzer (`tests/avsim/scenario/test_fuzz.py`) checks what every mutated file gets; this
+times the largest of them, which the machines' load makes too noisy to assert in a test:
+- an ALKS OpenSCENARIO file (4.6.2) with one element repeated until the file is refused
+  by its element bound or is as large as its byte bound lets it be;
+- its OpenDRIVE road, the same way;
+- a bundled YAML scenario as long as its file bound allows (a road of many segments).
+
+Target: each under 5 s on the reference machine (2 cores). Best of `--repeat` loads.
+`make bench` runs it; `--json FILE` also writes the figures.
+"""
+
+from __future__ import annotations
+
+import argparse
+import copy
+import json
+import shutil
+import tempfile
+import time
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import yaml
+
+from avsim.scenario.bounds import MAX_FILE_BYTES as MAX_YAML_BYTES
+from avsim.scenario.files import SCENARIO_DIR, read_raw
+from avsim.scenario.load import ScenarioError, load_scenario
+from avsim.scenario.openscenario.xmlread import MAX_ELEMENTS as MAX_XOSC_ELEMENTS
+from avsim.scenario.openscenario.xmlread import MAX_FILE_BYTES as MAX_XOSC_BYTES
+from world.map.opendrive.parse import MAX_FILE_BYTES as MAX_XODR_BYTES
+from world.map.opendrive.xmltree import MAX_ELEMENTS as MAX_XODR_ELEMENTS
+
+ALKS = (Path(__file__).parents[1] / "tests" / "data" / "alks" / "logical_scenarios"
+        / "concrete_scenarios")
+XOSC = "alks_scenario_4_6_2_lateral_detection_range_template.xosc"
+ROAD = Path("road_networks") / "alks_road_straight.xodr"
+TARGET = 5.0  # [s]
+
+
+def best_load(path: Path, repeat: int) -> tuple[float, str]:
+    """[s] the fastest of `repeat` loads of `path`, and what it gave."""
+    best, outcome = float("inf"), ""
+    for _ in range(repeat):
+        start = time.perf_counter()
+        try:
+            load_scenario(path)
+            outcome = "loaded"
+        except ScenarioError as exc:
+            outcome = str(exc).rsplit(": ", 1)[-1]
+        best = min(best, time.perf_counter() - start)
+    return best, outcome
+
+
+def flood(source: Path, target: Path, max_elements: int, max_bytes: int) -> None:
+    """`source` written to `target` with its shortest leaf element repeated until the file
+    holds more than `max_elements` or is about to outgrow `max_bytes`."""
+    tree = ET.parse(source)
+    root = tree.getroot()
+    parents = {child: parent for parent in root.iter() for child in parent}
+    leaf = min((e for e in root.iter() if e is not root and len(e) == 0),
+               key=lambda e: len(ET.tostring(e)))
+    room = max_bytes - source.stat().st_size - 1024
+    for _ in range(min(max_elements, room // len(ET.tostring(leaf)))):
+        parents[leaf].append(copy.deepcopy(leaf))
+    tree.write(target, encoding="unicode")
+
+
+def huge_yaml(folder: Path) -> Path:
+    """normal_driving with as many road segments as the file bound allows."""
+    file = SCENARIO_DIR / "normal_driving.yaml"
+    doc = read_raw(file)
+    road = doc["road"]
+    one = len(yaml.safe_dump(road["segments"][:1], width=1_000_000))
+    road["segments"] = [copy.deepcopy(road["segments"][0])] * (MAX_YAML_BYTES // one - 100)
+    path = folder / file.name
+    path.write_text(yaml.safe_dump(doc, sort_keys=False, width=1_000_000), encoding="utf-8")
+    return path
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--repeat", type=int, default=3)
+    parser.add_argument("--json", type=Path, default=None)
+    args = parser.parse_args()
+    figures: dict[str, float] = {}
+    print(f"worst-case loads (best of {args.repeat}; target under {TARGET:.0f} s each)")
+    with tempfile.TemporaryDirectory() as tmp:
+        alks = Path(tmp) / "concrete_scenarios"
+        shutil.copytree(ALKS, alks)
+        flood(ALKS / XOSC, alks / XOSC, MAX_XOSC_ELEMENTS, MAX_XOSC_BYTES)
+        figures["xosc_past_element_bound_s"], xosc = best_load(alks / XOSC, args.repeat)
+        shutil.copyfile(ALKS / XOSC, alks / XOSC)
+        flood(ALKS / ROAD, alks / ROAD, MAX_XODR_ELEMENTS, MAX_XODR_BYTES)
+        figures["xodr_past_element_bound_s"], xodr = best_load(alks / XOSC, args.repeat)
+        figures["yaml_huge_entries_s"], yml = best_load(huge_yaml(Path(tmp)), args.repeat)
+    for (key, value), outcome in zip(figures.items(), (xosc, xodr, yml), strict=True):
+        print(f"  {key:<28} {value:6.2f} s  {outcome[:60]}")
+    if args.json:
+        args.json.write_text(json.dumps(figures, indent=2) + "\n")
+
+
+if __name__ == "__main__":
+    main()
