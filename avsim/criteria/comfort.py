@@ -16,14 +16,22 @@ off unless set). Two criteria, on the ego's true forward speed at the criteria r
 Each window uses the newest sample at least its span back, so an extra sample (the runner
 samples at each contact onset too) does not bend it.
 
-Excused (the truth shows no comfortable solution): from the first sample at which the
-deceleration needed to stop closing on the vehicle ahead in the ego's lane before a bumper
-gap of `D_STOP` exceeds `A_ISO` -- ``(v - v_l)^2 / (2 (d - D_STOP))`` against its speed
-now, or, while it brakes, ``v^2 / (2 (d + v_l^2 / (2 b_l) - D_STOP))`` to stop behind
-where it stops (b_l its deceleration) -- such as a cut-in close ahead or a lead braking
-hard, until `EXCUSE_AFTER` (2 s, the longest window) after the ego's braking has ended
-(its 0.5 s deceleration under `BRAKING`). The criterion cannot tell whether the stack
-itself let the need grow (braking late); `min_gap` and `no_collision` judge that.
+Excused (the truth shows no comfortable solution): from the first sample at which no
+braking within both limits stops the ego's closing on a vehicle ahead in its lane before
+a bumper gap of `D_STOP` -- against that vehicle's speed now, and, while it brakes (b_l its
+deceleration), also `D_STOP` behind where it comes to rest -- such as a cut-in close ahead,
+a lead braking hard, or a car standing in the lane behind a lead about to cut out (every
+vehicle ahead in the lane counts, not only the nearest: the lead leaving does not move the
+car it reveals), until `EXCUSE_AFTER` (2 s, the longest window) after the ego's
+braking has ended (its 0.5 s deceleration under `BRAKING`). "Within both limits": the
+deceleration rises from the ego's 0.5 s deceleration now at `J_ISO` to `A_ISO` and holds
+(`closing_distance`), since a step to 3.5 m/s^2 is itself beyond the jerk bound: the
+closing of a cut-in at 5.6 m/s ends in 4.5 m at a step to 3.5 m/s^2 but takes 8.1 m at
+2.5 m/s^3 from coasting, so a cut-in 9 m ahead at that closing has no comfortable solution,
+though ``(v - v_l)^2 / (2 (d - D_STOP))`` is only 2.2 m/s^2 (until 2026-11-27 the
+criterion judged by that instant need against `A_ISO`, and failed such a run on its jerk).
+The criterion cannot tell whether the stack itself let the vehicle come this close
+unseen (braking late); `min_gap` and `no_collision` judge that.
 
 Value: the peak judged (0 before a window first fills). Not applicable when the ego never
 braked outside the excused windows (its 0.5 s deceleration never reached `BRAKING`). The
@@ -58,18 +66,39 @@ SPAN_TOLERANCE = 1e-9  # [s] in comparing spans of sample times (sums of float s
 ISO15622 = "iso15622"  # the setting
 
 
-def required_decel(speed: float, gap: float, lead_speed: float, lead_accel: float) -> float:
-    """[m/s^2] >= 0: the deceleration that stops the ego (speed [m/s]) closing on a vehicle
-    ahead at bumper gap `gap` [m] with speed `lead_speed` [m/s] and acceleration `lead_accel`
-    [m/s^2] before the gap falls to `D_STOP` (module doc); inf with no room left."""
-    closing = speed - lead_speed
+def closing_distance(closing: float, decel_now: float) -> float:
+    """[m] the least distance in which a comfortable braking ends a closing speed `closing`
+    [m/s] (a speed relative to a vehicle that keeps its own): the deceleration rises from
+    the ego's now, `decel_now` [m/s^2] (clipped to [0, `A_ISO`]), at `J_ISO` to `A_ISO` and
+    holds there. A step to `A_ISO` (``closing^2 / (2 A_ISO)``) would break the jerk bound
+    the comfortable solution is judged by."""
+    if closing <= 0.0:
+        return 0.0
+    a0 = min(max(decel_now, 0.0), A_ISO)
+    ramp = (A_ISO - a0) / J_ISO  # [s] to reach A_ISO
+    shed = a0 * ramp + 0.5 * J_ISO * ramp * ramp  # [m/s] closing shed on the way
+    if closing <= shed:  # it ends during the rise
+        t = (math.sqrt(a0 * a0 + 2.0 * J_ISO * closing) - a0) / J_ISO
+        return closing * t - 0.5 * a0 * t * t - J_ISO * t ** 3 / 6.0
+    rest = closing - shed
+    return (closing * ramp - 0.5 * a0 * ramp * ramp - J_ISO * ramp ** 3 / 6.0
+            + rest * rest / (2.0 * A_ISO))
+
+
+def comfortable_solution(speed: float, gap: float, lead_speed: float, lead_accel: float,
+                         decel_now: float) -> bool:
+    """Whether a braking within ISO's limits (`closing_distance`) from the ego's speed
+    [m/s] and deceleration now `decel_now` [m/s^2] stops its closing on a vehicle ahead at
+    bumper gap `gap` [m] with speed `lead_speed` [m/s] before the gap falls to `D_STOP`,
+    and, while that vehicle brakes (acceleration `lead_accel` [m/s^2] under
+    -`LEAD_BRAKING`), stops the ego `D_STOP` behind where it comes to rest (module doc)."""
     room = gap - D_STOP
-    need = closing * closing / (2.0 * room) if closing > 0.0 and room > 0.0 else \
-        (math.inf if closing > 0.0 else 0.0)
+    if speed > lead_speed and closing_distance(speed - lead_speed, decel_now) > room:
+        return False
     if lead_accel < -LEAD_BRAKING:
-        stop_room = room + lead_speed * lead_speed / (2.0 * -lead_accel)
-        need = max(need, speed * speed / (2.0 * stop_room) if stop_room > 0.0 else math.inf)
-    return need
+        rest = room + lead_speed * lead_speed / (2.0 * -lead_accel)
+        return closing_distance(speed, decel_now) <= rest
+    return True
 
 
 class _Window:
@@ -148,9 +177,10 @@ class _Comfort(Criterion):
         decel, short, jerk = self.signals.push(sample.t, sample.speed)
         braking = short is not None and short >= BRAKING
         ahead = ahead_of(sample, self.road, self.ego_length)
-        need = required_decel(sample.speed, ahead[0].gap, ahead[0].speed, ahead[0].accel) \
-            if ahead else 0.0
-        if need > A_ISO:  # no comfortable solution: a window opens (or goes on)
+        decel_now = max(short or 0.0, 0.0)
+        comfortable = all(comfortable_solution(sample.speed, a.gap, a.speed, a.accel, decel_now)
+                          for a in ahead)
+        if not comfortable:  # a window opens (or goes on)
             self.excused += 0 if self._in_window else 1
             self._in_window, self._excused_until = True, math.inf
         elif self._in_window:  # it lasts until EXCUSE_AFTER after the braking has ended
