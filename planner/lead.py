@@ -11,8 +11,10 @@ with its gap, speed and lateral offset from the lane's centre line.
   is bumper to bumper along the ego's heading, the speed [m/s] the track's over ground along
   the ego's heading (>= 0), both at the track's time; a pedestrian's offset is the one
   nearest the centre line on its way until the car reaches it (at the closing speed, at most
-  ``CROSSING_HORIZON`` ahead; `crossing_lateral`): a walker crossing the road is in the
-  car's path before it steps into the lane; a vehicle moving across the lane towards its
+  ``CROSSING_HORIZON`` ahead, its velocity across the lane where it is; `crossing_lateral`):
+  a walker crossing the road is in the car's path before it steps into the lane (a track
+  classed a pedestrian but faster than ``WALKER_SPEED`` is taken as a vehicle); a vehicle
+  of the ego's direction (not ``ONCOMING``) moving across the lane towards its
   centre line faster than ``CUT_IN_SPEED`` (its velocity over ground across the lane's
   direction where it is: no yaw of the ego's in it) is taken where it will be
   ``CUT_IN_HORIZON`` later (`cut_in_lateral`; its lateral speed is the track's, which lags
@@ -69,6 +71,16 @@ from world.hdmap import Lane
 
 CROSSING_HORIZON = 3.0  # [s] a pedestrian's walk is predicted this far ahead at most (the
 #   time to collision at which AEB pedestrian systems brake; 50 m at 60 km/h)
+WALKER_SPEED = 5.0  # [m/s] a track classed a pedestrian but faster over ground than this is
+#   taken as a vehicle: its first returns were boxed small (a runner makes about 4 m/s;
+#   Euro NCAP's AEB pedestrian targets walk at 5 and run at 8 km/h). Its walk would be
+#   predicted up to CROSSING_HORIZON ahead on a velocity its track has not settled yet: an
+#   oncoming car 48 m ahead, boxed as a walker (`tracking` at 12.8 s), crossed by it.
+ONCOMING = 2.0  # [m/s] a vehicle moving against the ego's heading faster than this is
+#   oncoming: taken where it is, never where its velocity across the lane would take it (a
+#   cut-in is a vehicle of the ego's direction moving over; an ACC follows no oncoming
+#   vehicle, ISO 15622). A new track's velocity has not settled: an oncoming car's, two
+#   lanes left 48 m ahead, crossed the lane at 3.6 m/s (`tracking` at 12.8 s)
 CUT_IN_HORIZON = 1.5  # [s] a vehicle moving into the lane is taken where it will be this
 #   much later (a lane change's lateral move lasts 3 to 6 s)
 CUT_IN_SPEED = 0.4  # [m/s] ... if it moves across faster than this (a car keeping its lane
@@ -184,18 +196,23 @@ def lane_candidates(tracks: Sequence[Track], centre_y: Callable[[float], float],
         if tr.cls is ObjectClass.OTHER or tr.rel_x <= 0.0:
             continue
         gap = tr.rel_x - front_overhang - 0.5 * tr.length
-        speed = max(0.0, tr.vx * math.cos(ego_heading) + tr.vy * math.sin(ego_heading))
+        along = tr.vx * math.cos(ego_heading) + tr.vy * math.sin(ego_heading)
+        speed = max(0.0, along)
         lateral = tr.rel_y - centre_y(tr.rel_x)
-        if tr.cls is ObjectClass.PEDESTRIAN:
-            lateral = crossing_lateral(lateral, tr.rel_vy, gap, -tr.rel_vx)
-        else:
-            slope = 0.5 * (centre_y(tr.rel_x + 1.0) - centre_y(tr.rel_x - 1.0))
-            lane = ego_heading + math.atan(slope)  # the lane's heading where the track is
-            across = tr.vy * math.cos(lane) - tr.vx * math.sin(lane)  # over ground, left +
-            out.append(Candidate(Lead(tr.id, tr.t, gap, speed),
-                                 cut_in_lateral(lateral, across), lateral, across))
+        slope = 0.5 * (centre_y(tr.rel_x + 1.0) - centre_y(tr.rel_x - 1.0))
+        lane = ego_heading + math.atan(slope)  # the lane's heading where the track is
+        across = tr.vy * math.cos(lane) - tr.vx * math.sin(lane)  # over ground, left +
+        if tr.cls is ObjectClass.PEDESTRIAN and tr.speed <= WALKER_SPEED:  # across the
+            #   lane where it is, not the car's axis: 50 m into a 250 m bend, a car keeping
+            #   the oncoming lane moves across the car's axis at a fifth of its speed
+            lateral = crossing_lateral(lateral, across, gap, -tr.rel_vx)
+            out.append(Candidate(Lead(tr.id, tr.t, gap, speed), lateral))
             continue
-        out.append(Candidate(Lead(tr.id, tr.t, gap, speed), lateral))
+        if along < -ONCOMING:  # not a cut-in: where it is (`ONCOMING`)
+            out.append(Candidate(Lead(tr.id, tr.t, gap, speed), lateral))
+            continue
+        out.append(Candidate(Lead(tr.id, tr.t, gap, speed), cut_in_lateral(lateral, across),
+                             lateral, across))
     return out
 
 

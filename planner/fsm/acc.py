@@ -166,7 +166,9 @@ class AccParams:
     a_hysteresis: float = 0.5  # [m/s^2] BRAKE is left with a_need this far under a_comf_max
     d_band: float = 1.0  # [m] BRAKE is left for TRAIL without closing this far above d_min
     v_band: float = 0.5  # [m/s] a lead counts as faster than a speed once this much faster
-    lead_hold: float = 0.5  # [s] TRAIL outlives a lost lead this long (lead_lost)
+    lead_hold: float = 1.0  # [s] TRAIL outlives a lost lead this long (lead_lost): a cut-out
+    #   at 2.5 m/s, r157_cut_out_003: the lead left the lane 0.6 s before the stopped car it
+    #   had hidden was tracked (at 0.5 s CRUISE was held 0.1 s between)
     d_let_go: float = 2.0  # [m] TRAIL lets a lead go this far beyond d_max (hysteresis
     #   against the entry within d_max: a gap about d_max flicked TRAIL and CRUISE a tick)
 

@@ -170,6 +170,42 @@ def test_a_walker_heading_into_the_lane_is_in_it_and_one_on_the_pavement_is_not(
         -4.2 + 1.4 * CUT_IN_HORIZON)
 
 
+def test_a_walker_crosses_the_lane_where_it_is_not_the_cars_axis() -> None:
+    """Where the lane bends left (radius 250 m), a car keeping the oncoming lane 50 m ahead
+    whose first returns were boxed as a walker (`tracking` at 12.8 s) moves across the
+    ego's axis at 2.5 m/s, towards it, but along its own lane: it stays where it is. The
+    ego's axis made it a walker about to cross, taken at once as the lead; and too fast for
+    a walker, it is taken as a vehicle, an oncoming one: where it is."""
+    bend = math.atan(50.0 / 250.0)  # the lane's heading 50 m ahead
+
+    def centre(x: float) -> float:
+        return x * x / 500.0
+
+    velocity = (-12.8 * math.cos(bend), -12.8 * math.sin(bend))  # oncoming, along its lane
+    oncoming = replace(walker(centre(50.0) + 3.5, velocity[1]), vx=velocity[0],
+                       vy=velocity[1], rel_vx=velocity[0] - 19.0, x=50.0, rel_x=50.0)
+    (c,) = lane_candidates([oncoming], centre, 0.0, 2.4)
+    assert c.lateral == pytest.approx(3.5, abs=0.01)
+    # across the ego's axis alone it would cross the centre line before the car got there
+    assert crossing_lateral(3.5, velocity[1], 50.0 - 2.4 - 0.35, 31.5) == 0.0
+    # the same box on a straight road, its new track's velocity not yet settled (3 m/s
+    # across, 4.5 m/s towards the ego, the ego at 13.9 m/s): too fast for a walker, and an
+    # oncoming vehicle, so where it is; as a walker it would cross within 2.6 s, and as a
+    # vehicle of the ego's direction it would be 4.5 m nearer by its cut-in horizon
+    unsettled = replace(walker(7.0, -3.0), vx=-4.5, rel_vx=-18.4)
+    (c,) = lane_candidates([unsettled], lambda x: 0.0, 0.0, 2.4)
+    assert c.lateral == pytest.approx(7.0)
+    assert crossing_lateral(7.0, -3.0, 55.0 - 2.4 - 0.35, 18.4) == 0.0
+    same_way = replace(unsettled, vx=4.5, rel_vx=-9.4)
+    (c,) = lane_candidates([same_way], lambda x: 0.0, 0.0, 2.4)
+    assert c.lateral == pytest.approx(7.0 - 3.0 * CUT_IN_HORIZON)
+    # a walker crossing that lane at 1.5 m/s still is taken where it will be
+    right = (math.sin(bend), -math.cos(bend))
+    crossing = replace(oncoming, vx=1.5 * right[0], vy=1.5 * right[1], rel_vx=-19.0)
+    (c,) = lane_candidates([crossing], centre, 0.0, 2.4)
+    assert c.lateral == pytest.approx(0.0)
+
+
 @pytest.mark.parametrize(("lateral", "lateral_speed", "expected"), [
     (3.5, -1.0, 3.5 - CUT_IN_HORIZON),  # cutting in from the left at 1 m/s
     (-3.5, 2.0, -3.5 + 2.0 * CUT_IN_HORIZON),  # from the right at 2 m/s

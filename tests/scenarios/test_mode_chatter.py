@@ -23,17 +23,17 @@ MIN_HOLD = 0.5  # [s]
 #   town_route's CRUISE for 0.1 s between two YIELDs (a gap is taken once clear for
 #   gap_confirm, then committed to, `planner.junctions`). Their runs hold every mode >= 2.1 s
 #   (decs_route), 3.6 s (town_route, town_left_turn) once their goldens are rewritten.
+#   tracking's TRAIL for 0.1 s at 12.8 s: an oncoming car two lanes left 48 m ahead, its
+#   first returns boxed as a walker, its new track's velocity crossing the lane at 3.6 m/s,
+#   predicted into the lane and taken as the lead (`planner.lead`: ONCOMING, WALKER_SPEED,
+#   a walker's crossing judged across the lane where it is).
 
 
 def test_every_bundled_scenario_has_a_golden_run() -> None:
     assert len(GOLDEN) >= 15
 
 
-KNOWN = {  # run -> why it still chatters (issue K, item 2)
-    "tracking": "TRAIL for 0.1 s at 12.8 s: a new track 48 m ahead, a car's first returns "
-                "boxed as a pedestrian standing in the lane (time to collision 2.4 s: urgent, "
-                "the lead at once), is a car in the next lane on the next scan",
-}
+KNOWN: dict[str, str] = {}  # run -> why it still chatters (a strict xfail)
 
 
 @pytest.mark.parametrize("path", [
