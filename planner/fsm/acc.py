@@ -94,7 +94,7 @@ holds, so Cruise and SpeedLimit are tried first.
     d_min))
 25. speed_limit -> trail: (V_GPS < V_s or V_l < V_GPS) and d_min < d < d_max (d_des < d:
     inside d_des too *)
-26. cruise, trail -> speed_limit: V_GPS < V_s and ((d >= d_max (trail: + d_let_go) and not
+26. cruise, trail -> speed_limit: V_GPS < V_s and (d >= d_max (trail: + d_let_go and not
     lead_lost) or (V_GPS + v_band <= V_l and d_min < d < inf)) (Trail *; v_band, lead_lost,
     d_let_go *)
 
@@ -274,9 +274,10 @@ def _why_hard(x: AccInput, _g: Gaps) -> str:
 
 
 def _beyond(m: AccMode, x: AccInput, g: Gaps) -> bool:
-    """The lead is beyond d_max (TRAIL: by d_let_go) and not just lost."""
-    reach = g.d_max + (g.d_let_go if m is AccMode.TRAIL else 0.0)
-    return x.d >= reach and not x.lead_lost
+    """The lead is beyond d_max (TRAIL: by d_let_go, and not just lost)."""
+    if m is AccMode.TRAIL:
+        return x.d >= g.d_max + g.d_let_go and not x.lead_lost
+    return x.d >= g.d_max
 
 
 def _to_limit(m: AccMode, x: AccInput, g: Gaps) -> bool:
@@ -389,7 +390,7 @@ TABLE: Table[AccMode, AccInput, Gaps] = Table(AccMode, (
         "(V_GPS < V_s or V_l < V_GPS) and d_min < d < d_max (d_des < d: inside d_des too *)",
         "a vehicle ahead within d_max"),
     Row(frozenset({M.CRUISE, M.TRAIL}), M.SPEED_LIMIT, _to_limit,
-        "V_GPS < V_s and ((d >= d_max (trail: + d_let_go) and not lead_lost) or (V_GPS + "
+        "V_GPS < V_s and (d >= d_max (trail: + d_let_go and not lead_lost) or (V_GPS + "
         "v_band <= V_l and d_min < d < inf)) (Trail *; v_band, lead_lost, d_let_go *)",
         "the posted limit is below the set speed"),
 ))

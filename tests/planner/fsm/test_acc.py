@@ -120,6 +120,8 @@ TABLE_CASES = [
     # a lead just lost: TRAIL holds for lead_hold (the car it hid may become the lead; *)
     ("trail_stays_lead_just_lost", M.TRAIL, x(lead_lost=True), None),
     ("trail_limit_waits_lead_just_lost", M.TRAIL, x(v_gps=13.0, lead_lost=True), None),
+    # ... TRAIL only: cruising (an event just over) with a lead lost, the limit binds at once
+    ("cruise_limit_lead_just_lost", M.CRUISE, x(v_gps=13.0, lead_lost=True), M.SPEED_LIMIT),
     ("brake_trail_lead_at_set_speed", M.BRAKE, x(d=G.d_min + 1.5, v_l=15.2), M.TRAIL),
     ("limit_stays_lead_at_limit", M.SPEED_LIMIT,
      x(v_s=13.0, v_gps=13.0, d=G.d_des + 2.0, v_l=13.2), None),
