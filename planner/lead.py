@@ -197,7 +197,7 @@ def lane_candidates(tracks: Sequence[Track], centre_y: Callable[[float], float],
             continue
         gap = tr.rel_x - front_overhang - 0.5 * tr.length
         along = tr.vx * math.cos(ego_heading) + tr.vy * math.sin(ego_heading)
-        speed = max(0.0, along)
+        lead = Lead(tr.id, tr.t, gap, max(0.0, along))
         lateral = tr.rel_y - centre_y(tr.rel_x)
         slope = 0.5 * (centre_y(tr.rel_x + 1.0) - centre_y(tr.rel_x - 1.0))
         lane = ego_heading + math.atan(slope)  # the lane's heading where the track is
@@ -205,14 +205,11 @@ def lane_candidates(tracks: Sequence[Track], centre_y: Callable[[float], float],
         if tr.cls is ObjectClass.PEDESTRIAN and tr.speed <= WALKER_SPEED:  # across the
             #   lane where it is, not the car's axis: 50 m into a 250 m bend, a car keeping
             #   the oncoming lane moves across the car's axis at a fifth of its speed
-            lateral = crossing_lateral(lateral, across, gap, -tr.rel_vx)
-            out.append(Candidate(Lead(tr.id, tr.t, gap, speed), lateral))
-            continue
-        if along < -ONCOMING:  # not a cut-in: where it is (`ONCOMING`)
-            out.append(Candidate(Lead(tr.id, tr.t, gap, speed), lateral))
-            continue
-        out.append(Candidate(Lead(tr.id, tr.t, gap, speed), cut_in_lateral(lateral, across),
-                             lateral, across))
+            out.append(Candidate(lead, crossing_lateral(lateral, across, gap, -tr.rel_vx)))
+        elif along < -ONCOMING:  # not a cut-in: where it is (`ONCOMING`)
+            out.append(Candidate(lead, lateral))
+        else:
+            out.append(Candidate(lead, cut_in_lateral(lateral, across), lateral, across))
     return out
 
 
