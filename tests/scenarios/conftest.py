@@ -12,6 +12,12 @@ from avsim.run.sensor_loop import FrameHook
 from avsim.scenario.load import load_scenario
 from world.sensors.setup import Profile
 
+SENSING = "inline"  # the cameras render in the test's own process: xdist keeps both cores
+#   busy, and a render worker (`--sensing auto`) builds the world a second time and passes
+#   every frame through shared memory: normal_driving's first 20 s took 22.3 s of CPU over
+#   four processes with it, 18.0 s inline. The two give the same run, bit for bit
+#   (tests/avsim/run/test_speedups.py, tests/world/sensors/test_pipeline.py).
+
 
 @pytest.fixture(scope="module")
 def run_scenario(tmp_path_factory: pytest.TempPathFactory) -> Callable[..., RunResult]:
@@ -29,7 +35,8 @@ def run_scenario(tmp_path_factory: pytest.TempPathFactory) -> Callable[..., RunR
                                      Path(criteria) if criteria is not None else None)
             out: Path | None = (tmp_path_factory.mktemp("runs") / f"{scenario.name}.rrd"
                                 if record else None)
-            cache[key] = Runner(scenario, out, profile=profile, frame_hook=frame_hook).run()
+            cache[key] = Runner(scenario, out, profile=profile, frame_hook=frame_hook,
+                                sensing=SENSING).run()
         return cache[key]
 
     return run

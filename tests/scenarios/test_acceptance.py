@@ -40,6 +40,12 @@ def _runs() -> list[tuple[str, str, dict[str, object]]]:
 
 
 RUNS = _runs()
+KNOWN = {  # grid point -> why it fails (a strict xfail: it is reported when it passes)
+    f"ncap_ccrm_{k:03d}": "80 km/h closing on a car at 20 km/h: the roof LiDAR's lowest "
+    "ring that clears the ground meets the car's rear above min_top from 72 m, its track "
+    "starts at 65 m, and keeping UN R157's d_min from there needs more than ISO 15622's "
+    "3.5 m/s^2: the gap falls to 5.4 m, under d_min's 11.3 m (following_gap)"
+    for k in range(25, 30)}
 
 
 def actor(result: RunResult, k: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -128,7 +134,9 @@ def test_the_grids_are_the_set() -> None:
     assert len(RUNS) == 113
 
 
-@pytest.mark.parametrize(("name", "path", "overrides"), RUNS, ids=[r[0] for r in RUNS])
+@pytest.mark.parametrize(("name", "path", "overrides"), [
+    pytest.param(*r, marks=pytest.mark.xfail(strict=True, reason=KNOWN[r[0]]))
+    if r[0] in KNOWN else r for r in RUNS], ids=[r[0] for r in RUNS])
 def test_the_situation_happens_and_every_criterion_passes(
         run_scenario: Callable[..., RunResult], name: str, path: str,
         overrides: dict[str, object]) -> None:
