@@ -6,7 +6,7 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 PYTEST_ARGS ?=
 
-.PHONY: setup demo test test-quick acceptance lint golden bench soak clean
+.PHONY: setup demo test test-quick acceptance fuzz lint golden bench soak clean
 
 # The virtual environment with the pinned dependencies (pyproject.toml), installed once.
 $(STAMP): pyproject.toml
@@ -44,6 +44,14 @@ test-quick: lint
 # per run, each asserting its situation happened and its verdicts; too long for `make test`.
 acceptance: $(STAMP)
 	$(BIN)/pytest -n 2 --dist load -m acceptance tests/scenarios $(PYTEST_ARGS)
+
+# The fuzzers (tests marked `fuzz`) with many more inputs than `make test` tries, on a fresh
+# seed each time unless AVSIM_FUZZ_SEED is given (a failure prints the seed to replay).
+FUZZ_EXAMPLES ?= 3000
+fuzz: $(STAMP)
+	seed=$${AVSIM_FUZZ_SEED:-$$RANDOM}; echo "make fuzz: seed $$seed"; \
+	AVSIM_FUZZ_EXAMPLES=$(FUZZ_EXAMPLES) AVSIM_FUZZ_SEED=$$seed $(BIN)/pytest -n 2 -m fuzz \
+		-p no:cacheprovider --hypothesis-seed=$$seed tests $(PYTEST_ARGS)
 
 # Rewrite the golden results (tests/scenarios/golden/) from the scenario tests' own runs: only
 # for a change meant to alter behaviour, whose commit says which and why.

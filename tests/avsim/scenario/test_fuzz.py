@@ -23,19 +23,19 @@ from typing import Any
 
 import pytest
 import yaml
-from hypothesis import HealthCheck, Phase, given, settings
+from hypothesis import given
 from hypothesis import strategies as st
 
 from avsim.scenario.files import SCENARIO_DIR, read_raw
 from avsim.scenario.load import ScenarioError, load_scenario
+from tests.fuzzing import FUZZ
 
 FILES = sorted([*SCENARIO_DIR.glob("*.yaml"), *(SCENARIO_DIR / "acceptance").glob("*.yaml")])
 ALKS = (Path(__file__).parents[2] / "data" / "alks" / "logical_scenarios"
         / "concrete_scenarios")
 XOSC = sorted(ALKS.glob("alks_scenario_*.xosc"))
-FUZZ = settings(derandomize=True, deadline=None, max_examples=100, database=None,
-                phases=[Phase.explicit, Phase.generate],  # no shrinking: bounded time
-                suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+
+pytestmark = pytest.mark.fuzz
 
 Path_ = tuple[str | int, ...]  # keys and list indices from the document's root
 
