@@ -1,5 +1,9 @@
 """The result file (`--json`) of a run, as SCENARIO_FORMAT.md specifies it: strict JSON,
-every number finite or null (`dumps` refuses anything else)."""
+every number finite or null (`dumps` refuses anything else).
+
+``verdict`` says how the run ended (`avsim.run.verdict`: pass, fail, error, interrupted);
+``passed`` is true only for pass; ``error`` is the exception that ended a run in error
+(type, message, traceback, sim time [s]), else null."""
 
 from __future__ import annotations
 
@@ -27,8 +31,10 @@ def result_json(result: RunResult, file: str | Path, recording: Path, profile: s
         "seed": scenario.seed,
         "profile": profile,
         "renderer": result.renderer,
+        "verdict": result.verdict.value,
         "passed": result.passed,
         "interrupted": result.interrupted,
+        "error": None if result.error is None else result.error.as_json(),
         "sim_time": round(result.sim_time, 4),
         "wall_time": round(result.wall_time, 3),
         "criteria": [c.as_json() for c in result.criteria],
@@ -42,6 +48,21 @@ def result_json(result: RunResult, file: str | Path, recording: Path, profile: s
         ],
         "recording": str(recording),
     }
+
+
+def headline(payload: dict[str, object]) -> str:
+    """A result's verdict in a few words: ``PASS``, ``FAIL``, ``PASS so far (interrupted
+    at T s)`` or ``ERROR at T s (FAIL so far)``, from the criteria judged so far [s]."""
+    criteria = payload["criteria"]
+    assert isinstance(criteria, list)
+    so_far = "FAIL" if any(c["passed"] is False for c in criteria) else "PASS"
+    t = payload["sim_time"]
+    assert isinstance(t, (int, float))
+    if payload.get("verdict") == "error":
+        return f"ERROR at {t:.1f} s ({so_far} so far)"
+    if payload.get("interrupted"):
+        return f"{so_far} so far (interrupted at {t:.1f} s)"
+    return so_far
 
 
 def dumps(payload: object) -> str:

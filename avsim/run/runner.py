@@ -27,6 +27,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from functools import partial
 from pathlib import Path
+from typing import TypeVar
 
 import numpy as np
 from numpy.typing import NDArray
@@ -54,6 +55,7 @@ from avsim.run.spill import SpillFile
 from avsim.run.stack import Stack, StackOutput
 from avsim.run.story import ScriptedStory, StoryboardStory, StoryEntry
 from avsim.run.storyboard.director import Director
+from avsim.run.verdict import RunError, RunVerdict
 from avsim.scenario.scenario import Scenario
 from planner.messages import MACHINES, AccMode, HazardLights, Motion, Plan, SpeedSource, StateChange
 from world.core.rates import (
@@ -78,6 +80,7 @@ SETTLE_AFTER_DONE = 1.0  # [s] the run goes on this long after it may end: `comp
 #   reached and every required action and event fired
 
 ProgressCallback = Callable[[float, float], None]  # (sim time, duration) [s]
+T = TypeVar("T")
 VERDICT_WORDS = {Verdict.PASS: "pass", Verdict.FAIL: "FAIL", Verdict.NOT_APPLICABLE: "n/a"}
 
 
@@ -168,11 +171,24 @@ class RunResult:
     story: tuple[StoryEntry, ...] = ()  # each scripted action and event, and when it fired
     interrupted: bool = False  # stopped early by `Runner.interrupt` (a signal): the criteria
     #   are those judged so far (`avsim.criteria.base.judged_so_far`)
+    error: RunError | None = None  # the exception that ended the run (verdict error): the
+    #   criteria are those judged until then
+
+    @property
+    def verdict(self) -> RunVerdict:
+        """Error, else interrupted, else fail if a criterion failed, else pass
+        (`avsim.run.verdict`)."""
+        if self.error is not None:
+            return RunVerdict.ERROR
+        if self.interrupted:
+            return RunVerdict.INTERRUPTED
+        return RunVerdict.FAIL if any(c.failed for c in self.criteria) else RunVerdict.PASS
 
     @property
     def passed(self) -> bool:
-        """No criterion failed (one not applicable does not fail the run)."""
-        return not any(c.failed for c in self.criteria)
+        """The run went to its end and no criterion failed (one not applicable does not
+        fail the run); an interrupted run or one that ended in error has not passed."""
+        return self.verdict is RunVerdict.PASS
 
 
 class Runner:
@@ -241,7 +257,11 @@ class Runner:
         self.state_changes: list[StateChange] = []
         self._touching: frozenset[int] = frozenset()
         self._last: StackOutput | None = None
-        self._interrupted = False
+        self._interrupted = False  # a signal asked the run to end
+        self._stopped = False  # the run ended early for it (not after its last tick)
+        self.error: RunError | None = None  # the exception that ended the run, if one did
+        self._sim_time = 0.0  # [s] when the run ended (set as it closes)
+        self._closing = False
 
     def interrupt(self) -> None:
         """End the run at the current tick (safe from a signal handler): `run` closes the
@@ -251,47 +271,93 @@ class Runner:
     # -- the loop ------------------------------------------------------------------------------
 
     def run(self, progress: ProgressCallback | None = None) -> RunResult:
+        """Run to the end (duration, `completes` reached, a StopTrigger) and judge the run.
+
+        Never raises for what a stage does wrong: an exception in any stage (the sensors and
+        perception, the planner, control, the storyboard, a criterion, the recorder, the
+        world) ends the run at that tick with verdict error (`RunResult.error`: its type,
+        message, traceback and sim time [s]); the criteria are those judged so far, the
+        recording logs the error as an event at its sim time and is closed whole."""
         start = time.perf_counter()
-        w, watch = self.world, self.watch
-        if self.recorder is not None:
-            with watch("recording"):
-                self._record_static()
-        steps = round(self.scenario.duration * PHYSICS_RATE)
-        done_at: float | None = None
         try:
-            # one control period per pass: decide on this snapshot, then hold the command
-            # on the joints for the period's physics steps (contacts watched at their rate)
-            while w.clock.step < steps and not self._interrupted:
-                self._tick()
-                self._period(steps)
-                if done_at is None and self._may_end():
-                    done_at = w.t
-                if self._over(done_at):
-                    break
-                if progress is not None and w.clock.step % PHYSICS_RATE == 0:
-                    progress(w.t, self.scenario.duration)
+            self._loop(progress)
+        except Exception as exc:  # a stage's bug ends this run, not the program
+            self._failed(exc)
         finally:
-            self.sensors.close()
-            if self.recorder is not None:
-                with watch("recording"):
-                    self._record_criteria()
-                    self.recorder.close()
-            sim_time = w.t
-            w.close()
+            criteria = self._close()
         renderer = self.sensors.sensing.renderer
-        criteria = self.criteria.results()
-        if self._interrupted:
-            criteria = judged_so_far(criteria, sim_time)
+        metrics: dict[str, float] = self._attempt(self._metrics, {})
+        story: tuple[StoryEntry, ...] = self._attempt(self.story.now, ())
         return RunResult(
-            scenario=self.scenario, criteria=criteria, metrics=self._metrics(),
-            sim_time=sim_time, wall_time=time.perf_counter() - start, log=self.log,
+            scenario=self.scenario, criteria=criteria, metrics=metrics,
+            sim_time=self._sim_time, wall_time=time.perf_counter() - start, log=self.log,
             recording=self.recorder.path if self.recorder else None,
             state_changes=tuple(self.state_changes), infractions=tuple(self.infractions),
             profile=self.setup.profile.value if self.setup is not None else None,
             renderer=renderer.value if renderer is not None else None,
-            stage_times=dict(watch.seconds), story=self.story.now(),
-            interrupted=self._interrupted,
+            stage_times=dict(self.watch.seconds), story=story,
+            interrupted=self._stopped, error=self.error,
         )
+
+    def _loop(self, progress: ProgressCallback | None) -> None:
+        """The static recording, then one control period per pass: decide on this
+        snapshot, then hold the command on the joints for the period's physics steps
+        (contacts watched at their rate); ends early on `interrupt` (the run is then
+        marked interrupted) or once the run may end."""
+        w = self.world
+        if self.recorder is not None:
+            with self.watch("recording"):
+                self._record_static()
+        steps = round(self.scenario.duration * PHYSICS_RATE)
+        done_at: float | None = None
+        while w.clock.step < steps:
+            if self._interrupted:
+                self._stopped = True
+                break
+            self._tick()
+            self._period(steps)
+            if done_at is None and self._may_end():
+                done_at = w.t
+            if self._over(done_at):
+                break
+            if progress is not None and w.clock.step % PHYSICS_RATE == 0:
+                progress(w.t, self.scenario.duration)
+
+    def _failed(self, exc: BaseException) -> None:
+        """The run ended in error with `exc` (only the first error is kept)."""
+        if self.error is None:
+            self.error = RunError.of(exc, self._sim_time if self._closing else self.world.t)
+
+    def _attempt(self, step: Callable[[], T], otherwise: T) -> T:
+        """`step()`, or `otherwise` when it raises (the run then ends in error with it)."""
+        try:
+            return step()
+        except Exception as exc:  # a bug while closing or judging ends the run in error
+            self._failed(exc)
+            return otherwise
+
+    def _close(self) -> list[CriterionResult]:
+        """Close what the run opened, each even if one before failed: the sensors, the
+        recording (the verdicts and any error logged first, so the file is whole), the
+        world. Returns the criteria's results, judged so far when the run ended early."""
+        self._sim_time, self._closing = self.world.t, True
+        self._attempt(self.sensors.close, None)
+        criteria: list[CriterionResult] = self._attempt(self._judged, [])
+        if self.recorder is not None:
+            with self.watch("recording"):
+                self._attempt(partial(self._record_end, criteria), None)
+                self._attempt(self.recorder.close, None)
+        self._attempt(self.world.close, None)
+        return criteria
+
+    def _judged(self) -> list[CriterionResult]:
+        """The criteria's results; judged so far (`judged_so_far`) if the run ended early."""
+        criteria = self.criteria.results()
+        if self.error is not None:
+            return judged_so_far(criteria, self._sim_time, "the run ended in error")
+        if self._stopped:
+            return judged_so_far(criteria, self._sim_time)
+        return criteria
 
     def _period(self, steps: int) -> None:
         """The physics steps of one control period (at most up to `steps`), with the
@@ -362,6 +428,12 @@ class Runner:
         lo, hi = ego_lane_edges(w.road, s, float(route.offsets[0]))
         ahead = vehicles_ahead(w.road, w.actors.poses, s, float(route.offsets[0]),
                                self.car.body_length) if w.actors.bodies else ()
+        # everything computed before the first append: a tick's row is whole or absent
+        pose_error = math.hypot(out.plan.ego.x - float(truth.position[0]),
+                                out.plan.ego.y - float(truth.position[1]))
+        actor_station = np.array([m.s for m in w.actors.motions])
+        actor_offset = np.array([m.offset for m in w.actors.motions])
+        crossing = self.lanes.crossing is not None
         log.t.append(w.t)
         log.x.append(float(truth.position[0]))
         log.y.append(float(truth.position[1]))
@@ -383,12 +455,11 @@ class Runner:
         log.lane.append(out.plan.lane)
         log.changing.append(out.plan.lane != out.plan.origin_lane)
         log.pedal.append(w.accelerator_pedal)
-        log.pose_error.append(math.hypot(out.plan.ego.x - float(truth.position[0]),
-                                         out.plan.ego.y - float(truth.position[1])))
+        log.pose_error.append(pose_error)
         log.lane_error.append(float(route.offsets[0]) - 0.5 * (lo + hi))
-        log.crossing.append(self.lanes.crossing is not None)
-        log.actor_station.append(np.array([m.s for m in w.actors.motions]))
-        log.actor_offset.append(np.array([m.offset for m in w.actors.motions]))
+        log.crossing.append(crossing)
+        log.actor_station.append(actor_station)
+        log.actor_offset.append(actor_offset)
         log.lead_gap.append(ahead[0].gap if ahead else math.nan)
         log.lead_speed.append(ahead[0].speed if ahead else math.nan)
 
@@ -524,17 +595,20 @@ class Runner:
             rec.log_actors(w.t, p.ids, p.centres, p.half_sizes, quats,
                            [k.value for k in p.kinds])
 
-    def _record_criteria(self) -> None:
+    def _record_end(self, criteria: list[CriterionResult]) -> None:
+        """The run's end in the recording: the error that ended it (at its sim time), the
+        perception scores and each criterion's verdict."""
         rec = self.recorder
         assert rec is not None
+        if self.error is not None:
+            rec.log_event(self.error.sim_time, self.error.line(), "ERROR")
         if self.setup is not None:
             scores = ", ".join(f"{k} {v:.3f}" for k, v in self.sensors.metrics().items())
-            rec.log_event(self.world.t, f"perception against the truth: {scores}", "INFO")
-        for r in self.criteria.results():
+            rec.log_event(self._sim_time, f"perception against the truth: {scores}", "INFO")
+        for r in criteria:
             level = "ERROR" if r.failed else "INFO"
-            t = r.first_failure if r.first_failure is not None else self.world.t
+            t = r.first_failure if r.first_failure is not None else self._sim_time
             value = "none" if r.value is None else f"{r.value:.3f} {r.unit}"
             note = f"; {r.note}" if r.note else ""
             rec.log_event(t, f"criterion {r.name}: {VERDICT_WORDS[r.verdict]} (value {value}, "
                              f"threshold {r.threshold} {r.unit}{note})", level)
-
