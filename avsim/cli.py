@@ -1,7 +1,10 @@
 """The `avsim` command line (SCENARIO_FORMAT.md, "Command line").
 
 Exit status: 0 every criterion passed, 1 one failed, 2 bad input (one line on stderr naming
-the file, the key and the problem; no traceback; no output file written).
+the file, the key and the problem; no traceback; no output file written), 3 the run ended in
+error (an exception in a stage: one line on stderr, the traceback in the result file),
+130 / 143 interrupted by SIGINT / SIGTERM (`avsim.run.interrupts`). A run's status is its
+verdict's (`avsim.run.verdict`); a batch's is `avsim.batch.suite.exit_status`.
 """
 
 from __future__ import annotations
@@ -21,8 +24,9 @@ from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.table import Table
 
 from avsim.files import write_atomic
-from avsim.run.interrupts import Interrupts
-from avsim.run.result import dumps, result_json
+from avsim.run.interrupts import ExitAtOnce, Interrupts
+from avsim.run.result import dumps, headline, result_json
+from avsim.run.verdict import RunVerdict
 from avsim.scenario.load import ScenarioError, bundled_scenarios, load_scenario
 from avsim.scenario.profile_fit import check_profile
 from avsim.scenario.schema import scenario_json_schema
@@ -33,7 +37,7 @@ if TYPE_CHECKING:
 
 PROFILES = ("fast", "default", "paper", "none")  # sensor profiles (`world.sensors.setup`)
 SENSING = ("auto", "inline", "process")  # where the cameras render
-EXIT_FAILED, EXIT_BAD_INPUT = 1, 2  # exit statuses (module doc)
+EXIT_FAILED, EXIT_BAD_INPUT, EXIT_ERROR = 1, 2, 3  # exit statuses (module doc)
 PARAMETER_PREFIX = "parameters."  # `--param NAME=V` is `--set parameters.NAME=V`
 PLOT_NEXT_TO_RECORDING = "\0next-to-recording"  # `--plot` given without a file name
 
@@ -56,8 +60,10 @@ def _writable(path: Path, what: str) -> None:
 
 
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})
-def main() -> None:
+@click.pass_context
+def main(ctx: click.Context) -> None:
     """avsim: a headless 3D driving sandbox for classical autonomous-driving stacks."""
+    ctx.with_resource(ExitAtOnce())  # a signal while a command starts: exit 130 / 143
 
 
 @main.command()
@@ -133,9 +139,17 @@ def run(scenario: str, out: Path | None, json_path: Path | None, profile: str, s
 
             plot_speed_profile(result, plot_path)
         _print_verdict(payload)
-    if stop.exit_status is not None:
-        sys.exit(stop.exit_status)
-    sys.exit(0 if result.passed else EXIT_FAILED)
+        if result.error is not None:
+            click.echo(f"avsim: {result.error.line()}", err=True)
+        sys.exit(_exit_status(result, stop))
+
+
+def _exit_status(result: RunResult, stop: Interrupts) -> int:
+    """The run's exit status (module doc): its verdict's; an interrupted run's is the
+    signal's."""
+    if result.verdict is RunVerdict.INTERRUPTED and stop.exit_status is not None:
+        return stop.exit_status
+    return {RunVerdict.PASS: 0, RunVerdict.FAIL: EXIT_FAILED}.get(result.verdict, EXIT_ERROR)
 
 
 def _run_with_progress(runner: Runner, duration: float, show: bool) -> RunResult:
@@ -169,10 +183,7 @@ def pace(sim: float, duration: float, wall: float) -> str:
 def _print_verdict(payload: dict[str, object]) -> None:
     """The result file's verdict as a table of criteria, then the run's times and files."""
     console = Console()
-    verdict = "PASS" if payload["passed"] else "FAIL"
-    if payload.get("interrupted"):
-        verdict += f" so far (interrupted at {payload['sim_time']:.1f} s)"
-    table = Table(title=f"{payload['scenario']}: {verdict}")
+    table = Table(title=f"{payload['scenario']}: {headline(payload)}")
     for column in ("criterion", "verdict", "value", "threshold", "unit"):
         table.add_column(column)
     criteria = payload["criteria"]
