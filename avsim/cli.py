@@ -277,7 +277,7 @@ def suite(paths: tuple[str, ...], out: Path, jobs: int | None, executor: str,
     with Interrupts() as stop:  # Ctrl-C / SIGTERM: finished runs and reports are kept
         outcomes = _execute(planned, executor, jobs, address, stop)
         _report(outcomes, out, f"avsim suite ({len(outcomes)} runs)", snapshots)
-    sys.exit(stop.exit_status or batch.exit_status(outcomes))
+    sys.exit(batch.exit_status(outcomes, stop.exit_status))
 
 
 @main.command()
@@ -320,7 +320,7 @@ def sweep(scenario: str, sets: tuple[str, ...], params: tuple[str, ...], out: Pa
         _report(outcomes, out, f"avsim sweep {name} ({len(outcomes)} runs)", snapshots)
         _sweep_report(outcomes, out, [a.path for a in axes if len(a.values) > 1],
                       [a.path for a in axes], metric, name)
-    sys.exit(stop.exit_status or batch.exit_status(outcomes))
+    sys.exit(batch.exit_status(outcomes, stop.exit_status))
 
 
 def _execute(planned: Sequence[RunJob], executor: str, jobs: int | None,

@@ -19,6 +19,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from avsim.files import write_atomic
+from avsim.run.verdict import RunError, RunVerdict
 from avsim.scenario.load import ScenarioError, load_scenario
 from avsim.scenario.profile_fit import check_profile
 
@@ -33,7 +34,9 @@ class Status(Enum):
     PASSED = "passed"  # every criterion passed (exit 0)
     FAILED = "failed"  # a criterion failed (exit 1)
     BAD_INPUT = "bad_input"  # the scenario or an override is invalid (exit 2)
-    ERROR = "error"  # the run crashed (a bug): the message is the exception's last line
+    ERROR = "error"  # the run ended in error (exit 3): an exception in a stage (its result
+    #   judged so far, the error line `avsim.run.verdict.RunError.line`), or the run could
+    #   not start or its worker died (no result: the exception's last line)
     INTERRUPTED = "interrupted"  # the batch was interrupted (SIGINT / SIGTERM): the run
     #   ended at its tick, its result judged so far, or it never started (no result)
 
@@ -132,6 +135,10 @@ class RunOutcome:
 
 
 ProgressCallback = Callable[[float, float], None]  # (sim time, duration) [s]
+VERDICT_STATUS = {  # a result's verdict (`avsim.run.verdict`) -> the run's status
+    RunVerdict.PASS.value: Status.PASSED, RunVerdict.FAIL.value: Status.FAILED,
+    RunVerdict.ERROR.value: Status.ERROR, RunVerdict.INTERRUPTED.value: Status.INTERRUPTED,
+}
 
 
 def not_run(job: RunJob) -> RunOutcome:
@@ -163,9 +170,11 @@ def run_job(job: RunJob, into: Path | None = None,
         last = traceback.format_exception_only(exc)[-1].strip()
         return RunOutcome(job, Status.ERROR, error=f"{job.name}: {last}",
                           wall_time=time.perf_counter() - start)
-    status = (Status.INTERRUPTED if result.get("interrupted") else
-              Status.PASSED if result["passed"] else Status.FAILED)
-    return RunOutcome(job, status, result, wall_time=time.perf_counter() - start)
+    status = VERDICT_STATUS[str(result["verdict"])]
+    error = None
+    if isinstance(fault := result.get("error"), dict):
+        error = f"{job.name}: {RunError(**fault).line()}"
+    return RunOutcome(job, status, result, error, wall_time=time.perf_counter() - start)
 
 
 def _simulate(job: RunJob, scenario: Scenario, into: Path, progress: ProgressCallback | None,

@@ -251,9 +251,18 @@ def _canonical(value: object) -> object:
     return value
 
 
-def exit_status(outcomes: Sequence[RunOutcome]) -> int:
-    """0 all passed; 2 when a run had bad input; else 1 when any failed or crashed."""
-    if any(o.status is Status.BAD_INPUT for o in outcomes):
+def exit_status(outcomes: Sequence[RunOutcome], signalled: int | None = None) -> int:
+    """The batch's exit status (the CLI's statuses, `avsim.cli`), the first that applies:
+    `signalled` (128 + the number of the signal the batch caught: 130, 143) when a run
+    was interrupted or never started for it; 3 when a run ended in error (or was
+    interrupted by a signal only its worker got); 2 when a run had bad input; 1 when one
+    failed; else 0. A signal caught after every run had finished changes nothing."""
+    statuses = {o.status for o in outcomes}
+    if Status.INTERRUPTED in statuses and signalled is not None:
+        return signalled
+    if statuses & {Status.ERROR, Status.INTERRUPTED}:
+        return 3
+    if Status.BAD_INPUT in statuses:
         return 2
-    return 0 if all(o.passed for o in outcomes) else 1
+    return 0 if statuses <= {Status.PASSED} else 1
 

@@ -4,8 +4,9 @@ Pure functions over the `RunOutcome`s of a batch (`avsim.batch.jobs`): nothing h
 scenario or writes a file; the caller writes the text they return.
 
 - `junit_xml`: one `<testsuite>` per run, one `<testcase>` per criterion (a failed
-  criterion has a `<failure>`); a run that did not finish is one `<testcase name="run">`
-  with an `<error>`. Attributes follow the common (Jenkins / Surefire) JUnit schema.
+  criterion has a `<failure>`); a run that did not finish or ended in error has a
+  `<testcase name="run">` with an `<error>` (a run that ended in error also keeps its
+  criteria judged so far). Attributes follow the common (Jenkins / Surefire) JUnit schema.
 - `summary_markdown`: the counts, a table of runs with links to their files, a table of
   criteria per run, and the snapshot of each failed run at its first failure.
 - `summary_table`: the same verdicts as a `rich` table for the terminal.
@@ -170,12 +171,21 @@ def _criterion_case(suite: ET.Element, outcome: RunOutcome,
 
 
 def _error_case(suite: ET.Element, outcome: RunOutcome) -> None:
-    """Append the `<testcase name="run">` with the `<error>` of a run that did not finish."""
+    """Append the `<testcase name="run">` with the `<error>` of a run that did not finish
+    or ended in error (its text: the message, then the traceback when the result has
+    one)."""
     case = ET.SubElement(suite, "testcase", classname=f"avsim.{outcome.job.name}",
                          name="run", time=_seconds(outcome.wall_time))
     message = outcome.error or f"the run did not finish ({outcome.status.value})"
     error = ET.SubElement(case, "error", message=message, type=outcome.status.value)
-    error.text = message
+    fault = (outcome.result or {}).get("error")
+    trace = fault.get("traceback") if isinstance(fault, Mapping) else None
+    error.text = f"{message}\n{trace}" if trace else message
+
+
+def _in_error(outcome: RunOutcome) -> bool:
+    """The run did not finish (no result) or ended in error."""
+    return outcome.result is None or outcome.status is Status.ERROR
 
 
 def _testsuite(parent: ET.Element, outcome: RunOutcome) -> tuple[int, int, int]:
@@ -185,16 +195,16 @@ def _testsuite(parent: ET.Element, outcome: RunOutcome) -> tuple[int, int, int]:
     for name, value in _properties(outcome).items():
         ET.SubElement(properties, "property", name=name, value=value)
     criteria = outcome.criteria()
-    if outcome.result is None:
+    if _in_error(outcome):
         _error_case(suite, outcome)
     elif not criteria:  # a finished run with nothing to check still shows, as passed
         ET.SubElement(suite, "testcase", classname=f"avsim.{outcome.job.name}", name="run",
                       time=_seconds(outcome.wall_time))
     for criterion in criteria:
         _criterion_case(suite, outcome, criterion)
-    tests = max(len(criteria), 1)
+    errors = int(_in_error(outcome))
+    tests = max(len(criteria) + errors, 1)
     failures = len(_failed_names(outcome))
-    errors = int(outcome.result is None)
     suite.attrib.update(tests=str(tests), failures=str(failures), errors=str(errors),
                         skipped=str(len(_skipped_names(outcome))),
                         time=_seconds(outcome.wall_time))
@@ -349,8 +359,10 @@ def _run_section(outcome: RunOutcome) -> list[str]:
     lines += [f"Scenario `{props['file']}`, seed {props.get('seed', DASH)}, profile "
               f"{props['profile']}" + "".join(f", {_inline_code(k)} = {_inline_code(v)}"
                                               for k, v in job.overrides.items()) + ".", ""]
+    if _in_error(outcome):
+        lines += [f"> {_md_text(outcome.error or outcome.status.value)}", ""]
     if outcome.result is None:
-        return [*lines, f"> {_md_text(outcome.error or outcome.status.value)}", ""]
+        return lines
     lines += ["| criterion | verdict | value | threshold | unit | first failure [s] | note |",
               "|---|---|--:|--:|---|--:|---|"]
     lines += [_criterion_row(c) for c in outcome.criteria()]
@@ -411,9 +423,9 @@ def summary_table(outcomes: Sequence[RunOutcome]) -> Table:
     table.add_column(Text("wall time [s]"), justify="right")
     for outcome in outcomes:
         word, style = VERDICTS[outcome.status]
-        if outcome.result is None:
+        if outcome.result is None or outcome.status is Status.ERROR:
             detail = Text(outcome.error or "", style="yellow")
-            sim = DASH
+            sim = DASH if outcome.result is None else format_value(_sim_time(outcome))
         else:
             detail = Text(", ".join(_failed_names(outcome)), style="red")
             sim = format_value(_sim_time(outcome))
