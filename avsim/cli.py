@@ -26,7 +26,7 @@ from rich.table import Table
 from avsim.files import write_atomic
 from avsim.run.interrupts import ExitAtOnce, Interrupts
 from avsim.run.result import dumps, headline, result_json
-from avsim.run.verdict import RunVerdict
+from avsim.run.verdict import RunError, RunVerdict
 from avsim.scenario.load import ScenarioError, bundled_scenarios, load_scenario
 from avsim.scenario.profile_fit import check_profile
 from avsim.scenario.schema import scenario_json_schema
@@ -127,8 +127,13 @@ def run(scenario: str, out: Path | None, json_path: Path | None, profile: str, s
     out.parent.mkdir(parents=True, exist_ok=True)
     partial = out.with_name(f".{out.name}.partial")
     with Interrupts() as stop:  # Ctrl-C / SIGTERM end the run at its tick, files kept
-        runner = Runner(loaded, partial, None if profile == "none" else Profile(profile),
-                        sensing)
+        try:
+            runner = Runner(loaded, partial, None if profile == "none" else Profile(profile),
+                            sensing)
+        except Exception as exc:  # the world cannot be built: a bug, exit 3, nothing kept
+            partial.unlink(missing_ok=True)
+            click.echo(f"avsim: {RunError.of(exc, 0.0).line()}", err=True)
+            sys.exit(EXIT_ERROR)
         stop.on_signal(runner.interrupt)
         result = _run_with_progress(runner, loaded.duration, not no_progress)
         partial.replace(out)

@@ -7,6 +7,7 @@ MARK when the moment comes, then waits (at most `WAIT`) until the test creates t
 - ``import``: while the run's heavy modules are imported (`avsim.run.runner`);
 - ``build``: while the world is built (`world.world.World`'s constructor);
 - ``after``: after the run's last tick, before its files are written (`Runner.run`);
+- ``world``: no waiting: building the world raises a RuntimeError;
 - ``planner``: no waiting: the planner's 30th update raises the ValueError the planner
   raises when the car does not head along the lane (MARK and GO unused).
 """
@@ -79,6 +80,19 @@ def install(hook: str, mark: Path, go: Path) -> None:
             return result
 
         wrap(Runner, "run", paused_end)
+    else:
+        install_fault(hook)
+
+
+def install_fault(hook: str) -> None:
+    """Install the `world` or `planner` hook (module doc)."""
+    if hook == "world":
+        from world.world import World
+
+        def broken_build(_call: Callable[[], Any], _self: Any) -> Any:
+            raise RuntimeError("the world cannot be built")
+
+        wrap(World, "__init__", broken_build)
     elif hook == "planner":
         from planner.planner import Planner
 

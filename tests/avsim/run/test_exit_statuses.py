@@ -101,6 +101,18 @@ def test_a_run_that_ends_in_error_exits_3_with_one_line_and_its_files(tmp_path: 
     assert sorted(p.name for p in out.parent.iterdir()) == ["nd.json", "nd.rrd"]
 
 
+def test_a_world_that_cannot_be_built_exits_3_with_one_line_and_nothing_kept(
+        tmp_path: Path) -> None:
+    out = tmp_path / "run" / "nd.rrd"
+    proc, _, _ = avsim(tmp_path, "world", *run_args(out))
+    _, stderr = proc.communicate(timeout=DEADLINE)
+    assert proc.returncode == EXIT_ERROR, stderr
+    assert "Traceback" not in stderr
+    assert stderr.strip().splitlines()[-1] == ("avsim: run ended in error at t = 0.000 s: "
+                                               "RuntimeError: the world cannot be built")
+    assert not out.parent.exists() or not list(out.parent.iterdir())
+
+
 @pytest.mark.parametrize(("sig", "status"), [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
 def test_a_signal_during_the_imports_exits_at_once_and_writes_nothing(
         tmp_path: Path, sig: signal.Signals, status: int) -> None:
