@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -46,7 +46,7 @@ from avsim.scenario.openscenario.model import (
     TeleportAction,
     Vehicle,
 )
-from avsim.scenario.openscenario.parse import load_openscenario
+from avsim.scenario.openscenario.parse import load_openscenario, scenario_roots
 from avsim.scenario.openscenario.program import StoryProgram
 from avsim.scenario.openscenario.resolve import Pose, PositionError, Resolver
 from avsim.scenario.openscenario.sidecar import load_sidecar, sidecar_path, split_overrides
@@ -75,14 +75,16 @@ class _Placed:
 
 
 def load_xosc(path: Path, overrides: Mapping[str, object] | None = None,
-              criteria_file: Path | None = None) -> Scenario:
+              criteria_file: Path | None = None, search_paths: Sequence[Path] = ()) -> Scenario:
     """The scenario of the OpenSCENARIO file `path` (module doc) with `overrides` (the
     file's `parameters.NAME`, the sidecar's keys) and the sidecar `criteria_file` (None:
-    `NAME.criteria.yaml` beside it if there is one); `ScenarioError` (one line) for
-    anything it cannot run."""
+    `NAME.criteria.yaml` beside it if there is one), its road and catalogs found in its
+    folder tree or `search_paths` (`references`); `ScenarioError` (one line) for anything
+    it cannot run."""
     params, rest = split_overrides(overrides or {})
-    side = load_sidecar(sidecar_path(path, criteria_file), rest)
-    osc = load_openscenario(path, params)
+    roots = scenario_roots(path, search_paths)
+    side = load_sidecar(sidecar_path(path, criteria_file, roots), rest)
+    osc = load_openscenario(path, params, search_paths)
     if osc.road_network is None:
         raise ScenarioError(str(path), "RoadNetwork", "no OpenDRIVE LogicFile: avsim needs "
                             "the road")
