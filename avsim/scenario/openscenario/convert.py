@@ -30,7 +30,8 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-from avsim.scenario.errors import ScenarioError
+from avsim.scenario.checks import check_spawn
+from avsim.scenario.errors import LocatedError, ScenarioError
 from avsim.scenario.openscenario.actions import engages
 from avsim.scenario.openscenario.model import (
     AbsoluteTargetSpeed,
@@ -107,10 +108,25 @@ def load_xosc(path: Path, overrides: Mapping[str, object] | None = None,
         init_commands=tuple(deferred))
     world = spec.WorldSpec(road=route.spec, ego=ego_spec, actors=actors, seed=side.seed,
                            sensors=side.sensors, scenery_roads=route.scenery)
+    _check_spawn(path, world, ego.name, [e.name for e in others])
     return Scenario(name=_name(path), description=osc.description, situation="openscenario",
                     duration=side.duration, world=world,
                     driver=DriverSettings(set_speed=ego_spec.speed), criteria=side.criteria,
                     story=program)
+
+
+def _check_spawn(path: Path, world: spec.WorldSpec, ego: str, others: list[str]) -> None:
+    """No two bodies overlap at t = 0, by the YAML format's rule (`checks.check_spawn`: boxes
+    along the lane, the ego's avsim body), refused at the later entity by its name."""
+    try:
+        check_spawn(world)
+    except LocatedError as e:
+        names = {f"actors.{k} ({world.actors[k].id})": name for k, name in enumerate(others)}
+        names["the ego"] = f"the ego ({ego})"
+        problem = re.sub(r"actors\.\d+ \([^)]*\)|the ego", lambda m: names[m.group(0)],
+                         e.problem)
+        entity = others[int(e.key.split(".")[1])]
+        raise ScenarioError(str(path), f"Entities.{entity}", problem) from None
 
 
 def _name(path: Path) -> str:

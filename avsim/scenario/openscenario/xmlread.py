@@ -17,6 +17,7 @@ from world.core.safe_xml import Refusal, XmlMalformedError, XmlRefusedError, par
 
 MAX_FILE_BYTES = 20 * 1024 * 1024  # the largest file read [bytes]
 MAX_ELEMENTS = 200_000  # the most elements a file may hold
+MAX_PATH_NAME = 40  # [characters] of a `name` shown in an element's path
 
 
 class Node:
@@ -41,6 +42,8 @@ class Node:
         node: Node | None = self
         while node is not None:
             name = node.attrs.get("name")
+            if name is not None and len(name) > MAX_PATH_NAME:  # a message stays one short line
+                name = name[: MAX_PATH_NAME - 3] + "..."
             parts.append(f"{node.tag}[{name}]" if name is not None else node.tag)
             node = node.parent
         return "/" + "/".join(reversed(parts))
