@@ -61,7 +61,7 @@ class _CountingText(str):
 
     copied = 0
 
-    def __getitem__(self, key: object) -> str:  # type: ignore[override]
+    def __getitem__(self, key: object) -> str:
         piece = str.__getitem__(self, key)  # type: ignore[index]
         _CountingText.copied += len(piece)
         return piece
