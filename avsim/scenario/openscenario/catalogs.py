@@ -21,7 +21,7 @@ from avsim.scenario.openscenario.parameters import (
     evaluate_declarations,
     parse_declarations,
 )
-from avsim.scenario.openscenario.references import ReferenceError, Roots
+from avsim.scenario.openscenario.references import ReferenceError, Roots, is_dir
 from avsim.scenario.openscenario.xmlread import MAX_FILE_BYTES, Node, read_xml_sized
 
 CATALOG_LOCATIONS: tuple[str, ...] = (
@@ -108,7 +108,8 @@ class Catalogs:
                 )
             assignments[param] = attrs.text(assignment, "value")
         scope = evaluate_declarations(
-            declarations, None, assignments, file=entry.file, overrides_from="assignment"
+            declarations, None, assignments, file=entry.file, overrides_from="assignment",
+            budget=attrs.scope.budget,
         )
         return CatalogEntry(catalog, name, entry, scope)
 
@@ -119,7 +120,7 @@ def _directory(node: Node, roots: Roots, attrs: Attributes) -> Path:
         directory = roots.find(attrs.text(node, "path"))
     except ReferenceError as exc:
         raise node.error(f"path: {exc}") from None
-    if not directory.is_dir():
+    if not is_dir(directory):
         raise node.error(f"catalog directory not found: {directory}")
     return directory
 

@@ -50,6 +50,7 @@ _INT = re.compile(r"[+-]?\d+")
 _DOUBLE = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|[+-]?INF|NaN")
 _NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 MAX_INT_DIGITS = 20  # the longest integer literal read [digits] (2**63 has 19)
+MAX_EXPRESSION_CHARS = 500_000  # [characters] of `${...}` evaluated by one load, in all
 MAX_SHOWN = 40  # [characters] of a bad value quoted in a message
 _INT_RANGE: Mapping[str, tuple[int, int]] = {
     "unsignedInt": (0, 2**32 - 1),
@@ -79,14 +80,36 @@ class ParameterInfo:
     line: int  # where it is declared
 
 
+class Budget:
+    """The expression text one load may evaluate, in all [characters]: each `${...}` spends
+    its length (a catalog entry's expressions again at every reference), so that a file of
+    many long expressions cannot make a load take minutes."""
+
+    __slots__ = ("left",)
+
+    def __init__(self, left: int = MAX_EXPRESSION_CHARS) -> None:
+        self.left = left
+
+    def spend(self, chars: int) -> None:
+        """Takes `chars` from the budget; `ResolveError` once it is spent."""
+        self.left -= chars
+        if self.left < 0:
+            raise ResolveError(f"the file's expressions add up to over {MAX_EXPRESSION_CHARS} "
+                               f"characters evaluated (at most {MAX_EXPRESSION_CHARS})")
+
+
 class Scope:
-    """Parameter values by name, with the enclosing scope's as fallback."""
+    """Parameter values by name, with the enclosing scope's as fallback; the expression
+    budget of the load (shared with the enclosing scope's)."""
 
-    __slots__ = ("parent", "values")
+    __slots__ = ("budget", "parent", "values")
 
-    def __init__(self, values: dict[str, ParamValue], parent: Scope | None = None) -> None:
+    def __init__(self, values: dict[str, ParamValue], parent: Scope | None = None,
+                 budget: Budget | None = None) -> None:
         self.values = values
         self.parent = parent
+        inherited: Budget | None = parent.budget if parent is not None else None
+        self.budget: Budget = budget or inherited or Budget()
 
     def get(self, name: str) -> ParamValue | None:
         scope: Scope | None = self
@@ -124,6 +147,7 @@ def resolve(raw: str, scope: Scope) -> ParamValue:
     """The value of an attribute as written: `${expr}` evaluated, `$name` looked up, else
     the text itself; `ResolveError` for an unresolved reference or a bad expression."""
     if raw.startswith("${"):
+        scope.budget.spend(len(raw))
         if not raw.endswith("}"):
             raise ResolveError(f"expression {brief(raw)} lacks its closing brace")
         try:
@@ -310,10 +334,12 @@ def evaluate_declarations(
     *,
     file: str,
     overrides_from: str = "override",
+    budget: Budget | None = None,
 ) -> Scope:
     """The scope of the parameters declared under `node` (a ParameterDeclarations element),
     each value `overrides[name]` if given, else its declared default; references resolve in
-    this scope (earlier parameters) then in `parent`. Checks types and constraints; raises
+    this scope (earlier parameters) then in `parent`; expressions spend `budget` (None: the
+    parent's, or a new one). Checks types and constraints; raises
     `ScenarioError` for an unknown override name, a badly typed value or a broken constraint.
     """
     infos = parse_declarations(node)
@@ -323,7 +349,7 @@ def evaluate_declarations(
             listing = ", ".join(sorted(known)) or "none"
             problem = f"unknown parameter {name}; declared: {listing}"
             raise ScenarioError(file, f"({overrides_from}s)", problem)
-    scope = Scope({}, parent)
+    scope = Scope({}, parent, budget)
     assert node is not None or not infos
     decls = node.all("ParameterDeclaration") if node is not None else []
     for info, decl in zip(infos, decls, strict=True):

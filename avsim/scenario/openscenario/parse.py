@@ -22,7 +22,7 @@ from avsim.scenario.openscenario.parameters import (
 )
 from avsim.scenario.openscenario.parse_entities import parse_entities
 from avsim.scenario.openscenario.parse_storyboard import parse_storyboard
-from avsim.scenario.openscenario.references import ReferenceError, Roots
+from avsim.scenario.openscenario.references import ReferenceError, Roots, is_file
 from avsim.scenario.openscenario.xmlread import Node, read_xml
 
 SUPPORTED_MINOR = (0, 1, 2)  # OpenSCENARIO 1.0, 1.1, 1.2
@@ -74,7 +74,7 @@ def _road_network(root: Node, roots: Roots, attrs: Attributes) -> Path | None:
         road = roots.find(attrs.text(logic, "filepath"))
     except ReferenceError as exc:
         raise logic.error(f"filepath: {exc}") from None
-    if not road.is_file():
+    if not is_file(road):
         raise logic.error(f"road network file not found: {road}")
     return road
 

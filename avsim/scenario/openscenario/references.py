@@ -27,14 +27,33 @@ def _real(path: Path) -> Path:
     """`path` with every symlink resolved (missing parts kept as written)."""
     try:
         return path.resolve()
-    except (RuntimeError, OSError):  # a symlink loop (RuntimeError before Python 3.13)
+    except RuntimeError:  # a symlink loop (an OSError from Python 3.13)
         raise ReferenceError(f"a symlink loop: {path}") from None
+    except OSError as exc:
+        raise ReferenceError(f"cannot resolve {path} ({exc.strerror})") from None
 
 
 def _exists(path: Path) -> bool:
     try:
         return path.exists()
     except OSError:  # a name too long for the file system, ...
+        return False
+
+
+def is_file(path: Path) -> bool:
+    """Whether `path` is a file (False where the file system refuses to look: a name too
+    long, ...)."""
+    try:
+        return path.is_file()
+    except OSError:
+        return False
+
+
+def is_dir(path: Path) -> bool:
+    """Whether `path` is a directory (False where the file system refuses to look)."""
+    try:
+        return path.is_dir()
+    except OSError:
         return False
 
 

@@ -163,3 +163,8 @@ def test_the_cli_refuses_a_road_outside_in_one_line(tree: Path, tmp_path: Path,
     assert proc.stderr.startswith(f"avsim: error: {path}: line ")
     assert "RoadNetwork/LogicFile: filepath: /etc/passwd is outside" in proc.stderr
     assert proc.stdout == "" and list(work.iterdir()) == []
+
+
+def test_a_road_name_too_long_for_the_file_system_is_one_line(tree: Path) -> None:
+    message = _refusal(_edit(tree, ROAD, 'filepath="' + "x" * 999 + '"'))
+    assert "RoadNetwork/LogicFile: road network file not found" in message

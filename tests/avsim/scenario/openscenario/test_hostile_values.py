@@ -22,6 +22,7 @@ from avsim.scenario.openscenario.expressions import (
     tokenize,
 )
 from avsim.scenario.openscenario.limits import MAX_NAME_CHARS
+from avsim.scenario.openscenario.parameters import MAX_EXPRESSION_CHARS
 
 ALKS = Path(__file__).parents[3] / "data" / "alks" / "logical_scenarios" / "concrete_scenarios"
 CUT_IN = "alks_scenario_4_4_1_cut_in_no_collision_template.xosc"
@@ -183,3 +184,15 @@ def test_an_entity_placed_on_the_ego_is_refused_by_name(tree: Path) -> None:
     message = _refused(tree, 'dLane="$CutInVehicle_InitPosition_RelativeLaneId" ds="${$Cut',
                        'dLane="0" ds="1" x="${$Cut')  # 1 m ahead of the ego, in its lane
     assert message.startswith(f"{tree / CUT_IN}: Entities.CutInVehicle: overlaps the ego (Ego)")
+
+
+def test_the_expressions_of_one_load_are_bounded_in_all(tree: Path) -> None:
+    """Many long expressions, each within MAX_LENGTH: the load stops once it has evaluated
+    MAX_EXPRESSION_CHARS of them (not minutes of work)."""
+    one = "${" + "+".join(["1"] * 4000) + "}"  # 8,001 characters
+    count = MAX_EXPRESSION_CHARS // len(one) + 1
+    many = "".join(f'<ParameterDeclaration name="P{k}" parameterType="double" value="{one}"/>'
+                   for k in range(count))
+    message = _refused(tree, "<ParameterDeclarations>", "<ParameterDeclarations>" + many)
+    assert f"ParameterDeclaration[P{count - 1}]: " in message
+    assert f"over {MAX_EXPRESSION_CHARS} characters evaluated" in message
