@@ -66,6 +66,12 @@ def main(ctx: click.Context) -> None:
     ctx.with_resource(ExitAtOnce())  # a signal while a command starts: exit 130 / 143
 
 
+search_path_option = click.option(
+    "--search-path", "search_paths", type=click.Path(path_type=Path), multiple=True,
+    metavar="DIR", help="A folder an OpenSCENARIO file's road, catalogs and sidecar may be "
+    "in, besides the file's own folder tree (repeatable; tried in order).")
+
+
 @main.command()
 @click.argument("scenario")
 @click.option("--out", "out", type=click.Path(path_type=Path), default=None,
@@ -91,9 +97,10 @@ def main(ctx: click.Context) -> None:
 @click.option("--criteria", "criteria", type=click.Path(path_type=Path), default=None,
               help="An OpenSCENARIO file's criteria (default: NAME.criteria.yaml beside it).")
 @click.option("--no-progress", is_flag=True, help="No progress bar.")
+@search_path_option
 def run(scenario: str, out: Path | None, json_path: Path | None, profile: str, sensing: str,
         seed: int | None, sets: tuple[str, ...], plot: str | None, params: tuple[str, ...],
-        criteria: Path | None, no_progress: bool) -> None:
+        criteria: Path | None, no_progress: bool, search_paths: tuple[Path, ...]) -> None:
     """Run SCENARIO (a YAML or OpenSCENARIO file, or a bundled name) and judge it."""
     from avsim.batch.sweep import SweepError, parse_set
 
@@ -106,7 +113,7 @@ def run(scenario: str, out: Path | None, json_path: Path | None, profile: str, s
             overrides[axis.path] = axis.values[0]
         if seed is not None:
             overrides["seed"] = seed
-        loaded = load_scenario(scenario, overrides, criteria)
+        loaded = load_scenario(scenario, overrides, criteria, search_paths)
         check_profile(loaded, profile, scenario)
     except (ScenarioError, SweepError) as exc:
         _bad_input(str(exc))
@@ -267,16 +274,18 @@ def batch_options(f: Callable[..., None]) -> Callable[..., None]:
 @click.option("--out", "out", type=click.Path(path_type=Path), default=Path("runs/suite"),
               show_default=True, help="Folder for the runs' files and the reports.")
 @batch_options
+@search_path_option
 def suite(paths: tuple[str, ...], out: Path, jobs: int | None, executor: str,
-          address: str | None, profile: str, snapshots: bool) -> None:
+          address: str | None, profile: str, snapshots: bool,
+          search_paths: tuple[Path, ...]) -> None:
     """Run scenarios in parallel: files, folders or bundled names (default: every bundled
     scenario). Writes each run's .rrd, .json and .png, junit.xml, summary.md."""
     from avsim.batch import suite as batch
 
     try:
         batch.validate_out_dir(out)
-        entries = batch.suite_entries(batch.collect_scenarios(paths))
-        planned = batch.plan(entries, out, profile)
+        entries = batch.suite_entries(batch.collect_scenarios(paths), search_paths)
+        planned = batch.plan(entries, out, profile, search_paths)
     except (ScenarioError, batch.BatchError) as exc:
         _bad_input(str(exc))
     with Interrupts() as stop:  # Ctrl-C / SIGTERM: finished runs and reports are kept
@@ -297,9 +306,10 @@ def suite(paths: tuple[str, ...], out: Path, jobs: int | None, executor: str,
 @click.option("--metric", default="min_gap", show_default=True,
               help="The heat map's metric (a metric or a criterion of the result).")
 @batch_options
+@search_path_option
 def sweep(scenario: str, sets: tuple[str, ...], params: tuple[str, ...], out: Path | None,
           metric: str, jobs: int | None, executor: str, address: str | None, profile: str,
-          snapshots: bool) -> None:
+          snapshots: bool, search_paths: tuple[Path, ...]) -> None:
     """Run SCENARIO over the grid of --set values (default: the file's own `grid`), like a
     suite; write sweep.csv, sweep.md and, over two swept keys, heatmap.png of --metric."""
     from avsim.batch import suite as batch
@@ -307,7 +317,7 @@ def sweep(scenario: str, sets: tuple[str, ...], params: tuple[str, ...], out: Pa
 
     try:
         axes = [parse_set(s) for s in sets + tuple(PARAMETER_PREFIX + p for p in params)]
-        loaded = load_scenario(scenario)
+        loaded = load_scenario(scenario, search_paths=search_paths)
         axes = axes or [Axis(path, values) for path, values in loaded.grid]
         if not axes:
             raise SweepError("give at least one --set or --param to sweep (the file has "
@@ -317,7 +327,7 @@ def sweep(scenario: str, sets: tuple[str, ...], params: tuple[str, ...], out: Pa
         out = out if out is not None else Path("runs") / f"sweep_{name}"
         batch.validate_out_dir(out)
         entries = [(f"{name}_{k:03d}", scenario, overrides) for k, overrides in enumerate(runs)]
-        planned = batch.plan(entries, out, profile)
+        planned = batch.plan(entries, out, profile, search_paths)
     except (ScenarioError, SweepError, batch.BatchError) as exc:
         _bad_input(str(exc))
     with Interrupts() as stop:  # Ctrl-C / SIGTERM: finished runs and reports are kept
@@ -378,7 +388,8 @@ def _sweep_report(outcomes: Sequence[RunOutcome], out: Path, swept: list[str],
 @click.argument("file", type=click.Path(path_type=Path))
 @click.option("--criteria", "criteria", type=click.Path(path_type=Path), default=None,
               help="The file's criteria (default: NAME.criteria.yaml beside it).")
-def convert_command(file: Path, criteria: Path | None) -> None:
+@search_path_option
+def convert_command(file: Path, criteria: Path | None, search_paths: tuple[Path, ...]) -> None:
     """Print the avsim/1 YAML of an OpenSCENARIO FILE where it fits that format; what does
     not fit is listed at its top (and counted on stderr)."""
     import yaml
@@ -388,7 +399,7 @@ def convert_command(file: Path, criteria: Path | None) -> None:
     if file.suffix != ".xosc":
         _bad_input(f"{file}: (file): convert takes an OpenSCENARIO file (.xosc)")
     try:
-        conversion = convert_xosc(file, criteria)
+        conversion = convert_xosc(file, criteria, search_paths)
     except ScenarioError as exc:
         _bad_input(str(exc))
     head = [f"# avsim/1, converted from {file}"]

@@ -80,6 +80,24 @@ def huge_yaml(folder: Path) -> Path:
     return path
 
 
+def expression_flood(alks: Path) -> Path:
+    """An ALKS file whose parameters are as many expressions of `MAX_LENGTH` characters as
+    one load may evaluate (`MAX_EXPRESSION_CHARS`), and one more: the worst expression work
+    a file can ask for, refused at the budget."""
+    from avsim.scenario.openscenario.expressions import MAX_LENGTH
+    from avsim.scenario.openscenario.parameters import MAX_EXPRESSION_CHARS
+
+    one = "${" + "+".join(["(-$A*2)"] * (MAX_LENGTH // 8)) + "}"
+    decls = [f'<ParameterDeclaration name="P{k}" parameterType="double" value="{one}"/>'
+             for k in range(MAX_EXPRESSION_CHARS // len(one) + 1)]
+    text = (ALKS / XOSC).read_text(encoding="utf-8-sig").replace(
+        "<ParameterDeclarations>", '<ParameterDeclarations><ParameterDeclaration name="A" '
+        'parameterType="double" value="1.5"/>' + "".join(decls), 1)
+    path = alks / "expressions.xosc"
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=3)
@@ -96,7 +114,9 @@ def main() -> None:
         flood(ALKS / ROAD, alks / ROAD, MAX_XODR_ELEMENTS, MAX_XODR_BYTES)
         figures["xodr_past_element_bound_s"], xodr = best_load(alks / XOSC, args.repeat)
         figures["yaml_huge_entries_s"], yml = best_load(huge_yaml(Path(tmp)), args.repeat)
-    for (key, value), outcome in zip(figures.items(), (xosc, xodr, yml), strict=True):
+        figures["xosc_expression_budget_s"], expr = best_load(expression_flood(alks),
+                                                             args.repeat)
+    for (key, value), outcome in zip(figures.items(), (xosc, xodr, yml, expr), strict=True):
         print(f"  {key:<28} {value:6.2f} s  {outcome[:60]}")
     if args.json:
         args.json.write_text(json.dumps(figures, indent=2) + "\n")

@@ -59,14 +59,16 @@ def collect_scenarios(args: Sequence[str]) -> list[str]:
     return found
 
 
-def suite_entries(scenarios: Sequence[str]) -> list[tuple[str | None, str, dict[str, object]]]:
+def suite_entries(scenarios: Sequence[str], search_paths: Sequence[Path] = (),
+                  ) -> list[tuple[str | None, str, dict[str, object]]]:
     """The runs of a suite over `scenarios` (`plan`'s entries): one per scenario, or one per
-    point of its file's `grid` (named ``<name>_<k:03d>``, as a sweep names its runs)."""
+    point of its file's `grid` (named ``<name>_<k:03d>``, as a sweep names its runs);
+    `search_paths` as `load_scenario` takes them."""
     from avsim.batch.sweep import Axis, grid
 
     entries: list[tuple[str | None, str, dict[str, object]]] = []
     for scenario in scenarios:
-        loaded = load_scenario(scenario)
+        loaded = load_scenario(scenario, search_paths=search_paths)
         if not loaded.grid:
             entries.append((None, scenario, {}))
             continue
@@ -90,14 +92,14 @@ def overrides_of(point: Mapping[str, object]) -> dict[str, object]:
 
 
 def plan(entries: Sequence[tuple[str | None, str, Mapping[str, object]]], out_dir: Path,
-         profile: str) -> list[RunJob]:
+         profile: str, search_paths: Sequence[Path] = ()) -> list[RunJob]:
     """Validate each (job name or None for the scenario's own, scenario, overrides) and make
-    its job. Raises `ScenarioError` for the first bad one, `BatchError` for two runs that
-    would write the same files."""
+    its job, which carries `search_paths` to its worker. Raises `ScenarioError` for the
+    first bad one, `BatchError` for two runs that would write the same files."""
     planned: list[RunJob] = []
     names: dict[str, str] = {}
     for name, scenario, overrides in entries:
-        loaded = load_scenario(scenario, dict(overrides))
+        loaded = load_scenario(scenario, dict(overrides), search_paths=search_paths)
         check_profile(loaded, profile, scenario)
         job_name = name or loaded.name
         if job_name in names:
@@ -105,7 +107,7 @@ def plan(entries: Sequence[tuple[str | None, str, Mapping[str, object]]], out_di
                              f"{names[job_name]} (their files would collide in {out_dir})")
         names[job_name] = scenario
         planned.append(RunJob(job_name, scenario, out_dir, dict(overrides), profile,
-                              duration=loaded.duration))
+                              duration=loaded.duration, search_paths=tuple(search_paths)))
     return planned
 
 

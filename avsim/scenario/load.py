@@ -19,7 +19,7 @@ stations on the route, `after` indices, arc radii, actor ids; `checks`) and conv
 
 from __future__ import annotations
 
-from collections.abc import Iterator, Mapping
+from collections.abc import Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -49,7 +49,7 @@ UNSUPPORTED: dict[str, str] = {
 
 def load_scenario(
     path_or_name: str | Path, overrides: Mapping[str, object] | None = None,
-    criteria_file: Path | None = None,
+    criteria_file: Path | None = None, search_paths: Sequence[Path] = (),
 ) -> Scenario:
     """Load, validate and convert a scenario file.
 
@@ -59,7 +59,9 @@ def load_scenario(
     used as given (parse command-line text with `avsim.scenario.files.parse_value` first).
 
     An OpenSCENARIO file (`.xosc`) loads with its sidecar (`criteria_file`, else
-    `NAME.criteria.yaml` beside it): `avsim.scenario.openscenario.convert.load_xosc`.
+    `NAME.criteria.yaml` beside it): `avsim.scenario.openscenario.convert.load_xosc`. Its
+    references (road, catalogs, sidecar) must resolve inside its own folder tree or one of
+    `search_paths` (`avsim run --search-path DIR`); a YAML file references none.
 
     Raises `ScenarioError` with a one-line message `<file>: <key.path>: <problem>`.
     """
@@ -67,7 +69,7 @@ def load_scenario(
     if path.suffix == ".xosc":
         from avsim.scenario.openscenario.convert import load_xosc
 
-        return load_xosc(path, overrides, criteria_file)
+        return load_xosc(path, overrides, criteria_file, search_paths)
     if criteria_file is not None:
         raise ScenarioError(str(path_or_name), FILE_KEY, "--criteria is for OpenSCENARIO "
                             "files (a YAML scenario has its own criteria: section)")

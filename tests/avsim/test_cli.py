@@ -139,13 +139,14 @@ def _openscenario_inputs(directory: Path) -> dict[str, Case]:
     for name, (content, key) in bad.items():
         path = directory / f"{name}.xosc"
         path.write_text(content, encoding="utf-8")
-        cases[name] = Case(_run_args(str(path)), str(path), key)
+        cases[name] = Case((*_run_args(str(path)), "--search-path", str(ALKS)), str(path), key)
     junction = HERE.parent / "world" / "map" / "opendrive" / "data" / "junction.xodr"
     path = directory / "xosc_road_with_junction.xosc"
     path.write_text(text.replace(f"{ALKS}/road_networks/alks_road_straight.xodr",
                                  str(junction)), encoding="utf-8")
-    cases["xosc_road_with_junction"] = Case(_run_args(str(path)), str(junction),
-                                            "not supported yet (junctions)")
+    cases["xosc_road_with_junction"] = Case(
+        (*_run_args(str(path)), "--search-path", str(ALKS), "--search-path",
+         str(junction.parent)), str(junction), "not supported yet (junctions)")
     return cases
 
 

@@ -6,11 +6,13 @@ from __future__ import annotations
 from collections.abc import Collection
 from dataclasses import dataclass
 
-from avsim.scenario.errors import ScenarioError
+from avsim.scenario.errors import ScenarioError, fmt
+from avsim.scenario.openscenario.limits import MAX_NAME_CHARS
 from avsim.scenario.openscenario.parameters import (
     ParamValue,
     ResolveError,
     Scope,
+    brief,
     resolve,
     to_bool,
     to_float,
@@ -23,6 +25,12 @@ from avsim.scenario.openscenario.xmlread import Node
 def unsupported(node: Node) -> ScenarioError:
     """The error for an element this reader does not handle yet."""
     return node.error(f"not supported yet ({node.tag})")
+
+
+def _within(node: Node, name: str, value: float, low: float, high: float, unit: str) -> float:
+    if not low <= value <= high:
+        raise node.error(f"{name}: must be in [{fmt(low)}, {fmt(high)}] {unit}, got {fmt(value)}")
+    return value
 
 
 @dataclass(frozen=True, slots=True)
@@ -47,7 +55,12 @@ class Attributes:
         return value
 
     def text(self, node: Node, name: str) -> str:
-        return to_str(self._need(node, name))
+        """An attribute as text; a `name` (of an entity, a storyboard element, a catalog
+        entry, ...) at most MAX_NAME_CHARS long."""
+        value = to_str(self._need(node, name))
+        if name == "name" and len(value) > MAX_NAME_CHARS:
+            raise node.error(f"name: {len(value)} characters: at most {MAX_NAME_CHARS}")
+        return value
 
     def opt_text(self, node: Node, name: str) -> str | None:
         value = self.value(node, name)
@@ -67,6 +80,16 @@ class Attributes:
             return to_float(value)
         except ResolveError as exc:
             raise node.error(f"{name}: {exc}") from None
+
+    def bounded(self, node: Node, name: str, low: float, high: float, unit: str) -> float:
+        """A number in [low, high] (`unit` for the message); an error outside."""
+        return _within(node, name, self.number(node, name), low, high, unit)
+
+    def opt_bounded(self, node: Node, name: str, low: float, high: float,
+                    unit: str) -> float | None:
+        """An optional number in [low, high]; None when the attribute is absent."""
+        value = self.opt_number(node, name)
+        return None if value is None else _within(node, name, value, low, high, unit)
 
     def number_or(self, node: Node, name: str, default: float) -> float:
         value = self.opt_number(node, name, default)
@@ -102,7 +125,7 @@ class Attributes:
     def choice(self, node: Node, name: str, allowed: Collection[str]) -> str:
         text = self.text(node, name)
         if text not in allowed:
-            raise node.error(f"{name}: {text!r} is not one of {', '.join(allowed)}")
+            raise node.error(f"{name}: {brief(text)} is not one of {', '.join(allowed)}")
         return text
 
     def choice_or(self, node: Node, name: str, allowed: Collection[str], default: str) -> str:

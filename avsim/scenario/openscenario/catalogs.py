@@ -1,5 +1,6 @@
-"""Catalogs: CatalogLocations (directories relative to the scenario file's folder), the
-catalog files in them, and CatalogReference resolution with ParameterAssignments.
+"""Catalogs: CatalogLocations (directories relative to the scenario file's folder, or a
+search path: `references`), the catalog files in them (bounded in number and bytes), and
+CatalogReference resolution with ParameterAssignments.
 
 Every `.xosc` file in a location's directory is read; each holds one `<Catalog name=...>`
 whose children are its entries. A reference names a catalog and an entry; the entry's own
@@ -13,13 +14,15 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
+from avsim.scenario.errors import ScenarioError
 from avsim.scenario.openscenario.attributes import Attributes
 from avsim.scenario.openscenario.parameters import (
     Scope,
     evaluate_declarations,
     parse_declarations,
 )
-from avsim.scenario.openscenario.xmlread import Node, read_xml
+from avsim.scenario.openscenario.references import ReferenceError, Roots, is_dir
+from avsim.scenario.openscenario.xmlread import MAX_FILE_BYTES, Node, read_xml_sized
 
 CATALOG_LOCATIONS: tuple[str, ...] = (
     "VehicleCatalog",
@@ -32,6 +35,8 @@ CATALOG_LOCATIONS: tuple[str, ...] = (
     "RouteCatalog",
     "SensorCatalog",
 )  # all accepted and read; entries are used by kind (Vehicle, Controller, ...)
+MAX_CATALOG_FILES = 100  # the most catalog files a scenario's CatalogLocations may hold
+MAX_CATALOG_BYTES = MAX_FILE_BYTES  # [bytes] their sizes added up
 
 
 @dataclass(frozen=True, slots=True)
@@ -51,24 +56,26 @@ class Catalogs:
         self.entries = entries
 
     @classmethod
-    def load(cls, locations: Node | None, base_dir: Path, attrs: Attributes) -> Catalogs:
-        """Reads every catalog file under the CatalogLocations element `locations`."""
+    def load(cls, locations: Node | None, roots: Roots, attrs: Attributes) -> Catalogs:
+        """Reads every catalog file under the CatalogLocations element `locations`, each
+        directory found in the scenario's folder tree or a search path (`roots`)."""
         entries: dict[str, dict[str, Node]] = {}
         if locations is None:
             return cls(entries)
+        files: list[Path] = []
         read: set[Path] = set()  # a directory may serve several kinds; read it once
         for loc in locations.children:
             if loc.tag not in CATALOG_LOCATIONS:
                 raise loc.error(f"not supported yet ({loc.tag})")
             directory_node = loc.need("Directory")
-            directory = (base_dir / attrs.text(directory_node, "path")).resolve()
-            if not directory.is_dir():
-                raise directory_node.error(f"catalog directory not found: {directory}")
+            directory = _directory(directory_node, roots, attrs)
             if directory in read:
                 continue
             read.add(directory)
-            for file in sorted(directory.glob("*.xosc")):
-                _read_catalog_file(file, entries)
+            files += _catalog_files(directory, directory_node, len(files))
+        budget = MAX_CATALOG_BYTES
+        for file in files:
+            budget -= _read_catalog_file(file, roots, entries, budget)
         return cls(entries)
 
     def resolve(self, ref: Node, attrs: Attributes, kinds: tuple[str, ...]) -> CatalogEntry:
@@ -101,13 +108,51 @@ class Catalogs:
                 )
             assignments[param] = attrs.text(assignment, "value")
         scope = evaluate_declarations(
-            declarations, None, assignments, file=entry.file, overrides_from="assignment"
+            declarations, None, assignments, file=entry.file, overrides_from="assignment",
+            budget=attrs.scope.budget,
         )
         return CatalogEntry(catalog, name, entry, scope)
 
 
-def _read_catalog_file(file: Path, entries: dict[str, dict[str, Node]]) -> None:
-    root = read_xml(file)
+def _directory(node: Node, roots: Roots, attrs: Attributes) -> Path:
+    """The catalog directory a Directory element names, resolved and checked."""
+    try:
+        directory = roots.find(attrs.text(node, "path"))
+    except ReferenceError as exc:
+        raise node.error(f"path: {exc}") from None
+    if not is_dir(directory):
+        raise node.error(f"catalog directory not found: {directory}")
+    return directory
+
+
+def _catalog_files(directory: Path, node: Node, before: int) -> list[Path]:
+    """The `.xosc` files of a catalog directory, sorted; at most MAX_CATALOG_FILES in all
+    (`before` already listed)."""
+    files: list[Path] = []
+    try:
+        for file in directory.iterdir():
+            if file.suffix != ".xosc":
+                continue
+            files.append(file)
+            if before + len(files) > MAX_CATALOG_FILES:
+                raise node.error(f"over {MAX_CATALOG_FILES} catalog files: at most "
+                                 f"{MAX_CATALOG_FILES}")
+    except OSError as exc:
+        raise node.error(f"cannot list the catalog directory ({exc.strerror})") from None
+    return sorted(files)
+
+
+def _read_catalog_file(file: Path, roots: Roots, entries: dict[str, dict[str, Node]],
+                       budget: int) -> int:
+    """Reads one catalog file (at most `budget` bytes) into `entries`; its size [bytes]."""
+    try:
+        roots.check(file)
+    except ReferenceError as exc:
+        raise ScenarioError(str(file), "(file)", str(exc)) from None
+    if budget <= 0:
+        raise ScenarioError(str(file), "(file)", f"the catalogs hold over {MAX_CATALOG_BYTES} "
+                            f"bytes: at most {MAX_CATALOG_BYTES}")
+    root, size = read_xml_sized(file, min(budget, MAX_FILE_BYTES))
     catalog = root.need("Catalog")
     catalog_name = catalog.attrs.get("name")
     if catalog_name is None:
@@ -120,3 +165,4 @@ def _read_catalog_file(file: Path, entries: dict[str, dict[str, Node]]) -> None:
         if entry_name in table:
             raise entry.error(f"entry {entry_name} is already in catalog {catalog_name}")
         table[entry_name] = entry
+    return size

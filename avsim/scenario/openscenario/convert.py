@@ -26,11 +26,12 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-from avsim.scenario.errors import ScenarioError
+from avsim.scenario.checks import check_spawn
+from avsim.scenario.errors import LocatedError, ScenarioError
 from avsim.scenario.openscenario.actions import engages
 from avsim.scenario.openscenario.model import (
     AbsoluteTargetSpeed,
@@ -46,7 +47,7 @@ from avsim.scenario.openscenario.model import (
     TeleportAction,
     Vehicle,
 )
-from avsim.scenario.openscenario.parse import load_openscenario
+from avsim.scenario.openscenario.parse import load_openscenario, scenario_roots
 from avsim.scenario.openscenario.program import StoryProgram
 from avsim.scenario.openscenario.resolve import Pose, PositionError, Resolver
 from avsim.scenario.openscenario.sidecar import load_sidecar, sidecar_path, split_overrides
@@ -75,14 +76,16 @@ class _Placed:
 
 
 def load_xosc(path: Path, overrides: Mapping[str, object] | None = None,
-              criteria_file: Path | None = None) -> Scenario:
+              criteria_file: Path | None = None, search_paths: Sequence[Path] = ()) -> Scenario:
     """The scenario of the OpenSCENARIO file `path` (module doc) with `overrides` (the
     file's `parameters.NAME`, the sidecar's keys) and the sidecar `criteria_file` (None:
-    `NAME.criteria.yaml` beside it if there is one); `ScenarioError` (one line) for
-    anything it cannot run."""
+    `NAME.criteria.yaml` beside it if there is one), its road and catalogs found in its
+    folder tree or `search_paths` (`references`); `ScenarioError` (one line) for anything
+    it cannot run."""
     params, rest = split_overrides(overrides or {})
-    side = load_sidecar(sidecar_path(path, criteria_file), rest)
-    osc = load_openscenario(path, params)
+    roots = scenario_roots(path, search_paths)
+    side = load_sidecar(sidecar_path(path, criteria_file, roots), rest)
+    osc = load_openscenario(path, params, search_paths)
     if osc.road_network is None:
         raise ScenarioError(str(path), "RoadNetwork", "no OpenDRIVE LogicFile: avsim needs "
                             "the road")
@@ -105,10 +108,25 @@ def load_xosc(path: Path, overrides: Mapping[str, object] | None = None,
         init_commands=tuple(deferred))
     world = spec.WorldSpec(road=route.spec, ego=ego_spec, actors=actors, seed=side.seed,
                            sensors=side.sensors, scenery_roads=route.scenery)
+    _check_spawn(path, world, ego.name, [e.name for e in others])
     return Scenario(name=_name(path), description=osc.description, situation="openscenario",
                     duration=side.duration, world=world,
                     driver=DriverSettings(set_speed=ego_spec.speed), criteria=side.criteria,
                     story=program)
+
+
+def _check_spawn(path: Path, world: spec.WorldSpec, ego: str, others: list[str]) -> None:
+    """No two bodies overlap at t = 0, by the YAML format's rule (`checks.check_spawn`: boxes
+    along the lane, the ego's avsim body), refused at the later entity by its name."""
+    try:
+        check_spawn(world)
+    except LocatedError as e:
+        names = {f"actors.{k} ({world.actors[k].id})": name for k, name in enumerate(others)}
+        names["the ego"] = f"the ego ({ego})"
+        problem = re.sub(r"actors\.\d+ \([^)]*\)|the ego", lambda m: names[m.group(0)],
+                         e.problem)
+        entity = others[int(e.key.split(".")[1])]
+        raise ScenarioError(str(path), f"Entities.{entity}", problem) from None
 
 
 def _name(path: Path) -> str:

@@ -15,6 +15,12 @@ Grammar (lowest precedence first)::
 
 Numbers are doubles; `and`/`or`/`not` take and give booleans; `%` is the remainder with
 the sign of the dividend (C's fmod), as the standard's reference implementations do.
+
+Every number, written or computed, must be finite: a literal like `1e999`, a product that
+overflows, a function whose argument is out of its domain is an `ExpressionError`. The
+work is linear in the text: its length is bounded (`MAX_LENGTH`) and its nesting checked
+on the tokens (`MAX_DEPTH`) before anything is evaluated; tokenizing scans each character
+once, and evaluating takes each token once.
 """
 
 from __future__ import annotations
@@ -29,6 +35,7 @@ Lookup = Callable[[str], Value]  # a parameter's value by name; raises Expressio
 
 
 MAX_DEPTH = 100  # deepest nesting of parentheses, unary minus and `not`
+MAX_LENGTH = 10_000  # [characters] the longest expression text (inside `${...}`)
 
 
 class ExpressionError(ValueError):
@@ -50,22 +57,71 @@ class Token:
     pos: int  # offset in the expression text
 
 
+_SPACE = re.compile(r"\s*")
+
+
 def tokenize(text: str) -> list[Token]:
-    """The tokens of an expression; `ExpressionError` at an unknown character."""
+    """The tokens of an expression; `ExpressionError` at an unknown character or for a text
+    over `MAX_LENGTH`. Each character is looked at a bounded number of times."""
+    if len(text) > MAX_LENGTH:
+        raise ExpressionError(f"{len(text)} characters long: at most {MAX_LENGTH}")
     tokens: list[Token] = []
-    pos = 0
+    pos = _space_end(text, 0)
     while pos < len(text):
-        if text[pos:].strip() == "":
-            break
         m = _TOKEN.match(text, pos)
         if m is None or m.lastgroup is None:
-            rest = text[pos:].lstrip()
-            at = len(text) - len(rest)
-            raise ExpressionError(f"unexpected character {rest[:1]!r} at {at}")
+            raise ExpressionError(f"unexpected character {text[pos]!r} at {pos}")
         tokens.append(Token(m.lastgroup, m.group(m.lastgroup), m.start(m.lastgroup)))
-        pos = m.end()
+        pos = _space_end(text, m.end())
     tokens.append(Token("end", "", len(text)))
     return tokens
+
+
+def _space_end(text: str, pos: int) -> int:
+    """The offset of the first non-space character at or after `pos`."""
+    found = _SPACE.match(text, pos)
+    assert found is not None  # `\s*` matches the empty string
+    return found.end()
+
+
+def check_nesting(tokens: list[Token]) -> None:
+    """`ExpressionError` when parentheses, unary minus or `not` nest over MAX_DEPTH, counted
+    on the tokens before evaluating, as the evaluator counts them: the expression itself
+    is one level, each open parenthesis one until it closes, and each unary operator one
+    until the value it applies to ends (with that value's parentheses)."""
+    depth = 1  # levels open now
+    pending = 0  # unary operators in a row, not yet applied to a value
+    opened: list[int] = []  # for each open parenthesis: the unary operators before it
+    previous_is_value = False  # a `-` after a value is binary
+    for tok in tokens:
+        if (tok.kind == "op" and tok.text == "-" and not previous_is_value) or (
+                tok.kind == "word" and tok.text == "not"):
+            pending += 1
+            depth += 1
+        elif tok.kind == "op" and tok.text == "(":
+            opened.append(pending)
+            depth += 1
+            pending = 0
+        elif tok.kind == "op" and tok.text == ")" and opened:
+            depth -= 1 + opened.pop()
+        elif tok.kind in ("num", "param") or tok.text in ("true", "false"):
+            depth -= pending
+            pending = 0
+        if depth > MAX_DEPTH:
+            raise ExpressionError(f"nested more than {MAX_DEPTH} deep")
+        previous_is_value = tok.kind in ("num", "param") or tok.text in (")", "true", "false")
+
+
+def _cut(text: str) -> str:
+    """A token's text as a message quotes it: at most 20 characters."""
+    return text if len(text) <= 20 else text[:17] + "..."
+
+
+def finite(value: float, what: str) -> float:
+    """`value` if finite, else `ExpressionError` ("<what>: result out of range")."""
+    if not math.isfinite(value):
+        raise ExpressionError(f"{what}: result out of range")
+    return value
 
 
 def _check_domain(name: str, ok: bool) -> None:
@@ -150,6 +206,7 @@ class _Evaluator:
 
     def __init__(self, text: str, lookup: Lookup) -> None:
         self.tokens = tokenize(text)
+        check_nesting(self.tokens)
         self.i = 0
         self.lookup = lookup
         self.depth = 0
@@ -171,7 +228,7 @@ class _Evaluator:
     def expect(self, text: str) -> None:
         tok = self.take()
         if tok.text != text:
-            found = repr(tok.text) if tok.kind != "end" else "the end"
+            found = repr(_cut(tok.text)) if tok.kind != "end" else "the end"
             raise ExpressionError(f"expected {text!r} at {tok.pos}, found {found}")
 
     def is_word(self, word: str) -> bool:
@@ -182,7 +239,7 @@ class _Evaluator:
         value = self.or_()
         tok = self.peek()
         if tok.kind != "end":
-            raise ExpressionError(f"unexpected {tok.text!r} at {tok.pos}")
+            raise ExpressionError(f"unexpected {_cut(tok.text)!r} at {tok.pos}")
         return value
 
     def or_(self) -> Value:
@@ -227,7 +284,7 @@ class _Evaluator:
             op = self.take().text
             right = _number(self.product(), op)
             left = _number(value, op)
-            value = left + right if op == "+" else left - right
+            value = finite(left + right if op == "+" else left - right, op)
         return value
 
     def product(self) -> Value:
@@ -237,11 +294,11 @@ class _Evaluator:
             right = _number(self.unary(), op)
             left = _number(value, op)
             if op == "*":
-                value = left * right
+                value = finite(left * right, op)
             elif right == 0:
                 raise ExpressionError("division by zero" if op == "/" else "modulo by zero")
             else:
-                value = left / right if op == "/" else math.fmod(left, right)
+                value = finite(left / right if op == "/" else math.fmod(left, right), op)
         return value
 
     def unary(self) -> Value:
@@ -257,9 +314,10 @@ class _Evaluator:
     def primary(self) -> Value:
         tok = self.take()
         if tok.kind == "num":
-            return float(tok.text)
+            return finite(float(tok.text), f"number {_cut(tok.text)} at {tok.pos}")
         if tok.kind == "param":
-            return self.lookup(tok.text[1:])
+            value = self.lookup(tok.text[1:])
+            return value if isinstance(value, bool) else finite(value, tok.text)
         if tok.kind == "op" and tok.text == "(":
             value = self.or_()
             self.expect(")")
@@ -269,8 +327,8 @@ class _Evaluator:
                 return tok.text == "true"
             if tok.text in FUNCTIONS:
                 return self.call(tok.text)
-            raise ExpressionError(f"unknown name {tok.text!r} at {tok.pos}")
-        found = repr(tok.text) if tok.kind != "end" else "the end"
+            raise ExpressionError(f"unknown name {_cut(tok.text)!r} at {tok.pos}")
+        found = repr(_cut(tok.text)) if tok.kind != "end" else "the end"
         raise ExpressionError(f"expected a value at {tok.pos}, found {found}")
 
     def call(self, name: str) -> float:
@@ -283,10 +341,11 @@ class _Evaluator:
         self.expect(")")
         if len(args) != arity:
             raise ExpressionError(f"{name} takes {arity} argument(s), got {len(args)}")
-        result = float(fn(*args))
-        if not math.isfinite(result):
-            raise ExpressionError(f"{name}: result out of range")
-        return result
+        try:
+            result = float(fn(*args))
+        except (ValueError, OverflowError):  # sin(inf), floor of a huge value, ...
+            raise ExpressionError(f"{name}: argument out of range") from None
+        return finite(result, name)
 
 
 def evaluate(text: str, lookup: Lookup) -> Value:

@@ -19,6 +19,7 @@ from typing import Literal
 
 from avsim.scenario.errors import ScenarioError, fmt
 from avsim.scenario.openscenario.expressions import ExpressionError, Value, evaluate
+from avsim.scenario.openscenario.limits import MAX_NAME_CHARS
 from avsim.scenario.openscenario.xmlread import Node
 
 ParamValue = int | float | bool | str  # a parameter's value (dateTime kept as its text)
@@ -48,6 +49,9 @@ RULES: tuple[str, ...] = (
 _INT = re.compile(r"[+-]?\d+")
 _DOUBLE = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|[+-]?INF|NaN")
 _NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+MAX_INT_DIGITS = 20  # the longest integer literal read [digits] (2**63 has 19)
+MAX_EXPRESSION_CHARS = 500_000  # [characters] of `${...}` evaluated by one load, in all
+MAX_SHOWN = 40  # [characters] of a bad value quoted in a message
 _INT_RANGE: Mapping[str, tuple[int, int]] = {
     "unsignedInt": (0, 2**32 - 1),
     "unsignedShort": (0, 2**16 - 1),
@@ -76,14 +80,36 @@ class ParameterInfo:
     line: int  # where it is declared
 
 
+class Budget:
+    """The expression text one load may evaluate, in all [characters]: each `${...}` spends
+    its length (a catalog entry's expressions again at every reference), so that a file of
+    many long expressions cannot make a load take minutes."""
+
+    __slots__ = ("left",)
+
+    def __init__(self, left: int = MAX_EXPRESSION_CHARS) -> None:
+        self.left = left
+
+    def spend(self, chars: int) -> None:
+        """Takes `chars` from the budget; `ResolveError` once it is spent."""
+        self.left -= chars
+        if self.left < 0:
+            raise ResolveError(f"the file's expressions add up to over {MAX_EXPRESSION_CHARS} "
+                               f"characters evaluated (at most {MAX_EXPRESSION_CHARS})")
+
+
 class Scope:
-    """Parameter values by name, with the enclosing scope's as fallback."""
+    """Parameter values by name, with the enclosing scope's as fallback; the expression
+    budget of the load (shared with the enclosing scope's)."""
 
-    __slots__ = ("parent", "values")
+    __slots__ = ("budget", "parent", "values")
 
-    def __init__(self, values: dict[str, ParamValue], parent: Scope | None = None) -> None:
+    def __init__(self, values: dict[str, ParamValue], parent: Scope | None = None,
+                 budget: Budget | None = None) -> None:
         self.values = values
         self.parent = parent
+        inherited: Budget | None = parent.budget if parent is not None else None
+        self.budget: Budget = budget or inherited or Budget()
 
     def get(self, name: str) -> ParamValue | None:
         scope: Scope | None = self
@@ -98,6 +124,12 @@ class ResolveError(ValueError):
     """A value cannot be resolved or converted: the message says why (one line)."""
 
 
+def brief(value: object) -> str:
+    """`repr(value)`, cut to MAX_SHOWN characters (a message stays one short line)."""
+    text = repr(value)
+    return text if len(text) <= MAX_SHOWN else text[: MAX_SHOWN - 3] + "..."
+
+
 def _expression_value(name: str, scope: Scope) -> Value:
     value = scope.get(name)
     if value is None:
@@ -107,24 +139,26 @@ def _expression_value(name: str, scope: Scope) -> Value:
     if isinstance(value, int):
         return float(value)
     if _DOUBLE.fullmatch(value.strip()):
-        return float(value)
-    raise ExpressionError(f"parameter ${name} is not a number ({value!r})")
+        return float(value.strip().replace("INF", "inf"))  # the evaluator refuses non-finite
+    raise ExpressionError(f"parameter ${name} is not a number ({brief(value)})")
 
 
 def resolve(raw: str, scope: Scope) -> ParamValue:
     """The value of an attribute as written: `${expr}` evaluated, `$name` looked up, else
     the text itself; `ResolveError` for an unresolved reference or a bad expression."""
     if raw.startswith("${"):
+        scope.budget.spend(len(raw))
         if not raw.endswith("}"):
-            raise ResolveError(f"expression {raw!r} lacks its closing brace")
+            raise ResolveError(f"expression {brief(raw)} lacks its closing brace")
         try:
             return evaluate(raw[2:-1], lambda n: _expression_value(n, scope))
         except ExpressionError as exc:
-            raise ResolveError(f"expression {raw}: {exc}") from None
+            shown = raw if len(raw) <= MAX_SHOWN else brief(raw)
+            raise ResolveError(f"expression {shown}: {exc}") from None
     if raw.startswith("$"):
         name = raw[1:]
         if not _NAME.fullmatch(name):
-            raise ResolveError(f"bad parameter reference {raw!r}")
+            raise ResolveError(f"bad parameter reference {brief(raw)}")
         value = scope.get(name)
         if value is None:
             raise ResolveError(f"unresolved parameter reference {raw}")
@@ -133,15 +167,20 @@ def resolve(raw: str, scope: Scope) -> ParamValue:
 
 
 def to_float(value: ParamValue) -> float:
-    """A number from a resolved value; `ResolveError` when it is not one."""
+    """A finite number from a resolved value; `ResolveError` when it is not one (`INF`,
+    `NaN` and literals beyond a double's range, like `1e999`, are refused)."""
     if isinstance(value, bool):
         raise ResolveError(f"expected a number, got {str(value).lower()}")
     if isinstance(value, int | float):
-        return float(value)
-    text = value.strip()
-    if not _DOUBLE.fullmatch(text):
-        raise ResolveError(f"expected a number, got {value!r}")
-    return float(text.replace("INF", "inf"))
+        number = float(value)
+    else:
+        text = value.strip()
+        if not _DOUBLE.fullmatch(text):
+            raise ResolveError(f"expected a number, got {brief(value)}")
+        number = float(text.replace("INF", "inf"))
+    if not math.isfinite(number):
+        raise ResolveError(f"expected a finite number, got {brief(value)}")
+    return number
 
 
 def to_int(value: ParamValue) -> int:
@@ -157,7 +196,10 @@ def to_int(value: ParamValue) -> int:
         return math.floor(abs(value) + 0.5) * (1 if value >= 0 else -1)
     text = value.strip()
     if not _INT.fullmatch(text):
-        raise ResolveError(f"expected an integer, got {value!r}")
+        raise ResolveError(f"expected an integer, got {brief(value)}")
+    digits = len(text.lstrip("+-"))
+    if digits > MAX_INT_DIGITS:
+        raise ResolveError(f"an integer of {digits} digits: at most {MAX_INT_DIGITS}")
     return int(text)
 
 
@@ -167,7 +209,7 @@ def to_bool(value: ParamValue) -> bool:
         return value
     if isinstance(value, str) and value.strip() in ("true", "false", "1", "0"):
         return value.strip() in ("true", "1")
-    raise ResolveError(f"expected true or false, got {value!r}")
+    raise ResolveError(f"expected true or false, got {brief(value)}")
 
 
 def to_str(value: ParamValue) -> str:
@@ -196,7 +238,7 @@ def convert(value: ParamValue, ptype: ParameterType) -> ParamValue:
         try:
             datetime.fromisoformat(text)
         except ValueError:
-            raise ResolveError(f"expected a dateTime, got {text!r}") from None
+            raise ResolveError(f"expected a dateTime, got {brief(text)}") from None
         return text
     return to_str(value)
 
@@ -213,8 +255,11 @@ def parse_declarations(node: Node | None) -> tuple[ParameterInfo, ...]:
         if name is None or ptype is None or default is None:
             missing = "name" if name is None else "parameterType" if ptype is None else "value"
             raise decl.error(f"missing attribute {missing}")
+        if len(name) > MAX_NAME_CHARS:
+            raise decl.error(f"name: {len(name)} characters: at most {MAX_NAME_CHARS}")
         if ptype not in PARAMETER_TYPES:
-            raise decl.error(f"parameterType {ptype!r} is not one of {', '.join(PARAMETER_TYPES)}")
+            known = ", ".join(PARAMETER_TYPES)
+            raise decl.error(f"parameterType {brief(ptype)} is not one of {known}")
         if any(i.name == name for i in infos):
             raise decl.error(f"parameter {name} declared twice")
         groups: list[ConstraintGroup] = []
@@ -289,10 +334,12 @@ def evaluate_declarations(
     *,
     file: str,
     overrides_from: str = "override",
+    budget: Budget | None = None,
 ) -> Scope:
     """The scope of the parameters declared under `node` (a ParameterDeclarations element),
     each value `overrides[name]` if given, else its declared default; references resolve in
-    this scope (earlier parameters) then in `parent`. Checks types and constraints; raises
+    this scope (earlier parameters) then in `parent`; expressions spend `budget` (None: the
+    parent's, or a new one). Checks types and constraints; raises
     `ScenarioError` for an unknown override name, a badly typed value or a broken constraint.
     """
     infos = parse_declarations(node)
@@ -302,12 +349,12 @@ def evaluate_declarations(
             listing = ", ".join(sorted(known)) or "none"
             problem = f"unknown parameter {name}; declared: {listing}"
             raise ScenarioError(file, f"({overrides_from}s)", problem)
-    scope = Scope({}, parent)
+    scope = Scope({}, parent, budget)
     assert node is not None or not infos
     decls = node.all("ParameterDeclaration") if node is not None else []
     for info, decl in zip(infos, decls, strict=True):
         raw = overrides.get(info.name, info.default)
-        source = f" ({overrides_from} {raw!r})" if info.name in overrides else ""
+        source = f" ({overrides_from} {brief(raw)})" if info.name in overrides else ""
         try:
             value = convert(resolve(raw, scope), info.type)
         except ResolveError as exc:

@@ -6,7 +6,7 @@ Every problem is one `ScenarioError` line: `<file>: line N: <element path>: <pro
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from types import MappingProxyType
 
@@ -22,6 +22,7 @@ from avsim.scenario.openscenario.parameters import (
 )
 from avsim.scenario.openscenario.parse_entities import parse_entities
 from avsim.scenario.openscenario.parse_storyboard import parse_storyboard
+from avsim.scenario.openscenario.references import ReferenceError, Roots, is_file
 from avsim.scenario.openscenario.xmlread import Node, read_xml
 
 SUPPORTED_MINOR = (0, 1, 2)  # OpenSCENARIO 1.0, 1.1, 1.2
@@ -47,13 +48,21 @@ def _read_root(path: Path) -> tuple[Node, int, int]:
     return root, major, minor
 
 
+def scenario_roots(path: Path, search_paths: Sequence[Path]) -> Roots:
+    """The folders the scenario file `path` may reference files in (`references`)."""
+    try:
+        return Roots.of(path, search_paths)
+    except ReferenceError as exc:
+        raise ScenarioError(str(path), "--search-path", str(exc)) from None
+
+
 def declared_parameters(path: Path) -> tuple[ParameterInfo, ...]:
     """The scenario's global parameters as declared (type, default, constraint groups)."""
     root, _, _ = _read_root(path)
     return parse_declarations(root.child("ParameterDeclarations"))
 
 
-def _road_network(root: Node, base_dir: Path, attrs: Attributes) -> Path | None:
+def _road_network(root: Node, roots: Roots, attrs: Attributes) -> Path | None:
     network = root.need("RoadNetwork")
     signals = network.child("TrafficSignals")
     if signals is not None and signals.children:
@@ -61,24 +70,29 @@ def _road_network(root: Node, base_dir: Path, attrs: Attributes) -> Path | None:
     logic = network.child("LogicFile")
     if logic is None:
         return None
-    road = (base_dir / attrs.text(logic, "filepath")).resolve()
-    if not road.is_file():
+    try:
+        road = roots.find(attrs.text(logic, "filepath"))
+    except ReferenceError as exc:
+        raise logic.error(f"filepath: {exc}") from None
+    if not is_file(road):
         raise logic.error(f"road network file not found: {road}")
     return road
 
 
-def load_openscenario(path: Path, overrides: Mapping[str, str] = _NO_OVERRIDES) -> OpenScenario:
+def load_openscenario(path: Path, overrides: Mapping[str, str] = _NO_OVERRIDES,
+                      search_paths: Sequence[Path] = ()) -> OpenScenario:
     """The scenario in the .xosc file at `path`, with the parameter values in `overrides`
-    (name -> value as text) replacing the declared defaults; `ScenarioError` on any problem."""
+    (name -> value as text) replacing the declared defaults; its road and catalogs found in
+    its folder tree or in `search_paths` (`references`); `ScenarioError` on any problem."""
     path = Path(path)
     root, major, minor = _read_root(path)
-    base_dir = path.resolve().parent
+    roots = scenario_roots(path, search_paths)
     scope = evaluate_declarations(
         root.child("ParameterDeclarations"), None, overrides, file=str(path)
     )
     attrs = Attributes(scope)
-    catalogs = Catalogs.load(root.child("CatalogLocations"), base_dir, attrs)
-    road_network = _road_network(root, base_dir, attrs)
+    catalogs = Catalogs.load(root.child("CatalogLocations"), roots, attrs)
+    road_network = _road_network(root, roots, attrs)
     ctx = Context(attrs, catalogs, None)
     entities_node = root.child("Entities")
     entities = parse_entities(entities_node, ctx) if entities_node is not None else ()
@@ -99,4 +113,4 @@ def load_openscenario(path: Path, overrides: Mapping[str, str] = _NO_OVERRIDES) 
     )
 
 
-__all__ = ["declared_parameters", "load_openscenario"]
+__all__ = ["declared_parameters", "load_openscenario", "scenario_roots"]

@@ -31,6 +31,7 @@ from avsim.scenario.openscenario.actions import (
 )
 from avsim.scenario.openscenario.attributes import unsupported
 from avsim.scenario.openscenario.context import Context
+from avsim.scenario.openscenario.limits import MAX_SPEED, MAX_TIME
 from avsim.scenario.openscenario.parse_entities import parse_controller
 from avsim.scenario.openscenario.parse_positions import parse_position
 from avsim.scenario.openscenario.xmlread import Node
@@ -46,10 +47,13 @@ def parse_dynamics(node: Node, ctx: Context) -> TransitionDynamics:
     mode = None
     if "followingMode" in node.attrs:
         mode = a.choice(node, "followingMode", FOLLOWING_MODES)
+    dimension = a.choice(node, "dynamicsDimension", DIMENSIONS)
+    value = (a.bounded(node, "value", 0.0, MAX_TIME, "s") if dimension == "time"
+             else a.number(node, "value"))
     return TransitionDynamics(
         shape=a.choice(node, "dynamicsShape", SHAPES),  # type: ignore[arg-type]
-        dimension=a.choice(node, "dynamicsDimension", DIMENSIONS),  # type: ignore[arg-type]
-        value=a.number(node, "value"),
+        dimension=dimension,  # type: ignore[arg-type]
+        value=value,
         following_mode=mode,  # type: ignore[arg-type]
     )
 
@@ -63,12 +67,15 @@ def _speed(node: Node, ctx: Context) -> PrivateAction:
     target = node.need("SpeedActionTarget").only_child()
     speed_target: AbsoluteTargetSpeed | RelativeTargetSpeed
     if target.tag == "AbsoluteTargetSpeed":
-        speed_target = AbsoluteTargetSpeed(a.number(target, "value"))
+        speed_target = AbsoluteTargetSpeed(a.bounded(target, "value", -MAX_SPEED, MAX_SPEED,
+                                                     "m/s"))
     elif target.tag == "RelativeTargetSpeed":
+        value_type = a.choice(target, "speedTargetValueType", ("delta", "factor"))
         speed_target = RelativeTargetSpeed(
             entity=ctx.entity_ref(target),
-            value=a.number(target, "value"),
-            value_type=a.choice(target, "speedTargetValueType", ("delta", "factor")),  # type: ignore[arg-type]
+            value=(a.bounded(target, "value", -MAX_SPEED, MAX_SPEED, "m/s")
+                   if value_type == "delta" else a.number(target, "value")),
+            value_type=value_type,  # type: ignore[arg-type]
             continuous=a.boolean(target, "continuous"),
         )
     else:
@@ -83,7 +90,7 @@ def _constraints(node: Node | None, ctx: Context) -> DynamicConstraints | None:
     return DynamicConstraints(
         max_acceleration=a.opt_number(node, "maxAcceleration"),
         max_deceleration=a.opt_number(node, "maxDeceleration"),
-        max_speed=a.opt_number(node, "maxSpeed"),
+        max_speed=a.opt_bounded(node, "maxSpeed", 0.0, MAX_SPEED, "m/s"),
         max_acceleration_rate=a.opt_number(node, "maxAccelerationRate"),
         max_deceleration_rate=a.opt_number(node, "maxDecelerationRate"),
     )
@@ -92,7 +99,7 @@ def _constraints(node: Node | None, ctx: Context) -> DynamicConstraints | None:
 def _longitudinal_distance(node: Node, ctx: Context) -> PrivateAction:
     a = ctx.attrs
     distance = a.opt_number(node, "distance")
-    time_gap = a.opt_number(node, "timeGap")
+    time_gap = a.opt_bounded(node, "timeGap", 0.0, MAX_TIME, "s")
     if (distance is None) == (time_gap is None):
         raise node.error("needs exactly one of distance and timeGap")
     return LongitudinalDistanceAction(

@@ -29,6 +29,7 @@ from avsim.scenario.openscenario.conditions import (
     TriggeringEntities,
 )
 from avsim.scenario.openscenario.context import Context
+from avsim.scenario.openscenario.limits import MAX_SPEED, MAX_TIME
 from avsim.scenario.openscenario.parse_positions import parse_position
 from avsim.scenario.openscenario.xmlread import Node
 
@@ -63,8 +64,14 @@ def _distance_type(node: Node, ctx: Context, default: str) -> str:
     return ctx.attrs.choice_or(node, "relativeDistanceType", DISTANCE_TYPES, default)
 
 
+def _duration(node: Node, ctx: Context) -> float:
+    """[s] a condition's `duration`, in [0, MAX_TIME]."""
+    return ctx.attrs.bounded(node, "duration", 0.0, MAX_TIME, "s")
+
+
 def _simulation_time(node: Node, ctx: Context) -> ConditionKind:
-    return SimulationTimeCondition(ctx.attrs.number(node, "value"), _rule(node, ctx))  # type: ignore[arg-type]
+    value = ctx.attrs.bounded(node, "value", 0.0, MAX_TIME, "s")
+    return SimulationTimeCondition(value, _rule(node, ctx))  # type: ignore[arg-type]
 
 
 def _element_state(node: Node, ctx: Context) -> ConditionKind:
@@ -113,7 +120,7 @@ def _time_headway(node: Node, ctx: Context) -> ConditionKind:
     a = ctx.attrs
     return TimeHeadwayCondition(
         entity=ctx.entity_ref(node),
-        value=a.number(node, "value"),
+        value=a.bounded(node, "value", 0.0, MAX_TIME, "s"),
         freespace=a.boolean(node, "freespace"),
         rule=_rule(node, ctx),  # type: ignore[arg-type]
         coordinate_system=_coordinates(node, ctx),  # type: ignore[arg-type]
@@ -134,7 +141,7 @@ def _time_to_collision(node: Node, ctx: Context) -> ConditionKind:
     return TimeToCollisionCondition(
         entity=entity,
         position=position,
-        value=a.number(node, "value"),
+        value=a.bounded(node, "value", 0.0, MAX_TIME, "s"),
         freespace=a.boolean(node, "freespace"),
         rule=_rule(node, ctx),  # type: ignore[arg-type]
         coordinate_system=_coordinates(node, ctx),  # type: ignore[arg-type]
@@ -151,7 +158,8 @@ def _reach_position(node: Node, ctx: Context) -> ConditionKind:
 def _speed(node: Node, ctx: Context) -> ConditionKind:
     if "direction" in node.attrs:  # 1.2: a directional speed
         raise node.error("not supported yet (SpeedCondition direction)")
-    return SpeedCondition(ctx.attrs.number(node, "value"), _rule(node, ctx))  # type: ignore[arg-type]
+    value = ctx.attrs.bounded(node, "value", -MAX_SPEED, MAX_SPEED, "m/s")
+    return SpeedCondition(value, _rule(node, ctx))  # type: ignore[arg-type]
 
 
 def _relative_speed(node: Node, ctx: Context) -> ConditionKind:
@@ -188,9 +196,9 @@ _ENTITY: dict[str, Callable[[Node, Context], ConditionKind]] = {
     "TraveledDistanceCondition": lambda n, c: TraveledDistanceCondition(c.attrs.number(n, "value")),
     "SpeedCondition": _speed,
     "RelativeSpeedCondition": _relative_speed,
-    "StandStillCondition": lambda n, c: StandStillCondition(c.attrs.number(n, "duration")),
-    "EndOfRoadCondition": lambda n, c: EndOfRoadCondition(c.attrs.number(n, "duration")),
-    "OffroadCondition": lambda n, c: OffroadCondition(c.attrs.number(n, "duration")),
+    "StandStillCondition": lambda n, c: StandStillCondition(_duration(n, c)),
+    "EndOfRoadCondition": lambda n, c: EndOfRoadCondition(_duration(n, c)),
+    "OffroadCondition": lambda n, c: OffroadCondition(_duration(n, c)),
     "CollisionCondition": _collision,
 }
 
@@ -224,7 +232,7 @@ def parse_condition(node: Node, ctx: Context) -> Condition:
         raise unsupported(body)
     return Condition(
         name=a.text(node, "name"),
-        delay=a.number(node, "delay"),
+        delay=a.bounded(node, "delay", 0.0, MAX_TIME, "s"),
         edge=a.choice(node, "conditionEdge", EDGES),  # type: ignore[arg-type]
         triggering_entities=triggering,
         kind=kind,

@@ -3,6 +3,7 @@ a catalog) and their ObjectController."""
 
 from __future__ import annotations
 
+from avsim.scenario.errors import fmt
 from avsim.scenario.openscenario.attributes import unsupported
 from avsim.scenario.openscenario.context import Context
 from avsim.scenario.openscenario.entities import (
@@ -15,12 +16,22 @@ from avsim.scenario.openscenario.entities import (
     Pedestrian,
     Vehicle,
 )
+from avsim.scenario.openscenario.limits import MAX_BOX_HEIGHT, MAX_BOX_LENGTH, MAX_BOX_WIDTH
 from avsim.scenario.openscenario.xmlread import Node
 
 OBJECT_KINDS = ("Vehicle", "Pedestrian", "MiscObject")
 
 
+def _size(node: Node, ctx: Context, name: str, most: float) -> float:
+    """[m] a bounding box dimension: > 0 and at most `most`."""
+    value = ctx.attrs.number(node, name)
+    if not 0.0 < value <= most:
+        raise node.error(f"{name}: must be > 0 and <= {fmt(most)} m, got {fmt(value)}")
+    return value
+
+
 def parse_bbox(node: Node, ctx: Context) -> BoundingBox:
+    """A BoundingBox: its centre (finite) and its dimensions (`limits`)."""
     center = node.need("Center")
     dims = node.need("Dimensions")
     a = ctx.attrs
@@ -28,9 +39,9 @@ def parse_bbox(node: Node, ctx: Context) -> BoundingBox:
         center_x=a.number(center, "x"),
         center_y=a.number(center, "y"),
         center_z=a.number(center, "z"),
-        length=a.number(dims, "length"),
-        width=a.number(dims, "width"),
-        height=a.number(dims, "height"),
+        length=_size(dims, ctx, "length", MAX_BOX_LENGTH),
+        width=_size(dims, ctx, "width", MAX_BOX_WIDTH),
+        height=_size(dims, ctx, "height", MAX_BOX_HEIGHT),
     )
 
 

@@ -23,10 +23,11 @@ from pydantic import Field
 
 from avsim.criteria.registry import CriteriaSettings, setting_keys
 from avsim.scenario.convert import sensors_spec
-from avsim.scenario.errors import LocatedError, ScenarioError
+from avsim.scenario.errors import FILE_KEY, LocatedError, ScenarioError
 from avsim.scenario.fields import FormatModel, NonNegInt, PosFloat
 from avsim.scenario.files import read_raw
 from avsim.scenario.model import CriteriaModel, SensorsModel
+from avsim.scenario.openscenario.references import ReferenceError, Roots
 from avsim.scenario.overrides import apply_overrides
 from avsim.scenario.validation import validate_as
 from world.spec import SensorsSpec
@@ -67,16 +68,25 @@ def bundled_sets() -> tuple[str, ...]:
     return tuple(sorted(p.name.removesuffix(SUFFIX) for p in SETS.glob("*" + SUFFIX)))
 
 
-def sidecar_path(xosc: Path, given: Path | None) -> Path | None:
-    """The sidecar of `xosc`: `given` (a file, or a bundled set's name), else
-    `NAME.criteria.yaml` beside it if it exists."""
+def sidecar_path(xosc: Path, given: Path | None, roots: Roots | None = None) -> Path | None:
+    """The sidecar of `xosc`: `given` (a file, or a bundled set's name: the user's choice,
+    allowed anywhere), else `NAME.criteria.yaml` beside it if it exists, which must resolve
+    inside `roots` (`references`; None: the folder of `xosc`) and be a regular file."""
     if given is not None:
         named = SETS / f"{given}{SUFFIX}"
         if given.suffix == "" and len(given.parts) == 1 and named.exists():
             return named
         return given
     beside = xosc.with_name(xosc.stem + SUFFIX)
-    return beside if beside.exists() else None
+    if not beside.exists():
+        return None
+    try:
+        real = (roots or Roots.of(xosc)).check(beside)
+    except ReferenceError as exc:
+        raise ScenarioError(str(beside), FILE_KEY, f"the sidecar: {exc}") from None
+    if not real.is_file():
+        raise ScenarioError(str(beside), FILE_KEY, "the sidecar is not a regular file")
+    return beside
 
 
 def split_overrides(overrides: Mapping[str, object]) -> tuple[dict[str, str],

@@ -23,6 +23,7 @@ else is listed as not fitting (the YAML is then an approximation, and says so).
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -61,10 +62,11 @@ class Conversion:
     misfits: list[str] = field(default_factory=list)
 
 
-def convert_xosc(path: Path, criteria_file: Path | None = None) -> Conversion:
-    """The `avsim/1` YAML of an OpenSCENARIO file (module doc); `ScenarioError` if it does
-    not load."""
-    scenario = load_xosc(path, None, criteria_file)
+def convert_xosc(path: Path, criteria_file: Path | None = None,
+                 search_paths: Sequence[Path] = ()) -> Conversion:
+    """The `avsim/1` YAML of an OpenSCENARIO file (module doc), its references found in
+    its folder tree or `search_paths`; `ScenarioError` if it does not load."""
+    scenario = load_xosc(path, None, criteria_file, search_paths)
     out = Conversion({})
     story = scenario.story
     assert story is not None

@@ -12,10 +12,12 @@ from __future__ import annotations
 from pathlib import Path
 
 from avsim.scenario.errors import ScenarioError
+from world.core.safe_read import UnreadableFileError, read_bounded
 from world.core.safe_xml import Refusal, XmlMalformedError, XmlRefusedError, parse_tree
 
 MAX_FILE_BYTES = 20 * 1024 * 1024  # the largest file read [bytes]
 MAX_ELEMENTS = 200_000  # the most elements a file may hold
+MAX_PATH_NAME = 40  # [characters] of a `name` shown in an element's path
 
 
 class Node:
@@ -40,6 +42,8 @@ class Node:
         node: Node | None = self
         while node is not None:
             name = node.attrs.get("name")
+            if name is not None and len(name) > MAX_PATH_NAME:  # a message stays one short line
+                name = name[: MAX_PATH_NAME - 3] + "..."
             parts.append(f"{node.tag}[{name}]" if name is not None else node.tag)
             node = node.parent
         return "/" + "/".join(reversed(parts))
@@ -81,19 +85,22 @@ class Node:
 def read_xml(
     path: Path, *, max_bytes: int = MAX_FILE_BYTES, max_elements: int = MAX_ELEMENTS
 ) -> Node:
-    """The root element of the XML file at `path`; `ScenarioError` when it cannot be read,
+    """The root element of the XML file at `path` (`read_xml_sized`)."""
+    return read_xml_sized(path, max_bytes, max_elements)[0]
+
+
+def read_xml_sized(
+    path: Path, max_bytes: int = MAX_FILE_BYTES, max_elements: int = MAX_ELEMENTS
+) -> tuple[Node, int]:
+    """The root element of the XML file at `path` and its size [bytes]; `ScenarioError` when
+    it is not a regular file (a FIFO, a device, a directory, a symlink loop: `read_bounded`),
     is too large, is not well-formed, or declares a DOCTYPE or entities."""
     file = str(path)
     try:
-        size = path.stat().st_size
-        if size > max_bytes:
-            raise ScenarioError(file, "(file)", f"file too large: {size} bytes > {max_bytes}")
-        data = path.read_bytes()
-    except FileNotFoundError:
-        raise ScenarioError(file, "(file)", f"file not found: {file}") from None
-    except OSError as exc:
-        raise ScenarioError(file, "(file)", f"cannot read: {exc.strerror}") from None
-    return parse_xml_bytes(data, file, max_elements=max_elements)
+        data = read_bounded(path, max_bytes)
+    except UnreadableFileError as exc:
+        raise ScenarioError(file, "(file)", exc.problem) from None
+    return parse_xml_bytes(data, file, max_elements=max_elements), len(data)
 
 
 def parse_xml_bytes(data: bytes, file: str, *, max_elements: int = MAX_ELEMENTS) -> Node:

@@ -76,12 +76,12 @@ def test_a_value_outside_the_constraint_groups_is_refused_before_any_run(work: P
 def test_a_suite_mixes_openscenario_and_yaml_files(work: Path) -> None:
     folder = work / "mixed"
     folder.mkdir()
-    text = CUT_IN.read_text(encoding="utf-8-sig").replace("./", f"{ALKS}/")
+    text = CUT_IN.read_text(encoding="utf-8-sig")  # its road and catalogs: ./ of ALKS
     (folder / "cut_in.xosc").write_text(text, encoding="utf-8")
     (folder / "cut_in.criteria.yaml").write_text("duration: 5\n", encoding="utf-8")
     shutil.copy(HERE / "batch_scenarios" / "follow.yaml", folder / "follow.yaml")
     out = avsim("suite", str(folder), "--profile", "none", "--jobs", "2", "--no-snapshots",
-                "--out", "suite", cwd=work)
+                "--out", "suite", "--search-path", str(ALKS), cwd=work)  # to the workers
     assert out.returncode in (0, 1), out.stderr
     runs = json.loads((work / "suite" / "results.json").read_text())
     names = sorted(run["result"]["scenario"] for run in runs)

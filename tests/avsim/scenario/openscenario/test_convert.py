@@ -107,11 +107,10 @@ def test_a_parameter_override_moves_the_story() -> None:
 
 def test_the_sidecar_beside_the_file_and_a_named_set(tmp_path: Path) -> None:
     copy = tmp_path / CUT_IN.name
-    text = CUT_IN.read_text(encoding="utf-8-sig").replace("./", f"{ALKS}/")
-    copy.write_text(text, encoding="utf-8")
+    copy.write_text(CUT_IN.read_text(encoding="utf-8-sig"), encoding="utf-8")
     (tmp_path / (copy.stem + ".criteria.yaml")).write_text(
         "criteria:\n  max_decel: 4.5\nseed: 7\nduration: 40\n", encoding="utf-8")
-    scenario = load_scenario(copy)
+    scenario = load_scenario(copy, search_paths=(ALKS,))  # its road and catalogs there
     assert scenario.criteria.get("max_decel") == 4.5
     assert scenario.seed == 7 and scenario.duration == 40.0
     assert "r157" in bundled_sets()
@@ -140,11 +139,11 @@ def test_bad_input_is_one_line(overrides: dict[str, object], criteria: str | Non
 
 def test_an_entity_placed_off_the_road_is_refused(tmp_path: Path) -> None:
     copy = tmp_path / "off.xosc"
-    text = CUT_IN.read_text(encoding="utf-8-sig").replace("./", f"{ALKS}/")
+    text = CUT_IN.read_text(encoding="utf-8-sig")
     copy.write_text(text.replace('s="5.0"></LanePosition>', 's="20000"></LanePosition>'),
                     encoding="utf-8")
     with pytest.raises(ScenarioError) as err:
-        load_scenario(copy)
+        load_scenario(copy, search_paths=(ALKS,))
     assert "Storyboard.Init.Ego" in str(err.value) and "off road 0" in str(err.value)
 
 

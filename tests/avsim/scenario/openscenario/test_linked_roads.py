@@ -77,7 +77,7 @@ def test_a_position_off_the_roads_names_its_road(resolver: Resolver, position: L
 
 
 def test_the_scenario_loads_on_the_merged_route() -> None:
-    scenario = load_scenario(XOSC)
+    scenario = load_scenario(XOSC, search_paths=(XODR.parent,))  # its road is found there
     assert scenario.story is not None
     assert scenario.story.chain.starts == {"1": 0.0, "2": 100.0, "3": 160.0}
     assert scenario.story.lane_ids == (-2, -1)
