@@ -116,13 +116,14 @@ def run(scenario: str, out: Path | None, json_path: Path | None, profile: str, s
 
     with quiet_c_output():  # PyBullet's build banner
         from avsim.run.runner import Runner  # heavy: only once the input is known good
-        from world.sensors.setup import Profile
+        from world.sensors.setup import Profile, localisation
 
     out.parent.mkdir(parents=True, exist_ok=True)
     partial = out.with_name(f".{out.name}.partial")
     with Interrupts() as stop:  # Ctrl-C / SIGTERM end the run at its tick, files kept
-        runner = Runner(loaded, partial, None if profile == "none" else Profile(profile),
-                        sensing)
+        setup = None if profile == "none" else Profile(profile)
+        runner = Runner(loaded, partial, setup, sensing)
+        click.echo(f"{loaded.name}: {localisation(setup, loaded.world.sensors.gnss).note}")
         stop.on_signal(runner.interrupt)
         result = _run_with_progress(runner, loaded.duration, not no_progress)
         partial.replace(out)

@@ -1,5 +1,7 @@
 """The result file (`--json`) of a run, as SCENARIO_FORMAT.md specifies it: strict JSON,
-every number finite or null (`dumps` refuses anything else)."""
+every number finite or null (`dumps` refuses anything else). Beside the sensor profile,
+`localisation` says where the stack's pose came from and the receiver's expected error
+(`world.sensors.setup.localisation`)."""
 
 from __future__ import annotations
 
@@ -7,6 +9,8 @@ import json
 import math
 from pathlib import Path
 from typing import TYPE_CHECKING
+
+from world.sensors.setup import Localisation, Profile, localisation
 
 if TYPE_CHECKING:
     from avsim.run.runner import RunResult
@@ -26,6 +30,7 @@ def result_json(result: RunResult, file: str | Path, recording: Path, profile: s
         "file": str(file),
         "seed": scenario.seed,
         "profile": profile,
+        "localisation": run_localisation(result, profile).as_json(),
         "renderer": result.renderer,
         "passed": result.passed,
         "interrupted": result.interrupted,
@@ -42,6 +47,12 @@ def result_json(result: RunResult, file: str | Path, recording: Path, profile: s
         ],
         "recording": str(recording),
     }
+
+
+def run_localisation(result: RunResult, profile: str) -> Localisation:
+    """The pose's source of a run with sensor profile `profile` ("none": no profile)."""
+    return localisation(None if profile == "none" else Profile(profile),
+                        result.scenario.world.sensors.gnss)
 
 
 def dumps(payload: object) -> str:
