@@ -98,3 +98,27 @@ def test_a_vehicle_nearly_as_fast_is_not_passed() -> None:
 def test_closing_time(distance: float, v0: float, v_max: float, a: float,
                       expected: float) -> None:
     assert closing_time(distance, v0, v_max, a) == pytest.approx(expected)
+
+
+def test_the_motion_layer_says_once_why_it_stays_behind() -> None:
+    """overtake on, a 1 + 1 road, a stopped car ahead: the car keeps its lane, and the
+    reason (the sight too short) is logged once, not every tick."""
+    from perception.messages import EgoState, ObjectClass, Track
+    from planner.fsm.acc import AccParams
+    from planner.fsm.motion import Motion
+    from planner.motion_layer import MotionLayer, MotionLayerParams
+    from tests.vehicle import VEHICLE
+
+    road = one_each_way(BROKEN)
+    layer = MotionLayer(road, 0, AccParams(), VEHICLE, MotionLayerParams(overtake=True))
+    logged = []
+    for k in range(30):
+        t = 0.1 * k
+        ego = EgoState(t, 100.0, 0.0, 0.0, 5.0, 0.0, 0.0, 0.1)
+        car = Track(id=7, t=t, x=125.0, y=0.0, vx=0.0, vy=0.0, rel_x=25.0, rel_y=0.0,
+                    rel_vx=-5.0, rel_vy=0.0, length=4.6, width=1.8, height=1.5, yaw=0.0,
+                    cls=ObjectClass.CAR, hits=20, misses=0, position_sigma=0.1)
+        manoeuvre, changes = layer.update(ego, 30.0 * KPH, (car,))
+        assert manoeuvre.motion is Motion.LANE_KEEP and manoeuvre.lane == 0
+        logged += [c.reason for c in changes]
+    assert len(logged) == 1 and logged[0].startswith("no pass: sight 55 m < ")
