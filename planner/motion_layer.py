@@ -53,6 +53,11 @@ driver leaves to see the tyres of the car ahead), as much of it as a stop at
 Keeping right after a pass waits for a car behind in the right lane to be
 ``keep_right_gap`` back (a margin over the gap that aborts).
 
+On a road where the leftmost lane of the car's direction has an oncoming lane beside it,
+a blocked car may not pass there: `planner.oncoming_pass` decides whether a pass would be
+safe, and the reason it is not is logged once per change of reason (a motion change
+lane_keep -> lane_keep); the pass through the oncoming lane itself is not built.
+
 At a town junction where the route turns, the turn is entered when the car's centre passes
 the stop line and done at the junction's exit (`RoadMap.junctions`); its path is the map's
 lane 0, which turns along the junction's arc (`world.map.town`), so the path needs nothing
