@@ -129,18 +129,19 @@ def run(scenario: str, out: Path | None, json_path: Path | None, profile: str, s
 
     with quiet_c_output():  # PyBullet's build banner
         from avsim.run.runner import Runner  # heavy: only once the input is known good
-        from world.sensors.setup import Profile
+        from world.sensors.setup import Profile, localisation
 
     out.parent.mkdir(parents=True, exist_ok=True)
     partial = out.with_name(f".{out.name}.partial")
     with Interrupts() as stop:  # Ctrl-C / SIGTERM end the run at its tick, files kept
+        setup = None if profile == "none" else Profile(profile)
         try:
-            runner = Runner(loaded, partial, None if profile == "none" else Profile(profile),
-                            sensing)
+            runner = Runner(loaded, partial, setup, sensing)
         except Exception as exc:  # the world cannot be built: a bug, exit 3, nothing kept
             partial.unlink(missing_ok=True)
             click.echo(f"avsim: {RunError.of(exc, 0.0).line()}", err=True)
             sys.exit(EXIT_ERROR)
+        click.echo(f"{loaded.name}: {localisation(setup, loaded.world.sensors.gnss).note}")
         stop.on_signal(runner.interrupt)
         result = _run_with_progress(runner, loaded.duration, not no_progress)
         partial.replace(out)

@@ -72,6 +72,7 @@ class Neighbour:
     speed: float  # [m/s] along the route
     offset: float = 0.0  # [m] its centre's offset from the route's reference line, left +
     half_width: float = 0.0  # [m] half its box's extent across the road
+    length: float = 0.0  # [m] its box's extent along the road
 
 
 @dataclass(frozen=True, slots=True)
@@ -104,8 +105,8 @@ def lane_traffic(road: RoadMap, tracks: Sequence[Track], t: float, station: floa
             centre, width = float(lane.offset_at(s)), float(lane.width_at(s))
             if abs(d - centre) > 0.5 * width + half_wid - p.overlap:
                 continue
-            out[k] = _add(out[k], Neighbour(tr.id, tr.t, 0.0, speed, d, half_wid), ahead,
-                          half_len, vehicle)
+            n = Neighbour(tr.id, tr.t, 0.0, speed, d, half_wid, 2.0 * half_len)
+            out[k] = _add(out[k], n, ahead, half_len, vehicle)
     return out
 
 

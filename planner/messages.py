@@ -32,6 +32,8 @@ class SpeedSource(enum.Enum):
     that lowered it, or the map's plan that it left alone)."""
 
     SET_SPEED = "set_speed"  # the driver's set speed (capped at the vehicle's maximum)
+    SIGHT = "sight"  # the sight cap: the fastest speed whose desired gap and emergency stop
+    #   lie within the forward sensing range (`planner.fsm.acc.sight_speed`)
     LIMIT = "limit"  # a posted limit, in force or ahead (braking towards it)
     CURVE = "curve"  # a curve's speed, here or ahead
     FOLLOWING = "following"  # the ACC's trail or brake law behind the vehicle ahead

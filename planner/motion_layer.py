@@ -53,6 +53,11 @@ driver leaves to see the tyres of the car ahead), as much of it as a stop at
 Keeping right after a pass waits for a car behind in the right lane to be
 ``keep_right_gap`` back (a margin over the gap that aborts).
 
+On a road where the leftmost lane of the car's direction has an oncoming lane beside it,
+a blocked car may not pass there: `planner.oncoming_pass` decides whether a pass would be
+safe, and the reason it is not is logged once per change of reason (a motion change
+lane_keep -> lane_keep); the pass through the oncoming lane itself is not built.
+
 At a town junction where the route turns, the turn is entered when the car's centre passes
 the stop line and done at the junction's exit (`RoadMap.junctions`); its path is the map's
 lane 0, which turns along the junction's arc (`world.map.town`), so the path needs nothing
@@ -90,6 +95,7 @@ from planner.lane_occupancy import (
     is_free,
     lane_traffic,
 )
+from planner.oncoming_pass import Oncoming, PassParams, Slow, decide
 from world.frames import VehicleInfo
 from world.hdmap import SHOULDER, Junction, RoadMap
 from world.hdmap import Manoeuvre as JunctionManoeuvre
@@ -121,6 +127,8 @@ class MotionLayerParams:
     motion: MotionParams = field(default_factory=MotionParams)
     occupancy: OccupancyParams = field(default_factory=OccupancyParams)
     lane_change: LaneChangeParams = field(default_factory=LaneChangeParams)
+    oncoming_pass: PassParams = field(default_factory=PassParams)  # a pass through the
+    #   oncoming lane (`planner.oncoming_pass`)
 
 
 @dataclass(frozen=True, slots=True)
@@ -158,6 +166,8 @@ class MotionLayer:
         #   start, `Planner.localise`; a town route crossing itself passes a point twice:
         #   `world.hdmap.ReferenceLine.project`)
         self._passing = False  # the change in hand is one to pass a slower vehicle
+        self._no_pass = ""  # why the car stays behind a slower vehicle it may not pass
+        #   through the oncoming lane (logged once per change of reason)
 
     def update(self, ego: EgoState, v_want: float, tracks: Sequence[Track],
                pull_over: bool = False, v_rear: float | None = None,
@@ -186,7 +196,7 @@ class MotionLayer:
         elif self.path is not None and self.motion is Motion.LANE_KEEP and s >= self.path.end:
             self.path = None  # the way back after an abort is done
             self.origin = self.lane
-        changes = self.machine.apply(ego.t, change)
+        changes = self.machine.apply(ego.t, change) + self._why_no_pass(ego, s, x, traffic)
         room_for, room = self._room(traffic, ego.speed, v_want)
         return Manoeuvre(self.motion, self.lane, self.origin, self.path,
                          self._leads(traffic, s, d, ego.speed), room, room_for), changes
@@ -207,7 +217,41 @@ class MotionLayer:
                         if 0 <= k < min(n_now, n_later))
         if self.lane == 0 and pull_over and self.road.shoulder.exists_at(s):
             near.add(SHOULDER)
+        if self._oncoming_side(s):
+            near.add(-1)
         return tuple(sorted(near))
+
+    def _oncoming_side(self, s: float) -> bool:
+        """Whether overtaking is on, the car keeps the leftmost lane of its direction at
+        station `s` [m] and an oncoming lane lies beside it: the only way past is that lane."""
+        section = self.road.cross_section_at(s)
+        return (self.params.overtake and self.lane == section.lanes - 1
+                and section.oncoming_lanes > 0)
+
+    def _why_no_pass(self, ego: EgoState, s: float, x: MotionInput,
+                     traffic: dict[int, LaneTraffic]) -> tuple[StateChange, ...]:
+        """While the car keeps its lane behind a slower vehicle that blocks it on a road
+        whose only way past is the oncoming lane, why it may not pass there now
+        (`planner.oncoming_pass.decide`): a change of reason is logged (the motion state
+        stays LANE_KEEP), once per change, not every tick."""
+        reason = ""
+        slow = traffic[self.lane].ahead if self.lane in traffic else None
+        if (self.motion is Motion.LANE_KEEP and x.blocked and slow is not None
+                and -1 in traffic):
+            ahead = traffic[-1].ahead
+            oncoming = () if ahead is None else (Oncoming(ahead.gap, -ahead.speed),)
+            verdict = decide(self.road, s + self.vehicle.front_overhang, ego.speed,
+                             self._v_want, Slow(slow.gap, max(slow.speed, 0.0), slow.length),
+                             oncoming, self.vehicle.length, self.params.oncoming_pass)
+            # the pass itself is not built: a safe verdict still keeps the car behind
+            reason = verdict.reason or "no pass: the pass through the oncoming lane is not built"
+        if reason == self._no_pass:
+            return ()
+        self._no_pass = reason
+        if not reason:
+            return ()
+        state = self.motion.value
+        return (StateChange(ego.t, "motion", state, state, reason),)
 
     @staticmethod
     def _right_of(lane: int, pull_over: bool) -> int:
@@ -233,8 +277,9 @@ class MotionLayer:
             self._blocked_since = t
         blocked = self._blocked_since is not None and t - self._blocked_since >= p.blocked_time
         left = traffic.get(self.lane + 1) if self.lane != SHOULDER else None
-        right = traffic.get(self._right_of(self.lane, pull_over)) \
-            if self.lane != SHOULDER else None
+        right_of = self._right_of(self.lane, pull_over)
+        right = traffic.get(right_of) if self.lane != SHOULDER and (
+            right_of >= 0 or right_of == SHOULDER) else None  # never the oncoming lane
         x = MotionInput(
             t=t, since=self.machine.since, overtake=p.overtake, blocked=blocked,
             left_free=left is not None and self._seen(left, t)

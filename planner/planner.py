@@ -27,17 +27,17 @@ reference line, speeds [m/s]. Steps:
 4. the lead vehicle (`planner.lead`: in the path's lane, or along the map lane through a
    junction, or in the lanes a lane change occupies);
 5. the speed, a chain of `planner.speed.PlannedSpeed`s, each link keeping what it was given
-   unless it lowers it: the map's plan (`planner.speed_planning`: set speed, the lane kept's
-   limits and curves), the driver's pedal (`planner.driver_override`: it raises the plan up
-   to the limit), the ACC / event law (`planner.acc_layer`: cruise, trail or brake behind
-   the lead, which is nearer by the motion layer's room to pull out when it is a stationary
-   vehicle the car may pass; a stop, a bump's pass speed, a flat tyre's crawl), the
-   degraded modes' cap (ramped down at ``a_comf`` to the hold speed in MAP_HOLD, to a stop
-   in STOP_IN_LANE; to the slow speed when the sensing machine, `planner.fsm.sensing`,
-   answers a faulty GNSS with DEGRADED, to a stop in lane when it answers a lost LiDAR with
-   MINIMUM_RISK: the sensors' health as `perception.health` noticed it) and the emergency
-   stop; the plan's `speed_source` is the link that set
-   the speed;
+   unless it lowers it: the map's plan (`planner.speed_planning`: set speed, the sight cap
+   (`SpeedSource.SIGHT`), the lane kept's limits and curves), the driver's pedal
+   (`planner.driver_override`: it raises the plan up to the limit), the ACC / event law
+   (`planner.acc_layer`: cruise, trail or brake behind the lead, which is nearer by the
+   motion layer's room to pull out when it is a stationary vehicle the car may pass; a
+   stop, a bump's pass speed, a flat tyre's crawl), the degraded modes' cap (ramped down at
+   ``a_comf`` to the hold speed in MAP_HOLD, to a stop in STOP_IN_LANE; to the slow speed
+   when the sensing machine, `planner.fsm.sensing`, answers a faulty GNSS with DEGRADED, to
+   a stop in lane when it answers a lost LiDAR with MINIMUM_RISK: the sensors' health as
+   `perception.health` noticed it) and the emergency stop; the plan's `speed_source` is the
+   link that set the speed;
 6. while the automated driving function is not engaged (`PlannerInput.engaged`: an
    OpenSCENARIO file's car under test before its controller is activated) the ACC is off
    (ACC_OFF) and the driver holds the set speed (`SpeedSource.DRIVER`) in the lane kept,
@@ -141,8 +141,9 @@ class Planner:
         self.road = road
         self.params = params
         self._speed_planners: dict[int, SpeedPlanner] = {}
-        self.max_speed = min(params.max_speed, sight_speed(  # [m/s]
-            params.sight_range, params.acc.modes, A_EMERGENCY))
+        self.max_speed = params.max_speed  # [m/s]
+        self.sight_speed = sight_speed(  # [m/s] the cap of the forward sensing range
+            params.sight_range, params.acc.modes, A_EMERGENCY)
         self.reset()
 
     def reset(self) -> None:
@@ -200,11 +201,12 @@ class Planner:
 
     def speed_for(self, station: float, set_speed: float | None = None) -> SpeedTarget:
         """The map's speed target for the car's centre at ``station`` [m] (at ``set_speed``
-        [m/s], by default the driver's set speed)."""
+        [m/s], by default the driver's set speed), never above the sight cap (its binding
+        SIGHT where the cap is what limits it)."""
         p = self.params
         return self.speed_planner.target(
             station, set_speed=p.set_speed if set_speed is None else set_speed,
-            max_speed=self.max_speed)
+            max_speed=self.max_speed, sight_speed=self.sight_speed)
 
     def update(self, inp: PlannerInput) -> Plan:
         """The plan for this tick (module doc)."""

@@ -32,6 +32,7 @@ class PlannedSpeed:
 BINDING_SOURCE = {  # the map plan's binding constraint, as a source of the plan's speed
     Binding.SET_SPEED: SpeedSource.SET_SPEED,
     Binding.MAX_SPEED: SpeedSource.SET_SPEED,  # the set speed, capped at the vehicle's
+    Binding.SIGHT: SpeedSource.SIGHT,  # capped at what the forward sensing range covers
     Binding.LIMIT: SpeedSource.LIMIT,
     Binding.LIMIT_AHEAD: SpeedSource.LIMIT,
     Binding.CURVE: SpeedSource.CURVE,

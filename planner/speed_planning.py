@@ -3,7 +3,9 @@
 Along one lane of the map (parameters `SpeedPlanningParams`; speeds [m/s], distances [m]),
 the target is the minimum of
 
-* the driver's set speed and the vehicle's maximum speed,
+* the driver's set speed, the vehicle's maximum speed and the sight speed (the fastest
+  speed whose following gap and stop the forward sensing covers: `planner.fsm.acc.sight_speed`,
+  given by the planner),
 * the posted limit in force at the FRONT BUMPER, less ``limit_margin``,
 * the curvature speed ``sqrt(a_lat_max / |kappa|)`` of the lane between the car's centre and
   its front axle,
@@ -62,6 +64,7 @@ class Binding(enum.Enum):
 
     SET_SPEED = "set_speed"  # the driver's set speed
     MAX_SPEED = "max_speed"  # the vehicle's maximum speed
+    SIGHT = "sight"  # the fastest speed the forward sensing range covers
     LIMIT = "limit"  # the posted limit in force at the front bumper
     LIMIT_AHEAD = "limit_ahead"  # braking towards a lower posting ahead
     CURVE = "curve"  # the curvature speed between the car's centre and front axle
@@ -178,11 +181,12 @@ class SpeedPlanner:
 
     # -- the target -----------------------------------------------------------------------------
 
-    def target(self, s: float, *, set_speed: float, max_speed: float) -> SpeedTarget:
+    def target(self, s: float, *, set_speed: float, max_speed: float,
+               sight_speed: float = math.inf) -> SpeedTarget:
         """The target speed for a car whose centre is at station ``s`` [m] of the lane.
 
-        ``set_speed`` and ``max_speed`` [m/s]. Ties go to the first of: set speed, max
-        speed, limit, curve now, curve ahead, limit ahead.
+        ``set_speed``, ``max_speed`` and ``sight_speed`` [m/s]. Ties go to the first of: set
+        speed, max speed, sight, limit, curve now, curve ahead, limit ahead.
         """
         p = self.params
         s_front = self.front_station(s)
@@ -191,6 +195,7 @@ class SpeedPlanner:
         candidates = [
             (set_speed, Binding.SET_SPEED, 0.0),
             (max_speed, Binding.MAX_SPEED, 0.0),
+            (sight_speed, Binding.SIGHT, 0.0),
             (limit_at_front - p.limit_margin, Binding.LIMIT, 0.0),
             *self._curve_constraints(s, s_axle),
             *self._limit_constraints(s_front),

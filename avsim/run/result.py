@@ -1,5 +1,7 @@
 """The result file (`--json`) of a run, as SCENARIO_FORMAT.md specifies it: strict JSON,
-every number finite or null (`dumps` refuses anything else).
+every number finite or null (`dumps` refuses anything else). Beside the sensor profile,
+`localisation` says where the stack's pose came from and the receiver's expected error
+(`world.sensors.setup.localisation`).
 
 ``verdict`` says how the run ended (`avsim.run.verdict`: pass, fail, error, interrupted);
 ``passed`` is true only for pass; ``error`` is the exception that ended a run in error
@@ -11,6 +13,8 @@ import json
 import math
 from pathlib import Path
 from typing import TYPE_CHECKING
+
+from world.sensors.setup import Localisation, Profile, localisation
 
 if TYPE_CHECKING:
     from avsim.run.runner import RunResult
@@ -30,6 +34,7 @@ def result_json(result: RunResult, file: str | Path, recording: Path, profile: s
         "file": str(file),
         "seed": scenario.seed,
         "profile": profile,
+        "localisation": run_localisation(result, profile).as_json(),
         "renderer": result.renderer,
         "verdict": result.verdict.value,
         "passed": result.passed,
@@ -63,6 +68,12 @@ def headline(payload: dict[str, object]) -> str:
     if payload.get("interrupted"):
         return f"{so_far} so far (interrupted at {t:.1f} s)"
     return so_far
+
+
+def run_localisation(result: RunResult, profile: str) -> Localisation:
+    """The pose's source of a run with sensor profile `profile` ("none": no profile)."""
+    return localisation(None if profile == "none" else Profile(profile),
+                        result.scenario.world.sensors.gnss)
 
 
 def dumps(payload: object) -> str:

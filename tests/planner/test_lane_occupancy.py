@@ -37,10 +37,11 @@ def traffic(*tracks: Track, t: float = 1.0) -> dict[int, LaneTraffic]:
 def test_neighbours_ahead_behind_and_alongside() -> None:
     lt = traffic(car(150.0, 0.1, 8.0, 1), car(130.0, 0.0, 9.0, 2), car(60.0, W, 20.0, 3),
                  car(102.0, W + 0.2, 14.0, 4))
-    assert lt[0].ahead == Neighbour(2, 1.0, pytest.approx(30.0 - 2.3 - 2.4), 9.0, 0.0, 0.9)
+    assert lt[0].ahead == Neighbour(2, 1.0, pytest.approx(30.0 - 2.3 - 2.4), 9.0, 0.0, 0.9,
+                                    pytest.approx(4.6))
     assert lt[0].behind is None and not lt[0].alongside
     assert lt[1].behind == Neighbour(3, 1.0, pytest.approx(40.0 - 2.3 - 2.4), 20.0,
-                                     pytest.approx(W), 0.9)
+                                     pytest.approx(W), 0.9, pytest.approx(4.6))
     assert lt[1].alongside and lt[1].ahead is None
 
 

@@ -157,3 +157,19 @@ def test_not_engaged_the_driver_holds_the_set_speed_whatever_is_ahead() -> None:
     assert plan.acc_mode is not AccMode.ACC_OFF and plan.lead is not None
     assert plan.speed_source is SpeedSource.FOLLOWING and plan.target_speed < 20.0
     assert [c.source for c in plan.changes if c.machine == "acc"] == ["acc_off"]
+
+
+@pytest.mark.parametrize(("set_kph", "source"), [(100.0, SpeedSource.SIGHT),
+                                                  (80.0, SpeedSource.SET_SPEED)])
+def test_the_sight_cap_is_its_own_speed_source(set_kph: float, source: SpeedSource) -> None:
+    """A set speed above what the forward sensing range covers (about 91 km/h) is capped,
+    and the plan says the sight cap set the speed, not the set speed; below it the set
+    speed binds."""
+    road = straight_road("real", 2000.0, 130.0)
+    p = planner(road, lane=0, set_kph=set_kph)
+    plan = p.update(PlannerInput(ego_on(road, 0, 200.0, 0.0, 25.0)))
+    assert plan.target_speed == pytest.approx(min(set_kph * KPH, p.sight_speed))
+    assert 90.0 * KPH < p.sight_speed < 92.0 * KPH
+    assert plan.speed_source is source
+    assert p.speed_for(200.0).binding is (Binding.SIGHT if source is SpeedSource.SIGHT
+                                          else Binding.SET_SPEED)

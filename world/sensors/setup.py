@@ -23,6 +23,15 @@ Cameras have an 80 deg horizontal field of view. The LiDAR is VLP-16-like: chann
 vehicle frame's origin is on the ground, the base link's origin `CarGeometry.ride_height`
 above it: the wheel radius less the tyres' static compression).
 The scenario's `sensors.lidar` block sets range noise and dropout.
+
+Without a profile (`--profile none`) the car has no camera and no LiDAR: the stack sees no
+lane and no object, and its pose is the scenario's GNSS receiver (`sensors.gnss`, the
+`consumer` preset by default: a wandering bias of 1.2 m 1-sigma per axis) + odometry, placed
+on the HD map, never corrected across the lane. The car then keeps its lane only as well as
+the receiver places it. This is no privileged mode: the stack sees only its sensors, and a
+run that checks planning and control without perception names an accurate receiver
+(`sensors.gnss: {preset: rtk}`, 5 cm). `localisation` states the pose's source and its
+expected error for the run's header and result file.
 """
 
 from __future__ import annotations
@@ -34,7 +43,7 @@ from dataclasses import dataclass, replace
 from vehicle_urdf import MountPose, read_geometry, read_sensor_mounts
 from world.core.rates import CAR_SENSORS, PROFILE_SENSORS, SensorTiming
 from world.frames import CameraInfo, LidarInfo, SensorMount
-from world.spec import LidarNoiseSpec
+from world.spec import GNSS_PRESETS, GnssSpec, LidarNoiseSpec
 
 CAMERA_FOV = math.radians(80.0)  # [rad] horizontal
 LIDAR_ELEVATIONS = tuple(math.radians(e) for e in range(-15, 16, 2))  # [rad] 16 channels
@@ -121,3 +130,43 @@ def sensor_timings(setup: SensorSetup | None) -> tuple[tuple[str, SensorTiming],
     profile's cameras (front first) and LiDAR (none without a profile), then the sensors on
     every car (GNSS, odometry)."""
     return (setup.timings if setup is not None else ()) + tuple(CAR_SENSORS.items())
+
+
+@dataclass(frozen=True, slots=True)
+class Localisation:
+    """Where the stack's pose comes from in a run (module doc), as the run's header and the
+    result file state it."""
+
+    source: str  # what the pose is made of
+    receiver: str  # the GNSS receiver: its preset's name (`world.spec.GNSS_PRESETS`), or custom
+    error: float  # [m] the receiver's expected position error per axis: its stated 1-sigma
+    #   (white noise and wandering bias) plus the constant bias's size
+    privileged: bool  # the pose is the truth, not the sensors' (never, in this project)
+    note: str  # one line for the run's header
+
+    def as_json(self) -> dict[str, object]:
+        return {"source": self.source, "receiver": self.receiver,
+                "error": round(self.error, 4), "privileged": self.privileged}
+
+
+def receiver_name(gnss: GnssSpec) -> str:
+    """The preset `gnss` is (`world.spec.GNSS_PRESETS`), or "custom" when knobs changed it."""
+    return next((name for name, spec in GNSS_PRESETS.items() if spec == gnss), "custom")
+
+
+def localisation(profile: Profile | None, gnss: GnssSpec) -> Localisation:
+    """The pose's source for a run with `profile` (None: `--profile none`) and the scenario's
+    receiver `gnss` (module doc)."""
+    receiver = receiver_name(gnss)
+    error = gnss.stated_sigma + math.hypot(*gnss.bias)  # [m]
+    fix = f"GNSS ({receiver} receiver, {error:.2f} m 1-sigma per axis) + odometry"
+    if profile is None:
+        return Localisation(
+            "gnss+odometry", receiver, error, False,
+            f"profile none: no camera or LiDAR (no lane, no objects seen); the pose is {fix} "
+            f"on the map: expect lane-keeping errors of the receiver's size ({error:.2f} m); "
+            "sensors.gnss: {preset: rtk} for 5 cm")
+    return Localisation(
+        "gnss+odometry+camera_lane", receiver, error, False,
+        f"profile {profile.value}: the pose is {fix}, corrected across the lane by the front "
+        "camera's lane; objects from the LiDAR")
