@@ -1,7 +1,8 @@
 """The `avsim` command line (SCENARIO_FORMAT.md, "Command line").
 
 Exit status: 0 every criterion passed, 1 one failed, 2 bad input (one line on stderr naming
-the file, the key and the problem; no traceback; no output file written).
+the file, the key and the problem; no traceback; no output file written), 4 an output could
+not be written (docs/cli.md, "Outputs").
 """
 
 from __future__ import annotations
@@ -21,6 +22,14 @@ from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.table import Table
 
 from avsim.files import write_atomic
+from avsim.outputs import (
+    Output,
+    OutputError,
+    RunFiles,
+    check_outputs,
+    claim_outputs,
+    deliver,
+)
 from avsim.run.interrupts import Interrupts
 from avsim.run.result import dumps, result_json
 from avsim.scenario.load import ScenarioError, bundled_scenarios, load_scenario
@@ -34,6 +43,8 @@ if TYPE_CHECKING:
 PROFILES = ("fast", "default", "paper", "none")  # sensor profiles (`world.sensors.setup`)
 SENSING = ("auto", "inline", "process")  # where the cameras render
 EXIT_FAILED, EXIT_BAD_INPUT = 1, 2  # exit statuses (module doc)
+EXIT_ERROR = 3  # the run ended in `error`
+EXIT_OUTPUT = 4  # an output could not be written (docs/cli.md, "Outputs")
 PARAMETER_PREFIX = "parameters."  # `--param NAME=V` is `--set parameters.NAME=V`
 PLOT_NEXT_TO_RECORDING = "\0next-to-recording"  # `--plot` given without a file name
 
@@ -44,15 +55,18 @@ def _bad_input(message: str) -> NoReturn:
     sys.exit(EXIT_BAD_INPUT)
 
 
-def _writable(path: Path, what: str) -> None:
-    """Bad input unless `path` can be created: its nearest existing ancestor is a directory."""
-    if path.is_dir():
-        _bad_input(f"{path}: {what}: is a directory")
-    for ancestor in path.absolute().parents:
-        if ancestor.exists():
-            if not ancestor.is_dir():
-                _bad_input(f"{path}: {what}: {ancestor} is not a directory")
-            return
+def _output_failed(message: str) -> NoReturn:
+    """Print `message` as one error line on stderr and exit with `EXIT_OUTPUT`."""
+    click.echo(f"avsim: error: {message}", err=True)
+    sys.exit(EXIT_OUTPUT)
+
+
+def _writable(outputs: Sequence[Output], inputs: Sequence[Path]) -> None:
+    """Bad input unless every output can be written (`avsim.outputs.check_outputs`)."""
+    try:
+        check_outputs(outputs, inputs)
+    except OutputError as exc:
+        _bad_input(str(exc))
 
 
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})
@@ -106,35 +120,35 @@ def run(scenario: str, out: Path | None, json_path: Path | None, profile: str, s
         _bad_input(str(exc))
     out = out if out is not None else Path("runs") / f"{loaded.name}.rrd"
     json_path = json_path if json_path is not None else out.with_suffix(".json")
-    _writable(out, "--out")
-    _writable(json_path, "--json")
     plot_path = None if plot is None else (
         out.with_suffix(".png") if plot == PLOT_NEXT_TO_RECORDING else Path(plot))
-    if plot_path is not None:
-        _writable(plot_path, "--plot")
+    files = RunFiles(out, json_path, plot_path)
+    _writable(files.outputs(), (*loaded.sources, *([criteria] if criteria else [])))
     from world.core.quiet import quiet_c_output
 
     with quiet_c_output():  # PyBullet's build banner
         from avsim.run.runner import Runner  # heavy: only once the input is known good
         from world.sensors.setup import Profile
 
-    out.parent.mkdir(parents=True, exist_ok=True)
-    partial = out.with_name(f".{out.name}.partial")
-    with Interrupts() as stop:  # Ctrl-C / SIGTERM end the run at its tick, files kept
-        runner = Runner(loaded, partial, None if profile == "none" else Profile(profile),
-                        sensing)
+    try:  # held from before the run until its files are written: one writer per file
+        claim = claim_outputs(files)
+    except OutputError as exc:
+        _output_failed(str(exc))
+    with claim, Interrupts() as stop:  # Ctrl-C / SIGTERM end the run at its tick, files kept
+        runner = Runner(loaded, claim.partial,
+                        None if profile == "none" else Profile(profile), sensing)
         stop.on_signal(runner.interrupt)
         result = _run_with_progress(runner, loaded.duration, not no_progress)
-        partial.replace(out)
         payload = result_json(result, scenario, out, profile)
-        write_atomic(json_path, dumps(payload))
-        if plot_path is not None:
-            from avsim.report.speed_plot import plot_speed_profile
+        from avsim.report.speed_plot import plot_speed_profile
 
-            plot_speed_profile(result, plot_path)
+        unwritten = deliver(files, claim, loaded.name, dumps(payload),
+                            lambda path: plot_speed_profile(result, path))
         _print_verdict(payload)
     if stop.exit_status is not None:
         sys.exit(stop.exit_status)
+    if unwritten is not None:
+        _output_failed(unwritten)
     sys.exit(0 if result.passed else EXIT_FAILED)
 
 
@@ -399,7 +413,7 @@ def snapshot(recording: Path, at: float, out: Path | None, size: tuple[int, int]
     from avsim.record.snapshot import SnapshotError, render_snapshot
 
     out = out if out is not None else recording.with_name(f"{recording.stem}_{at:g}s.png")
-    _writable(out, "--out")
+    _writable([Output("--out", out)], [recording])
     try:
         render_snapshot(recording, at, out, width=size[0], height=size[1])
     except SnapshotError as exc:

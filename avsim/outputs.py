@@ -244,21 +244,31 @@ class RunFiles:
         return (*named, *([Output("--plot", self.plot)] if self.plot is not None else []))
 
 
-@dataclass(slots=True)
 class Claim:
-    """What `claimed` holds for a run: the recording's temporary file, and whether it is to
-    be left for the user (`deliver` could not rename it into place)."""
+    """What `claim_outputs` holds for a run, until the end of its `with` block: the outputs'
+    locks and the recording's temporary file `partial`, removed at the end unless `deliver`
+    renamed it into place or kept it for the user (`keep`)."""
 
-    partial: Path  # the recording's temporary file, created exclusively beside `--out`
-    keep: bool = False  # leave `partial` at the end (else it is removed if still there)
+    def __init__(self, partial: Path, locks: ExitStack) -> None:
+        self.partial = partial  # the recording's temporary file, created beside `--out`
+        self.keep = False  # leave `partial` at the end
+        self._locks = locks
+
+    def __enter__(self) -> Claim:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        try:
+            if not self.keep:
+                self.partial.unlink(missing_ok=True)
+        finally:
+            self._locks.close()
 
 
-@contextmanager
-def claimed(files: RunFiles) -> Iterator[Claim]:
-    """Make the folders, hold the locks and yield the claim whose `partial` the run records
-    to (`avsim.files.temporary_beside`); `partial` is removed at the end unless `deliver`
-    renamed it into place or kept it. `OutputError` (`OutputBusyError` for a lock another
-    command holds) before the block."""
+def claim_outputs(files: RunFiles) -> Claim:
+    """Make the outputs' folders, take their locks (`output_lock`) and create the
+    recording's temporary file (`avsim.files.temporary_beside`), for the run to write.
+    `OutputError` (`OutputBusyError` for a lock another command holds), nothing held then."""
     outputs = files.outputs()
     for output in outputs:
         try:
@@ -266,17 +276,15 @@ def claimed(files: RunFiles) -> Iterator[Claim]:
         except OSError as exc:
             raise OutputError(output.path, output.option,
                               f"its folder cannot be made ({exc.strerror})") from None
-    with output_lock(outputs):
+    with ExitStack() as locks:
+        locks.enter_context(output_lock(outputs))
         try:
-            claim = Claim(temporary_beside(files.recording))
+            partial = temporary_beside(files.recording)
         except OSError as exc:
             raise OutputError(files.recording, "--out", f"cannot create a temporary file "
                               f"beside it ({exc.strerror})") from None
-        try:
-            yield claim
-        finally:
-            if not claim.keep:
-                claim.partial.unlink(missing_ok=True)
+        return Claim(partial, locks.pop_all())
+    raise AssertionError("unreachable")  # the block returns or raises
 
 
 def deliver(files: RunFiles, claim: Claim, name: str, result_text: str,

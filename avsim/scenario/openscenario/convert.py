@@ -81,7 +81,8 @@ def load_xosc(path: Path, overrides: Mapping[str, object] | None = None,
     `NAME.criteria.yaml` beside it if there is one); `ScenarioError` (one line) for
     anything it cannot run."""
     params, rest = split_overrides(overrides or {})
-    side = load_sidecar(sidecar_path(path, criteria_file), rest)
+    side_file = sidecar_path(path, criteria_file)
+    side = load_sidecar(side_file, rest)
     osc = load_openscenario(path, params)
     if osc.road_network is None:
         raise ScenarioError(str(path), "RoadNetwork", "no OpenDRIVE LogicFile: avsim needs "
@@ -108,7 +109,13 @@ def load_xosc(path: Path, overrides: Mapping[str, object] | None = None,
     return Scenario(name=_name(path), description=osc.description, situation="openscenario",
                     duration=side.duration, world=world,
                     driver=DriverSettings(set_speed=ego_spec.speed), criteria=side.criteria,
-                    story=program)
+                    story=program, sources=_sources(path, osc.road_network, side_file))
+
+
+def _sources(*files: Path | None) -> tuple[Path, ...]:
+    """The files the scenario was read from (its catalogs are `.xosc` files: no command
+    writes over an existing one, `avsim.outputs`)."""
+    return tuple(f for f in files if f is not None)
 
 
 def _name(path: Path) -> str:
