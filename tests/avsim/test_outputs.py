@@ -13,6 +13,7 @@ import errno
 import json
 import os
 import shutil
+import tempfile
 from collections.abc import Callable
 from pathlib import Path
 
@@ -169,15 +170,16 @@ def test_a_folder_that_cannot_be_written_is_refused_before_the_run(
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """`os.access` says yes to root: the real check (a file created there) says no."""
     scenario = _scenario(tmp_path)
-    real = avsim.outputs.tempfile.mkstemp
+    real = tempfile.mkstemp
 
-    def read_only(*args: object, **kwargs: object) -> tuple[int, str]:
-        if Path(str(kwargs.get("dir"))).resolve() == (tmp_path / "ro").resolve():
+    def read_only(suffix: str | None = None, prefix: str | None = None,
+                  dir: str | Path | None = None) -> tuple[int, str]:
+        if dir is not None and Path(dir).resolve() == (tmp_path / "ro").resolve():
             raise OSError(errno.EROFS, os.strerror(errno.EROFS))
-        return real(*args, **kwargs)  # type: ignore[call-overload,no-any-return]
+        return real(suffix, prefix, dir)
 
     (tmp_path / "ro").mkdir()
-    monkeypatch.setattr(avsim.outputs.tempfile, "mkstemp", read_only)
+    monkeypatch.setattr(tempfile, "mkstemp", read_only)
     line = _one_line_error(_invoke("run", scenario, "--out", tmp_path / "ro" / "x.rrd", *SHORT),
                            EXIT_BAD_INPUT)
     assert "--out: cannot write in" in line
@@ -224,9 +226,9 @@ def test_a_second_command_writing_the_same_output_is_refused(tmp_path: Path) -> 
 
 def test_a_lock_is_exclusive_and_its_file_is_never_followed(tmp_path: Path) -> None:
     out = Output("--out", tmp_path / "x.rrd")
-    with output_lock([out]), pytest.raises(OutputBusyError):
-        with output_lock([Output("--out", tmp_path / "sub" / ".." / "x.rrd")]):
-            pass  # pragma: no cover
+    again = Output("--out", tmp_path / "sub" / ".." / "x.rrd")
+    with output_lock([out]), pytest.raises(OutputBusyError), output_lock([again]):
+        pass  # pragma: no cover
     victim = tmp_path / "victim"
     victim.write_text("precious")
     lock_path(out.path).symlink_to(victim)
