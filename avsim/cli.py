@@ -61,6 +61,17 @@ def _output_failed(message: str) -> NoReturn:
     sys.exit(EXIT_OUTPUT)
 
 
+def _exit(interrupted: int | None, unwritten: str | None, status: int) -> NoReturn:
+    """End a command that ran: the line of an output that could not be written (if any) on
+    stderr, then the interrupt's exit status, else `EXIT_OUTPUT` for that output, else
+    `status`."""
+    if unwritten is not None:
+        click.echo(f"avsim: error: {unwritten}", err=True)
+    if interrupted:
+        sys.exit(interrupted)
+    sys.exit(EXIT_OUTPUT if unwritten is not None else status)
+
+
 def _writable(outputs: Sequence[Output], inputs: Sequence[Path]) -> None:
     """Bad input unless every output can be written (`avsim.outputs.check_outputs`)."""
     try:
@@ -145,11 +156,7 @@ def run(scenario: str, out: Path | None, json_path: Path | None, profile: str, s
         unwritten = deliver(files, claim, loaded.name, dumps(payload),
                             lambda path: plot_speed_profile(result, path))
         _print_verdict(payload)
-    if stop.exit_status is not None:
-        sys.exit(stop.exit_status)
-    if unwritten is not None:
-        _output_failed(unwritten)
-    sys.exit(0 if result.passed else EXIT_FAILED)
+    _exit(stop.exit_status, unwritten, 0 if result.passed else EXIT_FAILED)
 
 
 def _run_with_progress(runner: Runner, duration: float, show: bool) -> RunResult:
@@ -279,8 +286,9 @@ def suite(paths: tuple[str, ...], out: Path, jobs: int | None, executor: str,
         _bad_input(str(exc))
     with Interrupts() as stop:  # Ctrl-C / SIGTERM: finished runs and reports are kept
         outcomes = _execute(planned, executor, jobs, address, stop)
-        _report(outcomes, out, f"avsim suite ({len(outcomes)} runs)", snapshots)
-    sys.exit(stop.exit_status or batch.exit_status(outcomes))
+        unwritten = batch.reports_written(outcomes, out, lambda: _report(
+            outcomes, out, f"avsim suite ({len(outcomes)} runs)", snapshots))
+    _exit(stop.exit_status, unwritten, batch.exit_status(outcomes))
 
 
 @main.command()
@@ -320,10 +328,14 @@ def sweep(scenario: str, sets: tuple[str, ...], params: tuple[str, ...], out: Pa
         _bad_input(str(exc))
     with Interrupts() as stop:  # Ctrl-C / SIGTERM: finished runs and reports are kept
         outcomes = _execute(planned, executor, jobs, address, stop)
-        _report(outcomes, out, f"avsim sweep {name} ({len(outcomes)} runs)", snapshots)
-        _sweep_report(outcomes, out, [a.path for a in axes if len(a.values) > 1],
-                      [a.path for a in axes], metric, name)
-    sys.exit(stop.exit_status or batch.exit_status(outcomes))
+
+        def reports() -> None:
+            _report(outcomes, out, f"avsim sweep {name} ({len(outcomes)} runs)", snapshots)
+            _sweep_report(outcomes, out, [a.path for a in axes if len(a.values) > 1],
+                          [a.path for a in axes], metric, name)
+
+        unwritten = batch.reports_written(outcomes, out, reports)
+    _exit(stop.exit_status, unwritten, batch.exit_status(outcomes))
 
 
 def _execute(planned: Sequence[RunJob], executor: str, jobs: int | None,

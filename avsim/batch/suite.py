@@ -14,7 +14,7 @@
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -25,7 +25,14 @@ from rich.progress import Progress as RichProgress
 from avsim.batch.executors import Executor, Progress
 from avsim.batch.jobs import RunJob, RunOutcome, Status
 from avsim.files import write_atomic
-from avsim.outputs import Output, OutputError, check_outputs, identity, same_file
+from avsim.outputs import (
+    Output,
+    OutputError,
+    check_outputs,
+    identity,
+    keep_result,
+    same_file,
+)
 from avsim.run.interrupts import Interrupts
 from avsim.run.result import dumps
 from avsim.scenario.load import bundled_scenarios, load_scenario
@@ -249,6 +256,23 @@ def write_reports(outcomes: Sequence[RunOutcome], out_dir: Path, title: str,
     write_atomic(out_dir / SUMMARY,
                  summary_markdown(outcomes, title=title, out_dir=out_dir, snapshots=snapshots))
     write_atomic(out_dir / RESULTS, dumps(results_json(outcomes)))
+
+
+def reports_written(outcomes: Sequence[RunOutcome], out_dir: Path,
+                    write: Callable[[], object]) -> str | None:
+    """Call `write` (the batch's reports); None when it wrote them. When a write fails
+    (a read-only or removed folder, a full disk) one line instead: what failed and where
+    every run's result is kept (`avsim.outputs.keep_result`), for exit status 4."""
+    try:
+        write()
+    except OSError as exc:
+        line = f"{exc.filename or out_dir}: --out: could not be written ({exc.strerror or exc})"
+        try:
+            kept = keep_result("batch", dumps(results_json(outcomes)))
+        except OSError as again:
+            return f"{line}; the results could not be kept either ({again.strerror or again})"
+        return f"{line}; the results are kept in {kept}"
+    return None
 
 
 def results_json(outcomes: Sequence[RunOutcome]) -> list[dict[str, object]]:

@@ -13,6 +13,7 @@ import errno
 import json
 import os
 import shutil
+import stat
 import tempfile
 from collections.abc import Callable
 from pathlib import Path
@@ -22,6 +23,7 @@ from click.testing import CliRunner, Result
 
 import avsim.outputs
 from avsim.batch import suite as batch
+from avsim.batch.jobs import RunJob, RunOutcome, Status
 from avsim.cli import EXIT_BAD_INPUT, EXIT_OUTPUT, main
 from avsim.files import NAME_MAX, temporary_beside, write_atomic
 from avsim.outputs import (
@@ -148,12 +150,19 @@ def test_snapshot_out_equal_to_its_recording_is_refused(tmp_path: Path) -> None:
 # ---- checked before the run ------------------------------------------------------------------
 
 
-@pytest.mark.parametrize("target", ["/dev/null", "/dev/full", "fifo", "directory"])
+@pytest.mark.parametrize("target", ["device", "fifo", "directory"])
 @pytest.mark.parametrize("option", ["--out", "--json"])
 def test_an_output_that_is_not_a_regular_file_is_refused(tmp_path: Path, target: str,
                                                          option: str) -> None:
+    """Nodes made here (a copy of /dev/null's device, a FIFO, a folder): the command is not
+    pointed at the real /dev/null, which a regression would replace with a file."""
     scenario = _scenario(tmp_path)
-    path = Path(target) if target.startswith("/") else tmp_path / target
+    path = tmp_path / target
+    if target == "device":
+        try:
+            os.mknod(path, 0o666 | stat.S_IFCHR, os.stat("/dev/null").st_rdev)
+        except PermissionError:
+            pytest.skip("making a device node needs CAP_MKNOD")
     if target == "fifo":
         os.mkfifo(path)
     if target == "directory":
@@ -164,6 +173,12 @@ def test_an_output_that_is_not_a_regular_file_is_refused(tmp_path: Path, target:
     line = _one_line_error(_invoke("run", scenario, *args, *SHORT), EXIT_BAD_INPUT)
     assert option in line and ("regular file" in line or "directory" in line), line
     assert path.stat().st_mode == mode  # still the device, FIFO or directory
+
+
+@pytest.mark.parametrize("device", ["/dev/null", "/dev/full", "/dev/zero"])
+def test_the_system_devices_are_refused_as_outputs(device: str) -> None:
+    with pytest.raises(OutputError, match="not a regular file"):
+        check_outputs([Output("--json", Path(device))], [])
 
 
 def test_a_folder_that_cannot_be_written_is_refused_before_the_run(
@@ -332,3 +347,20 @@ def test_a_batch_into_its_scenarios_folder_never_writes_over_one(tmp_path: Path)
     with pytest.raises(batch.BatchError, match="is an input of the batch"):
         batch.plan([(None, str(scenario), {})], tmp_path, "none")
     assert batch.plan([(None, str(scenario), {})], tmp_path / "out", "none")
+
+
+def test_reports_that_cannot_be_written_keep_the_results(tmp_path: Path,
+                                                        monkeypatch: pytest.MonkeyPatch) -> None:
+    """A full disk when a batch writes its reports: one line and every run's result kept."""
+    monkeypatch.setattr(batch, "write_atomic", _failing(errno.ENOSPC))
+    job = RunJob("a", "a.yaml", tmp_path)
+    outcomes = [RunOutcome(job, Status.BAD_INPUT, error="a.yaml: x: bad")]
+    line = batch.reports_written(outcomes, tmp_path,
+                                 lambda: batch.write_reports(outcomes, tmp_path, "t", {}))
+    assert line is not None and "--out: could not be written (No space left" in line
+    kept = Path(line.split("the results are kept in ")[1])
+    try:
+        assert json.loads(kept.read_text())[0]["error"] == "a.yaml: x: bad"
+    finally:
+        kept.unlink()
+    assert batch.reports_written(outcomes, tmp_path, lambda: None) is None
