@@ -3,8 +3,9 @@
 Exit status: 0 every criterion passed, 1 one failed, 2 bad input (one line on stderr naming
 the file, the key and the problem; no traceback; no output file written), 3 the run ended in
 error (an exception in a stage: one line on stderr, the traceback in the result file),
-130 / 143 interrupted by SIGINT / SIGTERM (`avsim.run.interrupts`). A run's status is its
-verdict's (`avsim.run.verdict`); a batch's is `avsim.batch.suite.exit_status`.
+4 an output could not be written (docs/cli.md, "Outputs"), 130 / 143 interrupted by SIGINT /
+SIGTERM (`avsim.run.interrupts`). A run's status is its verdict's (`avsim.run.verdict`); a
+batch's is `avsim.batch.suite.exit_status`.
 """
 
 from __future__ import annotations
@@ -24,6 +25,14 @@ from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.table import Table
 
 from avsim.files import write_atomic
+from avsim.outputs import (
+    Output,
+    OutputError,
+    RunFiles,
+    check_outputs,
+    claim_outputs,
+    deliver,
+)
 from avsim.run.interrupts import ExitAtOnce, Interrupts
 from avsim.run.result import dumps, headline, result_json
 from avsim.run.verdict import RunError, RunVerdict
@@ -37,7 +46,9 @@ if TYPE_CHECKING:
 
 PROFILES = ("fast", "default", "paper", "none")  # sensor profiles (`world.sensors.setup`)
 SENSING = ("auto", "inline", "process")  # where the cameras render
-EXIT_FAILED, EXIT_BAD_INPUT, EXIT_ERROR = 1, 2, 3  # exit statuses (module doc)
+EXIT_FAILED, EXIT_BAD_INPUT = 1, 2  # exit statuses (module doc)
+EXIT_ERROR = 3  # the run ended in `error`
+EXIT_OUTPUT = 4  # an output could not be written (docs/cli.md, "Outputs")
 PARAMETER_PREFIX = "parameters."  # `--param NAME=V` is `--set parameters.NAME=V`
 PLOT_NEXT_TO_RECORDING = "\0next-to-recording"  # `--plot` given without a file name
 
@@ -48,15 +59,29 @@ def _bad_input(message: str) -> NoReturn:
     sys.exit(EXIT_BAD_INPUT)
 
 
-def _writable(path: Path, what: str) -> None:
-    """Bad input unless `path` can be created: its nearest existing ancestor is a directory."""
-    if path.is_dir():
-        _bad_input(f"{path}: {what}: is a directory")
-    for ancestor in path.absolute().parents:
-        if ancestor.exists():
-            if not ancestor.is_dir():
-                _bad_input(f"{path}: {what}: {ancestor} is not a directory")
-            return
+def _output_failed(message: str) -> NoReturn:
+    """Print `message` as one error line on stderr and exit with `EXIT_OUTPUT`."""
+    click.echo(f"avsim: error: {message}", err=True)
+    sys.exit(EXIT_OUTPUT)
+
+
+def _exit(interrupted: int | None, unwritten: str | None, status: int) -> NoReturn:
+    """End a command that ran: the line of an output that could not be written (if any) on
+    stderr, then the interrupt's exit status, else `EXIT_OUTPUT` for that output, else
+    `status`."""
+    if unwritten is not None:
+        click.echo(f"avsim: error: {unwritten}", err=True)
+    if interrupted:
+        sys.exit(interrupted)
+    sys.exit(EXIT_OUTPUT if unwritten is not None else status)
+
+
+def _writable(outputs: Sequence[Output], inputs: Sequence[Path]) -> None:
+    """Bad input unless every output can be written (`avsim.outputs.check_outputs`)."""
+    try:
+        check_outputs(outputs, inputs)
+    except OutputError as exc:
+        _bad_input(str(exc))
 
 
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})
@@ -119,50 +144,46 @@ def run(scenario: str, out: Path | None, json_path: Path | None, profile: str, s
         _bad_input(str(exc))
     out = out if out is not None else Path("runs") / f"{loaded.name}.rrd"
     json_path = json_path if json_path is not None else out.with_suffix(".json")
-    _writable(out, "--out")
-    _writable(json_path, "--json")
     plot_path = None if plot is None else (
         out.with_suffix(".png") if plot == PLOT_NEXT_TO_RECORDING else Path(plot))
-    if plot_path is not None:
-        _writable(plot_path, "--plot")
+    files = RunFiles(out, json_path, plot_path)
+    _writable(files.outputs(), (*loaded.sources, *([criteria] if criteria else [])))
     from world.core.quiet import quiet_c_output
 
     with quiet_c_output():  # PyBullet's build banner
         from avsim.run.runner import Runner  # heavy: only once the input is known good
         from world.sensors.setup import Profile, localisation
 
-    out.parent.mkdir(parents=True, exist_ok=True)
-    partial = out.with_name(f".{out.name}.partial")
-    with Interrupts() as stop:  # Ctrl-C / SIGTERM end the run at its tick, files kept
+    try:  # held from before the run until its files are written: one writer per file
+        claim = claim_outputs(files)
+    except OutputError as exc:
+        _output_failed(str(exc))
+    with claim, Interrupts() as stop:  # Ctrl-C / SIGTERM end the run at its tick, files kept
         setup = None if profile == "none" else Profile(profile)
         try:
-            runner = Runner(loaded, partial, setup, sensing)
+            runner = Runner(loaded, claim.partial, setup, sensing)
         except Exception as exc:  # the world cannot be built: a bug, exit 3, nothing kept
-            partial.unlink(missing_ok=True)
             click.echo(f"avsim: {RunError.of(exc, 0.0).line()}", err=True)
             sys.exit(EXIT_ERROR)
         click.echo(f"{loaded.name}: {localisation(setup, loaded.world.sensors.gnss).note}")
         stop.on_signal(runner.interrupt)
         result = _run_with_progress(runner, loaded.duration, not no_progress)
-        partial.replace(out)
         payload = result_json(result, scenario, out, profile)
-        write_atomic(json_path, dumps(payload))
-        if plot_path is not None:
-            from avsim.report.speed_plot import plot_speed_profile
+        from avsim.report.speed_plot import plot_speed_profile
 
-            plot_speed_profile(result, plot_path)
+        unwritten = deliver(files, claim, loaded.name, dumps(payload),
+                            lambda path: plot_speed_profile(result, path))
         _print_verdict(payload)
         if result.error is not None:
             click.echo(f"avsim: {result.error.line()}", err=True)
-        sys.exit(_exit_status(result, stop))
+    interrupted = stop.exit_status if result.verdict is RunVerdict.INTERRUPTED else None
+    _exit(interrupted, unwritten, _verdict_status(result.verdict))
 
 
-def _exit_status(result: RunResult, stop: Interrupts) -> int:
-    """The run's exit status (module doc): its verdict's; an interrupted run's is the
-    signal's."""
-    if result.verdict is RunVerdict.INTERRUPTED and stop.exit_status is not None:
-        return stop.exit_status
-    return {RunVerdict.PASS: 0, RunVerdict.FAIL: EXIT_FAILED}.get(result.verdict, EXIT_ERROR)
+def _verdict_status(verdict: RunVerdict) -> int:
+    """A run's exit status from its verdict (module doc; an interrupted run's is its
+    signal's, given to `_exit`)."""
+    return {RunVerdict.PASS: 0, RunVerdict.FAIL: EXIT_FAILED}.get(verdict, EXIT_ERROR)
 
 
 def _run_with_progress(runner: Runner, duration: float, show: bool) -> RunResult:
@@ -291,8 +312,10 @@ def suite(paths: tuple[str, ...], out: Path, jobs: int | None, executor: str,
         _bad_input(str(exc))
     with Interrupts() as stop:  # Ctrl-C / SIGTERM: finished runs and reports are kept
         outcomes = _execute(planned, executor, jobs, address, stop)
-        _report(outcomes, out, f"avsim suite ({len(outcomes)} runs)", snapshots)
-    sys.exit(batch.exit_status(outcomes, stop.exit_status))
+        unwritten = batch.reports_written(outcomes, out, lambda: _report(
+            outcomes, out, f"avsim suite ({len(outcomes)} runs)", snapshots))
+    status = batch.exit_status(outcomes, stop.exit_status)
+    _exit(status if status > EXIT_OUTPUT else None, unwritten, status)
 
 
 @main.command()
@@ -333,10 +356,15 @@ def sweep(scenario: str, sets: tuple[str, ...], params: tuple[str, ...], out: Pa
         _bad_input(str(exc))
     with Interrupts() as stop:  # Ctrl-C / SIGTERM: finished runs and reports are kept
         outcomes = _execute(planned, executor, jobs, address, stop)
-        _report(outcomes, out, f"avsim sweep {name} ({len(outcomes)} runs)", snapshots)
-        _sweep_report(outcomes, out, [a.path for a in axes if len(a.values) > 1],
-                      [a.path for a in axes], metric, name)
-    sys.exit(batch.exit_status(outcomes, stop.exit_status))
+
+        def reports() -> None:
+            _report(outcomes, out, f"avsim sweep {name} ({len(outcomes)} runs)", snapshots)
+            _sweep_report(outcomes, out, [a.path for a in axes if len(a.values) > 1],
+                          [a.path for a in axes], metric, name)
+
+        unwritten = batch.reports_written(outcomes, out, reports)
+    status = batch.exit_status(outcomes, stop.exit_status)
+    _exit(status if status > EXIT_OUTPUT else None, unwritten, status)
 
 
 def _execute(planned: Sequence[RunJob], executor: str, jobs: int | None,
@@ -427,7 +455,7 @@ def snapshot(recording: Path, at: float, out: Path | None, size: tuple[int, int]
     from avsim.record.snapshot import SnapshotError, render_snapshot
 
     out = out if out is not None else recording.with_name(f"{recording.stem}_{at:g}s.png")
-    _writable(out, "--out")
+    _writable([Output("--out", out)], [recording])
     try:
         render_snapshot(recording, at, out, width=size[0], height=size[1])
     except SnapshotError as exc:

@@ -18,7 +18,7 @@ from enum import Enum
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from avsim.files import write_atomic
+from avsim.files import publish, temporary_beside, write_atomic
 from avsim.run.verdict import RunError, RunVerdict
 from avsim.scenario.load import ScenarioError, load_scenario
 from avsim.scenario.profile_fit import check_profile
@@ -191,15 +191,17 @@ def _simulate(job: RunJob, scenario: Scenario, into: Path, progress: ProgressCal
         from avsim.run.runner import Runner
         from world.sensors.setup import Profile
 
-    into.mkdir(parents=True, exist_ok=True)
     recording = into / job.recording.name
-    partial = into / f".{recording.name}.partial"
-    profile = None if job.profile == "none" else Profile(job.profile)
-    runner = Runner(scenario, partial, profile, job.sensing)
-    if interrupts is not None:
-        interrupts.on_signal(runner.interrupt)
-    result = runner.run(progress)
-    partial.replace(recording)
+    partial = temporary_beside(recording)  # created exclusively, an unpredictable name
+    try:
+        profile = None if job.profile == "none" else Profile(job.profile)
+        runner = Runner(scenario, partial, profile, job.sensing)
+        if interrupts is not None:
+            interrupts.on_signal(runner.interrupt)
+        result = runner.run(progress)
+        publish(partial, recording)
+    finally:
+        partial.unlink(missing_ok=True)
     payload = result_json(result, job.scenario, job.recording, job.profile)
     write_atomic(into / job.result_file.name, dumps(payload))
     if job.plot:

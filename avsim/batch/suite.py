@@ -7,13 +7,14 @@
 3. The reports go into the batch's folder beside the runs' own files: ``junit.xml``,
    ``summary.md`` (with a snapshot of each failed run at its first failing moment, or at
    its end when it failed only there, in ``snapshots/``) and ``results.json`` (every run's
-   result, in job order).
+   result, in job order). A run's name is never a report's (`REPORT_NAMES`), and no run's
+   file is an input of the batch: both are refused in step 1.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -24,6 +25,14 @@ from rich.progress import Progress as RichProgress
 from avsim.batch.executors import Executor, Progress
 from avsim.batch.jobs import RunJob, RunOutcome, Status
 from avsim.files import write_atomic
+from avsim.outputs import (
+    Output,
+    OutputError,
+    check_outputs,
+    identity,
+    keep_result,
+    same_file,
+)
 from avsim.run.interrupts import Interrupts
 from avsim.run.result import dumps
 from avsim.scenario.load import bundled_scenarios, load_scenario
@@ -32,6 +41,12 @@ from avsim.scenario.openscenario.sidecar import SUFFIX as SIDECAR_SUFFIX
 from avsim.scenario.profile_fit import check_profile
 
 SNAPSHOT_DIR = "snapshots"  # the failed runs' pictures, below the batch's folder
+JUNIT, SUMMARY, RESULTS = "junit.xml", "summary.md", "results.json"  # every batch's reports
+SWEEP_CSV, SWEEP_MD, HEAT_MAP = "sweep.csv", "sweep.md", "heatmap.png"  # a sweep's reports
+REPORT_NAMES = frozenset(Path(f).stem for f in (JUNIT, SUMMARY, RESULTS, SWEEP_CSV, SWEEP_MD,
+                                                HEAT_MAP, SNAPSHOT_DIR))  # no run's name
+#   (a run writes NAME.rrd, NAME.json, NAME.png beside the reports: `results` and `heatmap`
+#   would be overwritten by a report, the others are refused too so that one rule holds)
 
 
 class BatchError(ValueError):
@@ -95,9 +110,12 @@ def plan(entries: Sequence[tuple[str | None, str, Mapping[str, object]]], out_di
          profile: str, search_paths: Sequence[Path] = ()) -> list[RunJob]:
     """Validate each (job name or None for the scenario's own, scenario, overrides) and make
     its job, which carries `search_paths` to its worker. Raises `ScenarioError` for the
-    first bad one, `BatchError` for two runs that would write the same files."""
+    first bad one, `BatchError` for two runs that would write the same files, a run named
+    like a report (`REPORT_NAMES`) or a run's file that is an input of the batch (a
+    scenario file, an OpenSCENARIO file's road or sidecar)."""
     planned: list[RunJob] = []
     names: dict[str, str] = {}
+    sources: set[Path] = set()
     for name, scenario, overrides in entries:
         loaded = load_scenario(scenario, dict(overrides), search_paths=search_paths)
         check_profile(loaded, profile, scenario)
@@ -105,22 +123,41 @@ def plan(entries: Sequence[tuple[str | None, str, Mapping[str, object]]], out_di
         if job_name in names:
             raise BatchError(f"{scenario}: name: {job_name!r} is also the name of "
                              f"{names[job_name]} (their files would collide in {out_dir})")
+        if job_name in REPORT_NAMES:
+            raise BatchError(f"{scenario}: name: {job_name!r} is the name of a report of the "
+                             f"batch (runs may not be named {', '.join(sorted(REPORT_NAMES))})")
         names[job_name] = scenario
+        sources.update(loaded.sources)
         planned.append(RunJob(job_name, scenario, out_dir, dict(overrides), profile,
                               duration=loaded.duration, search_paths=tuple(search_paths)))
+    _check_not_inputs(planned, sorted(sources))
     return planned
+
+
+def _check_not_inputs(jobs: Sequence[RunJob], sources: Sequence[Path]) -> None:
+    """`BatchError` when a run's file would be one of the batch's input files."""
+    inputs = [(source, identity(source)) for source in sources]
+    for job in jobs:
+        for file in (job.recording, job.result_file, job.plot_file):
+            try:
+                ident = identity(file)
+            except OSError as exc:
+                raise BatchError(f"{file}: --out: cannot be resolved ({exc})") from None
+            for source, source_ident in inputs:
+                if same_file(ident, source_ident):
+                    raise BatchError(f"{file}: --out: is an input of the batch ({source}): "
+                                     "avsim never writes over its inputs")
 
 
 def validate_out_dir(out_dir: Path) -> None:
     """`BatchError` unless `out_dir` is a folder or can be made: its nearest existing
-    ancestor is a directory."""
+    ancestor is a directory, where a file can be written."""
     if out_dir.exists() and not out_dir.is_dir():
         raise BatchError(f"{out_dir}: --out: not a directory")
-    for ancestor in out_dir.absolute().parents:
-        if ancestor.exists():
-            if not ancestor.is_dir():
-                raise BatchError(f"{out_dir}: --out: {ancestor} is not a directory")
-            return
+    try:
+        check_outputs([Output("--out", out_dir / RESULTS)], [])
+    except OutputError as exc:
+        raise BatchError(f"{out_dir}: --out: {exc.problem}") from None
 
 
 # ---- the live display ----------------------------------------------------------------------
@@ -217,10 +254,27 @@ def write_reports(outcomes: Sequence[RunOutcome], out_dir: Path, title: str,
     """``junit.xml``, ``summary.md`` and ``results.json`` in `out_dir`."""
     from avsim.report.suite import junit_xml, summary_markdown
 
-    write_atomic(out_dir / "junit.xml", junit_xml(outcomes, title))
-    write_atomic(out_dir / "summary.md",
+    write_atomic(out_dir / JUNIT, junit_xml(outcomes, title))
+    write_atomic(out_dir / SUMMARY,
                  summary_markdown(outcomes, title=title, out_dir=out_dir, snapshots=snapshots))
-    write_atomic(out_dir / "results.json", dumps(results_json(outcomes)))
+    write_atomic(out_dir / RESULTS, dumps(results_json(outcomes)))
+
+
+def reports_written(outcomes: Sequence[RunOutcome], out_dir: Path,
+                    write: Callable[[], object]) -> str | None:
+    """Call `write` (the batch's reports); None when it wrote them. When a write fails
+    (a read-only or removed folder, a full disk) one line instead: what failed and where
+    every run's result is kept (`avsim.outputs.keep_result`), for exit status 4."""
+    try:
+        write()
+    except OSError as exc:
+        line = f"{exc.filename or out_dir}: --out: could not be written ({exc.strerror or exc})"
+        try:
+            kept = keep_result("batch", dumps(results_json(outcomes)))
+        except OSError as again:
+            return f"{line}; the results could not be kept either ({again.strerror or again})"
+        return f"{line}; the results are kept in {kept}"
+    return None
 
 
 def results_json(outcomes: Sequence[RunOutcome]) -> list[dict[str, object]]:

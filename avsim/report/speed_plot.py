@@ -31,6 +31,7 @@ display is needed).
 
 from __future__ import annotations
 
+import io
 import math
 from functools import cache
 from pathlib import Path
@@ -41,6 +42,7 @@ from matplotlib.axes import Axes
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
+from avsim.files import write_atomic
 from avsim.report import margins
 from avsim.report.bands import BAND_ALPHA, FloatArray, draw_bands, mode_runs
 from planner.fsm.acc import AccMode
@@ -184,11 +186,7 @@ def plot_speed_profile(result: RunResult, path: Path) -> Path:
     directory is made; the file appears whole, through a temporary file beside it). Returns
     `path`."""
     fig = speed_profile_figure(result)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    partial = path.with_name(f".{path.name}.partial")
-    try:
-        fig.savefig(partial, format="png", dpi=DPI)
-        partial.replace(path)
-    finally:
-        partial.unlink(missing_ok=True)
+    png = io.BytesIO()
+    fig.savefig(png, format="png", dpi=DPI)
+    write_atomic(path, png.getvalue())
     return path

@@ -20,6 +20,7 @@ stations on the route, `after` indices, arc radii, actor ids; `checks`) and conv
 from __future__ import annotations
 
 from collections.abc import Iterator, Mapping, Sequence
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -82,7 +83,7 @@ def load_scenario(
         raw = apply_overrides(read_raw(path), overrides or {})
         model = validate(raw, overrides or {})
         _check_supported(raw)
-        return convert(model)
+        return replace(convert(model), sources=(path,))
     except LocatedError as problem:
         raise ScenarioError(shown, problem.key, problem.problem) from None
 

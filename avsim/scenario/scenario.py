@@ -12,6 +12,7 @@ stack (`avsim.run.stack`); the criteria settings choose and tune the criteria
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from pathlib import Path
 
 from avsim.criteria.registry import CriteriaSettings
 from avsim.scenario.openscenario.program import StoryProgram
@@ -42,6 +43,9 @@ class Scenario:
     #   plays it: `avsim.run.storyboard`); None: the world spec's own scripted actions
     grid: tuple[tuple[str, tuple[object, ...]], ...] = ()  # the file's test grid: key paths
     #   and their values (`avsim suite` runs every point: `avsim.batch.suite.grid_entries`)
+    sources: tuple[Path, ...] = field(default=(), compare=False)  # the files it was read
+    #   from: the scenario file, an OpenSCENARIO file's road and sidecar (`avsim.outputs`
+    #   never writes over one); not part of what the scenario is
 
     @property
     def seed(self) -> int:

@@ -84,7 +84,8 @@ def load_xosc(path: Path, overrides: Mapping[str, object] | None = None,
     it cannot run."""
     params, rest = split_overrides(overrides or {})
     roots = scenario_roots(path, search_paths)
-    side = load_sidecar(sidecar_path(path, criteria_file, roots), rest)
+    side_file = sidecar_path(path, criteria_file, roots)
+    side = load_sidecar(side_file, rest)
     osc = load_openscenario(path, params, search_paths)
     if osc.road_network is None:
         raise ScenarioError(str(path), "RoadNetwork", "no OpenDRIVE LogicFile: avsim needs "
@@ -112,7 +113,13 @@ def load_xosc(path: Path, overrides: Mapping[str, object] | None = None,
     return Scenario(name=_name(path), description=osc.description, situation="openscenario",
                     duration=side.duration, world=world,
                     driver=DriverSettings(set_speed=ego_spec.speed), criteria=side.criteria,
-                    story=program)
+                    story=program, sources=_sources(path, osc.road_network, side_file))
+
+
+def _sources(*files: Path | None) -> tuple[Path, ...]:
+    """The files the scenario was read from (its catalogs are `.xosc` files: no command
+    writes over an existing one, `avsim.outputs`)."""
+    return tuple(f for f in files if f is not None)
 
 
 def _check_spawn(path: Path, world: spec.WorldSpec, ego: str, others: list[str]) -> None:
