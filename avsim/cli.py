@@ -49,6 +49,7 @@ SENSING = ("auto", "inline", "process")  # where the cameras render
 EXIT_FAILED, EXIT_BAD_INPUT = 1, 2  # exit statuses (module doc)
 EXIT_ERROR = 3  # the run ended in `error`
 EXIT_OUTPUT = 4  # an output could not be written (docs/cli.md, "Outputs")
+EXIT_SIGNAL_BASE = 128  # interrupted: 128 + the signal's number (`avsim.run.interrupts`)
 PARAMETER_PREFIX = "parameters."  # `--param NAME=V` is `--set parameters.NAME=V`
 PLOT_NEXT_TO_RECORDING = "\0next-to-recording"  # `--plot` given without a file name
 
@@ -65,15 +66,14 @@ def _output_failed(message: str) -> NoReturn:
     sys.exit(EXIT_OUTPUT)
 
 
-def _exit(interrupted: int | None, unwritten: str | None, status: int) -> NoReturn:
-    """End a command that ran: the line of an output that could not be written (if any) on
-    stderr, then the interrupt's exit status, else `EXIT_OUTPUT` for that output, else
-    `status`."""
+def _exit(unwritten: str | None, status: int) -> NoReturn:
+    """End a command that ran with `status`: the line of an output that could not be
+    written (if any) on stderr, and `EXIT_OUTPUT` for it unless `status` is an interrupt's
+    (130 / 143), which comes first."""
     if unwritten is not None:
         click.echo(f"avsim: error: {unwritten}", err=True)
-    if interrupted:
-        sys.exit(interrupted)
-    sys.exit(EXIT_OUTPUT if unwritten is not None else status)
+    interrupted = status > EXIT_SIGNAL_BASE
+    sys.exit(EXIT_OUTPUT if unwritten is not None and not interrupted else status)
 
 
 def _writable(outputs: Sequence[Output], inputs: Sequence[Path]) -> None:
@@ -176,14 +176,16 @@ def run(scenario: str, out: Path | None, json_path: Path | None, profile: str, s
         _print_verdict(payload)
         if result.error is not None:
             click.echo(f"avsim: {result.error.line()}", err=True)
-    interrupted = stop.exit_status if result.verdict is RunVerdict.INTERRUPTED else None
-    _exit(interrupted, unwritten, _verdict_status(result.verdict))
+    status = _exit_status(result, stop)
+    _exit(unwritten, status)
 
 
-def _verdict_status(verdict: RunVerdict) -> int:
-    """A run's exit status from its verdict (module doc; an interrupted run's is its
-    signal's, given to `_exit`)."""
-    return {RunVerdict.PASS: 0, RunVerdict.FAIL: EXIT_FAILED}.get(verdict, EXIT_ERROR)
+def _exit_status(result: RunResult, stop: Interrupts) -> int:
+    """The run's exit status (module doc): its verdict's; an interrupted run's is the
+    signal's."""
+    if result.verdict is RunVerdict.INTERRUPTED and stop.exit_status is not None:
+        return stop.exit_status
+    return {RunVerdict.PASS: 0, RunVerdict.FAIL: EXIT_FAILED}.get(result.verdict, EXIT_ERROR)
 
 
 def _run_with_progress(runner: Runner, duration: float, show: bool) -> RunResult:
@@ -315,7 +317,7 @@ def suite(paths: tuple[str, ...], out: Path, jobs: int | None, executor: str,
         unwritten = batch.reports_written(outcomes, out, lambda: _report(
             outcomes, out, f"avsim suite ({len(outcomes)} runs)", snapshots))
     status = batch.exit_status(outcomes, stop.exit_status)
-    _exit(status if status > EXIT_OUTPUT else None, unwritten, status)
+    _exit(unwritten, status)
 
 
 @main.command()
@@ -364,7 +366,7 @@ def sweep(scenario: str, sets: tuple[str, ...], params: tuple[str, ...], out: Pa
 
         unwritten = batch.reports_written(outcomes, out, reports)
     status = batch.exit_status(outcomes, stop.exit_status)
-    _exit(status if status > EXIT_OUTPUT else None, unwritten, status)
+    _exit(unwritten, status)
 
 
 def _execute(planned: Sequence[RunJob], executor: str, jobs: int | None,
