@@ -24,7 +24,7 @@ from world.map.opendrive.shapes import FloatArray
 CHECKS = 65  # stations per piece where its deviation is checked
 MIN_PIECE = 1e-3  # [m] pieces are not split below this length
 SAFETY = 0.8  # the split criterion is SAFETY * tolerance (the deviation between checks)
-MAX_PIECES = 10_000  # per road: the pieces of its whole reference line (a bound on the work;
+MAX_PIECES = 5_000  # per road: the pieces of its whole reference line (a bound on the work;
 #   the curviest ALKS road, 10 km of arcs and spirals, needs 337)
 
 
@@ -68,9 +68,10 @@ def _piece(plan_view: PlanView, s0: float, s1: float) -> ArcPiece:
 
 
 def arc_spline(plan_view: PlanView, tolerance: float = 1e-3,
-               max_pieces: int = MAX_PIECES) -> list[ArcPiece]:
+               max_pieces: int | None = None) -> list[ArcPiece]:
     """The chain of pieces approximating `plan_view` within `tolerance` [m] (module doc);
-    `PieceBoundError` if it needs more than `max_pieces` pieces in all."""
+    `PieceBoundError` if it needs more than `max_pieces` (default `MAX_PIECES`) in all."""
+    max_pieces = MAX_PIECES if max_pieces is None else max_pieces
     pieces: list[ArcPiece] = []
     for g in plan_view.geometries:
         if g.length <= 0:
@@ -88,7 +89,7 @@ def arc_spline(plan_view: PlanView, tolerance: float = 1e-3,
 
 
 def _split_record(record: PlanView, s0: float, s1: float, tolerance: float,
-                  pieces: list[ArcPiece], max_pieces: int = MAX_PIECES) -> None:
+                  pieces: list[ArcPiece], max_pieces: int) -> None:
     """Append to `pieces` the pieces of one record (`record`: its end evaluated on itself,
     whatever the next record's start), halving each until it is within `tolerance`; stops
     once `pieces` holds more than `max_pieces`."""

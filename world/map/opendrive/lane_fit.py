@@ -38,7 +38,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from world.map.opendrive.arcspline import MAX_PIECES, SAFETY
+from world.map.opendrive import arcspline
+from world.map.opendrive.arcspline import SAFETY
 from world.map.opendrive.arcspline import piece_points as arc_points
 from world.map.opendrive.geometry import PlanView
 from world.map.opendrive.lanes import border_polynomials, lane_section_index
@@ -152,13 +153,14 @@ def record_starts(road: Road) -> list[float]:
 
 
 def fit_lanes(road: Road, borders: list[tuple[int, ...]], stations: list[float],
-              tolerance: float, max_pieces: int = MAX_PIECES) -> list[FittedPiece]:
+              tolerance: float, max_pieces: int | None = None) -> list[FittedPiece]:
     """The route's pieces along the whole road (module doc): lane 0's centre within
     `tolerance` [m] of the file's, every boundary within it of its cubic. `borders`: per
     lane section, the lane ids whose outer border is each boundary, right to left ([1],
     [2]: lane 0's right and left edge; id 0: the lane offset); `stations` [m]: where
-    pieces must split besides record starts; `PieceBoundError` beyond `max_pieces` pieces in
-    all."""
+    pieces must split besides record starts; `PieceBoundError` beyond `max_pieces` (default
+    `arcspline.MAX_PIECES`) pieces in all."""
+    bound = arcspline.MAX_PIECES if max_pieces is None else max_pieces
     view = road.plan_view
     cuts = sorted({view.start, view.end, *(s for s in (*record_starts(road), *stations)
                                             if view.start < s < view.end)})
@@ -166,7 +168,7 @@ def fit_lanes(road: Road, borders: list[tuple[int, ...]], stations: list[float],
     for a, b in itertools.pairwise(cuts):
         if b - a > STATION_EPS:
             section = borders[lane_section_index(road, 0.5 * (a + b))]
-            out += _fit_interval(road, section, a, b, tolerance, max_pieces - len(out))
+            out += _fit_interval(road, section, a, b, tolerance, bound - len(out))
     return out
 
 

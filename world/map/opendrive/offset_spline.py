@@ -126,10 +126,11 @@ def deviation(curve: OffsetCurve, piece: CurvePiece, checks: int = CHECKS) -> fl
 
 def offset_arc_spline(curve: OffsetCurve, a: float, b: float, tolerance: float,
                       accept: Callable[[CurvePiece], bool] | None = None,
-                      max_pieces: int = MAX_PIECES) -> list[CurvePiece]:
+                      max_pieces: int | None = None) -> list[CurvePiece]:
     """The chain of pieces approximating the curve between stations a and b within
     `tolerance` [m] and accepted by `accept` (module doc); `PieceBoundError` beyond
-    `max_pieces`."""
+    `max_pieces` (default `MAX_PIECES`)."""
+    bound = MAX_PIECES if max_pieces is None else max_pieces
     pieces: list[CurvePiece] = []
     stack = [(a, b)]
     while stack:
@@ -139,9 +140,9 @@ def offset_arc_spline(curve: OffsetCurve, a: float, b: float, tolerance: float,
                 and (accept is None or accept(piece)))
         if good or hi - lo <= MIN_PIECE:
             pieces.append(piece)
-            if len(pieces) > max_pieces:
+            if len(pieces) > bound:
                 raise PieceBoundError(f"the lanes need more arc-spline pieces than a road may "
-                                      f"have ({MAX_PIECES}; at s = {lo:g} m)")
+                                      f"have (at s = {lo:g} m)")
             continue
         mid = 0.5 * (lo + hi)
         stack.extend([(mid, hi), (lo, mid)])  # the first half is popped first

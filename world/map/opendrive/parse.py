@@ -46,7 +46,7 @@ from world.map.opendrive.xmltree import Node, parse_xml
 
 MAX_FILE_BYTES = 50 * 1024 * 1024  # [byte]
 MAX_ROADS = 100_000
-MAX_GEOMETRIES = 100_000  # planView records in the whole file
+MAX_GEOMETRIES = 5_000  # planView records in the whole file (at most `arcspline.MAX_PIECES`)
 REV_MINORS = range(4, 9)  # OpenDRIVE 1.4 .. 1.8
 LENGTH_TOLERANCE = 1e-2  # [m] the road length vs its planView's, at least
 PARAM_LENGTH_TOLERANCE = 1e-2  # [1] paramPoly3 arc length vs its record's (esmini scales)
