@@ -98,6 +98,29 @@ def expression_flood(alks: Path) -> Path:
     return path
 
 
+def worst_xodr(folder: Path) -> tuple[float, str]:
+    """[s] the OpenDRIVE reader and route builder on the worst road within the reader's
+    bounds: `MAX_GEOMETRIES` spiral records swinging between curvatures +-1 /m (the
+    tightest allowed) over the longest route, refused by the arc spline's piece bound."""
+    from tests.world.map.opendrive.roads import geometry_xml, road_xml, winding
+    from world.map.opendrive import OpenDriveError, load_opendrive
+    from world.map.opendrive.parse import MAX_GEOMETRIES, MAX_ROUTE_LENGTH
+    from world.map.opendrive.route import build_route
+
+    length = MAX_ROUTE_LENGTH / MAX_GEOMETRIES  # [m] each record
+    geoms = winding(MAX_GEOMETRIES, length, 1.0)
+    path = folder / "worst_spirals.xodr"
+    path.write_text(road_xml("".join(geometry_xml(g) for g in geoms), MAX_ROUTE_LENGTH),
+                    encoding="utf-8")
+    start = time.perf_counter()
+    try:
+        build_route(load_opendrive(path))
+        outcome = "loaded"
+    except OpenDriveError as exc:
+        outcome = exc.problem
+    return time.perf_counter() - start, outcome
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=3)
@@ -113,10 +136,13 @@ def main() -> None:
         shutil.copyfile(ALKS / XOSC, alks / XOSC)
         flood(ALKS / ROAD, alks / ROAD, MAX_XODR_ELEMENTS, MAX_XODR_BYTES)
         figures["xodr_past_element_bound_s"], xodr = best_load(alks / XOSC, args.repeat)
+        shutil.copyfile(ALKS / ROAD, alks / ROAD)
         figures["yaml_huge_entries_s"], yml = best_load(huge_yaml(Path(tmp)), args.repeat)
         figures["xosc_expression_budget_s"], expr = best_load(expression_flood(alks),
                                                              args.repeat)
-    for (key, value), outcome in zip(figures.items(), (xosc, xodr, yml, expr), strict=True):
+        figures["xodr_worst_spirals_s"], spirals = worst_xodr(Path(tmp))
+    for (key, value), outcome in zip(figures.items(), (xosc, xodr, yml, expr, spirals),
+                                     strict=True):
         print(f"  {key:<28} {value:6.2f} s  {outcome[:60]}")
     if args.json:
         args.json.write_text(json.dumps(figures, indent=2) + "\n")

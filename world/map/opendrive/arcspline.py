@@ -7,6 +7,8 @@ piece joints are exact. Lines and arcs are one piece each; spirals, poly3 and pa
 records are halved until the piece's largest position deviation from the exact record
 (checked at `CHECKS` stations per piece) is below `tolerance` (each record is approximated
 on its own, so a gap between records in the file is not split into ever smaller pieces).
+A reference line that needs more than `MAX_PIECES` pieces in all is refused
+(`PieceBoundError`): each piece costs a bounded number of evaluations, so the work is bounded.
 """
 
 from __future__ import annotations
@@ -22,7 +24,12 @@ from world.map.opendrive.shapes import FloatArray
 CHECKS = 65  # stations per piece where its deviation is checked
 MIN_PIECE = 1e-3  # [m] pieces are not split below this length
 SAFETY = 0.8  # the split criterion is SAFETY * tolerance (the deviation between checks)
-MAX_PIECES = 100_000  # per record: a bound on the work for pathological curves
+MAX_PIECES = 5_000  # per road: the pieces of its whole reference line (a bound on the work;
+#   the curviest ALKS road, 10 km of arcs and spirals, needs 337)
+
+
+class PieceBoundError(ValueError):
+    """A curve that needs more pieces than its bound (one-line message)."""
 
 
 class ArcPiece(NamedTuple):
@@ -60,9 +67,11 @@ def _piece(plan_view: PlanView, s0: float, s1: float) -> ArcPiece:
     return ArcPiece(s0, s1 - s0, float(k), float(x[0]), float(y[0]), float(h[0]))
 
 
-def arc_spline(plan_view: PlanView, tolerance: float = 1e-3) -> list[ArcPiece]:
+def arc_spline(plan_view: PlanView, tolerance: float = 1e-3,
+               max_pieces: int | None = None) -> list[ArcPiece]:
     """The chain of pieces approximating `plan_view` within `tolerance` [m] (module doc);
-    ValueError if a record needs more than `MAX_PIECES` pieces."""
+    `PieceBoundError` if it needs more than `max_pieces` (default `MAX_PIECES`) in all."""
+    max_pieces = MAX_PIECES if max_pieces is None else max_pieces
     pieces: list[ArcPiece] = []
     for g in plan_view.geometries:
         if g.length <= 0:
@@ -71,19 +80,25 @@ def arc_spline(plan_view: PlanView, tolerance: float = 1e-3) -> list[ArcPiece]:
         if isinstance(g.shape, Line | Arc):
             k = 0.0 if isinstance(g.shape, Line) else g.shape.curvature
             pieces.append(ArcPiece(s0, g.length, k, g.x, g.y, g.hdg))
-            continue
-        record = PlanView((g,))  # its end evaluated on itself, whatever the next record's start
-        stack = [(s0, s1)]
-        count = 0
-        while stack:
-            a, b = stack.pop()
-            piece = _piece(record, a, b)
-            if b - a > MIN_PIECE and piece_deviation(record, piece) > SAFETY * tolerance:
-                mid = 0.5 * (a + b)
-                stack.extend([(mid, b), (a, mid)])  # the first half is popped first
-            else:
-                pieces.append(piece)
-                count += 1
-                if count > MAX_PIECES:
-                    raise ValueError(f"the record at s={g.s} needs over {MAX_PIECES} pieces")
+        else:
+            _split_record(PlanView((g,)), s0, s1, tolerance, pieces, max_pieces)
+        if len(pieces) > max_pieces:
+            raise PieceBoundError(f"the reference line needs over {max_pieces} arc-spline "
+                                  f"pieces (at s = {g.s:g} m)")
     return pieces
+
+
+def _split_record(record: PlanView, s0: float, s1: float, tolerance: float,
+                  pieces: list[ArcPiece], max_pieces: int) -> None:
+    """Append to `pieces` the pieces of one record (`record`: its end evaluated on itself,
+    whatever the next record's start), halving each until it is within `tolerance`; stops
+    once `pieces` holds more than `max_pieces`."""
+    stack = [(s0, s1)]
+    while stack and len(pieces) <= max_pieces:
+        a, b = stack.pop()
+        piece = _piece(record, a, b)
+        if b - a > MIN_PIECE and piece_deviation(record, piece) > SAFETY * tolerance:
+            mid = 0.5 * (a + b)
+            stack.extend([(mid, b), (a, mid)])  # the first half is popped first
+        else:
+            pieces.append(piece)

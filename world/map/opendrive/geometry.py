@@ -39,6 +39,24 @@ class PlanView:
         object.__setattr__(self, "_tree", [])
 
     @property
+    def curves(self) -> tuple[LocalCurve, ...]:
+        """Each record's evaluator in its local frame (`shapes.local_curve`)."""
+        return self._curves
+
+    def record_ends(self) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """x, y [m] and heading [rad, not wrapped] where each record ends, evaluated on the
+        record itself (whatever the next record's start says)."""
+        n = len(self.geometries)
+        x, y, h = np.empty(n), np.empty(n), np.empty(n)
+        for i, (g, curve) in enumerate(zip(self.geometries, self._curves, strict=True)):
+            u, v, lh = curve.local(np.array([g.length]))
+            c, sn = np.cos(g.hdg), np.sin(g.hdg)
+            x[i] = g.x + c * u[0] - sn * v[0]
+            y[i] = g.y + sn * u[0] + c * v[0]
+            h[i] = g.hdg + lh[0]
+        return x, y, h
+
+    @property
     def start(self) -> float:
         """[m] the station of the first record (normally 0)."""
         return self.geometries[0].s

@@ -38,6 +38,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from world.map.opendrive import arcspline
 from world.map.opendrive.arcspline import SAFETY
 from world.map.opendrive.arcspline import piece_points as arc_points
 from world.map.opendrive.geometry import PlanView
@@ -152,12 +153,14 @@ def record_starts(road: Road) -> list[float]:
 
 
 def fit_lanes(road: Road, borders: list[tuple[int, ...]], stations: list[float],
-              tolerance: float) -> list[FittedPiece]:
+              tolerance: float, max_pieces: int | None = None) -> list[FittedPiece]:
     """The route's pieces along the whole road (module doc): lane 0's centre within
     `tolerance` [m] of the file's, every boundary within it of its cubic. `borders`: per
     lane section, the lane ids whose outer border is each boundary, right to left ([1],
     [2]: lane 0's right and left edge; id 0: the lane offset); `stations` [m]: where
-    pieces must split besides record starts."""
+    pieces must split besides record starts; `PieceBoundError` beyond `max_pieces` (default
+    `arcspline.MAX_PIECES`) pieces in all."""
+    bound = arcspline.MAX_PIECES if max_pieces is None else max_pieces
     view = road.plan_view
     cuts = sorted({view.start, view.end, *(s for s in (*record_starts(road), *stations)
                                             if view.start < s < view.end)})
@@ -165,12 +168,12 @@ def fit_lanes(road: Road, borders: list[tuple[int, ...]], stations: list[float],
     for a, b in itertools.pairwise(cuts):
         if b - a > STATION_EPS:
             section = borders[lane_section_index(road, 0.5 * (a + b))]
-            out += _fit_interval(road, section, a, b, tolerance)
+            out += _fit_interval(road, section, a, b, tolerance, bound - len(out))
     return out
 
 
 def _fit_interval(road: Road, borders: tuple[int, ...], a: float, b: float,
-                  tolerance: float) -> list[FittedPiece]:
+                  tolerance: float, max_pieces: int) -> list[FittedPiece]:
     """`fit_lanes` between two consecutive record starts a and b."""
     mid = 0.5 * (a + b)
     polys = border_polynomials(road, mid, a)
@@ -185,7 +188,7 @@ def _fit_interval(road: Road, borders: tuple[int, ...], a: float, b: float,
         width = t[2][0] - t[1][0]
         coef[1, 0], coef[2, 0] = -0.5 * width, 0.5 * width
         return [FittedPiece(p, coef, True, 0.0)
-                for p in offset_arc_spline(curve, a, b, tolerance)]
+                for p in offset_arc_spline(curve, a, b, tolerance, None, max_pieces)]
     curves = [OffsetCurve(record, a, tuple(p)) for p in t]
     fits: dict[tuple[float, float], tuple[FloatArray, float]] = {}
 
@@ -194,7 +197,7 @@ def _fit_interval(road: Road, borders: tuple[int, ...], a: float, b: float,
         fits[(piece.s0, piece.s1)] = coef, skew
         return error <= FIT_SHARE * SAFETY * tolerance
 
-    pieces = offset_arc_spline(curve, a, b, CENTRE_SHARE * tolerance, accept)
+    pieces = offset_arc_spline(curve, a, b, CENTRE_SHARE * tolerance, accept, max_pieces)
     for p in pieces:  # a piece at MIN_PIECE may have skipped `accept`
         if (p.s0, p.s1) not in fits:
             accept(p)

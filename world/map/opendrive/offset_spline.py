@@ -30,7 +30,14 @@ import numpy as np
 from numpy.polynomial import legendre
 from numpy.polynomial import polynomial as poly
 
-from world.map.opendrive.arcspline import CHECKS, MAX_PIECES, MIN_PIECE, SAFETY, ArcPiece
+from world.map.opendrive.arcspline import (
+    CHECKS,
+    MAX_PIECES,
+    MIN_PIECE,
+    SAFETY,
+    ArcPiece,
+    PieceBoundError,
+)
 from world.map.opendrive.arcspline import piece_points as arc_points
 from world.map.opendrive.geometry import PlanView
 from world.map.opendrive.shapes import FloatArray
@@ -118,9 +125,12 @@ def deviation(curve: OffsetCurve, piece: CurvePiece, checks: int = CHECKS) -> fl
 
 
 def offset_arc_spline(curve: OffsetCurve, a: float, b: float, tolerance: float,
-                      accept: Callable[[CurvePiece], bool] | None = None) -> list[CurvePiece]:
+                      accept: Callable[[CurvePiece], bool] | None = None,
+                      max_pieces: int | None = None) -> list[CurvePiece]:
     """The chain of pieces approximating the curve between stations a and b within
-    `tolerance` [m] and accepted by `accept` (module doc); ValueError beyond `MAX_PIECES`."""
+    `tolerance` [m] and accepted by `accept` (module doc); `PieceBoundError` beyond
+    `max_pieces` (default `MAX_PIECES`)."""
+    bound = MAX_PIECES if max_pieces is None else max_pieces
     pieces: list[CurvePiece] = []
     stack = [(a, b)]
     while stack:
@@ -130,8 +140,9 @@ def offset_arc_spline(curve: OffsetCurve, a: float, b: float, tolerance: float,
                 and (accept is None or accept(piece)))
         if good or hi - lo <= MIN_PIECE:
             pieces.append(piece)
-            if len(pieces) > MAX_PIECES:
-                raise ValueError(f"the curve from s={a} needs over {MAX_PIECES} pieces")
+            if len(pieces) > bound:
+                raise PieceBoundError(f"the lanes need more arc-spline pieces than a road may "
+                                      f"have (at s = {lo:g} m)")
             continue
         mid = 0.5 * (lo + hi)
         stack.extend([(mid, hi), (lo, mid)])  # the first half is popped first

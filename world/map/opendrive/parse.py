@@ -6,9 +6,16 @@ types and speeds, planView records (line, arc, spiral, poly3, paramPoly3), lanes
 signals and surface; userData anywhere is skipped. Everything else - junctions, objects,
 signals, elevation, superelevation, any other element - is refused as "not supported yet
 (...)" naming the element, as are bad numbers and files beyond the size limits. Checked on
-the geometry: records ascend in s and add up to the road's length (within 1 cm), a
-paramPoly3's arc length is within 1 % of its record's length, no number is beyond 1e9, no
-arc or spiral record turns more than 1e4 rad.
+the geometry, in this order and all before any curve is evaluated: the counts (roads,
+planView records in the file), every number (finite, at most 64 characters, within 1e9),
+each road's length (above 0, the file's roads together at most `MAX_ROUTE_LENGTH`), each
+record's length (at least `MIN_RECORD_LENGTH`), curvature (at most `MAX_CURVATURE`, 1 / the
+smallest radius) and turn (at most `MAX_TURN`), each record starting at the station where the
+one before ends and the records adding up to the road's length (within 1 cm); then, on the
+exact curves (each record's cost bounded: `shapes`), a polynomial record's sampled curvature
+and a paramPoly3's arc length (within 1 % of its record's length), and the planView's
+continuity (`continuity`: each record starts where the one before ends, within 1 cm and
+1e-3 rad). Lane sections start inside their road.
 """
 
 from __future__ import annotations
@@ -16,6 +23,8 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Literal
 
+from world.core.safe_read import UnreadableFileError, read_bounded
+from world.map.opendrive.continuity import check_continuity, check_stations
 from world.map.opendrive.errors import OpenDriveError
 from world.map.opendrive.geometry import PlanView
 from world.map.opendrive.model import (
@@ -32,16 +41,20 @@ from world.map.opendrive.model import (
     Spiral,
 )
 from world.map.opendrive.parse_lanes import lanes, speed
-from world.map.opendrive.shapes import PolyCurve, local_curve
+from world.map.opendrive.shapes import PolyCurve
 from world.map.opendrive.xmltree import Node, parse_xml
 
 MAX_FILE_BYTES = 50 * 1024 * 1024  # [byte]
 MAX_ROADS = 100_000
-MAX_GEOMETRIES = 100_000  # planView records in the whole file
+MAX_GEOMETRIES = 5_000  # planView records in the whole file (at most `arcspline.MAX_PIECES`)
 REV_MINORS = range(4, 9)  # OpenDRIVE 1.4 .. 1.8
 LENGTH_TOLERANCE = 1e-2  # [m] the road length vs its planView's, at least
 PARAM_LENGTH_TOLERANCE = 1e-2  # [1] paramPoly3 arc length vs its record's (esmini scales)
 MAX_TURN = 1e4  # [rad] the most an arc or spiral record may turn (a bound on the work)
+MAX_ROUTE_LENGTH = 20_000.0  # [m] a road, and the file's roads together (one route)
+MIN_RECORD_LENGTH = 1e-3  # [m] the shortest planView record (real files: 12.7 mm)
+MIN_RADIUS = 1.0  # [m] the tightest bend of a reference line (real files: 5.7 m)
+MAX_CURVATURE = 1.0 / MIN_RADIUS  # [1/m]
 FLAT_PROFILES = {
     "elevation": "elevation",
     "superelevation": "superelevation",
@@ -53,35 +66,42 @@ def load_opendrive(path: Path) -> OpenDrive:
     """The OpenDRIVE file `path`; raises `OpenDriveError` (one-line message)."""
     path = Path(path)
     try:
-        size = path.stat().st_size
-        if size > MAX_FILE_BYTES:
-            raise OpenDriveError(path, f"file is {size} bytes, over the {MAX_FILE_BYTES} limit")
-        data = path.read_bytes()
-    except FileNotFoundError:
-        raise OpenDriveError(path, "file not found") from None
-    except OSError as e:
-        raise OpenDriveError(path, f"cannot read: {e.strerror}") from None
+        data = read_bounded(path, MAX_FILE_BYTES)
+    except UnreadableFileError as e:
+        raise OpenDriveError(path, e.problem) from None
     root = parse_xml(str(path), data)
     if root.tag != "OpenDRIVE":
         raise root.error(f"the root element is <{root.tag}>, not <OpenDRIVE>")
     kids = root.only("header", "road")
     header = root.exactly_one(kids["header"], "header")
     major, minor, name = _header(header)
-    if len(kids["road"]) > MAX_ROADS:
-        raise kids["road"][MAX_ROADS].error(f"more than {MAX_ROADS} roads")
+    _check_counts(kids["road"])
     roads: list[Road] = []
     seen: set[str] = set()
-    count = 0
+    total = 0.0  # [m]
     for node in kids["road"]:
         road = _road(node)
-        count += len(road.plan_view.geometries)
-        if count > MAX_GEOMETRIES:
-            raise node.error(f"more than {MAX_GEOMETRIES} geometry records in the file")
+        total += road.length
+        if total > MAX_ROUTE_LENGTH:
+            raise node.error(f"the roads add up to more than {MAX_ROUTE_LENGTH:g} m")
         if road.id in seen:
             raise node.error(f"duplicate road id {road.id!r}")
         seen.add(road.id)
         roads.append(road)
     return OpenDrive(path, major, minor, name, tuple(roads))
+
+
+def _check_counts(roads: list[Node]) -> None:
+    """Refuse too many roads or planView records before any is read."""
+    if len(roads) > MAX_ROADS:
+        raise roads[MAX_ROADS].error(f"more than {MAX_ROADS} roads")
+    count = 0
+    for node in roads:
+        for view in node.children:
+            if view.tag == "planView":
+                count += sum(1 for g in view.children if g.tag == "geometry")
+        if count > MAX_GEOMETRIES:
+            raise node.error(f"more than {MAX_GEOMETRIES} geometry records in the file")
 
 
 def _header(node: Node) -> tuple[int, int, str]:
@@ -145,46 +165,70 @@ def _shape(node: Node) -> Shape:
     )
 
 
+def _curvature(shape: Shape) -> float:
+    """[1/m] the largest |curvature| of a line, arc or spiral record (0 for the others)."""
+    if isinstance(shape, Arc):
+        return abs(shape.curvature)
+    if isinstance(shape, Spiral):
+        return max(abs(shape.curv_start), abs(shape.curv_end))
+    return 0.0
+
+
 def _geometry(node: Node) -> Geometry:
+    """One planView record, its numbers, length, curvature and turn checked (cheap)."""
     kids = node.only("line", "arc", "spiral", "poly3", "paramPoly3")
     shapes = [n for group in kids.values() for n in group]
     if len(shapes) != 1:
         raise node.error(f"has {len(shapes)} shapes, not one (line, arc, spiral, ...)")
     length = node.num("length")
-    if length < 0:
-        raise node.error(f"length is negative ({length})")
+    if not MIN_RECORD_LENGTH <= length <= MAX_ROUTE_LENGTH:
+        raise node.error(f"length must be >= {MIN_RECORD_LENGTH:g} and <= "
+                         f"{MAX_ROUTE_LENGTH:g} m, got {length:g}")
     shape = _shape(shapes[0])
-    curvature = 0.0
-    if isinstance(shape, Arc):
-        curvature = abs(shape.curvature)
-    elif isinstance(shape, Spiral):
-        curvature = max(abs(shape.curv_start), abs(shape.curv_end))
+    curvature = _curvature(shape)
+    if curvature > MAX_CURVATURE:
+        raise shapes[0].error(f"curvature {curvature:g} 1/m is beyond {MAX_CURVATURE:g} 1/m "
+                              f"(a radius under {MIN_RADIUS:g} m)")
     if curvature * length > MAX_TURN:
         raise shapes[0].error(f"turns more than {MAX_TURN:g} rad")
-    geom = Geometry(node.num("s"), node.num("x"), node.num("y"), node.num("hdg"), length, shape)
-    curve = local_curve(geom)
-    if isinstance(curve, PolyCurve) and abs(curve.scale - 1.0) > PARAM_LENGTH_TOLERANCE:
-        raise shapes[0].error(
-            f"its arc length {curve.cum[-1]:.6g} m is not the record's length {length:.6g} m"
-        )
-    return geom
+    return Geometry(node.num("s"), node.num("x"), node.num("y"), node.num("hdg"), length, shape)
+
+
+def _check_polynomials(pv: PlanView, nodes: list[Node]) -> None:
+    """Refuse a poly3 or paramPoly3 record that bends beyond `MAX_CURVATURE` (sampled) or a
+    paramPoly3 whose arc length is not its record's."""
+    for g, curve, node in zip(pv.geometries, pv.curves, nodes, strict=True):
+        if not isinstance(curve, PolyCurve):
+            continue
+        shape = next(c for c in node.children if c.tag in ("poly3", "paramPoly3"))
+        curvature = curve.max_curvature()
+        if not curvature <= MAX_CURVATURE:
+            raise shape.error(f"curvature {curvature:g} 1/m is beyond {MAX_CURVATURE:g} "
+                              f"1/m (a radius under {MIN_RADIUS:g} m)")
+        if abs(curve.scale - 1.0) > PARAM_LENGTH_TOLERANCE:
+            raise shape.error(f"its arc length {curve.cum[-1]:.6g} m is not the record's "
+                              f"length {g.length:.6g} m")
 
 
 def _plan_view(node: Node, road_length: float) -> PlanView:
+    """A road's planView: the cheap checks on every record first, then the exact curves'
+    (module doc)."""
     nodes = node.only("geometry")["geometry"]
     if not nodes:
         raise node.error("missing <geometry>")
     if len(nodes) > MAX_GEOMETRIES:
         raise nodes[MAX_GEOMETRIES].error(f"more than {MAX_GEOMETRIES} geometry records")
     geoms = [_geometry(n) for n in nodes]
-    for prev, g, n in zip(geoms, geoms[1:], nodes[1:], strict=False):
-        if g.s < prev.s:
-            raise n.error(f"geometry records do not ascend in s ({g.s} after {prev.s})")
-    pv = PlanView(tuple(geoms))
-    if abs(pv.length - road_length) > max(LENGTH_TOLERANCE, 1e-6 * road_length):
+    check_stations(geoms, nodes)
+    last = geoms[-1]
+    length = last.s + last.length - geoms[0].s
+    if abs(length - road_length) > max(LENGTH_TOLERANCE, 1e-6 * road_length):
         raise node.error(
-            f"the geometry records' length {pv.length} is not the road's length {road_length}"
+            f"the geometry records' length {length} is not the road's length {road_length}"
         )
+    pv = PlanView(tuple(geoms))
+    _check_polynomials(pv, nodes)
+    check_continuity(pv, nodes)
     return pv
 
 
@@ -228,8 +272,11 @@ def _road(node: Node) -> Road:
     _flat(node.at_most_one(kids["elevationProfile"], "elevationProfile"), "elevation")
     _flat(node.at_most_one(kids["lateralProfile"], "lateralProfile"), "superelevation", "shape")
     length = node.num("length")
+    if not 0.0 < length <= MAX_ROUTE_LENGTH:
+        raise node.error(f"length must be > 0 and <= {MAX_ROUTE_LENGTH:g} m, got {length:g}")
+    plan_view = _plan_view(node.exactly_one(kids["planView"], "planView"), length)
     predecessor, successor = _link(node.at_most_one(kids["link"], "link"))
-    offsets, sections = lanes(node.exactly_one(kids["lanes"], "lanes"))
+    offsets, sections = lanes(node.exactly_one(kids["lanes"], "lanes"), length)
     return Road(
         id=node.get("id"),
         name=node.get("name", ""),
@@ -238,7 +285,7 @@ def _road(node: Node) -> Road:
         rule=_rule(node),
         predecessor=predecessor,
         successor=successor,
-        plan_view=_plan_view(node.exactly_one(kids["planView"], "planView"), length),
+        plan_view=plan_view,
         lane_offsets=offsets,
         lane_sections=sections,
         speeds=_speeds(kids["type"]),

@@ -13,6 +13,7 @@ from world.map.opendrive.xmltree import Node
 MAX_SIDE_LANES = 32  # lanes on one side of a lane section (every type: driving, shoulder,
 #   border, sidewalk, ...): a bound on the work; real roads have under a dozen
 
+MAX_LATERAL = 100.0  # [m] a lane's width and the lane offset where each record starts
 SPEED_UNITS = {"m/s": 1.0, "km/h": 1 / 3.6, "mph": 0.44704}  # [m/s] per unit
 NO_LIMIT = frozenset({"no limit", "undefined"})
 DEFAULT_MARK_WIDTH = 0.12  # [m]
@@ -23,6 +24,26 @@ def poly3(node: Node, s_name: str) -> Poly3:
     """A width/offset/elevation-like record `<... s_name= a= b= c= d=>`."""
     node.only()
     return Poly3(node.num(s_name), node.num("a"), node.num("b"), node.num("c"), node.num("d"))
+
+
+def width_record(node: Node) -> Poly3:
+    """A lane's <width>: it starts at or after its section's start, at a width of 0 ..
+    `MAX_LATERAL`."""
+    rec = poly3(node, "sOffset")
+    if rec.s < 0.0:
+        raise node.error(f"sOffset is negative ({rec.s:g})")
+    if not 0.0 <= rec.a <= MAX_LATERAL:
+        raise node.error(f"width a = {rec.a:g} m is not within 0 .. {MAX_LATERAL:g} m")
+    return rec
+
+
+def offset_record(node: Node) -> Poly3:
+    """A road's <laneOffset>: at most `MAX_LATERAL` off the reference line where it
+    starts."""
+    rec = poly3(node, "s")
+    if abs(rec.a) > MAX_LATERAL:
+        raise node.error(f"a = {rec.a:g} m is beyond {MAX_LATERAL:g} m")
+    return rec
 
 
 def ascending(records: list[Poly3], nodes: list[Node], what: str) -> tuple[Poly3, ...]:
@@ -108,7 +129,7 @@ def lane(node: Node) -> OdrLane:
     if kids["border"]:
         raise kids["border"][0].unsupported()
     lane_id = node.integer("id")
-    widths = ascending([poly3(w, "sOffset") for w in kids["width"]], kids["width"], "width")
+    widths = ascending([width_record(w) for w in kids["width"]], kids["width"], "width")
     if lane_id == 0 and widths:
         raise kids["width"][0].error("the centre lane has a <width>")
     if lane_id != 0 and not widths:
@@ -163,15 +184,19 @@ def lane_section(node: Node) -> LaneSection:
     )
 
 
-def lanes(node: Node) -> tuple[tuple[Poly3, ...], tuple[LaneSection, ...]]:
-    """A road's <lanes>: its lane offsets and lane sections."""
+def lanes(node: Node, length: float) -> tuple[tuple[Poly3, ...], tuple[LaneSection, ...]]:
+    """A road's <lanes>: its lane offsets and lane sections (each starting at or after 0
+    and before the road's `length` [m])."""
     kids = node.only("laneOffset", "laneSection")
     offsets = ascending(
-        [poly3(n, "s") for n in kids["laneOffset"]], kids["laneOffset"], "laneOffset"
+        [offset_record(n) for n in kids["laneOffset"]], kids["laneOffset"], "laneOffset"
     )
     if not kids["laneSection"]:
         raise node.error("missing <laneSection>")
     sections = [lane_section(n) for n in kids["laneSection"]]
+    for sec, n in zip(sections, kids["laneSection"], strict=True):
+        if not 0.0 <= sec.s < length:
+            raise n.error(f"starts at s = {sec.s:g} m, outside its road (0 .. {length:g} m)")
     for prev, sec, n in zip(sections, sections[1:], kids["laneSection"][1:], strict=False):
         if sec.s <= prev.s:
             raise n.error(f"laneSection records do not ascend in s ({sec.s} after {prev.s})")

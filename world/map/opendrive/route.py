@@ -53,7 +53,7 @@ import numpy as np
 
 from world.frames import MPS_PER_KPH
 from world.hdmap import CrossSection, LaneProfile, LinePaint, Zone
-from world.map.opendrive.arcspline import ArcPiece, arc_spline, piece_points
+from world.map.opendrive.arcspline import ArcPiece, PieceBoundError, arc_spline, piece_points
 from world.map.opendrive.chain import Chain, chain_roads
 from world.map.opendrive.errors import OpenDriveError
 from world.map.opendrive.far_side import far_side
@@ -139,7 +139,15 @@ def _refuse(odr: OpenDrive, what: str) -> OpenDriveError:
 
 def build_route(odr: OpenDrive) -> OdrRoute:
     """The route road of the file's roads linked end to end (module doc); raises
-    `OpenDriveError`."""
+    `OpenDriveError`, also for a road that needs more arc-spline pieces than
+    `arcspline.MAX_PIECES` (the bound on the work)."""
+    try:
+        return _build_route(odr)
+    except PieceBoundError as e:
+        raise OpenDriveError(odr.path, str(e)) from None
+
+
+def _build_route(odr: OpenDrive) -> OdrRoute:
     chain = chain_roads(odr)
     road = chain.road
     if road.rule != "RHT":
@@ -328,6 +336,9 @@ def _layout(odr: OpenDrive, road: Road, section: LaneSection) -> Layout:
     if uniform:  # the numbers as ever
         (w,) = widths
         assert w is not None
+        if w <= 0.0:
+            raise OpenDriveError(odr.path, f"the route's lanes at s = {section.s:g} m are "
+                                 f"{w:g} m wide: a driving lane needs a width above 0")
         inner = sum(constant_width(lane) or 0.0 for lane in right[:first])
         ref_t = -(inner + (len(drive) - 0.5) * w)
         shoulder = constant_width(hard) or 0.0 if hard is not None else 0.0

@@ -35,6 +35,7 @@ PANELS = 64  # arc-length table panels of a polynomial curve
 RATE_IS_ZERO = 1e-12  # [rad] heading effect of a spiral's curvature rate below which it is an arc
 FRESNEL_CONDITION = 1e5  # [m] |k0/c| above which the spiral is integrated numerically
 PANEL_TURN = 0.5  # [rad] heading change per quadrature panel of an ill-conditioned spiral
+CURVATURE_SAMPLES = 1025  # [-] parameters where a polynomial curve's curvature is checked
 
 
 class LocalCurve:
@@ -135,11 +136,24 @@ class PolyCurve(LocalCurve):
         self.scale = 1.0
         if p_end is None:  # poly3: the curve ends where its arc length is the record's
             p_end = float(self._invert(np.array([min(length, self.cum[-1])]))[0])
-        elif self.cum[-1] > 0:
-            self.scale = self.cum[-1] / length if length > 0 else 1.0
+        elif length > 0:  # 0 for a curve of no length: no station reaches its end
+            self.scale = self.cum[-1] / length
         self.p_end = p_end
         self.h0 = float(np.arctan2(self.dv[0], self.du[0]))  # [rad] the start tangent's
         self.c0, self.s0 = np.cos(self.h0), np.sin(self.h0)
+
+    def max_curvature(self, samples: int = CURVATURE_SAMPLES) -> float:
+        """[1/m] the largest |curvature| at `samples` parameters evenly over [0, p_end] (inf
+        where the curve stops: a cusp, or no curve at all)."""
+        p = np.linspace(0.0, self.p_end, samples)
+        pv = np.polynomial.polynomial.polyval
+        du, dv = pv(p, self.du), pv(p, self.dv)
+        ddu = pv(p, np.polynomial.polynomial.polyder(self.du))
+        ddv = pv(p, np.polynomial.polynomial.polyder(self.dv))
+        cross, speed = np.abs(du * ddv - dv * ddu), np.hypot(du, dv)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            k = np.where(speed > 0.0, cross / np.maximum(speed, 1e-300) ** 3, np.inf)
+        return float(np.max(k))
 
     def _speed(self, p: FloatArray) -> FloatArray:
         du = np.polynomial.polynomial.polyval(p, self.du)

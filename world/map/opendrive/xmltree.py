@@ -17,10 +17,19 @@ from world.map.opendrive.errors import OpenDriveError
 
 MAX_ELEMENTS = 1_000_000  # elements in one file (refused past it in 2.9 s: bench/bench_load.py)
 MAX_MAGNITUDE = 1e9  # no number in a file is larger (coordinates [m], lengths, coefficients)
+MAX_NUMBER_CHARS = 64  # characters of one number attribute (a double needs under 25)
+SHOWN_CHARS = 40  # characters of a bad value quoted in an error message
 IGNORED = frozenset({"userData"})  # children skipped wherever they appear
 NUMBER = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?")
 # how an unsupported element is named in "not supported yet (...)", where not by its tag
 UNSUPPORTED_AS = {"junction": "junctions", "border": "lane border"}
+
+
+def shown(raw: str) -> str:
+    """`raw` quoted for an error message, cut to `SHOWN_CHARS` characters."""
+    if len(raw) <= SHOWN_CHARS:
+        return repr(raw)
+    return f"{raw[:SHOWN_CHARS]!r}... ({len(raw)} characters)"
 
 
 @dataclass(eq=False, slots=True)
@@ -69,13 +78,16 @@ class Node:
             if default is None:
                 raise self.error(f"missing attribute {name}")
             return default
+        if len(raw) > MAX_NUMBER_CHARS:
+            raise self.error(f"{name} is {len(raw)} characters long, over the "
+                             f"{MAX_NUMBER_CHARS} of a number ({shown(raw)})")
         if not NUMBER.fullmatch(raw.strip()):
-            raise self.error(f"{name} is not a number ({raw!r})")
+            raise self.error(f"{name} is not a number ({shown(raw)})")
         value = float(raw)
         if not math.isfinite(value):
-            raise self.error(f"{name} is not a finite number ({raw!r})")
+            raise self.error(f"{name} is not a finite number ({shown(raw)})")
         if abs(value) > MAX_MAGNITUDE:
-            raise self.error(f"{name} is beyond the limit of {MAX_MAGNITUDE:g} ({raw!r})")
+            raise self.error(f"{name} is beyond the limit of {MAX_MAGNITUDE:g} ({shown(raw)})")
         return value
 
     def integer(self, name: str, default: int | None = None) -> int:
@@ -86,7 +98,7 @@ class Node:
                 raise self.error(f"missing attribute {name}")
             return default
         if not re.fullmatch(r"[+-]?\d{1,18}", raw.strip()):
-            raise self.error(f"{name} is not an integer ({raw!r})")
+            raise self.error(f"{name} is not an integer ({shown(raw)})")
         return int(raw)
 
     def only(self, *allowed: str) -> dict[str, list[Node]]:
