@@ -23,7 +23,7 @@ from rich.table import Table
 from avsim.files import write_atomic
 from avsim.run.interrupts import Interrupts
 from avsim.run.result import dumps, result_json
-from avsim.scenario.load import ScenarioError, bundled_scenarios, load_scenario
+from avsim.scenario.load import ScenarioError, load_scenario
 from avsim.scenario.profile_fit import check_profile
 from avsim.scenario.schema import scenario_json_schema
 
@@ -206,14 +206,22 @@ def view(recording: Path, web: bool) -> None:
 
 @main.command(name="list")
 def list_scenarios() -> None:
-    """Bundled scenarios, one per line: name, situation, description."""
-    for path in bundled_scenarios():
-        try:
-            loaded = load_scenario(path)
-        except ScenarioError as exc:
-            click.echo(f"{path.stem}\t(invalid)\t{exc}")
-            continue
-        click.echo(f"{loaded.name}\t{loaded.situation}\t{loaded.description}")
+    """Bundled scenarios by folder: a heading line per folder, then one line per scenario,
+    tab-separated: the name to give `avsim run`, situation, description."""
+    from avsim.scenario.files import REPO_ROOT, bundled_groups
+
+    for number, group in enumerate(bundled_groups()):
+        folder = group.folder.relative_to(REPO_ROOT).as_posix() + "/"
+        note = f" ({group.note})" if group.note else ""
+        click.echo(("\n" if number else "") + f"{folder}{note}")
+        for path in group.files():
+            name = group.name_of(path)
+            try:
+                loaded = load_scenario(path)
+            except ScenarioError as exc:
+                click.echo(f"{name}\t(invalid)\t{exc}")
+                continue
+            click.echo(f"{name}\t{loaded.situation}\t{loaded.description}")
 
 
 @main.command()

@@ -248,18 +248,49 @@ def test_every_bad_fixture_is_rejected_in_process(
     assert list((tmp_path / "tmp").iterdir()) == []
 
 
-def test_list_prints_one_line_per_bundled_scenario(outcomes: dict[str, Outcome]) -> None:
+def _listed(stdout: str) -> dict[str, list[list[str]]]:
+    """`avsim list`'s output: each folder heading's rows (name, situation, description)."""
+    groups: dict[str, list[list[str]]] = {}
+    heading = ""
+    for line in stdout.splitlines():
+        if "\t" in line:
+            groups[heading].append(line.split("\t"))
+        elif line:
+            heading = line.split(" (")[0]
+            groups[heading] = []
+    return groups
+
+
+def test_list_prints_every_bundled_scenario_by_folder(outcomes: dict[str, Outcome]) -> None:
     out = outcomes["list"]
     assert out.returncode == 0, out.stderr
-    files = sorted(SCENARIOS.glob("*.yaml"))
-    expected = {yaml.safe_load(path.read_text(encoding="utf-8"))["name"] for path in files}
-    lines = out.stdout.splitlines()
-    assert len(lines) == len(files)
-    rows = [line.split("\t") for line in lines]
-    assert all(len(row) == 3 for row in rows), lines  # name, situation, description
-    assert {row[0] for row in rows} == expected
-    assert "normal_driving" in expected
-    assert all(row[1] != "(invalid)" for row in rows), lines
+    groups = _listed(out.stdout)
+    alks = ALKS.relative_to(REPO).as_posix() + "/"
+    assert list(groups) == ["scenarios/", "scenarios/acceptance/", "scenarios/faults/", alks]
+    for heading, pattern, prefix in (("scenarios/", "*.yaml", ""),
+                                     ("scenarios/acceptance/", "*.yaml", "acceptance/"),
+                                     ("scenarios/faults/", "*.yaml", "faults/")):
+        files = sorted((REPO / heading).glob(pattern))
+        rows = groups[heading]
+        assert len(rows) == len(files) > 0, heading
+        assert [row[0] for row in rows] == [prefix + path.stem for path in files]
+    assert len(groups[alks]) == len(list(ALKS.glob("alks_scenario_*.xosc"))) == 15
+    rows = [row for group in groups.values() for row in group]
+    assert all(len(row) == 3 for row in rows), rows  # name, situation, description
+    assert all(row[1] != "(invalid)" for row in rows), rows
+    names = {row[0] for row in rows}
+    assert {"normal_driving", "acceptance/ncap_ccrs", "faults/lidar_outage",
+            "alks/4_4_1_cut_in_no_collision"} <= names
+
+
+def test_every_listed_name_resolves_to_its_file(outcomes: dict[str, Outcome]) -> None:
+    from avsim.scenario.load import load_scenario, scenario_path
+
+    for heading, rows in _listed(outcomes["list"].stdout).items():
+        for name, _situation, description in rows:
+            path = scenario_path(name)
+            assert path.is_relative_to(REPO / heading), (name, path)
+            assert load_scenario(name).description == description
 
 
 def test_schema_is_a_json_schema_that_accepts_the_bundled_scenario(
@@ -383,3 +414,29 @@ def test_the_progress_line_gives_the_pace(sim: float, duration: float, wall: flo
     from avsim.cli import pace
 
     assert pace(sim, duration, wall) == text
+
+
+def test_a_bundled_name_that_is_also_a_file_here_is_refused(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "normal_driving").write_text(MINIMAL, encoding="utf-8")
+    result = CliRunner().invoke(main, ["run", "normal_driving", "--out", "x.rrd"])
+    assert result.exit_code == EXIT_BAD_INPUT, result.output
+    assert result.stderr.startswith("avsim: error: normal_driving: (file): ambiguous: a file "
+                                    "here and the bundled ")
+    assert "./normal_driving" in result.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["normal_driving"]
+
+
+def test_two_bundled_files_of_one_name_are_refused(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    from avsim.scenario import files
+
+    for stem in ("alks_scenario_9_9_9_template", "alks_scenario_9_9_9"):
+        (tmp_path / f"{stem}.xosc").write_text("<OpenSCENARIO/>", encoding="utf-8")
+    monkeypatch.setattr(files, "ALKS_DIR", tmp_path)
+    result = CliRunner().invoke(main, ["run", "alks/9_9_9", "--out", str(tmp_path / "x.rrd")])
+    assert result.exit_code == EXIT_BAD_INPUT, result.output
+    line = result.stderr.strip()
+    assert line.startswith("avsim: error: alks/9_9_9: (file): ambiguous bundled name: "), line
+    assert line.count(".xosc") == 2 and "\n" not in line
