@@ -244,6 +244,9 @@ _batch_options = [
                  show_default=True, help="Sensor profile of every run."),
     click.option("--snapshots/--no-snapshots", default=True, show_default=True,
                  help="A picture of each failed run at its first failing moment."),
+    click.option("--dry-run", is_flag=True,
+                 help="Load and check every run, print each as its `avsim run` command "
+                      "line, and run none."),
 ]
 
 
@@ -258,23 +261,61 @@ def batch_options(f: Callable[..., None]) -> Callable[..., None]:
 @click.argument("paths", nargs=-1)
 @click.option("--out", "out", type=click.Path(path_type=Path), default=Path("runs/suite"),
               show_default=True, help="Folder for the runs' files and the reports.")
+@click.option("--set", "sets", multiple=True, metavar="PATH=VALUE",
+              help="Set a key of every file before validation (one value; a file without "
+                   "the key is refused).")
+@click.option("--param", "params", multiple=True, metavar="NAME=VALUE",
+              help="A parameter of every OpenSCENARIO file (short for --set "
+                   "parameters.NAME=VALUE).")
+@click.option("--criteria", "criteria", type=click.Path(path_type=Path), default=None,
+              help="The OpenSCENARIO files' criteria: a sidecar file or a bundled set "
+                   "(default: each file's NAME.criteria.yaml beside it).")
 @batch_options
-def suite(paths: tuple[str, ...], out: Path, jobs: int | None, executor: str,
-          address: str | None, profile: str, snapshots: bool) -> None:
-    """Run scenarios in parallel: files, folders or bundled names (default: every bundled
-    scenario). Writes each run's .rrd, .json and .png, junit.xml, summary.md."""
+def suite(paths: tuple[str, ...], out: Path, sets: tuple[str, ...], params: tuple[str, ...],
+          criteria: Path | None, jobs: int | None, executor: str, address: str | None,
+          profile: str, snapshots: bool, dry_run: bool) -> None:
+    """Run scenarios in parallel: files, folders or bundled names (default: every scenario
+    in scenarios/). Writes each run's .rrd, .json and .png, junit.xml, summary.md."""
     from avsim.batch import suite as batch
+    from avsim.batch.sweep import SweepError
 
     try:
+        overrides = _one_value_each(sets + tuple(PARAMETER_PREFIX + p for p in params))
         batch.validate_out_dir(out)
-        entries = batch.suite_entries(batch.collect_scenarios(paths))
-        planned = batch.plan(entries, out, profile)
-    except (ScenarioError, batch.BatchError) as exc:
+        entries = batch.suite_entries(batch.collect_scenarios(paths), overrides)
+        planned = batch.plan(entries, out, profile, criteria)
+    except (ScenarioError, SweepError, batch.BatchError) as exc:
         _bad_input(str(exc))
+    if dry_run:
+        _print_plan(planned)
     with Interrupts() as stop:  # Ctrl-C / SIGTERM: finished runs and reports are kept
         outcomes = _execute(planned, executor, jobs, address, stop)
         _report(outcomes, out, f"avsim suite ({len(outcomes)} runs)", snapshots)
     sys.exit(stop.exit_status or batch.exit_status(outcomes))
+
+
+def _one_value_each(texts: Sequence[str]) -> dict[str, object]:
+    """`PATH=VALUE` texts as overrides; `SweepError` for a malformed one or several values."""
+    from avsim.batch.sweep import SweepError, parse_set
+
+    overrides: dict[str, object] = {}
+    for text in texts:
+        axis = parse_set(text)
+        if len(axis.values) != 1:
+            raise SweepError(f"--set {text}: suite takes one value (sweep takes several)")
+        overrides[axis.path] = axis.values[0]
+    return overrides
+
+
+def _print_plan(planned: Sequence[RunJob]) -> NoReturn:
+    """`--dry-run`: every planned run as the `avsim run` command that makes it, then exit 0
+    (nothing run, nothing written)."""
+    from avsim.batch.suite import run_command
+
+    for job in planned:
+        click.echo(run_command(job))
+    click.echo(f"# {len(planned)} runs planned, none run (--dry-run)", err=True)
+    sys.exit(0)
 
 
 @main.command()
@@ -291,7 +332,7 @@ def suite(paths: tuple[str, ...], out: Path, jobs: int | None, executor: str,
 @batch_options
 def sweep(scenario: str, sets: tuple[str, ...], params: tuple[str, ...], out: Path | None,
           metric: str, jobs: int | None, executor: str, address: str | None, profile: str,
-          snapshots: bool) -> None:
+          snapshots: bool, dry_run: bool) -> None:
     """Run SCENARIO over the grid of --set values (default: the file's own `grid`), like a
     suite; write sweep.csv, sweep.md and, over two swept keys, heatmap.png of --metric."""
     from avsim.batch import suite as batch
@@ -312,6 +353,8 @@ def sweep(scenario: str, sets: tuple[str, ...], params: tuple[str, ...], out: Pa
         planned = batch.plan(entries, out, profile)
     except (ScenarioError, SweepError, batch.BatchError) as exc:
         _bad_input(str(exc))
+    if dry_run:
+        _print_plan(planned)
     with Interrupts() as stop:  # Ctrl-C / SIGTERM: finished runs and reports are kept
         outcomes = _execute(planned, executor, jobs, address, stop)
         _report(outcomes, out, f"avsim sweep {name} ({len(outcomes)} runs)", snapshots)

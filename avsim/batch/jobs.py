@@ -50,6 +50,7 @@ class RunJob:
     sensing: str = "inline"  # cameras render in this process (workers run in parallel)
     plot: bool = True  # also write the speed-profile PNG
     duration: float = 0.0  # [s] the scenario's simulated time: its cost, longest run first
+    criteria: Path | None = None  # an OpenSCENARIO file's sidecar (`--criteria`), else None
 
     @property
     def recording(self) -> Path:
@@ -152,7 +153,7 @@ def run_job(job: RunJob, into: Path | None = None,
     written)."""
     start = time.perf_counter()
     try:
-        scenario = load_scenario(job.scenario, dict(job.overrides))
+        scenario = load_scenario(job.scenario, dict(job.overrides), job.criteria)
         check_profile(scenario, job.profile, job.scenario)
     except ScenarioError as exc:
         return RunOutcome(job, Status.BAD_INPUT, error=str(exc),

@@ -12,7 +12,9 @@
 
 from __future__ import annotations
 
+import json
 import math
+import shlex
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -26,11 +28,12 @@ from avsim.batch.jobs import RunJob, RunOutcome, Status
 from avsim.files import write_atomic
 from avsim.run.interrupts import Interrupts
 from avsim.run.result import dumps
-from avsim.scenario.load import bundled_scenarios, load_scenario
+from avsim.scenario.load import ScenarioError, bundled_scenarios, load_scenario, scenario_path
 from avsim.scenario.model import grid_paths
 from avsim.scenario.openscenario.sidecar import SUFFIX as SIDECAR_SUFFIX
 from avsim.scenario.profile_fit import check_profile
 
+OVERRIDES_FILE = "(overrides)"  # the file a sidecar's override problem names
 SNAPSHOT_DIR = "snapshots"  # the failed runs' pictures, below the batch's folder
 
 
@@ -59,19 +62,28 @@ def collect_scenarios(args: Sequence[str]) -> list[str]:
     return found
 
 
-def suite_entries(scenarios: Sequence[str]) -> list[tuple[str | None, str, dict[str, object]]]:
+def suite_entries(scenarios: Sequence[str], overrides: Mapping[str, object] | None = None,
+                  ) -> list[tuple[str | None, str, dict[str, object]]]:
     """The runs of a suite over `scenarios` (`plan`'s entries): one per scenario, or one per
-    point of its file's `grid` (named ``<name>_<k:03d>``, as a sweep names its runs)."""
+    point of its file's `grid` (named ``<name>_<k:03d>``, as a sweep names its runs), each
+    with `overrides` (`--set`, `--param`) besides its point. A key both set and swept by the
+    file's grid is a `BatchError`: the grid's points would all be the same run."""
     from avsim.batch.sweep import Axis, grid
 
+    given = dict(overrides or {})
     entries: list[tuple[str | None, str, dict[str, object]]] = []
     for scenario in scenarios:
         loaded = load_scenario(scenario)
         if not loaded.grid:
-            entries.append((None, scenario, {}))
+            entries.append((None, scenario, dict(given)))
             continue
+        swept = {path for key, _ in loaded.grid for path in grid_paths(key)}
+        both = sorted(swept & set(given))
+        if both:
+            raise BatchError(f"{scenario}: {both[0]}: the file's grid sweeps this key "
+                             "(--set would make its points one run)")
         points = grid([Axis(key, values) for key, values in loaded.grid])
-        entries += [(f"{loaded.name}_{k:03d}", scenario, overrides_of(point))
+        entries += [(f"{loaded.name}_{k:03d}", scenario, given | overrides_of(point))
                     for k, point in enumerate(points)]
     return entries
 
@@ -90,14 +102,21 @@ def overrides_of(point: Mapping[str, object]) -> dict[str, object]:
 
 
 def plan(entries: Sequence[tuple[str | None, str, Mapping[str, object]]], out_dir: Path,
-         profile: str) -> list[RunJob]:
+         profile: str, criteria: Path | None = None) -> list[RunJob]:
     """Validate each (job name or None for the scenario's own, scenario, overrides) and make
-    its job. Raises `ScenarioError` for the first bad one, `BatchError` for two runs that
-    would write the same files."""
+    its job; `criteria` is the sidecar of the OpenSCENARIO files among them (`--criteria`).
+    Raises `ScenarioError` (naming the scenario) for the first bad one, `BatchError` for two
+    runs that would write the same files."""
     planned: list[RunJob] = []
     names: dict[str, str] = {}
     for name, scenario, overrides in entries:
-        loaded = load_scenario(scenario, dict(overrides))
+        sidecar = criteria if scenario_path(scenario).suffix == ".xosc" else None
+        try:
+            loaded = load_scenario(scenario, dict(overrides), sidecar)
+        except ScenarioError as exc:  # a sidecar's override problem names no file
+            if exc.file != OVERRIDES_FILE:
+                raise
+            raise ScenarioError(scenario, exc.key, exc.problem) from None
         check_profile(loaded, profile, scenario)
         job_name = name or loaded.name
         if job_name in names:
@@ -105,8 +124,21 @@ def plan(entries: Sequence[tuple[str | None, str, Mapping[str, object]]], out_di
                              f"{names[job_name]} (their files would collide in {out_dir})")
         names[job_name] = scenario
         planned.append(RunJob(job_name, scenario, out_dir, dict(overrides), profile,
-                              duration=loaded.duration))
+                              duration=loaded.duration, criteria=sidecar))
     return planned
+
+
+def run_command(job: RunJob) -> str:
+    """The `avsim run` command line that makes `job`'s run (`--dry-run` prints them): its
+    scenario, overrides as `--set PATH=VALUE` (JSON, which YAML reads the same), sidecar,
+    profile and files, quoted for a POSIX shell."""
+    words = ["avsim", "run", job.scenario]
+    for key, value in job.overrides.items():
+        words += ["--set", f"{key}={json.dumps(value)}"]
+    if job.criteria is not None:
+        words += ["--criteria", str(job.criteria)]
+    words += ["--profile", job.profile, "--out", str(job.recording)]
+    return shlex.join(words)
 
 
 def validate_out_dir(out_dir: Path) -> None:

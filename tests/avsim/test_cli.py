@@ -440,3 +440,65 @@ def test_two_bundled_files_of_one_name_are_refused(
     line = result.stderr.strip()
     assert line.startswith("avsim: error: alks/9_9_9: (file): ambiguous bundled name: "), line
     assert line.count(".xosc") == 2 and "\n" not in line
+
+
+# ---- suite: --set, --param, --criteria, --dry-run (nothing is simulated) ----------------
+
+
+def _suite(tmp_path: Path, *args: str) -> tuple[int, str, str]:
+    result = CliRunner().invoke(main, ["suite", *args, "--out", str(tmp_path / "out"),
+                                       "--dry-run", "--jobs", "1"])
+    assert result.exception is None or isinstance(result.exception, SystemExit), (
+        result.exception)  # not a crash
+    return result.exit_code, result.stdout, result.stderr
+
+
+def test_suite_dry_run_prints_every_run_with_the_suite_options(tmp_path: Path) -> None:
+    code, out, err = _suite(tmp_path, "normal_driving", str(CUT_IN), "--set", "duration=3",
+                            "--param", "Ego_InitSpeed_Ve0_kph=50", "--criteria", "r157",
+                            "--profile", "none")
+    assert code == EXIT_BAD_INPUT  # normal_driving has no parameters
+    assert "normal_driving" in err and "parameters.Ego_InitSpeed_Ve0_kph" in err
+    code, out, err = _suite(tmp_path, "acceptance/r157_cut_out", str(CUT_IN), "--set",
+                            "duration=3", "--criteria", "r157", "--profile", "none")
+    assert code == 0, err
+    lines = out.splitlines()
+    assert len(lines) == 6 + 1  # the file's grid, and the ALKS file
+    assert all(line.startswith("avsim run ") and "--set duration=3 " in line
+               and "--profile none" in line for line in lines)
+    assert ["--criteria r157" in line for line in lines] == [False] * 6 + [True]
+    assert lines[0].startswith("avsim run acceptance/r157_cut_out --set duration=3 --set "
+                               "actors.0.actions.0.trigger.ego_s=")
+    assert not (tmp_path / "out").exists()  # nothing written
+
+
+def test_suite_refuses_a_key_a_file_does_not_have_naming_the_file(tmp_path: Path) -> None:
+    code, out, err = _suite(tmp_path, str(SCENARIOS / "normal_driving.yaml"), str(CUT_IN),
+                            "--set", "actors.0.speed_kph=20")
+    assert code == EXIT_BAD_INPUT and out == ""
+    assert err.startswith(f"avsim: error: {CUT_IN}: actors.0.speed_kph: cannot set"), err
+    assert err.count("\n") == 1
+    code, out, err = _suite(tmp_path, "traffic_jam", "--set", "actors.0.speed_kph=20,30")
+    assert code == EXIT_BAD_INPUT and "suite takes one value" in err
+    code, out, err = _suite(tmp_path, "acceptance/r157_cut_out", "--set",
+                            "actors.0.actions.0.lane_change.lateral_speed=2")
+    assert code == EXIT_BAD_INPUT
+    assert "actors.0.actions.0.lane_change.lateral_speed: the file's grid sweeps" in err
+    assert not (tmp_path / "out").exists()
+
+
+def test_suite_criteria_reach_the_openscenario_runs(tmp_path: Path) -> None:
+    from avsim.batch.jobs import Status, run_job
+    from avsim.batch.suite import plan, suite_entries
+
+    sidecar = tmp_path / "bad.criteria.yaml"
+    sidecar.write_text("duration: -1\n", encoding="utf-8")
+    code, _, err = _suite(tmp_path, "traffic_jam", str(CUT_IN), "--criteria", str(sidecar))
+    assert code == EXIT_BAD_INPUT and f"{sidecar}: duration" in err, err
+    good = tmp_path / "good.criteria.yaml"
+    good.write_text("duration: 2\n", encoding="utf-8")
+    jobs = plan(suite_entries(["traffic_jam", str(CUT_IN)]), tmp_path, "none", good)
+    assert [job.criteria for job in jobs] == [None, good]
+    good.write_text("duration: -1\n", encoding="utf-8")  # the worker loads it again
+    outcome = run_job(jobs[1])
+    assert outcome.status is Status.BAD_INPUT and f"{good}: duration" in (outcome.error or "")
