@@ -36,7 +36,7 @@ from avsim.outputs import (
 from avsim.run.interrupts import ExitAtOnce, Interrupts
 from avsim.run.result import dumps, headline, result_json
 from avsim.run.verdict import RunError, RunVerdict
-from avsim.scenario.load import ScenarioError, bundled_scenarios, load_scenario
+from avsim.scenario.load import ScenarioError, load_scenario
 from avsim.scenario.profile_fit import check_profile
 from avsim.scenario.schema import scenario_json_schema
 
@@ -253,14 +253,22 @@ def view(recording: Path, web: bool) -> None:
 
 @main.command(name="list")
 def list_scenarios() -> None:
-    """Bundled scenarios, one per line: name, situation, description."""
-    for path in bundled_scenarios():
-        try:
-            loaded = load_scenario(path)
-        except ScenarioError as exc:
-            click.echo(f"{path.stem}\t(invalid)\t{exc}")
-            continue
-        click.echo(f"{loaded.name}\t{loaded.situation}\t{loaded.description}")
+    """Bundled scenarios by folder: a heading line per folder, then one line per scenario,
+    tab-separated: the name to give `avsim run`, situation, description."""
+    from avsim.scenario.files import REPO_ROOT, bundled_groups
+
+    for number, group in enumerate(bundled_groups()):
+        folder = group.folder.relative_to(REPO_ROOT).as_posix() + "/"
+        note = f" ({group.note})" if group.note else ""
+        click.echo(("\n" if number else "") + f"{folder}{note}")
+        for path in group.files():
+            name = group.name_of(path)
+            try:
+                loaded = load_scenario(path)
+            except ScenarioError as exc:
+                click.echo(f"{name}\t(invalid)\t{exc}")
+                continue
+            click.echo(f"{name}\t{loaded.situation}\t{loaded.description}")
 
 
 @main.command()
@@ -283,6 +291,9 @@ _batch_options = [
                  show_default=True, help="Sensor profile of every run."),
     click.option("--snapshots/--no-snapshots", default=True, show_default=True,
                  help="A picture of each failed run at its first failing moment."),
+    click.option("--dry-run", is_flag=True,
+                 help="Load and check every run, print each as its `avsim run` command "
+                      "line, and run none."),
 ]
 
 
@@ -297,27 +308,64 @@ def batch_options(f: Callable[..., None]) -> Callable[..., None]:
 @click.argument("paths", nargs=-1)
 @click.option("--out", "out", type=click.Path(path_type=Path), default=Path("runs/suite"),
               show_default=True, help="Folder for the runs' files and the reports.")
+@click.option("--set", "sets", multiple=True, metavar="PATH=VALUE",
+              help="Set a key of every file before validation (one value; a file without "
+                   "the key is refused).")
+@click.option("--param", "params", multiple=True, metavar="NAME=VALUE",
+              help="A parameter of every OpenSCENARIO file (short for --set "
+                   "parameters.NAME=VALUE).")
+@click.option("--criteria", "criteria", type=click.Path(path_type=Path), default=None,
+              help="The OpenSCENARIO files' criteria: a sidecar file or a bundled set "
+                   "(default: each file's NAME.criteria.yaml beside it).")
 @batch_options
 @search_path_option
-def suite(paths: tuple[str, ...], out: Path, jobs: int | None, executor: str,
-          address: str | None, profile: str, snapshots: bool,
-          search_paths: tuple[Path, ...]) -> None:
-    """Run scenarios in parallel: files, folders or bundled names (default: every bundled
-    scenario). Writes each run's .rrd, .json and .png, junit.xml, summary.md."""
+def suite(paths: tuple[str, ...], out: Path, sets: tuple[str, ...], params: tuple[str, ...],
+          criteria: Path | None, jobs: int | None, executor: str, address: str | None,
+          profile: str, snapshots: bool, dry_run: bool, search_paths: tuple[Path, ...]) -> None:
+    """Run scenarios in parallel: files, folders or bundled names (default: every scenario
+    in scenarios/). Writes each run's .rrd, .json and .png, junit.xml, summary.md."""
     from avsim.batch import suite as batch
+    from avsim.batch.sweep import SweepError
 
     try:
+        overrides = _one_value_each(sets + tuple(PARAMETER_PREFIX + p for p in params))
         batch.validate_out_dir(out)
-        entries = batch.suite_entries(batch.collect_scenarios(paths), search_paths)
-        planned = batch.plan(entries, out, profile, search_paths)
-    except (ScenarioError, batch.BatchError) as exc:
+        entries = batch.suite_entries(batch.collect_scenarios(paths), overrides, search_paths)
+        planned = batch.plan(entries, out, profile, criteria, search_paths)
+    except (ScenarioError, SweepError, batch.BatchError) as exc:
         _bad_input(str(exc))
+    if dry_run:
+        _print_plan(planned)
     with Interrupts() as stop:  # Ctrl-C / SIGTERM: finished runs and reports are kept
         outcomes = _execute(planned, executor, jobs, address, stop)
         unwritten = batch.reports_written(outcomes, out, lambda: _report(
             outcomes, out, f"avsim suite ({len(outcomes)} runs)", snapshots))
     status = batch.exit_status(outcomes, stop.exit_status)
     _exit(unwritten, status)
+
+
+def _one_value_each(texts: Sequence[str]) -> dict[str, object]:
+    """`PATH=VALUE` texts as overrides; `SweepError` for a malformed one or several values."""
+    from avsim.batch.sweep import SweepError, parse_set
+
+    overrides: dict[str, object] = {}
+    for text in texts:
+        axis = parse_set(text)
+        if len(axis.values) != 1:
+            raise SweepError(f"--set {text}: suite takes one value (sweep takes several)")
+        overrides[axis.path] = axis.values[0]
+    return overrides
+
+
+def _print_plan(planned: Sequence[RunJob]) -> NoReturn:
+    """`--dry-run`: every planned run as the `avsim run` command that makes it, then exit 0
+    (nothing run, nothing written)."""
+    from avsim.batch.suite import run_command
+
+    for job in planned:
+        click.echo(run_command(job))
+    click.echo(f"# {len(planned)} runs planned, none run (--dry-run)", err=True)
+    sys.exit(0)
 
 
 @main.command()
@@ -335,7 +383,7 @@ def suite(paths: tuple[str, ...], out: Path, jobs: int | None, executor: str,
 @search_path_option
 def sweep(scenario: str, sets: tuple[str, ...], params: tuple[str, ...], out: Path | None,
           metric: str, jobs: int | None, executor: str, address: str | None, profile: str,
-          snapshots: bool, search_paths: tuple[Path, ...]) -> None:
+          snapshots: bool, dry_run: bool, search_paths: tuple[Path, ...]) -> None:
     """Run SCENARIO over the grid of --set values (default: the file's own `grid`), like a
     suite; write sweep.csv, sweep.md and, over two swept keys, heatmap.png of --metric."""
     from avsim.batch import suite as batch
@@ -353,9 +401,11 @@ def sweep(scenario: str, sets: tuple[str, ...], params: tuple[str, ...], out: Pa
         out = out if out is not None else Path("runs") / f"sweep_{name}"
         batch.validate_out_dir(out)
         entries = [(f"{name}_{k:03d}", scenario, overrides) for k, overrides in enumerate(runs)]
-        planned = batch.plan(entries, out, profile, search_paths)
+        planned = batch.plan(entries, out, profile, search_paths=search_paths)
     except (ScenarioError, SweepError, batch.BatchError) as exc:
         _bad_input(str(exc))
+    if dry_run:
+        _print_plan(planned)
     with Interrupts() as stop:  # Ctrl-C / SIGTERM: finished runs and reports are kept
         outcomes = _execute(planned, executor, jobs, address, stop)
 

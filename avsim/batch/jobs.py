@@ -54,6 +54,7 @@ class RunJob:
     plot: bool = True  # also write the speed-profile PNG
     duration: float = 0.0  # [s] the scenario's simulated time: its cost, longest run first
     search_paths: tuple[Path, ...] = ()  # folders an OpenSCENARIO file's references may be in
+    criteria: Path | None = None  # an OpenSCENARIO file's sidecar (`--criteria`), else None
 
     @property
     def recording(self) -> Path:
@@ -160,7 +161,7 @@ def run_job(job: RunJob, into: Path | None = None,
     written)."""
     start = time.perf_counter()
     try:
-        scenario = load_scenario(job.scenario, dict(job.overrides),
+        scenario = load_scenario(job.scenario, dict(job.overrides), job.criteria,
                                  search_paths=job.search_paths)
         check_profile(scenario, job.profile, job.scenario)
     except ScenarioError as exc:

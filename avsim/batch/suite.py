@@ -13,7 +13,9 @@
 
 from __future__ import annotations
 
+import json
 import math
+import shlex
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -35,11 +37,12 @@ from avsim.outputs import (
 )
 from avsim.run.interrupts import Interrupts
 from avsim.run.result import dumps
-from avsim.scenario.load import bundled_scenarios, load_scenario
+from avsim.scenario.load import ScenarioError, bundled_scenarios, load_scenario, scenario_path
 from avsim.scenario.model import grid_paths
 from avsim.scenario.openscenario.sidecar import SUFFIX as SIDECAR_SUFFIX
 from avsim.scenario.profile_fit import check_profile
 
+OVERRIDES_FILE = "(overrides)"  # the file a sidecar's override problem names
 SNAPSHOT_DIR = "snapshots"  # the failed runs' pictures, below the batch's folder
 JUNIT, SUMMARY, RESULTS = "junit.xml", "summary.md", "results.json"  # every batch's reports
 SWEEP_CSV, SWEEP_MD, HEAT_MAP = "sweep.csv", "sweep.md", "heatmap.png"  # a sweep's reports
@@ -74,21 +77,30 @@ def collect_scenarios(args: Sequence[str]) -> list[str]:
     return found
 
 
-def suite_entries(scenarios: Sequence[str], search_paths: Sequence[Path] = (),
+def suite_entries(scenarios: Sequence[str], overrides: Mapping[str, object] | None = None,
+                  search_paths: Sequence[Path] = (),
                   ) -> list[tuple[str | None, str, dict[str, object]]]:
     """The runs of a suite over `scenarios` (`plan`'s entries): one per scenario, or one per
-    point of its file's `grid` (named ``<name>_<k:03d>``, as a sweep names its runs);
-    `search_paths` as `load_scenario` takes them."""
+    point of its file's `grid` (named ``<name>_<k:03d>``, as a sweep names its runs), each
+    with `overrides` (`--set`, `--param`) besides its point; `search_paths` as
+    `load_scenario` takes them. A key both set and swept by the file's grid is a
+    `BatchError`: the grid's points would all be the same run."""
     from avsim.batch.sweep import Axis, grid
 
+    given = dict(overrides or {})
     entries: list[tuple[str | None, str, dict[str, object]]] = []
     for scenario in scenarios:
         loaded = load_scenario(scenario, search_paths=search_paths)
         if not loaded.grid:
-            entries.append((None, scenario, {}))
+            entries.append((None, scenario, dict(given)))
             continue
+        swept = {path for key, _ in loaded.grid for path in grid_paths(key)}
+        both = sorted(swept & set(given))
+        if both:
+            raise BatchError(f"{scenario}: {both[0]}: the file's grid sweeps this key "
+                             "(--set would make its points one run)")
         points = grid([Axis(key, values) for key, values in loaded.grid])
-        entries += [(f"{loaded.name}_{k:03d}", scenario, overrides_of(point))
+        entries += [(f"{loaded.name}_{k:03d}", scenario, given | overrides_of(point))
                     for k, point in enumerate(points)]
     return entries
 
@@ -107,17 +119,25 @@ def overrides_of(point: Mapping[str, object]) -> dict[str, object]:
 
 
 def plan(entries: Sequence[tuple[str | None, str, Mapping[str, object]]], out_dir: Path,
-         profile: str, search_paths: Sequence[Path] = ()) -> list[RunJob]:
+         profile: str, criteria: Path | None = None, search_paths: Sequence[Path] = (),
+         ) -> list[RunJob]:
     """Validate each (job name or None for the scenario's own, scenario, overrides) and make
-    its job, which carries `search_paths` to its worker. Raises `ScenarioError` for the
-    first bad one, `BatchError` for two runs that would write the same files, a run named
-    like a report (`REPORT_NAMES`) or a run's file that is an input of the batch (a
-    scenario file, an OpenSCENARIO file's road or sidecar)."""
+    its job, which carries `search_paths` to its worker; `criteria` is the sidecar of the
+    OpenSCENARIO files among them (`--criteria`). Raises `ScenarioError` (naming the
+    scenario) for the first bad one, `BatchError` for two runs that would write the same
+    files, a run named like a report (`REPORT_NAMES`) or a run's file that is an input of the
+    batch (a scenario file, an OpenSCENARIO file's road or sidecar)."""
     planned: list[RunJob] = []
     names: dict[str, str] = {}
     sources: set[Path] = set()
     for name, scenario, overrides in entries:
-        loaded = load_scenario(scenario, dict(overrides), search_paths=search_paths)
+        sidecar = criteria if scenario_path(scenario).suffix == ".xosc" else None
+        try:
+            loaded = load_scenario(scenario, dict(overrides), sidecar, search_paths=search_paths)
+        except ScenarioError as exc:  # a sidecar's override problem names no file
+            if exc.file != OVERRIDES_FILE:
+                raise
+            raise ScenarioError(scenario, exc.key, exc.problem) from None
         check_profile(loaded, profile, scenario)
         job_name = name or loaded.name
         if job_name in names:
@@ -129,7 +149,8 @@ def plan(entries: Sequence[tuple[str | None, str, Mapping[str, object]]], out_di
         names[job_name] = scenario
         sources.update(loaded.sources)
         planned.append(RunJob(job_name, scenario, out_dir, dict(overrides), profile,
-                              duration=loaded.duration, search_paths=tuple(search_paths)))
+                              duration=loaded.duration, criteria=sidecar,
+                              search_paths=tuple(search_paths)))
     _check_not_inputs(planned, sorted(sources))
     return planned
 
@@ -147,6 +168,21 @@ def _check_not_inputs(jobs: Sequence[RunJob], sources: Sequence[Path]) -> None:
                 if same_file(ident, source_ident):
                     raise BatchError(f"{file}: --out: is an input of the batch ({source}): "
                                      "avsim never writes over its inputs")
+
+
+def run_command(job: RunJob) -> str:
+    """The `avsim run` command line that makes `job`'s run (`--dry-run` prints them): its
+    scenario, overrides as `--set PATH=VALUE` (JSON, which YAML reads the same), sidecar,
+    search paths, profile and files, quoted for a POSIX shell."""
+    words = ["avsim", "run", job.scenario]
+    for key, value in job.overrides.items():
+        words += ["--set", f"{key}={json.dumps(value)}"]
+    if job.criteria is not None:
+        words += ["--criteria", str(job.criteria)]
+    for folder in job.search_paths:
+        words += ["--search-path", str(folder)]
+    words += ["--profile", job.profile, "--out", str(job.recording)]
+    return shlex.join(words)
 
 
 def validate_out_dir(out_dir: Path) -> None:

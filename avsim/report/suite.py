@@ -165,9 +165,21 @@ def _criterion_case(suite: ET.Element, outcome: RunOutcome,
     if criterion["passed"] is None:
         ET.SubElement(case, "skipped", message=str(criterion.get("note") or "not applicable"))
     elif not criterion["passed"]:
-        failure = ET.SubElement(case, "failure", message=_failure_message(criterion),
-                                type="criterion")
-        failure.text = _failure_text(criterion)
+        said = _infractions(outcome, str(criterion["name"]))
+        message = _failure_message(criterion)
+        if said:  # what happened first, then the numbers
+            message = f"{said[0]}; {message}"
+        failure = ET.SubElement(case, "failure", message=message, type="criterion")
+        failure.text = "\n".join([_failure_text(criterion), *said[1:]])
+
+
+def _infractions(outcome: RunOutcome, name: str) -> list[str]:
+    """The run's infractions of criterion `name` in time order, each as `at T s: message`."""
+    found = (outcome.result or {}).get("infractions")
+    if not isinstance(found, list):
+        return []
+    mine = [i for i in found if isinstance(i, dict) and i.get("kind") == name]
+    return [f"at {format_value(i.get('t'))} s: {i.get('message')}" for i in mine]
 
 
 def _error_case(suite: ET.Element, outcome: RunOutcome) -> None:
@@ -217,8 +229,10 @@ def junit_xml(outcomes: Sequence[RunOutcome], suite_name: str) -> str:
     `<testsuites name=suite_name>` holds one `<testsuite name=job name>` per run, with
     `<properties>` (scenario, file, seed, profile, status, `override.<key>` per swept key)
     and one `<testcase classname="avsim.<job name>" name=<criterion>>` per criterion; a
-    failed criterion's `<failure message="value V unit (threshold T)">` text adds its first
-    failure time [s] and note. A run that did not finish is one `<testcase name="run">` with
+    failed criterion's `<failure message="at T s: <its first infraction>; value V unit
+    (threshold T)">` (no infraction: the numbers only) has as text the numbers, its first
+    failure time [s], note and later infractions, a line each.
+    A run that did not finish is one `<testcase name="run">` with
     `<error message=<its error line> type=bad_input|error>`. `time` attributes are wall
     times [s]. ElementTree escapes `<`, `&` and quotes in attributes and text.
     """

@@ -1,7 +1,9 @@
 """Finding a scenario file and reading its YAML.
 
-A scenario argument is a file path, or the name of a bundled scenario in `<repo>/scenarios/`
-(`SCENARIO_DIR`). The YAML is read with a strict safe loader: a key written twice in one
+A scenario argument is a file path, or the name of a bundled scenario (`bundled_groups`:
+`scenarios/NAME.yaml` is `NAME`, `scenarios/acceptance/NAME.yaml` `acceptance/NAME`, the
+vendored `alks_scenario_4_4_1_..._template.xosc` `alks/4_4_1_...`, and so on).
+The YAML is read with a strict safe loader: a key written twice in one
 mapping is an error (PyYAML would keep the last), plain scalars are read by the YAML 1.2
 core schema (``1e9`` is a number, ``yes`` is text), and a file over `MAX_FILE_BYTES` or
 holding over `MAX_VALUES` values (anchors expanded) is refused. Problems are `LocatedError`s keyed
@@ -10,46 +12,109 @@ holding over `MAX_VALUES` values (anchors expanded) is refused. Problems are `Lo
 
 from __future__ import annotations
 
-import os
 import re
 from collections.abc import Hashable
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import yaml
 
 from avsim.scenario.bounds import MAX_FILE_BYTES, MAX_VALUES
-from avsim.scenario.errors import FILE_KEY, LocatedError, show
+from avsim.scenario.errors import FILE_KEY, LocatedError, ScenarioError, show
 
 REPO_ROOT = Path(__file__).resolve().parents[2]  # the repository this package sits in
 SCENARIO_DIR = REPO_ROOT / "scenarios"  # the bundled scenarios
+ALKS_DIR = REPO_ROOT / "tests/data/alks/logical_scenarios/concrete_scenarios"  # vendored
+SCENARIO_SUFFIXES = frozenset({".yaml", ".yml", ".xosc"})  # an argument ending so is a path
+
+
+@dataclass(frozen=True, slots=True)
+class BundledGroup:
+    """One folder of bundled scenarios and how its files are named on the command line:
+    `prefix` + the file's stem, less `strip`'s leading and trailing parts."""
+
+    folder: Path  # where the files are
+    pattern: str  # which files of it are scenarios (a glob)
+    prefix: str = ""  # the names' folder part: "" or "<group>/"
+    strip: tuple[str, str] = ("", "")  # removed from the stem's start and end
+    note: str = ""  # what `avsim list` says of the group besides its folder
+
+    def name_of(self, path: Path) -> str:
+        """The bundled name of `path`, one of this group's files."""
+        head, tail = self.strip
+        return self.prefix + path.stem.removeprefix(head).removesuffix(tail)
+
+    def files(self) -> list[Path]:
+        """The group's scenario files, sorted by name."""
+        return sorted(self.folder.glob(self.pattern))
+
+
+def bundled_groups() -> tuple[BundledGroup, ...]:
+    """The folders of bundled scenarios, in the order `avsim list` shows them."""
+    return (
+        BundledGroup(SCENARIO_DIR, "*.yaml"),
+        BundledGroup(SCENARIO_DIR / "acceptance", "*.yaml", "acceptance/",
+                     note="test protocols; a file's grid runs as a suite or a sweep"),
+        BundledGroup(SCENARIO_DIR / "faults", "*.yaml", "faults/", note="sensor faults"),
+        BundledGroup(ALKS_DIR, "alks_scenario_*.xosc", "alks/",
+                     ("alks_scenario_", "_template"),
+                     note="ASAM ALKS OpenSCENARIO files for UN R157 (MPL-2.0); "
+                          "add --criteria r157"),
+    )
 
 
 def bundled_scenarios() -> list[Path]:
-    """The bundled scenario files, `<repo>/scenarios/*.yaml`, sorted by name."""
-    return sorted(SCENARIO_DIR.glob("*.yaml"))
+    """The bundled scenario files a suite runs by default, `<repo>/scenarios/*.yaml`, sorted
+    by name (`bundled_names` has every group)."""
+    return bundled_groups()[0].files()
+
+
+def bundled_names() -> dict[str, list[Path]]:
+    """Every bundled name (`avsim run NAME`) and the files it names, group by group: one file
+    each, unless two files of a group differ only in what the name leaves out."""
+    names: dict[str, list[Path]] = {}
+    for group in bundled_groups():
+        for path in group.files():
+            names.setdefault(group.name_of(path), []).append(path)
+    return names
 
 
 def scenario_path(path_or_name: str | Path) -> Path:
-    """The file a scenario argument names: a path (anything with a `/`, a `.yaml` / `.yml` /
-    `.xosc` suffix, or an existing file), else the bundled `<repo>/scenarios/<name>.yaml`."""
-    candidate = Path(path_or_name)
-    if looks_like_path(path_or_name) or candidate.exists():
-        return candidate
-    return SCENARIO_DIR / f"{candidate.name}.yaml"
+    """The file a scenario argument names: a path (a `Path`, or text ending in `.yaml`,
+    `.yml` or `.xosc`), else a bundled name (`bundled_names`), else the path it spells (a
+    bare name: `scenarios/<name>.yaml`), which may not exist: the loader says so. Raises
+    `ScenarioError` for an ambiguous name: two bundled files, or a bundled name that is also
+    a file here."""
+    if looks_like_path(path_or_name):
+        return Path(path_or_name)
+    text = str(path_or_name)
+    found = bundled_names().get(text)
+    if found is None:  # the loader says "no such file or bundled scenario"
+        return Path(text) if "/" in text or Path(text).exists() else SCENARIO_DIR / f"{text}.yaml"
+    if len(found) > 1:
+        raise ScenarioError(text, FILE_KEY, "ambiguous bundled name: "
+                            + " and ".join(str(p) for p in found))
+    if Path(text).exists():
+        raise ScenarioError(text, FILE_KEY, f"ambiguous: a file here and the bundled "
+                            f"{found[0]} (write ./{text} for the file)")
+    return found[0]
 
 
 def looks_like_path(path_or_name: str | Path) -> bool:
-    """Whether a scenario argument is meant as a path (not a bundled scenario's name)."""
+    """Whether a scenario argument is meant as a path, not a bundled name: a `Path`, or text
+    ending in a scenario file's suffix or starting with `./`, `../` or the root."""
     text = str(path_or_name)
-    is_file_name = Path(text).suffix in {".yaml", ".yml", ".xosc"}
-    return isinstance(path_or_name, Path) or is_file_name or "/" in text or os.sep in text
+    explicit = text.startswith(("./", "../", "/", "~")) or Path(text).is_absolute()
+    return (isinstance(path_or_name, Path) or Path(text).suffix in SCENARIO_SUFFIXES
+            or explicit)
 
 
 def shown_name(path_or_name: str | Path, path: Path) -> str:
     """How the file is named in messages: as the user wrote it, or for a bundled name its
     path relative to the working directory when it lies below it."""
-    if looks_like_path(path_or_name) or not path.is_relative_to(SCENARIO_DIR):
+    bundled = any(path.is_relative_to(group.folder) for group in bundled_groups())
+    if looks_like_path(path_or_name) or not bundled:
         return str(path_or_name)
     try:
         return str(path.relative_to(Path.cwd()))

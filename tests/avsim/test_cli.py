@@ -249,18 +249,49 @@ def test_every_bad_fixture_is_rejected_in_process(
     assert list((tmp_path / "tmp").iterdir()) == []
 
 
-def test_list_prints_one_line_per_bundled_scenario(outcomes: dict[str, Outcome]) -> None:
+def _listed(stdout: str) -> dict[str, list[list[str]]]:
+    """`avsim list`'s output: each folder heading's rows (name, situation, description)."""
+    groups: dict[str, list[list[str]]] = {}
+    heading = ""
+    for line in stdout.splitlines():
+        if "\t" in line:
+            groups[heading].append(line.split("\t"))
+        elif line:
+            heading = line.split(" (")[0]
+            groups[heading] = []
+    return groups
+
+
+def test_list_prints_every_bundled_scenario_by_folder(outcomes: dict[str, Outcome]) -> None:
     out = outcomes["list"]
     assert out.returncode == 0, out.stderr
-    files = sorted(SCENARIOS.glob("*.yaml"))
-    expected = {yaml.safe_load(path.read_text(encoding="utf-8"))["name"] for path in files}
-    lines = out.stdout.splitlines()
-    assert len(lines) == len(files)
-    rows = [line.split("\t") for line in lines]
-    assert all(len(row) == 3 for row in rows), lines  # name, situation, description
-    assert {row[0] for row in rows} == expected
-    assert "normal_driving" in expected
-    assert all(row[1] != "(invalid)" for row in rows), lines
+    groups = _listed(out.stdout)
+    alks = ALKS.relative_to(REPO).as_posix() + "/"
+    assert list(groups) == ["scenarios/", "scenarios/acceptance/", "scenarios/faults/", alks]
+    for heading, pattern, prefix in (("scenarios/", "*.yaml", ""),
+                                     ("scenarios/acceptance/", "*.yaml", "acceptance/"),
+                                     ("scenarios/faults/", "*.yaml", "faults/")):
+        files = sorted((REPO / heading).glob(pattern))
+        rows = groups[heading]
+        assert len(rows) == len(files) > 0, heading
+        assert [row[0] for row in rows] == [prefix + path.stem for path in files]
+    assert len(groups[alks]) == len(list(ALKS.glob("alks_scenario_*.xosc"))) == 15
+    rows = [row for group in groups.values() for row in group]
+    assert all(len(row) == 3 for row in rows), rows  # name, situation, description
+    assert all(row[1] != "(invalid)" for row in rows), rows
+    names = {row[0] for row in rows}
+    assert {"normal_driving", "acceptance/ncap_ccrs", "faults/lidar_outage",
+            "alks/4_4_1_cut_in_no_collision"} <= names
+
+
+def test_every_listed_name_resolves_to_its_file(outcomes: dict[str, Outcome]) -> None:
+    from avsim.scenario.load import load_scenario, scenario_path
+
+    for heading, rows in _listed(outcomes["list"].stdout).items():
+        for name, _situation, description in rows:
+            path = scenario_path(name)
+            assert path.is_relative_to(REPO / heading), (name, path)
+            assert load_scenario(name).description == description
 
 
 def test_schema_is_a_json_schema_that_accepts_the_bundled_scenario(
@@ -384,3 +415,91 @@ def test_the_progress_line_gives_the_pace(sim: float, duration: float, wall: flo
     from avsim.cli import pace
 
     assert pace(sim, duration, wall) == text
+
+
+def test_a_bundled_name_that_is_also_a_file_here_is_refused(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "normal_driving").write_text(MINIMAL, encoding="utf-8")
+    result = CliRunner().invoke(main, ["run", "normal_driving", "--out", "x.rrd"])
+    assert result.exit_code == EXIT_BAD_INPUT, result.output
+    assert result.stderr.startswith("avsim: error: normal_driving: (file): ambiguous: a file "
+                                    "here and the bundled ")
+    assert "./normal_driving" in result.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["normal_driving"]
+
+
+def test_two_bundled_files_of_one_name_are_refused(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    from avsim.scenario import files
+
+    for stem in ("alks_scenario_9_9_9_template", "alks_scenario_9_9_9"):
+        (tmp_path / f"{stem}.xosc").write_text("<OpenSCENARIO/>", encoding="utf-8")
+    monkeypatch.setattr(files, "ALKS_DIR", tmp_path)
+    result = CliRunner().invoke(main, ["run", "alks/9_9_9", "--out", str(tmp_path / "x.rrd")])
+    assert result.exit_code == EXIT_BAD_INPUT, result.output
+    line = result.stderr.strip()
+    assert line.startswith("avsim: error: alks/9_9_9: (file): ambiguous bundled name: "), line
+    assert line.count(".xosc") == 2 and "\n" not in line
+
+
+# ---- suite: --set, --param, --criteria, --dry-run (nothing is simulated) ----------------
+
+
+def _suite(tmp_path: Path, *args: str) -> tuple[int, str, str]:
+    result = CliRunner().invoke(main, ["suite", *args, "--out", str(tmp_path / "out"),
+                                       "--dry-run", "--jobs", "1"])
+    assert result.exception is None or isinstance(result.exception, SystemExit), (
+        result.exception)  # not a crash
+    return result.exit_code, result.stdout, result.stderr
+
+
+def test_suite_dry_run_prints_every_run_with_the_suite_options(tmp_path: Path) -> None:
+    code, out, err = _suite(tmp_path, "normal_driving", str(CUT_IN), "--set", "duration=3",
+                            "--param", "Ego_InitSpeed_Ve0_kph=50", "--criteria", "r157",
+                            "--profile", "none")
+    assert code == EXIT_BAD_INPUT  # normal_driving has no parameters
+    assert "normal_driving" in err and "parameters.Ego_InitSpeed_Ve0_kph" in err
+    code, out, err = _suite(tmp_path, "acceptance/r157_cut_out", str(CUT_IN), "--set",
+                            "duration=3", "--criteria", "r157", "--profile", "none")
+    assert code == 0, err
+    lines = out.splitlines()
+    assert len(lines) == 6 + 1  # the file's grid, and the ALKS file
+    assert all(line.startswith("avsim run ") and "--set duration=3 " in line
+               and "--profile none" in line for line in lines)
+    assert ["--criteria r157" in line for line in lines] == [False] * 6 + [True]
+    assert lines[0].startswith("avsim run acceptance/r157_cut_out --set duration=3 --set "
+                               "actors.0.actions.0.trigger.ego_s=")
+    assert not (tmp_path / "out").exists()  # nothing written
+
+
+def test_suite_refuses_a_key_a_file_does_not_have_naming_the_file(tmp_path: Path) -> None:
+    code, out, err = _suite(tmp_path, str(SCENARIOS / "normal_driving.yaml"), str(CUT_IN),
+                            "--set", "actors.0.speed_kph=20")
+    assert code == EXIT_BAD_INPUT and out == ""
+    assert err.startswith(f"avsim: error: {CUT_IN}: actors.0.speed_kph: cannot set"), err
+    assert err.count("\n") == 1
+    code, out, err = _suite(tmp_path, "traffic_jam", "--set", "actors.0.speed_kph=20,30")
+    assert code == EXIT_BAD_INPUT and "suite takes one value" in err
+    code, out, err = _suite(tmp_path, "acceptance/r157_cut_out", "--set",
+                            "actors.0.actions.0.lane_change.lateral_speed=2")
+    assert code == EXIT_BAD_INPUT
+    assert "actors.0.actions.0.lane_change.lateral_speed: the file's grid sweeps" in err
+    assert not (tmp_path / "out").exists()
+
+
+def test_suite_criteria_reach_the_openscenario_runs(tmp_path: Path) -> None:
+    from avsim.batch.jobs import Status, run_job
+    from avsim.batch.suite import plan, suite_entries
+
+    sidecar = tmp_path / "bad.criteria.yaml"
+    sidecar.write_text("duration: -1\n", encoding="utf-8")
+    code, _, err = _suite(tmp_path, "traffic_jam", str(CUT_IN), "--criteria", str(sidecar))
+    assert code == EXIT_BAD_INPUT and f"{sidecar}: duration" in err, err
+    good = tmp_path / "good.criteria.yaml"
+    good.write_text("duration: 2\n", encoding="utf-8")
+    jobs = plan(suite_entries(["traffic_jam", str(CUT_IN)]), tmp_path, "none", good)
+    assert [job.criteria for job in jobs] == [None, good]
+    good.write_text("duration: -1\n", encoding="utf-8")  # the worker loads it again
+    outcome = run_job(jobs[1])
+    assert outcome.status is Status.BAD_INPUT and f"{good}: duration" in (outcome.error or "")

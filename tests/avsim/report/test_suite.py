@@ -358,3 +358,28 @@ def test_summary_scenario_table_gives_pass_rates_and_worst_margins(tmp_path: Pat
     rows = [line for line in text.splitlines() if line.startswith("| `")][:2]
     assert rows == ["| `cut_in` | 3 | 1 | 33 % | 1.1 | 12 | 4.2 |",
                     "| `typo` | 1 | 0 | 0 % | — | — | — |"]
+
+
+def test_junit_failure_says_what_happened_first(tmp_path: Path) -> None:
+    job = RunJob("cut_in_fail", "cut_in", tmp_path)
+    criteria = [_criterion("no_collision", False, 2, 0, "contacts", 12.3),
+                _criterion("min_gap", False, 0.5, 15.6, "m")]
+    result = _result(job, criteria, 30.0, {})
+    result["infractions"] = [
+        {"t": 12.3, "kind": "no_collision", "message": "contact with car <lead> & co",
+         "where": [1.0, 2.0]},
+        {"t": 13.0, "kind": "speed_limit", "message": "62 km/h over a 50 km/h limit",
+         "where": None},
+        {"t": 20.25, "kind": "no_collision", "message": "contact with truck_1",
+         "where": None},
+    ]
+    root = ET.fromstring(junit_xml([RunOutcome(job, Status.FAILED, result)], "s").encode())
+    failures = {c.attrib["name"]: c.find("failure") for c in root.iter("testcase")}
+    contact, gap = failures["no_collision"], failures["min_gap"]
+    assert contact is not None and gap is not None
+    assert contact.attrib["message"] == ("at 12.3 s: contact with car <lead> & co; "
+                                         "value 2 contacts (threshold 0)")
+    text = (contact.text or "").splitlines()
+    assert text[-1] == "at 20.25 s: contact with truck_1"
+    assert "speed_limit" not in (contact.text or "") and "62 km/h" not in (contact.text or "")
+    assert gap.attrib["message"] == "value 0.5 m (threshold 15.6)"  # no infraction: numbers
