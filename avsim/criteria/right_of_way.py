@@ -46,6 +46,7 @@ from numpy.typing import NDArray
 
 from avsim.criteria.base import Criterion, CriterionResult, Need, TruthSample
 from avsim.criteria.declaration import Declaration, RunInputs
+from avsim.criteria.wording import beside
 from avsim.scenario.fields import PosFloat
 from world.actors.all_way_stop import AllWayStop
 from world.hdmap import LightColour
@@ -121,7 +122,8 @@ class MaxWaitWithRightOfWay(Criterion):
             self.longest, self.worst = waited, key
         if waited > self.threshold and key not in self._reported:
             self._reported.add(key)
-            self._infraction(sample, f"{key} has stood {waited:.1f} s with the right of way "
+            shown = beside(waited, self.threshold)
+            self._infraction(sample, f"{key} has stood {shown} s with the right of way "
                                      f"(more than {self.threshold:g} s)")
 
     def _vehicles(self, sample: TruthSample) -> tuple[list[str], FloatArray, FloatArray,
