@@ -7,16 +7,10 @@ import re
 
 import pytest
 
+from avsim.criteria.lane import LINE_HALF_WIDTH, TyresInLane
 from avsim.criteria.wording import beside, signed
-from tests.avsim.criteria.test_criteria_situations import (
-    LINE_HALF_WIDTH,
-    ROAD,
-    TRACK,
-    TYRE,
-    TyresInLane,
-    W,
-    truth,
-)
+from tests.avsim.criteria.test_criteria_situations import ROAD, TRACK, TYRE, truth
+from tests.roads import W
 
 
 @pytest.mark.parametrize(("x", "text"), [
