@@ -515,5 +515,35 @@ def snapshot(recording: Path, at: float, out: Path | None, size: tuple[int, int]
     click.echo(str(out))
 
 
+
+@main.command()
+@click.argument("recording", type=click.Path(path_type=Path))
+@click.option("--csv", "fmt", flag_value="csv", help="Write CSV.")
+@click.option("--parquet", "fmt", flag_value="parquet", help="Write Parquet.")
+@click.option("--out", "out", type=click.Path(path_type=Path), default=None,
+              help="The table's file. Default: RECORDING's name with .csv / .parquet.")
+@click.option("--force", is_flag=True, help="Overwrite --out if it exists.")
+def export(recording: Path, fmt: str | None, out: Path | None, force: bool) -> None:
+    """Write the time series of RECORDING (.rrd of `avsim run`) as one table, a row per
+    recorded ego pose: time, the ego, the margins (gap, TTC, d_min), the plan's states, the
+    actors (docs/cli.md, "Exporting a run")."""
+    from avsim.report.export import ExportError, default_out, export_run
+
+    if fmt not in ("csv", "parquet"):
+        _bad_input(f"{recording}: --csv|--parquet: give the table's format")
+    out = out if out is not None else default_out(recording, "csv" if fmt == "csv" else "parquet")
+    if out.absolute() == recording.absolute() or (out.exists() and recording.exists()
+                                                  and out.samefile(recording)):
+        _bad_input(f"{out}: --out: is the recording itself")
+    if out.exists() and not force:
+        _bad_input(f"{out}: --out: exists (--force overwrites it)")
+    _writable(out, "--out")
+    try:
+        table = export_run(recording, out, "csv" if fmt == "csv" else "parquet")
+    except ExportError as exc:
+        _bad_input(f"{recording}: (file): {exc}")
+    click.echo(f"{out}: {table.num_rows} rows, {table.num_columns} columns")
+
+
 if __name__ == "__main__":
     main()

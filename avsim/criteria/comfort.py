@@ -51,6 +51,7 @@ from numpy.typing import NDArray
 from avsim.criteria.base import Criterion, CriterionResult, Need, TruthSample
 from avsim.criteria.declaration import Declaration
 from avsim.criteria.following import ahead_of
+from avsim.criteria.wording import beside
 from world.hdmap import RoadMap
 
 A_ISO = 3.5  # [m/s^2] ISO 15622 / 22179 (above 20 m/s): deceleration, 2 s average
@@ -197,7 +198,8 @@ class _Comfort(Criterion):
             return
         self.peak = max(self.peak, value)
         if value > self.limit:
-            self._fail(sample, f"{self.name} {value:.2f} {self.unit} beyond {self.limit:g} "
+            shown = beside(value, self.limit, 2)
+            self._fail(sample, f"{self.name} {shown} {self.unit} beyond {self.limit:g} "
                                f"{self.unit} with a comfortable solution at hand")
 
     def result(self) -> CriterionResult:

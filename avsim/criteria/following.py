@@ -18,6 +18,7 @@ from avsim.criteria.base import (
     TruthSample,
 )
 from avsim.criteria.declaration import Declaration
+from avsim.criteria.wording import beside
 from avsim.scenario.fields import NonNegFloat, PosFloat, problem
 from planner.fsm.acc import r157_min_gap
 from world.frames import kph
@@ -71,7 +72,7 @@ class MinGap(Criterion):
         if gap - d_min < self.margin:
             self.margin, self.gap, self.threshold = gap - d_min, gap, d_min
         if gap < d_min:
-            self._fail(sample, f"gap {gap:.1f} m to {name} under {d_min:.1f} m")
+            self._fail(sample, f"gap {beside(gap, d_min)} m to {name} under {d_min:.1f} m")
 
     def result(self) -> CriterionResult:
         if self.gap is None:  # asked for by name: it fails
@@ -157,7 +158,8 @@ class StandstillGap(Criterion):
         if self.worst is None or abs(gap - mid) > abs(self.worst - mid):
             self.worst = gap
         if not self.low <= gap <= self.high:
-            self._fail(sample, f"standing {gap:.1f} m behind the vehicle ahead, outside "
+            shown = beside(gap, self.low if gap < self.low else self.high)
+            self._fail(sample, f"standing {shown} m behind the vehicle ahead, outside "
                                f"[{self.low:g}, {self.high:g}] m")
 
     def result(self) -> CriterionResult:
@@ -213,7 +215,8 @@ class TimeToResume(Criterion):
         wait = sample.t - self._clear_at
         self.waits.append(wait)
         if wait > self.threshold:
-            self._infraction(sample, f"{wait:.1f} s to resume after the lane ahead cleared, "
+            shown = beside(wait, self.threshold)
+            self._infraction(sample, f"{shown} s to resume after the lane ahead cleared, "
                                      f"over {self.threshold:g} s")
         self._clear_at = None
 

@@ -26,6 +26,7 @@ from collections import deque
 
 from avsim.criteria.base import Criterion, CriterionResult, TruthSample
 from avsim.criteria.declaration import Declaration
+from avsim.criteria.wording import beside, signed
 from avsim.scenario.fields import PosFloat
 
 JERK_WINDOW = 0.2  # [s] of the moving average
@@ -59,7 +60,8 @@ class MaxJerk(Criterion):
         jerk = (self._accels[-1][1] - a0) / (m - m0)
         self.peak = max(self.peak, abs(jerk))
         if abs(jerk) > self.threshold:
-            self._fail(sample, f"longitudinal jerk {jerk:+.1f} m/s^3 beyond "
+            self._fail(sample, f"longitudinal jerk {signed(jerk, 1)} m/s^3 (magnitude "
+                               f"{beside(abs(jerk), self.threshold)}) beyond "
                                f"{self.threshold:g} m/s^3")
 
     def result(self) -> CriterionResult:

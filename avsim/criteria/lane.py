@@ -37,6 +37,7 @@ from avsim.criteria.base import (
     TruthSample,
 )
 from avsim.criteria.declaration import Declaration, RunInputs
+from avsim.criteria.wording import beside, signed
 from avsim.scenario.fields import FormatModel, PosFloat
 from world.hdmap import SHOULDER, RoadMap
 
@@ -245,7 +246,8 @@ class TyresInLane(Criterion):
         self.margin = min(self.margin, place.margin)
         if place.margin < 0.0:
             where = "the junction's corridor" if place.junction else "the lanes"
-            self._fail(sample, f"a tyre {-place.margin:.2f} m outside {where}")
+            self._fail(sample, f"a tyre's margin inside {where} {signed(place.margin)} m "
+                               f"(negative: over their outer lines)")
         if place.junction:
             self._close(None)
         elif place.lane is None:
@@ -279,9 +281,10 @@ class TyresInLane(Criterion):
                                f"{self.max_duration:g} s")
         if isinstance(ended, Crossing) and ended.origin_margin < 0.0:
             self.margin = min(self.margin, ended.origin_margin)
-            self._fail(sample, f"tyres {-ended.origin_margin:.2f} m over the lines of lane "
-                               f"{ended.origin} from t = {ended.since:.1f} s and back: "
-                               f"no lane change", at=ended.since)
+            self._fail(sample, f"the tyres' margin inside the lines of lane {ended.origin} "
+                               f"{signed(ended.origin_margin)} m (negative: over them) from "
+                               f"t = {ended.since:.1f} s and back: no lane change",
+                       at=ended.since)
 
     def result(self) -> CriterionResult:
         margin = self.margin
@@ -378,7 +381,8 @@ class LaneChangeLateralAccel(Criterion):
                 _, a, at = self.recent.popleft()
                 self.peak = max(self.peak, a)
                 if a > self.threshold:
-                    self._fail(at, f"lane change lateral acceleration {a:.2f} m/s^2 over "
+                    self._fail(at, f"lane change lateral acceleration "
+                                   f"{beside(a, self.threshold, 2)} m/s^2 over "
                                    f"{self.threshold:g} m/s^2")
 
     def result(self) -> CriterionResult:

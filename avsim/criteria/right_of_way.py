@@ -14,7 +14,14 @@ At each sample, for every vehicle (the ego; each NPC car or truck in the world):
 3. Else, when it stands **at a stop line** (its front bumper ``-LINE_OVER`` to
    ``LINE_ZONE`` before an approach's line, within the approach's lanes, heading within
    45 deg of the approach's), it has the right of way
-   - at a traffic light: while the light (its true signal plan) is green;
+   - at a traffic light: while the light (its true signal plan) is green and no moving
+     vehicle that has the right of way over it is in its way: none moving inside the
+     junction's box, and none coming the other way (heading within 45 deg of the
+     opposite, moving, on the far side of the junction's centre within the street's half
+     width across) that reaches the box within ``YIELD_GAP`` [s] at its speed. Its turn
+     is not in the truth: one that stands on green for oncoming traffic may turn left
+     across it (oncoming traffic has the way), and a town in which traffic still moves
+     through the junction is not deadlocked;
    - at an all-way stop: while it is its turn in order of arrival
      (`world.actors.all_way_stop`, arrivals from these samples: first to stop at its line,
      first to go, ties to the right; a turn here never passes on for not being taken) and
@@ -32,12 +39,14 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
 
 from avsim.criteria.base import Criterion, CriterionResult, Need, TruthSample
 from avsim.criteria.declaration import Declaration, RunInputs
+from avsim.criteria.wording import beside
 from avsim.scenario.fields import PosFloat
 from world.actors.all_way_stop import AllWayStop
 from world.hdmap import LightColour
@@ -51,6 +60,8 @@ QUEUE_GAP = 8.0  # [m] bumper gap to the vehicle ahead within which one is queue
 LINE_ZONE = 6.0  # [m] front bumper this far before a line, or nearer: at the line
 LINE_OVER = 1.0  # [m] ... or this far over it
 SAME_WAY = math.cos(math.radians(45.0))  # [-] headings within 45 deg: the same way
+YIELD_GAP = 5.0  # [s] oncoming traffic this near the box in time keeps the way from a left
+#   turn on green (the critical gap of a left turn across oncoming traffic, ~4-5 s)
 EGO = "ego"
 
 FloatArray = NDArray[np.float64]
@@ -94,11 +105,12 @@ class MaxWaitWithRightOfWay(Criterion):
         standing = speed < STANDING
         for i, key in enumerate(keys):
             self._arrivals(sample.t, key, int(line[i]), bool(standing[i]))
+        moving = Moving(xy, fwd, speed)
         for i, key in enumerate(keys):
             if not standing[i]:
                 self._with_way.pop(key, None)
                 continue
-            way = not queued[i] and self._has_way(sample.t, key, int(line[i]), xy, i)
+            way = not queued[i] and self._has_way(sample.t, key, int(line[i]), moving, i)
             if way:
                 self._count(sample, key, dt)
 
@@ -110,7 +122,8 @@ class MaxWaitWithRightOfWay(Criterion):
             self.longest, self.worst = waited, key
         if waited > self.threshold and key not in self._reported:
             self._reported.add(key)
-            self._infraction(sample, f"{key} has stood {waited:.1f} s with the right of way "
+            shown = beside(waited, self.threshold)
+            self._infraction(sample, f"{key} has stood {shown} s with the right of way "
                                      f"(more than {self.threshold:g} s)")
 
     def _vehicles(self, sample: TruthSample) -> tuple[list[str], FloatArray, FloatArray,
@@ -158,22 +171,21 @@ class MaxWaitWithRightOfWay(Criterion):
             self.order.arrive(a.junction, key, _HEADINGS[a.heading], t)
             self._at[key] = line
 
-    def _has_way(self, t: float, key: str, line: int, xy: FloatArray, i: int) -> bool:
+    def _has_way(self, t: float, key: str, line: int, moving: Moving, i: int) -> bool:
         """Whether vehicle i (`key`, not queued) standing at approach `line` (-1: none) has
         the right of way."""
         if line < 0:
             return True
         a = self.approaches[line]
+        assert self.layout is not None
+        centre, hw = self.layout.centre(a.junction), self.layout.half_width
         if a.light is not None:
-            return light_colour(a.light, t) is LightColour.GREEN
+            return light_colour(a.light, t) is LightColour.GREEN and \
+                not _yields_on_green(moving, i, centre, hw, self._line_f[line])
         if key not in self._at or self.order.turn(a.junction, t) != key:
             return False
-        assert self.layout is not None
-        cx, cy = self.layout.centre(a.junction)
-        hw = self.layout.half_width
-        others = np.delete(xy, i, axis=0)
-        inside = (np.abs(others[:, 0] - cx) < hw) & (np.abs(others[:, 1] - cy) < hw)
-        return not bool(inside.any())
+        others = np.delete(moving.xy, i, axis=0)
+        return not bool(_in_box(others, centre, hw).any())
 
     def result(self) -> CriterionResult:
         if self.layout is None:
@@ -186,6 +198,40 @@ class MaxWaitWithRightOfWay(Criterion):
         note = f"longest: {self.worst}" if self.worst is not None else None
         return CriterionResult(self.name, self.longest <= self.threshold, self.longest,
                                self.threshold, self.unit, self.first_failure, note)
+
+
+@dataclass(frozen=True, slots=True)
+class Moving:
+    """The vehicles at one sample: centres (N, 2) [m], unit headings (N, 2), speeds (N,)
+    [m/s]."""
+
+    xy: FloatArray
+    fwd: FloatArray
+    speed: FloatArray
+
+
+def _in_box(xy: FloatArray, centre: tuple[float, float], hw: float) -> NDArray[np.bool_]:
+    """Per centre (N, 2) [m], whether it is inside the junction's box (half width hw)."""
+    out: NDArray[np.bool_] = (np.abs(xy[:, 0] - centre[0]) < hw) & \
+        (np.abs(xy[:, 1] - centre[1]) < hw)
+    return out
+
+
+def _yields_on_green(v: Moving, i: int, centre: tuple[float, float], hw: float,
+                     f: FloatArray) -> bool:
+    """Whether vehicle i, standing on green at an approach heading `f` (unit) into the
+    junction at `centre` [m] (half width hw [m]), waits for a vehicle with the right of way
+    over it (module doc): one moving inside the box, or one coming the other way that
+    reaches the box within `YIELD_GAP`."""
+    rel = v.xy - np.asarray(centre)
+    along = rel @ f  # [m] beyond the centre, the way vehicle i heads in
+    across = rel[:, 1] * f[0] - rel[:, 0] * f[1]  # [m] left +
+    moving = v.speed >= STANDING
+    moving[i] = False
+    inside = _in_box(v.xy, centre, hw)
+    oncoming = (v.fwd @ f < -SAME_WAY) & (along > 0.0) & (np.abs(across) < hw) & \
+        ((along - hw) <= YIELD_GAP * v.speed)
+    return bool((moving & (inside | oncoming)).any())
 
 
 def _queued(xy: FloatArray, fwd: FloatArray, half: FloatArray) -> NDArray[np.bool_]:
@@ -214,5 +260,6 @@ MAX_WAIT_WITH_RIGHT_OF_WAY: Declaration[float] = Declaration(
     key="max_wait_with_right_of_way", setting=PosFloat, example=60.0,
     doc="[s] in a town, no vehicle (the ego or an NPC car) stands longer than this while it "
     "has the right of way, judged from the truth: not queued behind a vehicle ahead in its "
-    "lane, and at a stop line only on green or in its turn at an all-way stop (first to "
+    "lane, and at a stop line only on green with no moving vehicle in the box or coming the "
+    "other way within 5 s of it, or in its turn at an all-way stop (first to "
     "stop, first to go, ties to the right) with the box clear; > 0. Default: off.")

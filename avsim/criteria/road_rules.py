@@ -17,6 +17,7 @@ from avsim.criteria.base import (
     TruthSample,
 )
 from avsim.criteria.declaration import Declaration
+from avsim.criteria.wording import beside, signed
 from world.frames import to_kph
 from world.hdmap import Crosswalk, RoadMap, SpeedBump, StopSign
 from world.spec import ActorType, TrafficLightSpec
@@ -56,8 +57,9 @@ class StopSigns(Criterion):
             if front > s:
                 self._over[i] = self.judged[i] = True
                 if self.longest[i] < self.HOLD:  # over it without the stop
+                    shown = beside(self.longest[i], self.HOLD)
                     self._infraction(sample, f"over the stop line at s = {s:.0f} m after a "
-                                             f"{self.longest[i]:.1f} s stop (1 s needed)")
+                                             f"{shown} s stop ({self.HOLD:g} s needed)")
             elif sample.speed < self.STOPPED and front >= s - self.ZONE:
                 since = self._since[i]
                 if since is None:
@@ -105,7 +107,8 @@ class RedLights(Criterion):
                 self.margin = min(self.margin, margin)
                 if margin < 0.0:
                     self._infraction(sample, f"entered the junction at s = {light.s:.0f} m "
-                                             f"{-margin:.1f} s into red")
+                                             f"with a margin of {signed(margin)} s to red "
+                                             f"(negative: into red)")
 
     def result(self) -> CriterionResult:
         if math.isinf(self.margin):
@@ -170,7 +173,7 @@ class Crosswalks(Criterion):
             overlap = min(sample.front_station, c1) - max(rear, c0)
             self.worst = overlap if self.worst is None else max(self.worst, overlap)
             if overlap > 0.0:
-                self._fail(sample, f"{overlap:.1f} m onto the crosswalk at s = {c0:.0f} m "
+                self._fail(sample, f"{beside(overlap, 0.0)} m onto the crosswalk at s = {c0:.0f} m "
                                    f"with a pedestrian on it")
 
     def _ego_lanes(self, sample: TruthSample, s: float) -> tuple[float, float]:
@@ -227,7 +230,8 @@ class SpeedBumps(Criterion):
             self.worst = excess if self.worst is None else max(self.worst, excess)
             if excess > SPEED_TOLERANCE_KPH:
                 self._fail(sample, f"speed {to_kph(sample.speed):.1f} km/h over the bump "
-                                   f"{to_kph(pass_speed):.0f} km/h by {excess:.1f} km/h")
+                                   f"{to_kph(pass_speed):.0f} km/h by "
+                                   f"{beside(excess, SPEED_TOLERANCE_KPH)} km/h")
 
     def result(self) -> CriterionResult:
         if self.worst is None:

@@ -18,6 +18,7 @@ from avsim.criteria.base import (
 )
 from avsim.criteria.declaration import Declaration
 from avsim.criteria.lane import footprint
+from avsim.criteria.wording import beside
 from avsim.scenario.fields import PosFloat
 from world.hdmap import SHOULDER, RoadMap
 
@@ -119,7 +120,8 @@ class MinimumRiskStop(Criterion):
             stopped = watch.stop is not None
             decel = watch.update(sample)
             if decel is not None and decel > MRM_DECEL:
-                self._fail(sample, f"deceleration {decel:.2f} m/s^2 after {what}, over "
+                shown = beside(decel, MRM_DECEL, 2)
+                self._fail(sample, f"deceleration {shown} m/s^2 after {what}, over "
                                    f"{MRM_DECEL:g} m/s^2")
             stop = watch.stop
             if not stopped and stop is not None and stop[1] is not None:

@@ -15,6 +15,7 @@ from avsim.criteria.base import (
     TruthSample,
 )
 from avsim.criteria.declaration import Declaration
+from avsim.criteria.wording import beside
 from avsim.scenario.fields import PosFloat
 from world.frames import to_kph
 from world.hdmap import RoadMap
@@ -37,8 +38,9 @@ class SpeedLimit(Criterion):
         excess = to_kph(sample.speed - limit)
         self.excess = max(self.excess, excess)
         if excess > SPEED_TOLERANCE_KPH:
+            shown = beside(excess, SPEED_TOLERANCE_KPH)
             self._fail(sample, f"speed {to_kph(sample.speed):.1f} km/h over the limit "
-                               f"{to_kph(limit):.0f} km/h by {excess:.1f} km/h")
+                               f"{to_kph(limit):.0f} km/h by {shown} km/h")
 
     def result(self) -> CriterionResult:
         if math.isinf(self.excess):
@@ -69,7 +71,8 @@ class MaxDecel(Criterion):
             decel = (self._speeds[0] - self._speeds[-1]) * self._rate / self._window
             self.peak = max(self.peak, decel)
             if decel > self.threshold:
-                self._fail(sample, f"deceleration {decel:.2f} m/s^2 over {self.threshold:g} "
+                self._fail(sample, f"deceleration {beside(decel, self.threshold, 2)} m/s^2 over "
+                                   f"{self.threshold:g} "
                                    f"m/s^2")
 
     def result(self) -> CriterionResult:

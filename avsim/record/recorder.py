@@ -103,6 +103,8 @@ SERIES_STYLES: dict[str, tuple[str, Rgb]] = {  # metric -> (label with unit, col
     "steering": ("steering [rad]", (255, 127, 14)),
     "cross_track_error": ("cross-track error [m]", (148, 103, 189)),
     "gap": ("gap [m]", (140, 86, 75)),
+    "lead_gap": ("gap to the lead [m]", (140, 86, 75)),
+    "lead_speed": ("lead speed [m/s]", (26, 35, 126)),
     "lane_offset_error": ("camera lane offset error [m]", (23, 190, 207)),
     "lane_heading_error": ("camera lane heading error [rad]", (188, 189, 34)),
     "lane_confidence": ("camera lane confidence [-]", (127, 127, 127)),

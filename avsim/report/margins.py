@@ -47,22 +47,23 @@ MOTION_REASONS = {ABORTED: "abort", PULL_OVER: "pull over"}  # what the logged r
 NEUTRAL = frozenset({Motion.LANE_KEEP.value})  # states with no band
 # one colour per manoeuvre (legend order), none of them an ACC mode's or a speed source's
 MOTION_COLOURS: dict[str, str] = {
-    Motion.LANE_CHANGE_LEFT.value: "#3949ab",
-    Motion.LANE_CHANGE_RIGHT.value: "#00897b",
-    ABORTED: "#c0ca33",
-    PULL_OVER: "#ec407a",
-    Motion.TURN_RIGHT.value: "#5e35b1",
-    Motion.TURN_LEFT.value: "#827717",
-    Motion.U_TURN.value: "#37474f",
+    "lane_change_left": "#0203e2",
+    "lane_change_right": "#0aff02",
+    ABORTED: "#fe01b1",
+    PULL_OVER: "#7ebd01",
+    "turn_right": "#703be7",
+    "turn_left": "#2dfe54",
+    "u_turn": "#06470c",
 }
+LEAD_COLOUR = "#1a237e"  # the lead's lines (its speed, the gap to it)
 GAP_LINES = {  # series -> (label, colour, style, width); no band's colour (their pixels
     #   would count as a band's in the tests)
-    "gap": ("gap to the lead", "#1a237e", "-", 1.5),
+    "gap": ("gap to the lead", LEAD_COLOUR, "-", 1.5),
     "d_min": ("R157 d_min at ego speed", "#c62828", "--", 1.2),
     "ttc": ("time to collision", "#e65100", "-", 1.5),
     "ttc_hard": (f"ttc_hard {TTC_HARD:g} s", "#ad1457", "--", 1.2),
     "offset": ("lateral offset (true)", "#000000", "-", 1.2),
-    "bound": ("body at the lane's edge", "#c62828", "--", 1.0),
+    "bound": ("body at the lane's edge", "#00695c", "--", 1.0),
 }
 UNDER_D_MIN = "#ef9a9a"  # the shading where the gap is under d_min
 

@@ -2,22 +2,35 @@
 below it (`avsim run --plot`). Panels, top to bottom, on one time axis [s]:
 
 1. Speeds in km/h: the ego's (true), the lead vehicle's, the posted limit at the ego's front
-   bumper and the driver's set speed, with the ACC / event layer's mode
-   (`planner.fsm.acc.AccMode`) as coloured bands behind them, one colour per mode.
+   bumper and the driver's set speed, with the ACC / event layer's mode (the log's
+   `acc_mode`, `planner.fsm.acc.AccMode`'s values) as coloured bands behind them, one colour
+   per mode.
 2. A strip of the motion FSM's manoeuvres (`planner.fsm.motion.Motion`): lane changes left
    and right, an aborted one, a flat tyre's pull over, turns and U-turns, one colour per
    manoeuvre; lane keeping blank (`avsim.report.margins.motion_runs`).
-3. A strip saying which constraint set the plan's speed at each tick
-   (`planner.messages.SpeedSource`: set speed, limit, curve, following, event, pedal, degraded
-   lane, emergency).
-4. The bumper gap to the lead [m] with UN R157's d_min at the ego's speed, shaded where the
+3. A strip saying which constraint set the plan's speed at each tick (the log's
+   `speed_source`, `planner.messages.SpeedSource`'s values: set speed, limit, curve,
+   following, event, pedal, degraded lane, emergency, driver, sight).
+4. The ego's true longitudinal acceleration [m/s^2] (0.25 s mean of dv/dt, and its 2 s
+   mean) with ISO 15622's +-3.5 m/s^2, and
+5. its jerk [m/s^3] (1 s mean of da/dt) with ISO 15622's +-2.5 m/s^3
+   (`avsim.report.dynamics` says how they are derived and filtered).
+6. The bumper gap to the lead [m] with UN R157's d_min at the ego's speed, shaded where the
    gap is under it.
-5. The time to collision to the lead [s] (gap / closing speed while the ego closes on it),
+7. The time to collision to the lead [s] (gap / closing speed while the ego closes on it),
    0-10 s, with `ttc_hard` (2.5 s, `avsim.report.margins.TTC_HARD`) dashed.
-6. The ego's true lateral offset [m] from the centre of the lane the stack keeps, with
+8. The ego's true lateral offset [m] from the centre of the lane the stack keeps, with
    +-(lane width - car width) / 2, where the body touches the lane's edge.
 
-(`avsim.report.margins` has what panels 2, 4, 5 and 6 show and how.)
+(`avsim.report.margins` has what panels 2, 6, 7 and 8 show and how.) On every panel, a
+dash-dotted line where each scripted action or event fired and a hatched span over each
+sensor fault's (or pedal override's) window, labelled at the top (`avsim.report.marks`).
+
+Colours mean one thing across the figure: every ACC mode, speed source and manoeuvre has a
+colour of its own (the band tables are keyed by the recorded states' values, so the report
+imports no stack code; a state the tables lack is grey), no line shares a band's colour,
+and lines share a colour only when they show the same subject (the ego's true motion in
+black, the lead in navy).
 
 The lead vehicle at a tick is the nearest car or truck ahead of the ego in its lane, as the
 run's log has it from the truth and the map by the `min_gap` criterion's rule
@@ -43,10 +56,9 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from avsim.files import write_atomic
-from avsim.report import margins
+from avsim.report import dynamics, margins
 from avsim.report.bands import BAND_ALPHA, FloatArray, draw_bands, mode_runs
-from planner.fsm.acc import AccMode
-from planner.messages import SpeedSource
+from avsim.report.marks import draw_marks, story_marks
 from vehicle_urdf.geometry import read_geometry
 from world.frames import MPS_PER_KPH
 from world.truth import time_to_collision
@@ -60,41 +72,43 @@ __all__ = ["BAND_ALPHA", "MODE_COLOURS", "SOURCE_COLOURS", "lead_speed", "mode_r
 SIZE = (16.0, 12.0)  # [in] at DPI: 1600 x 1200 px
 DPI = 100  # [px/in]
 VEHICLES = frozenset({"car", "truck"})  # actor types that can be a lead
-# one colour per ACC / event mode, by `AccMode` value (legend order: AccMode's)
+# one colour per ACC / event mode, by the recorded `acc_mode` value (legend order)
 MODE_COLOURS: dict[str, str] = {
-    AccMode.ACC_OFF.value: "#b0bec5",
-    AccMode.CRUISE.value: "#4caf50",
-    AccMode.TRAIL.value: "#2196f3",
-    AccMode.BRAKE.value: "#e53935",
-    AccMode.SPEED_LIMIT.value: "#ffc107",
-    AccMode.OFF_RAMP.value: "#9c27b0",
-    AccMode.PEDESTRIAN.value: "#00bcd4",
-    AccMode.SPEED_BUMP.value: "#ff5722",
-    AccMode.STOP_SIGN.value: "#880e4f",
-    AccMode.FLAT.value: "#795548",
-    AccMode.RED_LIGHT.value: "#b71c1c",
-    AccMode.YIELD.value: "#ff9800",
+    "acc_off": "#b2996e",
+    "cruise": "#089404",
+    "trail": "#0d75f8",
+    "brake": "#fe0002",
+    "speed_limit": "#ffda03",
+    "off_ramp": "#be03fd",
+    "pedestrian": "#00fbb0",
+    "speed_bump": "#c2ff89",
+    "stop_sign": "#680018",
+    "red_light": "#ca0147",
+    "yield": "#ff9408",
+    "flat": "#4e7496",
 }
-# one colour per speed source, by `SpeedSource` value (legend order: SpeedSource's)
+# one colour per speed source, by the recorded `speed_source` value (legend order); "sight"
+#   is the speed cap from the forward sensing range
 SOURCE_COLOURS: dict[str, str] = {
-    SpeedSource.SET_SPEED.value: "#66bb6a",
-    SpeedSource.LIMIT.value: "#ffca28",
-    SpeedSource.CURVE.value: "#8d6e63",
-    SpeedSource.FOLLOWING.value: "#42a5f5",
-    SpeedSource.EVENT.value: "#ab47bc",
-    SpeedSource.PEDAL.value: "#26c6da",
-    SpeedSource.DEGRADED.value: "#ff7043",
-    SpeedSource.EMERGENCY.value: "#d50000",
-    SpeedSource.DRIVER.value: "#6d4c41",
+    "set_speed": "#9dff00",
+    "limit": "#758000",
+    "curve": "#caa0ff",
+    "following": "#02ccfe",
+    "event": "#ff63e9",
+    "pedal": "#fc86aa",
+    "degraded": "#c45508",
+    "emergency": "#02066f",
+    "driver": "#029386",
+    "sight": "#8cffdb",
 }
 # [-] the panels' heights, relative to the speed panel's
-PANELS = {"speed": 1.0, "motion": 0.07, "source": 0.07, "gap": 0.45, "ttc": 0.35,
-          "offset": 0.35}
+PANELS = {"speed": 1.0, "motion": 0.07, "source": 0.07, "accel": 0.4, "jerk": 0.3,
+          "gap": 0.4, "ttc": 0.3, "offset": 0.3}
 STRIP_LABELS = {"motion": "manoeuvre", "source": "speed set by"}
 LINES = {  # series -> (label, colour, style, width)
     "ego": ("ego speed", "#000000", "-", 2.0),
-    "lead": ("lead speed", "#1a237e", "-", 1.5),
-    "limit": ("posted limit", "#d50000", "--", 1.5),
+    "lead": ("lead speed", margins.LEAD_COLOUR, "-", 1.5),
+    "limit": ("posted limit", "#b71c1c", "--", 1.5),
     "set": ("set speed", "#1b5e20", ":", 1.8),
 }
 
@@ -174,7 +188,11 @@ def speed_profile_figure(result: RunResult) -> Figure:
     for key, label in STRIP_LABELS.items():
         axes[key].set_yticks([])
         axes[key].set_ylabel(label, rotation=0, ha="right", va="center")
+    t, speed = log.array("t"), log.array("speed")
+    dynamics.draw_accel(axes["accel"], t, speed)
+    dynamics.draw_jerk(axes["jerk"], t, speed)
     _draw_margins(axes, result)
+    draw_marks(list(axes.values()), story_marks(result))
     if runs:
         ax.set_xlim(runs[0][1], runs[-1][2])
     axes["offset"].set_xlabel("time [s]")

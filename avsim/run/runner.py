@@ -586,6 +586,7 @@ class Runner:
             "speed": truth.speed, "target_speed": out.plan.target_speed,
             "speed_limit": out.plan.speed_limit, "steering": out.command.steering_angle,
             "cross_track_error": log.cross_track[-1],
+            "lead_gap": log.lead_gap[-1], "lead_speed": log.lead_speed[-1],  # NaN: no lead
         })
         rec.log_path(w.t, out.plan.path.xy)
         if ACTOR_RECORD_RATE.fires(w.clock.step):

@@ -81,8 +81,10 @@ def test_each_red_light_entered_is_an_infraction() -> None:
         c.update(sample(k / RATE, 25.0 * k / RATE - 91.4, 25.0))
     got = c.take_infractions()
     assert [i.message for i in got] == [
-        "entered the junction at s = 100 m 1.6 s into red",
-        "entered the junction at s = 130 m 2.8 s into red"]
+        "entered the junction at s = 100 m with a margin of -1.58 s to red (negative: into "
+        "red)",
+        "entered the junction at s = 130 m with a margin of -2.78 s to red (negative: into "
+        "red)"]
     assert [i.t for i in got] == [303 / RATE, 351 / RATE]
     assert c.result().first_failure == 303 / RATE
 

@@ -9,6 +9,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pytest
 
 from avsim.criteria.base import TruthSample
 from avsim.criteria.right_of_way import MaxWaitWithRightOfWay
@@ -27,8 +28,9 @@ def town(junctions: str) -> TownSpec:
 
 
 def sample(t: float, ego: tuple[float, float, float], npcs: list[tuple[float, float, float]],
-           ego_speed: float = 0.0) -> TruthSample:
-    """The ego at (x, y, heading) and standing NPC sedans at theirs."""
+           ego_speed: float = 0.0, npc_speeds: list[float] | None = None) -> TruthSample:
+    """The ego at (x, y, heading) and NPC sedans at theirs, standing unless `npc_speeds`
+    [m/s] says."""
     x, y, h = ego
     f, left = np.array([math.cos(h), math.sin(h)]), np.array([-math.sin(h), math.cos(h)])
     tyres = np.array([(x, y) + a * f + b * left
@@ -38,7 +40,8 @@ def sample(t: float, ego: tuple[float, float, float], npcs: list[tuple[float, fl
         ids=tuple(f"car_{i}" for i in range(n)), kinds=(ActorType.CAR,) * n,
         centres=np.array([(px, py, 0.7) for px, py, _ in npcs]).reshape(-1, 3),
         yaws=np.array([ph for _, _, ph in npcs]), half_sizes=np.tile([HALF, 0.9, 0.7], (n, 1)),
-        stations=np.zeros(n), offsets=np.zeros(n), speeds=np.zeros(n), accels=np.zeros(n))
+        stations=np.zeros(n), offsets=np.zeros(n),
+        speeds=np.array(npc_speeds or [0.0] * n, dtype=np.float64), accels=np.zeros(n))
     return TruthSample(t=t, speed=ego_speed, station=0.0, front_station=HALF, tyres=tyres,
                        tyre_stations=np.zeros(4), tyre_offsets=np.zeros(4),
                        touching=frozenset(), actors=poses, xy=(x, y))
@@ -89,8 +92,9 @@ def test_at_a_light_only_green_counts_over_one_standstill() -> None:
     light = layout.signal((1, 1), "east")
     green = sum(light_colour(light, k / RATE).value == "green"
                 for k in range(1, int(200.0 * RATE) + 1)) / RATE
-    assert c.result().value is not None
-    assert abs(c.result().value - green) < 0.5  # the green phases add up
+    value = c.result().value
+    assert value is not None
+    assert abs(value - green) < 0.5  # the green phases add up
     assert c.result().failed  # ~75 s of green over five cycles: stuck
 
 
@@ -123,3 +127,44 @@ def test_at_an_all_way_stop_the_first_to_stop_has_the_turn() -> None:
 def test_not_a_town_is_not_applicable() -> None:
     c = run(None, (40.0, -1.75, 0.0), [], 5.0)
     assert c.result().passed is None and c.idle
+
+
+def _green_from(layout: TownLayout, t0: float) -> float:
+    """[s] the first time from t0 at which the east light of junction (1, 1) is green."""
+    light = layout.signal((1, 1), "east")
+    k = 0
+    while light_colour(light, t0 + k / RATE).value != "green":
+        k += 1
+    return t0 + k / RATE
+
+
+@pytest.mark.parametrize(("case", "counted"), [
+    ("clear junction", True),
+    ("oncoming car approaching", False),  # a left turn on green yields to it: its way
+    ("car moving in the box", False),
+    ("oncoming car standing", True),  # it waits at its own line: not in the ego's way
+    ("oncoming car far away", True),  # over YIELD_GAP from the box at its speed
+    ("car behind the ego going away", True),  # not oncoming: it heads away from the box
+])
+def test_on_green_waiting_for_a_vehicle_with_the_way_is_not_counted(case: str,
+                                                                    counted: bool) -> None:
+    spec = town("traffic_lights")
+    layout = TownLayout(spec)
+    ego = at_line(layout, (1, 1), "east")
+    cx, cy = layout.centre((1, 1))
+    west = math.pi
+    npcs = {  # (x, y, heading), speed [m/s]
+        "clear junction": [],
+        "oncoming car approaching": [((cx + 25.0, cy + 1.75, west), 8.0)],
+        "car moving in the box": [((cx + 1.0, cy - 1.0, 0.5 * math.pi), 5.0)],
+        "oncoming car standing": [((cx + 12.0, cy + 1.75, west), 0.0)],
+        "oncoming car far away": [((cx + 80.0, cy + 1.75, west), 8.0)],
+        "car behind the ego going away": [((cx - 40.0, cy + 1.75, west), 8.0)],
+    }[case]
+    c = MaxWaitWithRightOfWay(60.0, spec, HALF)
+    start = _green_from(layout, 0.0)
+    for k in range(20):  # 5 s of green
+        c.update(sample(start + k / RATE, ego, [p for p, _ in npcs],
+                        npc_speeds=[v for _, v in npcs]))
+    assert (c._with_way.get("ego", 0.0) > 4.0) is counted, c._with_way
+    assert ("ego" in c._with_way) is counted

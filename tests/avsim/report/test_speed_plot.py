@@ -27,7 +27,7 @@ from numpy.typing import NDArray
 
 from avsim.cli import main
 from avsim.criteria.base import CriterionResult
-from avsim.report import margins
+from avsim.report import dynamics, margins, marks
 from avsim.report import speed_plot as plot
 from avsim.run.runner import RunResult, TrajectoryLog
 from avsim.scenario.load import load_scenario
@@ -126,16 +126,59 @@ def test_mode_runs_cover_the_run_without_gaps() -> None:
     assert plot.mode_runs([], []) == []
 
 
-def test_every_acc_mode_has_its_own_colour() -> None:
-    assert set(plot.MODE_COLOURS) == {m.value for m in AccMode}
-    assert len(set(plot.MODE_COLOURS.values())) == len(AccMode)
-    assert set(plot.SOURCE_COLOURS) == {s.value for s in SpeedSource}
-    assert len(set(plot.SOURCE_COLOURS.values())) == len(SpeedSource)
+def _lab(colour: str, alpha: float = 1.0) -> NDArray[np.float64]:
+    """CIE L*a*b* (D65) of `colour` drawn at `alpha` over white."""
+    rgb = alpha * np.array(colors.to_rgb(colour)) + (1.0 - alpha)
+    lin = np.where(rgb > 0.04045, ((rgb + 0.055) / 1.055) ** 2.4, rgb / 12.92)
+    m = np.array([[0.4124, 0.3576, 0.1805], [0.2126, 0.7152, 0.0722],
+                  [0.0193, 0.1192, 0.9505]])
+    xyz = m @ lin / np.array([0.95047, 1.0, 1.08883])
+    f = np.where(xyz > 0.008856, np.cbrt(xyz), 7.787 * xyz + 16 / 116)
+    return np.array([116 * f[1] - 16, 500 * (f[0] - f[1]), 200 * (f[1] - f[2])])
+
+
+MIN_DELTA_E = 10.0  # [-] CIE76 distance between any two bands as drawn: told apart at a glance
+
+
+def _bands() -> dict[str, str]:
+    """Every band's meaning -> colour, over the three tables."""
+    return {**{f"mode {k}": v for k, v in plot.MODE_COLOURS.items()},
+            **{f"source {k}": v for k, v in plot.SOURCE_COLOURS.items()},
+            **{f"manoeuvre {k}": v for k, v in margins.MOTION_COLOURS.items()}}
+
+
+def _lines() -> dict[str, str]:
+    """Every line's and mark's subject -> colour (lines of one subject share its colour)."""
+    subject = {"ego": "ego", "offset": "ego", "accel": "ego", "accel_2s": "ego",
+               "jerk": "ego", "lead": "lead", "gap": "lead"}
+    out: dict[str, str] = {}
+    for table in (plot.LINES, margins.GAP_LINES, dynamics.LINES):
+        for key, (_, colour, _, _) in table.items():
+            name = subject.get(key, key)
+            assert out.get(name, colour) == colour, name
+            out[name] = colour
+    return {**out, "story event": marks.EVENT_COLOUR, "fault window": marks.WINDOW_COLOUR,
+            "under d_min": margins.UNDER_D_MIN}
+
+
+def test_every_state_has_a_colour_of_its_own() -> None:
+    """Every ACC mode, speed source and manoeuvre of the stack's enums has a band colour; no
+    colour has two meanings across the figure (bands, lines, marks); the bands as drawn are
+    at least MIN_DELTA_E apart."""
+    assert {m.value for m in AccMode} <= set(plot.MODE_COLOURS)
+    assert {s.value for s in SpeedSource} <= set(plot.SOURCE_COLOURS)
     moves = {m.value for m in Motion} - margins.NEUTRAL | {margins.ABORTED, margins.PULL_OVER}
-    assert set(margins.MOTION_COLOURS) == moves
-    every = [*plot.MODE_COLOURS.values(), *plot.SOURCE_COLOURS.values(),
-             *margins.MOTION_COLOURS.values()]
-    assert len(set(every)) == len(every)  # a band's pixels tell which table it is from
+    assert moves <= set(margins.MOTION_COLOURS)
+    meanings = {**_bands(), **_lines()}
+    by_colour: dict[str, list[str]] = {}
+    for meaning, colour in meanings.items():
+        by_colour.setdefault(colors.to_hex(colour), []).append(meaning)
+    shared = {c: m for c, m in by_colour.items() if len(m) > 1}
+    assert not shared, shared
+    bands = list(_bands().items())
+    for (a, ca), (b, cb) in itertools.combinations(bands, 2):
+        delta = float(np.linalg.norm(_lab(ca, plot.BAND_ALPHA) - _lab(cb, plot.BAND_ALPHA)))
+        assert delta >= MIN_DELTA_E, (a, b, delta)
 
 
 def _band_pixels(png: np.ndarray, colour: str) -> int:
@@ -180,9 +223,9 @@ def test_figure_title_axes_and_legends() -> None:
     ax = fig.axes[0]
     assert ax.get_title() == "traffic_jam (traffic_jam): FAIL (min_gap)"
     assert [a.get_ylabel() for a in fig.axes] == [
-        "speed [km/h]", "manoeuvre", "speed set by", "gap [m]", "TTC [s]",
-        "lateral offset [m]"]
-    assert [a.get_xlabel() for a in fig.axes] == [""] * 5 + ["time [s]"]
+        "speed [km/h]", "manoeuvre", "speed set by", "accel. [m/s^2]", "jerk [m/s^3]",
+        "gap [m]", "TTC [s]", "lateral offset [m]"]
+    assert [a.get_xlabel() for a in fig.axes] == [""] * 7 + ["time [s]"]
     assert all(a.get_shared_x_axes().joined(ax, a) for a in fig.axes)
     assert [line.get_label() for line in ax.get_lines()] == [
         "ego speed", "lead speed", "posted limit", "set speed"]
@@ -205,7 +248,7 @@ def _ydata(line: Line2D) -> NDArray[np.float64]:
 def test_margin_panels_show_the_gap_ttc_and_offset() -> None:
     result = synthetic_result()
     log = result.log
-    _, _, _, gap, ttc, offset = plot.speed_profile_figure(result).axes
+    _, _, _, _, _, gap, ttc, offset = plot.speed_profile_figure(result).axes
     # the gap and d_min at the ego's speed, shaded where the gap is under d_min
     assert [line.get_label() for line in gap.get_lines()] == [
         "gap to the lead", "R157 d_min at ego speed"]
@@ -374,3 +417,74 @@ def test_run_plot_bad_path_is_bad_input(fake_runner: Path, where: str) -> None:
     assert result.stderr.count("\n") == 1 and "Traceback" not in result.stderr
     assert "--plot" in result.stderr and bad in result.stderr
     assert sorted(p.name for p in fake_runner.iterdir()) == ["a_file.txt"]  # nothing written
+
+
+# -- acceleration, jerk and the story's marks --------------------------------------------------
+
+
+def test_acceleration_and_jerk_of_a_known_speed() -> None:
+    """A speed rising at 1 m/s^2 for 10 s then falling at 2 m/s^2: the acceleration is those
+    values away from the corner, the jerk 0 there and -3 m/s^3 in mean over the corner's
+    1 s window at the corner."""
+    t = np.arange(0.0, 20.0, 1.0 / RATE)
+    v = np.where(t < 10.0, 5.0 + t, 15.0 - 2.0 * (t - 10.0))
+    a = dynamics.acceleration(t, v)
+    np.testing.assert_allclose(a[(t > 1.0) & (t < 9.0)], 1.0, atol=1e-9)
+    np.testing.assert_allclose(a[(t > 11.0) & (t < 19.0)], -2.0, atol=1e-9)
+    j = dynamics.jerk(t, v)
+    np.testing.assert_allclose(j[(t > 2.0) & (t < 8.0)], 0.0, atol=1e-9)
+    corner = int(np.argmin(np.abs(t - 10.0)))
+    assert j[corner] == pytest.approx(-3.0, rel=0.05)
+    assert dynamics.moving_mean(np.array([0.0]), np.array([2.0]), 1.0).tolist() == [2.0]
+
+
+def test_the_accel_and_jerk_panels_show_the_ego_with_iso_15622s_limits() -> None:
+    result = synthetic_result()
+    axes = plot.speed_profile_figure(result).axes
+    accel, jerk = axes[3], axes[4]
+    labels = [line.get_label() for line in accel.get_lines()]
+    assert labels[:3] == ["acceleration (true, 0.25 s mean)", "acceleration, 2 s mean",
+                          "ISO 15622 +-3.5 m/s^2 (2 s mean)"]
+    t, v = result.log.array("t"), result.log.array("speed")
+    np.testing.assert_array_equal(_ydata(accel.get_lines()[0]), dynamics.acceleration(t, v))
+    levels = {float(_ydata(line)[0]) for line in accel.get_lines()[2:]}
+    assert levels == {3.5, -3.5, 0.0}
+    assert [line.get_label() for line in jerk.get_lines()][:2] == [
+        "jerk (true, 1 s mean)", "ISO 15622 +-2.5 m/s^3"]
+    np.testing.assert_array_equal(_ydata(jerk.get_lines()[0]), dynamics.jerk(t, v))
+    assert {float(_ydata(line)[0]) for line in jerk.get_lines()[1:]} == {2.5, -2.5, 0.0}
+
+
+def _with_story(result: RunResult) -> RunResult:
+    """The synthetic run with a GNSS outage at 20 s for 4 s (ego event 0), a lead's scripted
+    speed change at 30 s and an event that never fired."""
+    from dataclasses import replace
+
+    from avsim.run.story import StoryEntry
+    from world.spec import EventSpec, GnssOutage, TimeTrigger
+
+    world = replace(result.scenario.world, events=(
+        EventSpec(TimeTrigger(20.0), GnssOutage(duration=4.0)),
+        EventSpec(TimeTrigger(50.0), GnssOutage(duration=1.0), optional=True)))
+    story = (StoryEntry("lead", 0, "speed", False, 30.0),
+             StoryEntry(None, 0, "gnss_outage", False, 20.0),
+             StoryEntry(None, 1, "gnss_outage", True, None))
+    return RunResult(scenario=replace(result.scenario, world=world), criteria=result.criteria,
+                     metrics={}, sim_time=DURATION, wall_time=1.0, log=result.log,
+                     recording=None, state_changes=result.state_changes, story=story)
+
+
+def test_story_events_and_fault_windows_are_marked_on_every_panel() -> None:
+    result = _with_story(synthetic_result())
+    assert marks.story_marks(result) == [marks.Mark(20.0, 4.0, "gnss outage"),
+                                         marks.Mark(30.0, 0.0, "lead: speed")]
+    fig = plot.speed_profile_figure(result)
+    for ax in fig.axes:
+        lines = [line for line in ax.get_lines() if line.get_color() == marks.EVENT_COLOUR]
+        assert sorted(float(np.asarray(line.get_xdata())[0]) for line in lines) == [20.0, 30.0]
+        spans = [p for p in ax.patches if p.get_hatch() == marks.WINDOW_HATCH]
+        assert len(spans) == 1
+        x0, _, width, _ = spans[0].get_extents().bounds  # in pixels: its data extent below
+        assert width > 0 and x0 > 0
+    texts = [t.get_text() for t in fig.axes[0].texts]
+    assert texts == ["gnss outage (4 s)", "lead: speed"]
