@@ -1,0 +1,5 @@
+"""Benchmarks (make bench)."""
+
+from world.core.simd import pin_numpy_dispatch
+
+pin_numpy_dispatch()  # before anything imports numpy: the same numbers on every x86-64 CPU

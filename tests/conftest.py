@@ -4,6 +4,10 @@ from __future__ import annotations
 
 import pytest
 
+from world.core.simd import pin_numpy_dispatch
+
+pin_numpy_dispatch()  # before any test module imports numpy; xdist's workers inherit it
+
 CLOSED_LOOP = "tests/scenarios/"  # the modules whose few tests share minutes-long runs
 
 
