@@ -13,7 +13,7 @@ import sys
 import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, NoReturn
+from typing import TYPE_CHECKING, Any, NoReturn
 
 import click
 from rich.console import Console
@@ -23,6 +23,7 @@ from rich.table import Table
 from avsim.files import write_atomic
 from avsim.run.interrupts import Interrupts
 from avsim.run.result import dumps, result_json
+from avsim.scenario.bounds import MAX_SEED
 from avsim.scenario.load import ScenarioError, bundled_scenarios, load_scenario
 from avsim.scenario.profile_fit import check_profile
 from avsim.scenario.schema import scenario_json_schema
@@ -60,6 +61,21 @@ def main() -> None:
     """avsim: a headless 3D driving sandbox for classical autonomous-driving stacks."""
 
 
+class SeedType(click.IntRange):
+    """`--seed`: an integer in 0..MAX_SEED (numpy's seed range); a text too long to be one
+    is refused by its length, not echoed back."""
+
+    def __init__(self) -> None:
+        super().__init__(0, MAX_SEED)
+
+    def convert(self, value: Any, param: click.Parameter | None,
+                ctx: click.Context | None) -> int:
+        """The seed, or click's usage error (exit 2)."""
+        if isinstance(value, str) and len(value) > len(str(MAX_SEED)):
+            self.fail(f"{len(value)} characters: a seed is at most {MAX_SEED}", param, ctx)
+        return super().convert(value, param, ctx)
+
+
 @main.command()
 @click.argument("scenario")
 @click.option("--out", "out", type=click.Path(path_type=Path), default=None,
@@ -70,7 +86,8 @@ def main() -> None:
               help="Sensor profile: cameras and LiDAR (none: GNSS + odometry on the map).")
 @click.option("--sensing", type=click.Choice(SENSING), default="auto", show_default=True,
               help="Where cameras render: a worker process (auto on 2+ cores) or inline.")
-@click.option("--seed", type=int, default=None, help="Override the scenario's seed.")
+@click.option("--seed", type=SeedType(), default=None,
+              help="Override the scenario's seed.")
 @click.option("--plot", "plot", is_flag=False, flag_value=PLOT_NEXT_TO_RECORDING, default=None,
               metavar="[PNG]",
               help="Also write the speed profile (ego, lead, limit and set speed over time, "
