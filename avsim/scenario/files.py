@@ -156,8 +156,10 @@ def read_raw(path: Path) -> dict[str, Any]:
         raise LocatedError(f"line {exc.line}", exc.problem) from None
     except yaml.MarkedYAMLError as exc:
         raise _yaml_problem(exc) from None
+    except yaml.reader.ReaderError as exc:
+        raise _reader_problem(exc, text) from None
     except yaml.YAMLError as exc:
-        raise LocatedError(FILE_KEY, f"YAML error: {exc}") from None
+        raise LocatedError(FILE_KEY, "YAML error: " + " ".join(str(exc).split())) from None
     if data is None:
         raise LocatedError(FILE_KEY, "empty file")
     if not isinstance(data, dict):
@@ -165,6 +167,17 @@ def read_raw(path: Path) -> dict[str, Any]:
             FILE_KEY, f"must be a mapping of keys (format, name, ...), got {show(data)}"
         )
     return data
+
+
+def _reader_problem(exc: yaml.reader.ReaderError, text: str) -> LocatedError:
+    """`line N: YAML does not allow the character #xHHHH` (a NUL, a control character)."""
+    char = exc.character
+    code = char if isinstance(char, int) else ord(char)
+    if yaml.__with_libyaml__:  # libyaml counts the position in bytes, PyYAML's reader in
+        line = text.encode("utf-8")[: exc.position].count(b"\n") + 1  # characters
+    else:
+        line = text[: exc.position].count("\n") + 1
+    return LocatedError(f"line {line}", f"YAML does not allow the character #x{code:04x}")
 
 
 def _yaml_problem(exc: yaml.MarkedYAMLError) -> LocatedError:

@@ -90,6 +90,15 @@ def test_read_raw_reads_at_most_the_bound(tmp_path: Path) -> None:
     assert (info.value.key, info.value.problem) == ("(file)", "over 524288 bytes: at most 524288")
 
 
+@pytest.mark.parametrize("char", ["\x00", "\x01", "\ufffe"])
+def test_a_character_yaml_does_not_allow_is_one_line_at_its_line(
+    char: str, tmp_path: Path
+) -> None:
+    path = _write(tmp_path, MINIMAL + f"description: a{char}b\n")
+    assert _error(path) == (
+        f"{path}: line 6: YAML does not allow the character #x{ord(char):04x}")
+
+
 # -- 2. nesting depth ---------------------------------------------------------------------
 
 
