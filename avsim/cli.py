@@ -17,7 +17,7 @@ import sys
 import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, NoReturn
+from typing import TYPE_CHECKING, Any, NoReturn
 
 import click
 from rich.console import Console
@@ -36,6 +36,7 @@ from avsim.outputs import (
 from avsim.run.interrupts import ExitAtOnce, Interrupts
 from avsim.run.result import dumps, headline, result_json
 from avsim.run.verdict import RunError, RunVerdict
+from avsim.scenario.bounds import MAX_SEED
 from avsim.scenario.load import ScenarioError, load_scenario
 from avsim.scenario.profile_fit import check_profile
 from avsim.scenario.schema import scenario_json_schema
@@ -97,6 +98,21 @@ search_path_option = click.option(
     "in, besides the file's own folder tree (repeatable; tried in order).")
 
 
+class SeedType(click.IntRange):
+    """`--seed`: an integer in 0..MAX_SEED (numpy's seed range); a text too long to be one
+    is refused by its length, not echoed back."""
+
+    def __init__(self) -> None:
+        super().__init__(0, MAX_SEED)
+
+    def convert(self, value: Any, param: click.Parameter | None,
+                ctx: click.Context | None) -> int:
+        """The seed, or click's usage error (exit 2)."""
+        if isinstance(value, str) and len(value) > len(str(MAX_SEED)):
+            self.fail(f"{len(value)} characters: a seed is at most {MAX_SEED}", param, ctx)
+        return super().convert(value, param, ctx)
+
+
 @main.command()
 @click.argument("scenario")
 @click.option("--out", "out", type=click.Path(path_type=Path), default=None,
@@ -107,7 +123,8 @@ search_path_option = click.option(
               help="Sensor profile: cameras and LiDAR (none: GNSS + odometry on the map).")
 @click.option("--sensing", type=click.Choice(SENSING), default="auto", show_default=True,
               help="Where cameras render: a worker process (auto on 2+ cores) or inline.")
-@click.option("--seed", type=int, default=None, help="Override the scenario's seed.")
+@click.option("--seed", type=SeedType(), default=None,
+              help="Override the scenario's seed.")
 @click.option("--plot", "plot", is_flag=False, flag_value=PLOT_NEXT_TO_RECORDING, default=None,
               metavar="[PNG]",
               help="Also write the speed profile (ego, lead, limit and set speed over time, "
@@ -515,7 +532,6 @@ def snapshot(recording: Path, at: float, out: Path | None, size: tuple[int, int]
     click.echo(str(out))
 
 
-
 @main.command()
 @click.argument("recording", type=click.Path(path_type=Path))
 @click.option("--csv", "fmt", flag_value="csv", help="Write CSV.")
@@ -532,12 +548,9 @@ def export(recording: Path, fmt: str | None, out: Path | None, force: bool) -> N
     if fmt not in ("csv", "parquet"):
         _bad_input(f"{recording}: --csv|--parquet: give the table's format")
     out = out if out is not None else default_out(recording, "csv" if fmt == "csv" else "parquet")
-    if out.absolute() == recording.absolute() or (out.exists() and recording.exists()
-                                                  and out.samefile(recording)):
-        _bad_input(f"{out}: --out: is the recording itself")
+    _writable([Output("--out", out)], [recording])  # never the recording, even with --force
     if out.exists() and not force:
         _bad_input(f"{out}: --out: exists (--force overwrites it)")
-    _writable(out, "--out")
     try:
         table = export_run(recording, out, "csv" if fmt == "csv" else "parquet")
     except ExportError as exc:

@@ -6,9 +6,18 @@ times the largest of them, which the machines' load makes too noisy to assert in
 - an ALKS OpenSCENARIO file (4.6.2) with one element repeated until the file is refused
   by its element bound or is as large as its byte bound lets it be;
 - its OpenDRIVE road, the same way;
-- a bundled YAML scenario as long as its file bound allows (a road of many segments).
+- a bundled YAML scenario as long as its file bound allows (a road of many segments);
+- a YAML file full of values nested as deep as allowed (`MAX_DEPTH`), up to its value bound:
+  parsed, composed and validated to its one-line error;
+- a YAML merge-key bomb as large as the file bound allows, refused by the value count
+  while it is parsed (`avsim.scenario.yaml_events`);
+- a town at its bounds (`MAX_TOWN_BLOCKS` x `MAX_TOWN_BLOCKS` blocks of `MAX_BLOCK`,
+  `MAX_TOWN_LANES` lanes of `MAX_LANE_WIDTH`): the file loaded and the run built as
+  `avsim run` builds it (the world with its buildings, lights, meshes and the LiDAR's
+  Embree scene, the default sensors, the stack).
 
-Target: each under 5 s on the reference machine (2 cores). Best of `--repeat` loads.
+Target: each under 5 s on the reference machine (2 cores), the town's start under 15 s.
+Best of `--repeat` loads (the town: of at most 2).
 `make bench` runs it; `--json FILE` also writes the figures.
 """
 
@@ -25,6 +34,14 @@ from pathlib import Path
 
 import yaml
 
+from avsim.scenario.bounds import (
+    MAX_BLOCK,
+    MAX_DEPTH,
+    MAX_LANE_WIDTH,
+    MAX_TOWN_BLOCKS,
+    MAX_TOWN_LANES,
+    MAX_VALUES,
+)
 from avsim.scenario.bounds import MAX_FILE_BYTES as MAX_YAML_BYTES
 from avsim.scenario.files import SCENARIO_DIR, read_raw
 from avsim.scenario.load import ScenarioError, load_scenario
@@ -37,7 +54,15 @@ ALKS = (Path(__file__).parents[1] / "tests" / "data" / "alks" / "logical_scenari
         / "concrete_scenarios")
 XOSC = "alks_scenario_4_6_2_lateral_detection_range_template.xosc"
 ROAD = Path("road_networks") / "alks_road_straight.xodr"
+MINIMAL_YAML = """\
+format: avsim/1
+name: bench
+duration: 10
+road: {lanes: 2, speed_limit_kph: 50, segments: [{straight: 200}]}
+ego: {s: 20, set_speed_kph: 40}
+"""
 TARGET = 5.0  # [s]
+TOWN_TARGET = 15.0  # [s] a town at its bounds, loaded and built
 
 
 def best_load(path: Path, repeat: int) -> tuple[float, str]:
@@ -121,6 +146,52 @@ def worst_xodr(folder: Path) -> tuple[float, str]:
     return time.perf_counter() - start, outcome
 
 
+def deepest_yaml(folder: Path) -> Path:
+    """A minimal scenario with an extra key holding values nested `MAX_DEPTH` deep, as many
+    as `MAX_VALUES` lets it hold: read, composed and validated in full (then refused as an
+    unknown key)."""
+    inner = MAX_DEPTH - 2  # the file's mapping and the list of copies are two levels
+    one = "[" * inner + "1" + "]" * inner
+    copies = (MAX_VALUES - 100) // (inner + 1)
+    path = folder / "deepest.yaml"
+    path.write_text(MINIMAL_YAML + f"extra: [{', '.join([one] * copies)}]\n", encoding="utf-8")
+    return path
+
+
+def merge_bomb_yaml(folder: Path) -> Path:
+    """A minimal scenario followed by merge keys of one 10-key anchor up to the file bound:
+    refused by the value count partway through its parse."""
+    head = MINIMAL_YAML + "a: &a {" + ", ".join(f"k{k}: {k}" for k in range(10)) + "}\n"
+    line = "m{:06d}: {{<<: *a}}\n"
+    count = (MAX_YAML_BYTES - len(head) - 100) // len(line.format(0))
+    path = folder / "merge_bomb.yaml"
+    path.write_text(head + "".join(line.format(k) for k in range(count)), encoding="utf-8")
+    return path
+
+
+def best_town_start(repeat: int) -> tuple[float, str]:
+    """[s] the fastest of `repeat` starts of a town at its bounds (module doc), and its size."""
+    from avsim.run.runner import Runner
+    from world.core.quiet import quiet_c_output
+    from world.sensors.setup import Profile
+
+    overrides: dict[str, object] = {
+        "town.blocks_x": MAX_TOWN_BLOCKS, "town.blocks_y": MAX_TOWN_BLOCKS,
+        "town.block": MAX_BLOCK, "town.lanes": MAX_TOWN_LANES,
+        "town.lane_width": MAX_LANE_WIDTH}
+    best, outcome = float("inf"), ""
+    for _ in range(repeat):
+        start = time.perf_counter()
+        scenario = load_scenario("town_route", overrides)
+        with quiet_c_output():
+            runner = Runner(scenario, None, Profile.DEFAULT, "inline")
+        best = min(best, time.perf_counter() - start)
+        outcome = f"{runner.world.client.getNumBodies()} bodies"
+        with quiet_c_output():
+            runner.world.close()
+    return best, outcome
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=3)
@@ -141,8 +212,13 @@ def main() -> None:
         figures["xosc_expression_budget_s"], expr = best_load(expression_flood(alks),
                                                              args.repeat)
         figures["xodr_worst_spirals_s"], spirals = worst_xodr(Path(tmp))
-    for (key, value), outcome in zip(figures.items(), (xosc, xodr, yml, expr, spirals),
-                                     strict=True):
+        figures["yaml_deepest_nesting_s"], deep = best_load(deepest_yaml(Path(tmp)),
+                                                            args.repeat)
+        figures["yaml_merge_bomb_refused_s"], bomb = best_load(merge_bomb_yaml(Path(tmp)),
+                                                               args.repeat)
+    figures["town_at_bounds_start_s"], town = best_town_start(min(args.repeat, 2))
+    outcomes = (xosc, xodr, yml, expr, spirals, deep, bomb, town)
+    for (key, value), outcome in zip(figures.items(), outcomes, strict=True):
         print(f"  {key:<28} {value:6.2f} s  {outcome[:60]}")
     if args.json:
         args.json.write_text(json.dumps(figures, indent=2) + "\n")

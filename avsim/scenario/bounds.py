@@ -15,7 +15,11 @@ from typing import Annotated
 from pydantic import Field
 
 MAX_FILE_BYTES = 512 * 1024  # a scenario file's size (the bundled ones are about 2 kB)
-MAX_VALUES = 100_000  # the values (scalars, lists, mappings) a file holds, anchors expanded
+MAX_VALUES = 100_000  # the values (scalars, lists, mappings, keys) a file holds, anchors expanded
+MAX_DEPTH = 64  # collections nested in a file or a `--set` value, anchors expanded (the
+# bundled files nest 6 deep; YAML's composer and everything after it recurse per level)
+MAX_INT_DIGITS = 20  # digits of an integer in a file or a `--set` value (2**64 has 20)
+MAX_NAME_LENGTH = 100  # characters of `name` (it names the run's files: runs/<name>.rrd)
 MAX_DURATION = 7200.0  # [s] `duration`, and every time in the file (triggers, delays, lights)
 MAX_SEED = 2**32 - 1  # `seed` (numpy's seed range)
 MAX_LANES = 6  # driving lanes per direction on a road, oncoming lanes

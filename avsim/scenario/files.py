@@ -5,9 +5,12 @@ A scenario argument is a file path, or the name of a bundled scenario (`bundled_
 vendored `alks_scenario_4_4_1_..._template.xosc` `alks/4_4_1_...`, and so on).
 The YAML is read with a strict safe loader: a key written twice in one
 mapping is an error (PyYAML would keep the last), plain scalars are read by the YAML 1.2
-core schema (``1e9`` is a number, ``yes`` is text), and a file over `MAX_FILE_BYTES` or
-holding over `MAX_VALUES` values (anchors expanded) is refused. Problems are `LocatedError`s keyed
-`(file)` or `line N`.
+core schema (``1e9`` is a number, ``yes`` is text) with integers of at most `MAX_INT_DIGITS`
+digits. Only a regular file is read, and at most `MAX_FILE_BYTES` of it
+(`world.core.safe_read.read_bounded`: `/dev/zero` or a FIFO is refused, not read). Before
+the YAML is composed, its parser's events are walked (`avsim.scenario.yaml_events`): a text
+nested over `MAX_DEPTH` levels or holding over `MAX_VALUES` values (anchors and merge keys
+expanded) is refused there. Problems are `LocatedError`s keyed `(file)` or `line N`.
 """
 
 from __future__ import annotations
@@ -20,8 +23,10 @@ from typing import TYPE_CHECKING, Any
 
 import yaml
 
-from avsim.scenario.bounds import MAX_FILE_BYTES, MAX_VALUES
+from avsim.scenario.bounds import MAX_FILE_BYTES, MAX_INT_DIGITS
 from avsim.scenario.errors import FILE_KEY, LocatedError, ScenarioError, show
+from avsim.scenario.yaml_events import YamlBoundError, check_events
+from world.core.safe_read import UnreadableFileError, read_bounded
 
 REPO_ROOT = Path(__file__).resolve().parents[2]  # the repository this package sits in
 SCENARIO_DIR = REPO_ROOT / "scenarios"  # the bundled scenarios
@@ -178,8 +183,13 @@ def _core_schema(loader: type[yaml.SafeLoader]) -> None:
 
 def _core_int(loader: yaml.SafeLoader, node: yaml.Node) -> int:
     """An int of the core schema: ``0o17`` octal, ``0x1f`` hex, else decimal (``010`` is 10,
-    not YAML 1.1's octal 8)."""
+    not YAML 1.1's octal 8); a `YamlBoundError` over `MAX_INT_DIGITS` digits (Python refuses
+    to convert over 4300, and no count or seed needs more than 20)."""
     text = str(loader.construct_scalar(node))  # type: ignore[arg-type]
+    digits = len(text.lstrip("+-").removeprefix("0o").removeprefix("0x"))
+    if digits > MAX_INT_DIGITS:
+        raise YamlBoundError(node.start_mark.line + 1,
+                             f"an integer of {digits} digits: at most {MAX_INT_DIGITS}")
     if text.startswith(("0o", "0x")):
         return int(text[2:], 8 if text[1] == "o" else 16)
     return int(text, 10)
@@ -189,35 +199,34 @@ _core_schema(_StrictLoader)
 
 
 def parse_value(text: str) -> Any:
-    """One YAML value as the scenario files read it (`_StrictLoader`: the core schema), for
-    a value given on the command line (`--set PATH=VALUE`). Raises `yaml.YAMLError`."""
+    """One YAML value as the scenario files read it (`_StrictLoader`: the core schema, the
+    same bounds), for a value given on the command line (`--set PATH=VALUE`). Raises
+    `yaml.YAMLError` (a `YamlBoundError` past a bound)."""
+    check_events(text)
     return yaml.load(text, Loader=_StrictLoader)
 
 
 def read_raw(path: Path) -> dict[str, Any]:
     """The file's YAML as a mapping, or a `LocatedError` keyed `(file)` or `line N`."""
     try:
-        size = path.stat().st_size
-        if size > MAX_FILE_BYTES and path.is_file():
-            raise LocatedError(FILE_KEY, f"{size} bytes: at most {MAX_FILE_BYTES}")
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise LocatedError(FILE_KEY, "no such file") from None
-    except IsADirectoryError:
-        raise LocatedError(FILE_KEY, "is a directory, not a file") from None
+        text = read_bounded(path, MAX_FILE_BYTES).decode("utf-8")
+    except UnreadableFileError as exc:
+        raise LocatedError(FILE_KEY, exc.problem) from None
     except UnicodeDecodeError:
         raise LocatedError(FILE_KEY, "not UTF-8 text") from None
-    except OSError as exc:
-        raise LocatedError(FILE_KEY, f"cannot read it ({exc.strerror})") from None
     try:
+        check_events(text)
         data = yaml.load(text, Loader=_StrictLoader)
+    except YamlBoundError as exc:
+        raise LocatedError(f"line {exc.line}", exc.problem) from None
     except yaml.MarkedYAMLError as exc:
         raise _yaml_problem(exc) from None
+    except yaml.reader.ReaderError as exc:
+        raise _reader_problem(exc, text) from None
     except yaml.YAMLError as exc:
-        raise LocatedError(FILE_KEY, f"YAML error: {exc}") from None
+        raise LocatedError(FILE_KEY, "YAML error: " + " ".join(str(exc).split())) from None
     if data is None:
         raise LocatedError(FILE_KEY, "empty file")
-    _check_values(data)
     if not isinstance(data, dict):
         raise LocatedError(
             FILE_KEY, f"must be a mapping of keys (format, name, ...), got {show(data)}"
@@ -225,20 +234,15 @@ def read_raw(path: Path) -> dict[str, Any]:
     return data
 
 
-def _check_values(data: object) -> None:
-    """At most `MAX_VALUES` values in the document, counting every use of an anchor (YAML
-    aliases share one value, but everything after the loader walks each use: a few nested
-    anchors would otherwise ask for billions). The count stops at the bound."""
-    count, todo = 0, [data]
-    while todo:
-        node = todo.pop()
-        count += 1
-        if count > MAX_VALUES:
-            raise LocatedError(FILE_KEY, f"more than {MAX_VALUES} values (anchors expanded)")
-        if isinstance(node, dict):
-            todo.extend(node.values())
-        elif isinstance(node, list):
-            todo.extend(node)
+def _reader_problem(exc: yaml.reader.ReaderError, text: str) -> LocatedError:
+    """`line N: YAML does not allow the character #xHHHH` (a NUL, a control character)."""
+    char = exc.character
+    code = char if isinstance(char, int) else ord(char)
+    if yaml.__with_libyaml__:  # libyaml counts the position in bytes, PyYAML's reader in
+        line = text.encode("utf-8")[: exc.position].count(b"\n") + 1  # characters
+    else:
+        line = text[: exc.position].count("\n") + 1
+    return LocatedError(f"line {line}", f"YAML does not allow the character #x{code:04x}")
 
 
 def _yaml_problem(exc: yaml.MarkedYAMLError) -> LocatedError:

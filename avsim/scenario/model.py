@@ -76,6 +76,8 @@ CameraName = Literal["front", "left", "right"]
 DelayedSensor = Literal["front", "left", "right", "lidar"]
 
 Identifier = Annotated[str, Field(pattern=NAME_PATTERN)]
+ScenarioName = Annotated[str, Field(pattern=NAME_PATTERN, max_length=b.MAX_NAME_LENGTH)]  # it
+# names the run's files (runs/<name>.rrd, a sweep's <name>_000.rrd): a file name's characters
 MAX_GRID_POINTS = 1000  # runs a file's `grid` may ask for
 MAX_GRID_VALUES = 100  # values of one grid key
 GridPath = Annotated[str, Field(  # a key path, or several joined by commas (values go together)
@@ -804,7 +806,9 @@ class ScenarioModel(FormatModel):
     model_config = ConfigDict(json_schema_extra=_one_of(("road", "town")))
 
     format: Literal["avsim/1"] = Field(description="The format version, `avsim/1`; required.")
-    name: Identifier = Field(description="Scenario name, [a-z0-9_]+; required.")
+    name: ScenarioName = Field(
+        description=f"Scenario name, [a-z0-9_]+, at most {b.MAX_NAME_LENGTH} characters; "
+        "required.")
     description: str = Field(default="", description="One line for humans. Default empty.")
     situation: Situation = Field(
         default="other",

@@ -58,6 +58,7 @@ from numpy.typing import NDArray
 from world.hdmap import RoadMap, Zone
 from world.map.road import build_road_map
 from world.map.town import HEADINGS, STOP_SETBACK, TownLayout
+from world.scene.box_index import BoxIndex, Rect
 from world.scene.road_marks import MARK_Z, STOP_LINE_WIDTH, paint_texture
 from world.scene.road_mesh import (
     ASPHALT_NOISE,
@@ -95,6 +96,7 @@ BUILDING_FRONTAGE = (12.5, 30.0)  # [m] (min, max), the least over the LiDAR det
 #   `DetectorParams.max_length`: a facade seen whole is no object to it
 BUILDING_DENSITY = 0.7  # [-] built-up fraction of a block side's frontage
 START_JITTER = 5.0  # [m] the first building of a side starts up to this far from its corner
+INDEX_CELL = 50.0  # [m] cell of the placed buildings' index: a few buildings per cell
 PAVEMENT_TEXELS = 8  # [px] per colour in the pavement's two-colour texture
 _CONCRETE_UV = (0.25, 0.5)  # [-] the middle of the texture's concrete half ...
 _GROUND_UV = (0.75, 0.5)  # [-] ... and of its ground half
@@ -415,25 +417,17 @@ def building_zone(layout: TownLayout, block: Index) -> tuple[float, float, float
     return x + margin, y + margin, x + t.block - margin, y + t.block - margin
 
 
-def _aabb(box: BuildingBox) -> FloatArray:
-    """[m] (4,) x0, y0, x1, y1 of the box's footprint."""
+def _aabb(box: BuildingBox) -> Rect:
+    """[m] x0, y0, x1, y1 of the box's footprint."""
     corners = box.footprint()
-    return np.concatenate([corners.min(axis=0), corners.max(axis=0)])
-
-
-def _clear(box: BuildingBox, others: list[BuildingBox]) -> bool:
-    """Whether the (axis-aligned) box keeps MIN_BUILDING_GAP from all others."""
-    a = _aabb(box)
-    for other in others:
-        b = _aabb(other)
-        if (a[0] < b[2] + MIN_BUILDING_GAP and b[0] < a[2] + MIN_BUILDING_GAP
-                and a[1] < b[3] + MIN_BUILDING_GAP and b[1] < a[3] + MIN_BUILDING_GAP):
-            return False
-    return True
+    x0, y0 = corners.min(axis=0)
+    x1, y1 = corners.max(axis=0)
+    return float(x0), float(y0), float(x1), float(y1)
 
 
 def _side_buildings(zone: tuple[float, float, float, float], side: int,
-                    rng: np.random.Generator, boxes: list[BuildingBox]) -> None:
+                    rng: np.random.Generator, boxes: list[BuildingBox],
+                    placed: BoxIndex) -> None:
     """Walk side `side` (0 south, 1 east, 2 north, 3 west) of the zone counter-clockwise,
     adding boxes whose front is on it (module doc)."""
     x0, y0, x1, y1 = zone
@@ -455,8 +449,10 @@ def _side_buildings(zone: tuple[float, float, float, float], side: int,
             xy = np.array(start) + (t + 0.5 * frontage) * u + 0.5 * depth * v
             box = BuildingBox((float(xy[0]), float(xy[1]), 0.5 * height),
                               (0.5 * frontage, 0.5 * depth, 0.5 * height), yaw, rgb)
-            if _clear(box, boxes):
+            rect = _aabb(box)
+            if placed.clear(rect):  # MIN_BUILDING_GAP from every other box (axis-aligned)
                 boxes.append(box)
+                placed.add(rect)
         t += frontage + gap
 
 
@@ -464,6 +460,7 @@ def layout_town_buildings(layout: TownLayout, rng: np.random.Generator) -> list[
     """Buildings along the four sides of every block's zone (`building_zone`), block by block
     row by row from the south-west, each block's sides south, east, north, west."""
     boxes: list[BuildingBox] = []
+    placed = BoxIndex(MIN_BUILDING_GAP, INDEX_CELL)
     t = layout.spec
     for by in range(t.blocks_y):
         for bx in range(t.blocks_x):
@@ -471,7 +468,7 @@ def layout_town_buildings(layout: TownLayout, rng: np.random.Generator) -> list[
             if zone[2] - zone[0] < BUILDING_FRONTAGE[0] or zone[3] - zone[1] < BUILDING_FRONTAGE[0]:
                 continue
             for side in range(4):
-                _side_buildings(zone, side, rng, boxes)
+                _side_buildings(zone, side, rng, boxes, placed)
     return boxes
 
 

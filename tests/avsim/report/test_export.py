@@ -106,7 +106,7 @@ def test_the_default_out_is_beside_the_recording_and_never_overwritten(run_dir: 
     assert forced.exit_code == 0 and sorted(_files(tmp_path)) == sorted(before)
     for out in (str(rrd), str(tmp_path / "." / "r.rrd")):  # the recording itself, even forced
         bad = _export(str(rrd), "--csv", "--out", out, "--force")
-        assert bad.exit_code == EXIT_BAD_INPUT and "recording itself" in bad.stderr
+        assert bad.exit_code == EXIT_BAD_INPUT and "is an input" in bad.stderr
     assert rrd.read_bytes() == (run_dir / "run.rrd").read_bytes()
 
 
