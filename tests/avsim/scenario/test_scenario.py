@@ -29,7 +29,7 @@ def test_the_world_spec_is_what_a_world_is_built_from() -> None:
     assert fields(spec.EgoSpec) == ["lane", "s", "speed", "max_speed", "engaged"]
     assert not hasattr(spec, "CriteriaSpec") and not hasattr(spec, "ScenarioSpec")
     assert fields(Scenario) == ["name", "description", "situation", "duration", "world",
-                                "driver", "criteria", "story", "grid"]
+                                "driver", "criteria", "story", "grid", "sources"]
     assert fields(DriverSettings) == ["set_speed", "overtake"]
 
 
