@@ -3,9 +3,9 @@ collision to the lead, the lateral offset in the lane, and the motion FSM's mano
 
 - Gap [m]: the log's bumper gap to the vehicle ahead in the ego's lane (truth and map), with
   UN R157's minimum following distance d_min at the ego's true speed
-  (`planner.fsm.acc.r157_min_gap`) as the reference; where the gap is under d_min the space
-  between them is shaded. The gap axis shows at most `GAP_VIEW` times the run's largest
-  d_min (a far lead leaves the top).
+  (`avsim.criteria.regulations.r157_min_gap`, the judge's) as the reference; where the gap
+  is under d_min the space between them is shaded. The gap axis shows at most `GAP_VIEW`
+  times the run's largest d_min (a far lead leaves the top).
 - Time to collision [s] (`world.truth.time_to_collision`): gap / closing speed where the
   ego closes on its lead (ego speed - lead speed > 0), nothing where there is no lead or it
   pulls away; shown from 0 to `TTC_VIEW` (longer ones leave the top), with `TTC_HARD` (2.5
@@ -31,8 +31,8 @@ from collections.abc import Sequence
 import numpy as np
 from matplotlib.axes import Axes
 
+from avsim.criteria.regulations import r157_min_gap
 from avsim.report.bands import FloatArray, Run, mode_runs
-from planner.fsm.acc import r157_min_gap
 from planner.fsm.machine import StateChange
 from planner.fsm.motion import LANE_CHANGES, Motion
 from world.spec import RoadSpec

@@ -9,7 +9,7 @@ import pytest
 
 from avsim.criteria.base import TruthSample
 from avsim.criteria.following import MinGap
-from planner.fsm.acc import r157_min_gap
+from avsim.criteria.regulations import r157_min_gap
 from tests.roads import make_map, seg
 from world.actors.actor_set import ActorPoses
 from world.spec import ActorType

@@ -27,11 +27,12 @@ from numpy.typing import NDArray
 
 from avsim.cli import main
 from avsim.criteria.base import CriterionResult
+from avsim.criteria.regulations import r157_min_gap
 from avsim.report import dynamics, margins, marks
 from avsim.report import speed_plot as plot
 from avsim.run.runner import RunResult, TrajectoryLog
 from avsim.scenario.load import load_scenario
-from planner.fsm.acc import AccMode, r157_min_gap
+from planner.fsm.acc import AccMode
 from planner.fsm.machine import StateChange
 from planner.fsm.motion import TABLE as MOTION_TABLE
 from planner.fsm.motion import Motion
@@ -292,9 +293,12 @@ def test_time_to_collision_of_the_synthetic_run() -> None:
 
 
 def test_min_gap_is_r157s_at_each_speed() -> None:
-    speeds = np.array([0.0, 2.0, 10.0, 30.0])
-    np.testing.assert_allclose(margins.min_gap(speeds), [2.0, 2.0 * 1.1, 10.0 * 1.36,
-                                                         30.0 * 2.08])
+    """R157's table: 1.0 s at 7.2 km/h (2 m/s), 1.1 s at 10 km/h, 0.1 s more every 10 km/h;
+    2 m at rest."""
+    speeds = np.array([0.0, 2.0, 2.5, 10.0, 30.0])
+    between = 1.0 + (9.0 - 7.2) / (10.0 - 7.2) * 0.1  # [s] at 2.5 m/s = 9 km/h
+    np.testing.assert_allclose(margins.min_gap(speeds), [2.0, 2.0 * 1.0, 2.5 * between,
+                                                         10.0 * 1.36, 30.0 * 2.08])
     assert margins.min_gap(np.array([])).shape == (0,)
 
 
