@@ -38,7 +38,7 @@ def sample(t: float, speed: float, station: float, actors: ActorPoses) -> TruthS
 
 
 def gap_of(lead_s: float, ego_s: float) -> float:
-    return lead_s - ego_s - (2 * CAR_HALF[0] + EGO_LENGTH) / 2
+    return float(lead_s - ego_s - (2 * CAR_HALF[0] + EGO_LENGTH) / 2)
 
 
 def test_lead_too_close_fails_with_value_and_threshold() -> None:
