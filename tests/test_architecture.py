@@ -23,6 +23,8 @@ STATIC_WORLD = ("world.frames", "world.hdmap")  # the sensor data types and the 
 WORLD_INIT = ("world.core.simd",)  # `world/__init__.py` also pins numpy's dispatch: a leaf
 #   of the standard library alone (no numpy, no simulator, no truth), checked below
 DYNAMIC_IMPORTS = ("importlib.import_module", "import_module", "__import__")
+STACK = ("perception", "planner", "control")  # the stack under test
+JUDGE = ("avsim/criteria", "avsim/report")  # the judge: imports nothing of `STACK`
 
 
 @dataclass(frozen=True)
@@ -116,6 +118,21 @@ def violations(source: str, filename: str, rule: Rule, module: str = "",
     return sorted(set(found), key=lambda message: (int(message.split(":")[1]), message))
 
 
+def stack_imports(root: Path = REPO, folders: tuple[str, ...] = JUDGE) -> list[str]:
+    """`file:line: imports ...` for each import statement of a stack package (`STACK`) in
+    the `.py` files under `root/<folder>/`, wherever it stands in the module (every node of
+    its AST: module level, functions, `if TYPE_CHECKING:`, literal dynamic imports), in file
+    and line order."""
+    found: list[tuple[str, int, str]] = []
+    for folder in folders:
+        for path in sorted((root / folder).rglob("*.py")):
+            source = path.read_text(encoding="utf-8")
+            for imp in imports(source, module_name(path, root), path.name == "__init__.py"):
+                if imp.module.split(".")[0] in STACK and not imp.from_name:
+                    found.append((str(path.relative_to(root)), imp.line, imp.module))
+    return [f"{file}:{line}: imports {module}" for file, line, module in sorted(found)]
+
+
 def package_files(package: str, root: Path = REPO) -> list[Path]:
     return sorted((root / package).rglob("*.py"))
 
@@ -161,6 +178,16 @@ def test_the_static_world_modules_reach_no_simulator() -> None:
                  if isinstance(n, ast.ImportFrom) and n.module}
     assert imported <= {"__future__", "os", "platform", "sys"}, imported
     assert not found, "the static world modules must stay PyBullet-free:\n" + "\n".join(found)
+
+
+def test_the_judge_imports_nothing_of_the_stack() -> None:
+    """`avsim/criteria/` and `avsim/report/` judge the truth and the run's records with their
+    own formulas and types: no import of `perception`, `planner` or `control` anywhere in
+    them (in functions and under `if TYPE_CHECKING:` too)."""
+    for folder in JUDGE:
+        assert list((REPO / folder).rglob("*.py")), f"no .py files under {folder}/"
+    found = stack_imports()
+    assert not found, "the judge imports the stack:\n" + "\n".join(found)
 
 
 # ---------------------------------------------------------------------------------------
@@ -251,3 +278,21 @@ def test_checker_walks_a_package_tree(tmp_path: Path) -> None:
     bad = str(Path("perception", "sub", "bad.py"))
     assert [message.split(": ")[0] for message in found] == [f"{bad}:4", f"{bad}:6"], found
     assert "pybullet" in found[0] and "world.world" in found[1]
+
+
+def test_the_judge_check_finds_nested_and_type_checking_imports(tmp_path: Path) -> None:
+    report = tmp_path / "avsim" / "report"
+    report.mkdir(parents=True)
+    (report / "ok.py").write_text("import numpy\nfrom avsim.report.states import LANE_KEEP\n"
+                                  "from world.frames import kph\n", encoding="utf-8")
+    (report / "bad.py").write_text(
+        "from typing import TYPE_CHECKING\n"
+        "if TYPE_CHECKING:\n    from planner.fsm.machine import StateChange\n"
+        "def f() -> None:\n    import perception.tracker\n"
+        "import importlib\nm = importlib.import_module('control.pid')\n"
+        "from planner import fsm, messages\n"
+        "from plannerish import x\n", encoding="utf-8")
+    bad = str(Path("avsim", "report", "bad.py"))
+    assert stack_imports(tmp_path, ("avsim/report",)) == [
+        f"{bad}:3: imports planner.fsm.machine", f"{bad}:5: imports perception.tracker",
+        f"{bad}:7: imports control.pid", f"{bad}:8: imports planner"]

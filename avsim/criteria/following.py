@@ -18,9 +18,9 @@ from avsim.criteria.base import (
     TruthSample,
 )
 from avsim.criteria.declaration import Declaration
+from avsim.criteria.regulations import r157_min_gap
 from avsim.criteria.wording import beside
 from avsim.scenario.fields import NonNegFloat, PosFloat, problem
-from planner.fsm.acc import r157_min_gap
 from world.frames import kph
 from world.hdmap import RoadMap
 from world.truth import VehicleAhead, vehicles_ahead

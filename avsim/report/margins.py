@@ -3,9 +3,9 @@ collision to the lead, the lateral offset in the lane, and the motion FSM's mano
 
 - Gap [m]: the log's bumper gap to the vehicle ahead in the ego's lane (truth and map), with
   UN R157's minimum following distance d_min at the ego's true speed
-  (`planner.fsm.acc.r157_min_gap`) as the reference; where the gap is under d_min the space
-  between them is shaded. The gap axis shows at most `GAP_VIEW` times the run's largest
-  d_min (a far lead leaves the top).
+  (`avsim.criteria.regulations.r157_min_gap`, the judge's) as the reference; where the gap
+  is under d_min the space between them is shaded. The gap axis shows at most `GAP_VIEW`
+  times the run's largest d_min (a far lead leaves the top).
 - Time to collision [s] (`world.truth.time_to_collision`): gap / closing speed where the
   ego closes on its lead (ego speed - lead speed > 0), nothing where there is no lead or it
   pulls away; shown from 0 to `TTC_VIEW` (longer ones leave the top), with `TTC_HARD` (2.5
@@ -16,8 +16,8 @@ collision to the lead, the lateral offset in the lane, and the motion FSM's mano
   where the body is still inside that lane (`lane_margin`: the lane width of the route's
   segment at the ego's station, the body width from the car's URDF). During a lane change
   the offset runs out to the bound and beyond until the stack keeps the target lane.
-- Manoeuvres (`motion_runs`): the motion FSM's states (`planner.fsm.motion.Motion`), with two
-  kinds of lane change told apart by the logged reasons of its changes (`MOTION_REASONS`):
+- Manoeuvres (`motion_runs`): the motion FSM's recorded states (`avsim.report.states`), with
+  two kinds of lane change told apart by the logged reasons of its changes (`MOTION_REASONS`):
   one that ends by an abort (back to the origin lane), and a flat tyre's pull over to the
   right. Lane keeping gets no band (`NEUTRAL`).
 
@@ -31,29 +31,37 @@ from collections.abc import Sequence
 import numpy as np
 from matplotlib.axes import Axes
 
-from avsim.report.bands import FloatArray, Run, mode_runs
-from planner.fsm.acc import r157_min_gap
-from planner.fsm.machine import StateChange
-from planner.fsm.motion import LANE_CHANGES, Motion
+from avsim.criteria.regulations import r157_min_gap
+from avsim.report.bands import FloatArray, Run, value_runs
+from avsim.report.states import (
+    LANE_CHANGE_LEFT,
+    LANE_CHANGE_RIGHT,
+    LANE_CHANGES,
+    LANE_KEEP,
+    MOTION_MACHINE,
+    TURN_LEFT,
+    TURN_RIGHT,
+    U_TURN,
+    RecordedChange,
+)
 from world.spec import RoadSpec
 
 TTC_VIEW = 10.0  # [s] the time-to-collision axis' top
 TTC_HARD = 2.5  # [s] a time to collision marked as short (module doc)
 GAP_VIEW = 4.0  # [-] the gap axis' top: at most this many times the run's largest d_min
-MOTION_MACHINE = "motion"  # the motion FSM's name in the state changes (`planner.motion_layer`)
 ABORTED = "lane_change_aborted"  # a lane change that ended by an abort
 PULL_OVER = "pull_over"  # a lane change to the right entered for a flat tyre
 MOTION_REASONS = {ABORTED: "abort", PULL_OVER: "pull over"}  # what the logged reason holds
-NEUTRAL = frozenset({Motion.LANE_KEEP.value})  # states with no band
+NEUTRAL = frozenset({LANE_KEEP})  # states with no band
 # one colour per manoeuvre (legend order), none of them an ACC mode's or a speed source's
 MOTION_COLOURS: dict[str, str] = {
-    "lane_change_left": "#0203e2",
-    "lane_change_right": "#0aff02",
+    LANE_CHANGE_LEFT: "#0203e2",
+    LANE_CHANGE_RIGHT: "#0aff02",
     ABORTED: "#fe01b1",
     PULL_OVER: "#7ebd01",
-    "turn_right": "#703be7",
-    "turn_left": "#2dfe54",
-    "u_turn": "#06470c",
+    TURN_RIGHT: "#703be7",
+    TURN_LEFT: "#2dfe54",
+    U_TURN: "#06470c",
 }
 LEAD_COLOUR = "#1a237e"  # the lead's lines (its speed, the gap to it)
 GAP_LINES = {  # series -> (label, colour, style, width); no band's colour (their pixels
@@ -85,11 +93,11 @@ def lane_margin(road: RoadSpec, station: FloatArray, car_width: float) -> FloatA
     return (widths[i] - car_width) / 2.0
 
 
-def _label(run: Run, moves: Sequence[StateChange], tol: float) -> str:
+def _label(run: Run, moves: Sequence[RecordedChange], tol: float) -> str:
     """The manoeuvre a motion run shows: its state, or for a lane change `ABORTED` (left by
     an abort at its end) or `PULL_OVER` (entered for a flat tyre at its start)."""
     state, start, end = run
-    if state not in {m.value for m in LANE_CHANGES}:
+    if state not in LANE_CHANGES:
         return state
     left = [c.reason for c in moves if c.source == state and abs(c.t - end) <= tol]
     if any(MOTION_REASONS[ABORTED] in reason for reason in left):
@@ -100,12 +108,13 @@ def _label(run: Run, moves: Sequence[StateChange], tol: float) -> str:
     return state
 
 
-def motion_runs(t: Sequence[float], motion: Sequence[Motion],
-                changes: Sequence[StateChange]) -> list[Run]:
-    """(manoeuvre, start [s], end [s]) of each run of equal motion states (`mode_runs`),
-    a lane change labelled by the reasons of the motion FSM's changes (`changes`, the run's)
-    within half a tick of its start and end (`_label`)."""
-    runs = mode_runs(t, motion)
+def motion_runs(t: Sequence[float], motion: Sequence[str],
+                changes: Sequence[RecordedChange]) -> list[Run]:
+    """(manoeuvre, start [s], end [s]) of each run of equal motion states (`value_runs`;
+    `motion`: the recorded state per tick), a lane change labelled by the reasons of the
+    motion FSM's changes (`changes`, the run's) within half a tick of its start and end
+    (`_label`)."""
+    runs = value_runs(t, motion)
     tol = 0.5 * (t[1] - t[0]) if len(t) > 1 else 0.0  # [s]
     moves = [c for c in changes if c.machine == MOTION_MACHINE]
     return [(_label(run, moves, tol), run[1], run[2]) for run in runs]

@@ -23,8 +23,8 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
+from avsim.report.states import RecordedChange
 from avsim.run.holds import Hold, holds
-from planner.fsm.machine import StateChange
 
 MIN_HOLD = 0.5  # [s] issue K's least hold of an ACC mode
 
@@ -60,7 +60,7 @@ def result_files(paths: Sequence[Path]) -> list[Path]:
     return out
 
 
-def state_changes(path: Path) -> list[StateChange]:
+def state_changes(path: Path) -> list[RecordedChange]:
     """The state changes of the result file at `path`."""
     try:
         record = json.loads(path.read_text(encoding="utf-8"))
@@ -70,8 +70,8 @@ def state_changes(path: Path) -> list[StateChange]:
     if not isinstance(rows, list):
         raise BadResultError(f"{path}: state_changes: missing or not a list (not a run's result)")
     try:
-        return [StateChange(float(c["t"]), str(c["machine"]), str(c["from"]), str(c["to"]),
-                            str(c.get("reason", ""))) for c in rows]
+        return [RecordedChange(float(c["t"]), str(c["machine"]), str(c["from"]),
+                               str(c["to"]), str(c.get("reason", ""))) for c in rows]
     except (KeyError, TypeError, ValueError) as e:
         raise BadResultError(f"{path}: state_changes: an entry lacks t, machine, from or to "
                        f"({e!r})") from e

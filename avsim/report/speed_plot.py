@@ -5,9 +5,9 @@ below it (`avsim run --plot`). Panels, top to bottom, on one time axis [s]:
    bumper and the driver's set speed, with the ACC / event layer's mode (the log's
    `acc_mode`, `planner.fsm.acc.AccMode`'s values) as coloured bands behind them, one colour
    per mode.
-2. A strip of the motion FSM's manoeuvres (`planner.fsm.motion.Motion`): lane changes left
-   and right, an aborted one, a flat tyre's pull over, turns and U-turns, one colour per
-   manoeuvre; lane keeping blank (`avsim.report.margins.motion_runs`).
+2. A strip of the motion FSM's manoeuvres (its recorded states, `avsim.report.states`): lane
+   changes left and right, an aborted one, a flat tyre's pull over, turns and U-turns, one
+   colour per manoeuvre; lane keeping blank (`avsim.report.margins.motion_runs`).
 3. A strip saying which constraint set the plan's speed at each tick (the log's
    `speed_source`, `planner.messages.SpeedSource`'s values: set speed, limit, curve,
    following, event, pedal, degraded lane, emergency, driver, sight).
@@ -59,6 +59,7 @@ from avsim.files import write_atomic
 from avsim.report import dynamics, margins
 from avsim.report.bands import BAND_ALPHA, FloatArray, draw_bands, mode_runs
 from avsim.report.marks import draw_marks, story_marks
+from avsim.run.recorded import recorded_changes, recorded_states
 from vehicle_urdf.geometry import read_geometry
 from world.frames import MPS_PER_KPH
 from world.truth import time_to_collision
@@ -180,7 +181,8 @@ def speed_profile_figure(result: RunResult) -> Figure:
     runs = mode_runs(log.t, log.acc_mode)
     draw_bands(fig, ax, runs, MODE_COLOURS, "ACC / event mode", "outside right lower")
     draw_bands(fig, axes["motion"],
-               margins.motion_runs(log.t, log.motion, result.state_changes),
+               margins.motion_runs(log.t, recorded_states(log.motion),
+                                   recorded_changes(result.state_changes)),
                margins.MOTION_COLOURS, "manoeuvre", "outside right center",
                skip=margins.NEUTRAL)
     draw_bands(fig, axes["source"], mode_runs(log.t, log.speed_source), SOURCE_COLOURS,

@@ -13,10 +13,21 @@ import itertools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
-
-from planner.fsm.machine import StateChange
+from typing import Protocol
 
 SAFETY_MODES = frozenset({"brake", "pedestrian", "flat"})  # ACC modes entered for safety
+
+
+class Change(Protocol):
+    """A state change as the rule reads it: the stack's (`planner.fsm.machine.StateChange`)
+    or a recorded one (`avsim.report.states.RecordedChange`)."""
+
+    @property
+    def t(self) -> float: ...  # [s]
+    @property
+    def machine(self) -> str: ...
+    @property
+    def target(self) -> str: ...  # the state entered
 
 
 @dataclass(frozen=True, slots=True)
@@ -29,7 +40,7 @@ class Hold:
     then: str  # the mode it was left for
 
 
-def holds(changes: Sequence[StateChange], machine: str,
+def holds(changes: Sequence[Change], machine: str,
           safety: frozenset[str] = SAFETY_MODES) -> list[Hold]:
     """The holds of the modes of `machine` not in `safety` that ended by a change into a
     mode not in `safety`, in time order (module doc)."""
@@ -38,7 +49,7 @@ def holds(changes: Sequence[StateChange], machine: str,
             if a.target not in safety and b.target not in safety]
 
 
-def shortest_hold(changes: Sequence[StateChange], machine: str,
+def shortest_hold(changes: Sequence[Change], machine: str,
                   safety: frozenset[str] = SAFETY_MODES) -> float:
     """[s] the shortest time a mode of `machine` not in `safety` was held before a change
     into a mode not in `safety`; inf if there is none (no such change)."""

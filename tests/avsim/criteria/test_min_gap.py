@@ -9,7 +9,7 @@ import pytest
 
 from avsim.criteria.base import TruthSample
 from avsim.criteria.following import MinGap
-from planner.fsm.acc import r157_min_gap
+from avsim.criteria.regulations import r157_min_gap
 from tests.roads import make_map, seg
 from world.actors.actor_set import ActorPoses
 from world.spec import ActorType
@@ -38,7 +38,7 @@ def sample(t: float, speed: float, station: float, actors: ActorPoses) -> TruthS
 
 
 def gap_of(lead_s: float, ego_s: float) -> float:
-    return lead_s - ego_s - (2 * CAR_HALF[0] + EGO_LENGTH) / 2
+    return float(lead_s - ego_s - (2 * CAR_HALF[0] + EGO_LENGTH) / 2)
 
 
 def test_lead_too_close_fails_with_value_and_threshold() -> None:

@@ -27,15 +27,19 @@ from numpy.typing import NDArray
 
 from avsim.cli import main
 from avsim.criteria.base import CriterionResult
-from avsim.report import dynamics, margins, marks
+from avsim.criteria.regulations import r157_min_gap
+from avsim.report import dynamics, margins, marks, states
 from avsim.report import speed_plot as plot
+from avsim.report.states import RecordedChange
+from avsim.run.recorded import recorded_changes, recorded_states
 from avsim.run.runner import RunResult, TrajectoryLog
 from avsim.scenario.load import load_scenario
-from planner.fsm.acc import AccMode, r157_min_gap
+from planner.fsm.acc import AccMode
 from planner.fsm.machine import StateChange
+from planner.fsm.motion import LANE_CHANGES as PLANNER_LANE_CHANGES
 from planner.fsm.motion import TABLE as MOTION_TABLE
 from planner.fsm.motion import Motion
-from planner.messages import SpeedSource
+from planner.messages import MACHINES, SpeedSource
 from world.spec import RoadSpec, SegmentSpec
 from world.truth import time_to_collision
 
@@ -292,9 +296,12 @@ def test_time_to_collision_of_the_synthetic_run() -> None:
 
 
 def test_min_gap_is_r157s_at_each_speed() -> None:
-    speeds = np.array([0.0, 2.0, 10.0, 30.0])
-    np.testing.assert_allclose(margins.min_gap(speeds), [2.0, 2.0 * 1.1, 10.0 * 1.36,
-                                                         30.0 * 2.08])
+    """R157's table: 1.0 s at 7.2 km/h (2 m/s), 1.1 s at 10 km/h, 0.1 s more every 10 km/h;
+    2 m at rest."""
+    speeds = np.array([0.0, 2.0, 2.5, 10.0, 30.0])
+    between = 1.0 + (9.0 - 7.2) / (10.0 - 7.2) * 0.1  # [s] at 2.5 m/s = 9 km/h
+    np.testing.assert_allclose(margins.min_gap(speeds), [2.0, 2.0 * 1.0, 2.5 * between,
+                                                         10.0 * 1.36, 30.0 * 2.08])
     assert margins.min_gap(np.array([])).shape == (0,)
 
 
@@ -314,27 +321,51 @@ def test_lane_margin_follows_the_segment_at_the_station() -> None:
 
 def test_motion_runs_tell_aborted_and_pull_over_lane_changes() -> None:
     result = synthetic_result()
-    assert margins.motion_runs(result.log.t, result.log.motion, result.state_changes) == [
+    motion = recorded_states(result.log.motion)
+    changes = recorded_changes(result.state_changes)
+    assert margins.motion_runs(result.log.t, motion, changes) == [
         ("lane_keep", 0.0, pytest.approx(5.0)),
         ("lane_change_left", pytest.approx(5.0), pytest.approx(9.0)),
         ("lane_keep", pytest.approx(9.0), pytest.approx(12.0)),
         ("lane_change_aborted", pytest.approx(12.0), pytest.approx(14.0)),
         ("lane_keep", pytest.approx(14.0), DURATION)]
     # without the changes' reasons, a lane change is only its state
-    assert [r[0] for r in margins.motion_runs(result.log.t, result.log.motion, ())] == [
+    assert [r[0] for r in margins.motion_runs(result.log.t, motion, ())] == [
         "lane_keep", "lane_change_left", "lane_keep", "lane_change_right", "lane_keep"]
-    keep, right = Motion.LANE_KEEP, Motion.LANE_CHANGE_RIGHT
-    pull = (StateChange(1.0, "motion", "lane_keep", "lane_change_right",
-                        "a flat tyre: pull over"),
-            StateChange(3.0, "acc", "cruise", "flat", "a flat tyre"),
-            StateChange(3.0, "motion", "lane_change_right", "lane_keep", "in the target lane"))
+    keep, right = states.LANE_KEEP, states.LANE_CHANGE_RIGHT
+    pull = (RecordedChange(1.0, "motion", "lane_keep", "lane_change_right",
+                           "a flat tyre: pull over"),
+            RecordedChange(3.0, "acc", "cruise", "flat", "a flat tyre"),
+            RecordedChange(3.0, "motion", "lane_change_right", "lane_keep",
+                           "in the target lane"))
     assert margins.motion_runs([0.0, 1.0, 2.0, 3.0], [keep, right, right, keep], pull) == [
         ("lane_keep", 0.0, 1.0), ("pull_over", 1.0, 3.0), ("lane_keep", 3.0, 4.0)]
     # an abort logged by another machine, or far from the run's end, is not this one's
-    other = (StateChange(3.0, "acc", "lane_change_right", "lane_keep", "abort"),
-             StateChange(2.0, "motion", "lane_change_right", "lane_keep", "abort"))
+    other = (RecordedChange(3.0, "acc", "lane_change_right", "lane_keep", "abort"),
+             RecordedChange(2.0, "motion", "lane_change_right", "lane_keep", "abort"))
     assert margins.motion_runs([0.0, 1.0, 2.0, 3.0], [keep, right, right, keep], other)[1] \
         == ("lane_change_right", 1.0, 3.0)
+
+
+def test_the_recorded_motion_states_are_the_planners() -> None:
+    """The report's names of the motion FSM's states are the values the planner records."""
+    assert tuple(m.value for m in Motion) == states.MOTION_STATES
+    assert {m.value for m in PLANNER_LANE_CHANGES} == states.LANE_CHANGES
+    assert MACHINES[states.MOTION_MACHINE] is Motion
+
+
+def test_the_runs_states_reach_the_report_as_recorded() -> None:
+    """At the runner's boundary the stack's changes become the result JSON's records, field
+    for field, and its per-tick states their values: the strip's runs are the stack's."""
+    result = synthetic_result()
+    changes = recorded_changes(result.state_changes)
+    assert [(c.t, c.machine, c.source, c.target, c.reason) for c in changes] == [
+        (c.t, c.machine, c.source, c.target, c.reason) for c in result.state_changes]
+    assert all(type(c) is RecordedChange for c in changes)
+    motion = recorded_states(result.log.motion)
+    assert motion == [m.value for m in result.log.motion]
+    assert [r[1:] for r in margins.motion_runs(result.log.t, motion, changes)] == \
+        [r[1:] for r in plot.mode_runs(result.log.t, result.log.motion)]
 
 
 def test_motion_reasons_are_the_motion_tables() -> None:

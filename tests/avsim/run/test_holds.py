@@ -6,7 +6,9 @@ import math
 
 import pytest
 
+from avsim.report.states import RecordedChange
 from avsim.run.holds import holds, shortest_hold
+from avsim.run.recorded import recorded_changes
 from planner.fsm.machine import StateChange
 
 
@@ -44,3 +46,16 @@ def test_holds_lists_what_shortest_hold_counts() -> None:
                                                ("yield", "cruise")]
     assert got[1].t == 8.0 and got[1].duration == pytest.approx(0.2)
     assert shortest_hold(changes, "acc") == min(h.duration for h in got)
+
+
+def test_recorded_changes_give_the_same_holds() -> None:
+    """The reports read the holds from recorded changes (`avsim.report.states`), the run's
+    metric from the stack's: the same rule gives the same holds."""
+    changes = [change(0.0, "acc_off", "cruise"), change(5.0, "cruise", "trail"),
+               change(5.1, "trail", "cruise"), change(6.0, "keep", "change", "motion"),
+               change(9.0, "cruise", "brake"), change(9.4, "brake", "cruise"),
+               change(12.0, "cruise", "trail")]
+    recorded = recorded_changes(changes)
+    assert all(type(c) is RecordedChange for c in recorded)
+    assert holds(recorded, "acc") == holds(changes, "acc")
+    assert shortest_hold(recorded, "acc") == pytest.approx(0.1)
