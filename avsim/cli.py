@@ -35,7 +35,7 @@ from avsim.outputs import (
 )
 from avsim.run.interrupts import ExitAtOnce, Interrupts
 from avsim.run.result import dumps, headline, result_json
-from avsim.run.verdict import RunError, RunVerdict
+from avsim.run.verdict import RunVerdict
 from avsim.scenario.load import ScenarioError, load_scenario
 from avsim.scenario.profile_fit import check_profile
 from avsim.scenario.schema import scenario_json_schema
@@ -152,6 +152,7 @@ def run(scenario: str, out: Path | None, json_path: Path | None, profile: str, s
 
     with quiet_c_output():  # PyBullet's build banner
         from avsim.run.runner import Runner  # heavy: only once the input is known good
+        from avsim.run.unbuilt import unbuilt_result
         from world.sensors.setup import Profile, localisation
 
     try:  # held from before the run until its files are written: one writer per file
@@ -160,18 +161,20 @@ def run(scenario: str, out: Path | None, json_path: Path | None, profile: str, s
         _output_failed(str(exc))
     with claim, Interrupts() as stop:  # Ctrl-C / SIGTERM end the run at its tick, files kept
         setup = None if profile == "none" else Profile(profile)
+        started = time.perf_counter()
         try:
             runner = Runner(loaded, claim.partial, setup, sensing)
-        except Exception as exc:  # the world cannot be built: a bug, exit 3, nothing kept
-            click.echo(f"avsim: {RunError.of(exc, 0.0).line()}", err=True)
-            sys.exit(EXIT_ERROR)
-        click.echo(f"{loaded.name}: {localisation(setup, loaded.world.sensors.gnss).note}")
-        stop.on_signal(runner.interrupt)
-        result = _run_with_progress(runner, loaded.duration, not no_progress)
+        except Exception as exc:  # the world cannot be built: the run ends in error at 0 s
+            runner, result = None, unbuilt_result(loaded, exc, claim.partial, setup, started)
+        if runner is not None:
+            click.echo(f"{loaded.name}: {localisation(setup, loaded.world.sensors.gnss).note}")
+            stop.on_signal(runner.interrupt)
+            result = _run_with_progress(runner, loaded.duration, not no_progress)
         payload = result_json(result, scenario, out, profile)
         from avsim.report.speed_plot import plot_speed_profile
 
         unwritten = deliver(files, claim, loaded.name, dumps(payload),
+                            None if runner is None else  # no run: nothing to plot
                             lambda path: plot_speed_profile(result, path))
         _print_verdict(payload)
         if result.error is not None:
@@ -537,7 +540,7 @@ def export(recording: Path, fmt: str | None, out: Path | None, force: bool) -> N
         _bad_input(f"{out}: --out: is the recording itself")
     if out.exists() and not force:
         _bad_input(f"{out}: --out: exists (--force overwrites it)")
-    _writable(out, "--out")
+    _writable([Output("--out", out)], [recording])
     try:
         table = export_run(recording, out, "csv" if fmt == "csv" else "parquet")
     except ExportError as exc:
