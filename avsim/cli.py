@@ -16,6 +16,7 @@ import subprocess
 import sys
 import time
 from collections.abc import Callable, Sequence
+from contextlib import AbstractContextManager, ExitStack
 from pathlib import Path
 from typing import TYPE_CHECKING, NoReturn
 
@@ -29,9 +30,11 @@ from avsim.outputs import (
     Output,
     OutputError,
     RunFiles,
+    batch_lock,
     check_outputs,
     claim_outputs,
     deliver,
+    output_lock,
 )
 from avsim.run.interrupts import ExitAtOnce, Interrupts
 from avsim.run.result import dumps, headline, result_json
@@ -339,12 +342,24 @@ def suite(paths: tuple[str, ...], out: Path, sets: tuple[str, ...], params: tupl
         _bad_input(str(exc))
     if dry_run:
         _print_plan(planned)
-    with Interrupts() as stop:  # Ctrl-C / SIGTERM: finished runs and reports are kept
+    with _held(batch_lock(out)), Interrupts() as stop:  # Ctrl-C / SIGTERM: what finished is kept
         outcomes = _execute(planned, executor, jobs, address, stop)
         unwritten = batch.reports_written(outcomes, out, lambda: _report(
             outcomes, out, f"avsim suite ({len(outcomes)} runs)", snapshots))
     status = batch.exit_status(outcomes, stop.exit_status)
     _exit(unwritten, status)
+
+
+def _held(lock: AbstractContextManager[None]) -> ExitStack:
+    """`lock` entered, held until the returned stack closes; exit 4 with its one line when
+    it cannot be (`avsim.outputs.OutputError`: another command holds it, a folder that
+    cannot be made)."""
+    held = ExitStack()
+    try:
+        held.enter_context(lock)
+    except OutputError as exc:
+        _output_failed(str(exc))
+    return held
 
 
 def _one_value_each(texts: Sequence[str]) -> dict[str, object]:
@@ -409,7 +424,7 @@ def sweep(scenario: str, sets: tuple[str, ...], params: tuple[str, ...], out: Pa
         _bad_input(str(exc))
     if dry_run:
         _print_plan(planned)
-    with Interrupts() as stop:  # Ctrl-C / SIGTERM: finished runs and reports are kept
+    with _held(batch_lock(out)), Interrupts() as stop:  # Ctrl-C / SIGTERM: what finished is kept
         outcomes = _execute(planned, executor, jobs, address, stop)
 
         def reports() -> None:
@@ -512,9 +527,14 @@ def snapshot(recording: Path, at: float, out: Path | None, size: tuple[int, int]
     out = out if out is not None else recording.with_name(f"{recording.stem}_{at:g}s.png")
     _writable([Output("--out", out)], [recording])
     try:
-        render_snapshot(recording, at, out, width=size[0], height=size[1])
-    except SnapshotError as exc:
-        _bad_input(f"{recording}: {exc.key}: {exc}")
+        out.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        _output_failed(f"{out}: --out: its folder cannot be made ({exc.strerror})")
+    with _held(output_lock([Output("--out", out)])):  # one writer of the picture at a time
+        try:
+            render_snapshot(recording, at, out, width=size[0], height=size[1])
+        except SnapshotError as exc:
+            _bad_input(f"{recording}: {exc.key}: {exc}")
     click.echo(str(out))
 
 
