@@ -16,6 +16,7 @@ import subprocess
 import sys
 import time
 from collections.abc import Callable, Sequence
+from contextlib import AbstractContextManager, ExitStack
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, NoReturn
 
@@ -29,13 +30,15 @@ from avsim.outputs import (
     Output,
     OutputError,
     RunFiles,
+    batch_lock,
     check_outputs,
     claim_outputs,
     deliver,
+    output_lock,
 )
 from avsim.run.interrupts import ExitAtOnce, Interrupts
 from avsim.run.result import dumps, headline, result_json
-from avsim.run.verdict import RunError, RunVerdict
+from avsim.run.verdict import RunVerdict
 from avsim.scenario.bounds import MAX_SEED
 from avsim.scenario.load import ScenarioError, load_scenario
 from avsim.scenario.profile_fit import check_profile
@@ -169,6 +172,7 @@ def run(scenario: str, out: Path | None, json_path: Path | None, profile: str, s
 
     with quiet_c_output():  # PyBullet's build banner
         from avsim.run.runner import Runner  # heavy: only once the input is known good
+        from avsim.run.unbuilt import unbuilt_result
         from world.sensors.setup import Profile, localisation
 
     try:  # held from before the run until its files are written: one writer per file
@@ -177,18 +181,20 @@ def run(scenario: str, out: Path | None, json_path: Path | None, profile: str, s
         _output_failed(str(exc))
     with claim, Interrupts() as stop:  # Ctrl-C / SIGTERM end the run at its tick, files kept
         setup = None if profile == "none" else Profile(profile)
+        started = time.perf_counter()
         try:
             runner = Runner(loaded, claim.partial, setup, sensing)
-        except Exception as exc:  # the world cannot be built: a bug, exit 3, nothing kept
-            click.echo(f"avsim: {RunError.of(exc, 0.0).line()}", err=True)
-            sys.exit(EXIT_ERROR)
-        click.echo(f"{loaded.name}: {localisation(setup, loaded.world.sensors.gnss).note}")
-        stop.on_signal(runner.interrupt)
-        result = _run_with_progress(runner, loaded.duration, not no_progress)
+        except Exception as exc:  # the world cannot be built: the run ends in error at 0 s
+            runner, result = None, unbuilt_result(loaded, exc, claim.partial, setup, started)
+        if runner is not None:
+            click.echo(f"{loaded.name}: {localisation(setup, loaded.world.sensors.gnss).note}")
+            stop.on_signal(runner.interrupt)
+            result = _run_with_progress(runner, loaded.duration, not no_progress)
         payload = result_json(result, scenario, out, profile)
         from avsim.report.speed_plot import plot_speed_profile
 
         unwritten = deliver(files, claim, loaded.name, dumps(payload),
+                            None if runner is None else  # no run: nothing to plot
                             lambda path: plot_speed_profile(result, path))
         _print_verdict(payload)
         if result.error is not None:
@@ -353,12 +359,24 @@ def suite(paths: tuple[str, ...], out: Path, sets: tuple[str, ...], params: tupl
         _bad_input(str(exc))
     if dry_run:
         _print_plan(planned)
-    with Interrupts() as stop:  # Ctrl-C / SIGTERM: finished runs and reports are kept
+    with _held(batch_lock(out)), Interrupts() as stop:  # Ctrl-C / SIGTERM: what finished is kept
         outcomes = _execute(planned, executor, jobs, address, stop)
         unwritten = batch.reports_written(outcomes, out, lambda: _report(
             outcomes, out, f"avsim suite ({len(outcomes)} runs)", snapshots))
     status = batch.exit_status(outcomes, stop.exit_status)
     _exit(unwritten, status)
+
+
+def _held(lock: AbstractContextManager[None]) -> ExitStack:
+    """`lock` entered, held until the returned stack closes; exit 4 with its one line when
+    it cannot be (`avsim.outputs.OutputError`: another command holds it, a folder that
+    cannot be made)."""
+    held = ExitStack()
+    try:
+        held.enter_context(lock)
+    except OutputError as exc:
+        _output_failed(str(exc))
+    return held
 
 
 def _one_value_each(texts: Sequence[str]) -> dict[str, object]:
@@ -423,7 +441,7 @@ def sweep(scenario: str, sets: tuple[str, ...], params: tuple[str, ...], out: Pa
         _bad_input(str(exc))
     if dry_run:
         _print_plan(planned)
-    with Interrupts() as stop:  # Ctrl-C / SIGTERM: finished runs and reports are kept
+    with _held(batch_lock(out)), Interrupts() as stop:  # Ctrl-C / SIGTERM: what finished is kept
         outcomes = _execute(planned, executor, jobs, address, stop)
 
         def reports() -> None:
@@ -526,9 +544,14 @@ def snapshot(recording: Path, at: float, out: Path | None, size: tuple[int, int]
     out = out if out is not None else recording.with_name(f"{recording.stem}_{at:g}s.png")
     _writable([Output("--out", out)], [recording])
     try:
-        render_snapshot(recording, at, out, width=size[0], height=size[1])
-    except SnapshotError as exc:
-        _bad_input(f"{recording}: {exc.key}: {exc}")
+        out.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        _output_failed(f"{out}: --out: its folder cannot be made ({exc.strerror})")
+    with _held(output_lock([Output("--out", out)])):  # one writer of the picture at a time
+        try:
+            render_snapshot(recording, at, out, width=size[0], height=size[1])
+        except SnapshotError as exc:
+            _bad_input(f"{recording}: {exc.key}: {exc}")
     click.echo(str(out))
 
 

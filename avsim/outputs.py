@@ -13,9 +13,11 @@ Before anything runs (`check_outputs`; bad input, nothing written):
   existing ancestor is a directory) and is writable: `os.access`, then a real check
   (a file created exclusively there and removed at once).
 
-While it runs (`OutputLock`): each output's lock file, `.NAME.<hash>.lock` beside it, is held
-(`flock`) from before the run until its files are written; a second command writing the same
-file is refused (`OutputBusyError`) instead of both writing it.
+While it runs (`output_lock`): each output's lock file, `.NAME.<hash>.lock` beside it, is
+held (`flock`) from before the run until its files are written; a second command writing the
+same file is refused (`OutputBusyError`) instead of both writing it. A batch (suite, sweep)
+holds its `--out` folder's lock (`batch_lock`: `BATCH_LOCK` in the folder) from before its
+first run until its reports are written: a second batch into the same folder is refused.
 
 After it runs, a write that fails (a read-only or removed folder, a full disk) keeps the
 result: `keep_result` writes the result JSON to a new file in the system's temporary folder
@@ -40,6 +42,7 @@ LOCK_SUFFIX = ".lock"
 LOCK_HASH_CHARS = 16  # [-] hex digits of the resolved path's SHA-256 in a lock file's name
 LOCK_NAME_CHARS = 100  # [-] characters of the output's name in its lock file's name
 PROBE_PREFIX = ".avsim-probe-"  # the folder check's file (removed at once)
+BATCH_LOCK = ".avsim-batch.lock"  # a batch folder's lock file, in the folder
 
 
 class OutputError(Exception):
@@ -182,18 +185,36 @@ def output_lock(outputs: Sequence[Output]) -> Iterator[None]:
 
 
 @contextmanager
-def _locked(output: Output) -> Iterator[None]:
-    """Hold `output`'s lock file: opened without following a symlink, locked without
-    waiting, and still the file at its name once locked (a command that ended meanwhile
-    removes its lock file: then the lock is the new command's to make)."""
-    path = lock_path(output.path)
+def batch_lock(folder: Path) -> Iterator[None]:
+    """Make the batch folder `folder` (and its parents) and hold its lock, `BATCH_LOCK` in
+    it, for the block: `OutputBusyError` when another batch holds it (another suite or
+    sweep writing into the same folder), `OutputError` when the folder cannot be made. The
+    lock file is removed at the end."""
+    output = Output("--out", folder)
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise OutputError(folder, "--out", f"the folder cannot be made ({exc.strerror})"
+                          ) from None
+    with _locked(output, folder.resolve() / BATCH_LOCK, "writing into this folder"):
+        yield
+
+
+@contextmanager
+def _locked(output: Output, path: Path | None = None,
+            doing: str = "writing this file") -> Iterator[None]:
+    """Hold `output`'s lock file (`path`, by default `lock_path(output.path)`): opened
+    without following a symlink, locked without waiting, and still the file at its name
+    once locked (a command that ended meanwhile removes its lock file: then the lock is the
+    new command's to make). `doing`: what the holder does, for the busy message."""
+    path = path if path is not None else lock_path(output.path)
     try:
         fd = os.open(path, os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW | os.O_CLOEXEC, 0o644)
     except OSError as exc:
         raise OutputError(output.path, output.option,
                           f"cannot open its lock file {path} ({exc.strerror})") from None
     try:
-        _lock_fd(fd, path, output)
+        _lock_fd(fd, path, output, doing)
         try:
             yield
         finally:
@@ -202,10 +223,10 @@ def _locked(output: Output) -> Iterator[None]:
         os.close(fd)
 
 
-def _lock_fd(fd: int, path: Path, output: Output) -> None:
+def _lock_fd(fd: int, path: Path, output: Output, doing: str) -> None:
     """Lock the open lock file `fd` (at `path`) or raise `OutputBusyError`."""
-    busy = OutputBusyError(output.path, output.option, f"another avsim command is writing this "
-                      f"file (it holds {path}); try again when it has ended")
+    busy = OutputBusyError(output.path, output.option, f"another avsim command is {doing} "
+                           f"(it holds {path}); try again when it has ended")
     try:
         fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
     except BlockingIOError:

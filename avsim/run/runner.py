@@ -24,6 +24,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable
+from contextlib import suppress
 from dataclasses import dataclass, field
 from functools import partial
 from pathlib import Path
@@ -215,6 +216,9 @@ class Runner:
         except BaseException:
             if worker is not None:
                 worker.close()
+            if (world := getattr(self, "world", None)) is not None:
+                with suppress(Exception):  # the build's exception is the one to raise
+                    world.close()  # built before a later part raised: its server freed
             raise
 
     def _build(self, scenario: Scenario, recording: Path | None, mode: str,

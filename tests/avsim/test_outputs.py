@@ -27,9 +27,11 @@ from avsim.batch.jobs import RunJob, RunOutcome, Status
 from avsim.cli import EXIT_BAD_INPUT, EXIT_OUTPUT, main
 from avsim.files import NAME_MAX, temporary_beside, write_atomic
 from avsim.outputs import (
+    BATCH_LOCK,
     Output,
     OutputBusyError,
     OutputError,
+    batch_lock,
     check_outputs,
     lock_path,
     output_lock,
@@ -364,3 +366,50 @@ def test_reports_that_cannot_be_written_keep_the_results(tmp_path: Path,
     finally:
         kept.unlink()
     assert batch.reports_written(outcomes, tmp_path, lambda: None) is None
+
+
+@pytest.mark.parametrize("command", ["suite", "sweep"])
+def test_a_second_batch_into_the_same_folder_is_refused(tmp_path: Path, command: str) -> None:
+    """While a batch holds its --out folder (`batch_lock`, as a suite or sweep does from
+    before its first run until its reports are written), another suite or sweep into that
+    folder, named another way, exits 4 with one line before it runs anything."""
+    scenario = _scenario(tmp_path)
+    out = tmp_path / "batch"
+    values = "0.3" if command == "suite" else "0.3,0.4"  # a sweep sweeps
+    args: list[str | Path] = [command, scenario, "--set", f"duration={values}"]
+    with batch_lock(out):
+        assert sorted(p.name for p in out.iterdir()) == [BATCH_LOCK]
+        line = _one_line_error(_invoke(*args, "--out", tmp_path / "x" / ".." / "batch",
+                                       "--profile", "none", "--no-snapshots"), EXIT_OUTPUT)
+        assert "--out: another avsim command is writing into this folder" in line
+        assert sorted(p.name for p in out.iterdir()) == [BATCH_LOCK]
+        dry = _invoke(*args, "--out", out, "--profile", "none", "--dry-run")
+        assert dry.exit_code == 0, dry.output  # a dry run writes nothing: no lock needed
+    assert list(out.iterdir()) == []  # the lock file is removed by its holder
+
+
+def test_a_batch_lock_is_exclusive_and_its_file_is_never_followed(tmp_path: Path) -> None:
+    out = tmp_path / "batch"
+    with batch_lock(out), pytest.raises(OutputBusyError), batch_lock(tmp_path / "." / "batch"):
+        pass  # pragma: no cover
+    with batch_lock(out):  # free again once its holder ended
+        pass
+    victim = tmp_path / "victim"
+    victim.write_text("precious")
+    (out / BATCH_LOCK).symlink_to(victim)
+    with pytest.raises(OutputError, match="lock file"), batch_lock(out):
+        pass  # pragma: no cover
+    assert victim.read_text() == "precious"
+
+
+def test_a_second_snapshot_to_the_same_picture_is_refused(tmp_path: Path) -> None:
+    recording = tmp_path / "run.rrd"
+    recording.write_bytes(b"a recording")
+    png = tmp_path / "pics" / "at_1s.png"
+    png.parent.mkdir()
+    with output_lock([Output("--out", png)]):  # as the first snapshot holds it
+        line = _one_line_error(_invoke("snapshot", recording, "--at", "1", "--out",
+                                       tmp_path / "pics" / "." / "at_1s.png"), EXIT_OUTPUT)
+        assert "--out: another avsim command is writing this file" in line
+        assert sorted(p.name for p in png.parent.iterdir()) == [lock_path(png).name]
+    assert list(png.parent.iterdir()) == []

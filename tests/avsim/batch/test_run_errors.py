@@ -6,17 +6,21 @@ is: the batch's signal, error, bad input, failed, passed)."""
 from __future__ import annotations
 
 import json
+import subprocess
+import sys
 from pathlib import Path
 
+import pytest
 from junitparser import Error, JUnitXml
 
 from avsim.batch import suite as batch
 from avsim.batch.executors import Channel, LocalExecutor, _local_task
-from avsim.batch.jobs import RunJob, RunOutcome, Status
+from avsim.batch.jobs import RunJob, RunOutcome, Status, run_job
 from avsim.report.suite import summary_table
 
 HERE = Path(__file__).parents[1]
 FOLLOW = HERE / "batch_scenarios" / "follow.yaml"
+RERUN = Path(sys.executable).parent / "rerun"
 BUG = "heading error 2.856 rad: the car does not head along the lane"
 
 
@@ -85,3 +89,28 @@ def test_the_batch_status_follows_its_order() -> None:
     assert of(Status.PASSED, Status.INTERRUPTED, signalled=130) == 130
     assert of(Status.PASSED, Status.FAILED, signalled=130) == 1  # every run had finished
     assert of(Status.PASSED, Status.INTERRUPTED) == 3  # only its worker got a signal
+
+
+def test_a_run_whose_world_cannot_be_built_ends_in_error_with_its_files(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The worker (`run_job`): verdict error at 0 s, the traceback in the result, a valid
+    recording, no criterion judged; the batch's outcome is that run's error."""
+    from world.world import World
+
+    def broken(*_args: object, **_kwargs: object) -> None:
+        raise RuntimeError("the world cannot be built")
+
+    monkeypatch.setattr(World, "__init__", broken)
+    job = RunJob("unbuilt", str(FOLLOW), tmp_path, {"duration": 2.0}, "none", duration=2.0)
+    outcome = run_job(job)
+    assert outcome.status is Status.ERROR
+    assert outcome.error == ("unbuilt: run ended in error at t = 0.000 s: RuntimeError: the "
+                             "world cannot be built")
+    result = json.loads(job.result_file.read_text(encoding="utf-8"))
+    assert result == outcome.result
+    assert (result["verdict"], result["sim_time"], result["criteria"]) == ("error", 0.0, [])
+    assert "Traceback (most recent call last)" in result["error"]["traceback"]
+    check = subprocess.run([str(RERUN), "rrd", "verify", str(job.recording)],
+                           capture_output=True, text=True, check=False)
+    assert check.returncode == 0, check.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["unbuilt.json", "unbuilt.rrd"]

@@ -2,7 +2,8 @@
 130 / 143 interrupted by SIGINT / SIGTERM), and a signal at any moment of a run gives a
 status and files that agree: during the heavy imports (exit at once, nothing written),
 while the world is built (a valid recording and a result that says interrupted, never
-passed), after the last tick (the run is whole: its own verdict and status).
+passed), after the last tick (the run is whole: its own verdict and status). A world that
+cannot be built ends the run in error at 0 s, with its result and recording.
 
 The subprocesses run `tests.avsim.run.cli_hooks`, which says when the moment has come
 (a file) and waits for the test's go-ahead: no fixed sleeps."""
@@ -101,16 +102,27 @@ def test_a_run_that_ends_in_error_exits_3_with_one_line_and_its_files(tmp_path: 
     assert sorted(p.name for p in out.parent.iterdir()) == ["nd.json", "nd.rrd"]
 
 
-def test_a_world_that_cannot_be_built_exits_3_with_one_line_and_nothing_kept(
+def test_a_world_that_cannot_be_built_ends_in_error_with_its_result_and_recording(
         tmp_path: Path) -> None:
     out = tmp_path / "run" / "nd.rrd"
-    proc, _, _ = avsim(tmp_path, "world", *run_args(out))
-    _, stderr = proc.communicate(timeout=DEADLINE)
+    proc, _, _ = avsim(tmp_path, "world", *run_args(out), "--plot")
+    stdout, stderr = proc.communicate(timeout=DEADLINE)
     assert proc.returncode == EXIT_ERROR, stderr
     assert "Traceback" not in stderr
-    assert stderr.strip().splitlines()[-1] == ("avsim: run ended in error at t = 0.000 s: "
-                                               "RuntimeError: the world cannot be built")
-    assert not out.parent.exists() or not list(out.parent.iterdir())
+    lines = [line for line in stderr.splitlines() if line.startswith("avsim:")]
+    assert lines == ["avsim: run ended in error at t = 0.000 s: RuntimeError: the world "
+                     "cannot be built"]
+    result = json.loads(out.with_suffix(".json").read_text(encoding="utf-8"))
+    assert (result["verdict"], result["passed"], result["interrupted"], result["sim_time"]) \
+        == ("error", False, False, 0.0)
+    assert (result["criteria"], result["infractions"], result["metrics"]) == ([], [], {})
+    assert result["error"]["type"] == "RuntimeError"
+    assert result["error"]["message"] == "the world cannot be built"
+    assert result["error"]["sim_time"] == 0.0
+    assert "Traceback (most recent call last)" in result["error"]["traceback"]
+    assert "ERROR at 0.0 s" in stdout
+    verified(out)
+    assert sorted(p.name for p in out.parent.iterdir()) == ["nd.json", "nd.rrd"]  # no plot
 
 
 @pytest.mark.parametrize(("sig", "status"), [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
