@@ -57,13 +57,18 @@ def _interrupted_run(tmp_path: Path, profile: str, sig: signal.Signals,
     env = {**os.environ, "PYTHONPATH": str(REPO)}
     proc = subprocess.Popen(
         [sys.executable, "-m", "avsim.cli", "run", "normal_driving", "--out", str(out),
-         "--profile", profile, "--plot", "--no-progress"],
+         "--profile", profile, "--plot", "--no-progress",
+         # without a camera the lane is the receiver's: an RTK one keeps the car in it
+         *(["--set", "sensors={gnss: {preset: rtk}}"] if profile == "none" else [])],
         cwd=tmp_path, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
         start_new_session=True)
-    partial = out.with_name(f".{out.name}.partial")
+    def under_way() -> bool:  # the recording's temporary file is open
+        return out.parent.is_dir() and any(out.parent.glob(f".{out.name}.*.partial"))
+
     deadline = time.monotonic() + 120
-    while not partial.exists() and proc.poll() is None and time.monotonic() < deadline:
+    while not under_way() and proc.poll() is None and time.monotonic() < deadline:
         time.sleep(0.2)
+    assert under_way(), "the run never started"
     time.sleep(3.0)
     if group:
         os.killpg(proc.pid, sig)
@@ -112,10 +117,13 @@ def test_an_interrupted_sweep_keeps_its_finished_runs_and_reports(tmp_path: Path
          str(out)],
         cwd=tmp_path, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
         start_new_session=True)
-    second = out / ".normal_driving_001.rrd.partial"  # its recording is open: under way
+    def second_under_way() -> bool:  # its recording's temporary file is open
+        return any(out.glob(".normal_driving_001.rrd.*.partial"))
+
     deadline = time.monotonic() + 300
-    while not second.exists() and proc.poll() is None and time.monotonic() < deadline:
+    while not second_under_way() and proc.poll() is None and time.monotonic() < deadline:
         time.sleep(0.05)
+    assert second_under_way(), "the second run never started"
     time.sleep(1.0)  # well inside its 60 s simulated (6 s or more of wall time)
     os.killpg(proc.pid, signal.SIGINT)
     _, stderr = proc.communicate(timeout=300)
