@@ -135,6 +135,10 @@ class MotionLayerParams:
     keep_right_gap: float = 2.0  # [s] keeping right waits for this time gap to a car behind
     #   in the right lane (UN R157's t_G of 1 s aborts a change: the margin between the two
     #   keeps a gap that hovers near t_G from starting and aborting changes)
+    back_margin: float = 2.0  # [m] the return from the oncoming lane waits for this more
+    #   gap to the vehicle passed than the rear rule's (a standing vehicle's is
+    #   gap >= v t_G, no hysteresis in decelerations: its track's box wobbles by tenths of
+    #   a metre, which would start and abort the return)
     motion: MotionParams = field(default_factory=MotionParams)
     occupancy: OccupancyParams = field(default_factory=OccupancyParams)
     lane_change: LaneChangeParams = field(default_factory=LaneChangeParams)
@@ -285,11 +289,12 @@ class MotionLayer:
                 oncoming: LaneTraffic) -> Verdict:
         """`planner.oncoming_pass.decide` for passing `slow` from the car's centre station
         `s` [m], with the oncoming lane's traffic (nothing alongside in it, nor coming up
-        behind in it in the car's direction faster than the rear rule allows)."""
+        behind in it in the car's direction faster than the rear rule allows; one behind
+        that drives away, the oncoming traffic that has passed, does not count)."""
         if oncoming.alongside:
             return Verdict(False, "no pass: a vehicle alongside in the oncoming lane")
         behind = oncoming.behind
-        if behind is not None and rear_decel_needed(
+        if behind is not None and behind.speed > 0.0 and rear_decel_needed(
                 behind.gap, behind.speed, ego.speed, self.params.occupancy) \
                 > self.params.occupancy.rear_decel:
             return Verdict(False, "no pass: a vehicle coming up behind in the oncoming lane")
@@ -322,8 +327,9 @@ class MotionLayer:
                    traffic: dict[int, LaneTraffic]) -> bool:
         """In the oncoming lane: whether the car may take its own lane back now: the pass
         became unsafe before it drew alongside (`_still_safe`), or its own lane is free
-        (`planner.lane_occupancy.is_free`) with the vehicle passed behind by at least its
-        speed times ``t_return``, ``return_gap`` at least (`planner.oncoming_pass`)."""
+        (`planner.lane_occupancy.is_free`) with the vehicle passed behind by its speed times
+        ``t_return``, ``return_gap`` at least (`planner.oncoming_pass`), and at least the
+        car's speed times the rear rule's t_G, plus ``back_margin``."""
         if not self._still_safe(ego, traffic):
             return True
         if not self._alongside:
@@ -331,9 +337,10 @@ class MotionLayer:
         own = traffic.get(self.road.lanes_at(s) - 1)
         if own is None or not is_free(own, ego.speed, self.params.occupancy, v_low):
             return False
-        p = self.params.oncoming_pass
+        p, occ = self.params.oncoming_pass, self.params.occupancy
         return own.behind is None or own.behind.gap >= max(
-            max(own.behind.speed, 0.0) * p.t_return, p.return_gap)
+            max(own.behind.speed, 0.0) * p.t_return, p.return_gap,
+            ego.speed * occ.rear_time_gap) + self.params.back_margin
 
     @staticmethod
     def _right_of(lane: int, pull_over: bool) -> int:

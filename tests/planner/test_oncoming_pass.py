@@ -205,11 +205,11 @@ def test_the_pass_goes_through_the_oncoming_lane_and_back_at_30_kph() -> None:
     assert lanes[start] == -1 and run[start][0] < 130.0 - 2.3 - 4.0  # from behind it
     back = start + motions[start:].index(Motion.LANE_CHANGE_RIGHT)
     assert lanes[back] == 0 and run[back][1].origin == -1
-    # back once the stopped car (rear bumper to its front) is 8 m behind, not later than
-    # a tick after
+    # back once the stopped car (its front to the car's rear bumper) is return_gap (8 m)
+    # + back_margin (2 m) behind, within a tick (0.5 m) and the track's box (0.5 m)
     front_of_stopped = 130.0 + 2.3
     ego_rear = run[back][0] - VEHICLE.rear_overhang
-    assert 8.0 <= ego_rear - front_of_stopped < 8.0 + 5.0 * 0.1 + 0.5
+    assert 10.0 <= ego_rear - front_of_stopped < 10.0 + 5.0 * 0.1 + 0.5
     assert lanes[-1] == 0 and motions[-1] is Motion.LANE_KEEP
     caps = {m.speed_cap for _, m in run if min(m.lane, m.origin) < 0}
     assert caps == {speed_cap(30.0 * KPH, PassParams())}
