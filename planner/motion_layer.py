@@ -53,10 +53,17 @@ driver leaves to see the tyres of the car ahead), as much of it as a stop at
 Keeping right after a pass waits for a car behind in the right lane to be
 ``keep_right_gap`` back (a margin over the gap that aborts).
 
-On a road where the leftmost lane of the car's direction has an oncoming lane beside it,
-a blocked car may not pass there: `planner.oncoming_pass` decides whether a pass would be
-safe, and the reason it is not is logged once per change of reason (a motion change
-lane_keep -> lane_keep); the pass through the oncoming lane itself is not built.
+On a road where the leftmost lane of the car's direction has an oncoming lane beside it
+(and no lane to its left), a blocked car passes through the oncoming lane (-1) when
+`planner.oncoming_pass` finds the pass safe (no vehicle alongside in that lane, none coming
+up behind in it the car's way) and the path clears the vehicle; otherwise the reason is
+logged once per change of reason, its figures aside (a motion change lane_keep ->
+lane_keep). The change into lane -1 is committed once the car is alongside the vehicle
+passed (it is no longer ahead in the car's own lane); before that a tracked oncoming
+vehicle that makes the rest of the pass unsafe aborts it. In lane -1 the car goes back as
+soon as the vehicle passed is behind by max(its speed x ``t_return``, ``return_gap``, the
+car's speed x the rear rule's t_G) + ``back_margin`` and the own lane is free; its speed
+there (and on the ways in and back) is capped by `planner.oncoming_pass.speed_cap`.
 
 At a town junction where the route turns, the turn is entered when the car's centre passes
 the stop line and done at the junction's exit (`RoadMap.junctions`); its path is the map's
