@@ -53,10 +53,17 @@ driver leaves to see the tyres of the car ahead), as much of it as a stop at
 Keeping right after a pass waits for a car behind in the right lane to be
 ``keep_right_gap`` back (a margin over the gap that aborts).
 
-On a road where the leftmost lane of the car's direction has an oncoming lane beside it,
-a blocked car may not pass there: `planner.oncoming_pass` decides whether a pass would be
-safe, and the reason it is not is logged once per change of reason (a motion change
-lane_keep -> lane_keep); the pass through the oncoming lane itself is not built.
+On a road where the leftmost lane of the car's direction has an oncoming lane beside it
+(and no lane to its left), a blocked car passes through the oncoming lane (-1) when
+`planner.oncoming_pass` finds the pass safe (no vehicle alongside in that lane, none coming
+up behind in it the car's way) and the path clears the vehicle; otherwise the reason is
+logged once per change of reason, its figures aside (a motion change lane_keep ->
+lane_keep). The change into lane -1 is committed once the car is alongside the vehicle
+passed (it is no longer ahead in the car's own lane); before that a tracked oncoming
+vehicle that makes the rest of the pass unsafe aborts it. In lane -1 the car goes back as
+soon as the vehicle passed is behind by max(its speed x ``t_return``, ``return_gap``, the
+car's speed x the rear rule's t_G) + ``back_margin`` and the own lane is free; its speed
+there (and on the ways in and back) is capped by `planner.oncoming_pass.speed_cap`.
 
 At a town junction where the route turns, the turn is entered when the car's centre passes
 the stop line and done at the junction's exit (`RoadMap.junctions`); its path is the map's
@@ -68,6 +75,7 @@ into it before the junction ("a lane ends ahead").
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 
@@ -94,8 +102,18 @@ from planner.lane_occupancy import (
     is_blocked,
     is_free,
     lane_traffic,
+    rear_decel_needed,
 )
-from planner.oncoming_pass import Oncoming, PassParams, Slow, decide
+from planner.oncoming_pass import (
+    Oncoming,
+    PassParams,
+    Slow,
+    Verdict,
+    decide,
+    plan_pass,
+    speed_cap,
+    tracks_reason,
+)
 from world.frames import VehicleInfo
 from world.hdmap import SHOULDER, Junction, RoadMap
 from world.hdmap import Manoeuvre as JunctionManoeuvre
@@ -124,6 +142,10 @@ class MotionLayerParams:
     keep_right_gap: float = 2.0  # [s] keeping right waits for this time gap to a car behind
     #   in the right lane (UN R157's t_G of 1 s aborts a change: the margin between the two
     #   keeps a gap that hovers near t_G from starting and aborting changes)
+    back_margin: float = 2.0  # [m] the return from the oncoming lane waits for this more
+    #   gap to the vehicle passed than the rear rule's (a standing vehicle's is
+    #   gap >= v t_G, no hysteresis in decelerations: its track's box wobbles by tenths of
+    #   a metre, which would start and abort the return)
     motion: MotionParams = field(default_factory=MotionParams)
     occupancy: OccupancyParams = field(default_factory=OccupancyParams)
     lane_change: LaneChangeParams = field(default_factory=LaneChangeParams)
@@ -143,6 +165,8 @@ class Manoeuvre:
     room: float = 0.0  # [m] more gap for the ACC to keep behind track `room_for` (the room
     #   to pull out around a stationary vehicle it may pass)
     room_for: int | None = None  # the track id of that vehicle
+    speed_cap: float = math.inf  # [m/s] the highest speed while the car is in the oncoming
+    #   lane (`planner.oncoming_pass.speed_cap`); inf elsewhere
 
 
 class MotionLayer:
@@ -168,6 +192,9 @@ class MotionLayer:
         self._passing = False  # the change in hand is one to pass a slower vehicle
         self._no_pass = ""  # why the car stays behind a slower vehicle it may not pass
         #   through the oncoming lane (logged once per change of reason)
+        self._no_pass_now = ""  # ... this tick's reason
+        self._passed: int | None = None  # the track passed through the oncoming lane
+        self._alongside = False  # the car has drawn alongside it (the pass is committed)
 
     def update(self, ego: EgoState, v_want: float, tracks: Sequence[Track],
                pull_over: bool = False, v_rear: float | None = None,
@@ -196,10 +223,12 @@ class MotionLayer:
         elif self.path is not None and self.motion is Motion.LANE_KEEP and s >= self.path.end:
             self.path = None  # the way back after an abort is done
             self.origin = self.lane
-        changes = self.machine.apply(ego.t, change) + self._why_no_pass(ego, s, x, traffic)
-        room_for, room = self._room(traffic, ego.speed, v_want)
+        changes = self.machine.apply(ego.t, change) + self._why_no_pass(ego, x)
+        room_for, room = self._room(traffic, s, ego.speed, v_want)
+        cap = speed_cap(float(self.road.speed_limit_at(s)), self.params.oncoming_pass) \
+            if min(self.lane, self.origin) < 0 else math.inf
         return Manoeuvre(self.motion, self.lane, self.origin, self.path,
-                         self._leads(traffic, s, d, ego.speed), room, room_for), changes
+                         self._leads(traffic, s, d, ego.speed), room, room_for, cap), changes
 
     @property
     def motion(self) -> Motion:
@@ -228,30 +257,97 @@ class MotionLayer:
         return (self.params.overtake and self.lane == section.lanes - 1
                 and section.oncoming_lanes > 0)
 
-    def _why_no_pass(self, ego: EgoState, s: float, x: MotionInput,
-                     traffic: dict[int, LaneTraffic]) -> tuple[StateChange, ...]:
+    def _why_no_pass(self, ego: EgoState, x: MotionInput) -> tuple[StateChange, ...]:
         """While the car keeps its lane behind a slower vehicle that blocks it on a road
-        whose only way past is the oncoming lane, why it may not pass there now
-        (`planner.oncoming_pass.decide`): a change of reason is logged (the motion state
-        stays LANE_KEEP), once per change, not every tick."""
-        reason = ""
-        slow = traffic[self.lane].ahead if self.lane in traffic else None
-        if (self.motion is Motion.LANE_KEEP and x.blocked and slow is not None
-                and -1 in traffic):
-            ahead = traffic[-1].ahead
-            oncoming = () if ahead is None else (Oncoming(ahead.gap, -ahead.speed),)
-            verdict = decide(self.road, s + self.vehicle.front_overhang, ego.speed,
-                             self._v_want, Slow(slow.gap, max(slow.speed, 0.0), slow.length),
-                             oncoming, self.vehicle.length, self.params.oncoming_pass)
-            # the pass itself is not built: a safe verdict still keeps the car behind
-            reason = verdict.reason or "no pass: the pass through the oncoming lane is not built"
-        if reason == self._no_pass:
+        whose only way past is the oncoming lane, why it may not pass there now (this
+        tick's `_oncoming_input`): a change of reason is logged (the motion state stays
+        LANE_KEEP), once per change, not every tick."""
+        reason = self._no_pass_now if self.motion is Motion.LANE_KEEP and x.blocked else ""
+        if _kind(reason) == _kind(self._no_pass):  # the same reason with other figures
             return ()
         self._no_pass = reason
         if not reason:
             return ()
         state = self.motion.value
         return (StateChange(ego.t, "motion", state, state, reason),)
+
+    def _oncoming_input(self, ego: EgoState, s: float, x: MotionInput, blocked_now: bool,
+                        v_low: float, traffic: dict[int, LaneTraffic]) -> MotionInput:
+        """`x` with the inputs of a pass through the oncoming lane: in it, whether the car
+        may take its own lane back; behind a slower vehicle where the oncoming lane is the
+        only way past, whether a pass is safe (`planner.oncoming_pass.decide`, the lane free
+        alongside and behind) and its path clears the vehicle (else why not)."""
+        self._no_pass_now = ""
+        if self.lane < 0:
+            return replace(x, left_free=False, right_free=False, in_oncoming=True,
+                           back_free=self._back_free(ego, s, v_low, traffic))
+        slow = traffic[self.lane].ahead
+        if (not blocked_now or slow is None or self.motion is not Motion.LANE_KEEP
+                or not self._oncoming_side(s)):
+            return x
+        self._passed = slow.track_id
+        verdict = self._decide(ego, s, slow, traffic[-1])
+        ok = verdict.ok and self._pass_clears(ego, s, -1, traffic)
+        self._no_pass_now = verdict.reason or (
+            "" if ok else "no pass: too near the vehicle ahead for a path that clears it")
+        return replace(x, oncoming_pass=ok)
+
+    def _decide(self, ego: EgoState, s: float, slow: Neighbour,
+                oncoming: LaneTraffic) -> Verdict:
+        """`planner.oncoming_pass.decide` for passing `slow` from the car's centre station
+        `s` [m], with the oncoming lane's traffic (nothing alongside in it, nor coming up
+        behind in it in the car's direction faster than the rear rule allows; one behind
+        that drives away, the oncoming traffic that has passed, does not count)."""
+        if oncoming.alongside:
+            return Verdict(False, "no pass: a vehicle alongside in the oncoming lane")
+        behind = oncoming.behind
+        if behind is not None and behind.speed > 0.0 and rear_decel_needed(
+                behind.gap, behind.speed, ego.speed, self.params.occupancy) \
+                > self.params.occupancy.rear_decel:
+            return Verdict(False, "no pass: a vehicle coming up behind in the oncoming lane")
+        ahead = oncoming.ahead
+        cars = () if ahead is None else (Oncoming(ahead.gap, -ahead.speed),)
+        return decide(self.road, s + self.vehicle.front_overhang, ego.speed, self._v_want,
+                      Slow(slow.gap, max(slow.speed, 0.0), slow.length), cars,
+                      self.vehicle.length, self.params.oncoming_pass)
+
+    def _still_safe(self, ego: EgoState, traffic: dict[int, LaneTraffic]) -> bool:
+        """During a pass through the oncoming lane, until the car is alongside the vehicle
+        it passes: whether no tracked oncoming vehicle makes the rest of the pass unsafe
+        (`planner.oncoming_pass.tracks_reason`). Once alongside it (the vehicle no longer
+        ahead in the car's own lane) the pass is committed: true from then on."""
+        own = traffic.get(self.origin if self.origin >= 0 else self.lane + 1)
+        slow = None if own is None else own.ahead
+        if slow is None or slow.track_id != self._passed:
+            self._alongside = True
+        if self._alongside or slow is None:
+            return True
+        onc = traffic[-1]
+        plan = plan_pass(ego.speed, self._v_want, Slow(slow.gap, max(slow.speed, 0.0),
+                                                        slow.length),
+                         self.vehicle.length, self.params.oncoming_pass)
+        cars = () if onc.ahead is None else (Oncoming(onc.ahead.gap, -onc.ahead.speed),)
+        return not onc.alongside and (plan is None or not tracks_reason(
+            plan, self._v_want, cars, self.params.oncoming_pass))
+
+    def _back_free(self, ego: EgoState, s: float, v_low: float,
+                   traffic: dict[int, LaneTraffic]) -> bool:
+        """In the oncoming lane: whether the car may take its own lane back now: the pass
+        became unsafe before it drew alongside (`_still_safe`), or its own lane is free
+        (`planner.lane_occupancy.is_free`) with the vehicle passed behind by its speed times
+        ``t_return``, ``return_gap`` at least (`planner.oncoming_pass`), and at least the
+        car's speed times the rear rule's t_G, plus ``back_margin``."""
+        if not self._still_safe(ego, traffic):
+            return True
+        if not self._alongside:
+            return False
+        own = traffic.get(self.road.lanes_at(s) - 1)
+        if own is None or not is_free(own, ego.speed, self.params.occupancy, v_low):
+            return False
+        p, occ = self.params.oncoming_pass, self.params.occupancy
+        return own.behind is None or own.behind.gap >= max(
+            max(own.behind.speed, 0.0) * p.t_return, p.return_gap,
+            ego.speed * occ.rear_time_gap) + self.params.back_margin
 
     @staticmethod
     def _right_of(lane: int, pull_over: bool) -> int:
@@ -298,8 +394,13 @@ class MotionLayer:
             turn=_turn(self._junction_at(s)),
             turn_done=self.motion in TURNS and s >= self._turn_end,
         )
+        x = self._oncoming_input(ego, s, x, blocked_now, v_low, traffic)
         if self.motion not in LANE_CHANGES or self.path is None:
             return x
+        if self.lane < 0:  # into the oncoming lane: committed once alongside (module doc)
+            safe = self._still_safe(ego, traffic)
+            return replace(x, target_free=safe, committed=self._alongside,
+                           change_done=s >= self.path.end)
         target = self.road.lane(self.lane)
         centre, width = float(target.offset_at(s)), float(target.width_at(s))
         return replace(x, target_free=is_free(traffic[self.lane], v, p.occupancy, v_low,
@@ -326,8 +427,8 @@ class MotionLayer:
         self._near = set()
         if to in LANE_CHANGES:
             self.origin = self.lane
-            self.lane = self.lane + 1 if to is Motion.LANE_CHANGE_LEFT else \
-                self._right_of(self.lane, pull_over)
+            self.lane = self._target(to, s, pull_over)
+            self._alongside = False
             self.path = self._plan_into(self.lane, ego)
         elif abort:  # back to the origin; both lanes are in use until the path's end
             self.lane, self.origin = self.origin, self.lane
@@ -335,6 +436,15 @@ class MotionLayer:
         else:
             self.origin = self.lane
             self.path = None
+
+    def _target(self, to: Motion, s: float, pull_over: bool) -> int:
+        """The lane a change to `to` goes into at station `s` [m]: left of the leftmost lane
+        of the car's direction, the oncoming lane -1; right of the oncoming lane, that
+        leftmost lane; else the next lane (right of lane 0: the shoulder when pulling over)."""
+        n = self.road.lanes_at(s)
+        if to is Motion.LANE_CHANGE_LEFT:
+            return self.lane + 1 if self.lane + 1 < n else -1
+        return n - 1 if self.lane < 0 else self._right_of(self.lane, pull_over)
 
     def _plan_into(self, lane: int, ego: EgoState) -> LaneChangePath:
         # the estimate of a standing car's speed may be a hair below 0
@@ -388,11 +498,12 @@ class MotionLayer:
                      traffic: dict[int, LaneTraffic]) -> bool:
         """Whether a pass into `lane` started now would clear the vehicle ahead (`clears`)."""
         ahead = traffic[self.lane].ahead
-        if ahead is None or not 0 <= lane < self.road.lanes_at(s):
+        if ahead is None or not -self.road.cross_section_at(s).oncoming_lanes <= lane \
+                < self.road.lanes_at(s):
             return True
         return self.clears(self._plan_into(lane, ego), ahead, s, ego.speed)
 
-    def _room(self, traffic: dict[int, LaneTraffic], v: float,
+    def _room(self, traffic: dict[int, LaneTraffic], s: float, v: float,
               v_want: float) -> tuple[int | None, float]:
         """The track id of a stationary vehicle blocking the lane kept, which the car may
         pass (overtaking on, keeping its lane, a lane beside it), and the room [m] the ACC
@@ -402,7 +513,9 @@ class MotionLayer:
         stops as far back as it comfortably can."""
         p = self.params
         ahead = traffic[self.lane].ahead if self.lane in traffic else None
-        side = any(k in traffic for k in (self.lane - 1, self.lane + 1) if k >= 0)
+        side = self.lane >= 0 and (
+            any(k in traffic for k in (self.lane - 1, self.lane + 1) if k >= 0)
+            or self._oncoming_side(s))
         if (not p.overtake or not side or self.motion is not Motion.LANE_KEEP or ahead is None
                 or ahead.speed >= p.stationary
                 or not is_blocked(traffic[self.lane], v, v_want, p.occupancy, self.acc)):
@@ -410,6 +523,15 @@ class MotionLayer:
         comfortable = ahead.gap - self.acc.d0 - v * v / (2.0 * p.room_decel)
         room = min(max(p.pass_gap - self.acc.d0, 0.0), max(comfortable, 0.0))
         return ahead.track_id, room
+
+
+def _kind(reason: str) -> str:
+    """A reason without its figures (an oncoming car's gap changes every tick; the reason
+    does not)."""
+    return _FIGURES.sub("#", reason)
+
+
+_FIGURES = re.compile(r"[0-9]+(\.[0-9]+)?")
 
 
 def _turn(junction: Junction | None) -> Turn | None:

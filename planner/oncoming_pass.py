@@ -15,18 +15,30 @@ vehicle's is its speed towards the car, > 0). The pass is planned as three phase
 3. ``t_margin`` s more.
 
 The pass takes ``T = t_rel + t_lane + t_margin`` and the car travels ``X = v_s t_rel +
-distance + v_p (t_lane + t_margin)`` in it. An oncoming vehicle closes ``u T`` in that time:
-the nearest oncoming track at its speed ``u``, and, beyond the LiDAR's sight, one that may be
-there unseen at the posted limit. So the oncoming lane must be free of tracks to
-``X + u T + margin`` ahead, and the sight (`PassParams.sight`) must reach ``X + v_limit T +
-margin``: what lies beyond it may be a car at the limit. The centre line must be broken over
+distance + v_p (t_lane + t_margin)`` in it. Two kinds of oncoming vehicle are judged:
+
+- a *tracked* one (speed ``u`` towards the car) closes ``u T`` meanwhile: the oncoming lane
+  must be free of tracks to ``X + u T + margin`` ahead;
+- an *unseen* one beyond the LiDAR's confirmed sight (`PassParams.sight`) is judged by the
+  road-traffic rule for lanes shared with oncoming traffic: every driver must be able to
+  stop within the distance it can see, and where oncoming traffic may be in its lane,
+  within half of it (German StVO 3(1); the Vienna Convention, art. 13, asks the same: stop
+  within the distance ahead that is clear). So the car's stopping distance at the pass
+  speed plus that of a vehicle coming at the posted limit must fit within the sight:
+  ``stop(v_p) + stop(v_limit) <= sight``, ``stop(v) = v t_react + v^2 / (2 a_stop)``
+  (``t_react`` 1 s, ``a_stop`` 6 m/s^2, a firm but not full stop). Each then stops short of
+  the other. With the stack's 55 m this allows passes on roads up to about 45 km/h; at
+  50 km/h the two need 60 m. While the car is in the oncoming lane its speed is capped to
+  the highest speed at which the rule holds (`speed_cap`).
+
+The centre line must be broken over
 the whole pass (a solid line may not be crossed: the map's paint, `world.hdmap.LinePaint`;
 a road the map file does not paint has the double solid yellow line of the road's own
 rules), and no junction or marked crossing may lie within the pass's travel (plus
 ``crossing_margin`` before a crossing).
 
 `decide` returns the verdict with the reason the car stays behind (for its state change,
-logged once per change of reason by the motion layer), e.g. ``no pass: sight 55 m < 262 m
+logged once per change of reason by the motion layer), e.g. ``no pass: sight 55 m < 60 m
 needed`` or ``no pass: oncoming car 180 m ahead closes in 9.1 s, pass needs 12.0 s``.
 """
 
@@ -51,6 +63,8 @@ class PassParams:
     crossing_margin: float = 20.0  # [m] no pass ends within this before a marked crossing
     sight: float = 55.0  # [m] how far ahead the tracks show a vehicle
     #   (`planner.planner.PlannerParams.sight_range`)
+    t_react: float = 1.0  # [s] reaction time of the stopping distance (both drivers)
+    a_stop: float = 6.0  # [m/s^2] deceleration of the stopping distance (both drivers)
 
 
 @dataclass(frozen=True, slots=True)
@@ -95,6 +109,29 @@ def closing_time(distance: float, v0: float, v_max: float, a: float) -> float:
     return t_acc + (distance - d_acc) / v_max
 
 
+def stopping_distance(v: float, p: PassParams) -> float:
+    """[m] ``v t_react + v^2 / (2 a_stop)`` from `v` [m/s] (module doc)."""
+    v = max(v, 0.0)
+    return v * p.t_react + v * v / (2.0 * p.a_stop)
+
+
+def sight_needed(v_pass: float, limit: float, p: PassParams) -> float:
+    """[m] the sight a pass at `v_pass` [m/s] needs on a road posted at `limit` [m/s]: the
+    car's stopping distance plus that of an unseen oncoming vehicle at the limit."""
+    return stopping_distance(v_pass, p) + stopping_distance(limit, p)
+
+
+def speed_cap(limit: float, p: PassParams) -> float:
+    """[m/s] the highest speed whose stopping distance leaves, within the sight, room for
+    an oncoming vehicle at `limit` [m/s] to stop (0 when none does): the root of
+    ``v t_react + v^2 / (2 a_stop) = sight - stop(limit)``."""
+    room = p.sight - stopping_distance(limit, p)
+    if room <= 0.0:
+        return 0.0
+    a, t = p.a_stop, p.t_react
+    return -a * t + math.sqrt(a * a * t * t + 2.0 * a * room)
+
+
 def plan_pass(v: float, v_pass: float, slow: Slow, ego_length: float,
               p: PassParams) -> PassPlan | None:
     """The pass of `slow` by the car at `v` [m/s] speeding up to `v_pass` [m/s]; None when
@@ -119,17 +156,25 @@ def decide(road: RoadMap, s_front: float, v: float, v_pass: float, slow: Slow,
     if paint:
         return Verdict(False, paint)
     limit = float(road.speed_limit_at(s_front))  # [m/s] an unseen oncoming car's speed
-    need = plan.travel + limit * plan.time + p.margin
+    need = sight_needed(v_pass, limit, p)
     if p.sight < need:
         return Verdict(False, f"no pass: sight {p.sight:.0f} m < {need:.0f} m needed")
+    reason = tracks_reason(plan, v_pass, oncoming, p)
+    return Verdict(not reason, reason)
+
+
+def tracks_reason(plan: PassPlan, v_pass: float, oncoming: Sequence[Oncoming],
+                  p: PassParams) -> str:
+    """Why a tracked oncoming vehicle makes the pass `plan` at up to `v_pass` [m/s] unsafe
+    (empty: none does): the nearest one within ``X + u T + margin`` (module doc)."""
     for car in sorted(oncoming, key=lambda c: c.gap):
         u = max(car.speed, 0.0)
         free = plan.travel + u * plan.time + p.margin
         if car.gap < free:
             meet = car.gap / (u + v_pass) if u + v_pass > 0.0 else math.inf
-            return Verdict(False, f"no pass: oncoming car {car.gap:.0f} m ahead closes in "
-                                  f"{meet:.1f} s, pass needs {plan.time:.1f} s")
-    return Verdict(True, "")
+            return (f"no pass: oncoming car {car.gap:.0f} m ahead closes in {meet:.1f} s, "
+                    f"pass needs {plan.time:.1f} s")
+    return ""
 
 
 def _paint_reason(road: RoadMap, s0: float, s1: float, crossing_margin: float) -> str:

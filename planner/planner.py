@@ -83,7 +83,7 @@ from planner.messages import Lead, Plan, ReferencePath, SpeedSource
 from planner.motion_layer import Manoeuvre, MotionLayer, MotionLayerParams
 from planner.route import lane_path
 from planner.speed import BINDING_SOURCE, PlannedSpeed, SpeedRef
-from planner.speed_planning import SpeedPlanner, SpeedPlanningParams, SpeedTarget
+from planner.speed_planning import Binding, SpeedPlanner, SpeedPlanningParams, SpeedTarget
 from world.frames import VehicleInfo
 from world.hdmap import SHOULDER, RoadMap
 
@@ -228,6 +228,9 @@ class Planner:
             self._keep(manoeuvre.lane)
             station, lateral = self.localise(ego)
             target = self.speed_for(station)
+        if manoeuvre.speed_cap < target.speed:  # in the oncoming lane: the half-sight rule
+            target = replace(target, speed=manoeuvre.speed_cap, accel=0.0,
+                             binding=Binding.SIGHT)
         changes = self._update_source(ego, dt, view, self.near_junction(station),
                                       self._other_lane(view, manoeuvre), inp.health.camera)
         health = inp.health

@@ -8,6 +8,11 @@ Where the footprint is (`footprint`): each tyre patch, with its tread's half wid
 lane when it lies wholly inside that lane's painted lines (a tyre on the paint is on the
 line). The lanes are the route's lanes of the ego's direction at the tyre's station; after
 a flat tyre the paved shoulder counts as one more (a minimum-risk stop pulls onto it).
+Where the map paints the centre line broken (on a segment of uniform lanes), the oncoming
+lanes count too, as lanes -1, -2, ...: a pass through them is lane changes out and back,
+each bounded like any, and a stay wholly in an oncoming lane of at most
+`MAX_ONCOMING_STAY`. Across a solid centre line (what a road not painted by a map file
+has) the oncoming lanes are a departure, as ever.
 Inside a town junction (the ego's centre station between a junction's `s_enter` and
 `s_exit`) there is no paint: the tyres must stay inside the turn corridor, the route's
 lanes of the ego's direction along its turn path, edge to edge.
@@ -39,9 +44,12 @@ from avsim.criteria.base import (
 from avsim.criteria.declaration import Declaration, RunInputs
 from avsim.criteria.wording import beside, signed
 from avsim.scenario.fields import FormatModel, PosFloat
-from world.hdmap import SHOULDER, RoadMap
+from world.hdmap import SHOULDER, MarkKind, RoadMap
 
 LINE_HALF_WIDTH = 0.075  # [m] half a painted lane line: a tyre touching paint is on the line
+MAX_ONCOMING_STAY = 10.0  # [s] the longest stay wholly inside an oncoming lane: a pass draws
+#   past the vehicle it passes and returns (a 5 m van passed at 30 km/h with 8 m of room
+#   either side takes under 3 s alongside)
 
 
 @dataclass(frozen=True, slots=True)
@@ -67,10 +75,13 @@ def footprint(road: RoadMap, sample: TruthSample, half_tread: float) -> Footprin
     else:
         w, n = road.section_widths[seg], road.section_lanes[seg]
         c0 = np.asarray(road.lane(0).offset_at(s), dtype=np.float64)
-        top = c0 + (n - 0.5) * w  # the leftmost lane's left edge
+        passable = _passable(road, seg)
+        top = c0 + (n + passable - 0.5) * w  # the leftmost lane's left edge (oncoming lanes
+        #   beyond a broken centre line included)
         bottom = c0 - 0.5 * w  # lane 0's right edge
         band = np.floor((y - c0 + 0.5 * w) / w)  # the lane whose edges hold the patch centre
         lo, hi = c0 + (band - 0.5) * w, c0 + (band + 0.5) * w
+        band = np.where(band >= n, n - 1 - band, band)  # oncoming lanes -1, -2, ...
         shoulder = road.section_shoulders[seg]
     junction = any(j.s_enter <= sample.station <= j.s_exit for j in road.junctions)
     if junction:
@@ -90,6 +101,19 @@ def footprint(road: RoadMap, sample: TruthSample, half_tread: float) -> Footprin
         return Footprint(int(lanes[0]), float(margins.min()),
                          (float(right.min()), float(left.min())), False)
     return Footprint(None, float(margins.min()), (math.inf, math.inf), False)
+
+
+def _passable(road: RoadMap, seg: NDArray[np.intp]) -> NDArray[np.float64]:
+    """[-] per tyre (its segment `seg`), the oncoming lanes a pass may use: all of them
+    where the map paints the centre line broken, none where it is solid (the road's own
+    double solid yellow line when no map file paints it)."""
+    out = np.zeros(len(seg))
+    for k, i in enumerate(seg.tolist()):
+        section = road.sections[i]
+        paint = section.paint
+        if paint is not None and paint.left_edge.kind is MarkKind.BROKEN:
+            out[k] = section.oncoming_lanes
+    return out
 
 
 def _profiled_bands(road: RoadMap, s: NDArray[np.float64],
@@ -213,8 +237,18 @@ class Stay:
 
 
 def _side(change: LaneChange) -> str:
-    """The side a lane change goes to (the shoulder is right of every lane)."""
-    return "left" if change.origin is not None and change.target > change.origin else "right"
+    """The side a lane change goes to (the shoulder is right of every lane, the oncoming
+    lanes -1, -2, ... left of every lane of the ego's direction)."""
+    return "left" if change.origin is not None and _across(change.target) > _across(
+        change.origin) else "right"
+
+
+def _across(lane: int) -> int:
+    """[-] a lane's rank from right to left (oncoming lane -j after every ego lane)."""
+    return -lane + ONCOMING_RANK if SHOULDER < lane < 0 else lane
+
+
+ONCOMING_RANK = 1000  # [-] more than any road's lanes of the ego's direction
 
 
 class TyresInLane(Criterion):
@@ -238,6 +272,8 @@ class TyresInLane(Criterion):
         self.margin = math.inf  # [m] the least margin so far
         self._stay: Stay | None = None  # the lane kept now
         self._left: Stay | None = None  # the lane kept before the crossing under way
+        self._oncoming: float | None = None  # [s] since when the footprint is wholly in an
+        #   oncoming lane (None: it is not)
 
     def update(self, sample: TruthSample) -> None:
         ended = self.lanes.update(sample)
@@ -259,6 +295,20 @@ class TyresInLane(Criterion):
             assert self._stay is not None
             self._stay.add(place.sides)
         self._judge_crossings(sample, ended)
+        self._judge_oncoming(sample, place)
+
+    def _judge_oncoming(self, sample: TruthSample, place: Footprint) -> None:
+        """A stay wholly in an oncoming lane (a pass) fails once it lasts over
+        `MAX_ONCOMING_STAY`."""
+        if place.lane is None or not SHOULDER < place.lane < 0:
+            self._oncoming = None
+            return
+        if self._oncoming is None:
+            self._oncoming = sample.t
+        elif math.isfinite(self._oncoming) and sample.t - self._oncoming > MAX_ONCOMING_STAY:
+            self._oncoming = -math.inf  # failed once for this stay
+            self._fail(sample, f"in the oncoming lane {place.lane} for over "
+                               f"{MAX_ONCOMING_STAY:g} s")
 
     def _open(self, ended: LaneChange | Crossing | None) -> None:
         """A new stay in a lane, after a lane change, a crossing back, or neither."""

@@ -77,17 +77,36 @@ def _segment_spec(segment: SegmentModel, road: RoadModel) -> spec.SegmentSpec:
     else:
         length, curvature = float(given_or(segment.straight, 0.0)), 0.0
     limit = segment.speed_limit_kph
+    lanes = given_or(segment.lanes, road.lanes)
+    oncoming = given_or(segment.oncoming_lanes, road.oncoming_lanes)
     return spec.SegmentSpec(
         length=length,
         curvature=curvature,
-        lanes=given_or(segment.lanes, road.lanes),
-        oncoming_lanes=given_or(segment.oncoming_lanes, road.oncoming_lanes),
+        lanes=lanes,
+        oncoming_lanes=oncoming,
         lane_width=road.lane_width,
         shoulder=given_or(segment.shoulder, road.shoulder),
         speed_limit=None if limit is None else _kph(limit),
         zone=None if segment.zone is None else hdmap.Zone(segment.zone),
         exit=None if segment.exit is None else hdmap.Side(segment.exit),
+        paint=_broken_centre(lanes, oncoming) if road.centre_line == "broken" else None,
     )
+
+
+PAINT_WIDTH = 0.15  # [m] a painted line's width (`world.scene.road_mesh.LINE_WIDTH`)
+
+
+def _broken_centre(lanes: int, oncoming: int) -> hdmap.LinePaint | None:
+    """The paint of a road whose centre line is one broken yellow line: the road's own
+    lines otherwise (solid white edges, broken white between lanes); None without oncoming
+    lanes (no centre line)."""
+    if oncoming == 0:
+        return None
+    solid = hdmap.LineMark(hdmap.MarkKind.SOLID, PAINT_WIDTH)
+    broken = hdmap.LineMark(hdmap.MarkKind.BROKEN, PAINT_WIDTH)
+    centre = hdmap.LineMark(hdmap.MarkKind.BROKEN, PAINT_WIDTH, hdmap.PaintColour.YELLOW)
+    return hdmap.LinePaint(solid, (broken,) * (lanes - 1), centre,
+                           (broken,) * (oncoming - 1) + (solid,))
 
 
 def _feature_spec(feature: FeatureModel) -> spec.FeatureSpec:

@@ -290,6 +290,12 @@ class RoadModel(FormatModel):
     shoulder: b.Shoulder = Field(
         default=2.5, description="[m] paved right shoulder, >= 0. Default 2.5."
     )
+    centre_line: Literal["solid", "broken"] = Field(
+        default="solid",
+        description="The centre line between the two directions: solid (a double solid "
+        "yellow line, which may not be crossed) | broken (one broken yellow line: a pass "
+        "through the oncoming lane is allowed). Default solid.",
+    )
     speed_limit_kph: b.PosSpeed = Field(description="[km/h] limit posted at s = 0; required, > 0.")
     segments: list[SegmentModel] = Field(
         min_length=1, max_length=b.MAX_SEGMENTS,

@@ -11,7 +11,9 @@ vehicle approaching from behind in the target lane need not brake harder than 3 
 so guards every lateral move: a pass, a flat tyre's pull-over, a route change before an exit,
 keeping right), whether a pass path to either side would clear the vehicle ahead, the
 lanes the route needs the car to move, the route's turn at a junction, a flat tyre's
-pull-over, and the progress of the manoeuvre in hand.
+pull-over, whether a pass through the oncoming lane is safe (`planner.oncoming_pass`),
+whether the car keeps the oncoming lane and may take its own lane back, and the progress of
+the manoeuvre in hand.
 
 A lane change is *committed* once the car's centre is inside the target lane: before that,
 a target lane that stops being free aborts the change (a change to LANE_KEEP before the
@@ -20,38 +22,51 @@ change is done, back to the origin lane); after it, finishing is the safer way o
 Transitions (`TABLE`, as data). For the state the car is in, the rows that leave it are
 tried in this order and the first that holds is taken:
 
-1. lane_keep -> lane_change_right: a flat tyre: pull over (right lane, then shoulder), once
+1. lane_keep -> lane_change_right: back from the oncoming lane as soon as the own lane may
+   be taken: the vehicle passed is a safe gap behind, or the pass became unsafe before the
+   car drew alongside it (no `keep_time`)
+2. lane_keep -> lane_change_right: a flat tyre: pull over (right lane, then shoulder), once
    `route_keep_time` has passed and the lane to the right is free
-2. lane_keep -> turn_right: the route turns right at the junction being entered
-3. lane_keep -> turn_left: the route turns left there
-4. lane_keep -> u_turn: the route turns back there
-5. lane_keep -> lane_change_right: the route needs a lane to the right and it is free
-6. lane_keep -> lane_change_left: the route needs a lane to the left and it is free
-7. lane_keep -> lane_change_left: overtaking allowed, the lane blocked, the left free and a
+3. lane_keep -> turn_right: the route turns right at the junction being entered
+4. lane_keep -> turn_left: the route turns left there
+5. lane_keep -> u_turn: the route turns back there
+6. lane_keep -> lane_change_right: the route needs a lane to the right and it is free
+7. lane_keep -> lane_change_left: the route needs a lane to the left and it is free
+8. lane_keep -> lane_change_left: overtaking allowed, the lane blocked, the left free and a
    pass path into it clears the vehicle ahead, `keep_time` since the last change, and the
    route needs no other lane
-8. lane_keep -> lane_change_right: overtaking allowed, the lane blocked, only the right free
+9. lane_keep -> lane_change_right: overtaking allowed, the lane blocked, only the right free
    and clearing (as above)
-9. lane_keep -> lane_change_right: keep right: overtaking allowed, the lane not blocked, the
-   right free and clear (nothing slower ahead in it to block it), `keep_time` since the last
-   change, and the route needs no other lane
-10. lane_change_left, lane_change_right -> lane_keep: the change is done (in the target
+10. lane_keep -> lane_change_left: overtaking allowed, the lane blocked, the only way past
+    the oncoming lane and a pass through it safe (`planner.oncoming_pass`) on a path that
+    clears the vehicle ahead, `keep_time` since the last change, and the route needs no
+    other lane
+11. lane_keep -> lane_change_right: keep right: overtaking allowed, the lane not blocked,
+    the right free and clear (nothing slower ahead in it to block it), `keep_time` since the
+    last change, and the route needs no other lane
+12. lane_change_left, lane_change_right -> lane_keep: the change is done (in the target
     lane)
-11. lane_change_left, lane_change_right -> lane_keep: abort: the target lane is no longer
+13. lane_change_left, lane_change_right -> lane_keep: abort: the target lane is no longer
     free, not yet committed
-12. turn_right, turn_left, u_turn -> lane_keep: the turn is done (in the exit lane)
+14. turn_right, turn_left, u_turn -> lane_keep: the turn is done (in the exit lane)
 
-A flat tyre comes first and stops everything else out of LANE_KEEP: the car moves right
-lane by lane (`right_free` then means the next lane, or the paved shoulder from lane 0) and
-stays on the shoulder. Then the route's turns, then its lane needs, then overtaking, then
-keeping right: where the driver lets the car change lanes to pass, it goes back to the
-right once that lane is free and clear (no slower vehicle ahead in it within the ACC's
-d_max, which would make it pass again). A blocked lane is passed also from a standstill
-behind a stopped vehicle: `blocked` does not ask that the vehicle ahead moves, only that it
-is slower than wanted; while no side is free, or a pass path would not clear it, the car
-waits in its lane (the ACC stops it behind that vehicle) and goes once both hold.
-Overtaking and keeping right wait `keep_time` after the last change (no weaving); a route
-lane change waits `route_keep_time` only.
+In the oncoming lane (after a pass through it on a road with one lane each way) nothing
+but the way back is taken, and it is taken as soon as it may be: the car never stays there
+longer than needed. A change into the oncoming lane is committed once the car has drawn
+alongside the vehicle it passes (before that, an oncoming vehicle that makes the pass unsafe
+aborts it: back behind the vehicle).
+
+A flat tyre comes first among the rest and stops everything else out of LANE_KEEP: the car
+moves right lane by lane (`right_free` then means the next lane, or the paved shoulder from
+lane 0) and stays on the shoulder. Then the route's turns, then its lane needs, then
+overtaking, then keeping right: where the driver lets the car change lanes to pass, it goes
+back to the right once that lane is free and clear (no slower vehicle ahead in it within the
+ACC's d_max, which would make it pass again). A blocked lane is passed also from a
+standstill behind a stopped vehicle: `blocked` does not ask that the vehicle ahead moves,
+only that it is slower than wanted; while no side is free, or a pass path would not clear
+it, the car waits in its lane (the ACC stops it behind that vehicle) and goes once both
+hold. Overtaking and keeping right wait `keep_time` after the last change (no weaving); a
+route lane change waits `route_keep_time` only.
 """
 
 from __future__ import annotations
@@ -109,6 +124,11 @@ class MotionInput:
     turn: Turn | None = None  # the route's command at the junction being entered
     turn_done: bool = False  # the turn's path is finished
     pull_over: bool = False  # a flat tyre: get onto the shoulder
+    oncoming_pass: bool = False  # the only way past is the oncoming lane, a pass through it
+    #   is safe now (`planner.oncoming_pass`) and its path clears the vehicle ahead
+    in_oncoming: bool = False  # the car keeps the oncoming lane (a pass under way)
+    back_free: bool = False  # ... and may take its own lane back: the vehicle passed is a
+    #   safe gap behind, or the pass became unsafe before the car drew alongside it
 
 
 def _waited(x: MotionInput) -> float:
@@ -122,8 +142,13 @@ def _route_holds(x: MotionInput, p: MotionParams) -> bool:
 
 
 def _free_to_choose(x: MotionInput) -> bool:
-    """No flat tyre and no turn: the route and overtaking may move the car."""
-    return not x.pull_over and x.turn is None
+    """No flat tyre, no turn, not in the oncoming lane: the route and overtaking may move
+    the car."""
+    return not x.pull_over and x.turn is None and not x.in_oncoming
+
+
+def _back_from_oncoming(_m: Motion, x: MotionInput, _p: MotionParams) -> bool:
+    return x.in_oncoming and x.back_free
 
 
 def _pull_over(_m: Motion, x: MotionInput, p: MotionParams) -> bool:
@@ -159,6 +184,10 @@ def _overtake_right(_m: Motion, x: MotionInput, p: MotionParams) -> bool:
     return _may_overtake(x, p) and x.right_free and x.clears_right
 
 
+def _overtake_oncoming(_m: Motion, x: MotionInput, p: MotionParams) -> bool:
+    return _may_overtake(x, p) and x.oncoming_pass
+
+
 def _keep_right(_m: Motion, x: MotionInput, p: MotionParams) -> bool:
     return (_free_to_choose(x) and not _route_holds(x, p) and x.overtake and not x.blocked
             and x.right_free and x.right_clear and _waited(x) >= p.keep_time)
@@ -180,6 +209,10 @@ M = Motion
 _KEEP = frozenset({M.LANE_KEEP})
 
 TABLE: Table[Motion, MotionInput, MotionParams] = Table(Motion, (
+    Row(_KEEP, M.LANE_CHANGE_RIGHT, _back_from_oncoming,
+        "back from the oncoming lane as soon as the own lane may be taken: the vehicle "
+        "passed is a safe gap behind, or the pass became unsafe before the car drew "
+        "alongside it (no `keep_time`)", "back from the oncoming lane"),
     Row(_KEEP, M.LANE_CHANGE_RIGHT, _pull_over,
         "a flat tyre: pull over (right lane, then shoulder), once `route_keep_time` has "
         "passed and the lane to the right is free", "a flat tyre: pull over"),
@@ -203,6 +236,11 @@ TABLE: Table[Motion, MotionInput, MotionParams] = Table(Motion, (
     Row(_KEEP, M.LANE_CHANGE_RIGHT, _overtake_right,
         "overtaking allowed, the lane blocked, only the right free and clearing (as above)",
         "a slower vehicle ahead, only the right lane free"),
+    Row(_KEEP, M.LANE_CHANGE_LEFT, _overtake_oncoming,
+        "overtaking allowed, the lane blocked, the only way past the oncoming lane and a "
+        "pass through it safe (`planner.oncoming_pass`) on a path that clears the vehicle "
+        "ahead, `keep_time` since the last change, and the route needs no other lane",
+        "a slower vehicle ahead, a pass through the oncoming lane is safe"),
     Row(_KEEP, M.LANE_CHANGE_RIGHT, _keep_right,
         "keep right: overtaking allowed, the lane not blocked, the right free and clear "
         "(nothing slower ahead in it to block it), `keep_time` since the last change, and the "
@@ -222,7 +260,8 @@ def transition(state: Motion, x: MotionInput, p: MotionParams) -> Transition[Mot
     return next_state(TABLE, state, x, p)
 
 
-PASSES = frozenset({_overtake_left, _overtake_right})  # the rows' guards of a change to pass
+PASSES = frozenset({_overtake_left, _overtake_right, _overtake_oncoming})  # the rows' guards
+#   of a change to pass
 
 
 def is_pass(state: Motion, x: MotionInput, p: MotionParams) -> bool:

@@ -14,6 +14,7 @@ from avsim.criteria.base import CriterionResult, TruthSample, Verdict
 from avsim.criteria.following import StandstillGap, TimeToResume
 from avsim.criteria.lane import (
     LINE_HALF_WIDTH,
+    MAX_ONCOMING_STAY,
     LaneChangeDuration,
     LaneChangeLateralAccel,
     TyresInLane,
@@ -22,8 +23,18 @@ from tests.roads import SHOULDER, W, make_map, seg
 from tests.vehicle import CAR
 from world.actors.actor_set import ActorPoses
 from world.frames import MPS_PER_KPH as KPH
-from world.hdmap import Control, Junction, Manoeuvre, RoadMap
-from world.spec import ActorType
+from world.hdmap import (
+    Control,
+    Junction,
+    LineMark,
+    LinePaint,
+    Manoeuvre,
+    MarkKind,
+    PaintColour,
+    RoadMap,
+)
+from world.map.road import build_road_map
+from world.spec import ActorType, RoadSpec, SegmentSpec
 
 ROAD = make_map(seg(1000.0))  # lane 0 centred on offset 0, lane 1 on W; 50 km/h
 TYRE = CAR.tyre_width / 2  # [m] tyre half width (the URDF car's)
@@ -341,3 +352,41 @@ def test_a_lane_changes_own_lines_do_not_count_against_its_margin() -> None:
     hug = -IN_LANE + 0.05  # the right tyres 0.05 m from lane 0's right line
     r = judge(hug, 0.7, W / 2, W, every=0.5)
     assert r.passed and r.value == pytest.approx(0.05)
+
+
+def _one_each_way(centre: MarkKind | None) -> RoadMap:
+    """A straight 1 + 1 road whose centre line is painted `centre` (None: the road's own
+    double solid yellow line)."""
+    paint = None if centre is None else LinePaint(
+        LineMark(MarkKind.SOLID, 0.15), (), LineMark(MarkKind.BROKEN, 0.15, PaintColour.YELLOW)
+        if centre is MarkKind.BROKEN else LineMark(MarkKind.SOLID, 0.15, PaintColour.YELLOW),
+        (LineMark(MarkKind.SOLID, 0.15),))
+    segment = SegmentSpec(length=1000.0, curvature=0.0, lanes=1, oncoming_lanes=1,
+                          lane_width=W, shoulder=1.0, paint=paint)
+    return build_road_map(RoadSpec(segments=(segment,), speed_limit=30.0 * KPH))
+
+
+def test_a_pass_through_the_oncoming_lane_beyond_a_broken_centre_line_is_lane_changes(
+) -> None:
+    """Out into the oncoming lane (-1), a stay in it, and back: two lane changes, inside a
+    lane's lines all along; the same path across a solid centre line is a departure."""
+    path = (0.0, W / 2, W, W, W, W / 2, 0.0)
+    r = judge(*path, road=_one_each_way(MarkKind.BROKEN))
+    assert r.passed and r.value == pytest.approx(IN_LANE)
+    c = TyresInLane(_one_each_way(MarkKind.BROKEN), TYRE, 8.0)
+    for k, d in enumerate(path):
+        c.update(truth(float(k), d))
+    assert [(x.origin, x.target) for x in c.lanes.changes] == [(0, -1), (-1, 0)]
+    for centre in (None, MarkKind.SOLID):
+        r = judge(*path, road=_one_each_way(centre))
+        assert not r.passed and r.first_failure == 1.0
+
+
+def test_a_stay_in_the_oncoming_lane_is_bounded() -> None:
+    """A pass draws past and returns: over MAX_ONCOMING_STAY wholly in the oncoming lane
+    fails, once, when it runs over."""
+    road = _one_each_way(MarkKind.BROKEN)
+    n = int(MAX_ONCOMING_STAY) + 2
+    r = judge(0.0, W / 2, *[W] * n, W / 2, 0.0, road=road)
+    assert not r.passed and r.first_failure == 2.0 + MAX_ONCOMING_STAY + 1.0
+    assert judge(0.0, W / 2, *[W] * (n - 2), W / 2, 0.0, road=road).passed

@@ -572,3 +572,21 @@ def test_a_file_over_its_size_bound_is_refused_unread(tmp_path: Path) -> None:
     path = _write(tmp_path, MINIMAL + "# " + "x" * 600_000 + "\n")
     with pytest.raises(ScenarioError, match=r"\(file\): over 524288 bytes: at most 524288$"):
         load_scenario(path)
+
+
+def test_a_broken_centre_line_paints_the_road_for_a_pass() -> None:
+    """`centre_line: broken` paints one broken yellow centre line (the planner's pass and
+    tyres_in_lane read it); the default keeps the road's own double solid line (no paint)."""
+    from world.hdmap import MarkKind, PaintColour
+
+    segment = load_scenario("overtake_two_lane").world.road.segments[0]
+    assert segment.paint is not None
+    assert segment.paint.left_edge.kind is MarkKind.BROKEN
+    assert segment.paint.left_edge.colour is PaintColour.YELLOW
+    plain = load_scenario("overtake_two_lane", {"road.centre_line": "solid"})
+    assert plain.world.road.segments[0].paint is None
+
+
+def test_a_centre_line_of_another_kind_is_refused() -> None:
+    error = _error("overtake_two_lane", {"road.centre_line": "dotted"})
+    assert error.key == "road.centre_line" and "solid" in error.problem

@@ -93,9 +93,35 @@ TABLE_CASES = [
      x(route_lane=1, right_free=True, right_clear=True), None, False),
     ("keep_right_not_while_pulling_over_elsewhere", M.LANE_KEEP,
      x(turn=Turn.LEFT, right_free=True, right_clear=True), M.TURN_LEFT, False),
+    # LANE_KEEP -> a pass through the oncoming lane (a road with one lane each way)
+    ("keep_overtake_oncoming", M.LANE_KEEP, x(blocked=True, oncoming_pass=True),
+     M.LANE_CHANGE_LEFT, False),
+    ("keep_oncoming_waits_until_it_is_safe", M.LANE_KEEP, x(blocked=True), None, False),
+    ("keep_oncoming_only_when_blocked", M.LANE_KEEP, x(oncoming_pass=True), None, False),
+    ("keep_oncoming_waits_keep_time", M.LANE_KEEP,
+     x(since=T - 2.0, blocked=True, oncoming_pass=True), None, False),
+    ("keep_oncoming_not_allowed", M.LANE_KEEP,
+     x(overtake=False, blocked=True, oncoming_pass=True), None, False),
+    ("keep_oncoming_after_a_lane_beside", M.LANE_KEEP,
+     x(blocked=True, left_free=True, oncoming_pass=True), M.LANE_CHANGE_LEFT, False),
+    # LANE_KEEP in the oncoming lane -> back into the own lane at once, nothing else
+    ("oncoming_back", M.LANE_KEEP, x(in_oncoming=True, back_free=True), M.LANE_CHANGE_RIGHT,
+     False),
+    ("oncoming_back_needs_no_keep_time", M.LANE_KEEP,
+     x(since=T - 0.1, in_oncoming=True, back_free=True), M.LANE_CHANGE_RIGHT, False),
+    ("oncoming_back_before_a_flat_tyre", M.LANE_KEEP,
+     x(in_oncoming=True, back_free=True, pull_over=True, right_free=True),
+     M.LANE_CHANGE_RIGHT, False),
+    ("oncoming_stays_until_back_is_free", M.LANE_KEEP, x(in_oncoming=True), None, False),
+    ("oncoming_no_other_pass", M.LANE_KEEP,
+     x(in_oncoming=True, blocked=True, left_free=True, oncoming_pass=True), None, False),
+    ("oncoming_no_keep_right_row", M.LANE_KEEP,
+     x(in_oncoming=True, right_free=True, right_clear=True), None, False),
     # LANE_CHANGE_* -> LANE_KEEP
     ("left_done", M.LANE_CHANGE_LEFT, x(change_done=True), M.LANE_KEEP, False),
     ("left_abort", M.LANE_CHANGE_LEFT, x(target_free=False), M.LANE_KEEP, True),
+    ("oncoming_abort_before_alongside", M.LANE_CHANGE_LEFT,
+     x(target_free=False, oncoming_pass=True), M.LANE_KEEP, True),
     ("left_committed_no_abort", M.LANE_CHANGE_LEFT, x(target_free=False, committed=True), None,
      False),
     ("left_stays", M.LANE_CHANGE_LEFT, x(blocked=True, left_free=True), None, False),
@@ -154,6 +180,8 @@ def test_every_transition_of_the_table_has_a_row() -> None:
 @pytest.mark.parametrize(("state", "inp", "passing"), [
     (M.LANE_KEEP, x(blocked=True, left_free=True), True),  # overtake left
     (M.LANE_KEEP, x(blocked=True, right_free=True), True),  # overtake right
+    (M.LANE_KEEP, x(blocked=True, oncoming_pass=True), True),  # through the oncoming lane
+    (M.LANE_KEEP, x(in_oncoming=True, back_free=True), False),  # back from it
     (M.LANE_KEEP, x(route_lane=-1, right_free=True), False),  # the route's change
     (M.LANE_KEEP, x(pull_over=True, right_free=True), False),  # a flat tyre's
     (M.LANE_KEEP, x(right_free=True, right_clear=True), False),  # keeping right
