@@ -22,6 +22,10 @@ comfort and emergency limits are stated once:
 - `A_FLAT`: the most a flat tyre's stop may plan (the DECS acceptance);
 - `A_EMERGENCY`: the emergency stop; the plan asks for it as its feed-forward and control
   applies what the plan asks.
+
+And the one distance every braking plan ahead must fit in: `SIGHT`, the bumper gap [m] at
+which the forward LiDAR's track of a car is confirmed (`PlannerParams.sight_range`, the
+speed cap; `PassParams.sight`, a pass through the oncoming lane).
 """
 
 from __future__ import annotations
@@ -40,3 +44,4 @@ A_HARD = 5.0  # [m/s^2] hard
 A_FLAT = 4.0  # [m/s^2] DECS's acceptance for a flat tyre (UN R157's bound on a minimum-risk
 #   manoeuvre is the same)
 A_EMERGENCY = 8.0  # [m/s^2] near the tyres' grip (mu g, mu ~ 1)
+SIGHT = 55.0  # [m] the forward sensing's confirmed sight of a car (module doc)

@@ -48,6 +48,7 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+from planner.limits import SIGHT
 from world.hdmap import Crosswalk, MarkKind, RoadMap
 
 
@@ -61,7 +62,7 @@ class PassParams:
     margin: float = 20.0  # [m] added to the distance that must be free
     min_closing: float = 2.0  # [m/s] a pass needs the car this much faster than the vehicle
     crossing_margin: float = 20.0  # [m] no pass ends within this before a marked crossing
-    sight: float = 55.0  # [m] how far ahead the tracks show a vehicle
+    sight: float = SIGHT  # [m] how far ahead the tracks show a vehicle
     #   (`planner.planner.PlannerParams.sight_range`)
     t_react: float = 1.0  # [s] reaction time of the stopping distance (both drivers)
     a_stop: float = 6.0  # [m/s^2] deceleration of the stopping distance (both drivers)

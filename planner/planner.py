@@ -78,7 +78,7 @@ from planner.lead import (
     map_bend,
     route_candidates,
 )
-from planner.limits import A_EMERGENCY
+from planner.limits import A_EMERGENCY, SIGHT
 from planner.messages import Lead, Plan, ReferencePath, SpeedSource
 from planner.motion_layer import Manoeuvre, MotionLayer, MotionLayerParams
 from planner.route import lane_path
@@ -115,7 +115,7 @@ class PlannerParams:
     camera_agree: float = 1.0  # [m] the camera's lane is used only within this of the map's
     junction_before: float = 10.0  # [m] before a town junction's stop line ...
     junction_after: float = 15.0  # [m] ... to after its exit, the map's path is followed
-    sight_range: float = 55.0  # [m] the bumper gap at which the forward LiDAR's track of a
+    sight_range: float = SIGHT  # [m] the bumper gap at which the forward LiDAR's track of a
     #   car ahead is confirmed (measured: 53 m; its lowest ring that clears the ground meets
     #   a car's rear too low beyond about 72 m, `perception.objects.DetectorParams.roi_x`,
     #   and nearer than that one ring's few returns are found in too few scans); the speed
