@@ -201,6 +201,10 @@ class _Comfort(Criterion):
     def _measure(self, decel: Signal | None, jerk: Signal | None) -> Signal | None:
         raise NotImplementedError
 
+    def after_judging(self, sample: TruthSample) -> None:
+        """The contact spans go on (the note shows where they ended)."""
+        self.impulses.update(sample)
+
     def update(self, sample: TruthSample) -> None:
         self.impulses.update(sample)
         decel, short, jerk = self.signals.push(sample.t, sample.speed)

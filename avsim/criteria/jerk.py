@@ -53,6 +53,10 @@ class MaxJerk(Criterion):
         #   [s] t_(i-1): its first speed's time)
         self.impulses = ImpulseSpans()
 
+    def after_judging(self, sample: TruthSample) -> None:
+        """The contact spans go on (the note shows where they ended)."""
+        self.impulses.update(sample)
+
     def update(self, sample: TruthSample) -> None:
         self.impulses.update(sample)
         last, self._last = self._last, (sample.t, sample.speed)

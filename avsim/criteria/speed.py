@@ -71,6 +71,10 @@ class MaxDecel(Criterion):
         self.peak = 0.0  # [m/s^2] the largest deceleration so far
         self.impulses = ImpulseSpans()
 
+    def after_judging(self, sample: TruthSample) -> None:
+        """The contact spans go on (the note shows where they ended)."""
+        self.impulses.update(sample)
+
     def update(self, sample: TruthSample) -> None:
         self.impulses.update(sample)
         self._speeds.append((sample.t, sample.speed))

@@ -8,11 +8,13 @@ Then one closed-loop run of an UN R157 cut-in grid point with an unavoidable con
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
+from typing import TypeVar
 
 import numpy as np
 import pytest
 
-from avsim.criteria.base import Criterion, TruthSample, Verdict
+from avsim.criteria.base import CriteriaSet, Criterion, CriterionResult, TruthSample, Verdict
 from avsim.criteria.comfort import ComfortDecel, ComfortJerk, peaks
 from avsim.criteria.impulse import SETTLE, ImpulseSpans, describe, meets
 from avsim.criteria.jerk import MaxJerk
@@ -33,6 +35,7 @@ HIT = 6.0  # [s] the contact onset
 TOUCH = 0.2  # [s] the bodies touch this long
 DROP = 6.0  # [m/s] the speed the contact takes, over two samples
 BODY = 7
+C = TypeVar("C", Criterion, CriteriaSet)
 
 
 def trace(rate: float = RATE, hit: bool = True) -> list[tuple[float, float, bool]]:
@@ -56,7 +59,7 @@ def no_actors() -> ActorPoses:
                       offsets=np.zeros(0), speeds=np.zeros(0), accels=np.zeros(0))
 
 
-def feed(criterion: Criterion, hidden: bool = False, hit: bool = True) -> Criterion:
+def feed(criterion: C, hidden: bool = False, hit: bool = True) -> C:
     """`criterion` fed the struck trace (`hit`: else the same braking unstruck); `hidden`:
     the contact not in the samples (what the measure would show without the contact
     spans)."""
@@ -160,3 +163,26 @@ def test_an_unavoidable_cut_in_contact_is_counted_passed_and_braking_plausible()
     assert "TTC at lane intrusion" in contact.note and "<= bound 1.28 s" in contact.note
     assert result.metrics["max_decel_with_contact"] > 15.0  # the blow
     assert result.metrics["max_decel"] < 15.0  # the car's own braking
+
+
+class _Ender(Criterion):
+    """Ends the judging at the contact onset (as an excused contact does)."""
+
+    name, unit = "ender", ""
+
+    def update(self, sample: TruthSample) -> None:
+        if sample.touching:
+            self.ends_judging = "the contact"
+
+    def result(self) -> CriterionResult:
+        return CriterionResult(self.name, True, 0.0, None, self.unit)
+
+
+@pytest.mark.parametrize("make", [lambda: MaxDecel(5.0, RATE), lambda: MaxJerk(10.0),
+                                  lambda: ComfortDecel(ROAD, EGO_LENGTH)])
+def test_the_span_is_followed_after_the_judging_ended(make: Callable[[], Criterion]) -> None:
+    """The judging ends at the onset, the spans are still followed: the note gives where
+    the impulse really ended, not the run's end."""
+    criterion = make()
+    feed(CriteriaSet([_Ender(), criterion]))
+    assert (criterion.result().note or "").startswith("contact impulse left out: 6.00-6.70 s")
