@@ -486,7 +486,7 @@ def _sweep_report(outcomes: Sequence[RunOutcome], out: Path, swept: list[str],
     """sweep.csv and sweep.md over every parameter; heatmap.png when two keys were swept."""
     from avsim.report.sweep import heat_map, sweep_csv, sweep_markdown, sweep_rows
 
-    metrics = sorted({metric, "min_gap", "max_decel", "collisions"})
+    metrics = sorted({metric, "min_gap", "max_decel", "collisions", "collisions_excused"})
     rows = sweep_rows(outcomes, params, metrics)
     write_atomic(out / "sweep.csv", sweep_csv(rows))
     write_atomic(out / "sweep.md", sweep_markdown(rows))

@@ -14,6 +14,7 @@ the ICCAS normal-driving rule (tyres must not leave the lane).
 
 from __future__ import annotations
 
+import dataclasses
 import enum
 import math
 from dataclasses import dataclass, field
@@ -119,8 +120,9 @@ class CriterionResult:
     threshold: float | None  # [unit]; None: none (a limit that depends on what was met)
     unit: str  # the unit of value and threshold
     first_failure: float | None = None  # [s] sim time it first failed, if it did
-    note: str | None = None  # why it failed when the value does not say, or what never
-    #   happened (not applicable)
+    note: str | None = None  # why it failed when the value does not say, what never
+    #   happened (not applicable), or what qualifies a verdict (a contact a rule excuses,
+    #   samples left out, the judging ended early)
 
     def __post_init__(self) -> None:
         for what, x in (("value", self.value), ("threshold", self.threshold)):
@@ -175,6 +177,12 @@ def judged_so_far(results: list[CriterionResult], t: float,
             for r in results]
 
 
+def _noted(result: CriterionResult, note: str) -> CriterionResult:
+    """`result` with `note` after its own note."""
+    both = note if result.note is None else f"{result.note}; {note}"
+    return dataclasses.replace(result, note=both)
+
+
 def _round(x: float | None) -> float | None:
     """x to 4 decimals (no -0.0); None as it is."""
     return None if x is None else round(x, 4) + 0.0
@@ -198,6 +206,11 @@ class Criterion:
     def update(self, sample: TruthSample) -> None:
         """Watch one sample."""
         raise NotImplementedError
+
+    def after_judging(self, sample: TruthSample) -> None:
+        """Watch one sample after the judging of the run has ended (`CriteriaSet`): not
+        judged, but a criterion may keep counting what the run's metrics report (every
+        contact). Nothing by default."""
 
     def result(self) -> CriterionResult:
         """The verdict on the samples seen."""
@@ -229,7 +242,8 @@ class CriteriaSet:
     """All criteria of a run; `verdict` is their conjunction. A criterion may end the
     judging (`Criterion.ends_judging`: a collision UN R157 labels unavoidable, whose
     aftermath, the car pushed across the lane, is no behaviour of the stack's): from then
-    on no criterion sees a sample, and the results are those judged until then."""
+    on no criterion judges a sample (each still sees it through `after_judging`), and the
+    results are those judged until then, each of the others' verdicts noted so."""
 
     items: list[Criterion] = field(default_factory=list)
     needs: frozenset[Need] = frozenset()  # what the samples must carry for them
@@ -238,6 +252,8 @@ class CriteriaSet:
     def update(self, sample: TruthSample) -> list[Infraction]:
         """Every criterion sees the sample; the infractions it brought, in criteria order."""
         if self.ended is not None:
+            for c in self.items:
+                c.after_judging(sample)
             return []
         for c in self.items:
             c.update(sample)
@@ -250,10 +266,13 @@ class CriteriaSet:
     def results(self) -> list[CriterionResult]:
         """Every criterion's result, in the set's order."""
         results = [c.result() for c in self.items]
-        if self.ended is not None:
-            t, why = self.ended
-            return judged_so_far(results, t, f"judging ended with {why}")
-        return results
+        if self.ended is None:
+            return results
+        t, why = self.ended
+        judged = judged_so_far(results, t, f"judging ended with {why}")
+        return [r if r.passed is None or c.ends_judging is not None else
+                _noted(r, f"judged until {t:.2f} s: judging ended with {why}")
+                for c, r in zip(self.items, judged, strict=True)]
 
     def find(self, kind: type[C]) -> C:
         """The set's criterion of class `kind` (the first, if there are several)."""

@@ -16,6 +16,11 @@ off unless set). Two criteria, on the ego's true forward speed at the criteria r
 Each window uses the newest sample at least its span back, so an extra sample (the runner
 samples at each contact onset too) does not bend it.
 
+A value whose speeds meet a contact's impulse (`avsim.criteria.impulse`: from the onset
+until 0.5 s after the bodies part) is left out, of the criteria and of the run's `peaks`
+alike, and the criteria's notes say so: a collision's momentum, not the brakes, changes the
+speed then.
+
 Excused (the truth shows no comfortable solution): from the first sample at which no
 braking within both limits stops the ego's closing on a vehicle ahead in its lane before
 a bumper gap of `D_STOP` -- against that vehicle's speed now, and, while it brakes (b_l its
@@ -43,7 +48,9 @@ from __future__ import annotations
 
 import math
 from collections import deque
-from typing import Literal
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Generic, Literal, TypeVar
 
 import numpy as np
 from numpy.typing import NDArray
@@ -51,6 +58,7 @@ from numpy.typing import NDArray
 from avsim.criteria.base import Criterion, CriterionResult, Need, TruthSample
 from avsim.criteria.declaration import Declaration
 from avsim.criteria.following import ahead_of
+from avsim.criteria.impulse import ImpulseSpans, meets
 from avsim.criteria.wording import beside
 from world.hdmap import RoadMap
 
@@ -102,14 +110,17 @@ def comfortable_solution(speed: float, gap: float, lead_speed: float, lead_accel
     return True
 
 
-class _Window:
+V = TypeVar("V")
+
+
+class _Window(Generic[V]):
     """The newest (t, value) at least `span` [s] before the latest one."""
 
     def __init__(self, span: float) -> None:
         self.span = span
-        self.items: deque[tuple[float, float]] = deque()
+        self.items: deque[tuple[float, V]] = deque()
 
-    def push(self, t: float, value: float) -> tuple[float, float] | None:
+    def push(self, t: float, value: V) -> tuple[float, V] | None:
         """Add (t, value); the sample `span` back, or None until the window has filled."""
         self.items.append((t, value))
         while len(self.items) > 1 and t - self.items[1][0] >= self.span - SPAN_TOLERANCE:
@@ -118,40 +129,55 @@ class _Window:
         return (t0, v0) if t - t0 >= self.span - SPAN_TOLERANCE else None
 
 
+@dataclass(frozen=True, slots=True)
+class Signal:
+    """A comfort value and the time of the first speed it was taken from."""
+
+    value: float  # [m/s^2] or [m/s^3]
+    since: float  # [s] its window's first speed sample
+
+
 class ComfortSignals:
     """The 2 s deceleration and the braking jerk of a speed trace, sample by sample."""
 
     def __init__(self) -> None:
-        self._decel = _Window(DECEL_WINDOW)
-        self._short = _Window(ACCEL_WINDOW)
-        self._jerk = _Window(JERK_WINDOW)
+        self._decel: _Window[float] = _Window(DECEL_WINDOW)
+        self._short: _Window[float] = _Window(ACCEL_WINDOW)
+        self._jerk: _Window[Signal] = _Window(JERK_WINDOW)
 
-    def push(self, t: float, speed: float) -> tuple[float | None, float | None, float | None]:
+    def push(self, t: float, speed: float) -> tuple[Signal | None, Signal | None,
+                                                    Signal | None]:
         """([m/s^2] 2 s deceleration, [m/s^2] 0.5 s deceleration, [m/s^3] the rise of the
-        latter's braking part over 1 s) at time t [s] and speed [m/s]; None until each
-        window has filled."""
+        latter's braking part over 1 s), each with its first speed's time, at time t [s]
+        and speed [m/s]; None until each window has filled."""
         back = self._decel.push(t, speed)
-        decel = (back[1] - speed) / (t - back[0]) if back is not None and t > back[0] else None
+        decel = Signal((back[1] - speed) / (t - back[0]), back[0]) \
+            if back is not None and t > back[0] else None
         short_back = self._short.push(t, speed)
         if short_back is None or t <= short_back[0]:
             return decel, None, None
-        short = (short_back[1] - speed) / (t - short_back[0])
+        short = Signal((short_back[1] - speed) / (t - short_back[0]), short_back[0])
         jerk_back = self._jerk.push(t, short)
-        jerk = (max(short, 0.0) - max(jerk_back[1], 0.0)) / (t - jerk_back[0]) \
+        jerk = Signal((max(short.value, 0.0) - max(jerk_back[1].value, 0.0))
+                      / (t - jerk_back[0]), jerk_back[1].since) \
             if jerk_back is not None and t > jerk_back[0] else None
         return decel, short, jerk
 
 
-def peaks(t: NDArray[np.float64], speed: NDArray[np.float64]) -> dict[str, float]:
+def peaks(t: NDArray[np.float64], speed: NDArray[np.float64],
+          impulses: Sequence[tuple[float, float]] = ()) -> dict[str, float]:
     """The run's metrics: the peak 2 s deceleration `peak_decel_2s` [m/s^2] and the peak
     braking jerk `peak_braking_jerk` [m/s^3] of the speed trace (module doc), nothing
-    excused; 0 before a window fills."""
+    excused but the values that meet a contact's impulse (`impulses`: ([s] start, [s]
+    end) spans, `avsim.criteria.impulse`); 0 before a window fills."""
     signals = ComfortSignals()
     decel_peak = jerk_peak = 0.0
     for ti, vi in zip(t.tolist(), speed.tolist(), strict=True):
         decel, _, jerk = signals.push(ti, vi)
-        decel_peak = max(decel_peak, decel or 0.0)
-        jerk_peak = max(jerk_peak, jerk or 0.0)
+        if decel is not None and not meets(impulses, decel.since, ti):
+            decel_peak = max(decel_peak, decel.value)
+        if jerk is not None and not meets(impulses, jerk.since, ti):
+            jerk_peak = max(jerk_peak, jerk.value)
     return {"peak_decel_2s": decel_peak, "peak_braking_jerk": jerk_peak}
 
 
@@ -170,15 +196,21 @@ class _Comfort(Criterion):
         self.excused = 0  # how many excused windows there were
         self._in_window = False  # in an excused window
         self._excused_until = math.inf  # [s] its end, once the braking in it has ended
+        self.impulses = ImpulseSpans()  # the contacts' impulses, left out
 
-    def _measure(self, decel: float | None, jerk: float | None) -> float | None:
+    def _measure(self, decel: Signal | None, jerk: Signal | None) -> Signal | None:
         raise NotImplementedError
 
+    def after_judging(self, sample: TruthSample) -> None:
+        """The contact spans go on (the note shows where they ended)."""
+        self.impulses.update(sample)
+
     def update(self, sample: TruthSample) -> None:
+        self.impulses.update(sample)
         decel, short, jerk = self.signals.push(sample.t, sample.speed)
-        braking = short is not None and short >= BRAKING
+        braking = short is not None and short.value >= BRAKING
         ahead = ahead_of(sample, self.road, self.ego_length)
-        decel_now = max(short or 0.0, 0.0)
+        decel_now = max(short.value if short is not None else 0.0, 0.0)
         comfortable = all(comfortable_solution(sample.speed, a.gap, a.speed, a.accel, decel_now)
                           for a in ahead)
         if not comfortable:  # a window opens (or goes on)
@@ -190,12 +222,13 @@ class _Comfort(Criterion):
             elif self._excused_until == math.inf:
                 self._excused_until = sample.t + EXCUSE_AFTER
             self._in_window = sample.t <= self._excused_until
-        if self._in_window:
+        if self._in_window or (short is not None and self.impulses.meets(short.since, sample.t)):
             return
         self.braked = self.braked or braking
-        value = self._measure(decel, jerk)
-        if value is None:
+        signal = self._measure(decel, jerk)
+        if signal is None or self.impulses.meets(signal.since, sample.t):
             return
+        value = signal.value
         self.peak = max(self.peak, value)
         if value > self.limit:
             shown = beside(value, self.limit, 2)
@@ -206,10 +239,12 @@ class _Comfort(Criterion):
         if not self.braked:
             why = f" ({self.excused} braking(s) excused: no comfortable solution by the " \
                   f"truth)" if self.excused else ""
-            return CriterionResult.not_applicable(self.name, self.limit, self.unit,
-                                                  f"the ego never braked{why}")
+            return CriterionResult.not_applicable(
+                self.name, self.limit, self.unit,
+                "; ".join(filter(None, [f"the ego never braked{why}",
+                                        self.impulses.describe()])))
         return CriterionResult(self.name, self.first_failure is None, self.peak, self.limit,
-                               self.unit, self.first_failure)
+                               self.unit, self.first_failure, note=self.impulses.describe())
 
 
 class ComfortDecel(_Comfort):
@@ -217,7 +252,7 @@ class ComfortDecel(_Comfort):
 
     name, unit, limit = "comfort_decel", "m/s^2", A_ISO
 
-    def _measure(self, decel: float | None, jerk: float | None) -> float | None:
+    def _measure(self, decel: Signal | None, jerk: Signal | None) -> Signal | None:
         return decel
 
 
@@ -226,7 +261,7 @@ class ComfortJerk(_Comfort):
 
     name, unit, limit = "comfort_jerk", "m/s^3", J_ISO
 
-    def _measure(self, decel: float | None, jerk: float | None) -> float | None:
+    def _measure(self, decel: Signal | None, jerk: Signal | None) -> Signal | None:
         return jerk
 
 

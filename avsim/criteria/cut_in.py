@@ -52,12 +52,12 @@ class CutIn:
         """Why the regulation does or does not require avoiding it."""
         bound = self.v_rel / (2.0 * R157_DECEL) + R157_REACTION
         if self.v_rel <= 0.0:
-            return f"it was not slower than the ego (v_rel {self.v_rel:.1f} m/s)"
+            return f"it was not slower than the ego (v_rel {self.v_rel:.1f} m/s <= 0)"
         if self.visible_for < R157_VISIBLE:
             return (f"its lateral movement was visible {self.visible_for:.2f} s before the "
-                    f"lane intrusion, under {R157_VISIBLE} s")
+                    f"lane intrusion < bound {R157_VISIBLE} s")
         relation = ">" if self.ttc > bound else "<="
-        return f"TTC at lane intrusion {self.ttc:.2f} s {relation} {bound:.2f} s"
+        return f"TTC at lane intrusion {self.ttc:.2f} s {relation} bound {bound:.2f} s"
 
 
 class CutInWatch:

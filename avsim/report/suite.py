@@ -4,11 +4,14 @@ Pure functions over the `RunOutcome`s of a batch (`avsim.batch.jobs`): nothing h
 scenario or writes a file; the caller writes the text they return.
 
 - `junit_xml`: one `<testsuite>` per run, one `<testcase>` per criterion (a failed
-  criterion has a `<failure>`); a run that did not finish or ended in error has a
+  criterion has a `<failure>`, a passed one with a note, such as a contact a rule excused,
+  its note as `<system-out>`); a run that did not finish or ended in error has a
   `<testcase name="run">` with an `<error>` (a run that ended in error also keeps its
   criteria judged so far). Attributes follow the common (Jenkins / Surefire) JUnit schema.
-- `summary_markdown`: the counts, a table of runs with links to their files, a table of
-  criteria per run, and the snapshot of each failed run at its first failure.
+- `summary_markdown`: the counts, a table of scenarios (pass rate, worst margins, every
+  contact with those a rule excused), a table of runs with links to their files, a table
+  of criteria per run (and its contacts), and the snapshot of each failed run at its first
+  failure.
 - `summary_table`: the same verdicts as a `rich` table for the terminal.
 
 Times: "sim time" is the run's simulated time (the result's `sim_time`); "wall time" is
@@ -153,8 +156,10 @@ def _properties(outcome: RunOutcome) -> dict[str, str]:
 def _criterion_case(suite: ET.Element, outcome: RunOutcome,
                     criterion: Mapping[str, object]) -> None:
     """Append a criterion's `<testcase>`: with its `<failure>` if it failed (and its first
-    failure's sim time as a property), `<skipped>` if it was not applicable. No time: the
-    criteria are judged together over the whole run, which the suite's time is."""
+    failure's sim time as a property), `<skipped>` if it was not applicable, its note as
+    `<system-out>` if it passed with one (a contact a rule excused, the judging ended
+    early). No time: the criteria are judged together over the whole run, which the
+    suite's time is."""
     case = ET.SubElement(suite, "testcase", classname=f"avsim.{outcome.job.name}",
                          name=str(criterion["name"]))
     first = criterion.get("first_failure")
@@ -164,6 +169,8 @@ def _criterion_case(suite: ET.Element, outcome: RunOutcome,
                       value=f"{first}")
     if criterion["passed"] is None:
         ET.SubElement(case, "skipped", message=str(criterion.get("note") or "not applicable"))
+    elif criterion["passed"] and criterion.get("note"):
+        ET.SubElement(case, "system-out").text = f"note: {criterion['note']}"
     elif not criterion["passed"]:
         said = _infractions(outcome, str(criterion["name"]))
         message = _failure_message(criterion)
@@ -334,15 +341,30 @@ def _metric(outcome: RunOutcome, name: str) -> float | None:
     return float(value) if isinstance(value, int | float) else None
 
 
+CONTACTS, EXCUSED = "collisions", "collisions_excused"  # the metrics of the contacts
+
+
+def _contacts(runs: Sequence[RunOutcome]) -> str:
+    """Every contact of the finished runs, with those a rule excused: `3 (2 excused)`, `0`;
+    `—` when no run has the metric."""
+    counts = [v for o in runs if (v := _metric(o, CONTACTS)) is not None]
+    if not counts:
+        return DASH
+    excused = sum(v for o in runs if (v := _metric(o, EXCUSED)) is not None)
+    text = format_value(sum(counts))
+    return f"{text} ({format_value(excused)} excused)" if excused else text
+
+
 def _scenario_table(outcomes: Sequence[RunOutcome]) -> list[str]:
-    """A row per scenario file (a grid's points together): runs, passed, the pass rate and
-    the worst of each of `MARGINS` over its finished runs."""
+    """A row per scenario file (a grid's points together): runs, passed, the pass rate,
+    the worst of each of `MARGINS` over its finished runs and their contacts (`_contacts`:
+    every one, also those a rule excused)."""
     groups: dict[str, list[RunOutcome]] = {}
     for outcome in outcomes:
         groups.setdefault(outcome.job.scenario, []).append(outcome)
     lines = ["| scenario | runs | passed | pass rate | "
-             + " | ".join(heading for _, heading, _ in MARGINS) + " |",
-             "|---|--:|--:|--:|" + "--:|" * len(MARGINS)]
+             + " | ".join(heading for _, heading, _ in MARGINS) + " | contacts |",
+             "|---|--:|--:|--:|" + "--:|" * len(MARGINS) + "--:|"]
     for scenario, runs in groups.items():
         passed = sum(o.passed for o in runs)
         worst = []
@@ -351,7 +373,7 @@ def _scenario_table(outcomes: Sequence[RunOutcome]) -> list[str]:
             worst.append(format_value(pick(values)) if values else DASH)
         lines.append("| " + " | ".join([_md_code(Path(scenario).stem), str(len(runs)),
                                         str(passed), f"{100 * passed / len(runs):.0f} %",
-                                        *worst]) + " |")
+                                        *worst, _contacts(runs)]) + " |")
     return [*lines, ""]
 
 
@@ -377,6 +399,10 @@ def _run_section(outcome: RunOutcome) -> list[str]:
         lines += [f"> {_md_text(outcome.error or outcome.status.value)}", ""]
     if outcome.result is None:
         return lines
+    contacts = _contacts([outcome])
+    if contacts not in (DASH, "0"):
+        lines += [f"Contacts: {contacts} (every contact onset; `no_collision`'s note says "
+                  "which a rule excused and why).", ""]
     lines += ["| criterion | verdict | value | threshold | unit | first failure [s] | note |",
               "|---|---|--:|--:|---|--:|---|"]
     lines += [_criterion_row(c) for c in outcome.criteria()]
@@ -405,12 +431,14 @@ def summary_markdown(outcomes: Sequence[RunOutcome], *, title: str, out_dir: Pat
     """The text of `summary.md`, written into `out_dir` (links are relative to it).
 
     A header with the counts and total sim and wall times [s]; a table with a row per
-    scenario file (a grid's runs together: pass rate and worst margins, `MARGINS`); a table
+    scenario file (a grid's runs together: pass rate, worst margins, `MARGINS`, and every
+    contact, those a rule excused too); a table
     with a row per run
     (verdict, times, links to its .rrd and .json, and its speed-profile .png if that file
-    exists); a section per run with its scenario, seed, profile, overrides and a row per
-    criterion (or its error line); then, for each failed run with a snapshot in `snapshots`
-    (job name -> PNG), the image, titled with its first failure's time.
+    exists); a section per run with its scenario, seed, profile, overrides, its contacts
+    (when it had any) and a row per criterion (or its error line); then, for each failed
+    run with a snapshot in `snapshots` (job name -> PNG), the image, titled with its first
+    failure's time.
     """
     lines = _header(outcomes, title) + _scenario_table(outcomes) + _runs_table(outcomes, out_dir)
     for outcome in outcomes:

@@ -5,7 +5,9 @@ job's `overrides` holds its grid point. `sweep_rows` tabulates the swept keys, t
 and chosen metrics (`RunOutcome.metric`: a result metric or a criterion's value) per run;
 `heat_map` draws one metric over two swept keys, e.g. the UN R157 cut-in grid (initial gap
 [m] x relative speed [km/h]) coloured by `min_gap` [m], with the failed runs framed in red
-and marked "✗" ("✗ contact" where the ego touched something: `collisions` > 0).
+and marked "✗" ("✗ contact" where the ego touched something: `collisions` > 0). A contact
+is always marked: a run that passed with one (a rule excused it: UN R157's unavoidable
+cut-in) is framed in orange and marked "contact (excused)".
 
 Pure but for `heat_map`'s file: no pyplot (a bare `Figure` on the Agg canvas).
 """
@@ -40,7 +42,9 @@ NO_VALUE_COLOUR = "#bdbdbd"  # grey: a cell whose metric is NaN / inf, or that h
 FAIL_COLOUR = "#d50000"  # the frame of a failed run's cell
 FAIL_FRAME_WIDTH = 3.0  # [pt]
 FAIL_FRAME_INSET = 0.04  # [cell] so that neighbouring frames do not merge
-CONTACT_METRIC = "collisions"  # > 0: the ego touched something (`no_collision` failed)
+CONTACT_METRIC = "collisions"  # > 0: the ego touched something (every contact onset)
+EXCUSED_METRIC = "collisions_excused"  # of those, the ones a rule excused
+CONTACT_COLOUR = "#ff9100"  # orange: the frame of a run that passed with a contact
 DARK_CELL = 0.5  # [-] relative luminance below which a cell's annotation is white
 LARGE_GRID = 8  # [cells] along an axis beyond which annotations get smaller
 
@@ -187,8 +191,14 @@ def _norm(values: FloatArray) -> Normalize:
     return Normalize(float(finite.min()), float(finite.max()))
 
 
+def _contact(outcome: RunOutcome) -> bool:
+    """The run had a contact (excused or not)."""
+    return outcome.metric(CONTACT_METRIC) > 0  # NaN > 0 is False
+
+
 def _annotation(outcome: RunOutcome | None, value: float) -> str:
-    """A cell's text: its value, marked "✗" (and "contact") for a failed run."""
+    """A cell's text: its value, marked "✗" (and "contact") for a failed run, "contact
+    (excused)" for one that passed with a contact."""
     if outcome is None:
         return "no run"
     if outcome.result is None:
@@ -196,9 +206,20 @@ def _annotation(outcome: RunOutcome | None, value: float) -> str:
                                                                           "bad input")
     text = format_value(value)
     if outcome.status is Status.FAILED:
-        contact = outcome.metric(CONTACT_METRIC) > 0  # NaN > 0 is False
-        text += "\n✗ contact" if contact else "\n✗"
+        text += "\n✗ contact" if _contact(outcome) else "\n✗"
+    elif _contact(outcome):
+        text += "\ncontact (excused)"
     return text
+
+
+def _frame(outcome: RunOutcome | None) -> str | None:
+    """A cell's frame colour: red for a failed run, orange for one that passed with a
+    contact, None for none."""
+    if outcome is None:
+        return None
+    if outcome.status is Status.FAILED:
+        return FAIL_COLOUR
+    return CONTACT_COLOUR if outcome.result is not None and _contact(outcome) else None
 
 
 def _text_colour(cmap: Colormap, norm: Normalize, value: float) -> str:
@@ -210,7 +231,8 @@ def _text_colour(cmap: Colormap, norm: Normalize, value: float) -> str:
 
 
 def _annotate(ax: Axes, grid: HeatGrid, cmap: Colormap, norm: Normalize) -> None:
-    """The value of each cell, and a red frame and "✗" on the cells of failed runs."""
+    """The value of each cell, a red frame and "✗" on the cells of failed runs, an orange
+    frame and "contact (excused)" on those of runs that passed with a contact."""
     size = 11 if max(len(grid.xs), len(grid.ys)) <= LARGE_GRID else 7
     for j in range(len(grid.ys)):
         for i in range(len(grid.xs)):
@@ -218,10 +240,11 @@ def _annotate(ax: Axes, grid: HeatGrid, cmap: Colormap, norm: Normalize) -> None
             value = float(grid.values[j, i])
             ax.text(i, j, _annotation(outcome, value), ha="center", va="center",
                     fontsize=size, color=_text_colour(cmap, norm, value), zorder=3)
-            if outcome is not None and outcome.status is Status.FAILED:
+            colour = _frame(outcome)
+            if colour is not None:
                 side = 1.0 - 2.0 * FAIL_FRAME_INSET
                 ax.add_patch(Rectangle((i - 0.5 + FAIL_FRAME_INSET, j - 0.5 + FAIL_FRAME_INSET),
-                                       side, side, fill=False, edgecolor=FAIL_COLOUR,
+                                       side, side, fill=False, edgecolor=colour,
                                        linewidth=FAIL_FRAME_WIDTH, zorder=2))
 
 
@@ -246,8 +269,10 @@ def heat_map_figure(outcomes: Sequence[RunOutcome], x_param: str, y_param: str, 
     fig.legend(handles=[
         Patch(facecolor="none", edgecolor=FAIL_COLOUR, linewidth=FAIL_FRAME_WIDTH,
               label='failed run (✗; "contact": collisions > 0)'),
+        Patch(facecolor="none", edgecolor=CONTACT_COLOUR, linewidth=FAIL_FRAME_WIDTH,
+              label="passed with a contact a rule excused"),
         Patch(facecolor=NO_VALUE_COLOUR, label="no value (not finite, or did not finish)"),
-    ], loc="outside lower center", ncols=2, fontsize="small")
+    ], loc="outside lower center", ncols=3, fontsize="small")
     return fig
 
 
@@ -256,7 +281,9 @@ def heat_map(outcomes: Sequence[RunOutcome], x_param: str, y_param: str, metric:
     """Write a PNG (`SIZE` at `DPI`) of `metric` over the swept keys `x_param` x `y_param`.
 
     Each cell is one run, coloured by the metric and annotated with its value (`format_value`);
-    failed runs are framed in red and marked "✗" ("✗ contact" if `collisions` > 0); cells
+    failed runs are framed in red and marked "✗" ("✗ contact" if `collisions` > 0), runs
+    that passed with a contact (a rule excused it) framed in orange and marked "contact
+    (excused)"; cells
     with no finite value (a run that did not finish, an absent metric, inf) are grey. Axes
     keep the values' order of appearance in the runs (numbers or strings). `out` appears
     whole (through a temporary file beside it); its directory is made.

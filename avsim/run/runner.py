@@ -34,6 +34,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from avsim.criteria.base import (
+    DECEL_WINDOW,
     MAX_LANE_CHANGE,
     CriterionResult,
     Infraction,
@@ -45,6 +46,7 @@ from avsim.criteria.base import (
 from avsim.criteria.collision import NoCollision
 from avsim.criteria.comfort import peaks
 from avsim.criteria.declaration import RunInputs
+from avsim.criteria.impulse import meets
 from avsim.criteria.lane import TyresInLane
 from avsim.criteria.registry import build_criteria
 from avsim.criteria.route import Completes
@@ -513,27 +515,31 @@ class Runner:
     # -- results -------------------------------------------------------------------------------
 
     def _metrics(self) -> dict[str, float]:
+        """The run's metrics. Every contact onset is in `collisions`, those a rule excused
+        in `collisions_excused` too. The decelerations and jerks leave out the contacts'
+        impulses (`avsim.criteria.impulse`): `max_decel` [m/s^2] is the car's braking,
+        `max_decel_with_contact` the raw peak, the impulse in."""
         keeping = ~np.asarray(self.log.crossing, dtype=bool)  # lane changes are not errors
         xte = self.log.array("lane_error")[keeping]
-        speed = self.log.array("speed")
-        dt = CONTROL_RATE.period
-        decel = -np.diff(speed) / dt if len(speed) > 1 else np.zeros(1)
-        window = max(1, round(0.2 / dt))
-        smooth = np.convolve(decel, np.ones(window) / window, mode="valid") if len(decel) else decel
+        speed, t = self.log.array("speed"), self.log.array("t")
+        impulses = self.collisions.impulses.spans
+        raw, braking = _max_decel(t, speed, impulses)
         return {
             "max_lateral_error": float(np.max(np.abs(xte))) if len(xte) else math.nan,
             "rms_lateral_error": float(np.sqrt(np.mean(xte**2))) if len(xte) else math.nan,
             "max_front_axle_error":
                 float(np.max(np.abs(self.log.array("front_axle_error")[keeping])))
             if len(xte) else math.nan,
-            "max_decel": float(max(0.0, np.max(smooth))) if len(smooth) else 0.0,
+            "max_decel": braking,
+            "max_decel_with_contact": raw,
             "pose_rmse": float(np.sqrt(np.mean(self.log.array("pose_error") ** 2)))
             if len(speed) else math.nan,
             "max_speed": float(np.max(speed)) if len(speed) else 0.0,
             "distance": float(self.log.station[-1] - self.log.station[0]) if xte.size else 0.0,
             "collisions": float(self.collisions.count),
+            "collisions_excused": float(self.collisions.excused),
             "acc_shortest_mode": shortest_hold(self.state_changes, "acc"),
-        } | self._lead_margins() | peaks(self.log.array("t"), speed) \
+        } | self._lead_margins() | peaks(t, speed, impulses) \
             | (self.sensors.metrics() if self.setup is not None else {})
 
     def _lead_margins(self) -> dict[str, float]:
@@ -617,3 +623,19 @@ class Runner:
             note = f"; {r.note}" if r.note else ""
             rec.log_event(t, f"criterion {r.name}: {VERDICT_WORDS[r.verdict]} (value {value}, "
                              f"threshold {r.threshold} {r.unit}{note})", level)
+
+
+def _max_decel(t: NDArray[np.float64], speed: NDArray[np.float64],
+               impulses: list[tuple[float, float]]) -> tuple[float, float]:
+    """([m/s^2] the peak deceleration on a `DECEL_WINDOW` moving average of the logged
+    speeds (control rate), [m/s^2] the same leaving out the windows that meet a contact's
+    impulse, `avsim.criteria.impulse`); 0 where there is none."""
+    dt = CONTROL_RATE.period
+    window = max(1, round(DECEL_WINDOW / dt))
+    if len(speed) <= window:  # no window filled
+        return 0.0, 0.0
+    decel = -np.diff(speed) / dt
+    smooth = np.convolve(decel, np.ones(window) / window, mode="valid")
+    kept = [d for k, d in enumerate(smooth.tolist())
+            if not meets(impulses, float(t[k]), float(t[k + window]))]
+    return float(max(0.0, np.max(smooth))), max([0.0, *kept])

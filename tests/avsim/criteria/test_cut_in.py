@@ -1,8 +1,11 @@
 """UN R157 5.2.5.2 from the truth: a car cutting in from the next lane, slower than the ego;
 whether the regulation requires avoiding a collision with it decides, under
-`unavoidable: r157`, whether `no_collision` fails or reports it."""
+`unavoidable: r157`, whether `no_collision` fails or passes with the excuse in its note.
+Either way the contact is counted."""
 
 from __future__ import annotations
+
+import dataclasses
 
 import numpy as np
 import pytest
@@ -81,15 +84,22 @@ def test_a_cut_in_far_enough_ahead_must_be_avoided() -> None:
     assert result.verdict is Verdict.FAIL and criterion.count == 1
 
 
-def test_a_cut_in_too_close_is_reported_not_failed() -> None:
+def test_a_cut_in_too_close_is_counted_and_passes_with_its_excuse() -> None:
     """7 m ahead when it starts across at 1 m/s: 1.6 m at the intrusion, TTC 0.3 s, under
-    the bound of 0.81 s: unavoidable."""
-    watch, criterion = judge(cut_in(7.0))
+    the bound of 0.81 s: unavoidable. The contact is counted (the metric), excused (no
+    infraction), and `no_collision` passes with the regulation's figures in its note."""
+    samples = cut_in(7.0)
+    watch, criterion = judge(samples)
     (c,) = watch.cut_ins.values()
     assert not c.required and "TTC at lane intrusion" in c.reason()
     result = criterion.result()
-    assert result.verdict is Verdict.NOT_APPLICABLE and criterion.count == 0
-    assert "unavoidable under UN R157 5.2.5.2" in (result.note or "")
+    assert result.verdict is Verdict.PASS and result.value == 0
+    assert criterion.count == 1 and criterion.excused == 1
+    assert criterion.take_infractions() == [] and result.first_failure is None
+    bound = (20 / 3.6) / 12.0 + 0.35
+    assert result.note == (f"1 contact(s) excused: unavoidable: r157, actor cutter at "
+                           f"{samples[-1].t:.2f} s: TTC at lane intrusion {c.ttc:.2f} s <= "
+                           f"bound {bound:.2f} s")
 
 
 def test_a_lateral_move_seen_too_briefly_is_unavoidable() -> None:
@@ -151,11 +161,68 @@ def test_an_unavoidable_collision_ends_the_judging() -> None:
     assert criteria.ended is not None and criteria.ended[0] == crash
     assert unsettled.seen == len(samples)  # none after the collision
     results = criteria.results()
-    assert results[0].verdict is Verdict.NOT_APPLICABLE  # the collision: reported
+    assert results[0].verdict is Verdict.PASS  # the collision: counted, excused
+    assert "unavoidable: r157" in (results[0].note or "")
     assert results[1].verdict is Verdict.FAIL and results[1].first_failure == samples[5].t
+    assert results[1].note == (f"judged until {crash:.2f} s: judging ended with the "
+                               "unavoidable collision with actor cutter")
     assert results[2].verdict is Verdict.NOT_APPLICABLE
     assert "judging ended with the unavoidable collision with actor cutter" in (
         results[2].note or "")
+
+
+def test_a_pass_judged_until_an_unavoidable_collision_says_so() -> None:
+    samples = cut_in(7.0)
+    passing = _Seen(settles=1)
+    criteria = CriteriaSet([NoCollision({BODY: "actor cutter"}, {BODY: "cutter"},
+                                        CutInWatch(ROAD, EGO_LENGTH)), passing])
+    for s in samples:
+        criteria.update(s)
+    result = criteria.results()[1]
+    assert result.verdict is Verdict.PASS
+    assert result.note == (f"judged until {samples[-1].t:.2f} s: judging ended with the "
+                           "unavoidable collision with actor cutter")
+
+
+def test_contacts_after_the_judging_ended_are_counted_not_judged() -> None:
+    """The car pushed on, it parts from the cutter and strikes it again (and a kerb): the
+    judging has ended, yet each onset is counted and the note lists them."""
+    samples = cut_in(7.0)
+    crash, actors = samples[-1].t, samples[-1].actors or poses(0, 0, 0)
+    kerb = 9
+    after = [sample(crash + DT, 130.0, actors),  # parted
+             sample(crash + 2 * DT, 130.0, actors, True),  # the cutter again
+             dataclasses.replace(sample(crash + 3 * DT, 130.0, actors),
+                                 touching=frozenset({kerb}))]
+    collision = NoCollision({BODY: "actor cutter", kerb: "kerb"}, {BODY: "cutter"},
+                            CutInWatch(ROAD, EGO_LENGTH))
+    criteria = CriteriaSet([collision])
+    for s in samples + after:
+        criteria.update(s)
+    assert collision.count == 3 and collision.excused == 1
+    result = criteria.results()[0]
+    assert result.verdict is Verdict.PASS and result.value == 0
+    assert result.note is not None and result.note.endswith(
+        f"2 contact(s) after the judging ended, counted, not judged: actor cutter at "
+        f"{crash + 2 * DT:.2f} s, kerb at {crash + 3 * DT:.2f} s")
+
+
+def test_an_excused_contact_after_one_that_counts_does_not_end_the_judging() -> None:
+    """A kerb struck first (a failure), then the unavoidable cut-in: both counted, the
+    judging goes on (the run already failed on its own), the verdict a failure."""
+    kerb = 9
+    samples = cut_in(7.0)
+    first = dataclasses.replace(samples[3], touching=frozenset({kerb}))
+    collision = NoCollision({BODY: "actor cutter", kerb: "kerb"}, {BODY: "cutter"},
+                            CutInWatch(ROAD, EGO_LENGTH))
+    criteria = CriteriaSet([collision])
+    for s in [*samples[:3], first, *samples[4:]]:
+        criteria.update(s)
+    assert criteria.ended is None
+    assert collision.count == 2 and collision.excused == 1
+    result = criteria.results()[0]
+    assert result.verdict is Verdict.FAIL and result.value == 1
+    assert (result.note or "").startswith(f"kerb at {first.t:.2f} s; 1 contact(s) excused: ")
 
 
 def test_a_collision_to_avoid_does_not_end_the_judging() -> None:

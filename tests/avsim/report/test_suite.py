@@ -356,8 +356,48 @@ def test_summary_scenario_table_gives_pass_rates_and_worst_margins(tmp_path: Pat
         result["metrics"] = {"min_ttc": ttc, "min_lead_gap": gap, "max_decel": decel}
     text = summary_markdown(outcomes, title="T", out_dir=out_dir)
     rows = [line for line in text.splitlines() if line.startswith("| `")][:2]
-    assert rows == ["| `cut_in` | 3 | 1 | 33 % | 1.1 | 12 | 4.2 |",
-                    "| `typo` | 1 | 0 | 0 % | — | — | — |"]
+    assert rows == ["| `cut_in` | 3 | 1 | 33 % | 1.1 | 12 | 4.2 | — |",
+                    "| `typo` | 1 | 0 | 0 % | — | — | — | — |"]
+
+
+def _excused(tmp_path: Path) -> list[RunOutcome]:
+    """Two runs of a cut-in: one passed with a contact UN R157 excuses, one failed on a
+    contact no rule excuses."""
+    note = ("1 contact(s) excused: unavoidable: r157, actor cutter at 7.72 s: TTC at lane "
+            "intrusion 0.48 s <= bound 1.28 s")
+    hit = RunJob("cut_in_hit", "cut_in", tmp_path / "hit")
+    crash = RunJob("cut_in_crash", "cut_in", tmp_path / "crash")
+    excused = [_criterion("no_collision", True, 0, 0, "contacts", note=note),
+               _criterion("min_gap", None, None, 2.0, "m", note="not judged")]
+    counted = [_criterion("no_collision", False, 1, 0, "contacts", 9.5, "actor cutter")]
+    return [RunOutcome(hit, Status.PASSED, _result(hit, excused, 35.0, {
+                "collisions": 1.0, "collisions_excused": 1.0, "max_decel": 2.1}), None, 4.0),
+            RunOutcome(crash, Status.FAILED, _result(crash, counted, 35.0, {
+                "collisions": 2.0, "collisions_excused": 0.0}), None, 4.0)]
+
+
+def test_junit_an_excused_contact_is_a_passed_testcase_with_its_note(tmp_path: Path) -> None:
+    root = ET.fromstring(junit_xml(_excused(tmp_path), "r157").encode())
+    hit = next(s for s in root if s.attrib["name"] == "cut_in_hit")
+    case = hit.find("testcase[@name='no_collision']")
+    assert case is not None
+    assert case.find("skipped") is None and case.find("failure") is None
+    out = case.find("system-out")
+    assert out is not None and out.text is not None
+    assert out.text.startswith("note: 1 contact(s) excused: unavoidable: r157, actor cutter")
+    assert "<= bound 1.28 s" in out.text
+    assert (hit.attrib["failures"], hit.attrib["skipped"]) == ("0", "1")  # min_gap only
+    plain = next(s for s in root if s.attrib["name"] == "cut_in_crash")
+    assert plain.find("testcase/system-out") is None  # a failure says it in <failure>
+
+
+def test_summary_counts_every_contact_also_excused(tmp_path: Path) -> None:
+    text = summary_markdown(_excused(tmp_path), title="T", out_dir=tmp_path)
+    rows = [line for line in text.splitlines() if line.startswith("| `cut_in` |")]
+    assert rows == ["| `cut_in` | 2 | 1 | 50 % | — | — | 2.1 | 3 (1 excused) |"]
+    assert ("Contacts: 1 (1 excused) (every contact onset; `no_collision`'s note says which "
+            "a rule excused and why).") in text
+    assert "Contacts: 2 (every contact onset" in text
 
 
 def test_junit_failure_says_what_happened_first(tmp_path: Path) -> None:

@@ -19,9 +19,11 @@ import cv2
 import matplotlib as mpl
 import numpy as np
 import pytest
+from matplotlib.patches import Rectangle
 
 from avsim.batch.jobs import RunJob, RunOutcome, Status
 from avsim.report.sweep import (
+    CONTACT_COLOUR,
     FAIL_COLOUR,
     FAIL_FRAME_INSET,
     NO_VALUE_COLOUR,
@@ -261,3 +263,43 @@ def test_heat_map_bad_grids(tmp_path: Path) -> None:
         heat_map_figure(outcomes, GAP, GAP, "min_gap", title="t")
     with pytest.raises(ValueError, match="no runs"):
         heat_map_figure([], GAP, SPEED, "min_gap", title="t")
+
+
+EXCUSED = (20, 20)  # (gap, speed) of a run that passed with a contact UN R157 excuses
+
+
+def _excused_grid(tmp: Path) -> list[RunOutcome]:
+    """The grid, its run at `EXCUSED` passed with one contact, excused."""
+    outcomes = _grid(tmp)
+    for outcome in outcomes:
+        if (outcome.job.overrides[GAP], outcome.job.overrides[SPEED]) == EXCUSED:
+            assert outcome.result is not None and outcome.status is Status.PASSED
+            outcome.result["metrics"] = {"collisions": 1.0, "collisions_excused": 1.0,
+                                         "max_decel": 2.5}
+    return outcomes
+
+
+def test_sweep_rows_count_an_excused_contact(tmp_path: Path) -> None:
+    rows = sweep_rows(_excused_grid(tmp_path), [GAP, SPEED],
+                      ["collisions", "collisions_excused"])
+    row = next(r for r in rows if (r[GAP], r[SPEED]) == EXCUSED)
+    assert (row["passed"], row["collisions"], row["collisions_excused"]) == (True, 1.0, 1.0)
+    table = sweep_markdown(rows)
+    line = next(x for x in table.splitlines() if x.startswith("| cut_in_20_20 "))
+    assert line.split(" | ")[3:7] == ["pass", "passed", "1", "1"]
+
+
+def test_heat_map_marks_a_contact_a_rule_excused(tmp_path: Path) -> None:
+    outcomes = _excused_grid(tmp_path)
+    fig = heat_map_figure(outcomes, GAP, SPEED, "min_gap", title="t")
+    texts = {(round(t.get_position()[0]), round(t.get_position()[1])): t.get_text()
+             for t in fig.axes[0].texts}
+    i, j = GAPS.index(EXCUSED[0]), SPEEDS.index(EXCUSED[1])
+    assert texts[i, j] == "8\ncontact (excused)"
+    assert texts[GAPS.index(30), SPEEDS.index(20)] == "18"  # passed, no contact
+    frames = {(round(p.get_x() + 0.5 - FAIL_FRAME_INSET),
+               round(p.get_y() + 0.5 - FAIL_FRAME_INSET)): mpl.colors.to_hex(p.get_edgecolor())
+              for p in fig.axes[0].patches if isinstance(p, Rectangle)}
+    assert frames[i, j] == CONTACT_COLOUR
+    assert (GAPS.index(30), SPEEDS.index(20)) not in frames
+    assert frames[GAPS.index(10), SPEEDS.index(20)] == FAIL_COLOUR
