@@ -178,3 +178,68 @@ def shown_values(values: Mapping[str, object]) -> dict[str, object]:
     if SEED_KEY in values:
         ordered[SEED_KEY] = values[SEED_KEY]
     return ordered
+
+
+CAMPAIGN_JSON, WORST_REPRO = "campaign.json", "worst.yaml"  # a campaign's own reports
+
+
+@dataclass(frozen=True)
+class Refined:
+    """What `--shrink` and `--search` found (`avsim.batch.refine`'s results)."""
+
+    shrunk: Sequence[Any] = ()  # `refine.Shrunk`s
+    worst: Sequence[Any] = ()  # `refine.Worst`s
+
+
+def write_reports(runs: Sequence[DrawnRun], refined: Refined, settings: Settings,
+                  per_file: int, title: str) -> None:
+    """The repro files, ``junit.xml``, ``results.json``, ``campaign.json`` and
+    ``summary.md`` in the campaign's folder."""
+    from avsim.batch.suite import JUNIT, RESULTS, SUMMARY, results_json
+    from avsim.files import write_atomic
+    from avsim.report.campaign import campaign_json, campaign_markdown
+    from avsim.report.suite import junit_xml
+    from avsim.run.result import dumps
+
+    repros = _write_repros(runs, refined, settings)
+    outcomes = [r.outcome for r in runs]
+    write_atomic(settings.out_dir / JUNIT, junit_xml(outcomes, title))
+    write_atomic(settings.out_dir / RESULTS, dumps(results_json(outcomes)))
+    header: dict[str, object] = {
+        "seed": settings.seed, "n": per_file, "profile": settings.profile,
+        "set": dict(settings.fixed), "families": sorted({r.family.file for r in runs}),
+        "worst_repro": repros.get(Path(WORST_REPRO).stem)}
+    report = campaign_json(runs, repros, refined.shrunk, refined.worst, header)
+    write_atomic(settings.out_dir / CAMPAIGN_JSON, dumps(report))
+    write_atomic(settings.out_dir / SUMMARY, campaign_markdown(report, title))
+
+
+def _write_repros(runs: Sequence[DrawnRun], refined: Refined,
+                  settings: Settings) -> dict[str, str]:
+    """Each failure's repro file, each shrunk failure's, the search's worst case's; their
+    paths (relative to the campaign's folder) by name (run, run_shrunk, worst)."""
+    written: dict[str, str] = {}
+
+    def write(name: str, family: Family, values: Mapping[str, object], note: str) -> None:
+        from avsim.files import write_atomic
+
+        relative = f"{REPRO_DIR}/{name}.yaml"
+        text = repro_yaml(family, run_overrides(values, settings), note)
+        write_atomic(settings.out_dir / relative, text)
+        written[name] = relative
+
+    for run in failed(runs):
+        name = run.outcome.job.name
+        write(name, run.family, run.values, note_of(name, run.family, settings))
+    for s in refined.shrunk:
+        name = f"{s.run.outcome.job.name}_shrunk"
+        write(name, s.run.family, s.values,
+              f"{s.run.outcome.job.name} shrunk toward the nominal case: still fails "
+              f"{s.criterion}.\n" + note_of(name, s.run.family, settings).split("\n")[1])
+    found = [w for w in refined.worst if w.values]
+    if found:
+        w = min(found, key=lambda w: w.value)
+        write(Path(WORST_REPRO).stem, w.family, w.values,
+              f"the least {w.metric} the search found ({w.value:g}; nominal "
+              f"{w.nominal:g}).\n" + note_of("worst", w.family, settings).split("\n")[1])
+    return written
