@@ -5,10 +5,11 @@
   same way for all (`shorten`): a `run` gets `--set duration=2` (last given wins) and, when
   it names no profile, `--profile none`; a `suite`, `sweep` or `campaign` runs with
   `--dry-run` (every run loaded and checked, none run), and the first run it prints is then
-  run for real, shortened as a `run`. `view` needs a display: it is checked up to there, by its `--help`
-  and by the recording the page names being one an earlier command wrote (or `make demo`
-  writes). Commands run in a fresh folder that links the project's `scenarios/`, `docs/`
-  and `tests/` (so the pages' relative paths hold) and takes every output.
+  run for real, shortened as a `run`. `view` needs a display: it is checked up to there,
+  by its `--help` and by the recording the page names being one an earlier command wrote
+  (or `make demo` writes). Commands run in a fresh folder that links the project's
+  `scenarios/`, `docs/` and `tests/` (so the pages' relative paths hold) and takes every
+  output.
 - A command in any other fenced block is an error: a page cannot hide one from this test.
 - The minimal OpenSCENARIO example runs in full and passes.
 """
