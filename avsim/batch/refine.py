@@ -58,6 +58,12 @@ def _finished(outcomes: Sequence[RunOutcome]) -> list[RunOutcome]:
     return list(outcomes)
 
 
+def _interrupted(outcomes: Sequence[RunOutcome]) -> bool:
+    """Whether the campaign was interrupted (Ctrl-C, SIGTERM) during these runs: no more
+    rounds start, what was found so far is reported."""
+    return any(o.status is Status.INTERRUPTED for o in outcomes)
+
+
 def _job(name: str, family: Family, values: Mapping[str, object], settings: Settings,
          folder: str) -> RunJob | None:
     """A checked job of values, None when they do not load (never for values inside the
@@ -90,7 +96,10 @@ def shrink(failures: Sequence[DrawnRun], settings: Settings, execute: Execute) -
         if not pending:
             break
         jobs = [job for _, job in pending if job is not None]
-        outcomes = iter(_finished(execute(jobs)))
+        done = _finished(execute(jobs))
+        if _interrupted(done):
+            break
+        outcomes = iter(done)
         for shrinker, job in pending:
             shrinker.tell(_failed(next(outcomes)) if job is not None else [])
     return [Shrunk(run, s.criterion, dict(s.values), dict(s.moved), s.runs)
@@ -120,8 +129,10 @@ def search(families: Sequence[Family], settings: Settings, metric: str, iteratio
                      SEARCH_DIR)
                 for f, s, runs in zip(families, searches, draws, strict=True)
                 for k, values in enumerate(runs)]
-        measured = iter(_metrics(_finished(execute([j for j in jobs if j is not None])),
-                                 jobs, metric))
+        done = _finished(execute([j for j in jobs if j is not None]))
+        if _interrupted(done):
+            break
+        measured = iter(_metrics(done, jobs, metric))
         for s, runs in zip(searches, draws, strict=True):
             s.tell(runs, [next(measured) for _ in runs])
     worst = []
