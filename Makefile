@@ -6,7 +6,7 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 PYTEST_ARGS ?=
 
-.PHONY: setup demo test test-quick acceptance fuzz lint golden bench soak clean
+.PHONY: setup demo test test-quick acceptance fuzz lint golden bench soak campaign clean
 
 # The virtual environment with the pinned dependencies (pyproject.toml), installed once.
 $(STAMP): pyproject.toml
@@ -70,6 +70,14 @@ bench: $(STAMP)
 # and real-time factor over time (about 50 minutes here).
 soak: $(STAMP)
 	$(BIN)/python -m bench.bench_soak
+
+# The scenario campaigns (scenarios/campaigns/*.yaml, docs/cli.md "Campaigns"): CAMPAIGN_N
+# runs drawn from each family with a fixed seed, into runs/campaign_all.
+CAMPAIGN_N ?= 100
+CAMPAIGN_SEED ?= 1
+campaign: $(STAMP)
+	$(BIN)/avsim campaign scenarios/campaigns/*.yaml --n $(CAMPAIGN_N) --seed $(CAMPAIGN_SEED) \
+		--profile fast --out runs/campaign_all $(CAMPAIGN_ARGS)
 
 clean:
 	rm -rf runs .pytest_cache .mypy_cache .ruff_cache

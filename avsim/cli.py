@@ -500,6 +500,116 @@ def _sweep_report(outcomes: Sequence[RunOutcome], out: Path, swept: list[str],
                       highlight=False)
 
 
+# ---- campaigns --------------------------------------------------------------------------
+
+def _options(options: Sequence[Callable[..., Any]]) -> Callable[..., Any]:
+    """Decorate a command with `options`, in their order."""
+    def decorate(f: Callable[..., None]) -> Callable[..., None]:
+        for option in reversed(options):
+            f = option(f)
+        return f
+    return decorate
+
+
+_campaign_options = [_batch_options[k] for k in (0, 1, 2, 3, 5)]  # no snapshots
+
+
+@main.command()
+@click.argument("files", nargs=-1, required=True)
+@click.option("--n", "n", type=click.IntRange(0, 10_000), default=20, show_default=True,
+              help="Runs drawn from each file.")
+@click.option("--seed", type=SeedType(), default=0, show_default=True,
+              help="The campaign's seed: run k of a file draws the same values whatever "
+                   "--n, --jobs or the executor.")
+@click.option("--out", "out", type=click.Path(path_type=Path), default=None,
+              help="Folder for the runs and the reports. Default: runs/campaign_<name>")
+@click.option("--set", "sets", multiple=True, metavar="PATH=VALUE",
+              help="Set a key of every run (one value), besides the drawn ones.")
+@click.option("--record", type=click.Choice(("failures", "all")), default="failures",
+              show_default=True, help="Keep the recordings of the failed runs, or of all.")
+@click.option("--shrink", is_flag=True,
+              help="Move each failure's values toward the file's own while it still fails "
+                   "the same criterion; write repro/<run>_shrunk.yaml.")
+@click.option("--search", "metric", default=None, metavar="METRIC",
+              help="Minimise METRIC (a metric or a criterion of the result) over the laws "
+                   "by the cross-entropy method; write repro/worst.yaml.")
+@click.option("--iterations", type=click.IntRange(1, 20), default=4, show_default=True,
+              help="--search: iterations.")
+@click.option("--population", type=click.IntRange(2, 200), default=8, show_default=True,
+              help="--search: runs per iteration and file.")
+@_options(_campaign_options)
+def campaign(files: tuple[str, ...], n: int, seed: int, out: Path | None,
+             sets: tuple[str, ...], record: str, shrink: bool, metric: str | None,
+             iterations: int, population: int, jobs: int | None, executor: str,
+             address: str | None, profile: str, dry_run: bool) -> None:
+    """Run N scenarios drawn from each campaign FILE (a scenario file with a `vary:`
+    section) like a suite; write a repro file of each failure, campaign.json, summary.md,
+    junit.xml (docs/cli.md, "Campaigns")."""
+    from avsim.batch import campaign as c
+    from avsim.batch import refine
+    from avsim.batch import suite as batch
+    from avsim.batch.sweep import SweepError
+
+    try:
+        settings, families, planned, drawn = _campaign_plan(files, n, seed, out, sets,
+                                                            metric, profile)
+    except (ScenarioError, SweepError, batch.BatchError) as exc:
+        _bad_input(str(exc))
+    if dry_run:
+        _print_plan(planned)
+    with Interrupts() as stop:  # Ctrl-C / SIGTERM: finished runs and reports are kept
+
+        def execute(todo: list[RunJob]) -> list[RunOutcome]:
+            return _execute(todo, executor, jobs, address, stop) if todo else []
+
+        outcomes = execute(planned)
+        runs = [c.DrawnRun(families[k // n], values, outcome)
+                for k, (values, outcome) in enumerate(zip(drawn, outcomes, strict=True))]
+        c.keep_recordings(runs, record == "all")
+        going = stop.exit_status is None
+        refined = c.Refined(
+            refine.shrink(c.failed(runs), settings, execute) if shrink and going else (),
+            refine.search(families, settings, metric, iterations, population, execute)
+            if metric is not None and going else ())
+        title = f"avsim campaign {' '.join(files)} ({len(runs)} runs)"
+        unwritten = batch.reports_written(outcomes, settings.out_dir, lambda: _campaign_report(
+            runs, refined, settings, n, title))
+    _exit(unwritten, batch.exit_status(outcomes, stop.exit_status))
+
+
+def _campaign_plan(files: Sequence[str], n: int, seed: int, out: Path | None,
+                   sets: Sequence[str], metric: str | None, profile: str) -> tuple[Any, ...]:
+    """The campaign's settings, families, checked jobs and drawn values (bad input raises)."""
+    import re
+
+    from avsim.batch import campaign as c
+    from avsim.batch import suite as batch
+
+    fixed = _one_value_each(sets)
+    families = [c.load_family(file, index) for index, file in enumerate(files)]
+    if metric is not None and not re.fullmatch(r"[a-z0-9_]{1,64}", metric):
+        raise batch.BatchError(f"--search: {metric[:64]!r} is not a metric's name ([a-z0-9_]+)")
+    name = families[0].name if len(families) == 1 else "all"
+    out = out if out is not None else Path("runs") / f"campaign_{name}"
+    batch.validate_out_dir(out)
+    settings = c.Settings(out, profile, fixed, seed)
+    planned, drawn = c.draw_plan(families, n, settings)
+    return settings, families, planned, drawn
+
+
+def _campaign_report(runs: Sequence[Any], refined: Any, settings: Any, n: int,
+                     title: str) -> None:
+    """The campaign's reports and repro files; the verdicts table printed."""
+    from avsim.batch.campaign import write_reports
+    from avsim.report.suite import summary_table
+
+    write_reports(runs, refined, settings, n, title)
+    console = Console()
+    console.print(summary_table([r.outcome for r in runs]))
+    console.print(f"reports: {settings.out_dir / 'summary.md'}, "
+                  f"{settings.out_dir / 'campaign.json'}", highlight=False)
+
+
 @main.command("convert")
 @click.argument("file", type=click.Path(path_type=Path))
 @click.option("--criteria", "criteria", type=click.Path(path_type=Path), default=None,

@@ -3,12 +3,13 @@
 - No page points outside the project (`../shared/`, `shared/`): users have only the project.
 - Every `avsim` command line in a fenced ```bash block runs, as written but shortened the
   same way for all (`shorten`): a `run` gets `--set duration=2` (last given wins) and, when
-  it names no profile, `--profile none`; a `suite` or `sweep` runs with `--dry-run` (every
-  run loaded and checked, none run), and the first run it prints is then run for real,
-  shortened as a `run`. `view` needs a display: it is checked up to there, by its `--help`
-  and by the recording the page names being one an earlier command wrote (or `make demo`
-  writes). Commands run in a fresh folder that links the project's `scenarios/`, `docs/`
-  and `tests/` (so the pages' relative paths hold) and takes every output.
+  it names no profile, `--profile none`; a `suite`, `sweep` or `campaign` runs with
+  `--dry-run` (every run loaded and checked, none run), and the first run it prints is then
+  run for real, shortened as a `run`. `view` needs a display: it is checked up to there,
+  by its `--help` and by the recording the page names being one an earlier command wrote
+  (or `make demo` writes). Commands run in a fresh folder that links the project's
+  `scenarios/`, `docs/` and `tests/` (so the pages' relative paths hold) and takes every
+  output.
 - A command in any other fenced block is an error: a page cannot hide one from this test.
 - The minimal OpenSCENARIO example runs in full and passes.
 """
@@ -133,7 +134,7 @@ def _check(command: Command, cwd: Path) -> None:
         recording = next(w for w in words[1:] if not w.startswith("-"))
         assert (cwd / recording).is_file(), (what, "no earlier command wrote it")
         return
-    if words[0] in ("suite", "sweep"):
+    if words[0] in ("suite", "sweep", "campaign"):
         done = _avsim([*words, "--dry-run"], cwd)
         assert done.returncode == 0, (what, done.stderr)
         planned = done.stdout.splitlines()

@@ -85,6 +85,10 @@ GridPath = Annotated[str, Field(  # a key path, or several joined by commas (val
 GridValues = Annotated[list[Any], Field(min_length=1, max_length=MAX_GRID_VALUES)]
 
 
+MAX_VARY_KEYS = 100  # keys a file's `vary` may draw
+MAX_CHOICES = 100  # values of one `choice`
+
+
 def grid_paths(key: str) -> list[str]:
     """The key paths of one `grid` key: one, or several joined by commas."""
     return [path.strip() for path in key.split(",")]
@@ -801,6 +805,76 @@ else:
 
 
 # ---------------------------------------------------------------------------------------
+# Campaigns: `vary`
+# ---------------------------------------------------------------------------------------
+
+DISTRIBUTION_KINDS = ("uniform", "normal", "integers", "choice")
+Pair = Annotated[list[float], Field(min_length=2, max_length=2)]
+IntPair = Annotated[list[int], Field(min_length=2, max_length=2)]
+
+
+class NormalModel(FormatModel):
+    """A normal law clipped to [min, max] (a draw outside is set to the bound it passed)."""
+
+    mean: float = Field(description="The law's mean, in the key's unit; required.")
+    sd: float = Field(gt=0, description="The law's standard deviation, > 0; required.")
+    min: float = Field(description="The least value drawn (lower draws are clipped); required.")
+    max: float = Field(description="The most value drawn (higher draws are clipped); required.")
+
+    @model_validator(mode="after")
+    def _ordered(self) -> NormalModel:
+        if not self.min <= self.mean <= self.max:
+            raise problem(f"needs min <= mean <= max, got {self.min}, {self.mean}, {self.max}")
+        return self
+
+
+class DistributionModel(FormatModel):
+    """How a campaign draws one key of `vary`: exactly one law."""
+
+    model_config = ConfigDict(json_schema_extra=_one_of(DISTRIBUTION_KINDS))
+
+    uniform: Pair | None = Field(default=None, description="[lo, hi]: uniform over lo..hi.")
+    normal: NormalModel | None = Field(default=None, description="{mean, sd, min, max}: "
+                                       "normal, clipped to min..max.")
+    integers: IntPair | None = Field(default=None, description="[lo, hi]: an integer of "
+                                     "lo..hi (both included), each as likely.")
+    choice: list[Any] | None = Field(
+        default=None, min_length=1, max_length=MAX_CHOICES,
+        description=f"[v1, v2, ...]: one of the values (at most {MAX_CHOICES}); for a key "
+        "of several comma-joined paths each value is a list, one item per path.")
+    weights: list[Annotated[float, Field(ge=0)]] | None = Field(
+        default=None, max_length=MAX_CHOICES,
+        description="With `choice`: each value's weight (>= 0, not all 0). Default: equal.")
+
+    @model_validator(mode="before")
+    @classmethod
+    def _known_kind(cls, data: Any) -> Any:
+        return _reject_unknown_kind(data, {*DISTRIBUTION_KINDS, "weights"},
+                                    DISTRIBUTION_KINDS, "distribution")
+
+    @model_validator(mode="after")
+    def _one_law(self) -> DistributionModel:
+        kind = _exactly_one(self, DISTRIBUTION_KINDS, "distribution")
+        bounds = self.uniform if kind == "uniform" else self.integers
+        if bounds is not None and bounds[0] > bounds[1]:
+            raise problem(f"needs lo <= hi, got [{bounds[0]}, {bounds[1]}]", key=kind)
+        if self.weights is not None:
+            if self.choice is None:
+                raise problem("weights go with a choice", key="weights")
+            if len(self.weights) != len(self.choice):
+                raise problem(f"{len(self.weights)} weights for {len(self.choice)} values",
+                              key="weights")
+            if sum(self.weights) <= 0:
+                raise problem("the weights are all 0", key="weights")
+        return self
+
+    @property
+    def kind(self) -> str:
+        """The law: uniform, normal, integers or choice."""
+        return _present(self, DISTRIBUTION_KINDS)[0]
+
+
+# ---------------------------------------------------------------------------------------
 # The whole file
 # ---------------------------------------------------------------------------------------
 
@@ -859,6 +933,16 @@ class ScenarioModel(FormatModel):
         "NAME_000, NAME_001, ...); `avsim run` runs the file's own values. Default: none.",
     )
 
+    vary: dict[GridPath, DistributionModel] = Field(
+        default_factory=dict, max_length=MAX_VARY_KEYS,
+        description="A campaign's laws (`avsim campaign`): dotted key paths of this file (as "
+        "`grid` names them) and the distribution each run draws its value from: "
+        "`{uniform: [lo, hi]}`, `{normal: {mean, sd, min, max}}`, `{integers: [lo, hi]}`, "
+        "`{choice: [...], weights: [...]}`; several paths joined by commas are drawn "
+        f"together by a `choice` of lists. At most {MAX_VARY_KEYS} keys; not with `grid`. "
+        "`avsim run` runs the file's own values. Default: none.",
+    )
+
     @model_validator(mode="after")
     def _grid_size(self) -> ScenarioModel:
         for key, values in self.grid.items():
@@ -873,6 +957,25 @@ class ScenarioModel(FormatModel):
         points = math.prod(len(values) for values in self.grid.values())
         if points > MAX_GRID_POINTS:
             raise problem(f"{points} points: at most {MAX_GRID_POINTS}", key="grid")
+        return self
+
+    @model_validator(mode="after")
+    def _vary_laws(self) -> ScenarioModel:
+        if self.vary and self.grid:
+            raise problem("a file has a grid or a vary section, not both", key="vary")
+        drawn: set[str] = set()
+        for key, law in self.vary.items():
+            paths = grid_paths(key)
+            for path in paths:
+                if path.split(".")[0] in ("grid", "vary", "format", "name"):
+                    raise problem(f"{path!r}: a campaign cannot vary this key", key=f"vary.{key}")
+                if path in drawn:
+                    raise problem(f"{path!r} is drawn twice", key=f"vary.{key}")
+                drawn.add(path)
+            if len(paths) > 1 and (law.choice is None or any(
+                    not isinstance(v, list) or len(v) != len(paths) for v in law.choice)):
+                raise problem(f"several keys are drawn together by a choice of lists of "
+                              f"{len(paths)} (one item per key)", key=f"vary.{key}")
         return self
 
     @model_validator(mode="after")
