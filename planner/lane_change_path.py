@@ -174,21 +174,43 @@ class LaneChangePath:
         return ReferencePath(xy=xy, heading=heading, curvature=curvature)
 
 
+def heading_error(lane: Lane, x: float, y: float, heading: float,
+                  near: float | None = None) -> tuple[float, float, float]:
+    """(s0 [m], r0 [m], psi0 [rad]) of a car at (``x``, ``y``) [m] heading ``heading``
+    [rad] in ``lane``'s Frenet frame: its station, its offset from the lane's centre and its
+    heading minus the lane's, wrapped to (-pi, pi]. ``near`` [m] is the car's station (the
+    localiser's, `RoadMap.local_coordinates` with its hint): on a bend that turns back on
+    itself the nearest point of the whole route may lie on its other pass, where the lane
+    heads the other way (a heading error near pi)."""
+    xy = np.array([x, y], dtype=np.float64)
+    s_arr, r_arr = (lane.local_coordinates(xy) if near is None
+                    else lane.local_coordinates(xy, near))
+    s0, r0 = float(s_arr), float(r_arr)
+    return s0, r0, wrap_angle(heading - float(lane.heading_at(s0)))
+
+
+def can_start(lane: Lane, x: float, y: float, heading: float,
+              near: float | None = None) -> bool:
+    """Whether `start_lane_change` plans a path into ``lane`` from this pose: the car heads
+    less than 90 degrees off the lane (a car that has spun cannot change lanes; it holds
+    its lane)."""
+    return abs(heading_error(lane, x, y, heading, near)[2]) < 0.5 * math.pi
+
+
 def start_lane_change(
     lane: Lane, target_index: int, x: float, y: float, heading: float, speed: float,
-    params: LaneChangeParams,
+    params: LaneChangeParams, near: float | None = None,
 ) -> LaneChangePath:
     """Plan a change into the target ``lane`` (index ``target_index``) for a car at
-    (``x``, ``y``) [m] with ``heading`` [rad] and ``speed`` [m/s] >= 0.
+    (``x``, ``y``) [m] with ``heading`` [rad] and ``speed`` [m/s] >= 0, its station near
+    ``near`` [m] when given (`heading_error`).
 
     Raises ValueError if ``lane`` is not lane ``target_index`` or the car heads 90 degrees
-    or more off the lane (no cubic in s starts there).
+    or more off the lane (no cubic in s starts there: check `can_start` first).
     """
     if lane.index != target_index:
         raise ValueError(f"lane {lane.index} is not the target lane {target_index}")
-    s_arr, r_arr = lane.local_coordinates(np.array([x, y], dtype=np.float64))
-    s0, r0 = float(s_arr), float(r_arr)
-    psi0 = wrap_angle(heading - float(lane.heading_at(s0)))
+    s0, r0, psi0 = heading_error(lane, x, y, heading, near)
     if abs(psi0) >= 0.5 * math.pi:
         raise ValueError(f"heading error {psi0:.3f} rad: the car does not head along the lane")
     m0 = math.tan(psi0)

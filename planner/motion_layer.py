@@ -94,7 +94,12 @@ from planner.fsm.motion import (
     is_pass,
     transition,
 )
-from planner.lane_change_path import LaneChangeParams, LaneChangePath, start_lane_change
+from planner.lane_change_path import (
+    LaneChangeParams,
+    LaneChangePath,
+    can_start,
+    start_lane_change,
+)
 from planner.lane_occupancy import (
     LaneTraffic,
     Neighbour,
@@ -279,8 +284,10 @@ class MotionLayer:
         alongside and behind) and its path clears the vehicle (else why not)."""
         self._no_pass_now = ""
         if self.lane < 0:
+            back = self.road.lanes_at(s) - 1
             return replace(x, left_free=False, right_free=False, in_oncoming=True,
-                           back_free=self._back_free(ego, s, v_low, traffic))
+                           back_free=self._can_plan(back, ego)
+                           and self._back_free(ego, s, v_low, traffic))
         slow = traffic[self.lane].ahead
         if (not blocked_now or slow is None or self.motion is not Motion.LANE_KEEP
                 or not self._oncoming_side(s)):
@@ -379,9 +386,9 @@ class MotionLayer:
         x = MotionInput(
             t=t, since=self.machine.since, overtake=p.overtake, blocked=blocked,
             left_free=left is not None and self._seen(left, t)
-            and is_free(left, v, p.occupancy, v_low),
+            and self._can_plan(left.lane, ego) and is_free(left, v, p.occupancy, v_low),
             right_free=right is not None and self._seen(right, t)
-            and is_free(right, v, p.occupancy, v_low),
+            and self._can_plan(right.lane, ego) and is_free(right, v, p.occupancy, v_low),
             clears_left=not blocked_now or left is None
             or self._pass_clears(ego, s, self.lane + 1, traffic),
             clears_right=not blocked_now or right is None or right.lane == SHOULDER
@@ -398,13 +405,15 @@ class MotionLayer:
         if self.motion not in LANE_CHANGES or self.path is None:
             return x
         if self.lane < 0:  # into the oncoming lane: committed once alongside (module doc)
-            safe = self._still_safe(ego, traffic)
+            safe = self._still_safe(ego, traffic) or not self._can_plan(self.origin, ego)
             return replace(x, target_free=safe, committed=self._alongside,
                            change_done=s >= self.path.end)
         target = self.road.lane(self.lane)
         centre, width = float(target.offset_at(s)), float(target.width_at(s))
-        return replace(x, target_free=is_free(traffic[self.lane], v, p.occupancy, v_low,
-                                              under_way=True),
+        # an abort plans a path back: a car that heads off the origin lane goes on instead
+        target_free = is_free(traffic[self.lane], v, p.occupancy, v_low, under_way=True) \
+            or not self._can_plan(self.origin, ego)
+        return replace(x, target_free=target_free,
                        committed=abs(d - centre) < 0.5 * width, change_done=s >= self.path.end)
 
     def _junction_at(self, s: float) -> Junction | None:
@@ -447,9 +456,17 @@ class MotionLayer:
         return n - 1 if self.lane < 0 else self._right_of(self.lane, pull_over)
 
     def _plan_into(self, lane: int, ego: EgoState) -> LaneChangePath:
-        # the estimate of a standing car's speed may be a hair below 0
+        # the estimate of a standing car's speed may be a hair below 0; the car's station
+        # this tick is the projection's hint (a bend that turns back on itself passes near
+        # the car twice)
         return start_lane_change(self.road.lane(lane), lane, ego.x, ego.y, ego.heading,
-                                 max(ego.speed, 0.0), self.params.lane_change)
+                                 max(ego.speed, 0.0), self.params.lane_change, self._station)
+
+    def _can_plan(self, lane: int, ego: EgoState) -> bool:
+        """Whether a path into `lane` starts from the car's pose (it heads less than 90
+        degrees off the lane, `planner.lane_change_path.can_start`): a car that does not
+        (spun round) holds its lane, and a stop for a flat tyre is made in it."""
+        return can_start(self.road.lane(lane), ego.x, ego.y, ego.heading, self._station)
 
     def _leads(self, traffic: dict[int, LaneTraffic], s: float, d: float,
                v: float) -> tuple[Neighbour, ...]:
@@ -501,6 +518,8 @@ class MotionLayer:
         if ahead is None or not -self.road.cross_section_at(s).oncoming_lanes <= lane \
                 < self.road.lanes_at(s):
             return True
+        if not self._can_plan(lane, ego):
+            return False
         return self.clears(self._plan_into(lane, ego), ahead, s, ego.speed)
 
     def _room(self, traffic: dict[int, LaneTraffic], s: float, v: float,

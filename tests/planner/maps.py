@@ -61,7 +61,9 @@ class StraightLane:
         s_arr, r_arr = np.broadcast_arrays(np.asarray(s, float), np.asarray(r, float))
         return np.stack([s_arr, self.offset + r_arr], axis=-1)
 
-    def local_coordinates(self, xy: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    def local_coordinates(
+        self, xy: ArrayLike, near: float | None = None
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         pts = np.asarray(xy, dtype=np.float64)
         return pts[..., 0], pts[..., 1] - self.offset
 

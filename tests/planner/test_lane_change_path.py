@@ -10,6 +10,7 @@ import pytest
 from planner.lane_change_path import (
     LaneChangeParams,
     LaneChangePath,
+    can_start,
     path_length,
     peak_lateral_accel,
     plan_duration,
@@ -183,3 +184,19 @@ def test_progress_done_and_checks() -> None:
         path.reference_path(road.lane(0), 20.0, 0.0, 30.0, 0.5, road.length)
     with pytest.raises(ValueError, match="heading error"):
         start_lane_change(road.lane(1), 1, 10.0, 0.0, 2.0, V, P)
+
+
+def test_a_bend_that_turns_back_plans_from_the_cars_own_pass() -> None:
+    """A 200 deg bend (radius 8 m) brings the route back across its entry: the car's point
+    at station 10 m is also the nearest point of the exit, where the lane heads ~160 deg the
+    other way. With the car's station as the hint the path starts at the car's own pass."""
+    road = make_map(seg(60.0, lanes=2, oncoming=0), arc(-8.0, -200.0, lanes=2, oncoming=0),
+                    seg(60.0, lanes=2, oncoming=0))
+    x, y, heading = 10.0, 1.0, float(road.lane(0).heading_at(10.0))
+    with pytest.raises(ValueError, match=r"heading error -2\.79"):
+        start_lane_change(road.lane(1), 1, x, y, heading, V, P)  # no hint: the exit
+    assert not can_start(road.lane(1), x, y, heading)
+    assert can_start(road.lane(1), x, y, heading, near=10.0)
+    change = start_lane_change(road.lane(1), 1, x, y, heading, V, P, near=10.0)
+    assert change.s0 == pytest.approx(10.0) and change.m0 == pytest.approx(0.0, abs=1e-9)
+    assert change.r0 == pytest.approx(1.0 - W)

@@ -327,3 +327,16 @@ def test_a_lane_counts_as_seen_behind_only_a_while_after_a_car_alongside_in_it()
             break
     assert last_alongside > 0.0 and start is not None
     assert start - last_alongside == pytest.approx(0.5, abs=0.03)
+
+
+def test_a_car_heading_off_its_lane_holds_it_on_a_flat_tyre() -> None:
+    """A car turned ~164 deg off its lane (2.856 rad, as after a spin on a flat front tyre)
+    has no lane-change path: the pull-over waits in the lane, no exception."""
+    m = MotionLayer(ROAD, 1, AccParams(), VEHICLE, MotionLayerParams())
+    spun = replace(ego(0.0, 100.0, W), heading=2.856, speed=0.0)
+    for k in range(80):
+        man, _ = m.update(replace(spun, t=0.025 * k), V, [], pull_over=True)
+        assert man.motion is Motion.LANE_KEEP and man.lane == 1 and man.path is None
+    # heading along the lane again, it pulls over
+    man, _ = m.update(replace(spun, t=2.0, heading=0.0), V, [], pull_over=True)
+    assert man.motion is Motion.LANE_CHANGE_RIGHT and man.lane == 0
