@@ -46,7 +46,9 @@ only from about 9 m behind; so with overtaking on, behind a (nearly) stationary 
 blocks the lane the car stops ``pass_gap`` back instead of at the ACC's standstill gap d0: the
 manoeuvre asks the ACC to keep ``room`` = ``pass_gap`` - d0 more (the room to pull out, as a
 driver leaves to see the tyres of the car ahead), as much of it as a stop at
-``room_decel`` still leaves. Without overtaking, the ACC's d0 holds (UN R157
+``room_decel`` still leaves, or, when the stop at d0 alone needs more (a vehicle revealed
+late by a cut-out), a stop at ``room_decel_hard``; the room granted stays granted while the
+car stops behind that vehicle (`_room`). Without overtaking, the ACC's d0 holds (UN R157
 4.2.1: 2 to 6 m). From 2 to 6 m behind a car of the same width no forward path clears it
 (the turning circle): a pass from there waits for good.
 
@@ -142,7 +144,14 @@ class MotionLayerParams:
     #   lane behind it), its rear counts as seen again only after this: the tracks of what
     #   it hid need 3 of 5 scans at 10 Hz to be confirmed (`perception.tracking`)
     room_decel: float = 2.5  # [m/s^2] the room is kept only as far as a stop at this
-    #   leaves it (below ISO 15622's 3.5 m/s^2: never a hard stop for it)
+    #   leaves it (below ISO 15622's 3.5 m/s^2: never a hard stop for it) ...
+    room_decel_hard: float = 6.5  # [m/s^2] ... unless the stop at d0 alone already
+    #   needs more (a vehicle revealed late: the stop is a hard one anyway); then as far as a
+    #   stop at this leaves it (under the emergency stop's A_EMERGENCY, which a late stop at
+    #   d0 ends in): a car stopped at d0 behind a vehicle of its width has no forward path
+    #   around it, and would wait behind it for good. 50 km/h, 27 m from a stopped car:
+    #   8 m of room (A_HARD's 5 m/s^2 would leave 4.1, a stop short of the 9 m a pass
+    #   path from a standstill needs)
     stationary: float = 0.5  # [m/s] a vehicle slower than this is stationary
     keep_right_gap: float = 2.0  # [s] keeping right waits for this time gap to a car behind
     #   in the right lane (UN R157's t_G of 1 s aborts a change: the margin between the two
@@ -200,6 +209,8 @@ class MotionLayer:
         self._no_pass_now = ""  # ... this tick's reason
         self._passed: int | None = None  # the track passed through the oncoming lane
         self._alongside = False  # the car has drawn alongside it (the pass is committed)
+        self._kept: tuple[int, float] | None = None  # the room granted so far behind a
+        #   stationary vehicle: (its track id, the room [m]) (`_room`)
 
     def update(self, ego: EgoState, v_want: float, tracks: Sequence[Track],
                pull_over: bool = False, v_rear: float | None = None,
@@ -526,10 +537,12 @@ class MotionLayer:
               v_want: float) -> tuple[int | None, float]:
         """The track id of a stationary vehicle blocking the lane kept, which the car may
         pass (overtaking on, keeping its lane, a lane beside it), and the room [m] the ACC
-        is to keep behind it beyond d0: ``pass_gap`` - d0, or as much of it as a stop at
-        ``room_decel`` from speed `v` [m/s] still leaves (never a hard stop for it). As the
-        car slows on a gentler stop the room left grows, up to ``pass_gap`` - d0: the car
-        stops as far back as it comfortably can."""
+        is to keep behind it beyond d0: ``pass_gap`` - d0, or as much of it as a stop from
+        speed `v` [m/s] at ``room_decel`` still leaves (never a hard stop for it), or at
+        ``room_decel_hard`` when the stop at d0 alone needs more than ``room_decel``
+        (`room_left`). The room granted is kept (the largest so far for that vehicle): a
+        stop gentler than the deceleration it was granted at would shrink what is left of
+        it tick by tick, down to d0, where no path gets around the vehicle."""
         p = self.params
         ahead = traffic[self.lane].ahead if self.lane in traffic else None
         side = self.lane >= 0 and (
@@ -538,10 +551,24 @@ class MotionLayer:
         if (not p.overtake or not side or self.motion is not Motion.LANE_KEEP or ahead is None
                 or ahead.speed >= p.stationary
                 or not is_blocked(traffic[self.lane], v, v_want, p.occupancy, self.acc)):
+            self._kept = None
             return None, 0.0
-        comfortable = ahead.gap - self.acc.d0 - v * v / (2.0 * p.room_decel)
-        room = min(max(p.pass_gap - self.acc.d0, 0.0), max(comfortable, 0.0))
+        room = room_left(ahead.gap, v, self.acc.d0, p)
+        if self._kept is not None and self._kept[0] == ahead.track_id:
+            room = max(room, self._kept[1])
+        self._kept = (ahead.track_id, room)
         return ahead.track_id, room
+
+
+def room_left(gap: float, v: float, d0: float, p: MotionLayerParams) -> float:
+    """[m] the room beyond the standstill gap `d0` [m] that a stop from speed `v` [m/s] at
+    `gap` [m] behind a stationary vehicle leaves, up to ``pass_gap`` - d0: at ``room_decel``,
+    or at ``room_decel_hard`` when a stop at d0 itself needs more than ``room_decel``
+    (0 when even that stop cannot leave any)."""
+    room = gap - d0
+    hard = room <= 0.0 or v * v / (2.0 * room) > p.room_decel
+    decel = p.room_decel_hard if hard else p.room_decel
+    return min(max(p.pass_gap - d0, 0.0), max(room - v * v / (2.0 * decel), 0.0))
 
 
 def _kind(reason: str) -> str:

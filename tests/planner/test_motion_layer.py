@@ -14,7 +14,7 @@ from perception.messages import EgoState, ObjectClass, Track
 from planner.fsm.acc import AccParams
 from planner.fsm.motion import Motion
 from planner.lane_occupancy import Neighbour, lane_traffic
-from planner.motion_layer import MotionLayer, MotionLayerParams
+from planner.motion_layer import MotionLayer, MotionLayerParams, room_left
 from tests.roads import W, make_map, seg
 from tests.vehicle import VEHICLE
 from world.hdmap import SHOULDER, Manoeuvre, Side
@@ -280,6 +280,52 @@ def test_the_room_is_what_a_gentle_stop_leaves() -> None:
     m/s^2) takes 38.6 m, so 50 - 4 - 38.6 = 7.4 m of room (not the 8 m of `pass_gap`)."""
     man = layer().update(ego(0.0, 100.0), V, [stopped_car(0.0, 50.0)])[0]
     assert man.room == pytest.approx(50.0 - 4.0 - V**2 / 5.0, abs=0.05)
+
+
+def test_the_room_granted_is_kept_through_a_gentler_stop() -> None:
+    """The 7.4 m granted 50 m behind the stopped car at 13.9 m/s stay granted while the car
+    brakes at 1.5 m/s^2 (gentler than `room_decel`): what a stop at 2.5 m/s^2 would leave
+    from there shrinks every tick (to 50 - 11.9 - 4 - 12.6^2 / 5 = 2.4 m after 0.9 s, the
+    pass not yet started), which would bring the car to its d0, where no pass path clears
+    the car."""
+    m, t, x, v = layer(), 0.0, 100.0, V
+    first = m.update(ego(0.0, x), V, [stopped_car(0.0, 50.0)])[0].room
+    rooms = []
+    while t < 0.9:
+        t, x, v = t + 0.025, x + v * 0.025, v - 1.5 * 0.025
+        state = replace(ego(t, x), speed=v)
+        track = stopped_car(t, 50.0)  # at x = 100 + front overhang + 50 + 2.3: it stands
+        rooms.append(m.update(state, V, [track])[0].room)
+    assert first == pytest.approx(50.0 - 4.0 - V**2 / 5.0, abs=0.05)
+    assert rooms == pytest.approx([first] * len(rooms))
+
+
+@pytest.mark.parametrize("gap", [20.0, 27.0, 32.0])
+def test_a_late_reveal_keeps_room_at_a_hard_stop(gap: float) -> None:
+    """A stopped car revealed 20 to 32 m ahead at 13.9 m/s: a stop at d0 alone needs 4.1 to
+    6.0 m/s^2, more than `room_decel`; the room is then what a stop at `room_decel_hard`
+    leaves, so that the car stops where a pass path from a standstill clears the car (9 m
+    back does, `test_passes_a_stopped_car_from_a_standstill_only_with_room_to_pull_out`) as
+    far as that stop can; at d0 it would wait behind it for good."""
+    p, acc = MotionLayerParams(overtake=True), AccParams()
+    man = layer().update(ego(0.0, 100.0), V, [stopped_car(0.0, gap)])[0]
+    hard = gap - 4.0 - V**2 / (2.0 * p.room_decel_hard)
+    assert man.room_for == 7
+    assert man.room == pytest.approx(min(max(hard, 0.0), 8.0), abs=0.05)
+    if gap >= 27.0:
+        assert acc.d0 + man.room >= 9.0
+
+
+@pytest.mark.parametrize(("gap", "v", "room"), [
+    (50.0, V, 50.0 - 4.0 - V**2 / 5.0),  # a gentle stop: at room_decel
+    (60.0, V, 8.0),  # pass_gap - d0 at most
+    (26.0, V, 26.0 - 4.0 - V**2 / 13.0),  # a stop at d0 needs 4.4 m/s^2: at room_decel_hard
+    (10.0, V, 0.0),  # not even that stop leaves any
+    (3.0, 0.0, 0.0),  # nearer than d0
+    (9.0, 0.0, 5.0),  # standing: what lies beyond d0
+])
+def test_room_left(gap: float, v: float, room: float) -> None:
+    assert room_left(gap, v, 4.0, MotionLayerParams()) == pytest.approx(room, abs=1e-9)
 
 
 def test_a_flat_tyre_waits_for_the_car_behind_judged_at_the_speed_it_slows_to() -> None:
