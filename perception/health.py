@@ -25,7 +25,15 @@ monitor watches what they deliver and says, per sensor, how it noticed a fault
   (`perception.localization.Localizer.predicted_fix`: the estimate extrapolated to the fix,
   bias included) than its gate, max(``gnss_gate``, ``gnss_gate_sigmas`` x the 1-sigma of
   prediction and fix together), is inconsistent: it is rejected (not fused), and the GNSS is
-  faulty until a fix passes the gate again.
+  faulty until a fix passes the gate again. A fix that disagrees with the camera's lane
+  across the lane (`perception.localization.LaneMatch.fix_offset`, each confident lane
+  estimate against the fix of its time, both on the HD map) by more than its stated accuracy
+  allows (the squared difference over its variance, fix and camera together, above
+  ``across_gate``: a chi-square test) at every confident frame for ``across_time`` is
+  inconsistent with the camera (`gnss_inconsistent`): a receiver may be off by more than it
+  states (an RTK fix that is not), and the localiser stops believing its accuracy; it is
+  faulty until they agree for ``across_time`` again. No confident frame for ``across_time``
+  starts the count anew (the camera cannot tell).
 
 A sensor is watched from its first delivery on (a stack without a LiDAR, or before its first
 frame, has nothing to miss).
@@ -61,6 +69,10 @@ class HealthParams:
     #   receiver's own dropouts average 2 s and are bridged)
     gnss_gate: float = 5.0  # [m] the least gate between a fix and its prediction
     gnss_gate_sigmas: float = 4.0  # [-] the gate in 1-sigmas of prediction and fix together
+    across_gate: float = 10.8  # [-] squared difference across the lane over its variance
+    #   (chi^2, 1 dof, 99.9 %): an RTK fix (5 cm) more than 0.52 m from the camera's lane
+    across_time: float = 0.5  # [s] that long at every confident frame: inconsistent (a car
+    #   driving on a fix 1.3 m wrong leaves its lane within 1.5 s); as long agreeing: sound
 
 
 @dataclass(frozen=True, slots=True)
@@ -113,6 +125,10 @@ class HealthMonitor:
         self._fix_t: float | None = None  # [s] the last valid, accepted fix's time
         self._gnss_seen = False
         self._rejected: str | None = None  # how the last valid fix failed its gate
+        self._apart: float | None = None  # [s] the first frame of this run of disagreement
+        self._agree: float | None = None  # [s] the first frame of this run of agreement
+        self._across_t: float | None = None  # [s] the last confident frame compared
+        self._inconsistent: str | None = None  # how the fixes disagree with the camera
 
     def camera(self, frame: CameraFrame, speed: float, now: float) -> str | None:
         """Check the lane camera's `frame` (the car moving at `speed` [m/s]), delivered at
@@ -177,6 +193,38 @@ class HealthMonitor:
         self._fix_t, self._rejected = fix.t, None
         return FixCheck(True, distance, gate)
 
+    def across(self, t: float, offset: float, stated: float, camera: float) -> str | None:
+        """Compare a confident camera lane of time `t` [s] with the fix of its time: the
+        fix's `offset` [m] across the lane less the camera's (NaN: nothing to compare), the
+        fix stating `stated` [m] 1-sigma, the camera's offset of 1-sigma `camera` [m]. How
+        the fixes are inconsistent with the camera, or None."""
+        p = self.params
+        sigma = math.hypot(stated, camera)  # [m] of the difference
+        if math.isnan(offset) or sigma <= 0.0:
+            return self._inconsistent
+        if self._across_t is not None and t - self._across_t > p.across_time:
+            self._apart = self._agree = None  # the camera could not tell for a while
+        self._across_t = t
+        if offset * offset > p.across_gate * sigma * sigma:
+            self._agree = None
+            self._apart = t if self._apart is None else self._apart
+            if t - self._apart >= p.across_time - 1e-9:
+                self._inconsistent = (
+                    f"GNSS fix {abs(offset):.1f} m across the lane from the camera's lane for "
+                    f"{t - self._apart:.1f} s (it states {stated:.2f} m)")
+        else:
+            self._apart = None
+            self._agree = t if self._agree is None else self._agree
+            if t - self._agree >= p.across_time - 1e-9:
+                self._inconsistent = None
+        return self._inconsistent
+
+    @property
+    def gnss_inconsistent(self) -> str | None:
+        """How the GNSS fixes disagree with the camera's lane (`across`); None: they agree
+        (or there was nothing to compare)."""
+        return self._inconsistent
+
     def health(self, t: float) -> SensorHealth:
         """What is wrong at time `t` [s] (module doc)."""
         p = self.params
@@ -191,4 +239,6 @@ class HealthMonitor:
         gnss = self._rejected
         if gnss is None and self._fix_t is not None and t - self._fix_t > p.gnss_timeout:
             gnss = f"no valid GNSS fix for {t - self._fix_t:.1f} s"
+        if gnss is None:
+            gnss = self._inconsistent
         return SensorHealth(camera, lidar, gnss, self._occlusion)

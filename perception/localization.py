@@ -23,6 +23,13 @@ Steps:
    carrier-phase (RTK) accuracy (``rtk_sigma`` or better) is taken at its word: the camera's
    lane errors would otherwise pass into the bias estimate and move the car's pose where
    nothing corrects it (through a town junction's turn, out of its corridor by 0.35 m).
+   Its word holds only while it agrees with the camera's lane: every confident lane estimate
+   is compared with the fix of its time across the matched lane (`LaneMatch.fix_offset`),
+   and where `perception.health` finds them apart for long (`gnss_consistent`), the receiver
+   is assumed off by what they disagree by, at least the floor: the bias's variance is
+   opened to that (and the position's with it, their sum, what the fix measures, kept), so
+   that the camera's lane passes its gate and pins the position across the lane while the
+   fixes move only the bias; along the route the station stays the odometry's.
 3. Update at every odometry sample with its speed (mean rear wheel spin x nominal radius;
    while a wheel locks under hard braking, reading ``wheel_lock_ratio`` or more below the
    fastest one, the fastest wheel's: the reference speed of an ABS, `wheel_speed`) and the
@@ -61,7 +68,8 @@ own Jacobians; the prediction and the gated map-matching update are done here.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from collections import deque
+from dataclasses import dataclass, replace
 
 import numpy as np
 from filterpy.kalman import ExtendedKalmanFilter
@@ -76,6 +84,7 @@ FloatArray = NDArray[np.float64]
 DIM_X = 7
 IX, IY, IPSI, IV, IW, IBX, IBY = range(DIM_X)
 DEG = math.pi / 180.0  # [rad/deg]
+FIXES_KEPT = 4  # the last fused fixes kept to compare a camera frame (one period late) with
 
 _H_GNSS = np.eye(DIM_X)[[IX, IY, IPSI]] + np.eye(DIM_X)[[IBX, IBY, IPSI]] * [[1], [1], [0]]
 #   (3, 7): position + bias, heading
@@ -140,6 +149,9 @@ class LaneMatch:
     distance2: float  # [-] its squared Mahalanobis distance
     accepted: bool  # within the gate, applied
     correction: tuple[float, float, float]  # [m, m, rad] x, y, heading added to the state
+    fix_offset: float = math.nan  # [m] the fix nearest the frame's time, its offset across
+    #   the matched lane less the camera's (left +; NaN: no fix, or a lane not confident)
+    fix_sigma: float = math.nan  # [m] the 1-sigma accuracy that fix states
 
 
 def wheel_speed(odo: Odometry, lock_ratio: float) -> float:
@@ -247,6 +259,9 @@ class Localizer:
         self._station: float | None = 0.0  # [m] the estimate's station on the route when
         #   last placed on it (`_on_route`; first: the route's start, where the car begins)
         self.matched = False  # a camera lane has been matched on the map since the start
+        self._fixes: deque[GnssFix] = deque(maxlen=FIXES_KEPT)  # the last fused fixes
+        self._fix_offset = 0.0  # [m] the last `LaneMatch.fix_offset` measured
+        self.gnss_trusted = True  # the receiver's stated accuracy is believed (`gnss_consistent`)
 
     @property
     def initialised(self) -> bool:
@@ -284,6 +299,7 @@ class Localizer:
         if not self._initialised:
             self._initialise(fix)
             return
+        self._fixes.append(fix)
         self._bias_sigma = self._bias_sigma_of(fix)
         self._predict_to(fix.t)
         sigma = self._white_sigma(fix)
@@ -317,7 +333,36 @@ class Localizer:
         weight = min(1.0, lane.confidence / p.lane_confidence)
         match = self._gated_update(h, nu, self._r_lane / weight**2, p.lane_gate, index)
         self.matched = self.matched or match.accepted
-        return match
+        if lane.confidence < p.lane_confidence or not self._fixes:
+            return match
+        fix = min(self._fixes, key=lambda f: abs(f.t - lane.t))
+        r_fix = float(map_lane.local_coordinates(np.array([fix.x, fix.y]), self._station)[1])
+        self._fix_offset = r_fix - lane.offset
+        return replace(match, fix_offset=self._fix_offset, fix_sigma=fix.sigma)
+
+    def gnss_consistent(self, consistent: bool) -> None:
+        """Whether the receiver agrees with the camera's lane (`perception.health`); when it
+        stops agreeing, its stated accuracy is no longer believed across the car (module
+        doc, step 2): the bias's variance in that direction is opened to at least the square
+        of the floor and of the last disagreement, the position's by as much, their
+        covariance lowered by as much (the sum x + b, what a fix measures, keeps its
+        variance); along the car, where the camera cannot check the fixes, nothing changes.
+        """
+        if consistent == self.gnss_trusted:
+            return
+        self.gnss_trusted = consistent
+        if consistent or not self._initialised:
+            return
+        n2 = self._across()
+        pos, bias = [IX, IY], [IBX, IBY]
+        cov = self._ekf.P.copy()
+        wanted = max(self.params.gnss_bias_floor, abs(self._fix_offset)) ** 2
+        more = n2 * max(wanted - float(np.sum(n2 * cov[np.ix_(bias, bias)])), 0.0)
+        cov[np.ix_(pos, pos)] += more
+        cov[np.ix_(bias, bias)] += more
+        cov[np.ix_(pos, bias)] -= more
+        cov[np.ix_(bias, pos)] -= more
+        self._ekf.P = cov
 
     def _measures(self, lane: LaneEstimate) -> bool:
         """Whether ``lane`` is a measurement for map matching (`LocalizerParams`)."""
@@ -511,6 +556,13 @@ class Localizer:
         floor = p.gnss_bias_floor if self.road is not None and fix.sigma > p.rtk_sigma else 0.0
         return max(floor, fix.sigma)
 
+    def _across(self) -> FloatArray:
+        """(2, 2) the projection n n^T on the map-frame direction across the car (left)."""
+        psi = float(self._ekf.x[IPSI])
+        n = np.array([-math.sin(psi), math.cos(psi)])
+        out: FloatArray = np.outer(n, n)
+        return out
+
     def _white_sigma(self, fix: GnssFix) -> float:
         """[m] the white noise assumed of a fix: a part of its stated sigma, at least the
         floor."""
@@ -547,6 +599,9 @@ class Localizer:
         q = process_noise(x0, dt, self.params)
         q[IBX, IBX] += self._bias_sigma**2 * (1.0 - decay * decay)
         q[IBY, IBY] += self._bias_sigma**2 * (1.0 - decay * decay)
+        if not self.gnss_trusted and self.road is not None:  # across the car: the floor
+            floor2 = max(self.params.gnss_bias_floor**2 - self._bias_sigma**2, 0.0)
+            q[np.ix_([IBX, IBY], [IBX, IBY])] += self._across() * floor2 * (1.0 - decay * decay)
         self._ekf.x = x
         self._ekf.P = f @ self._ekf.P @ f.T + q
         self._t = t

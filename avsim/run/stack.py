@@ -204,6 +204,7 @@ class Stack:
             with watch("localisation"):
                 match = self.localizer.on_lane(lane, pose)
                 self.localizer.on_line_end(lane, pose)
+                self._gnss_across(lane.t, match)
             self._stop_line(front, lane, pose)
             self._view = LaneView(lane, _corrected(pose, match))
         if front is not None and self.sign_detector is not None:
@@ -221,6 +222,16 @@ class Stack:
                 tracks = self.tracker.update(t, pose, detections, (mount.x, mount.y))
             self._tracks = tracks
         return PerceptionOutput(t, pose, lane_raw, lane, detections, tracks)
+
+    def _gnss_across(self, t: float, match: LaneMatch | None) -> None:
+        """Compare the fix with the camera's lane of time `t` [s] across the lane
+        (`perception.health`); a receiver found inconsistent with it is no longer believed
+        by the localiser."""
+        if match is None:
+            return
+        self.health.across(t, match.fix_offset, match.fix_sigma,
+                           self.localizer.params.lane_offset_sigma)
+        self.localizer.gnss_consistent(self.health.gnss_inconsistent is None)
 
     def _stop_line(self, front: CameraFrame, lane: LaneEstimate, pose: EgoState) -> None:
         """Look for a stop line where the map has one ahead, and place the car along the

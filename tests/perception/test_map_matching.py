@@ -96,7 +96,8 @@ def test_a_receiver_that_understates_its_error_is_corrected_too() -> None:
 def test_a_receiver_stating_rtk_accuracy_is_taken_at_its_word() -> None:
     """5 cm stated (an RTK fix): the camera's lane does not move the pose against it, so a
     wrong RTK fix (1.5 m off) is followed; a right one is not disturbed by the camera's own
-    errors."""
+    errors. (In the stack `perception.health` notices such a fix against the camera's lane
+    and the localiser stops believing it: `test_gnss_consistency`.)"""
     _, t, err = drive(ROAD, 20.0, (0.0, 1.5), stated=0.05, noise=0.05)
     assert float(np.mean(err[t >= 2.0])) == pytest.approx(1.5, abs=0.2)
 

@@ -19,6 +19,7 @@ from numpy.typing import NDArray
 from avsim.criteria.route import MRM_DECEL
 from avsim.run.runner import RunResult
 from planner.fsm.machine import StateChange
+from tests.scenarios.golden import check
 from world.frames import CameraFrame
 from world.sensors.setup import Profile
 
@@ -255,3 +256,29 @@ def test_lidar_delay_is_noticed_from_the_scans_stamps_and_makes_a_minimum_risk_s
     assert [c.target for c in changes(r, "lane_source")] == ["camera"]
     assert_minimum_risk_stop(r, noticed.t + 11.0, end)
     assert speed_at(r, resumed.t + 8.0) > 12.0
+
+
+def test_gnss_false_rtk_is_found_inconsistent_with_the_camera_and_the_lane_is_kept(
+        run_scenario: Callable[..., RunResult]) -> None:
+    """A receiver stating 5 cm but 1.3 m off across the road: before, the stack took it at
+    its word, never found the camera's lane and left its lane by 0.45 m."""
+    r = run(run_scenario, "gnss_false_rtk")
+    gnss = r.scenario.world.sensors.gnss
+    assert gnss.stated_sigma == pytest.approx(0.05) and gnss.bias == (0.0, 1.3)
+    # how the stack noticed: its fixes 1.3 m across the lane from the camera's lane
+    sensing = changes(r, "sensing")
+    assert [c.target for c in sensing] == ["degraded"]
+    noticed = sensing[0]
+    assert noticed.t < 1.0
+    assert noticed.reason.startswith("GNSS fix 1.3 m across the lane from the camera's lane "
+                                     "for 0.5 s (it states 0.05 m): the lane kept without GNSS")
+    # the camera's lane was found at once and kept; the pose followed it, not the fixes
+    lane = changes(r, "lane_source")
+    assert [c.target for c in lane] == ["camera"] and lane[0].t < 1.5
+    assert changes(r, "hazard") == []
+    t, error = r.log.array("t"), r.log.array("pose_error")
+    assert np.max(error[t > 3.0]) < 0.3
+    assert speed_at(r, 10.0) == pytest.approx(30 / 3.6, abs=0.3)
+    for name in ("no_collision", "tyres_in_lane", "completes"):
+        assert verdict(r, name) == "pass", name
+    check(r, "fault_gnss_false_rtk")
