@@ -28,7 +28,18 @@ A lane is *free* for the ego to move into when nothing is alongside and
   guards every lateral move (`planner.motion_layer`). v is the *lowest* speed the ego plans
   during the move (`v_rear`; its speed now unless it is slowing, as after a flat tyre): a car
   that brakes while it moves over lets the one behind close faster. A change under way goes
-  on (the lane stays free for it) up to ``rear_decel_abort`` (hysteresis).
+  on (the lane stays free for it) up to ``rear_decel_abort`` (hysteresis);
+- behind, not braking: a faster vehicle behind that does not brake at all must not close
+  to within t_G of the ego before the move is over (`rear_closes`):
+
+      gap - dv T >= v t_G,   dv = max(V_behind - v, 0),
+
+  T the time the move takes (`t_move`: a move under way, the time left to its end, and it
+  goes on while the vehicle stays ``rear_time_gap_abort`` back: hysteresis). The rule above
+  lets a car that brakes make the room; this one keeps the ego from moving out, slow, in
+  front of one that does not: 37 m behind at +12.5 m/s (65 km/h on the ego at 20 km/h)
+  satisfies the rule above (36.6 m) yet closes the gap in 3 s, less than a change takes
+  (~5 s).
 
 The ego's own lane is *blocked* when the vehicle ahead in it moves slower than the speed
 the ego wants by more than ``block_margin`` and is within the ACC's d_max (the gap inside
@@ -59,6 +70,9 @@ class OccupancyParams:
     #   its commit point) only above this (hysteresis: a car still slowing as it starts, or a
     #   track's speed wobble, does not start and abort a change within a second)
     rear_time_gap: float = 1.0  # [s] t_G, UN R157
+    rear_time_gap_abort: float = 0.5  # [s] a vehicle behind that does not brake gives up a
+    #   change under way only when it would close to within this (`rear_closes`; hysteresis
+    #   over t_G: its track's speed wobbles by tenths of a m/s)
     block_margin: float = kph(10.0)  # [m/s] slower than wanted by this blocks the lane
 
 
@@ -143,11 +157,22 @@ def rear_decel_needed(gap: float, v_behind: float, v: float, p: OccupancyParams)
     return dv * dv / (2.0 * room)
 
 
+def rear_closes(gap: float, v_behind: float, v: float, t_move: float, p: OccupancyParams,
+                under_way: bool = False) -> bool:
+    """Whether a vehicle `gap` [m] behind at `v_behind` [m/s], not braking, comes within
+    ``rear_time_gap`` (``rear_time_gap_abort`` for a move `under_way`) of the ego at `v`
+    [m/s] during a move of `t_move` [s] (module doc)."""
+    t_gap = p.rear_time_gap_abort if under_way else p.rear_time_gap
+    return gap - max(v_behind - v, 0.0) * t_move < v * t_gap
+
+
 def is_free(lt: LaneTraffic, v: float, p: OccupancyParams, v_rear: float | None = None,
-            under_way: bool = False) -> bool:
+            under_way: bool = False, t_move: float = 0.0) -> bool:
     """The ego at speed `v` [m/s] may move into this lane now (see the module doc); the rear
-    rule is judged at `v_rear` [m/s], the lowest speed it plans during the move (`v`), and
-    against ``rear_decel_abort`` instead of ``rear_decel`` for a move `under_way`."""
+    rules are judged at `v_rear` [m/s], the lowest speed it plans during the move (`v`),
+    for a move `under_way` against ``rear_decel_abort`` and ``rear_time_gap_abort``, the
+    non-braking one over `t_move` [s], the time the move takes (the time left, under way;
+    0: not judged)."""
     if lt.alongside:
         return False
     if lt.ahead is not None:
@@ -158,6 +183,9 @@ def is_free(lt: LaneTraffic, v: float, p: OccupancyParams, v_rear: float | None 
         v_low = v if v_rear is None else min(v, v_rear)
         limit = p.rear_decel_abort if under_way else p.rear_decel
         if rear_decel_needed(lt.behind.gap, lt.behind.speed, v_low, p) > limit:
+            return False
+        if t_move > 0.0 and rear_closes(lt.behind.gap, lt.behind.speed, v_low, t_move, p,
+                                        under_way):
             return False
     return True
 

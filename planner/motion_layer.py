@@ -397,9 +397,11 @@ class MotionLayer:
         x = MotionInput(
             t=t, since=self.machine.since, overtake=p.overtake, blocked=blocked,
             left_free=left is not None and self._seen(left, t)
-            and self._can_plan(left.lane, ego) and is_free(left, v, p.occupancy, v_low),
+            and self._can_plan(left.lane, ego) and self._free_to_start(left, ego, s, v_low,
+                                                                       traffic),
             right_free=right is not None and self._seen(right, t)
-            and self._can_plan(right.lane, ego) and is_free(right, v, p.occupancy, v_low),
+            and self._can_plan(right.lane, ego) and self._free_to_start(right, ego, s, v_low,
+                                                                        traffic),
             clears_left=not blocked_now or left is None
             or self._pass_clears(ego, s, self.lane + 1, traffic),
             clears_right=not blocked_now or right is None or right.lane == SHOULDER
@@ -422,10 +424,41 @@ class MotionLayer:
         target = self.road.lane(self.lane)
         centre, width = float(target.offset_at(s)), float(target.width_at(s))
         # an abort plans a path back: a car that heads off the origin lane goes on instead
-        target_free = is_free(traffic[self.lane], v, p.occupancy, v_low, under_way=True) \
-            or not self._can_plan(self.origin, ego)
+        v_end, t_move = self._rear_move(self.path, traffic, s, v, v_low, p.pass_margin_keep)
+        target_free = is_free(traffic[self.lane], v, p.occupancy, v_end, under_way=True,
+                              t_move=t_move) or not self._can_plan(self.origin, ego)
         return replace(x, target_free=target_free,
                        committed=abs(d - centre) < 0.5 * width, change_done=s >= self.path.end)
+
+    def _free_to_start(self, lt: LaneTraffic, ego: EgoState, s: float, v_low: float,
+                       traffic: dict[int, LaneTraffic]) -> bool:
+        """Whether a move into `lt`'s lane may start now (`planner.lane_occupancy.is_free`):
+        the rear rules judged at the speed the car will have on the path into it and over
+        the time that path takes (`_rear_move`)."""
+        behind = lt.behind
+        if behind is None or behind.speed <= v_low or lt.lane == SHOULDER:
+            return is_free(lt, ego.speed, self.params.occupancy, v_low)
+        v_end, t_move = self._rear_move(self._plan_into(lt.lane, ego), traffic, s, ego.speed,
+                                        v_low, self.params.pass_margin)
+        return is_free(lt, ego.speed, self.params.occupancy, v_end, t_move=t_move)
+
+    def _rear_move(self, path: LaneChangePath, traffic: dict[int, LaneTraffic], s: float,
+                   v: float, v_low: float, margin: float) -> tuple[float, float]:
+        """The speed [m/s] the car will have on `path` from station `s` [m] at speed `v`
+        [m/s], and the time [s] it takes to the path's end: `v_low` [m/s], or the speed of
+        the vehicle ahead in the lane left when the path does not clear it by `margin` [m]
+        (`clears`: the car trails it); the time is the path's length left at that speed, at
+        most ``t_cap`` (a car at a standstill: ``t_cap``). A change under way is judged to
+        its end, not to its commit point: a car closing fast seen just after the start
+        reaches the ego after the commit point, while it still moves over, slow."""
+        ahead = traffic[self.origin].ahead if self.origin in traffic else None
+        v_end = v_low
+        if ahead is not None and ahead.speed < v_end and not self.clears(path, ahead, s, v,
+                                                                         margin):
+            v_end = max(ahead.speed, 0.0)
+        t_cap = self.params.lane_change.t_cap
+        left = max(path.end - s, 0.0)
+        return v_end, min(left / v_end, t_cap) if v_end > 0.0 else (t_cap if left else 0.0)
 
     def _junction_at(self, s: float) -> Junction | None:
         """The town junction whose stop line the car's centre has passed and whose exit it

@@ -13,6 +13,7 @@ from planner.lane_occupancy import (
     is_blocked,
     is_free,
     lane_traffic,
+    rear_closes,
     rear_decel_needed,
 )
 from tests.roads import W, make_map, seg
@@ -137,3 +138,22 @@ def test_a_change_under_way_goes_on_up_to_the_abort_deceleration() -> None:
     worse = next(g / 10 for g in range(2000, 1, -1)
                  if rear_decel_needed(g / 10, 25.0, V, P) > 4.0)
     assert not is_free(behind(worse), V, P, under_way=True)
+
+
+def test_free_behind_needs_a_car_not_braking_to_stay_t_g_back_through_the_move() -> None:
+    """The ego at 20 km/h, a car at 65 km/h 37 m behind: UN R157's rule holds (it would
+    brake at 2.9 m/s^2), but not braking it closes 12.5 m/s x 5 s: the lane is not free
+    for a 5 s move; it is when the gap covers that and 1 s of the ego's speed."""
+    v, fast, t_move = 5.56, 18.06, 5.0
+    lt = LaneTraffic(1, behind=Neighbour(1, 1.0, 37.0, fast))
+    assert rear_decel_needed(37.0, fast, v, P) < 3.0 and is_free(lt, v, P)
+    assert not is_free(lt, v, P, t_move=t_move)
+    need = (fast - v) * t_move + v * P.rear_time_gap
+    assert is_free(LaneTraffic(1, behind=Neighbour(1, 1.0, need + 0.01, fast)), v, P,
+                   t_move=t_move)
+    assert not rear_closes(need + 0.01, fast, v, t_move, P)
+    assert rear_closes(need - 0.01, fast, v, t_move, P)
+    # judged at the lowest speed planned, and never for a car no faster than that
+    assert not is_free(LaneTraffic(1, behind=Neighbour(1, 1.0, need + 0.01, fast)), 8.0, P,
+                       v_rear=4.0, t_move=t_move)
+    assert is_free(LaneTraffic(1, behind=Neighbour(1, 1.0, 6.0, v)), v, P, t_move=t_move)

@@ -386,3 +386,52 @@ def test_a_car_heading_off_its_lane_holds_it_on_a_flat_tyre() -> None:
     # heading along the lane again, it pulls over
     man, _ = m.update(replace(spun, t=2.0, heading=0.0), V, [], pull_over=True)
     assert man.motion is Motion.LANE_CHANGE_RIGHT and man.lane == 0
+
+
+VS = 5.56  # [m/s] 20 km/h: the ego and the slow car ahead it follows
+
+
+def follow_slow(m: MotionLayer, t0: float, t1: float,
+                fast: tuple[float, float] | None = None,
+                ) -> list[tuple[float, Motion, int]]:
+    """Step from t0 to t1 at 40 Hz with the ego at 20 km/h on the plan's path, wanting
+    13.9 m/s, 25 m behind (centres) a car at its speed in lane 0; `fast` = (the ego's
+    centre minus the car's at t0 [m], its speed [m/s]) of a car coming up in lane 1."""
+    out, t, y = [], t0, 0.0
+    while t < t1:
+        x = 100.0 + VS * t
+        tracks = [car(t, x + 25.0, 0.0, VS, 1)]
+        if fast is not None:
+            x_fast = 100.0 + VS * t0 - fast[0] + fast[1] * (t - t0)
+            tracks.append(car(t, x_fast, W, fast[1], 2))
+        man, _ = m.update(replace(ego(t, x, y), speed=VS), V, tracks)
+        if man.path is not None:
+            y = float(ROAD.lane(man.path.target_index).offset_at(x)) + float(
+                man.path.offset_at(x))
+        out.append((t, man.motion, man.lane))
+        t += 0.025
+    return out
+
+
+def test_a_slow_ego_does_not_move_out_in_front_of_a_car_closing_fast() -> None:
+    """At 20 km/h, a car at 65 km/h 37 m behind (bumpers) in the left lane: UN R157's rule
+    holds (it would brake at 2.9 m/s^2), yet not braking it closes the gap in 3 s, before a
+    change (~5 s) is over: the ego keeps its lane. Without that car it passes."""
+    assert Motion.LANE_CHANGE_LEFT in {s[1] for s in follow_slow(layer(), 0.0, 2.0)}
+    gap = 37.0 + VEHICLE.rear_overhang + 2.3  # [m] centre to centre, 37 m bumper to bumper
+    steps = follow_slow(layer(), 0.0, 2.0, fast=(gap, 18.06))
+    assert {s[1] for s in steps} == {Motion.LANE_KEEP}
+
+
+def test_a_change_just_started_is_given_up_when_a_car_closing_fast_appears() -> None:
+    """The pass has begun (not yet committed) when a car at 65 km/h is seen 35 m behind in
+    the target lane: not braking it would reach the ego before its centre is in that lane;
+    the change is aborted, back to lane 0."""
+    m = layer()
+    steps = follow_slow(m, 0.0, 2.0)
+    start = next(s[0] for s in steps if s[1] is Motion.LANE_CHANGE_LEFT)
+    assert m.motion is Motion.LANE_CHANGE_LEFT and 2.0 - start < 1.0
+    gap = 35.0 + VEHICLE.rear_overhang + 2.3
+    steps = follow_slow(m, 2.0, 2.2, fast=(gap, 18.06))
+    assert steps[-1][1] is Motion.LANE_KEEP and steps[-1][2] == 0  # back to lane 0
+    assert m.path is not None and m.path.target_index == 0
