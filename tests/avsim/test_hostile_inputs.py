@@ -21,7 +21,6 @@ import pytest
 from click.testing import CliRunner, Result
 
 from avsim.cli import EXIT_BAD_INPUT, main
-from avsim.scenario import bounds
 from tests.world.map.opendrive.roads import geometry_xml, winding
 from world.map.opendrive import arcspline
 
@@ -125,9 +124,6 @@ def test_a_bounding_box_out_of_bounds_is_refused_in_one_line(tree: Path, size: s
     assert problem in _refused(_run(tree), tree)
 
 
-@pytest.mark.xfail(not hasattr(bounds, "MAX_INT_DIGITS"), strict=True, raises=AssertionError,
-                   reason="--param values go through the YAML resolver, whose integer bound "
-                          "(bounds.MAX_INT_DIGITS) comes with the YAML loader's hardening")
 def test_a_5000_digit_integer_parameter_on_the_command_line_is_refused(tree: Path) -> None:
     line = _refused(_run(tree, "--param",
                          "CutInVehicle_InitPosition_RelativeLaneId=-" + "1" * 5000), tree)
