@@ -242,7 +242,7 @@ class MotionLayer:
         changes = self.machine.apply(ego.t, change) + self._why_no_pass(ego, x)
         room_for, room = self._room(traffic, s, ego.speed, v_want)
         cap = speed_cap(float(self.road.speed_limit_at(s)), self.params.oncoming_pass) \
-            if min(self.lane, self.origin) < 0 else math.inf
+            if _oncoming(self.lane) or _oncoming(self.origin) else math.inf
         return Manoeuvre(self.motion, self.lane, self.origin, self.path,
                          self._leads(traffic, s, d, ego.speed), room, room_for, cap), changes
 
@@ -294,7 +294,7 @@ class MotionLayer:
         only way past, whether a pass is safe (`planner.oncoming_pass.decide`, the lane free
         alongside and behind) and its path clears the vehicle (else why not)."""
         self._no_pass_now = ""
-        if self.lane < 0:
+        if _oncoming(self.lane):
             back = self.road.lanes_at(s) - 1
             return replace(x, left_free=False, right_free=False, in_oncoming=True,
                            back_free=self._can_plan(back, ego)
@@ -417,7 +417,7 @@ class MotionLayer:
         x = self._oncoming_input(ego, s, x, blocked_now, v_low, traffic)
         if self.motion not in LANE_CHANGES or self.path is None:
             return x
-        if self.lane < 0:  # into the oncoming lane: committed once alongside (module doc)
+        if _oncoming(self.lane):  # into the oncoming lane: committed once alongside (module doc)
             safe = self._still_safe(ego, traffic) or not self._can_plan(self.origin, ego)
             return replace(x, target_free=safe, committed=self._alongside,
                            change_done=s >= self.path.end)
@@ -497,7 +497,7 @@ class MotionLayer:
         n = self.road.lanes_at(s)
         if to is Motion.LANE_CHANGE_LEFT:
             return self.lane + 1 if self.lane + 1 < n else -1
-        return n - 1 if self.lane < 0 else self._right_of(self.lane, pull_over)
+        return n - 1 if _oncoming(self.lane) else self._right_of(self.lane, pull_over)
 
     def _plan_into(self, lane: int, ego: EgoState) -> LaneChangePath:
         # the estimate of a standing car's speed may be a hair below 0; the car's station
@@ -602,6 +602,12 @@ def room_left(gap: float, v: float, d0: float, p: MotionLayerParams) -> float:
     hard = room <= 0.0 or v * v / (2.0 * room) > p.room_decel
     decel = p.room_decel_hard if hard else p.room_decel
     return min(max(p.pass_gap - d0, 0.0), max(room - v * v / (2.0 * decel), 0.0))
+
+
+def _oncoming(lane: int) -> bool:
+    """Whether lane index `lane` is an oncoming lane (-1, -2, ...: `world.hdmap`), not the
+    paved shoulder (`SHOULDER`, also negative) nor a lane of the car's direction."""
+    return SHOULDER < lane < 0
 
 
 def _kind(reason: str) -> str:

@@ -5,6 +5,7 @@ end, and aborts back to its lane when a fast car comes up behind in the target l
 from __future__ import annotations
 
 import itertools
+import math
 from dataclasses import replace
 
 import numpy as np
@@ -127,14 +128,16 @@ def test_moves_to_the_lane_that_goes_on_before_an_exit() -> None:
 
 def test_a_flat_tyre_pulls_over_lane_by_lane_onto_the_shoulder() -> None:
     m = MotionLayer(ROAD, 1, AccParams(), VEHICLE, MotionLayerParams())
-    t, x, y, lanes = 0.0, 100.0, W, []
+    t, x, y, lanes, caps = 0.0, 100.0, W, [], set()
     while t < 20.0:
         man, _ = m.update(ego(t, x, y), V, [], pull_over=True)
         if man.path is not None:
             y = float(ROAD.lane(man.path.target_index).offset_at(x)) + float(
                 man.path.offset_at(x))
         lanes.append(man.lane)
+        caps.add(man.speed_cap)
         t, x = t + 0.025, x + V * 0.025
+    assert caps == {math.inf}  # the shoulder (a negative index too) is no oncoming lane
     assert lanes[0] == 0 and lanes[-1] == SHOULDER  # lane 1 -> 0 -> the shoulder
     assert sorted(set(lanes), key=lanes.index) == [0, SHOULDER]
     assert m.motion is Motion.LANE_KEEP and m.path is None
