@@ -24,10 +24,12 @@ Steps:
    lane errors would otherwise pass into the bias estimate and move the car's pose where
    nothing corrects it (through a town junction's turn, out of its corridor by 0.35 m).
    Its word holds only while it agrees with the camera's lane: every confident lane estimate
-   is compared with the fix of its time across the matched lane (`LaneMatch.fix_offset`),
-   and where `perception.health` finds them apart for long (`gnss_consistent`), the receiver
-   is assumed off by what they disagree by, at least the floor: the bias's variance is
-   opened to that (and the position's with it, their sum, what the fix measures, kept), so
+   is compared with the fix of its time across the matched lane (`LaneMatch.fix_offset`;
+   not where they are half a lane or more apart: the camera may then have matched the lane
+   beside, whose lines look alike, and the fix is what tells), and where
+   `perception.health` finds them apart for long (`gnss_consistent`), the receiver is
+   assumed off by what they disagree by, at least the floor: the bias's variance is opened
+   to that (and the position's with it, their sum, what the fix measures, kept), so
    that the camera's lane passes its gate and pins the position across the lane while the
    fixes move only the bias; along the route the station stays the odometry's.
 3. Update at every odometry sample with its speed (mean rear wheel spin x nominal radius;
@@ -337,6 +339,9 @@ class Localizer:
             return match
         fix = min(self._fixes, key=lambda f: abs(f.t - lane.t))
         r_fix = float(map_lane.local_coordinates(np.array([fix.x, fix.y]), self._station)[1])
+        if abs(r_fix - lane.offset) >= 0.5 * float(map_lane.width_at(s)):
+            return match  # as far apart as a neighbouring lane: which lane the camera sees
+            #   is what is in question (lines look alike), not the receiver
         self._fix_offset = r_fix - lane.offset
         return replace(match, fix_offset=self._fix_offset, fix_sigma=fix.sigma)
 

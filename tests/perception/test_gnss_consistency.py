@@ -147,6 +147,34 @@ def test_a_false_rtk_fix_is_noticed_and_the_camera_keeps_the_position_across(
     assert float(np.max(np.abs(along[settled]))) < abs(bias[0]) + 0.3
 
 
+@pytest.mark.parametrize(("camera", "compared"), [(1.0, True), (-1.5, True), (2.0, False),
+                                                  (-2.5, False)])
+def test_a_fix_half_a_lane_or_more_from_the_camera_is_not_compared(camera: float,
+                                                                  compared: bool) -> None:
+    """The fix on the lane's centre, the camera `camera` [m] across: within half the lane's
+    width (1.75 m) the two are compared; as far apart as the lane beside, the camera may be
+    the one wrong (lane lines look alike) and nothing is compared (no evidence against the
+    receiver)."""
+    loc = Localizer(road=ROAD)
+    lane0 = ROAD.lane(0)
+    spin = SPEED / WHEEL_RADIUS
+    pose = None
+    for k in range(round(1.0 * ODO_RATE) + 1):
+        t = k / ODO_RATE
+        s = 20.0 + SPEED * t
+        loc.on_odometry(Odometry(t, (spin,) * 4, WHEEL_RADIUS, 0.0, 0.0))
+        if k % GNSS_EVERY == 0:
+            xy = lane0.position(s, 0.0)
+            loc.on_gnss(GnssFix(t, float(xy[0]), float(xy[1]), 0.0, RTK, 0.003))
+        pose = loc.estimate(t)
+    assert pose is not None
+    match = loc.on_lane(estimate(pose.t, camera), pose)
+    assert match is not None
+    assert math.isnan(match.fix_offset) is not compared
+    if compared:
+        assert match.fix_offset == pytest.approx(-camera, abs=0.05)
+
+
 def test_without_the_comparison_the_false_fix_is_followed() -> None:
     _, _, t, across, _ = drive((0.0, 1.3), duration=10.0, watch=False)
     assert float(np.mean(across[t >= 2.0])) == pytest.approx(1.3, abs=0.2)
