@@ -64,13 +64,14 @@ own Jacobians; the prediction and the gated map-matching update are done here.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 from filterpy.kalman import ExtendedKalmanFilter
 from numpy.typing import NDArray
 
-from perception.messages import EgoState, LaneEstimate
+from perception.messages import EgoState, LaneEstimate, Track
 from world.frames import GnssFix, Odometry, wrap_angle
 from world.hdmap import Lane, RoadMap, StopSign
 
@@ -129,6 +130,8 @@ class LocalizerParams:
     line_end_sigma: float = 1.0  # [m] where the camera sees the painted lines end
     line_end_range: tuple[float, float] = (10.0, 28.0)  # [m] ahead of the car's centre where
     #   a line end is believed: well inside the bird's-eye view (5 .. 35 m), not cut by it
+    line_end_clear: float = 3.0  # [m] a line ending this near a car ahead's rear, or beyond
+    #   it, may end where that car hides it (the line's end seen moves with the car)
     line_end_gate: float = 10.8  # [-] Mahalanobis distance^2 gate (chi^2, 1 dof, 99.9 %),
     #   also of a stop line's
     stop_line_sigma: float = 0.3  # [m] where the camera sees a stop line's near edge
@@ -158,6 +161,15 @@ def wheel_speed(odo: Odometry, lock_ratio: float) -> float:
     if fastest > 0.0 and min(spins) < (1.0 - lock_ratio) * fastest:
         return fastest * odo.wheel_radius
     return odo.speed
+
+
+def clear_ahead(tracks: Sequence[Track], half_width: float) -> float:
+    """[m] how far ahead of the car's centre its lane is free: the nearest rear of a tracked
+    object ahead whose box reaches within ``half_width`` [m] of the car's centre line
+    (vehicle frame at each track's time); infinity when none."""
+    rears = [t.rel_x - 0.5 * t.length for t in tracks
+             if t.rel_x > 0.0 and abs(t.rel_y) < half_width + 0.5 * t.width]
+    return min(rears, default=math.inf)
 
 
 def motion(x: FloatArray, dt: float, lever: float = 0.0) -> tuple[FloatArray, FloatArray]:
@@ -338,14 +350,18 @@ class Localizer:
         return lane.confidence >= p.lane_confidence or (
             lane.age == 0.0 and lane.confidence >= p.weak_lane_confidence)
 
-    def on_line_end(self, lane: LaneEstimate, pose: EgoState) -> LaneMatch | None:
+    def on_line_end(self, lane: LaneEstimate, pose: EgoState,
+                    clear: float = math.inf) -> LaneMatch | None:
         """Along the route: at a town junction the painted lines end at its mouth
         (`world.hdmap.Junction.s_enter`). Where the map has a mouth within
         ``line_end_range`` ahead of ``pose`` (the pose at the frame's time) and the farthest
         painted line of ``lane`` ends within that range too, the car's station is the
         mouth's less that distance: an update of the position along the lane, gated like
-        the lateral one (``line_end_gate``). None when there is nothing to match; else what
-        was done (``innovation``: [m] along the route, 0)."""
+        the lateral one (``line_end_gate``). ``clear`` [m] is how far ahead of the car's
+        centre its lane is free (`clear_ahead`: a car ahead's rear): lines that end within
+        ``line_end_clear`` of it, or beyond, end where that car hides them, not at the mouth,
+        and are not believed. None when there is nothing to match; else what was done
+        (``innovation``: [m] along the route, 0)."""
         p = self.params
         road = self.road
         if road is None or not road.junctions or not self._initialised \
@@ -353,7 +369,7 @@ class Localizer:
             return None
         ends = [b.x_max for b in (lane.left, lane.right) if b is not None]
         lo, hi = p.line_end_range
-        if not ends or not lo <= max(ends) <= hi:
+        if not ends or not lo <= max(ends) <= hi or max(ends) > clear - p.line_end_clear:
             return None
         x_end = max(ends)  # [m] the farthest line: a car ahead hides the nearer ends
         s = self._on_route(np.array([pose.x, pose.y]))[0]
