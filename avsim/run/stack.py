@@ -26,7 +26,7 @@ from perception.flat_tyre import FlatTyreDetector
 from perception.health import HealthMonitor
 from perception.lanes import LaneDetector, LaneFilter
 from perception.lights import TrafficLightDetector
-from perception.localization import LaneMatch, Localizer
+from perception.localization import LaneMatch, Localizer, clear_ahead
 from perception.messages import (
     Detection,
     EgoState,
@@ -203,7 +203,8 @@ class Stack:
                 lane = self.lane_filter.update(lane_raw, pose.speed, pose.yaw_rate)
             with watch("localisation"):
                 match = self.localizer.on_lane(lane, pose)
-                self.localizer.on_line_end(lane, pose)
+                self.localizer.on_line_end(lane, pose,
+                                           clear_ahead(self._tracks, 0.5 * lane.width))
                 self._gnss_across(lane.t, match)
             self._stop_line(front, lane, pose)
             self._view = LaneView(lane, _corrected(pose, match))

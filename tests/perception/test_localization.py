@@ -198,3 +198,71 @@ def test_a_locking_wheel_does_not_stop_the_car_in_the_estimate(
                    steering_angle=0.0)
     assert wheel_speed(odo, LocalizerParams().wheel_lock_ratio) == pytest.approx(
         expected * 0.33)
+
+
+def test_motion_jacobian_with_the_lever_matches_finite_differences() -> None:
+    x = np.array([3.0, -2.0, 0.7, 11.0, 0.3])
+    dt = 0.025
+    _, f = motion(x, dt, 1.35)
+    eps = 1e-6
+    for j in range(5):
+        dx = np.zeros(5)
+        dx[j] = eps
+        num = (motion(x + dx, dt, 1.35)[0] - motion(x - dx, dt, 1.35)[0]) / (2 * eps)
+        np.testing.assert_allclose(f[:, j], num, atol=1e-7)
+
+
+REAR_AXLE = 1.35  # [m] the car's centre ahead of its rear axle
+
+
+def dead_reckon_turn(turn: float, radius: float, rear_axle: float) -> tuple[float, float]:
+    """A town turn through ``turn`` [rad] of ``radius`` [m] at the rear axle, 6 m/s there,
+    between 1 s straights, in a GNSS outage after the first fix: the estimate is odometry
+    alone. Returns (position error [m], heading error [rad]) of the car's centre at the end."""
+    v = 6.0  # [m/s] the rear axle's speed
+    w = math.copysign(v / radius, turn)  # [rad/s] in the turn
+    t_turn = turn / w
+    loc = Localizer(LocalizerParams(rear_axle=rear_axle))
+    rear = np.zeros(2)
+    psi = 0.0
+
+    def centre() -> np.ndarray:
+        return rear + REAR_AXLE * np.array([math.cos(psi), math.sin(psi)])
+
+    c0 = centre()
+    spin = v / WHEEL_RADIUS
+    loc.on_odometry(Odometry(0.0, (spin, spin, spin, spin), WHEEL_RADIUS, 0.0, 0.0))
+    loc.on_gnss(GnssFix(0.0, float(c0[0]), float(c0[1]), 0.0, 0.05, 0.001))
+    dt = 1.0 / ODO_RATE
+    steps = round((2.0 + t_turn) * ODO_RATE)
+    def rate_after(t: float) -> float:  # [rad/s] over the step that starts at t
+        return w if 1.0 < t + 0.5 * dt < 1.0 + t_turn else 0.0
+
+    for k in range(1, steps + 1):
+        t = k * dt
+        rate = rate_after(t - dt)  # the gyro read it at the step's start
+        a = psi + 0.5 * rate * dt  # exact chord of the rear axle's arc
+        chord = v * dt if rate == 0.0 else 2.0 * v / rate * math.sin(0.5 * rate * dt)
+        rear = rear + chord * np.array([math.cos(a), math.sin(a)])
+        psi += rate * dt
+        loc.on_odometry(Odometry(t, (spin, spin, spin, spin), WHEEL_RADIUS, rate_after(t),
+                                 0.0))
+    est = loc.estimate(steps * dt)
+    c = centre()
+    return math.hypot(est.x - c[0], est.y - c[1]), abs(wrap_angle(est.heading - psi))
+
+
+@pytest.mark.parametrize(("turn", "radius"), [(math.pi / 2, 10.0), (-math.pi / 2, 8.0),
+                                              (math.pi, 5.25)])
+def test_the_centre_ahead_of_the_rear_axle_is_dead_reckoned_through_a_turn(
+        turn: float, radius: float) -> None:
+    """Through a junction's turn the camera sees no line: the pose is dead reckoning. The
+    rear wheels give the rear axle's speed; the centre, 1.35 m ahead, swings out by
+    2 x 1.35 x sin(turn / 2) (1.9 m for a right angle, 2.7 m for a U-turn) unless the
+    motion model carries it."""
+    swing = 2.0 * REAR_AXLE * abs(math.sin(turn / 2))  # [m]
+    error, heading_error = dead_reckon_turn(turn, radius, REAR_AXLE)
+    assert error < 0.1 * swing  # left: the gyro's step at the turn's ends, one sample
+    assert heading_error < 1e-3
+    unmodelled = dead_reckon_turn(turn, radius, 0.0)[0]
+    assert unmodelled == pytest.approx(swing, abs=0.2)

@@ -10,8 +10,8 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from perception.localization import Localizer
-from perception.messages import EgoState, LaneBoundary, LaneEstimate
+from perception.localization import Localizer, clear_ahead
+from perception.messages import EgoState, LaneBoundary, LaneEstimate, ObjectClass, Track
 from tests.roads import W, arc, make_map, seg
 from world.frames import GnssFix, Odometry, wrap_angle
 from world.hdmap import RoadMap
@@ -242,3 +242,127 @@ def test_a_stop_line_seen_fixes_the_station() -> None:
     assert max(abs(e) for d, e, _ in along if 0.0 <= d < 12.0) < 0.3
     back = replace(loc.estimate(t), x=100.0)  # 50 m before the line: none 3 m ahead
     assert loc.on_stop_line(3.0, back) is None
+
+
+REAR_AXLE = 1.35  # [m] the car's centre ahead of its rear axle
+
+
+def turn_through_junction(rear_axle: float) -> tuple[float, list[bool]]:
+    """The town's left turn (radius 11.25 m) at 8 m/s, the rear axle on the lane's centre, a
+    1.2 m GNSS bias across the approach: the camera sees the lane before the junction's
+    mouth and after its exit, nothing in between. Returns the largest position error [m] in
+    the junction and the gate's verdicts on the first 2 s of camera frames after it."""
+    from avsim.scenario.load import load_scenario
+    from world.map.road import build_road_map
+
+    road = build_road_map(load_scenario("town_left_turn").world.road)
+    junction = road.junctions[0]
+    lane = road.lane(0)
+    rng = np.random.default_rng(3)
+    loc = Localizer(replace(Localizer().params, rear_axle=rear_axle), road=road)
+    speed, s0 = 8.0, 20.0  # [m/s], [m]
+    spin = speed / WHEEL_RADIUS
+    worst, after = 0.0, []
+    for k in range(round((junction.s_exit + 16.0 - s0) / speed * ODO_RATE) + 1):
+        t = k / ODO_RATE
+        s = s0 + speed * t
+        heading = float(lane.heading_at(s))
+        centre = lane.position(s, 0.0) + REAR_AXLE * np.array([math.cos(heading),
+                                                               math.sin(heading)])
+        # the gyro reads the rate of the step that starts now (the filter's convention)
+        rate = speed * float(lane.curvature_at(s + 0.5 * speed / ODO_RATE))
+        loc.on_odometry(Odometry(t, (spin, spin, spin, spin), WHEEL_RADIUS, rate, 0.0))
+        if k % GNSS_EVERY:
+            continue
+        loc.on_gnss(GnssFix(t, float(centre[0]) + rng.normal(0.0, 0.3),
+                            float(centre[1]) - 1.2 + rng.normal(0.0, 0.3),
+                            wrap_angle(heading + rng.normal(0.0, 0.005)), STATED_SIGMA,
+                            0.005))
+        pose = loc.estimate(t)
+        if junction.s_enter <= s <= junction.s_exit:
+            worst = max(worst, math.hypot(pose.x - centre[0], pose.y - centre[1]))
+            continue
+        match = loc.on_lane(estimate(t, rng.normal(0.0, 0.04)), pose)
+        if s > junction.s_exit and match is not None:
+            after.append(match.accepted)
+    return worst, after[:20]
+
+
+def test_the_lane_after_a_junction_turn_is_matched_at_once() -> None:
+    """Through the turn the pose is dead reckoning from the rear wheels and the gyro; the
+    centre, 1.35 m ahead of the rear axle, swings out with the heading. Carried by the
+    motion model, the pose stays within 0.3 m through the junction (the lateral bias
+    before it becomes one along the street after it: the lane takes it out), and the
+    camera's lane after it is matched from the first frame."""
+    worst, after = turn_through_junction(REAR_AXLE)
+    assert worst < 0.3
+    assert after and all(after)
+    unmodelled, _ = turn_through_junction(0.0)
+    assert unmodelled > 1.0  # what the turn did to the pose without the lever
+
+
+def approach_behind_a_car(clear: bool) -> tuple[list[float], int]:
+    """A 2.5 m GNSS bias along the street; a car 13 m ahead (its rear) hides the lines beyond
+    it, so they seem to end there, until it has crossed the junction's mouth. Returns the
+    errors [m] along the street from s = 20 to 61 m (the mouth at 71 m) and the number of
+    line-end updates accepted."""
+    from avsim.scenario.load import load_scenario
+    from world.map.road import build_road_map
+
+    road = build_road_map(load_scenario("town_left_turn").world.road)
+    mouth = road.junctions[0].s_enter
+    rng = np.random.default_rng(4)
+    loc = Localizer(road=road)
+    lane = road.lane(0)
+    gap = 13.0  # [m] the car ahead's rear from the ego's centre
+    errors, accepted = [], 0
+    for k in range(round(41.0 / SPEED * ODO_RATE) + 1):
+        t = k / ODO_RATE
+        s = 20.0 + SPEED * t
+        xy = lane.position(s, 0.0)
+        spin = SPEED / WHEEL_RADIUS
+        loc.on_odometry(Odometry(t, (spin, spin, spin, spin), WHEEL_RADIUS, 0.0, 0.0))
+        if k % GNSS_EVERY:
+            continue
+        loc.on_gnss(GnssFix(t, float(xy[0]) + 2.5 + rng.normal(0.0, 0.3),
+                            float(xy[1]) + rng.normal(0.0, 0.3), rng.normal(0.0, 0.005),
+                            STATED_SIGMA, 0.005))
+        pose = loc.estimate(t)
+        end = min(mouth - s, gap, 34.0)  # [m] the mouth, the car ahead or the view
+        line = LaneBoundary((1.75, 0.0, 0.0), 5.0, end + rng.normal(0.0, 0.2), 400)
+        seen = replace(estimate(t, rng.normal(0.0, 0.04)), left=line,
+                       right=replace(line, coefficients=(-1.75, 0.0, 0.0)))
+        loc.on_lane(seen, pose)
+        match = loc.on_line_end(seen, pose, gap if clear else math.inf)
+        accepted += match is not None and match.accepted
+        errors.append(loc.estimate(t).x - float(xy[0]))  # the street heads +x
+    return errors, accepted
+
+
+def test_lines_a_car_ahead_hides_do_not_place_the_car() -> None:
+    """Behind a car the lines seem to end at its rear: that is no junction's mouth. Told how
+    far the lane is clear, the localiser does not take those ends (the bias along the
+    street stays what it was, 2.5 m); taking them moved the car metres the wrong way."""
+    errors, accepted = approach_behind_a_car(clear=True)
+    assert accepted == 0
+    assert max(abs(e - 2.5) for e in errors) < 0.6
+    fooled, taken = approach_behind_a_car(clear=False)
+    assert taken > 0
+    assert max(abs(e - 2.5) for e in fooled) > 2.0
+
+
+def track(rel_x: float, rel_y: float) -> Track:
+    return Track(id=1, t=0.0, x=0.0, y=0.0, vx=0.0, vy=0.0, rel_x=rel_x, rel_y=rel_y,
+                 rel_vx=0.0, rel_vy=0.0, length=4.5, width=1.8, height=1.5,
+                 yaw=0.0, cls=ObjectClass.CAR, hits=5, misses=0, position_sigma=0.2)
+
+
+@pytest.mark.parametrize(("tracks", "clear"), [
+    ((), math.inf),
+    ((track(20.0, 0.3),), 17.75),  # in the lane: its rear
+    ((track(20.0, 0.3), track(12.0, -2.5)), 9.75),  # one overlapping the lane's edge
+    ((track(12.0, 3.5), track(-8.0, 0.0)), math.inf),  # the next lane, behind
+])
+def test_the_lane_is_clear_up_to_the_nearest_car_in_it(tracks: tuple[Track, ...],
+                                                         clear: float) -> None:
+    assert clear_ahead(tracks, 1.75) == pytest.approx(clear)
