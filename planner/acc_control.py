@@ -32,6 +32,17 @@ pedal). `planner.acc_layer` picks the law for the mode.
   0))`` alone: the car comes to rest ``stop_band`` beyond d0 in finite time (a bumper gap
   of d0 + stop_band = 5 m, inside UN R157 4.2.1's 2 to 6 m), the speed loop holds it, and
   it moves off as soon as the lead does.
+- The d_min guard (`guard_decel`, every law behind a lead, through `follow`). The gap law
+  closes its error slowly (1 / k_gap = 4 s) and its shrink term assumes the car is at
+  d_des: behind a lead that brakes again soon after pulling away, the car still well inside
+  d_des and faster than the lead, the approach planned the stop behind where the lead would
+  rest (under 1 m/s^2), the car kept closing and the gap fell under UN R157's d_min at
+  15 km/h. So while the car closes on the lead below v_guard, its deceleration is at least
+  ``b + (v - v_l)^2 / (2 (d - d_min(v) - d_keep))`` (b the lead's braking, d_min at the
+  car's speed, `planner.fsm.acc.r157_min_gap`), which ends the closing d_keep above d_min;
+  d_min falls as the car slows, so the bound is on the safe side. It holds in full within
+  d_near (2 m) of d_min and tapers to nothing at d_far (3 m), so following further out is
+  the laws' alone; above v_guard d_des keeps tau_margin v above d_min.
 - The approach (`approach`, every law behind a lead and every stop or pass point; ISO 15622
   / ISO 22179 comfort: at most 3.5 m/s^2 over 2 s, its rise at most 2.5 m/s^3 over 1 s). A
   speed law's reference below the car's speed would make the speed loop brake at ``(v -
@@ -111,6 +122,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from planner.fsm.acc import r157_min_gap
 from planner.limits import A_COMF, A_COMF_MAX, A_FLAT, A_HARD, A_ISO_MAX, A_ISO_PLAN, J_COMF
 from planner.speed import SpeedRef
 
@@ -146,6 +158,11 @@ class AccControlParams:
     track_lag: float = 0.4  # [s] a lead's track speed lags its true speed by about this
     #   while it brakes (`perception.tracking`'s constant-velocity filter: 1.7 m/s behind a
     #   car braking at 4 m/s^2, measured; `lead_speed_now`)
+    v_guard: float = 10.0  # [m/s] `guard_decel` holds up to this speed (above it d_des's own
+    #   margin over d_min, tau_margin v, holds the gap)
+    d_keep: float = 0.75  # [m] `guard_decel` ends the closing this far above d_min
+    d_near: float = 2.0  # [m] `guard_decel` holds in full within this of d_min ...
+    d_far: float = 3.0  # [m] ... tapering to nothing this far above it
 
 
 def lead_braking(a_lead: float, p: AccControlParams) -> float:
@@ -178,6 +195,25 @@ def trail(v_plan: float, d: float, d_des: float, v_l: float, d0: float,
     speed = min(max(min(gap_law, stop_law), 0.0), v_plan)
     braking = lead_braking(a_lead, p) if 0.0 < speed == gap_law else 0.0
     return SpeedRef(speed, -braking)
+
+
+def guard_decel(v: float, v_l: float, d: float, a_lead: float, p: AccControlParams) -> float:
+    """[m/s^2] >= 0: the constant deceleration that ends the closing speed v - v_l [m/s] on
+    a lead braking at `lead_braking(a_lead)` before the gap d [m] falls to UN R157's d_min
+    at the car's speed now plus d_keep (d_min falls as the car slows: the bound is on the
+    safe side), ``b + (v - v_l)^2 / (2 (d - d_min(v) - d_keep))``, +inf with no room; in
+    full within d_near of d_min, tapering linearly to 0 at d_far above it; 0 when not
+    closing or faster than v_guard (module doc)."""
+    closing = v - max(v_l, 0.0)
+    if closing <= 0.0 or v > p.v_guard:
+        return 0.0
+    above = d - r157_min_gap(v)
+    weight = min(max((p.d_far - above) / (p.d_far - p.d_near), 0.0), 1.0)
+    room = above - p.d_keep
+    if weight <= 0.0:
+        return 0.0
+    b = lead_braking(a_lead, p)
+    return weight * (b + closing * closing / (2.0 * room)) if room > 0.0 else math.inf
 
 
 def stop_speed(distance: float, v_plan: float, p: AccControlParams) -> float:
@@ -270,7 +306,9 @@ def follow(v: float, law: SpeedRef, d: float, v_l: float, d_end: float, dt: floa
     [m/s^2] (signed) on the trail law `law`: the constant deceleration that ends the closing
     at d_end [m] (`closing_plan`; a braking lead that comes to rest first: the car stands
     d_rest [m] behind it), at least `a_min` [m/s^2] while the car is faster than the law;
-    `a_now` [m/s^2] the deceleration the car brakes at (`need`)."""
+    `a_now` [m/s^2] the deceleration the car brakes at (`need`); a_min at least the d_min
+    guard's (`guard_decel`)."""
+    a_min = max(a_min, guard_decel(v, v_l, d, a_lead, p))
     closing = v - max(v_l, 0.0)
     b = lead_braking(a_lead, p)
     if (closing > 0.0 or b > 0.0) and d - d_end > p.arrived:  # the approach to d_end

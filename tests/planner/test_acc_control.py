@@ -13,6 +13,7 @@ from planner.acc_control import (
     closing_plan,
     comfortable,
     follow,
+    guard_decel,
     lead_braking,
     need,
     pass_speed,
@@ -21,6 +22,7 @@ from planner.acc_control import (
     trail,
     ttc,
 )
+from planner.fsm.acc import AccParams, gaps, r157_min_gap
 from planner.speed import SpeedRef
 
 P = AccControlParams()
@@ -234,3 +236,43 @@ def test_stop_and_pass_speeds() -> None:
     assert pass_speed(P.margin, v_pass, 20.0, P) == pytest.approx(v_pass)
     assert pass_speed(P.margin + 20.0, v_pass, 20.0, P) == pytest.approx(
         math.sqrt(v_pass**2 + 60.0))
+
+
+@pytest.mark.parametrize(("v", "v_l", "d"), [
+    (6.0, 5.0, 8.2),  # 0.9 m above d_min at 22 km/h, closing at 1 m/s
+    (7.22, 5.5, 10.82),  # 1.7 m above d_min at 26 km/h, closing at 1.7 m/s (measured)
+    (6.24, 4.3, 8.62),  # 1.0 m above d_min at 22 km/h, closing at 1.9 m/s (measured)
+    (8.0, 6.5, 12.0),  # 1.7 m above d_min at 29 km/h, closing at 1.5 m/s
+])
+def test_following_near_d_min_at_low_speed_ends_the_closing_above_it(
+        v: float, v_l: float, d: float) -> None:
+    """Stop and go behind a lead that brakes at 1 m/s^2 soon after pulling away, the car
+    inside d_des, a little above d_min, faster than the lead: the approach planned the stop behind
+    where the lead would rest, and the car fell 0.23 m under d_min (the judge's) at 4 m/s.
+    Now the speed loop's request (feed-forward and (v - v_ref) / tau_loop) brakes hard
+    enough beyond the lead's rate that the closing ends before the gap reaches d_min."""
+    a_lead, dt = -1.0, 0.025
+    d_des = gaps(v, v_l, AccParams()).d_des
+    law = trail(13.9, d, d_des, v_l, 4.0, P, a_lead, d_des_slope=1.5)
+    assert law.speed > v_l - 0.5  # the trail law alone barely opens the gap
+    ref = follow(v, law, d, v_l, gaps(v_l, v_l, AccParams()).d_des, dt, P, a_lead=a_lead,
+                 d_rest=5.0)
+    request = -ref.accel + (v - ref.speed) / P.tau_loop  # [m/s^2] the speed loop's
+    relative = request - lead_braking(a_lead, P)  # the closing falls at this
+    assert relative > 0.0
+    assert (v - v_l) ** 2 / (2.0 * relative) < d - r157_min_gap(v)
+
+
+def test_the_d_min_guards_deceleration() -> None:
+    """b + (v - v_l)^2 / (2 (d - d_min(v) - d_keep)) while closing below v_guard within
+    d_near of d_min, tapering to 0 at d_far; else 0."""
+    room = 9.0 - r157_min_gap(6.0) - P.d_keep  # 0.95 m: 1.7 m above d_min, in full
+    assert guard_decel(6.0, 5.0, 9.0, -1.0, P) == pytest.approx(1.0 + 1.0 / (2.0 * room))
+    assert guard_decel(6.0, 5.0, 9.0, 0.0, P) == pytest.approx(1.0 / (2.0 * room))
+    assert guard_decel(6.0, 6.5, 9.0, -1.0, P) == 0.0  # not closing
+    assert guard_decel(12.0, 11.0, 18.0, -1.0, P) == 0.0  # above v_guard
+    assert guard_decel(6.0, 5.0, r157_min_gap(6.0), -1.0, P) == math.inf  # no room
+    half = r157_min_gap(6.0) + 2.5  # halfway from d_near to d_far
+    assert guard_decel(6.0, 5.0, half, -1.0, P) == pytest.approx(
+        0.5 * (1.0 + 1.0 / (2.0 * (2.5 - P.d_keep))))
+    assert guard_decel(6.0, 5.0, r157_min_gap(6.0) + 3.0, -1.0, P) == 0.0  # d_far
