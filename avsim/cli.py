@@ -172,7 +172,7 @@ def run(scenario: str, out: Path | None, json_path: Path | None, profile: str, s
 
     with quiet_c_output():  # PyBullet's build banner
         from avsim.run.runner import Runner  # heavy: only once the input is known good
-        from avsim.run.unbuilt import unbuilt_result
+        from avsim.run.unbuilt import build_runner
         from world.sensors.setup import Profile, localisation
 
     try:  # held from before the run until its files are written: one writer per file
@@ -181,20 +181,18 @@ def run(scenario: str, out: Path | None, json_path: Path | None, profile: str, s
         _output_failed(str(exc))
     with claim, Interrupts() as stop:  # Ctrl-C / SIGTERM end the run at its tick, files kept
         setup = None if profile == "none" else Profile(profile)
-        started = time.perf_counter()
-        try:
-            runner = Runner(loaded, claim.partial, setup, sensing)
-        except Exception as exc:  # the world cannot be built: the run ends in error at 0 s
-            runner, result = None, unbuilt_result(loaded, exc, claim.partial, setup, started)
-        if runner is not None:
+        built = build_runner(loaded, claim.partial, setup, sensing)
+        if isinstance(built, Runner):  # else the world could not be built: its result
             click.echo(f"{loaded.name}: {localisation(setup, loaded.world.sensors.gnss).note}")
-            stop.on_signal(runner.interrupt)
-            result = _run_with_progress(runner, loaded.duration, not no_progress)
+            stop.on_signal(built.interrupt)
+            result = _run_with_progress(built, loaded.duration, not no_progress)
+        else:
+            result = built
         payload = result_json(result, scenario, out, profile)
         from avsim.report.speed_plot import plot_speed_profile
 
         unwritten = deliver(files, claim, loaded.name, dumps(payload),
-                            None if runner is None else  # no run: nothing to plot
+                            None if not isinstance(built, Runner) else  # no run: no plot
                             lambda path: plot_speed_profile(result, path))
         _print_verdict(payload)
         if result.error is not None:

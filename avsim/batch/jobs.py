@@ -190,27 +190,25 @@ def _simulate(job: RunJob, scenario: Scenario, into: Path, progress: ProgressCal
         from avsim.report.speed_plot import plot_speed_profile
         from avsim.run.result import dumps, result_json
         from avsim.run.runner import Runner
-        from avsim.run.unbuilt import unbuilt_result
+        from avsim.run.unbuilt import build_runner
         from world.sensors.setup import Profile
 
     recording = into / job.recording.name
     partial = temporary_beside(recording)  # created exclusively, an unpredictable name
     try:
         profile = None if job.profile == "none" else Profile(job.profile)
-        started = time.perf_counter()
-        try:
-            runner = Runner(scenario, partial, profile, job.sensing)
-        except Exception as exc:  # the world cannot be built: the run ends in error at 0 s
-            runner, result = None, unbuilt_result(scenario, exc, partial, profile, started)
-        if runner is not None:
+        built = build_runner(scenario, partial, profile, job.sensing)
+        if isinstance(built, Runner):  # else the world could not be built: its result
             if interrupts is not None:
-                interrupts.on_signal(runner.interrupt)
-            result = runner.run(progress)
+                interrupts.on_signal(built.interrupt)
+            result = built.run(progress)
+        else:
+            result = built
         publish(partial, recording)
     finally:
         partial.unlink(missing_ok=True)
     payload = result_json(result, job.scenario, job.recording, job.profile)
     write_atomic(into / job.result_file.name, dumps(payload))
-    if job.plot and runner is not None:  # a run that never started has nothing to plot
+    if job.plot and isinstance(built, Runner):  # a run that never started: nothing to plot
         plot_speed_profile(result, into / job.plot_file.name)
     return payload

@@ -14,10 +14,21 @@ from contextlib import suppress
 from pathlib import Path
 
 from avsim.record.recorder import Recorder
-from avsim.run.runner import RunResult, TrajectoryLog
+from avsim.run.runner import Runner, RunResult, TrajectoryLog
 from avsim.run.verdict import RunError
 from avsim.scenario.scenario import Scenario
 from world.sensors.setup import Profile
+
+
+def build_runner(scenario: Scenario, recording: Path | None, profile: Profile | None,
+                 sensing: str) -> Runner | RunResult:
+    """`Runner(scenario, recording, profile, sensing)`, or, when building it raises, the
+    run's result already (`unbuilt_result`): it ended in error at 0 s."""
+    started = time.perf_counter()
+    try:
+        return Runner(scenario, recording, profile, sensing)
+    except Exception as exc:  # the world cannot be built: the run ends in error at 0 s
+        return unbuilt_result(scenario, exc, recording, profile, started)
 
 
 def unbuilt_result(scenario: Scenario, exc: Exception, recording: Path | None,
