@@ -171,7 +171,7 @@ def run(scenario: str, out: Path | None, json_path: Path | None, profile: str, s
     from world.core.quiet import quiet_c_output
 
     with quiet_c_output():  # PyBullet's build banner
-        from avsim.run.runner import Runner  # heavy: only once the input is known good
+        from avsim.run.runner import RunResult  # heavy: only once the input is known good
         from avsim.run.unbuilt import build_runner
         from world.sensors.setup import Profile, localisation
 
@@ -182,17 +182,17 @@ def run(scenario: str, out: Path | None, json_path: Path | None, profile: str, s
     with claim, Interrupts() as stop:  # Ctrl-C / SIGTERM end the run at its tick, files kept
         setup = None if profile == "none" else Profile(profile)
         built = build_runner(loaded, claim.partial, setup, sensing)
-        if isinstance(built, Runner):  # else the world could not be built: its result
+        if isinstance(built, RunResult):  # the world could not be built: its result
+            result = built
+        else:
             click.echo(f"{loaded.name}: {localisation(setup, loaded.world.sensors.gnss).note}")
             stop.on_signal(built.interrupt)
             result = _run_with_progress(built, loaded.duration, not no_progress)
-        else:
-            result = built
         payload = result_json(result, scenario, out, profile)
         from avsim.report.speed_plot import plot_speed_profile
 
         unwritten = deliver(files, claim, loaded.name, dumps(payload),
-                            None if not isinstance(built, Runner) else  # no run: no plot
+                            None if isinstance(built, RunResult) else  # no run: no plot
                             lambda path: plot_speed_profile(result, path))
         _print_verdict(payload)
         if result.error is not None:

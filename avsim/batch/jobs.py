@@ -189,7 +189,7 @@ def _simulate(job: RunJob, scenario: Scenario, into: Path, progress: ProgressCal
     with quiet_c_output():  # PyBullet's build banner
         from avsim.report.speed_plot import plot_speed_profile
         from avsim.run.result import dumps, result_json
-        from avsim.run.runner import Runner
+        from avsim.run.runner import RunResult
         from avsim.run.unbuilt import build_runner
         from world.sensors.setup import Profile
 
@@ -198,17 +198,17 @@ def _simulate(job: RunJob, scenario: Scenario, into: Path, progress: ProgressCal
     try:
         profile = None if job.profile == "none" else Profile(job.profile)
         built = build_runner(scenario, partial, profile, job.sensing)
-        if isinstance(built, Runner):  # else the world could not be built: its result
+        if isinstance(built, RunResult):  # the world could not be built: its result
+            result = built
+        else:
             if interrupts is not None:
                 interrupts.on_signal(built.interrupt)
             result = built.run(progress)
-        else:
-            result = built
         publish(partial, recording)
     finally:
         partial.unlink(missing_ok=True)
     payload = result_json(result, job.scenario, job.recording, job.profile)
     write_atomic(into / job.result_file.name, dumps(payload))
-    if job.plot and isinstance(built, Runner):  # a run that never started: nothing to plot
+    if job.plot and not isinstance(built, RunResult):  # a run that never started: nothing to plot
         plot_speed_profile(result, into / job.plot_file.name)
     return payload

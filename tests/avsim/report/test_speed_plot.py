@@ -397,8 +397,8 @@ def test_an_empty_run_still_plots(tmp_path: Path) -> None:
 
 
 class FakeRunner:
-    """Stands in for `avsim.run.runner.Runner`: writes a recording stub, returns the
-    synthetic run."""
+    """Stands in for the `Runner` that `avsim.run.unbuilt.build_runner` builds: writes a
+    recording stub, returns the synthetic run."""
 
     def __init__(self, scenario: object, recording: Path, *_args: object) -> None:
         self.scenario = scenario
@@ -413,7 +413,7 @@ class FakeRunner:
 
 @pytest.fixture
 def fake_runner(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> Path:
-    monkeypatch.setattr("avsim.run.runner.Runner", FakeRunner)
+    monkeypatch.setattr("avsim.run.unbuilt.Runner", FakeRunner)
     monkeypatch.chdir(tmp_path)
     return tmp_path
 
