@@ -535,11 +535,14 @@ _campaign_options = [_batch_options[k] for k in (0, 1, 2, 3, 5)]  # no snapshots
               help="--search: iterations.")
 @click.option("--population", type=click.IntRange(2, 200), default=8, show_default=True,
               help="--search: runs per iteration and file.")
+@click.option("--resume", is_flag=True,
+              help="Take the result of each run that already finished in --out on the same "
+                   "file, values, profile and code; run the others.")
 @_options(_campaign_options)
 def campaign(files: tuple[str, ...], n: int, seed: int, out: Path | None,
              sets: tuple[str, ...], record: str, shrink: bool, metric: str | None,
-             iterations: int, population: int, jobs: int | None, executor: str,
-             address: str | None, profile: str, dry_run: bool) -> None:
+             iterations: int, population: int, resume: bool, jobs: int | None,
+             executor: str, address: str | None, profile: str, dry_run: bool) -> None:
     """Run N scenarios drawn from each campaign FILE (a scenario file with a `vary:`
     section) like a suite; write a repro file of each failure, campaign.json, summary.md,
     junit.xml (docs/cli.md, "Campaigns")."""
@@ -560,7 +563,7 @@ def campaign(files: tuple[str, ...], n: int, seed: int, out: Path | None,
         def execute(todo: list[RunJob]) -> list[RunOutcome]:
             return _execute(todo, executor, jobs, address, stop) if todo else []
 
-        outcomes = execute(planned)
+        outcomes = _campaign_runs(planned, resume, execute)
         runs = [c.DrawnRun(families[k // n], values, outcome)
                 for k, (values, outcome) in enumerate(zip(drawn, outcomes, strict=True))]
         c.keep_recordings(runs, record == "all")
@@ -573,6 +576,21 @@ def campaign(files: tuple[str, ...], n: int, seed: int, out: Path | None,
         unwritten = batch.reports_written(outcomes, settings.out_dir, lambda: _campaign_report(
             runs, refined, settings, n, title))
     _exit(unwritten, batch.exit_status(outcomes, stop.exit_status))
+
+
+def _campaign_runs(planned: list[RunJob], resume: bool,
+                   execute: Callable[[list[RunJob]], list[RunOutcome]]) -> list[RunOutcome]:
+    """Each planned run's outcome, in plan order: with `resume`, those that finished before
+    (`avsim.batch.resume`) taken from their files, the others run."""
+    from avsim.batch.resume import keyed, resumed
+
+    planned = keyed(planned)  # each run writes its key: any campaign can be resumed
+    done = resumed(planned) if resume else {}
+    if resume:
+        click.echo(f"resumed: {len(done)} of {len(planned)} runs had finished; "
+                   f"{len(planned) - len(done)} to run", err=True)
+    ran = {o.job.name: o for o in execute([job for job in planned if job.name not in done])}
+    return [done.get(job.name) or ran[job.name] for job in planned]
 
 
 def _campaign_plan(files: Sequence[str], n: int, seed: int, out: Path | None,

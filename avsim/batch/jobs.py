@@ -55,6 +55,8 @@ class RunJob:
     duration: float = 0.0  # [s] the scenario's simulated time: its cost, longest run first
     search_paths: tuple[Path, ...] = ()  # folders an OpenSCENARIO file's references may be in
     criteria: Path | None = None  # an OpenSCENARIO file's sidecar (`--criteria`), else None
+    resume_key: str | None = None  # a campaign run's key (`avsim.batch.resume.run_key`),
+    #   written to <out_dir>/<name>.key once its result JSON is (None: no key file)
 
     @property
     def recording(self) -> Path:
@@ -136,6 +138,7 @@ class RunOutcome:
         return first if first is not None else self.sim_time
 
 
+KEY_SUFFIX = ".key"  # a campaign run's key file, beside its result JSON (`resume_key`)
 ProgressCallback = Callable[[float, float], None]  # (sim time, duration) [s]
 VERDICT_STATUS = {  # a result's verdict (`avsim.run.verdict`) -> the run's status
     RunVerdict.PASS.value: Status.PASSED, RunVerdict.FAIL.value: Status.FAILED,
@@ -173,11 +176,18 @@ def run_job(job: RunJob, into: Path | None = None,
         last = traceback.format_exception_only(exc)[-1].strip()
         return RunOutcome(job, Status.ERROR, error=f"{job.name}: {last}",
                           wall_time=time.perf_counter() - start)
+    if job.resume_key is not None:  # after the result: a run cut off before has no key
+        write_atomic((into or job.out_dir) / f"{job.name}{KEY_SUFFIX}", job.resume_key.encode())
+    return outcome_of(job, result, time.perf_counter() - start)
+
+
+def outcome_of(job: RunJob, result: dict[str, object], wall_time: float) -> RunOutcome:
+    """The outcome of `job` whose run gave `result` (its result JSON) in `wall_time` [s]."""
     status = VERDICT_STATUS[str(result["verdict"])]
     error = None
     if isinstance(fault := result.get("error"), dict):
         error = f"{job.name}: {RunError(**fault).line()}"
-    return RunOutcome(job, status, result, error, wall_time=time.perf_counter() - start)
+    return RunOutcome(job, status, result, error, wall_time=wall_time)
 
 
 def _simulate(job: RunJob, scenario: Scenario, into: Path, progress: ProgressCallback | None,
