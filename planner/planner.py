@@ -23,7 +23,9 @@ reference line, speeds [m/s]. Steps:
    camera's lane itself corrects across the lane) and the lane is not the shoulder, else
    the map lane (ACQUIRING at the start, before the camera's lane has corrected the pose
    across the lane: the line parallel to the lane through the car, holding its offset); the
-   lane source is updated once the lane kept is known;
+   lane source is updated once the lane kept is known; with the shoulder the lane kept, the
+   path is moved across the road by the pose's error that the camera's view of the
+   shoulder's one painted line tells (`planner.shoulder_line`);
 4. the lead vehicle (`planner.lead`: in the path's lane, or along the map lane through a
    junction, or in the lanes a lane change occupies);
 5. the speed, a chain of `planner.speed.PlannedSpeed`s, each link keeping what it was given
@@ -82,6 +84,7 @@ from planner.limits import A_EMERGENCY, SIGHT
 from planner.messages import Lead, Plan, ReferencePath, SpeedSource
 from planner.motion_layer import Manoeuvre, MotionLayer, MotionLayerParams
 from planner.route import lane_path
+from planner.shoulder_line import ShoulderLine, ShoulderLineParams, shifted
 from planner.speed import BINDING_SOURCE, PlannedSpeed, SpeedRef
 from planner.speed_planning import Binding, SpeedPlanner, SpeedPlanningParams, SpeedTarget
 from world.frames import VehicleInfo
@@ -112,6 +115,7 @@ class PlannerParams:
     override: OverrideParams = field(default_factory=OverrideParams)
     events: EventParams = field(default_factory=EventParams)
     junctions: JunctionParams = field(default_factory=JunctionParams)
+    shoulder_line: ShoulderLineParams = field(default_factory=ShoulderLineParams)
     camera_agree: float = 1.0  # [m] the camera's lane is used only within this of the map's
     junction_before: float = 10.0  # [m] before a town junction's stop line ...
     junction_after: float = 15.0  # [m] ... to after its exit, the map's path is followed
@@ -172,6 +176,7 @@ class Planner:
         self.junctions = JunctionMonitor(self.road, p.vehicle, p.junctions)
         self.hazard = Machine("hazard", HazardLights.OFF)
         self.sensing = Machine("sensing", Sensing.NOMINAL)
+        self.shoulder_line = ShoulderLine(p.shoulder_line)
 
     def _keep(self, lane: int) -> None:
         """Make `lane` the lane whose stations, speed plan and map path are used."""
@@ -237,7 +242,8 @@ class Planner:
         changes += self.sensing.apply(ego.t, sensing.transition(
             self.sensing.state, SensingInput(health.lidar, health.gnss, health.occlusion),
             self.params.sensing))
-        lateral_choice = self._path(ego, station, view, manoeuvre)
+        lateral_choice = self._on_shoulder(self._path(ego, station, view, manoeuvre), dt,
+                                           view, station)
         lead = self._lead(view, tracks, ego, manoeuvre, lateral_choice.camera)
         planned = PlannedSpeed(SpeedRef(target.speed, target.accel),
                                BINDING_SOURCE[target.binding])
@@ -324,6 +330,17 @@ class Planner:
             return LateralChoice(self.path_for(ego, station, self.localise(ego)[1]),
                                  camera=False)
         return LateralChoice(self.path_for(ego, station), camera=False)
+
+    def _on_shoulder(self, choice: LateralChoice, dt: float, view: LaneView | None,
+                     station: float) -> LateralChoice:
+        """With the shoulder the lane kept (on it, or on the way onto it), the path moved
+        across the road by the pose's error there, which the camera's view of the
+        shoulder's line tells (`planner.shoulder_line`); else the path as it is."""
+        if self.lane_index != SHOULDER:
+            self.shoulder_line.reset()
+            return choice
+        error = self.shoulder_line.update(dt, view, self.lane, station)
+        return replace(choice, path=shifted(choice.path, error))
 
     def _other_lane(self, view: LaneView | None, manoeuvre: Manoeuvre) -> bool:
         """Whether the camera's lane is not the lane kept: its offset is more than
