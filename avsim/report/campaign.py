@@ -4,7 +4,7 @@ Pure functions over the campaign's runs (`avsim.batch.campaign.DrawnRun`), its s
 failures and its search results (`avsim.batch.refine`): nothing here runs or writes. Both
 reports hold the counts; the failures by criterion and by family (the campaign file); the
 worst margins over the runs (`WORST`: the least time to collision and gap, the most
-deceleration, lateral error and tyre excursion, with the run that had each); every
+deceleration and lateral error, the least tyre margin, with the run that had each); every
 failure with its drawn values and repro file; each shrunk failure's values, those that
 shrank marked; each family's search result.
 """
@@ -29,7 +29,8 @@ WORST: tuple[tuple[str, str, Callable[[float, float], bool]], ...] = (
     ("min_lead_gap", "least gap moving [m]", lambda a, b: a < b),
     ("max_decel", "most deceleration [m/s^2]", lambda a, b: a > b),
     ("max_lateral_error", "most lateral error [m]", lambda a, b: a > b),
-    ("tyres_in_lane", "most tyre excursion past the lane [m]", lambda a, b: a > b),
+    ("tyres_in_lane", "least tyre margin inside the lines [m] (negative: over)",
+     lambda a, b: a < b),
 )
 
 

@@ -16,9 +16,11 @@ import yaml
 from click.testing import CliRunner
 from junitparser import JUnitXml
 
-from avsim.batch.campaign import Settings, draw_plan, load_family
+from avsim.batch.campaign import DrawnRun, Family, Settings, draw_plan, load_family
+from avsim.batch.jobs import RunJob, RunOutcome, Status
 from avsim.batch.sampling import Law, draw_run, generator
 from avsim.cli import main
+from avsim.report.campaign import worst_margins
 from avsim.scenario.bounds import MAX_SEED
 
 REPO = Path(__file__).resolve().parents[3]
@@ -258,3 +260,24 @@ def test_shrink_moves_a_failure_toward_nominal_and_search_beats_nominal(work: Pa
     assert search["worst"] < search["nominal"]
     worst = yaml.safe_load((out / "repro" / "worst.yaml").read_text(encoding="utf-8"))
     assert worst["road"]["speed_limit_kph"] == search["values"]["road.speed_limit_kph"]
+
+
+# ---- the reports --------------------------------------------------------------------------
+
+
+def _drawn(name: str, tyres: float, decel: float) -> DrawnRun:
+    family = Family("f.yaml", 0, "f", (), {})
+    result: dict[str, object] = {
+        "metrics": {"max_decel": decel},
+        "criteria": [{"name": "tyres_in_lane", "passed": tyres >= 0.0, "value": tyres}]}
+    job = RunJob(name, "f.yaml", Path("."))
+    status = Status.PASSED if tyres >= 0.0 else Status.FAILED
+    return DrawnRun(family, {}, RunOutcome(job, status, result))
+
+
+def test_the_worst_margins_are_the_least_tyre_margin_and_the_most_deceleration() -> None:
+    runs = [_drawn("a", 0.8, 2.0), _drawn("b", -0.3, 6.0), _drawn("c", 0.1, 3.0)]
+    worst = {m["metric"]: (m["value"], m["run"]) for m in worst_margins(runs)}
+    assert worst["tyres_in_lane"] == (-0.3, "b")  # a tyre 0.3 m over: the worst, not 0.8 in
+    assert worst["max_decel"] == (6.0, "b")
+    assert "min_ttc" not in worst  # no run measured it
