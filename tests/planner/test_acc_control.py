@@ -171,7 +171,8 @@ def test_a_lead_that_pulls_away_and_brakes_at_once_is_followed_by_the_feed_forwa
     for k in range(round(17.0 / dt)):  # 9.1 s of pull-away, then the braking
         if v_l >= 40.0 / 3.6:
             a_lead = -3.0
-        law = trail(20.0, d, gaps(v, v_l, m).d_des, v_l, m.d0, P, a_lead)
+        slope = (gaps(v, v_l, m).d_des - gaps(max(v - 0.1, 0.0), v_l, m).d_des) / 0.1
+        law = trail(20.0, d, gaps(v, v_l, m).d_des, v_l, m.d0, P, a_lead, slope)
         request = loop.update(law.speed, law.accel, v, dt).accel
         if a_lead > 0.0 and k * dt > 6.0:
             shares.append(request - law.accel)  # the speed loop's own share
@@ -184,6 +185,8 @@ def test_a_lead_that_pulls_away_and_brakes_at_once_is_followed_by_the_feed_forwa
 
 
 @pytest.mark.parametrize(("a_lead", "shrink"), [
+    (2.5, -3.0),  # pulling away briskly: d_des grows at d_des' a_pull
+    (1.0, -1.5),  # pulling away: d_des grows at d_des' a_l, 1.5 s x 1 m/s^2
     (0.0, 0.0),  # holding its speed: no term
     (-0.4, 0.0),  # the estimate's noise
     (-1.0, 1.5),  # braking gently (a_gentle): d_des' b, the car's time gap 1.5 s x 1 m/s^2
@@ -191,14 +194,17 @@ def test_a_lead_that_pulls_away_and_brakes_at_once_is_followed_by_the_feed_forwa
     (-2.0, 0.0),  # ... to none at 2 a_gentle
     (-6.0, 0.0),  # braking hard: the lead is not closed in on
 ])
-def test_the_gap_law_follows_the_shrinking_desired_gap_behind_a_gently_braking_lead(
+def test_the_gap_law_follows_the_desired_gap_as_the_lead_brakes_or_pulls_away(
         a_lead: float, shrink: float) -> None:
     """ISO 22179 stop and go: d_des = d0 + 1.5 s v shrinks at 1.5 m/s behind a lead braking
     at 1 m/s^2 (the car braking with it); the gap law's reference is that much above the
-    lead's speed, so the gap follows d_des down instead of lagging it by 6 m."""
+    lead's speed, so the gap follows d_des down instead of lagging it by 6 m. Behind a lead
+    pulling away d_des grows as much: the reference is that much below its speed (it lagged
+    d_des by 10 m behind a lead pulling away at 2.5 m/s^2, and UN R157's d_min caught the
+    gap up)."""
     ref = trail(30.0, 40.0, 40.0, 20.0, 4.0, P, a_lead=a_lead, d_des_slope=1.5)
     assert ref.speed == pytest.approx(20.0 + shrink)
-    assert ref.accel == pytest.approx(a_lead if a_lead < -P.lead_brakes else 0.0)
+    assert ref.accel == pytest.approx(lead_feed_forward(a_lead, P))
 
 
 def test_closing_plan_behind_a_braking_lead() -> None:
