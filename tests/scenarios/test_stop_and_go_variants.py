@@ -6,7 +6,8 @@ R157's d_min at about 15 km/h in the second stop; with it, 012 and 013 still fel
 0.06 m under it: the speed loop's integrator held the pull-away's acceleration against the
 braking. With the lead's pull-away fed forward (`planner.acc_control.lead_feed_forward`,
 `gap_rate`) all three keep d_min with room. Shown from the truth: the lead stopped and drove
-off twice and the ego stood behind it; then `min_gap` passed with room."""
+off twice and the ego stood behind it (or, behind a lead standing 1 s, came nearly to
+rest); then `min_gap` passed with room."""
 
 from __future__ import annotations
 
@@ -21,6 +22,8 @@ from world.sensors.setup import Profile
 pytestmark = [pytest.mark.slow, pytest.mark.acceptance]
 FILE = "scenarios/acceptance/stop_and_go_variants.yaml"
 STOPPED = 0.1  # [m/s]
+SLOWED = 0.5  # [m/s] behind a lead standing 1 s the ego comes this near to rest, just
+#   after the lead drove off again (0.34 m/s at 012)
 ROOM = 0.5  # [m] the least gap - d_min asked of the ACC
 
 
@@ -54,8 +57,11 @@ def test_stop_and_go_keeps_d_min_with_room(run_scenario: Callable[..., RunResult
     v, lead_v, gap = log.array("speed"), log.array("lead_speed"), log.array("lead_gap")
     standing = lead_v < STOPPED
     assert _starts(standing) >= 2 and _starts(~standing) >= 2  # stopped and went twice
-    ego_stood = standing & (v < STOPPED) & np.isfinite(gap)
-    assert _starts(ego_stood) >= 2  # the ego stood behind it in both stops
+    if stand >= 5:  # the ego stood behind it in both stops
+        ego_stood = standing & (v < STOPPED) & np.isfinite(gap)
+    else:  # it came nearly to rest behind it twice
+        ego_stood = (v < SLOWED) & np.isfinite(gap)
+    assert _starts(ego_stood) >= 2
     c = {r.name: r for r in result.criteria}
     assert not any(r.failed for r in result.criteria), result.criteria
     min_gap = c["min_gap"]
