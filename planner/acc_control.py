@@ -26,12 +26,21 @@ pedal). `planner.acc_layer` picks the law for the mode.
   it shed since its track's measurement and over the track's lag (`lead_speed_now`, every
   law and the mode's inputs): without it the reference fell with the lead's speed and the speed loop
   followed tau_loop behind, and a car following at 90 km/h behind a lead braking at
-  2 m/s^2 fell 2 m under UN R157's d_min (issue K). Stop-and-go: behind a
-  lead slower than ``v_standstill`` the gap law would creep up on it for several of its time
-  constants, so the reference is the braking curve ``sqrt(2 a_final max(d - d0 - stop_band,
-  0))`` alone: the car comes to rest ``stop_band`` beyond d0 in finite time (a bumper gap
-  of d0 + stop_band = 5 m, inside UN R157 4.2.1's 2 to 6 m), the speed loop holds it, and
-  it moves off as soon as the lead does.
+  2 m/s^2 fell 2 m under UN R157's d_min (issue K). Where the first binds and the lead
+  pulls away (its acceleration a_l over `lead_brakes`), its acceleration up to `a_pull` is
+  the feed-forward: the gap law's reference rises with the lead's speed, and without it the
+  speed loop's integrator takes up the pull-away (0.9 m/s^2 behind a lead pulling away at
+  1 m/s^2) and holds it against the braking that follows when the lead brakes again at
+  once (ISO 22179 stop and go): the car brakes that much less than its plan. And as
+  while the lead brakes, d_des grows with the car's speed at d_des'(v) a_l: the first term
+  gets ``- d_des'(v) a_l`` (`gap_rate`), else the gap lags the growing d_des by d_des' a_l /
+  k_gap and UN R157's d_min, which grows faster still (1 s + 2 v / 100 km/h s of speed),
+  catches it up in a brisk pull-away (2.5 m/s^2 to 40 km/h: under d_min at 35 km/h). Stop-and-go:
+  behind a lead slower than ``v_standstill`` the gap law would creep up on it for several
+  of its time constants, so the reference is the braking curve ``sqrt(2 a_final max(d - d0
+  - stop_band, 0))`` alone: the car comes to rest ``stop_band`` beyond d0 in finite time (a
+  bumper gap of d0 + stop_band = 5 m, inside UN R157 4.2.1's 2 to 6 m), the speed loop
+  holds it, and it moves off as soon as the lead does.
 - The d_min guard (`guard_decel`, every law behind a lead, through `follow`). The gap law
   closes its error slowly (1 / k_gap = 4 s) and its shrink term assumes the car is at
   d_des: behind a lead that brakes again soon after pulling away, the car still well inside
@@ -155,6 +164,8 @@ class AccControlParams:
     stop_band: float = 1.0  # [m] behind a stopped lead, stop this far beyond d0 (trail)
     a_final: float = 0.5  # [m/s^2] the last metres' deceleration behind a stopped lead
     lead_brakes: float = 0.5  # [m/s^2] a lead decelerating more brakes (`lead_braking`)
+    a_pull: float = 2.0  # [m/s^2] the most of a lead's pull-away the trail law feeds forward
+    #   (ISO 15622's most an ACC accelerates above 20 m/s, 2 s average)
     track_lag: float = 0.4  # [s] a lead's track speed lags its true speed by about this
     #   while it brakes (`perception.tracking`'s constant-velocity filter: 1.7 m/s behind a
     #   car braking at 4 m/s^2, measured; `lead_speed_now`)
@@ -170,6 +181,15 @@ def lead_braking(a_lead: float, p: AccControlParams) -> float:
     (`planner.lead.LeadAccel`); 0 unless it brakes harder than `lead_brakes` (the estimate's
     noise while it holds its speed)."""
     return -a_lead if a_lead < -p.lead_brakes else 0.0
+
+
+def lead_feed_forward(a_lead: float, p: AccControlParams) -> float:
+    """[m/s^2] (signed) the trail law's feed-forward from the lead's acceleration `a_lead`
+    [m/s^2]: its braking (`lead_braking`), or its pull-away's acceleration, when harder than
+    `lead_brakes` (the estimate's noise), up to `a_pull`; 0 in between."""
+    if a_lead > p.lead_brakes:
+        return min(a_lead, p.a_pull)
+    return -lead_braking(a_lead, p)
 
 
 def lead_speed_now(v_l: float, a_lead: float, age: float, p: AccControlParams) -> float:
@@ -188,13 +208,21 @@ def trail(v_plan: float, d: float, d_des: float, v_l: float, d0: float,
     if v_l < p.v_standstill:
         approach = math.sqrt(2.0 * p.a_final * max(d - d0 - p.stop_band, 0.0))
         return SpeedRef(min(approach, v_plan), 0.0)
-    b = lead_braking(a_lead, p)
-    shrink = d_des_slope * (b if b <= p.a_gentle else max(2.0 * p.a_gentle - b, 0.0))
-    gap_law = v_l + shrink + p.k_gap * (d - d_des)
+    gap_law = v_l - d_des_slope * gap_rate(a_lead, p) + p.k_gap * (d - d_des)
     stop_law = math.sqrt(max(v_l, 0.0) ** 2 + 2.0 * p.a_comf * max(d - d0, 0.0))
     speed = min(max(min(gap_law, stop_law), 0.0), v_plan)
-    braking = lead_braking(a_lead, p) if 0.0 < speed == gap_law else 0.0
-    return SpeedRef(speed, -braking)
+    return SpeedRef(speed, lead_feed_forward(a_lead, p) if 0.0 < speed == gap_law else 0.0)
+
+
+def gap_rate(a_lead: float, p: AccControlParams) -> float:
+    """[m/s^2] (signed) the acceleration the car following the lead is taken to share
+    with it for d_des's rate, d_des'(v) times this: its pull-away's feed-forward
+    (`lead_feed_forward`), or its braking up to a_gentle, tapering to 0 at 2 a_gentle (a
+    lead braking harder is not closed in on)."""
+    b = lead_braking(a_lead, p)
+    if b > 0.0:
+        return -(b if b <= p.a_gentle else max(2.0 * p.a_gentle - b, 0.0))
+    return lead_feed_forward(a_lead, p)
 
 
 def guard_decel(v: float, v_l: float, d: float, a_lead: float, p: AccControlParams) -> float:

@@ -13,7 +13,10 @@ Per tick:
    collision, and whether a lead was lost within the FSM's ``lead_hold``;
 2. the FSM steps once;
 3. the mode's law gives the reference: ACC_OFF 0; CRUISE and SPEED_LIMIT the speed plan;
-   TRAIL and BRAKE their laws behind the lead; OFF_RAMP the speed plan (the ramp's limit
+   TRAIL and BRAKE their laws behind the lead (TRAIL with its lead lost within the FSM's
+   ``lead_hold``: the car's own speed, at most the plan's; the plan would speed it up into
+   a lead whose track dropped for a moment, closing on it at 5 m/s when it was found again
+   and under UN R157's d_min); OFF_RAMP the speed plan (the ramp's limit
    is a posting); STOP_SIGN, PEDESTRIAN, RED_LIGHT and YIELD a stop at the events' stop
    point; SPEED_BUMP the pass speed at the bump; FLAT down at ``a_flat_plan`` to
    ``v_pull_over`` while the car pulls over, then to a stop on the shoulder. Each law
@@ -188,6 +191,8 @@ class AccLayer:
             return self._lower(planned, PlannedSpeed(ref, SpeedSource.FOLLOWING), x.v)
         if self.mode is AccMode.TRAIL:
             following = self._following(x, dt, plan, driver_gap)
+            if x.lead_lost:  # its track dropped for a moment: hold the speed, not the plan
+                following = SpeedRef(min(plan.speed, x.v), 0.0)
             source = SpeedSource.FOLLOWING if following.speed < plan.speed else planned.source
             return PlannedSpeed(following, source)
         if self.mode is AccMode.ACC_OFF:

@@ -6,6 +6,7 @@ import math
 
 import pytest
 
+from control.longitudinal import SpeedController
 from planner.acc_control import (
     AccControlParams,
     approach,
@@ -15,6 +16,7 @@ from planner.acc_control import (
     follow,
     guard_decel,
     lead_braking,
+    lead_feed_forward,
     need,
     pass_speed,
     stop,
@@ -141,7 +143,50 @@ def test_a_braking_lead_is_fed_forward_past_the_estimates_noise() -> None:
     assert trail(30.0, 7.0, 5.0, 0.0, 4.0, P, a_lead=-2.0).accel == 0.0
 
 
+@pytest.mark.parametrize(("a_lead", "accel"), [
+    (1.0, 1.0),  # pulling away at 1 m/s^2: fed forward
+    (0.4, 0.0),  # the estimate's noise while it holds its speed
+    (2.5, P.a_pull),  # a brisk pull-away: fed forward up to a_pull
+    (-2.0, -2.0),  # braking: its deceleration
+])
+def test_the_leads_pull_away_is_fed_forward_where_the_gap_law_binds(
+        a_lead: float, accel: float) -> None:
+    assert lead_feed_forward(a_lead, P) == accel
+    assert trail(30.0, 40.0, 40.0, 20.0, 4.0, P, a_lead=a_lead) == SpeedRef(20.0, accel)
+    assert trail(19.0, 48.0, 40.0, 20.0, 4.0, P, a_lead=a_lead).accel == 0.0  # the plan
+    assert trail(30.0, 60.0, 4.0, 0.6, 4.0, P, a_lead=a_lead).accel == 0.0  # the stop law
+
+
+def test_a_lead_that_pulls_away_and_brakes_at_once_is_followed_by_the_feed_forward() -> None:
+    """ISO 22179 stop and go: a lead pulls away at 1 m/s^2 to 40 km/h and at once brakes at
+    3 m/s^2, the car on the trail law behind it through the speed loop
+    (`control.longitudinal`, point mass). The pull-away is the loop's feed-forward, so its
+    integrator holds no acceleration that it would set against the braking to come (it
+    held 0.9 m/s^2, and in the closed loop the car braked at 2.2 m/s^2 behind the lead's
+    3 and fell under UN R157's d_min); the car brakes at the lead's rate."""
+    m, dt = AccParams(), 0.05
+    loop = SpeedController()
+    v, v_l, d, a_lead = 1.0, 2.0, 8.0, 1.0
+    shares, braking = [], []
+    for k in range(round(17.0 / dt)):  # 9.1 s of pull-away, then the braking
+        if v_l >= 40.0 / 3.6:
+            a_lead = -3.0
+        slope = (gaps(v, v_l, m).d_des - gaps(max(v - 0.1, 0.0), v_l, m).d_des) / 0.1
+        law = trail(20.0, d, gaps(v, v_l, m).d_des, v_l, m.d0, P, a_lead, slope)
+        request = loop.update(law.speed, law.accel, v, dt).accel
+        if a_lead > 0.0 and k * dt > 6.0:
+            shares.append(request - law.accel)  # the speed loop's own share
+        if a_lead < 0.0 and v_l > 0.0:
+            braking.append(-request)
+        v, v_l = max(v + request * dt, 0.0), max(v_l + a_lead * dt, 0.0)
+        d += (v_l - v) * dt
+    assert max(abs(s) for s in shares) < 0.3
+    assert max(braking) >= 2.9
+
+
 @pytest.mark.parametrize(("a_lead", "shrink"), [
+    (2.5, -3.0),  # pulling away briskly: d_des grows at d_des' a_pull
+    (1.0, -1.5),  # pulling away: d_des grows at d_des' a_l, 1.5 s x 1 m/s^2
     (0.0, 0.0),  # holding its speed: no term
     (-0.4, 0.0),  # the estimate's noise
     (-1.0, 1.5),  # braking gently (a_gentle): d_des' b, the car's time gap 1.5 s x 1 m/s^2
@@ -149,14 +194,17 @@ def test_a_braking_lead_is_fed_forward_past_the_estimates_noise() -> None:
     (-2.0, 0.0),  # ... to none at 2 a_gentle
     (-6.0, 0.0),  # braking hard: the lead is not closed in on
 ])
-def test_the_gap_law_follows_the_shrinking_desired_gap_behind_a_gently_braking_lead(
+def test_the_gap_law_follows_the_desired_gap_as_the_lead_brakes_or_pulls_away(
         a_lead: float, shrink: float) -> None:
     """ISO 22179 stop and go: d_des = d0 + 1.5 s v shrinks at 1.5 m/s behind a lead braking
     at 1 m/s^2 (the car braking with it); the gap law's reference is that much above the
-    lead's speed, so the gap follows d_des down instead of lagging it by 6 m."""
+    lead's speed, so the gap follows d_des down instead of lagging it by 6 m. Behind a lead
+    pulling away d_des grows as much: the reference is that much below its speed (it lagged
+    d_des by 10 m behind a lead pulling away at 2.5 m/s^2, and UN R157's d_min caught the
+    gap up)."""
     ref = trail(30.0, 40.0, 40.0, 20.0, 4.0, P, a_lead=a_lead, d_des_slope=1.5)
     assert ref.speed == pytest.approx(20.0 + shrink)
-    assert ref.accel == pytest.approx(a_lead if a_lead < -P.lead_brakes else 0.0)
+    assert ref.accel == pytest.approx(lead_feed_forward(a_lead, P))
 
 
 def test_closing_plan_behind_a_braking_lead() -> None:

@@ -91,3 +91,21 @@ def test_cut_in_close_ahead_brakes_comfortably_then_recovers() -> None:
     v, gap = run["v"][late], run["gap"][late]
     assert np.all(gap >= np.array([r157_min_gap(x) for x in v]) - 0.5)
     assert math.isclose(float(run["v"][-1]), v0 - 20 / 3.6, abs_tol=0.1)
+
+
+def test_a_lead_lost_for_a_moment_is_not_sped_up_into() -> None:
+    """The DECS route, its lead at 50 km/h 42 m ahead at 61 km/h: its track dropped for
+    0.75 s; the reference went to the set speed and the car, found again closing at 5 m/s,
+    fell under UN R157's d_min. Within lead_hold the car holds its speed."""
+    acc, v, set_speed = AccLayer(), 17.0, 22.2
+    plan = PlannedSpeed(SpeedRef(set_speed, 0.0), SpeedSource.SET_SPEED)
+    for k in range(40):  # a second in TRAIL behind it
+        lead = Lead(track_id=1, t=k * DT - 0.1, gap=42.0, speed=13.9)
+        acc.update(k * DT, DT, v, set_speed, 30.0, plan, lead)
+    assert acc.mode.value == "trail"
+    out, _ = acc.update(40 * DT, DT, v, set_speed, 30.0, plan, None)
+    assert acc.mode.value == "trail"
+    assert out.speed.ref.speed <= v
+    for k in range(41, 41 + round(1.5 / DT)):  # past lead_hold: the plan again
+        out, _ = acc.update(k * DT, DT, v, set_speed, 30.0, plan, None)
+    assert out.speed.ref.speed == set_speed

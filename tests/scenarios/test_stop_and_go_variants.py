@@ -1,11 +1,13 @@
 """ISO 22179 stop and go, varied (`scenarios/acceptance/stop_and_go_variants.yaml`): the
-grid's worst points, a lead that brakes to a stop at 1 or 3 m/s^2, stands 5 s, drives off
-to 40 km/h at 1 m/s^2 and at once brakes to a stop again. Before the ACC's d_min guard
-(`planner.acc_control.guard_decel`) the ego fell 0.40 m (decelerations of 1 m/s^2) and
-0.06 m (3 m/s^2) under UN R157's d_min at about 15 km/h in the second stop; the guard
-lifts the first to 1.9 m above it, the second is a known failure (`HARD_STOP`). Shown from
-the truth: the lead stopped and drove off twice and the ego stood behind it; then `min_gap`
-passed with room."""
+grid's worst points, a lead that brakes to a stop at 1 or 3 m/s^2, stands 1 or 5 s, drives
+off to 40 km/h at 1 m/s^2 and at once brakes to a stop again (points 009, 012, 013). Before
+the ACC's d_min guard (`planner.acc_control.guard_decel`) the ego fell 0.40 m (009) under UN
+R157's d_min at about 15 km/h in the second stop; with it, 012 and 013 still fell 0.00 and
+0.06 m under it: the speed loop's integrator held the pull-away's acceleration against the
+braking. With the lead's pull-away fed forward (`planner.acc_control.lead_feed_forward`,
+`gap_rate`) all three keep d_min with room. Shown from the truth: the lead stopped and drove
+off twice and the ego stood behind it (or, behind a lead standing 1 s, came nearly to
+rest); then `min_gap` passed with room."""
 
 from __future__ import annotations
 
@@ -20,19 +22,22 @@ from world.sensors.setup import Profile
 pytestmark = [pytest.mark.slow, pytest.mark.acceptance]
 FILE = "scenarios/acceptance/stop_and_go_variants.yaml"
 STOPPED = 0.1  # [m/s]
+SLOWED = 0.5  # [m/s] behind a lead standing 1 s the ego comes this near to rest, just
+#   after the lead drove off again (0.34 m/s at 012)
 ROOM = 0.5  # [m] the least gap - d_min asked of the ACC
 
 
-def _point(decel: float) -> dict[str, object]:
-    """The grid point at 40 km/h, braking at `decel` [m/s^2], standing 5 s, driving off at
-    1 m/s^2."""
+def _point(decel: float, stand: float) -> dict[str, object]:
+    """The grid point at 40 km/h, braking at `decel` [m/s^2], standing `stand` [s], driving
+    off at 1 m/s^2."""
     accel = 1.0
     return {"ego.speed_kph": 40, "actors.0.speed_kph": 40,
             "actors.0.actions.1.speed.kph": 40, "actors.0.actions.3.speed.kph": 40,
             "actors.0.actions.0.speed.accel": -decel,
             "actors.0.actions.2.speed.accel": -decel,
             "actors.0.actions.1.speed.accel": accel, "actors.0.actions.3.speed.accel": accel,
-            "actors.0.actions.1.trigger.delay": 5, "actors.0.actions.3.trigger.delay": 5}
+            "actors.0.actions.1.trigger.delay": stand,
+            "actors.0.actions.3.trigger.delay": stand}
 
 
 def _starts(mask: np.ndarray) -> int:
@@ -40,24 +45,23 @@ def _starts(mask: np.ndarray) -> int:
     return int(np.count_nonzero(mask[1:] & ~mask[:-1]))
 
 
-HARD_STOP = ("grid point 013: the lead brakes at 3 m/s^2 (the judge's hard-braking bound, "
-             "still judged) from 40 km/h just as it reaches it; the ego, still inside d_des "
-             "after the pull-away (16 m, d_des 19.7 m) and at 10.3 m/s, builds its braking "
-             "at the comfort jerk to the comfortable cap, 3 m/s^2, and falls under d_min by "
-             "about 0.06 m at 16 km/h, with the guard or without it")
-
-
-@pytest.mark.parametrize("decel", [  # grid points 009 and 013
-    1.0, pytest.param(3.0, marks=pytest.mark.xfail(strict=True, reason=HARD_STOP))])
+@pytest.mark.parametrize(("decel", "stand"), [
+    (1.0, 5),  # grid point 009
+    (3.0, 1),  # 012: the lead brakes at the judge's hard-braking bound, still judged
+    (3.0, 5),  # 013
+])
 def test_stop_and_go_keeps_d_min_with_room(run_scenario: Callable[..., RunResult],
-                                           decel: float) -> None:
-    result = run_scenario(FILE, record=False, profile=Profile.FAST, **_point(decel))
+                                           decel: float, stand: float) -> None:
+    result = run_scenario(FILE, record=False, profile=Profile.FAST, **_point(decel, stand))
     log = result.log
     v, lead_v, gap = log.array("speed"), log.array("lead_speed"), log.array("lead_gap")
     standing = lead_v < STOPPED
     assert _starts(standing) >= 2 and _starts(~standing) >= 2  # stopped and went twice
-    ego_stood = standing & (v < STOPPED) & np.isfinite(gap)
-    assert _starts(ego_stood) >= 2  # the ego stood behind it in both stops
+    if stand >= 5:  # the ego stood behind it in both stops
+        ego_stood = standing & (v < STOPPED) & np.isfinite(gap)
+    else:  # it came nearly to rest behind it twice
+        ego_stood = (v < SLOWED) & np.isfinite(gap)
+    assert _starts(ego_stood) >= 2
     c = {r.name: r for r in result.criteria}
     assert not any(r.failed for r in result.criteria), result.criteria
     min_gap = c["min_gap"]
