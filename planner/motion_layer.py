@@ -53,7 +53,11 @@ car stops behind that vehicle (`_room`). Without overtaking, the ACC's d0 holds 
 (the turning circle): a pass from there waits for good.
 
 Keeping right after a pass waits for a car behind in the right lane to be
-``keep_right_gap`` back (a margin over the gap that aborts).
+``keep_right_gap`` back (a margin over the gap that aborts): that many seconds at the car's
+speed, or, while a faster vehicle comes up behind in the lane kept (it would reach the car
+within ``yield_time``: the FSM's ``yield_behind``, no ``keep_time`` then), at that car's own
+speed (UN R157's t_G is the time the vehicle behind takes to cover the gap): a vehicle just
+passed that stands or is slow does not hold the car in the faster vehicle's way.
 
 On a road where the leftmost lane of the car's direction has an oncoming lane beside it
 (and no lane to its left), a blocked car passes through the oncoming lane (-1) when
@@ -156,6 +160,9 @@ class MotionLayerParams:
     keep_right_gap: float = 2.0  # [s] keeping right waits for this time gap to a car behind
     #   in the right lane (UN R157's t_G of 1 s aborts a change: the margin between the two
     #   keeps a gap that hovers near t_G from starting and aborting changes)
+    yield_time: float = 10.0  # [s] a vehicle behind in the lane kept that would reach the
+    #   car within this at the speeds now comes up behind: keeping right yields to it
+    yield_margin: float = 1.0  # [m/s] ... when it is faster than the car by more than this
     back_margin: float = 2.0  # [m] the return from the oncoming lane waits for this more
     #   gap to the vehicle passed than the rear rule's (a standing vehicle's is
     #   gap >= v t_G, no hysteresis in decelerations: its track's box wobbles by tenths of
@@ -390,6 +397,7 @@ class MotionLayer:
         elif self._blocked_since is None:
             self._blocked_since = t
         blocked = self._blocked_since is not None and t - self._blocked_since >= p.blocked_time
+        yielding = self._yields(traffic[self.lane], v)
         left = traffic.get(self.lane + 1) if self.lane != SHOULDER else None
         right_of = self._right_of(self.lane, pull_over)
         right = traffic.get(right_of) if self.lane != SHOULDER and (
@@ -408,7 +416,8 @@ class MotionLayer:
             or self._pass_clears(ego, s, self.lane - 1, traffic),
             right_clear=right is not None and right.lane != SHOULDER
             and not is_blocked(right, v, v_want, p.occupancy, self.acc)
-            and (right.behind is None or right.behind.gap >= v * p.keep_right_gap),
+            and self._clear_behind(right, v, yielding),
+            yield_behind=yielding,
             route_lane=min(self._lanes_ahead(s, v) - 1 - self.lane, 0),
             pull_over=pull_over and self.lane != SHOULDER,
             turn=_turn(self._junction_at(s)),
@@ -429,6 +438,24 @@ class MotionLayer:
                               t_move=t_move) or not self._can_plan(self.origin, ego)
         return replace(x, target_free=target_free,
                        committed=abs(d - centre) < 0.5 * width, change_done=s >= self.path.end)
+
+    def _yields(self, kept: LaneTraffic, v: float) -> bool:
+        """Whether a vehicle behind in the lane kept (`kept`) comes up on the car at speed
+        `v` [m/s]: faster by more than ``yield_margin``, it would reach it within
+        ``yield_time`` (module doc)."""
+        p, behind = self.params, kept.behind
+        if behind is None or behind.speed <= v + p.yield_margin:
+            return False
+        return behind.gap < (behind.speed - v) * p.yield_time
+
+    def _clear_behind(self, right: LaneTraffic, v: float, yielding: bool) -> bool:
+        """Whether the vehicle behind in the lane to the right, if any, is
+        ``keep_right_gap`` back: seconds at the car's speed `v` [m/s], or at its own while
+        the car yields to a faster vehicle behind it (`yielding`, module doc)."""
+        if right.behind is None:
+            return True
+        speed = max(right.behind.speed, 0.0) if yielding else v
+        return right.behind.gap >= speed * self.params.keep_right_gap
 
     def _free_to_start(self, lt: LaneTraffic, ego: EgoState, s: float, v_low: float,
                        traffic: dict[int, LaneTraffic]) -> bool:

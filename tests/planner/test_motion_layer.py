@@ -438,3 +438,24 @@ def test_a_change_just_started_is_given_up_when_a_car_closing_fast_appears() -> 
     steps = follow_slow(m, 2.0, 2.2, fast=(gap, 18.06))
     assert steps[-1][1] is Motion.LANE_KEEP and steps[-1][2] == 0  # back to lane 0
     assert m.path is not None and m.path.target_index == 0
+
+
+def test_after_passing_it_yields_at_once_to_a_faster_car_coming_up_behind() -> None:
+    """A car at 75 km/h comes up in lane 1 30 m behind the ego, which has just passed a
+    stopped car in lane 0: it keeps right as soon as the right lane is free by UN R157's
+    rule (the stopped car 15 m behind: over 1 s at the ego's speed), without `keep_time`
+    and without `keep_right_gap` at its own speed (27.8 m behind a car that stands): not
+    lingering in the faster car's way."""
+    m = MotionLayer(ROAD, 1, AccParams(), VEHICLE, MotionLayerParams(overtake=True))
+    x0 = 100.0
+    stopped = car(0.0, x0 - VEHICLE.rear_overhang - 15.0 - 2.3, 0.0, 0.0, 1)  # 15 m behind
+    fast = car(0.0, x0 - VEHICLE.rear_overhang - 30.0 - 2.3, W, 20.8, 2)  # closing at 6.9 m/s
+    man = m.update(ego(0.0, x0, W), V, [stopped, fast])[0]
+    assert man.motion is Motion.LANE_CHANGE_RIGHT and man.lane == 0
+    m = MotionLayer(ROAD, 1, AccParams(), VEHICLE, MotionLayerParams(overtake=True))
+    assert m.update(ego(0.0, x0, W), V, [stopped])[0].motion is Motion.LANE_KEEP  # no
+    #   faster car: the stopped car is under keep_right_gap behind at the ego's speed
+    slow_behind = car(0.0, x0 - VEHICLE.rear_overhang - 30.0 - 2.3, W, V + 0.5, 2)
+    m = MotionLayer(ROAD, 1, AccParams(), VEHICLE, MotionLayerParams(overtake=True))
+    assert m.update(ego(0.0, x0, W), V, [stopped, slow_behind])[0].motion is \
+        Motion.LANE_KEEP  # a car behind barely faster does not come up on it
