@@ -26,10 +26,18 @@ Entering a lane change makes the target lane the lane kept (its speed plan and, 
 its camera lane) and plans the Hermite path into it from the car's pose
 (`planner.lane_change_path`); the change is done when the car's station reaches the path's
 end. An abort plans the same kind of path back to the origin lane, followed in LANE_KEEP
-until its end. While a path is followed, the vehicle ahead in the lane kept (the target
-lane) is the ACC's lead; the vehicle ahead in the origin lane is a lead too while the car's
-body (mirrors included) still overlaps that lane (`leads`): the car does not run into the
-vehicle it is leaving. On a pass (a change taken to pass a slower vehicle), the vehicle
+until its end, with its own parameters (``abort_change``): the car still heads out of the
+lane, and a cubic from that heading runs on outwards for about a quarter of its length
+before it turns back (4/27 of the length times the heading's slope), so the way back is
+the shortest whose peak lateral acceleration is within 2 m/s^2 rather than the 0.85 m/s^2
+of a planned change. At 50 km/h, 0.3 m out and heading out at 1.25 m/s, the longer path
+ran on 1.09 m further out (its tyres 0.6 m over the line they had not reached), this one
+0.46 m (braking 1.25 m/s across at 2 m/s^2 takes 0.39 m).
+
+While a path is followed, the vehicle ahead in the lane kept (the target lane) is the ACC's
+lead; the vehicle ahead in the origin lane is a lead too while the car's body (mirrors
+included) still overlaps that lane (`leads`): the car does not run into the vehicle it is
+leaving. On a pass (a change taken to pass a slower vehicle), the vehicle
 passed counts only once the path does not clear it by ``pass_margin_keep`` (`clears`,
 below; a hysteresis below the margin a pass starts with): the car does not
 trail it through the pass (issue K, item 6), yet stops behind it rather than run into it if
@@ -170,6 +178,10 @@ class MotionLayerParams:
     motion: MotionParams = field(default_factory=MotionParams)
     occupancy: OccupancyParams = field(default_factory=OccupancyParams)
     lane_change: LaneChangeParams = field(default_factory=LaneChangeParams)
+    abort_change: LaneChangeParams = field(default_factory=lambda: LaneChangeParams(
+        a_lat_design=2.0, t_min=1.5, t_max=3.0, t_cap=8.0, min_length=10.0))  # the way back
+    #   of an abort (module doc): the shortest path whose peak lateral acceleration is within
+    #   2 m/s^2 (ISO 11270's lane keeping bound is 3 m/s^2; the curves' a_lat_max too)
     oncoming_pass: PassParams = field(default_factory=PassParams)  # a pass through the
     #   oncoming lane (`planner.oncoming_pass`)
 
@@ -512,7 +524,7 @@ class MotionLayer:
             self.path = self._plan_into(self.lane, ego)
         elif abort:  # back to the origin; both lanes are in use until the path's end
             self.lane, self.origin = self.origin, self.lane
-            self.path = self._plan_into(self.lane, ego)
+            self.path = self._plan_into(self.lane, ego, self.params.abort_change)
         else:
             self.origin = self.lane
             self.path = None
@@ -526,12 +538,17 @@ class MotionLayer:
             return self.lane + 1 if self.lane + 1 < n else -1
         return n - 1 if _oncoming(self.lane) else self._right_of(self.lane, pull_over)
 
-    def _plan_into(self, lane: int, ego: EgoState) -> LaneChangePath:
+    def _plan_into(self, lane: int, ego: EgoState,
+                   params: LaneChangeParams | None = None) -> LaneChangePath:
+        """The path into `lane` from the car's pose (``lane_change``, or `params`: an
+        abort's ``abort_change``)."""
         # the estimate of a standing car's speed may be a hair below 0; the car's station
         # this tick is the projection's hint (a bend that turns back on itself passes near
         # the car twice)
         return start_lane_change(self.road.lane(lane), lane, ego.x, ego.y, ego.heading,
-                                 max(ego.speed, 0.0), self.params.lane_change, self._station)
+                                 max(ego.speed, 0.0),
+                                 self.params.lane_change if params is None else params,
+                                 self._station)
 
     def _can_plan(self, lane: int, ego: EgoState) -> bool:
         """Whether a path into `lane` starts from the car's pose (it heads less than 90
