@@ -165,6 +165,10 @@ class MotionLayerParams:
     #   8 m of room (A_HARD's 5 m/s^2 would leave 4.1, a stop short of the 9 m a pass
     #   path from a standstill needs)
     stationary: float = 0.5  # [m/s] a vehicle slower than this is stationary
+    same_place: float = 4.0  # [m] a stationary vehicle's new track whose rear is within this
+    #   of the one granted room is that vehicle (`_room`): two standing vehicles' rears are a
+    #   vehicle's length and a gap apart, and the first tracks of a car 50 m ahead placed its
+    #   rear 2 to 3.6 m short of where the tracks placed it from near
     keep_right_gap: float = 2.0  # [s] keeping right waits for this time gap to a car behind
     #   in the right lane (UN R157's t_G of 1 s aborts a change: the margin between the two
     #   keeps a gap that hovers near t_G from starting and aborting changes)
@@ -228,8 +232,9 @@ class MotionLayer:
         self._no_pass_now = ""  # ... this tick's reason
         self._passed: int | None = None  # the track passed through the oncoming lane
         self._alongside = False  # the car has drawn alongside it (the pass is committed)
-        self._kept: tuple[int, float] | None = None  # the room granted so far behind a
-        #   stationary vehicle: (its track id, the room [m]) (`_room`)
+        self._kept: tuple[int, float, float] | None = None  # the room granted so far
+        #   behind a stationary vehicle: (its track id, the room [m], the station [m] of its
+        #   rear less the car's front overhang) (`_room`)
 
     def update(self, ego: EgoState, v_want: float, tracks: Sequence[Track],
                pull_over: bool = False, v_rear: float | None = None,
@@ -619,21 +624,30 @@ class MotionLayer:
         ``room_decel_hard`` when the stop at d0 alone needs more than ``room_decel``
         (`room_left`). The room granted is kept (the largest so far for that vehicle): a
         stop gentler than the deceleration it was granted at would shrink what is left of
-        it tick by tick, down to d0, where no path gets around the vehicle."""
+        it tick by tick, down to d0, where no path gets around the vehicle. A vehicle is the
+        one granted the room when it has the same track id or its rear stands within
+        ``same_place`` of that one's: the tracker may give a standing car a new track (it
+        lost it, or split its returns) as the car brakes, which must not take the room
+        granted back. It is forgotten once the car leaves LANE_KEEP."""
         p = self.params
         ahead = traffic[self.lane].ahead if self.lane in traffic else None
         side = self.lane >= 0 and (
             any(k in traffic for k in (self.lane - 1, self.lane + 1) if k >= 0)
             or self._oncoming_side(s))
-        if (not p.overtake or not side or self.motion is not Motion.LANE_KEEP or ahead is None
-                or ahead.speed >= p.stationary
-                or not is_blocked(traffic[self.lane], v, v_want, p.occupancy, self.acc)):
+        if not p.overtake or not side or self.motion is not Motion.LANE_KEEP:
             self._kept = None
             return None, 0.0
+        if (ahead is None or ahead.speed >= p.stationary
+                or not is_blocked(traffic[self.lane], v, v_want, p.occupancy, self.acc)):
+            return None, 0.0  # the room granted is remembered: a new track's first speeds
+            #   wobble above `stationary`
         room = room_left(ahead.gap, v, self.acc.d0, p)
-        if self._kept is not None and self._kept[0] == ahead.track_id:
-            room = max(room, self._kept[1])
-        self._kept = (ahead.track_id, room)
+        rear = s + ahead.gap  # [m] its rear's station, less the car's front overhang
+        kept = self._kept
+        if kept is not None and (kept[0] == ahead.track_id
+                                 or abs(kept[2] - rear) <= p.same_place):
+            room = max(room, kept[1])
+        self._kept = (ahead.track_id, room, rear)
         return ahead.track_id, room
 
 

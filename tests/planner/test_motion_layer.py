@@ -510,3 +510,22 @@ def test_an_abort_before_the_body_reaches_the_line_keeps_it_off_the_line(
     assert m.motion is Motion.LANE_KEEP and m.path is not None and m.path.target_index == 0
     y_back = m.path.offset_at(np.linspace(x_now, m.path.end, 400))
     assert y_back.max() + half < line
+
+
+def test_the_room_granted_is_kept_when_the_stopped_car_gets_a_new_track() -> None:
+    """As `test_the_room_granted_is_kept_through_a_gentler_stop`, but the tracker gives the
+    stopped car a new track (id 9) after 0.3 s, 2 m nearer, whose first speed (0.1 s) wobbles
+    to 0.8 m/s: the room granted to id 7 stays (it had fallen to 2.9 m in a campaign run,
+    which then stood 7.2 m behind the car, where no pass path clears it, for good)."""
+    m, t, x, v = layer(), 0.0, 100.0, V
+    first = m.update(ego(0.0, x), V, [stopped_car(0.0, 50.0)])[0].room
+    rooms = []
+    while t < 0.9:
+        t, x, v = t + 0.025, x + v * 0.025, v - 1.5 * 0.025
+        track = stopped_car(t, 50.0)
+        if t > 0.3:
+            track = replace(track, id=9, x=track.x - 2.0, vx=0.8 if t < 0.4 else 0.0)
+        man = m.update(replace(ego(t, x), speed=v), V, [track])[0]
+        if man.room_for is not None:
+            rooms.append(man.room)
+    assert len(rooms) >= 30 and rooms == pytest.approx([first] * len(rooms))
