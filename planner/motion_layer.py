@@ -31,7 +31,7 @@ lane, and a cubic from that heading runs on outwards for about a quarter of its 
 before it turns back (4/27 of the length times the heading's slope), so the way back is
 the shortest whose peak lateral acceleration is within 2 m/s^2 rather than the 0.85 m/s^2
 of a planned change. At 50 km/h, 0.3 m out and heading out at 1.25 m/s, the longer path
-ran on 1.09 m further out (its tyres 0.6 m over the line they had not reached), this one
+ran on 1.09 m further out (its body 0.5 m over the line it had not reached), this one
 0.46 m (braking 1.25 m/s across at 2 m/s^2 takes 0.39 m).
 
 While a path is followed, the vehicle ahead in the lane kept (the target lane) is the ACC's
