@@ -85,7 +85,8 @@ def test_001_stops_with_room_and_passes_once_the_lane_is_free(
     t, s, v = log.array("t"), log.array("station"), log.array("speed")
     slow_s = np.array(log.actor_station)[:, 0]
     rear_s = np.array(log.actor_station)[:, 1]
-    out = next(m for m in _motion(result) if m[2] == "lane_change_left")
+    out = next((m for m in _motion(result) if m[2] == "lane_change_left"), None)
+    assert out is not None, "the ego never pulled out to pass"
     i = int(np.searchsorted(t, out[0]))
     assert rear_s[i] - s[i] > 0.5 * (CAR + EGO)  # the car behind had gone by
     before = t < out[0]
