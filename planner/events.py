@@ -22,6 +22,12 @@ bumper f, its axles); tracks are in the map frame. Each tick
   it along the route whose centre is inside the lane kept widened by ``lane_margin`` on each
   side, now or ``look_ahead`` ahead at its velocity, or crosses the lane's centre line in
   between; the car stops ``crossing_stop`` before the crosswalk and waits until it is clear.
+- a pedestrian waiting (`EventMonitor.waiting`, no event: the speed plan's lower crossing
+  speed, `planner.speed_planning`): a crosswalk ahead of the front bumper with a pedestrian
+  track on it or within ``crossing_margin`` of it along the route, and across no farther
+  than ``waiting_reach`` beyond the lane kept's edges (at the kerb, or crossing the other
+  lanes): it may step into the lane, and its track shows a walk only some 0.9 s after the
+  first step.
 - speed_bump: from ``approach(v)`` before a bump's near edge (front axle) until the rear
   axle is ``bump_margin`` past its far edge (held once entered: braking for it shrinks
   ``approach(v)``, and the event ended and began again for a tick); the speed at the bump
@@ -61,6 +67,9 @@ class EventParams:
     lane_margin: float = 1.5  # [m] across, a pedestrian this far beyond the lane's edges counts
     look_ahead: float = 2.0  # [s] a pedestrian walking into the lane within this counts
     crossing_stop: float = 1.0  # [m] stop this much (+ the law's margin) before a crosswalk
+    waiting_reach: float = 6.0  # [m] across, a pedestrian at a crosswalk this far beyond the
+    #   lane's edges waits to cross: from the far kerb of a road of one lane each way (3.5 m
+    #   lanes, 2 m shoulders: 5.5 m) it walks into the lane in under 3 s at 8 km/h
     bump_margin: float = 1.0  # [m] pass speed from this before a bump to this past it (the
     #   speed_bumps criterion's reach)
     bump_undershoot: float = kph(0.5)  # [m/s] aim this far below the pass speed
@@ -188,6 +197,26 @@ class EventMonitor:
         if not np.any(on & (lateral | crossing_between)):
             return None
         return cw.s - front - p.crossing_stop
+
+    def waiting(self, station: float, lane_offset: float, lane_width: float,
+                tracks: Sequence[Track]) -> frozenset[float]:
+        """The stations [m] of the crosswalks ahead of the front bumper of a car whose centre
+        is at `station` [m] where a pedestrian track waits (module doc): on the crosswalk or
+        within ``crossing_margin`` of it along the route, and across within ``waiting_reach``
+        of the edges of the lane kept (centre `lane_offset` [m] from the reference line, left
+        +, `lane_width` [m]); `tracks` in the map frame."""
+        p = self.params
+        front = station + self.vehicle.front_overhang
+        ahead = [c for c in self.crosswalks if front < c.s]
+        walkers = [tr for tr in tracks if tr.cls is ObjectClass.PEDESTRIAN]
+        if not ahead or not walkers:
+            return frozenset()
+        s_now, d_now = self.road.local_coordinates(np.array([[tr.x, tr.y] for tr in walkers]))
+        near = np.abs(np.asarray(d_now) - lane_offset) <= 0.5 * lane_width + p.waiting_reach
+        s_near = np.asarray(s_now)[near]
+        return frozenset(c.s for c in ahead
+                         if np.any((s_near >= c.s - p.crossing_margin)
+                                   & (s_near <= c.s + c.width + p.crossing_margin)))
 
     def _bump(self, station: float, approach: float) -> tuple[float, float] | None:
         p = self.params

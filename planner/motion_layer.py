@@ -26,10 +26,18 @@ Entering a lane change makes the target lane the lane kept (its speed plan and, 
 its camera lane) and plans the Hermite path into it from the car's pose
 (`planner.lane_change_path`); the change is done when the car's station reaches the path's
 end. An abort plans the same kind of path back to the origin lane, followed in LANE_KEEP
-until its end. While a path is followed, the vehicle ahead in the lane kept (the target
-lane) is the ACC's lead; the vehicle ahead in the origin lane is a lead too while the car's
-body (mirrors included) still overlaps that lane (`leads`): the car does not run into the
-vehicle it is leaving. On a pass (a change taken to pass a slower vehicle), the vehicle
+until its end, with its own parameters (``abort_change``): the car still heads out of the
+lane, and a cubic from that heading runs on outwards for about a quarter of its length
+before it turns back (4/27 of the length times the heading's slope), so the way back is
+the shortest whose peak lateral acceleration is within 2 m/s^2 rather than the 0.85 m/s^2
+of a planned change. At 50 km/h, 0.3 m out and heading out at 1.25 m/s, the longer path
+ran on 1.09 m further out (its body 0.5 m over the line it had not reached), this one
+0.46 m (braking 1.25 m/s across at 2 m/s^2 takes 0.39 m).
+
+While a path is followed, the vehicle ahead in the lane kept (the target lane) is the ACC's
+lead; the vehicle ahead in the origin lane is a lead too while the car's body (mirrors
+included) still overlaps that lane (`leads`): the car does not run into the vehicle it is
+leaving. On a pass (a change taken to pass a slower vehicle), the vehicle
 passed counts only once the path does not clear it by ``pass_margin_keep`` (`clears`,
 below; a hysteresis below the margin a pass starts with): the car does not
 trail it through the pass (issue K, item 6), yet stops behind it rather than run into it if
@@ -53,7 +61,11 @@ car stops behind that vehicle (`_room`). Without overtaking, the ACC's d0 holds 
 (the turning circle): a pass from there waits for good.
 
 Keeping right after a pass waits for a car behind in the right lane to be
-``keep_right_gap`` back (a margin over the gap that aborts).
+``keep_right_gap`` back (a margin over the gap that aborts): that many seconds at the car's
+speed, or, while a faster vehicle comes up behind in the lane kept (it would reach the car
+within ``yield_time``: the FSM's ``yield_behind``, no ``keep_time`` then), at that car's own
+speed (UN R157's t_G is the time the vehicle behind takes to cover the gap): a vehicle just
+passed that stands or is slow does not hold the car in the faster vehicle's way.
 
 On a road where the leftmost lane of the car's direction has an oncoming lane beside it
 (and no lane to its left), a blocked car passes through the oncoming lane (-1) when
@@ -153,9 +165,16 @@ class MotionLayerParams:
     #   8 m of room (A_HARD's 5 m/s^2 would leave 4.1, a stop short of the 9 m a pass
     #   path from a standstill needs)
     stationary: float = 0.5  # [m/s] a vehicle slower than this is stationary
+    same_place: float = 4.0  # [m] a stationary vehicle's new track whose rear is within this
+    #   of the one granted room is that vehicle (`_room`): two standing vehicles' rears are a
+    #   vehicle's length and a gap apart, and the first tracks of a car 50 m ahead placed its
+    #   rear 2 to 3.6 m short of where the tracks placed it from near
     keep_right_gap: float = 2.0  # [s] keeping right waits for this time gap to a car behind
     #   in the right lane (UN R157's t_G of 1 s aborts a change: the margin between the two
     #   keeps a gap that hovers near t_G from starting and aborting changes)
+    yield_time: float = 10.0  # [s] a vehicle behind in the lane kept that would reach the
+    #   car within this at the speeds now comes up behind: keeping right yields to it
+    yield_margin: float = 1.0  # [m/s] ... when it is faster than the car by more than this
     back_margin: float = 2.0  # [m] the return from the oncoming lane waits for this more
     #   gap to the vehicle passed than the rear rule's (a standing vehicle's is
     #   gap >= v t_G, no hysteresis in decelerations: its track's box wobbles by tenths of
@@ -163,6 +182,10 @@ class MotionLayerParams:
     motion: MotionParams = field(default_factory=MotionParams)
     occupancy: OccupancyParams = field(default_factory=OccupancyParams)
     lane_change: LaneChangeParams = field(default_factory=LaneChangeParams)
+    abort_change: LaneChangeParams = field(default_factory=lambda: LaneChangeParams(
+        a_lat_design=2.0, t_min=1.5, t_max=3.0, t_cap=8.0, min_length=10.0))  # the way back
+    #   of an abort (module doc): the shortest path whose peak lateral acceleration is within
+    #   2 m/s^2 (ISO 11270's lane keeping bound is 3 m/s^2; the curves' a_lat_max too)
     oncoming_pass: PassParams = field(default_factory=PassParams)  # a pass through the
     #   oncoming lane (`planner.oncoming_pass`)
 
@@ -209,8 +232,9 @@ class MotionLayer:
         self._no_pass_now = ""  # ... this tick's reason
         self._passed: int | None = None  # the track passed through the oncoming lane
         self._alongside = False  # the car has drawn alongside it (the pass is committed)
-        self._kept: tuple[int, float] | None = None  # the room granted so far behind a
-        #   stationary vehicle: (its track id, the room [m]) (`_room`)
+        self._kept: tuple[int, float, float] | None = None  # the room granted so far
+        #   behind a stationary vehicle: (its track id, the room [m], the station [m] of its
+        #   rear less the car's front overhang) (`_room`)
 
     def update(self, ego: EgoState, v_want: float, tracks: Sequence[Track],
                pull_over: bool = False, v_rear: float | None = None,
@@ -390,6 +414,7 @@ class MotionLayer:
         elif self._blocked_since is None:
             self._blocked_since = t
         blocked = self._blocked_since is not None and t - self._blocked_since >= p.blocked_time
+        yielding = self._yields(traffic[self.lane], v)
         left = traffic.get(self.lane + 1) if self.lane != SHOULDER else None
         right_of = self._right_of(self.lane, pull_over)
         right = traffic.get(right_of) if self.lane != SHOULDER and (
@@ -408,7 +433,8 @@ class MotionLayer:
             or self._pass_clears(ego, s, self.lane - 1, traffic),
             right_clear=right is not None and right.lane != SHOULDER
             and not is_blocked(right, v, v_want, p.occupancy, self.acc)
-            and (right.behind is None or right.behind.gap >= v * p.keep_right_gap),
+            and self._clear_behind(right, v, yielding),
+            yield_behind=yielding,
             route_lane=min(self._lanes_ahead(s, v) - 1 - self.lane, 0),
             pull_over=pull_over and self.lane != SHOULDER,
             turn=_turn(self._junction_at(s)),
@@ -429,6 +455,24 @@ class MotionLayer:
                               t_move=t_move) or not self._can_plan(self.origin, ego)
         return replace(x, target_free=target_free,
                        committed=abs(d - centre) < 0.5 * width, change_done=s >= self.path.end)
+
+    def _yields(self, kept: LaneTraffic, v: float) -> bool:
+        """Whether a vehicle behind in the lane kept (`kept`) comes up on the car at speed
+        `v` [m/s]: faster by more than ``yield_margin``, it would reach it within
+        ``yield_time`` (module doc)."""
+        p, behind = self.params, kept.behind
+        if behind is None or behind.speed <= v + p.yield_margin:
+            return False
+        return behind.gap < (behind.speed - v) * p.yield_time
+
+    def _clear_behind(self, right: LaneTraffic, v: float, yielding: bool) -> bool:
+        """Whether the vehicle behind in the lane to the right, if any, is
+        ``keep_right_gap`` back: seconds at the car's speed `v` [m/s], or at its own while
+        the car yields to a faster vehicle behind it (`yielding`, module doc)."""
+        if right.behind is None:
+            return True
+        speed = max(right.behind.speed, 0.0) if yielding else v
+        return right.behind.gap >= speed * self.params.keep_right_gap
 
     def _free_to_start(self, lt: LaneTraffic, ego: EgoState, s: float, v_low: float,
                        traffic: dict[int, LaneTraffic]) -> bool:
@@ -485,7 +529,7 @@ class MotionLayer:
             self.path = self._plan_into(self.lane, ego)
         elif abort:  # back to the origin; both lanes are in use until the path's end
             self.lane, self.origin = self.origin, self.lane
-            self.path = self._plan_into(self.lane, ego)
+            self.path = self._plan_into(self.lane, ego, self.params.abort_change)
         else:
             self.origin = self.lane
             self.path = None
@@ -499,12 +543,17 @@ class MotionLayer:
             return self.lane + 1 if self.lane + 1 < n else -1
         return n - 1 if _oncoming(self.lane) else self._right_of(self.lane, pull_over)
 
-    def _plan_into(self, lane: int, ego: EgoState) -> LaneChangePath:
+    def _plan_into(self, lane: int, ego: EgoState,
+                   params: LaneChangeParams | None = None) -> LaneChangePath:
+        """The path into `lane` from the car's pose (``lane_change``, or `params`: an
+        abort's ``abort_change``)."""
         # the estimate of a standing car's speed may be a hair below 0; the car's station
         # this tick is the projection's hint (a bend that turns back on itself passes near
         # the car twice)
         return start_lane_change(self.road.lane(lane), lane, ego.x, ego.y, ego.heading,
-                                 max(ego.speed, 0.0), self.params.lane_change, self._station)
+                                 max(ego.speed, 0.0),
+                                 self.params.lane_change if params is None else params,
+                                 self._station)
 
     def _can_plan(self, lane: int, ego: EgoState) -> bool:
         """Whether a path into `lane` starts from the car's pose (it heads less than 90
@@ -575,21 +624,30 @@ class MotionLayer:
         ``room_decel_hard`` when the stop at d0 alone needs more than ``room_decel``
         (`room_left`). The room granted is kept (the largest so far for that vehicle): a
         stop gentler than the deceleration it was granted at would shrink what is left of
-        it tick by tick, down to d0, where no path gets around the vehicle."""
+        it tick by tick, down to d0, where no path gets around the vehicle. A vehicle is the
+        one granted the room when it has the same track id or its rear stands within
+        ``same_place`` of that one's: the tracker may give a standing car a new track (it
+        lost it, or split its returns) as the car brakes, which must not take the room
+        granted back. It is forgotten once the car leaves LANE_KEEP."""
         p = self.params
         ahead = traffic[self.lane].ahead if self.lane in traffic else None
         side = self.lane >= 0 and (
             any(k in traffic for k in (self.lane - 1, self.lane + 1) if k >= 0)
             or self._oncoming_side(s))
-        if (not p.overtake or not side or self.motion is not Motion.LANE_KEEP or ahead is None
-                or ahead.speed >= p.stationary
-                or not is_blocked(traffic[self.lane], v, v_want, p.occupancy, self.acc)):
+        if not p.overtake or not side or self.motion is not Motion.LANE_KEEP:
             self._kept = None
             return None, 0.0
+        if (ahead is None or ahead.speed >= p.stationary
+                or not is_blocked(traffic[self.lane], v, v_want, p.occupancy, self.acc)):
+            return None, 0.0  # the room granted is remembered: a new track's first speeds
+            #   wobble above `stationary`
         room = room_left(ahead.gap, v, self.acc.d0, p)
-        if self._kept is not None and self._kept[0] == ahead.track_id:
-            room = max(room, self._kept[1])
-        self._kept = (ahead.track_id, room)
+        rear = s + ahead.gap  # [m] its rear's station, less the car's front overhang
+        kept = self._kept
+        if kept is not None and (kept[0] == ahead.track_id
+                                 or abs(kept[2] - rear) <= p.same_place):
+            room = max(room, kept[1])
+        self._kept = (ahead.track_id, room, rear)
         return ahead.track_id, room
 
 

@@ -173,6 +173,8 @@ class Planner:
         self.leads = LeadSelector(self.params.lead, self.params.acc.control)
         self.driver = DriverOverride(p.override)
         self.events = EventMonitor(self.road, p.vehicle, p.events)
+        self._waiting: frozenset[float] = frozenset()  # [m] the crosswalks ahead where a
+        #   pedestrian waits this tick (`EventMonitor.waiting`: a lower crossing speed)
         self.junctions = JunctionMonitor(self.road, p.vehicle, p.junctions)
         self.hazard = Machine("hazard", HazardLights.OFF)
         self.sensing = Machine("sensing", Sensing.NOMINAL)
@@ -207,11 +209,12 @@ class Planner:
     def speed_for(self, station: float, set_speed: float | None = None) -> SpeedTarget:
         """The map's speed target for the car's centre at ``station`` [m] (at ``set_speed``
         [m/s], by default the driver's set speed), never above the sight cap (its binding
-        SIGHT where the cap is what limits it)."""
+        SIGHT where the cap is what limits it); slower towards a crosswalk where a
+        pedestrian waits (this tick's `EventMonitor.waiting`)."""
         p = self.params
         return self.speed_planner.target(
             station, set_speed=p.set_speed if set_speed is None else set_speed,
-            max_speed=self.max_speed, sight_speed=self.sight_speed)
+            max_speed=self.max_speed, sight_speed=self.sight_speed, waiting=self._waiting)
 
     def update(self, inp: PlannerInput) -> Plan:
         """The plan for this tick (module doc)."""
@@ -223,6 +226,8 @@ class Planner:
         if inp.lights:
             self.junctions.see_lights(inp.lights)
         station, lateral = self.localise(ego)
+        self._waiting = self.events.waiting(station, float(self.lane.offset_at(station)),
+                                            float(self.lane.width_at(station)), tracks)
         target = self.speed_for(station)
         want = min(self.params.set_speed, target.limit_at_front)
         manoeuvre, motion_changes = self.motion.update(ego, want, tracks,

@@ -13,14 +13,18 @@ the target is the minimum of
   of a marked crossing it has not reached: a pedestrian who steps out is tracked from about
   that range, and from this speed the car still stops before the crossing within ISO 15622's
   comfort (about 2.5 m/s^2 with the ramp-in; `planner.acc_control`), where at the posted
-  40 km/h of a town it would need 5 m/s^2 (issue K);
+  40 km/h of a town it would need 5 m/s^2 (issue K). Where a pedestrian waits at the
+  crossing (`target`'s ``waiting``: `planner.events.EventMonitor.waiting`) the lower
+  ``crossing_speed_waiting``: the track of a walker who steps off the kerb shows the walk
+  about 0.9 s late (its velocity lags), 7.5 m of the approach at 30 km/h, after which a
+  stop before the crossing may need 4 m/s^2; from 20 km/h it needs about 1.5 m/s^2;
 * for every constraint ahead, the speed from which the car can reach it by braking at
   ``a_comf``: ``sqrt(v_c^2 + 2 a_comf max(d - brake_margin, 0))``. Constraints ahead are the
   speed-limit postings beyond the front bumper (``v_c`` = limit less ``limit_margin``, ``d``
   from the front bumper, so the limit already holds when the bumper reaches the sign), the
-  crossings (``v_c`` = crossing_speed, ``d`` from the front bumper to ``crossing_sight``
-  before the crossing) and the curvature-speed samples beyond the front axle (``d`` from the
-  front axle).
+  crossings (``v_c`` = crossing_speed or crossing_speed_waiting, ``d`` from the front
+  bumper to ``crossing_sight`` before the crossing) and the curvature-speed samples beyond
+  the front axle (``d`` from the front axle).
 
 ``brake_margin`` makes the braking curve reach ``v_c`` that many metres before the
 constraint: room for the speed loop's lag behind a falling target. ``limit_margin`` keeps
@@ -50,6 +54,7 @@ from __future__ import annotations
 import bisect
 import enum
 import math
+from collections.abc import Collection
 from dataclasses import dataclass
 
 import numpy as np
@@ -85,6 +90,9 @@ class SpeedPlanningParams:
     min_curvature: float = 1e-6  # [1/m] below this |kappa| the lane is straight (no limit)
     crossing_speed: float = kph(30.0)  # [m/s] near a marked crossing (module doc)
     crossing_sight: float = 20.0  # [m] ... within this of it (a pedestrian's tracking range)
+    crossing_speed_waiting: float = kph(20.0)  # [m/s] ... where a pedestrian waits at it
+    #   (module doc): a step-out seen 0.9 s late 17.6 m before the crossing leaves 12.6 m,
+    #   a stop from 5.6 m/s in 11.6 m (after ``crossing_stop``) at 1.3 m/s^2
 
 
 @dataclass(frozen=True, slots=True)
@@ -182,11 +190,14 @@ class SpeedPlanner:
     # -- the target -----------------------------------------------------------------------------
 
     def target(self, s: float, *, set_speed: float, max_speed: float,
-               sight_speed: float = math.inf) -> SpeedTarget:
+               sight_speed: float = math.inf,
+               waiting: Collection[float] = ()) -> SpeedTarget:
         """The target speed for a car whose centre is at station ``s`` [m] of the lane.
 
-        ``set_speed``, ``max_speed`` and ``sight_speed`` [m/s]. Ties go to the first of: set
-        speed, max speed, sight, limit, curve now, curve ahead, limit ahead.
+        ``set_speed``, ``max_speed`` and ``sight_speed`` [m/s]; ``waiting`` the stations [m]
+        of the marked crossings where a pedestrian waits (their speed is
+        ``crossing_speed_waiting``). Ties go to the first of: set speed, max speed, sight,
+        limit, curve now, curve ahead, limit ahead.
         """
         p = self.params
         s_front = self.front_station(s)
@@ -199,7 +210,7 @@ class SpeedPlanner:
             (limit_at_front - p.limit_margin, Binding.LIMIT, 0.0),
             *self._curve_constraints(s, s_axle),
             *self._limit_constraints(s_front),
-            *self._crossing_constraints(s_front),
+            *self._crossing_constraints(s_front, waiting),
         ]
         v, binding, d = min(candidates, key=lambda c: c[0])  # the first of equal minima
         braking = binding in _AHEAD and d > p.brake_margin
@@ -246,16 +257,19 @@ class SpeedPlanner:
                 out.append((v, Binding.LIMIT_AHEAD, d))
         return out
 
-    def _crossing_constraints(self, s_front: float) -> list[tuple[float, Binding, float]]:
+    def _crossing_constraints(self, s_front: float, waiting: Collection[float],
+                              ) -> list[tuple[float, Binding, float]]:
         """(speed, binding, distance) per marked crossing the front bumper has not reached:
-        the crossing speed within crossing_sight of it, the braking curve to it beyond."""
+        the crossing speed (``crossing_speed_waiting`` at those in `waiting`) within
+        crossing_sight of it, the braking curve to it beyond."""
         p = self.params
         d_front = self._distance_at(s_front)
         out = []
         for s_c in self._crossings:
             if s_front < s_c <= self.road.length:
                 d = max(self._distance_at(s_c) - d_front - p.crossing_sight, 0.0)
-                v = math.sqrt(p.crossing_speed**2 + 2.0 * p.a_comf
+                v_c = p.crossing_speed_waiting if s_c in waiting else p.crossing_speed
+                v = math.sqrt(v_c**2 + 2.0 * p.a_comf
                               * max(d - p.brake_margin, 0.0))
                 out.append((v, Binding.CROSSING, d))
         return out

@@ -43,7 +43,8 @@ tried in this order and the first that holds is taken:
     other lane
 11. lane_keep -> lane_change_right: keep right: overtaking allowed, the lane not blocked,
     the right free and clear (nothing slower ahead in it to block it), `keep_time` since the
-    last change, and the route needs no other lane
+    last change (none when a faster vehicle comes up behind), and the route needs no other
+    lane
 12. lane_change_left, lane_change_right -> lane_keep: the change is done (in the target
     lane)
 13. lane_change_left, lane_change_right -> lane_keep: abort: the target lane is no longer
@@ -66,7 +67,9 @@ standstill behind a stopped vehicle: `blocked` does not ask that the vehicle ahe
 only that it is slower than wanted; while no side is free, or a pass path would not clear
 it, the car waits in its lane (the ACC stops it behind that vehicle) and goes once both
 hold. Overtaking and keeping right wait `keep_time` after the last change (no weaving); a
-route lane change waits `route_keep_time` only.
+route lane change waits `route_keep_time` only. Keeping right with a faster vehicle coming
+up behind in the lane kept (`yield_behind`) waits no `keep_time`: the car leaves the lane to
+it as soon as the right lane is free and clear, rather than linger in its way after a pass.
 """
 
 from __future__ import annotations
@@ -115,6 +118,8 @@ class MotionInput:
     left_free: bool = False  # a lane to the left exists and is free by the tracks
     right_free: bool = False  # a lane to the right exists and is free by the tracks
     right_clear: bool = False  # ... and nothing slower ahead in it would block it
+    yield_behind: bool = False  # a faster vehicle comes up behind in the lane kept: keeping
+    #   right waits no `keep_time`
     clears_left: bool = True  # a pass path into the left lane clears the vehicle ahead
     clears_right: bool = True  # ... into the right lane
     route_lane: int = 0  # [lanes] the route needs the car to move: > 0 left, < 0 right
@@ -190,7 +195,8 @@ def _overtake_oncoming(_m: Motion, x: MotionInput, p: MotionParams) -> bool:
 
 def _keep_right(_m: Motion, x: MotionInput, p: MotionParams) -> bool:
     return (_free_to_choose(x) and not _route_holds(x, p) and x.overtake and not x.blocked
-            and x.right_free and x.right_clear and _waited(x) >= p.keep_time)
+            and x.right_free and x.right_clear
+            and (_waited(x) >= p.keep_time or x.yield_behind))
 
 
 def _change_done(_m: Motion, x: MotionInput, _p: MotionParams) -> bool:
@@ -243,8 +249,9 @@ TABLE: Table[Motion, MotionInput, MotionParams] = Table(Motion, (
         "a slower vehicle ahead, a pass through the oncoming lane is safe"),
     Row(_KEEP, M.LANE_CHANGE_RIGHT, _keep_right,
         "keep right: overtaking allowed, the lane not blocked, the right free and clear "
-        "(nothing slower ahead in it to block it), `keep_time` since the last change, and the "
-        "route needs no other lane", "keep right: the right lane is free"),
+        "(nothing slower ahead in it to block it), `keep_time` since the last change (none "
+        "when a faster vehicle comes up behind), and the route needs no other lane",
+        "keep right: the right lane is free"),
     Row(LANE_CHANGES, M.LANE_KEEP, _change_done, "the change is done (in the target lane)",
         "in the target lane"),
     Row(LANE_CHANGES, M.LANE_KEEP, _abort,

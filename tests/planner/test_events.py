@@ -173,3 +173,23 @@ def test_a_camera_stop_sign_confirms_the_map_line_near_it() -> None:
     seen = SignDetection(5.0, "stop", 38.0, -4.3, 2.0, 38.2, (0, 0, 1, 1), 0.9)
     m.see_signs([seen], pose)
     assert m.confirmed == {200.0}
+
+
+def test_a_pedestrian_waits_at_a_crossing_ahead_from_the_kerb_or_the_far_side() -> None:
+    """`EventMonitor.waiting`: the crosswalk at 400 m (width 4 m) counts while a walker is
+    at it, on either side within `waiting_reach` of the lane's edges, before it has
+    started to walk (no event yet) and until the front bumper reaches the crosswalk."""
+    m = EventMonitor(ROAD, VEHICLE, P)
+    edge = 0.5 * W + P.waiting_reach  # [m] from the lane's centre
+    kerb = walker(401.5, -5.0)  # standing on the right-hand pavement, 3.25 m off the lane
+    assert not at(m, 370.0, tracks=(kerb,)).holds(PEDESTRIAN)  # not walking: no event
+    assert m.waiting(370.0, 0.0, W, (kerb,)) == frozenset({400.0})
+    assert m.waiting(370.0, 0.0, W, (walker(401.5, 6.5),)) == frozenset({400.0})  # far side
+    assert m.waiting(370.0, 0.0, W, (walker(401.5, edge - 0.01),)) == frozenset({400.0})
+    assert m.waiting(370.0, 0.0, W, (walker(401.5, edge + 0.01),)) == frozenset()  # too far
+    assert m.waiting(370.0, 0.0, W, (walker(400.0 - P.crossing_margin - 0.01, -5.0),)) \
+        == frozenset()  # before the crosswalk along the road
+    assert m.waiting(370.0, 0.0, W, (walker(404.0 + P.crossing_margin, -5.0),)) \
+        == frozenset({400.0})  # just past its far edge, within the margin
+    assert m.waiting(397.7, 0.0, W, (kerb,)) == frozenset()  # the front bumper on it
+    assert m.waiting(370.0, 0.0, W, ()) == frozenset()

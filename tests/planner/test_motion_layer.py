@@ -438,3 +438,94 @@ def test_a_change_just_started_is_given_up_when_a_car_closing_fast_appears() -> 
     steps = follow_slow(m, 2.0, 2.2, fast=(gap, 18.06))
     assert steps[-1][1] is Motion.LANE_KEEP and steps[-1][2] == 0  # back to lane 0
     assert m.path is not None and m.path.target_index == 0
+
+
+def test_after_passing_it_yields_at_once_to_a_faster_car_coming_up_behind() -> None:
+    """A car at 75 km/h comes up in lane 1 30 m behind the ego, which has just passed a
+    stopped car in lane 0: it keeps right as soon as the right lane is free by UN R157's
+    rule (the stopped car 15 m behind: over 1 s at the ego's speed), without `keep_time`
+    and without `keep_right_gap` at its own speed (27.8 m behind a car that stands): not
+    lingering in the faster car's way."""
+    m = MotionLayer(ROAD, 1, AccParams(), VEHICLE, MotionLayerParams(overtake=True))
+    x0 = 100.0
+    stopped = car(0.0, x0 - VEHICLE.rear_overhang - 15.0 - 2.3, 0.0, 0.0, 1)  # 15 m behind
+    fast = car(0.0, x0 - VEHICLE.rear_overhang - 30.0 - 2.3, W, 20.8, 2)  # closing at 6.9 m/s
+    man = m.update(ego(0.0, x0, W), V, [stopped, fast])[0]
+    assert man.motion is Motion.LANE_CHANGE_RIGHT and man.lane == 0
+    m = MotionLayer(ROAD, 1, AccParams(), VEHICLE, MotionLayerParams(overtake=True))
+    assert m.update(ego(0.0, x0, W), V, [stopped])[0].motion is Motion.LANE_KEEP  # no
+    #   faster car: the stopped car is under keep_right_gap behind at the ego's speed
+    slow_behind = car(0.0, x0 - VEHICLE.rear_overhang - 30.0 - 2.3, W, V + 0.5, 2)
+    m = MotionLayer(ROAD, 1, AccParams(), VEHICLE, MotionLayerParams(overtake=True))
+    assert m.update(ego(0.0, x0, W), V, [stopped, slow_behind])[0].motion is \
+        Motion.LANE_KEEP  # a car behind barely faster does not come up on it
+
+
+def drive_heading(m: MotionLayer, t0: float, t1: float, slow_x0: float,
+                  fast: tuple[float, float] | None = None) -> list[tuple[float, Motion, int]]:
+    """`drive`, the ego heading along the plan's path too (its slope), as a car tracking it
+    does: a path planned from the pose starts from that heading. It starts on the path in
+    hand, if any."""
+    out, t, x, y, heading = [], t0, 100.0 + V * t0, 0.0, 0.0
+    if m.path is not None:
+        y = float(ROAD.lane(m.path.target_index).offset_at(x)) + float(m.path.offset_at(x))
+        heading = math.atan(float(m.path.slope_at(x)))
+    while t < t1:
+        tracks = [car(t, slow_x0 + 5.56 * t, 0.0, 5.56, 1)]
+        if fast is not None:
+            tracks.append(car(t, fast[0] + fast[1] * (t - t0), W, fast[1], 2))
+        pose = EgoState(t=t, x=x, y=y, heading=heading, speed=V, yaw_rate=0.0,
+                        steering_angle=0.0, position_sigma=0.05)
+        man, _ = m.update(pose, V, tracks)
+        t += 0.025
+        x += V * 0.025
+        if man.path is not None:
+            y = float(ROAD.lane(man.path.target_index).offset_at(x)) + float(
+                man.path.offset_at(x))
+            heading = math.atan(float(man.path.slope_at(x)))
+        out.append((t, man.motion, man.lane))
+    return out
+
+
+@pytest.mark.parametrize("t_abort", [2.2, 2.3])
+def test_an_abort_before_the_body_reaches_the_line_keeps_it_off_the_line(
+        t_abort: float) -> None:
+    """A change to pass starts at 1.0 s; at `t_abort` a car at 30 m/s appears 45 m behind
+    in the target lane (it would have to brake hard): the change is aborted while the
+    body is still inside lane 0 but heading out. On the way back (perfect tracking) the
+    body's side stays inside lane 0's left line: the way back is planned with
+    ``abort_change`` (2 m/s^2), not the 0.85 m/s^2 of a planned change, whose path ran on
+    0.40 and 0.44 m further out, the body 0.04 and 0.16 m over the line (now 0.17 and
+    0.18 m, inside it)."""
+    m = layer()
+    steps = drive_heading(m, 0.0, t_abort, slow_x0=170.0)
+    assert steps[-1][1] is Motion.LANE_CHANGE_LEFT and m.path is not None
+    line = 0.5 * W - 0.075  # [m] the inner edge of the line between lanes 0 and 1
+    half = 0.5 * VEHICLE.width  # [m] the body's half width
+    x_now = 100.0 + V * t_abort
+    y_now = float(m.path.offset_at(x_now)) + W  # lane 0's centre is the reference line
+    assert y_now > 0.1 and y_now + half < line  # out of the lane's centre, not on the line
+    assert float(m.path.slope_at(x_now)) > 0.02  # heading out
+    drive_heading(m, t_abort, t_abort + 0.1, slow_x0=170.0, fast=(x_now - 45.0, 30.0))
+    assert m.motion is Motion.LANE_KEEP and m.path is not None and m.path.target_index == 0
+    y_back = m.path.offset_at(np.linspace(x_now, m.path.end, 400))
+    assert y_back.max() + half < line
+
+
+def test_the_room_granted_is_kept_when_the_stopped_car_gets_a_new_track() -> None:
+    """As `test_the_room_granted_is_kept_through_a_gentler_stop`, but the tracker gives the
+    stopped car a new track (id 9) after 0.3 s, 2 m nearer, whose first speed (0.1 s) wobbles
+    to 0.8 m/s: the room granted to id 7 stays (it had fallen to 2.9 m in a campaign run,
+    which then stood 7.2 m behind the car, where no pass path clears it, for good)."""
+    m, t, x, v = layer(), 0.0, 100.0, V
+    first = m.update(ego(0.0, x), V, [stopped_car(0.0, 50.0)])[0].room
+    rooms = []
+    while t < 0.9:
+        t, x, v = t + 0.025, x + v * 0.025, v - 1.5 * 0.025
+        track = stopped_car(t, 50.0)
+        if t > 0.3:
+            track = replace(track, id=9, x=track.x - 2.0, vx=0.8 if t < 0.4 else 0.0)
+        man = m.update(replace(ego(t, x), speed=v), V, [track])[0]
+        if man.room_for is not None:
+            rooms.append(man.room)
+    assert len(rooms) >= 30 and rooms == pytest.approx([first] * len(rooms))

@@ -327,3 +327,28 @@ def test_a_crossing_caps_the_speed_within_its_sight_and_brakes_towards_it() -> N
                                         rel=1e-3)
     past = target(road, crossing - FRONT + 0.5, 40.0)  # the bumper on the crossing: free
     assert past.binding is Binding.LIMIT
+
+
+def test_a_pedestrian_waiting_at_a_crossing_lowers_its_speed_and_curve() -> None:
+    """With a pedestrian waiting at the crossing (`target`'s ``waiting``) its speed is
+    ``crossing_speed_waiting`` within its sight and the braking curve leads to that; a
+    crossing without one (another station) keeps ``crossing_speed``."""
+    crossing = 400.0
+    spec = road_spec([segment(1000.0)], 50.0)
+    road = real_map(replace(spec, features=(*spec.features, Crosswalk(s=crossing, width=4.0))))
+    planner = SpeedPlanner(road, road.lane(0), P, VEHICLE)
+    d_sight = crossing - P.crossing_sight
+
+    def at(s: float, waiting: tuple[float, ...]) -> SpeedTarget:
+        return planner.target(s, set_speed=50 * KPH, max_speed=200 * KPH, waiting=waiting)
+
+    assert P.crossing_speed_waiting < P.crossing_speed
+    near = at(d_sight - FRONT + 5.0, (crossing,))
+    assert near.binding is Binding.CROSSING
+    assert near.speed == pytest.approx(P.crossing_speed_waiting)
+    assert at(d_sight - FRONT + 5.0, (crossing + 50.0,)).speed == pytest.approx(
+        P.crossing_speed)
+    ahead = at(d_sight - FRONT - 10.0, (crossing,))
+    assert ahead.binding is Binding.CROSSING and ahead.accel == -A
+    assert ahead.speed == pytest.approx(
+        math.sqrt(P.crossing_speed_waiting**2 + 2 * A * (10 - MARGIN)), rel=1e-3)
