@@ -26,7 +26,7 @@ from perception.flat_tyre import FlatTyreDetector
 from perception.health import HealthMonitor
 from perception.lanes import LaneDetector, LaneFilter
 from perception.lights import TrafficLightDetector
-from perception.localization import LaneMatch, Localizer, clear_ahead
+from perception.localization import LaneMatch, Localizer, LocalizerParams, clear_ahead
 from perception.messages import (
     Detection,
     EgoState,
@@ -103,7 +103,8 @@ class Stack:
         self.reads = frozenset({*CAR_SENSORS, LIDAR}
                                | ({front_camera.name} if front_camera is not None else set()))
         #   the sensors whose frames it uses (it ignores the side cameras')
-        self.localizer = Localizer(road=road if front_camera is not None else None,
+        self.localizer = Localizer(LocalizerParams(rear_axle=car.rear_axle),
+                                   road=road if front_camera is not None else None,
                                    start_lane=ego.lane)
         #   the camera's lane corrects the pose across the lane (map matching)
         vehicle = vehicle_info(car)
