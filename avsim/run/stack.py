@@ -237,14 +237,24 @@ class Stack:
 
     def _stop_line(self, front: CameraFrame, lane: LaneEstimate, pose: EgoState) -> None:
         """Look for a stop line where the map has one ahead, and place the car along the
-        route by it (`perception.stop_lines`, `Localizer.on_stop_line`)."""
+        route by it (`perception.stop_lines`, `Localizer.on_stop_line`). Ahead means within
+        the reach a seen line is matched over (3 x ``stop_line_window``) of the camera's
+        view: the estimate may be off along the route by metres where a car ahead hid the
+        line, and the car then stands where it believes the line is, short of the view.
+        Across the camera's lane; where that is no measurement (its lines end at the
+        junction's mouth), across the map's lane on the pose (`Localizer.map_lane`)."""
         detector = self.stop_line_detector
-        if detector is None or lane.confidence < self.localizer.params.lane_confidence:
+        if detector is None:
             return
         p = detector.params
-        margin = self.localizer.params.stop_line_window
-        if not self.localizer.stop_lines_ahead(pose, p.min_x - margin, p.max_x + margin):
+        reach = 3.0 * self.localizer.params.stop_line_window
+        if not self.localizer.stop_lines_ahead(pose, p.min_x - reach, p.max_x + reach):
             return
+        if lane.confidence < self.localizer.params.lane_confidence:
+            on_map = self.localizer.map_lane(pose, lane.t)
+            if on_map is None:
+                return
+            lane = on_map
         with self.watch("perception stop lines"):
             distance = detector.detect(front, lane)
         if distance is not None:
