@@ -443,6 +443,29 @@ class Localizer:
         nearest = min(lanes, key=lambda lane: abs(float(lane.offset_at(s)) - d))
         return float(nearest.width_at(s))
 
+    def map_lane(self, pose: EgoState, t: float) -> LaneEstimate | None:
+        """The HD map's ego-direction lane nearest the car's centre at ``pose``, as a lane
+        estimate of time ``t`` [s] in the vehicle frame there (offset, heading error and
+        curvature of the map's lane on the pose; ``confidence`` 0 and no boundaries: it is
+        not a measurement), None without a map or a lane there. Where the camera sees too
+        little of the lane to be a measurement (its lines end at a junction's mouth, a car
+        ahead hides them), the stop line across the lane is looked for across this one: the
+        pose is pinned across the lane by the camera's earlier frames, and along the route
+        it is the stop line that is to place it."""
+        road = self.road
+        if road is None:
+            return None
+        s, d = self._on_route(np.array([pose.x, pose.y]))
+        lanes = [lane for lane in road.lanes if bool(lane.exists_at(s))]
+        if not lanes:
+            return None
+        nearest = min(lanes, key=lambda lane: abs(float(lane.offset_at(s)) - d))
+        return LaneEstimate(t=t, offset=d - float(nearest.offset_at(s)),
+                            heading_error=wrap_angle(pose.heading - float(road.heading_at(s))),
+                            curvature=float(road.curvature_at(s)),
+                            width=float(nearest.width_at(s)), confidence=0.0, left=None,
+                            right=None, lines=0)
+
     def stop_lines_ahead(self, pose: EgoState, near: float, far: float) -> list[float]:
         """[m] distances from ``pose`` to the map's painted stop lines (a stop sign's, a town
         junction's) between ``near`` and ``far`` ahead along the route."""

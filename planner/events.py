@@ -14,9 +14,13 @@ bumper f, its axles); tracks are in the map frame. Each tick
 - stop_sign: the next stop line L of the map ahead, once perception has confirmed its sign
   (`see_signs`: a camera stop sign, placed on the map, near the line and right of the
   route), from ``approach(v)`` before it until the car has stood (below ``stopped_speed``)
-  for ``stop_hold`` with its front bumper 0 to ``stop_zone`` before the line; the line is
-  then done until the front bumper is past it. The car aims to stand ``stop_margin`` plus
-  the law's margin before the line (`stop_distance` = L - f - stop_margin).
+  for ``stop_hold`` with its front bumper 0 to ``stop_zone`` before the line and no vehicle
+  right in front of it (`planner.queue`: a stop behind a car queued at the line is not the
+  stop at the line, however long, nor however near the line the car's estimate puts it; the
+  car moves up and stops at the line itself); the
+  line is then done until the front bumper is past it. The car aims to stand
+  ``stop_margin`` plus the law's margin before the line (`stop_distance` = L - f -
+  stop_margin).
 - pedestrian: the next crosswalk ahead, from ``approach(v)`` before it while the front
   bumper has not reached it, with a pedestrian track on it or within ``crossing_margin`` of
   it along the route whose centre is inside the lane kept widened by ``lane_margin`` on each
@@ -43,7 +47,7 @@ plus room to settle.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -51,6 +55,7 @@ import numpy as np
 from perception.messages import EgoState, ObjectClass, SignDetection, Track
 from planner.fsm.acc import NO_EVENTS, AccEvent
 from planner.limits import A_COMF
+from planner.queue import queued
 from world.frames import VehicleInfo, kph
 from world.hdmap import NEAR_WINDOW, Crosswalk, RoadMap, SpeedBump, StopSign, Zone
 
@@ -146,7 +151,9 @@ class EventMonitor:
         self._station = station
         limit_station = front if limit_station is None else limit_station
         approach = v * v / (2.0 * p.a_comf) + p.approach_extra
-        stop = self._stop_sign(t, front, v, approach)
+        stop = self._stop_sign(t, front, v, approach,
+                               lambda: queued(self.road, station, front, lane_offset, lane_width,
+                                              tracks))
         crossing = self._crossing(front, approach, lane_offset, lane_width, tracks)
         bump = self._bump(station, approach)
         zone = self.road.cross_section_at(limit_station).zone
@@ -161,7 +168,11 @@ class EventMonitor:
             bump_speed=bump[1] if bump is not None else math.inf,
         )
 
-    def _stop_sign(self, t: float, front: float, v: float, approach: float) -> float | None:
+    def _stop_sign(self, t: float, front: float, v: float, approach: float,
+                   in_queue: Callable[[], bool]) -> float | None:
+        """[m] to where the car must stand for the next stop line, or None; a standstill
+        counts towards the stop only at the line itself, not in a queue (`in_queue()`: a
+        vehicle right in front of the car, `planner.queue`)."""
         p = self.params
         self.done = {s for s in self.done if s > front - 1.0}  # passed: forget
         line = next((s for s in self.stop_lines if s > front - 1.0 and s not in self.done), None)
@@ -169,7 +180,7 @@ class EventMonitor:
             self._standing_since = None
             return None
         at_line = 0.0 <= line - front <= p.stop_zone
-        if v < p.stopped_speed and at_line:
+        if v < p.stopped_speed and at_line and not in_queue():
             self._standing_since = t if self._standing_since is None else self._standing_since
             if t - self._standing_since >= p.stop_hold:
                 self.done.add(line)

@@ -43,7 +43,9 @@ the line:
   soon as the car first to stop left its line, and met it in the box);
 - at a stop-sign junction (an all-way stop), in order of arrival (`ArrivalOrder`): first to
   stop, first to go; ties to the right. The car *arrives* when it stands (below
-  ``stopped``) with its front 0 to ``arrival_zone`` before its line. A vehicle track
+  ``stopped``) with its front 0 to ``arrival_zone`` before its line and no vehicle right in
+  front of it (`planner.queue`: queued behind the car at the line, it has not arrived,
+  whatever its own estimate of the distance to the line says). A vehicle track
   *waits at a line* of the junction when it stands (below ``moving``) in the inbound lane
   of an arm (right of the arm's axis, within the street's half width), its centre
   ``line_zone_near`` to ``line_zone_far`` beyond the line's distance from the centre (the
@@ -69,7 +71,8 @@ way until it has had nothing to wait for during ``gap_confirm`` in a row: a vehi
 comes out from behind another, or into the LiDAR's reach, is a confirmed track only after
 the tracker's M-of-N confirmation (up to 5 scans at 10 Hz), so a gap is taken once what it
 may hide has had the time to show. Then the gap is taken: the car goes, and if its front is
-within ``arrival_zone`` of its line it is committed to the junction (as above), the way
+within ``arrival_zone`` of its line, not in a queue, it is committed to the junction (as
+above), the way
 production stacks commit to a gap (queued farther back, behind a car that goes first, it
 is not: the gap is judged again on its way up to the line, as it would take seconds more
 to get there; issue K: town_traffic's ego took a gap 15 m back and turned 5 s later into
@@ -83,7 +86,7 @@ holds at least ``gap_confirm`` each time, and is not taken up again for the gap 
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -91,6 +94,7 @@ import numpy as np
 from perception.messages import LightDetection, ObjectClass, Track
 from planner.fsm.acc import NO_EVENTS, AccEvent
 from planner.limits import A_COMF, A_FIRM
+from planner.queue import queued
 from world.frames import VehicleInfo
 from world.hdmap import (
     Control,
@@ -180,15 +184,23 @@ class JunctionMonitor:
             if d.colour is not LightColour.GREEN or confirmed:
                 self._seen[d.light] = _Seen(d.colour, d.t)
 
-    def update(self, t: float, station: float, v: float,
-               tracks: Sequence[Track] = ()) -> JunctionEvents:
+    def update(self, t: float, station: float, v: float, tracks: Sequence[Track] = (),
+               lane: tuple[float, float] | None = None) -> JunctionEvents:
         """The junction events at time `t` [s] for the car's centre at `station` [m] with
-        speed `v` [m/s]; `tracks` the confirmed tracks (map frame)."""
+        speed `v` [m/s]; `tracks` the confirmed tracks (map frame); `lane` the lane kept
+        (its centre's offset from the reference line [m], left +, and its width [m]; by
+        default lane 0), where a vehicle queues the car short of its line."""
         p = self.params
         front = station + self.vehicle.front_overhang
         approach = v * v / (2.0 * p.a_comf) + p.approach_extra
         light_stop, colour = self._light(t, front, v, approach)
-        way_stop = self._give_way(t, front, v, approach, tracks)
+        if lane is None:
+            kept = self.road.lanes[0]
+            lane = float(kept.offset_at(station)), float(kept.width_at(station))
+        offset, width = lane
+        way_stop = self._give_way(t, front, v, approach, tracks,
+                                  lambda: queued(self.road, station, front, offset, width,
+                                                 tracks))
         stops = [d for d in (light_stop, way_stop) if d is not None]
         happening = {AccEvent.RED_LIGHT: light_stop is not None,
                      AccEvent.GIVE_WAY: way_stop is not None}
@@ -235,7 +247,11 @@ class JunctionMonitor:
         return -((x - j.x) * math.cos(j.heading) + (y - j.y) * math.sin(j.heading))
 
     def _give_way(self, t: float, front: float, v: float, approach: float,
-                  tracks: Sequence[Track]) -> float | None:
+                  tracks: Sequence[Track], in_queue: Callable[[], bool],
+                  ) -> float | None:
+        """[m] to where the car must stand to give way at the next junction, or None; the
+        car is at its line (arrived at an all-way stop, committed once it takes a gap) only
+        not in a queue (`in_queue()`: a vehicle right in front of it, `planner.queue`)."""
         p = self.params
         k = next((k for k, j in enumerate(self.road.junctions) if j.s_stop > front - 0.5), None)
         if k is None:
@@ -253,13 +269,14 @@ class JunctionMonitor:
         if j.control is Control.STOP_SIGNS:
             if self._order_at != k:
                 self._order, self._order_at = ArrivalOrder(p), k
-            standing = v < p.stopped and 0.0 <= j.s_stop - front <= p.arrival_zone
+            standing = v < p.stopped and 0.0 <= j.s_stop - front <= p.arrival_zone and \
+                not in_queue()
             wait = self._order.update(t, j, self._line_out[k], standing, tracks) or wait
         stops_first = j.control is Control.STOP_SIGNS and self._order.arrived is None
         if k not in self._waiting and v > p.moving and not stops_first and not can_stop:
             self._committed.add(k)  # past the last point it could stop comfortably: go on
             return None
-        at_line = j.s_stop - front <= p.arrival_zone
+        at_line = j.s_stop - front <= p.arrival_zone and not in_queue()
         return room if self._gives_way(t, k, wait, at_line) else None
 
     def _gives_way(self, t: float, k: int, wait: bool, at_line: bool) -> bool:

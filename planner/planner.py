@@ -261,7 +261,9 @@ class Planner:
                                     pulled_over=manoeuvre.lane == SHOULDER
                                     and manoeuvre.path is None,
                                     limit_station=self.speed_planner.front_station(station))
-        junction = self.junctions.update(ego.t, station, ego.speed, tracks)
+        junction = self.junctions.update(ego.t, station, ego.speed, tracks,
+                                         (float(self.lane.offset_at(station)),
+                                          float(self.lane.width_at(station))))
         events = replace(events, active=events.active | junction.active,
                          stop_distance=min(events.stop_distance, junction.stop_distance))
         lead_accel = self.lead_accel.update(lead)

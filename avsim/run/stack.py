@@ -26,7 +26,7 @@ from perception.flat_tyre import FlatTyreDetector
 from perception.health import HealthMonitor
 from perception.lanes import LaneDetector, LaneFilter
 from perception.lights import TrafficLightDetector
-from perception.localization import LaneMatch, Localizer, clear_ahead
+from perception.localization import LaneMatch, Localizer, LocalizerParams, clear_ahead
 from perception.messages import (
     Detection,
     EgoState,
@@ -103,7 +103,8 @@ class Stack:
         self.reads = frozenset({*CAR_SENSORS, LIDAR}
                                | ({front_camera.name} if front_camera is not None else set()))
         #   the sensors whose frames it uses (it ignores the side cameras')
-        self.localizer = Localizer(road=road if front_camera is not None else None,
+        self.localizer = Localizer(LocalizerParams(rear_axle=car.rear_axle),
+                                   road=road if front_camera is not None else None,
                                    start_lane=ego.lane)
         #   the camera's lane corrects the pose across the lane (map matching)
         vehicle = vehicle_info(car)
@@ -236,14 +237,24 @@ class Stack:
 
     def _stop_line(self, front: CameraFrame, lane: LaneEstimate, pose: EgoState) -> None:
         """Look for a stop line where the map has one ahead, and place the car along the
-        route by it (`perception.stop_lines`, `Localizer.on_stop_line`)."""
+        route by it (`perception.stop_lines`, `Localizer.on_stop_line`). Ahead means within
+        the reach a seen line is matched over (3 x ``stop_line_window``) of the camera's
+        view: the estimate may be off along the route by metres where a car ahead hid the
+        line, and the car then stands where it believes the line is, short of the view.
+        Across the camera's lane; where that is no measurement (its lines end at the
+        junction's mouth), across the map's lane on the pose (`Localizer.map_lane`)."""
         detector = self.stop_line_detector
-        if detector is None or lane.confidence < self.localizer.params.lane_confidence:
+        if detector is None:
             return
         p = detector.params
-        margin = self.localizer.params.stop_line_window
-        if not self.localizer.stop_lines_ahead(pose, p.min_x - margin, p.max_x + margin):
+        reach = 3.0 * self.localizer.params.stop_line_window
+        if not self.localizer.stop_lines_ahead(pose, p.min_x - reach, p.max_x + reach):
             return
+        if lane.confidence < self.localizer.params.lane_confidence:
+            on_map = self.localizer.map_lane(pose, lane.t)
+            if on_map is None:
+                return
+            lane = on_map
         with self.watch("perception stop lines"):
             distance = detector.detect(front, lane)
         if distance is not None:

@@ -366,3 +366,23 @@ def track(rel_x: float, rel_y: float) -> Track:
 def test_the_lane_is_clear_up_to_the_nearest_car_in_it(tracks: tuple[Track, ...],
                                                          clear: float) -> None:
     assert clear_ahead(tracks, 1.75) == pytest.approx(clear)
+
+
+@pytest.mark.parametrize(("lane", "off", "dpsi"), [(0, 0.4, 0.02), (1, -0.3, -0.05)])
+def test_the_map_lane_on_the_pose_is_the_lane_the_camera_would_see(lane: int, off: float,
+                                                                   dpsi: float) -> None:
+    """Where the camera's lane is no measurement, the stop line is looked for across the
+    map's lane on the pose (`Localizer.map_lane`): the car's centre `off` [m] left of the
+    centre of `lane` and `dpsi` [rad] left of its heading, in the vehicle frame there."""
+    loc = Localizer(road=ROAD)
+    centre = ROAD.lane(lane).position(100.0, 0.0)
+    normal = np.array([0.0, 1.0])  # the road runs along +x there
+    xy = centre + off * normal
+    pose = EgoState(t=5.0, x=float(xy[0]), y=float(xy[1]), heading=dpsi, speed=8.0,
+                    yaw_rate=0.0, steering_angle=0.0, position_sigma=0.5)
+    m = loc.map_lane(pose, 4.9)
+    assert m is not None and m.t == 4.9 and m.confidence == 0.0 and m.lines == 0
+    assert m.offset == pytest.approx(off) and m.heading_error == pytest.approx(dpsi)
+    assert m.width == pytest.approx(W) and m.curvature == 0.0
+    assert m.centre_y(0.0) == pytest.approx(-off)
+    assert Localizer().map_lane(pose, 4.9) is None  # no map
