@@ -95,6 +95,8 @@ class LaneTraffic:
     ahead: Neighbour | None = None  # nearest vehicle ahead
     behind: Neighbour | None = None  # nearest vehicle behind
     alongside: bool = False  # a vehicle overlapping the ego along the route
+    following: tuple[Neighbour, ...] = ()  # every vehicle behind, `behind` among them (in
+    #   the tracks' order)
 
 
 def lane_traffic(road: RoadMap, tracks: Sequence[Track], t: float, station: float, v: float,
@@ -136,14 +138,13 @@ def _add(lt: LaneTraffic, n: Neighbour, ahead: float, half_len: float,
     if ahead - half_len >= vehicle.front_overhang:
         gap = ahead - half_len - vehicle.front_overhang
         if lt.ahead is None or gap < lt.ahead.gap:
-            return LaneTraffic(lt.lane, replace(n, gap=gap), lt.behind, lt.alongside)
+            return replace(lt, ahead=replace(n, gap=gap))
         return lt
     if -ahead - half_len >= vehicle.rear_overhang:
-        gap = -ahead - half_len - vehicle.rear_overhang
-        if lt.behind is None or gap < lt.behind.gap:
-            return LaneTraffic(lt.lane, lt.ahead, replace(n, gap=gap), lt.alongside)
-        return lt
-    return LaneTraffic(lt.lane, lt.ahead, lt.behind, True)
+        n = replace(n, gap=-ahead - half_len - vehicle.rear_overhang)
+        nearest = n if lt.behind is None or n.gap < lt.behind.gap else lt.behind
+        return replace(lt, behind=nearest, following=(*lt.following, n))
+    return replace(lt, alongside=True)
 
 
 def rear_decel_needed(gap: float, v_behind: float, v: float, p: OccupancyParams) -> float:

@@ -15,7 +15,11 @@ shoulder). Per tick:
    reach 60 m behind, less past a vehicle alongside in the lane, which hides what follows
    it: the lane is free only ``rear_view_time`` after such a vehicle was last alongside,
    time for the tracks of what it hid to be confirmed); a pass
-   would clear the blocking vehicle (below); the route needs the car to move right when
+   would clear the blocking vehicle (below); a pass into a lane would be over, the car
+   back in its own lane, before any vehicle coming up behind in that lane, keeping its
+   speed, is nearer than UN R157's rear distance (`planner.rear_pass`: the move out timed
+   on the path planned, the pass at the speed the car wants, the way back a lane change at
+   that speed); the route needs the car to move right when
    the lane kept does not go on to max(``prepare_distance``, ``prepare_time`` v) ahead (a
    lane that ends at an exit or a lane drop is left in time); the route's turn at a
    junction; during a change, whether the target lane is still free, whether the car's
@@ -112,6 +116,8 @@ from planner.lane_change_path import (
     LaneChangeParams,
     LaneChangePath,
     can_start,
+    path_length,
+    plan_duration,
     start_lane_change,
 )
 from planner.lane_occupancy import (
@@ -133,6 +139,8 @@ from planner.oncoming_pass import (
     speed_cap,
     tracks_reason,
 )
+from planner.oncoming_pass import closing_time as time_to_cover
+from planner.rear_pass import Pass, RearPassParams, rear_catches
 from world.frames import VehicleInfo
 from world.hdmap import SHOULDER, Junction, RoadMap
 from world.hdmap import Manoeuvre as JunctionManoeuvre
@@ -431,6 +439,10 @@ class MotionLayer:
             or self._pass_clears(ego, s, self.lane + 1, traffic),
             clears_right=not blocked_now or right is None or right.lane == SHOULDER
             or self._pass_clears(ego, s, self.lane - 1, traffic),
+            outruns_left=not blocked_now or left is None
+            or self._outruns(ego, s, left, traffic),
+            outruns_right=not blocked_now or right is None or right.lane == SHOULDER
+            or self._outruns(ego, s, right, traffic),
             right_clear=right is not None and right.lane != SHOULDER
             and not is_blocked(right, v, v_want, p.occupancy, self.acc)
             and self._clear_behind(right, v, yielding),
@@ -598,6 +610,26 @@ class MotionLayer:
         need = 0.5 * self.vehicle.width + n.half_width + (
             self.params.pass_margin if margin is None else margin)
         return abs(y - n.offset) >= need
+
+    def _outruns(self, ego: EgoState, s: float, lt: LaneTraffic,
+                 traffic: dict[int, LaneTraffic]) -> bool:
+        """Whether a pass of the vehicle ahead into `lt`'s lane started now would be over,
+        the car back in its lane, with every vehicle coming up behind in `lt`, at its speed,
+        still UN R157's rear distance back (`planner.rear_pass.rear_catches`): the move out
+        timed on the path planned into that lane, the pass at the speed the car wants, the
+        move back a lane change at that speed."""
+        slow = traffic[self.lane].ahead
+        if slow is None or not lt.following or not self._can_plan(lt.lane, ego):
+            return True
+        p, v, v_pass = self.params, max(ego.speed, 0.0), self._v_want
+        rp = RearPassParams(p.oncoming_pass.a_pass, p.keep_right_gap)
+        out = max(self._plan_into(lt.lane, ego).end - s, 0.0)
+        t_out = time_to_cover(out, v, v_pass, rp.a_pass) if v_pass > 0.0 else 0.0
+        width = float(self.road.lane(self.lane).width_at(s))
+        t_back = path_length(v_pass, plan_duration(width, 0.0, v_pass, p.lane_change),
+                             p.lane_change) / v_pass if v_pass > 0.0 else 0.0
+        ps = Pass(v, v_pass, slow, self.vehicle.length, t_out, t_back)
+        return rear_catches(ps, lt.following, p.occupancy, rp) is None
 
     def _seen(self, lt: LaneTraffic, t: float) -> bool:
         """Whether the lane's rear has been in the LiDAR's view for ``rear_view_time`` since

@@ -9,7 +9,9 @@ ahead, whether the lanes to the left and right are free ("according to the prese
 absence of obstacles in the side", ICCAS 2020; rear traffic included: UN R157's rule that a
 vehicle approaching from behind in the target lane need not brake harder than 3 m/s^2, which
 so guards every lateral move: a pass, a flat tyre's pull-over, a route change before an exit,
-keeping right), whether a pass path to either side would clear the vehicle ahead, the
+keeping right), whether a pass path to either side would clear the vehicle ahead, whether
+the whole pass (out, past and back in) would be over before a vehicle coming up behind in
+that lane, not braking, is nearer than the rear rule's distance (`planner.rear_pass`), the
 lanes the route needs the car to move, the route's turn at a junction, a flat tyre's
 pull-over, whether a pass through the oncoming lane is safe (`planner.oncoming_pass`),
 whether the car keeps the oncoming lane and may take its own lane back, and the progress of
@@ -32,11 +34,12 @@ tried in this order and the first that holds is taken:
 5. lane_keep -> u_turn: the route turns back there
 6. lane_keep -> lane_change_right: the route needs a lane to the right and it is free
 7. lane_keep -> lane_change_left: the route needs a lane to the left and it is free
-8. lane_keep -> lane_change_left: overtaking allowed, the lane blocked, the left free and a
-   pass path into it clears the vehicle ahead, `keep_time` since the last change, and the
-   route needs no other lane
-9. lane_keep -> lane_change_right: overtaking allowed, the lane blocked, only the right free
-   and clearing (as above)
+8. lane_keep -> lane_change_left: overtaking allowed, the lane blocked, the left free, a
+   pass path into it clears the vehicle ahead and the whole pass outruns every vehicle
+   coming up behind in the left lane, `keep_time` since the last change, and the route needs
+   no other lane
+9. lane_keep -> lane_change_right: overtaking allowed, the lane blocked, only the right
+   free, clearing and outrun (as above)
 10. lane_keep -> lane_change_left: overtaking allowed, the lane blocked, the only way past
     the oncoming lane and a pass through it safe (`planner.oncoming_pass`) on a path that
     clears the vehicle ahead, `keep_time` since the last change, and the route needs no
@@ -65,11 +68,13 @@ back to the right once that lane is free and clear (no slower vehicle ahead in i
 ACC's d_max, which would make it pass again). A blocked lane is passed also from a
 standstill behind a stopped vehicle: `blocked` does not ask that the vehicle ahead moves,
 only that it is slower than wanted; while no side is free, or a pass path would not clear
-it, the car waits in its lane (the ACC stops it behind that vehicle) and goes once both
-hold. Overtaking and keeping right wait `keep_time` after the last change (no weaving); a
-route lane change waits `route_keep_time` only. Keeping right with a faster vehicle coming
-up behind in the lane kept (`yield_behind`) waits no `keep_time`: the car leaves the lane to
-it as soon as the right lane is free and clear, rather than linger in its way after a pass.
+it, or a faster vehicle coming up behind in the lane beside would reach the car before the
+pass is over, the car waits in its lane (the ACC stops it behind that vehicle, or it follows
+it) and goes once all hold. Overtaking and keeping right wait `keep_time` after the last
+change (no weaving); a route lane change waits `route_keep_time` only. Keeping right with a
+faster vehicle coming up behind in the lane kept (`yield_behind`) waits no `keep_time`: the
+car leaves the lane to it as soon as the right lane is free and clear, rather than linger in
+its way after a pass.
 """
 
 from __future__ import annotations
@@ -122,6 +127,10 @@ class MotionInput:
     #   right waits no `keep_time`
     clears_left: bool = True  # a pass path into the left lane clears the vehicle ahead
     clears_right: bool = True  # ... into the right lane
+    outruns_left: bool = True  # a pass into the left lane is over, the car back in its
+    #   lane, with every vehicle coming up behind in it (at its speed, not braking) still
+    #   UN R157's rear distance back (`planner.rear_pass`)
+    outruns_right: bool = True  # ... into the right lane
     route_lane: int = 0  # [lanes] the route needs the car to move: > 0 left, < 0 right
     target_free: bool = True  # the target lane of the change in hand is still free
     committed: bool = False  # the car's centre is in the target lane of the change
@@ -182,11 +191,11 @@ def _may_overtake(x: MotionInput, p: MotionParams) -> bool:
 
 
 def _overtake_left(_m: Motion, x: MotionInput, p: MotionParams) -> bool:
-    return _may_overtake(x, p) and x.left_free and x.clears_left
+    return _may_overtake(x, p) and x.left_free and x.clears_left and x.outruns_left
 
 
 def _overtake_right(_m: Motion, x: MotionInput, p: MotionParams) -> bool:
-    return _may_overtake(x, p) and x.right_free and x.clears_right
+    return _may_overtake(x, p) and x.right_free and x.clears_right and x.outruns_right
 
 
 def _overtake_oncoming(_m: Motion, x: MotionInput, p: MotionParams) -> bool:
@@ -235,12 +244,13 @@ TABLE: Table[Motion, MotionInput, MotionParams] = Table(Motion, (
         "the route needs a lane to the left and it is free",
         "the route needs a lane to the left"),
     Row(_KEEP, M.LANE_CHANGE_LEFT, _overtake_left,
-        "overtaking allowed, the lane blocked, the left free and a pass path into it clears "
-        "the vehicle ahead, `keep_time` since the last change, and the route needs no other "
-        "lane",
+        "overtaking allowed, the lane blocked, the left free, a pass path into it clears "
+        "the vehicle ahead and the whole pass outruns every vehicle coming up behind in the "
+        "left lane, `keep_time` since the last change, and the route needs no other lane",
         "a slower vehicle ahead, the left lane free"),
     Row(_KEEP, M.LANE_CHANGE_RIGHT, _overtake_right,
-        "overtaking allowed, the lane blocked, only the right free and clearing (as above)",
+        "overtaking allowed, the lane blocked, only the right free, clearing and outrun "
+        "(as above)",
         "a slower vehicle ahead, only the right lane free"),
     Row(_KEEP, M.LANE_CHANGE_LEFT, _overtake_oncoming,
         "overtaking allowed, the lane blocked, the only way past the oncoming lane and a "

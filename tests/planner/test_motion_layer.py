@@ -14,7 +14,13 @@ import pytest
 from perception.messages import EgoState, ObjectClass, Track
 from planner.fsm.acc import AccParams
 from planner.fsm.motion import Motion
-from planner.lane_occupancy import Neighbour, lane_traffic
+from planner.lane_occupancy import (
+    Neighbour,
+    OccupancyParams,
+    lane_traffic,
+    rear_closes,
+    rear_decel_needed,
+)
 from planner.motion_layer import MotionLayer, MotionLayerParams, room_left
 from tests.roads import W, make_map, seg
 from tests.vehicle import VEHICLE
@@ -529,3 +535,43 @@ def test_the_room_granted_is_kept_when_the_stopped_car_gets_a_new_track() -> Non
         if man.room_for is not None:
             rooms.append(man.room)
     assert len(rooms) >= 30 and rooms == pytest.approx([first] * len(rooms))
+
+
+def test_a_pass_waits_for_a_faster_car_it_would_not_outrun() -> None:
+    """A car at 76 km/h 55 m behind (bumpers) in the left lane when the lane has been
+    blocked for `blocked_time` (1 s), which never brakes: UN R157's rule for the move out
+    holds (it would brake at 0.7 m/s^2) and it stays over 1 s behind until the move out
+    (5 s) is over, but the pass of the 20 km/h car 63 m ahead (15 s, out, past and back) is
+    not over before it comes up: the ego follows in lane 0. Behind a car at 45 km/h 15 m
+    back in the left lane (the nearest, and not faster) the same: every vehicle behind
+    counts. With that slower car alone, or the faster one 250 m back, it passes."""
+    def bumper(gap: float) -> float:  # [m] the centre x at t = 0 of a car `gap` behind
+        return 100.0 - VEHICLE.rear_overhang - gap - 2.3
+
+    fast, slow = (bumper(55.0 + 76.0 / 3.6 - V), 76.0 / 3.6), (bumper(15.0), 45.0 / 3.6)
+    occ = OccupancyParams()
+    assert rear_decel_needed(55.0, fast[1], V, occ) < 1.0
+    assert not rear_closes(55.0, fast[1], V, 5.0, occ)
+    assert {s[1] for s in drive(layer(), 0.0, 3.0, 170.0, fast)} == {Motion.LANE_KEEP}
+    both = drive_many(layer(), 0.0, 3.0, 170.0, (slow, fast))
+    assert set(both) == {Motion.LANE_KEEP}
+    assert Motion.LANE_CHANGE_LEFT in drive_many(layer(), 0.0, 3.0, 170.0, (slow,))
+    far = (bumper(250.0), fast[1])
+    assert Motion.LANE_CHANGE_LEFT in {s[1] for s in drive(layer(), 0.0, 3.0, 170.0, far)}
+
+
+def drive_many(m: MotionLayer, t0: float, t1: float, slow_x0: float,
+               left: tuple[tuple[float, float], ...]) -> list[Motion]:
+    """`drive`'s motions with several cars in lane 1, each (x at t0, speed)."""
+    out, t, x, y = [], t0, 100.0 + V * t0, 0.0
+    while t < t1:
+        tracks = [car(t, slow_x0 + 5.56 * t, 0.0, 5.56, 1)] + [
+            car(t, x0 + v * (t - t0), W, v, 2 + k) for k, (x0, v) in enumerate(left)]
+        man, _ = m.update(ego(t, x, y), V, tracks)
+        if man.path is not None:
+            y = float(ROAD.lane(man.path.target_index).offset_at(x)) + float(
+                man.path.offset_at(x))
+        out.append(man.motion)
+        t += 0.025
+        x += V * 0.025
+    return out

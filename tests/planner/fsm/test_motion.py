@@ -75,6 +75,20 @@ TABLE_CASES = [
      x(blocked=True, right_free=True, clears_right=False), None, False),
     ("keep_route_change_needs_no_pass_clearance", M.LANE_KEEP,
      x(route_lane=-1, right_free=True, clears_right=False), M.LANE_CHANGE_RIGHT, False),
+    # a pass starts only if it is over, the car back in its lane, before a vehicle coming
+    # up behind in the lane it moves into (not braking) is nearer than the rear distance:
+    # the car follows the vehicle ahead (or stops behind it) until that one has gone by
+    ("keep_overtake_left_waits_for_a_faster_car_behind", M.LANE_KEEP,
+     x(blocked=True, left_free=True, outruns_left=False), None, False),
+    ("keep_overtake_right_when_only_it_outruns", M.LANE_KEEP,
+     x(blocked=True, left_free=True, right_free=True, outruns_left=False),
+     M.LANE_CHANGE_RIGHT, False),
+    ("keep_overtake_right_waits_for_a_faster_car_behind", M.LANE_KEEP,
+     x(blocked=True, right_free=True, outruns_right=False), None, False),
+    ("keep_route_change_needs_no_outrun", M.LANE_KEEP,
+     x(route_lane=1, left_free=True, outruns_left=False), M.LANE_CHANGE_LEFT, False),
+    ("keep_right_needs_no_outrun", M.LANE_KEEP,
+     x(right_free=True, right_clear=True, outruns_right=False), M.LANE_CHANGE_RIGHT, False),
     ("keep_free_not_blocked", M.LANE_KEEP, x(left_free=True, right_free=True), None, False),
     ("keep_overtake_not_allowed", M.LANE_KEEP, x(overtake=False, blocked=True, left_free=True),
      None, False),
