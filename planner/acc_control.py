@@ -26,7 +26,7 @@ pedal). `planner.acc_layer` picks the law for the mode.
   it shed since its track's measurement and over the track's lag (`lead_speed_now`, every
   law and the mode's inputs): without it the reference fell with the lead's speed and the speed loop
   followed tau_loop behind, and a car following at 90 km/h behind a lead braking at
-  2 m/s^2 fell 2 m under UN R157's d_min (issue K). Where the first binds and the lead
+  2 m/s^2 fell 2 m under UN R157's d_min. Where the first binds and the lead
   pulls away (its acceleration a_l over `lead_brakes`), its acceleration up to `a_pull` is
   the feed-forward: the gap law's reference rises with the lead's speed, and without it the
   speed loop's integrator takes up the pull-away (0.9 m/s^2 behind a lead pulling away at

@@ -13,7 +13,7 @@ the target is the minimum of
   of a marked crossing it has not reached: a pedestrian who steps out is tracked from about
   that range, and from this speed the car still stops before the crossing within ISO 15622's
   comfort (about 2.5 m/s^2 with the ramp-in; `planner.acc_control`), where at the posted
-  40 km/h of a town it would need 5 m/s^2 (issue K). Where a pedestrian waits at the
+  40 km/h of a town it would need 5 m/s^2. Where a pedestrian waits at the
   crossing (`target`'s ``waiting``: `planner.events.EventMonitor.waiting`) the lower
   ``crossing_speed_waiting``: the track of a walker who steps off the kerb shows the walk
   about 0.9 s late (its velocity lags), 7.5 m of the approach at 30 km/h, after which a

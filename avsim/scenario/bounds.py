@@ -1,4 +1,4 @@
-"""The upper bound of every size a scenario file can ask for (issue L): counts, lengths,
+"""The upper bound of every size a scenario file can ask for: counts, lengths,
 times, speeds and noise. A file over a bound is refused at load with the one-line error
 (`<file>: <key>: must be <= B, got V`), before anything is built, so that no file can make a
 run hang or exhaust memory while it starts. The bounds are far above what a driving scenario

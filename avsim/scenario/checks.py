@@ -61,7 +61,7 @@ def check_town(model: ScenarioModel, ego_road: spec.RoadSpec,
 
 
 def check_spawn(world: spec.WorldSpec) -> None:
-    """No two bodies overlap where they start (issue L). On a road: the ego and each actor,
+    """No two bodies overlap where they start. On a road: the ego and each actor,
     each a box of its length and width along the lane it starts in (at its offset), the
     ego's `vehicle_urdf.CarDimensions`'; the first overlap found is refused at the later
     body's key: ``actors.2: overlaps the ego at s = 11 m``. Pedestrians and obstacles count

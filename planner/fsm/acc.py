@@ -47,7 +47,7 @@ cruises (the chart's default ACC_ACTIVE state), and CRUISE's rows settle the mod
 input (`transition`: one change, from the event's mode to the mode they reach).
 The rows that leave a lead because it is as fast as the set speed or the limit (V_s <= V_l,
 V_GPS <= V_l in Table 2) ask it to be v_band faster (*): a lead driving at the set speed
-would otherwise flip TRAIL and CRUISE with every wobble of its measured speed (issue K).
+would otherwise flip TRAIL and CRUISE with every wobble of its measured speed.
 And a lead lost leaves TRAIL only after lead_hold (`lead_lost`: no lead now, one within
 lead_hold; *): when the lead cuts out, the vehicle it hid becomes the lead once its track
 is confirmed, and the mode goes on as TRAIL instead of flipping to CRUISE and back.
