@@ -3,12 +3,12 @@
 Each confirmed track (map frame) is placed on the map (its box centre projected onto the
 route's reference line: station [m], offset [m], left +) and counted in every lane its box
 overlaps by at least ``overlap`` across. Per lane, the nearest vehicle ahead of the ego and
-the nearest behind it give bumper gaps [m] along the route (stations, carried from the
-track's time to now at the relative speed), speeds [m/s] along the route, and where the box
-lies across (its centre's offset and half its width across the road); a box that overlaps
-the ego's along the route is alongside. The tracks see all round the car (the LiDAR's 360
-deg, `perception.objects`' region of interest reaches 60 m behind as ahead), so a vehicle
-coming up from behind in a lane is its `behind`.
+the nearest behind it give bumper gaps [m] along the route now (the track's station is its
+scan's, carried to now at the vehicle's own speed; the car's station is now's), speeds
+[m/s] along the route, and where the box lies across (its centre's offset and half its
+width across the road); a box that overlaps the ego's along the route is alongside. The
+tracks see all round the car (the LiDAR's 360 deg, `perception.objects`' region of interest
+reaches 60 m behind as ahead), so a vehicle coming up from behind in a lane is its `behind`.
 
 A lane is *free* for the ego to move into when nothing is alongside and
 
@@ -99,11 +99,14 @@ class LaneTraffic:
     #   the tracks' order)
 
 
-def lane_traffic(road: RoadMap, tracks: Sequence[Track], t: float, station: float, v: float,
+def lane_traffic(road: RoadMap, tracks: Sequence[Track], t: float, station: float,
                  lanes: Sequence[int], p: OccupancyParams,
                  vehicle: VehicleInfo) -> dict[int, LaneTraffic]:
     """The traffic in each of `lanes` (ego-direction lane indices) around the ego (of
-    `vehicle`'s size) at `station` [m] with speed `v` [m/s], now at time `t` [s]."""
+    `vehicle`'s size) whose centre is at `station` [m] now, at time `t` [s]. A track's
+    place is the one of its own time (the scan's, ``Track.t``): it is carried to `t` at the
+    vehicle's own speed along the route; the car's `station` is already now's, so its own
+    motion since the scan is not counted again."""
     out = {k: LaneTraffic(k) for k in lanes}
     if not tracks:
         return out
@@ -115,7 +118,7 @@ def lane_traffic(road: RoadMap, tracks: Sequence[Track], t: float, station: floa
         speed = tr.vx * math.cos(heading[i]) + tr.vy * math.sin(heading[i])
         half_len, half_wid = _half_extent(tr, float(heading[i]))
         dt = max(t - tr.t, 0.0)
-        ahead = s - station + (speed - v) * dt
+        ahead = s + speed * dt - station  # [m] centre to centre along the route, now
         for k in lanes:
             lane = road.lane(k)
             centre, width = float(lane.offset_at(s)), float(lane.width_at(s))

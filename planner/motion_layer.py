@@ -254,7 +254,7 @@ class MotionLayer:
         s, d = (float(a) for a in self.road.local_coordinates((ego.x, ego.y), self._station))
         self._station = s
         lanes = self._lanes_around(s, ego.speed, pull_over)
-        traffic = lane_traffic(self.road, tracks, ego.t, s, ego.speed, lanes,
+        traffic = lane_traffic(self.road, tracks, ego.t, s, lanes,
                                self.params.occupancy, self.vehicle)
         for k, lt in traffic.items():
             if lt.alongside:  # it hides the lane behind it from the LiDAR

@@ -32,7 +32,7 @@ def car(x: float, y: float, vx: float, ident: int = 1, t: float = 1.0) -> Track:
 
 
 def traffic(*tracks: Track, t: float = 1.0) -> dict[int, LaneTraffic]:
-    return lane_traffic(ROAD, tracks, t, EGO_S, V, (0, 1), P, VEHICLE)
+    return lane_traffic(ROAD, tracks, t, EGO_S, (0, 1), P, VEHICLE)
 
 
 def test_neighbours_ahead_behind_and_alongside() -> None:
@@ -55,9 +55,25 @@ def test_a_straddling_box_counts_in_both_lanes_a_grazing_one_in_neither_other() 
 
 
 def test_gaps_are_carried_to_now() -> None:
-    lt = traffic(car(140.0, 0.0, 8.0), t=1.5)  # the track is 0.5 s old, closing at 5.9 m/s
+    """The track's place is its scan's (0.5 s ago): the car at 8 m/s is 4 m farther on now;
+    the ego's station is now's, so its own 0.5 s of driving is not taken off again."""
+    lt = traffic(car(140.0, 0.0, 8.0), t=1.5)
     assert lt[0].ahead is not None
-    assert lt[0].ahead.gap == pytest.approx(40.0 - 4.7 - 0.5 * (V - 8.0))
+    assert lt[0].ahead.gap == pytest.approx(40.0 + 0.5 * 8.0 - 4.7)
+    behind = traffic(car(60.0, W, 20.0), t=1.5)[1].behind  # 20 m/s: 10 m nearer now
+    assert behind is not None and behind.gap == pytest.approx(40.0 - 10.0 - 4.7)
+
+
+@pytest.mark.parametrize("age", [0.1, 0.175])
+def test_a_standing_cars_gap_is_its_place_whatever_the_tracks_age(age: float) -> None:
+    """A standing car's gap is where it stands less the car's front now, however old its
+    track (the LiDAR's scans come at 10 Hz and are used a tick or more later): taking the
+    car's own speed x the track's age off as well put it 1.2 m nearer (7 m/s, 0.175 s), and
+    a pass under way, judging its path at that nearer place, took the car it was clearing
+    for a lead and stopped beside it."""
+    lt = traffic(car(140.0, 0.0, 0.0), t=1.0 + age)
+    assert lt[0].ahead is not None
+    assert lt[0].ahead.gap == pytest.approx(40.0 - 4.7)
 
 
 def test_free_ahead_needs_d_min_plus_closing() -> None:

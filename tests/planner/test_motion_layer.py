@@ -223,7 +223,7 @@ def test_a_pass_trails_the_car_it_leaves_once_the_path_would_not_clear_it() -> N
 
 def _ahead(m: MotionLayer, t: float, x: float, y: float, track: Track) -> Neighbour:
     """`track` as the motion layer sees it in lane 0 (its neighbour there)."""
-    traffic = lane_traffic(ROAD, [track], t, x, V, (0, 1), m.params.occupancy, VEHICLE)
+    traffic = lane_traffic(ROAD, [track], t, x, (0, 1), m.params.occupancy, VEHICLE)
     n = traffic[0].ahead
     assert n is not None
     return n
@@ -374,7 +374,7 @@ def test_a_lane_counts_as_seen_behind_only_a_while_after_a_car_alongside_in_it()
     for t in np.arange(0.0, 6.0, 0.025):
         passing = car(t, 100.0 - 40.0 + 16.7 * t, W, 16.7, 8)
         tracks = [stopped_car(t, 12.0), passing]
-        if lane_traffic(ROAD, tracks, t, 100.0, 0.0, (0, 1), m.params.occupancy,
+        if lane_traffic(ROAD, tracks, t, 100.0, (0, 1), m.params.occupancy,
                         VEHICLE)[1].alongside:
             last_alongside = t
         if m.update(standing(t, 100.0), V, tracks)[0].motion is Motion.LANE_CHANGE_LEFT:
