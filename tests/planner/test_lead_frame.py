@@ -1,8 +1,10 @@
 """Beyond the camera's reach the lane the lead is looked for in is the map's lane bent from
 its tangent at the car's station at the camera frame's time, the frame the camera's lane and
-the tracks are in (`Planner._bend`, `planner.lead.far_centre`). In a tight bend the car
-turns while a frame ages: a tangent taken at the car's station now places the lane, 60 m
-ahead, metres towards the outside of the bend, onto a car keeping the lane beside."""
+the tracks are in (`Planner._bend`, `planner.lead.far_centre`), and the lane's heading there
+is the car's heading at that time plus the lane's slope in that frame (`lane_candidates`). In
+a tight bend the car turns while a frame ages: a tangent taken at the car's station now
+places the lane ahead, beyond the bend, towards its outside, onto a car keeping the lane
+beside."""
 
 from __future__ import annotations
 
@@ -14,11 +16,11 @@ from tests.planner.maps import KPH
 from tests.roads import arc, make_map, seg
 from tests.vehicle import VEHICLE
 
-RADIUS = 50.0  # [m] a right bend (normal_driving's tightest is R <= 60 m)
-ROAD = make_map(seg(100.0), arc(RADIUS, -150.0), seg(200.0))
+RADIUS = 50.0  # [m] a right bend of 80 degrees, then a straight
+ROAD = make_map(seg(100.0), arc(RADIUS, -80.0), seg(300.0))  # normal_driving's bend
 V_EGO = 12.5  # [m/s] the car in the bend (45 km/h)
 V_OTHER = 8.3  # [m/s] the other car (lane 1 is left of the ego's lane 0)
-AGE = 0.15  # [s] the camera frame's and the tracks' age at each tick (0.1 to 0.175 s in
+AGE = 0.175  # [s] the camera frame's and the tracks' age at each tick (0.1 to 0.175 s in
 #   normal_driving: LiDAR scan and camera frame at 10 Hz, their processing)
 DT = 0.05  # [s] planner tick
 
@@ -55,17 +57,17 @@ def seen_from(at: EgoState) -> LaneView:
 
 
 def leads_through_the_bend(lane: int) -> list[int | None]:
-    """The lead's track id each tick over 1.6 s: the car 20 to 40 m into a right bend of
-    R 50 m at 45 km/h, the other car on `lane` 55 to 49 m ahead along it, the camera's frame
-    and the track `AGE` old."""
+    """The lead's track id each tick over 1.6 s: the car 35 to 54 m into the 70 m of the
+    bend at 45 km/h, the other car on `lane` 65 to 59 m ahead along it (on the straight
+    after the bend), the camera's frame, exact, and the track `AGE` old."""
     planner = Planner(ROAD, PlannerParams(50.0 * KPH, 180.0 * KPH, VEHICLE, lane=0,
                                           camera=True))
     leads: list[int | None] = []
     for k in range(int(1.6 / DT)):
         t = 10.0 + k * DT
-        s_frame = 120.0 + V_EGO * (t - AGE - 10.0)  # the car's station at the frame's time
+        s_frame = 135.0 + V_EGO * (t - AGE - 10.0)  # the car's station at the frame's time
         frame = pose(s_frame, t - AGE)
-        other = tracked(frame, lane, s_frame + 55.0 - (V_EGO - V_OTHER) * (t - AGE - 10.0))
+        other = tracked(frame, lane, s_frame + 65.0 - (V_EGO - V_OTHER) * (t - AGE - 10.0))
         assert other.rel_x > 30.0  # beyond the camera's reach: the map's bend
         plan = planner.update(PlannerInput(pose(s_frame + V_EGO * AGE, t),
                                            lane=seen_from(frame), tracks=(other,)))
@@ -74,14 +76,16 @@ def leads_through_the_bend(lane: int) -> list[int | None]:
 
 
 def test_a_car_keeping_the_lane_beside_through_a_tight_bend_is_never_the_lead() -> None:
-    """The frame 0.15 s old, the car's heading has turned 0.0375 rad since: the tangent at
-    the car's station now placed the lane ~2 m towards the lane beside at 55 m ahead, and
-    the car beside was the lead after `confirm`."""
+    """The frame 0.175 s old, the car's heading has turned 0.044 rad since: the tangent at
+    the car's station now placed the car beside 1.55 to 1.7 m from the lane's centre line
+    (3.3 to 3.7 m from the frame's), and it was the lead from 0.6 to 0.95 s."""
     assert leads_through_the_bend(1) == [None] * int(1.6 / DT)
 
 
 def test_a_car_in_the_lane_through_the_same_bend_is_the_lead() -> None:
-    """The same run with the other car in the car's own lane: the lead after `confirm`."""
+    """The same run with the other car in the car's own lane: the lead after `confirm`, and
+    kept (with the tangent at the station now it was placed 2.5 to 2.7 m right of the
+    centre line, out of the lane, and taken only after 1.4 s)."""
     leads = leads_through_the_bend(0)
     first = leads.index(7)
     assert leads[:first] == [None] * first and set(leads[first:]) == {7}
