@@ -413,12 +413,10 @@ class Planner:
                                           p.vehicle.front_overhang)
         else:
             centre: Callable[[float], float] = _straight_ahead
-            heading = ego.heading
-            if view is not None and camera:  # the camera frame's: the tracks' frame
+            if view is not None and camera:
                 centre = far_centre(view.estimate.centre_y, view.estimate.heading_error,
                                     p.camera_ahead, self._bend(view.pose))
-                heading = view.pose.heading
-            candidates = lane_candidates(tracks, centre, heading, p.vehicle.front_overhang)
+            candidates = lane_candidates(tracks, centre, ego.heading, p.vehicle.front_overhang)
         return self.leads.select(ego.t, ego.speed, candidates)
 
     def _bend(self, pose: EgoState) -> Callable[[float], float]:

@@ -1,10 +1,8 @@
 """Beyond the camera's reach the lane the lead is looked for in is the map's lane bent from
 its tangent at the car's station at the camera frame's time, the frame the camera's lane and
-the tracks are in (`Planner._bend`, `planner.lead.far_centre`), and the lane's heading there
-is the car's heading at that time plus the lane's slope in that frame (`lane_candidates`). In
-a tight bend the car turns while a frame ages: a tangent taken at the car's station now
-places the lane ahead, beyond the bend, towards its outside, onto a car keeping the lane
-beside."""
+the tracks are in (`Planner._bend`, `planner.lead.far_centre`). In a tight bend the car
+turns while a frame ages: a tangent taken at the car's station now places the lane ahead,
+beyond the bend, towards its outside, onto a car keeping the lane beside."""
 
 from __future__ import annotations
 
