@@ -433,15 +433,19 @@ class Localizer:
         """[m] the HD map's width of the ego-direction lane the car's centre is nearest at
         ``pose`` (the lane a camera frame taken there sees), None without a map or a lane
         there: the width the camera's lane keeps when one of its lines is hidden."""
-        road = self.road
-        if road is None:
+        found = self._nearest_lane(pose)
+        return None if found is None else float(found[0].width_at(found[1]))
+
+    def _nearest_lane(self, pose: EgoState) -> tuple[Lane, float, float] | None:
+        """The HD map's ego-direction lane nearest the car's centre at ``pose``, with the
+        centre's station and offset [m] on the route; None without a map or a lane there."""
+        if self.road is None:
             return None
         s, d = self._on_route(np.array([pose.x, pose.y]))
-        lanes = [lane for lane in road.lanes if bool(lane.exists_at(s))]
+        lanes = [lane for lane in self.road.lanes if bool(lane.exists_at(s))]
         if not lanes:
             return None
-        nearest = min(lanes, key=lambda lane: abs(float(lane.offset_at(s)) - d))
-        return float(nearest.width_at(s))
+        return min(lanes, key=lambda lane: abs(float(lane.offset_at(s)) - d)), s, d
 
     def map_lane(self, pose: EgoState, t: float) -> LaneEstimate | None:
         """The HD map's ego-direction lane nearest the car's centre at ``pose``, as a lane
@@ -452,14 +456,11 @@ class Localizer:
         ahead hides them), the stop line across the lane is looked for across this one: the
         pose is pinned across the lane by the camera's earlier frames, and along the route
         it is the stop line that is to place it."""
+        found = self._nearest_lane(pose)
+        if found is None or self.road is None:
+            return None
+        nearest, s, d = found
         road = self.road
-        if road is None:
-            return None
-        s, d = self._on_route(np.array([pose.x, pose.y]))
-        lanes = [lane for lane in road.lanes if bool(lane.exists_at(s))]
-        if not lanes:
-            return None
-        nearest = min(lanes, key=lambda lane: abs(float(lane.offset_at(s)) - d))
         return LaneEstimate(t=t, offset=d - float(nearest.offset_at(s)),
                             heading_error=wrap_angle(pose.heading - float(road.heading_at(s))),
                             curvature=float(road.curvature_at(s)),
