@@ -1,4 +1,4 @@
-"""Soak: an hour of simulated time on a town loop, per sensor profile (issue L 5).
+"""Soak: an hour of simulated time on a town loop, per sensor profile.
 
 The ego drives round a 1 x 1 town of 250 m blocks (all-way stops at the four corners, left
 at each) for `--minutes` simulated minutes, with three NPC cars on the same loop, and the

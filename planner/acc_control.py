@@ -84,7 +84,7 @@ pedal). `planner.acc_layer` picks the law for the mode.
   rest, ``v^2 / (2 (d - d_floor + v_l^2 / (2 b) - v t_ramp))``. Without the gain, the
   need of a car that ramps in as planned rose by a twentieth during the ramp (a stopped
   car found 63 m ahead at 60 km/h: 2.85 to 3.03 m/s^2, over a_comf_max: BRAKE, comfort
-  envelope off, issue K). The planned deceleration is
+  envelope off). The planned deceleration is
   capped at a_comf_max (`planner.limits.A_COMF_MAX`, under ISO's 3.5 m/s^2), so that a car
   short of room stops a little nearer rather than harder; only when even ``need`` exceeds
   a_comf_max is there no comfortable stop: the ACC enters BRAKE saying so (`planner.fsm.acc`:

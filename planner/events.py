@@ -9,8 +9,8 @@ bumper f, its axles); tracks are in the map frame. Each tick
   paper's [Off_Ramp]): the front bumper as the speed plan places it
   (`planner.speed_planning.SpeedPlanner.front_station`, passed as ``limit_station``), so
   that the ramp's event and its lower limit begin (and end) on the same tick, and the ACC
-  goes from its mode before the ramp straight into OFF_RAMP (issue K: no SPEED_LIMIT for
-  the time the bumper takes to the centre).
+  goes from its mode before the ramp straight into OFF_RAMP (no SPEED_LIMIT for the time
+  the bumper takes to the centre).
 - stop_sign: the next stop line L of the map ahead, once perception has confirmed its sign
   (`see_signs`: a camera stop sign, placed on the map, near the line and right of the
   route), from ``approach(v)`` before it until the car has stood (below ``stopped_speed``)

@@ -39,8 +39,8 @@ the line:
   that is not moving the car's way;
 - at a stop-sign junction, also going straight or turning right: for a vehicle track in
   the box (the same) that is not moving the car's way: a car that took its turn and moved
-  off its line is waited for until it has crossed (issue K: town_traffic's ego went as
-  soon as the car first to stop left its line, and met it in the box);
+  off its line is waited for until it has crossed (going as soon as the car first to stop
+  has left its line meets it in the box);
 - at a stop-sign junction (an all-way stop), in order of arrival (`ArrivalOrder`): first to
   stop, first to go; ties to the right. The car *arrives* when it stands (below
   ``stopped``) with its front 0 to ``arrival_zone`` before its line and no vehicle right in
@@ -65,8 +65,8 @@ over the line, it is committed to the junction and goes on (the control FSM's em
 stop still covers a vehicle in its path). A gap that closes after that point is not chased
 with a stop the car cannot make.
 
-**Taking a gap** (hysteresis, then commitment; issue K: a gap taken and given up 0.1 s
-later, for an oncoming car the one just gone by had hidden). Once giving way, the car gives
+**Taking a gap** (hysteresis, then commitment: without them a gap is taken and given up
+0.1 s later, for an oncoming car the one just gone by had hidden). Once giving way, the car gives
 way until it has had nothing to wait for during ``gap_confirm`` in a row: a vehicle that
 comes out from behind another, or into the LiDAR's reach, is a confirmed track only after
 the tracker's M-of-N confirmation (up to 5 scans at 10 Hz), so a gap is taken once what it
@@ -75,8 +75,8 @@ within ``arrival_zone`` of its line, not in a queue, it is committed to the junc
 above), the way
 production stacks commit to a gap (queued farther back, behind a car that goes first, it
 is not: the gap is judged again on its way up to the line, as it would take seconds more
-to get there; issue K: town_traffic's ego took a gap 15 m back and turned 5 s later into
-the oncoming car): it gives way there
+to get there: a gap taken 15 m back is turned into seconds later, when the oncoming car
+may be there): it gives way there
 again only for a safety reason, a vehicle inside the box that is not moving its way (at a
 junction whose rules look at the box) while it can still stop before the line at
 ``commit_decel``; never because an oncoming vehicle closes the gap. So the give-way event

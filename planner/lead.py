@@ -7,7 +7,7 @@ with its gap, speed and lateral offset from the lane's centre line.
   offset from the ego lane's centre line (the camera's lane when it is the path, else
   straight ahead; beyond the camera's reach, `far_centre`: the camera's lane continued along
   the car's heading to it and bent as the map's lane bends: the camera's curvature, fitted
-  on 30 m of paint, was 7e-4 1/m on a straight road in issue K: 1.4 m at 65 m); the gap [m]
+  on 30 m of paint, can be 7e-4 1/m on a straight road: 1.4 m at 65 m); the gap [m]
   is bumper to bumper along the ego's heading, the speed [m/s] the track's over ground along
   the ego's heading (>= 0), both at the track's time; a pedestrian's offset is the one
   nearest the centre line on its way until the car reaches it (at the closing speed, at most
@@ -20,8 +20,8 @@ with its gap, speed and lateral offset from the lane's centre line.
   ``CUT_IN_HORIZON`` later (`cut_in_lateral`; its lateral speed is the track's, which lags
   the move by a few tenths of a second): a car cutting in at 1 m/s has its body
   0.2 m inside the lane 0.8 s before its centre is within ``half_width``, and UN R157
-  5.2.5.2 counts from that intrusion (issue K: a cut-in 30 m ahead at 20 km/h slower was
-  taken as the lead 0.8 s after its intrusion and hit);
+  5.2.5.2 counts from that intrusion (taken by its centre alone, a cut-in 30 m ahead at
+  20 km/h slower becomes the lead 0.8 s after its intrusion, too late);
 - `route_candidates`, through a town junction, where the lane is the map's turn path: the
   tracks (map frame) up to ``path_reach`` ahead along the map lane kept; the gap is along the
   lane, the speed along the lane's heading where the track is.

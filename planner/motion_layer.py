@@ -44,7 +44,7 @@ included) still overlaps that lane (`leads`): the car does not run into the vehi
 leaving. On a pass (a change taken to pass a slower vehicle), the vehicle
 passed counts only once the path does not clear it by ``pass_margin_keep`` (`clears`,
 below; a hysteresis below the margin a pass starts with): the car does not
-trail it through the pass (issue K, item 6), yet stops behind it rather than run into it if
+trail it through the pass, yet stops behind it rather than run into it if
 it does not get past. A change the route or a flat tyre asks for keeps trailing it (the car
 may be moving into that vehicle's path).
 

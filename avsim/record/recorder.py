@@ -12,7 +12,7 @@ The flush interval sets the number of chunks, and the SDK keeps ~2-3 kB of metad
 chunk in memory until `close()` (the manifest it writes in the file's footer, which viewers
 need for random access): at a 2 s interval the town loop's ~10 entities made 300 chunks a
 simulated minute, ~1 MB a minute of memory that never came back. Every 30 s it is ~20 chunks
-a minute (~4 MB over an hour's run; issue L 5), and what waits for a flush stays small: 30 s
+a minute (~4 MB over an hour's run), and what waits for a flush stays small: 30 s
 of camera images and scans is a few MB at the `fast` profile's rates.
 
 Size is the caller's to choose, by its rates and point counts: camera images are

@@ -1,4 +1,4 @@
-"""Mode chatter over many runs (issue K, item 2: outside safety transitions, no ACC mode is
+"""Mode chatter over many runs (outside safety transitions, no ACC mode is
 held for less than 0.5 s): every hold under a minimum, read from the runs' result files by
 the rule of `avsim.run.holds` (the one the chatter test and the ``acc_shortest_mode``
 metric use).
@@ -26,7 +26,7 @@ from pathlib import Path
 from avsim.report.states import RecordedChange
 from avsim.run.holds import Hold, holds
 
-MIN_HOLD = 0.5  # [s] issue K's least hold of an ACC mode
+MIN_HOLD = 0.5  # [s] the least hold of an ACC mode outside safety transitions
 
 
 class BadResultError(Exception):

@@ -4,7 +4,7 @@ however long the run.
 A column keeps its newest values in a typed array (8 bytes a float, 1 a flag, 4 an int, where
 a list holds a 32-byte float object per value) and, once it is given a spill file
 (`spill_to`), moves each full chunk of `CHUNK` values there (`avsim.run.spill`): an hour's run
-then holds at most a chunk per column in memory (issue L 5). Every read sees the whole
+then holds at most a chunk per column in memory. Every read sees the whole
 column, in the order appended: indexing, slicing, iteration, `len`, `==` and
 ``np.asarray(column)``. Chunks are cut at fixed counts of values, so the same run spills the
 same way, and the bytes go to the file and back unchanged: the values read are bit for bit

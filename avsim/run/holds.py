@@ -1,5 +1,5 @@
 """How long the stack held each mode of a state machine: the shortest hold is the measure
-of mode chatter (issue K: outside safety transitions, no ACC mode is held for less than
+of mode chatter (outside safety transitions, no ACC mode is to be held for less than
 0.5 s). A hold is the time between entering a mode and leaving it; the mode held at the
 end of the run is not counted (it was not left), nor are safety transitions: a hold of a
 safety mode (entered because braking could not wait, `SAFETY_MODES`: it lasts as long as

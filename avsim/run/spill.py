@@ -1,7 +1,7 @@
 """Where a long run's log keeps its older values: an unnamed temporary file.
 
 An hour's run logs 144,000 control ticks (~40 MB as typed arrays), which would make the
-process's memory grow all run long (issue L 5: flat within 10 % over an hour). So the log's
+process's memory grow all run long (to be flat within 10 % over an hour). So the log's
 columns (`avsim.run.columns`) move their values here chunk by chunk and read them back when
 asked for the whole column.
 
