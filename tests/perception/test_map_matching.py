@@ -5,10 +5,12 @@ gated out."""
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
 from dataclasses import replace
 
 import numpy as np
 import pytest
+from numpy.typing import NDArray
 
 from perception.localization import Localizer, clear_ahead
 from perception.messages import EgoState, LaneBoundary, LaneEstimate, ObjectClass, Track
@@ -168,6 +170,28 @@ def test_an_unconfident_estimate_or_an_outage_changes_nothing(confidence: float,
     assert np.array_equal(loc.state, before)
 
 
+def along_the_lane(loc: Localizer, road: RoadMap, rng: np.random.Generator, s0: float,
+                   duration: float, bias_x: float,
+                   ) -> Iterator[tuple[float, float, NDArray[np.float64], EgoState]]:
+    """Drive lane 0 of a street heading +x from station `s0` [m] at SPEED for `duration`
+    [s]: wheel odometry every tick, a GNSS fix every GNSS_EVERY ticks biased `bias_x` [m]
+    along the street (noise 0.3 m); yields (t [s], station [m], true position, the pose
+    estimate) after each fix."""
+    lane = road.lane(0)
+    for k in range(round(duration * ODO_RATE) + 1):
+        t = k / ODO_RATE
+        s = s0 + SPEED * t
+        xy = lane.position(s, 0.0)
+        spin = SPEED / WHEEL_RADIUS
+        loc.on_odometry(Odometry(t, (spin, spin, spin, spin), WHEEL_RADIUS, 0.0, 0.0))
+        if k % GNSS_EVERY:
+            continue
+        loc.on_gnss(GnssFix(t, float(xy[0]) + bias_x + rng.normal(0.0, 0.3),
+                            float(xy[1]) + rng.normal(0.0, 0.3), rng.normal(0.0, 0.005),
+                            STATED_SIGMA, 0.005))
+        yield t, s, xy, loc.estimate(t)
+
+
 def test_where_the_lines_end_at_a_town_junction_fixes_the_station() -> None:
     """A 2.5 m GNSS bias along the street: the camera's lane pins the lateral position but
     not the station, until the painted lines end at the junction's mouth within view."""
@@ -178,20 +202,8 @@ def test_where_the_lines_end_at_a_town_junction_fixes_the_station() -> None:
     mouth = road.junctions[0].s_enter  # [m] 71: the lines of the approach end there
     rng = np.random.default_rng(1)
     loc = Localizer(road=road)
-    lane = road.lane(0)
     along: list[tuple[float, float]] = []
-    for k in range(round(4.0 * ODO_RATE) + 1):  # from s = 20 to 68 at 12 m/s
-        t = k / ODO_RATE
-        s = 20.0 + SPEED * t
-        xy = lane.position(s, 0.0)
-        spin = SPEED / WHEEL_RADIUS
-        loc.on_odometry(Odometry(t, (spin, spin, spin, spin), WHEEL_RADIUS, 0.0, 0.0))
-        if k % GNSS_EVERY:
-            continue
-        loc.on_gnss(GnssFix(t, float(xy[0]) + 2.5 + rng.normal(0.0, 0.3),
-                            float(xy[1]) + rng.normal(0.0, 0.3), rng.normal(0.0, 0.005),
-                            STATED_SIGMA, 0.005))
-        pose = loc.estimate(t)
+    for t, s, xy, pose in along_the_lane(loc, road, rng, 20.0, 4.0, 2.5):  # s 20 -> 68
         end = min(mouth - s, 34.0)  # [m] where the lines end, or the view does
         line = LaneBoundary((1.75, 0.0, 0.0), 5.0, end + rng.normal(0.0, 0.2), 400)
         seen = replace(estimate(t, rng.normal(0.0, 0.04)), left=line,
@@ -216,20 +228,8 @@ def test_a_stop_line_seen_fixes_the_station() -> None:
     road = make_map(seg(400.0), features=(StopSign(stop),))
     rng = np.random.default_rng(2)
     loc = Localizer(road=road)
-    lane = road.lane(0)
     along: list[tuple[float, float, bool]] = []
-    for k in range(round(10.0 * ODO_RATE) + 1):  # from s = 30 to 150 at 12 m/s
-        t = k / ODO_RATE
-        s = 30.0 + SPEED * t
-        xy = lane.position(s, 0.0)
-        spin = SPEED / WHEEL_RADIUS
-        loc.on_odometry(Odometry(t, (spin, spin, spin, spin), WHEEL_RADIUS, 0.0, 0.0))
-        if k % GNSS_EVERY:
-            continue
-        loc.on_gnss(GnssFix(t, float(xy[0]) + 2.0 + rng.normal(0.0, 0.3),
-                            float(xy[1]) + rng.normal(0.0, 0.3), rng.normal(0.0, 0.005),
-                            STATED_SIGMA, 0.005))
-        pose = loc.estimate(t)
+    for t, s, xy, pose in along_the_lane(loc, road, rng, 30.0, 10.0, 2.0):  # s 30 -> 150
         loc.on_lane(estimate(t, rng.normal(0.0, 0.04)), pose)
         match = None
         if 6.0 <= stop - s <= 17.0:
@@ -313,21 +313,9 @@ def approach_behind_a_car(clear: bool) -> tuple[list[float], int]:
     mouth = road.junctions[0].s_enter
     rng = np.random.default_rng(4)
     loc = Localizer(road=road)
-    lane = road.lane(0)
     gap = 13.0  # [m] the car ahead's rear from the ego's centre
     errors, accepted = [], 0
-    for k in range(round(41.0 / SPEED * ODO_RATE) + 1):
-        t = k / ODO_RATE
-        s = 20.0 + SPEED * t
-        xy = lane.position(s, 0.0)
-        spin = SPEED / WHEEL_RADIUS
-        loc.on_odometry(Odometry(t, (spin, spin, spin, spin), WHEEL_RADIUS, 0.0, 0.0))
-        if k % GNSS_EVERY:
-            continue
-        loc.on_gnss(GnssFix(t, float(xy[0]) + 2.5 + rng.normal(0.0, 0.3),
-                            float(xy[1]) + rng.normal(0.0, 0.3), rng.normal(0.0, 0.005),
-                            STATED_SIGMA, 0.005))
-        pose = loc.estimate(t)
+    for t, s, xy, pose in along_the_lane(loc, road, rng, 20.0, 41.0 / SPEED, 2.5):
         end = min(mouth - s, gap, 34.0)  # [m] the mouth, the car ahead or the view
         line = LaneBoundary((1.75, 0.0, 0.0), 5.0, end + rng.normal(0.0, 0.2), 400)
         seen = replace(estimate(t, rng.normal(0.0, 0.04)), left=line,
