@@ -28,6 +28,9 @@ if TYPE_CHECKING:
     from avsim.scenario.scenario import Scenario
 
 
+KEY_SUFFIX = ".key"  # a campaign run's key file, beside its result JSON (`resume_key`)
+
+
 class Status(Enum):
     """How a run ended, as the CLI's exit status says it."""
 
@@ -67,6 +70,11 @@ class RunJob:
     def result_file(self) -> Path:
         """The run's result JSON."""
         return self.out_dir / f"{self.name}.json"
+
+    @property
+    def key_file(self) -> Path:
+        """The run's key (`resume_key`), beside its result JSON."""
+        return self.out_dir / f"{self.name}{KEY_SUFFIX}"
 
     @property
     def plot_file(self) -> Path:
@@ -138,7 +146,6 @@ class RunOutcome:
         return first if first is not None else self.sim_time
 
 
-KEY_SUFFIX = ".key"  # a campaign run's key file, beside its result JSON (`resume_key`)
 ProgressCallback = Callable[[float, float], None]  # (sim time, duration) [s]
 VERDICT_STATUS = {  # a result's verdict (`avsim.run.verdict`) -> the run's status
     RunVerdict.PASS.value: Status.PASSED, RunVerdict.FAIL.value: Status.FAILED,
@@ -177,7 +184,7 @@ def run_job(job: RunJob, into: Path | None = None,
         return RunOutcome(job, Status.ERROR, error=f"{job.name}: {last}",
                           wall_time=time.perf_counter() - start)
     if job.resume_key is not None:  # after the result: a run cut off before has no key
-        write_atomic((into or job.out_dir) / f"{job.name}{KEY_SUFFIX}", job.resume_key.encode())
+        write_atomic((into or job.out_dir) / job.key_file.name, job.resume_key.encode())
     return outcome_of(job, result, time.perf_counter() - start)
 
 

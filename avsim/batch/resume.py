@@ -25,7 +25,7 @@ from dataclasses import replace
 from importlib import metadata
 from pathlib import Path
 
-from avsim.batch.jobs import KEY_SUFFIX, VERDICT_STATUS, RunJob, RunOutcome, Status, outcome_of
+from avsim.batch.jobs import VERDICT_STATUS, RunJob, RunOutcome, Status, outcome_of
 from avsim.scenario.load import scenario_path
 from world.core.safe_read import UnreadableFileError, read_bounded
 
@@ -74,16 +74,11 @@ def run_key(job: RunJob, fingerprint: str) -> str:
     return hashlib.sha256(text.encode()).hexdigest()
 
 
-def key_file(job: RunJob) -> Path:
-    """Where `job`'s run writes its key: beside its result JSON."""
-    return job.out_dir / f"{job.name}{KEY_SUFFIX}"
-
-
 def finished(job: RunJob, key: str) -> RunOutcome | None:
     """`job`'s outcome from its files when its key file holds `key` and its result JSON
     says it finished (passed, failed or error); else None (it must run)."""
     try:
-        held = read_bounded(key_file(job), MAX_KEY_BYTES).decode("ascii").strip()
+        held = read_bounded(job.key_file, MAX_KEY_BYTES).decode("ascii").strip()
         if held != key:
             return None
         result = json.loads(read_bounded(job.result_file, MAX_RESULT_BYTES))

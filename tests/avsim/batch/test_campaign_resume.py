@@ -15,7 +15,6 @@ from avsim.batch.jobs import RunJob, Status
 from avsim.batch.resume import (
     code_fingerprint,
     finished,
-    key_file,
     keyed,
     resumed,
     run_key,
@@ -63,7 +62,7 @@ def test_the_code_fingerprint_is_stable_within_a_process() -> None:
 def _finished_files(job: RunJob, key: str, verdict: str) -> None:
     job.result_file.write_text(json.dumps({"verdict": verdict, "wall_time": 1.5,
                                            "criteria": [], "metrics": {}}))
-    key_file(job).write_text(key)
+    job.key_file.write_text(key)
 
 
 @pytest.mark.parametrize(("verdict", "status"), [("pass", Status.PASSED),
@@ -82,7 +81,7 @@ def test_an_error_is_taken_with_its_line(tmp_path: Path) -> None:
     job.result_file.write_text(json.dumps({
         "verdict": "error", "criteria": [], "metrics": {},
         "error": {"type": "ValueError", "message": "bad", "traceback": "", "sim_time": 2.0}}))
-    key_file(job).write_text("k")
+    job.key_file.write_text("k")
     outcome = finished(job, "k")
     assert outcome is not None and outcome.status is Status.ERROR
     assert outcome.error == f"{job.name}: run ended in error at t = 2.000 s: ValueError: bad"
@@ -94,9 +93,9 @@ def test_anything_else_runs_again(tmp_path: Path, case: str) -> None:
     job = _job(tmp_path)
     _finished_files(job, "k", "interrupted" if case == "interrupted" else "pass")
     if case == "no key":
-        key_file(job).unlink()
+        job.key_file.unlink()
     elif case == "other key":
-        key_file(job).write_text("j")
+        job.key_file.write_text("j")
     elif case == "no result":
         job.result_file.unlink()
     elif case == "torn result":
@@ -104,8 +103,8 @@ def test_anything_else_runs_again(tmp_path: Path, case: str) -> None:
     elif case == "not a result":
         job.result_file.write_text("[1, 2]")
     elif case == "key is a directory":
-        key_file(job).unlink()
-        key_file(job).mkdir()
+        job.key_file.unlink()
+        job.key_file.mkdir()
     assert finished(job, "k") is None
 
 
