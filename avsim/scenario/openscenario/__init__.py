@@ -1,4 +1,4 @@
-"""ASAM OpenSCENARIO 1.0-1.2 (XML, .xosc) reading: `load_openscenario(path, overrides)`
+"""ASAM OpenSCENARIO 1.0-1.3 (XML, .xosc) reading: `load_openscenario(path, overrides)`
 parses a file, resolves its parameters (`$name`, `${...}`, constraint groups) and catalogs,
 and gives the typed model in `model` (`OpenScenario`); `declared_parameters(path)` lists the
 global parameters for sweeps. Every problem is one `ScenarioError` line."""

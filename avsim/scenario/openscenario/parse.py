@@ -1,4 +1,4 @@
-"""`load_openscenario`: an OpenSCENARIO 1.0-1.2 file (.xosc) read, its parameters and
+"""`load_openscenario`: an OpenSCENARIO 1.0-1.3 file (.xosc) read, its parameters and
 catalogs resolved, into the typed `OpenScenario` model; `declared_parameters` for sweeps.
 
 Every problem is one `ScenarioError` line: `<file>: line N: <element path>: <problem>`.
@@ -25,7 +25,7 @@ from avsim.scenario.openscenario.parse_storyboard import parse_storyboard
 from avsim.scenario.openscenario.references import ReferenceError, Roots, is_file
 from avsim.scenario.openscenario.xmlread import Node, read_xml
 
-SUPPORTED_MINOR = (0, 1, 2)  # OpenSCENARIO 1.0, 1.1, 1.2
+SUPPORTED_MINOR = (0, 1, 2, 3)  # OpenSCENARIO 1.0 to 1.3
 _NO_OVERRIDES: Mapping[str, str] = MappingProxyType({})
 
 

@@ -74,8 +74,8 @@ def test_doctype_is_refused() -> None:
 
 
 def test_other_versions_are_refused() -> None:
-    assert message("version_1_3.xosc") == (
-        "line 3: /OpenSCENARIO/FileHeader: not supported yet (OpenSCENARIO 1.3)"
+    assert message("version_1_4.xosc") == (
+        "line 3: /OpenSCENARIO/FileHeader: not supported yet (OpenSCENARIO 1.4)"
     )
 
 
