@@ -11,7 +11,10 @@ shoulder). Per tick:
    slower vehicle has blocked it for ``blocked_time``; the lanes left and right are free or
    not (by the tracks, rear traffic included: `planner.lane_occupancy.is_free`, UN R157's
    rule that a vehicle approaching from behind need not brake harder than 3 m/s^2, judged at
-   the lowest speed the car plans during the move, e.g. a flat tyre's slowing; the tracks
+   the lowest speed the car plans during the move, e.g. a flat tyre's slowing; a vehicle
+   coming up behind that does not brake is judged over the whole time the car will be in
+   the lane, for a pull-over through a driving lane its stay there too (`_pull_over_stay`:
+   the wait before the next change and that change toward the shoulder); the tracks
    reach 60 m behind, less past a vehicle alongside in the lane, which hides what follows
    it: the lane is free only ``rear_view_time`` after such a vehicle was last alongside,
    time for the tracks of what it hid to be confirmed); a pass
@@ -433,8 +436,9 @@ class MotionLayer:
             and self._can_plan(left.lane, ego) and self._free_to_start(left, ego, s, v_low,
                                                                        traffic),
             right_free=right is not None and self._seen(right, t)
-            and self._can_plan(right.lane, ego) and self._free_to_start(right, ego, s, v_low,
-                                                                        traffic),
+            and self._can_plan(right.lane, ego)
+            and self._free_to_start(right, ego, s, v_low, traffic,
+                                    self._pull_over_stay(right.lane, s, v_low, pull_over)),
             clears_left=not blocked_now or left is None
             or self._pass_clears(ego, s, self.lane + 1, traffic),
             clears_right=not blocked_now or right is None or right.lane == SHOULDER
@@ -463,6 +467,7 @@ class MotionLayer:
         centre, width = float(target.offset_at(s)), float(target.width_at(s))
         # an abort plans a path back: a car that heads off the origin lane goes on instead
         v_end, t_move = self._rear_move(self.path, traffic, s, v, v_low, p.pass_margin_keep)
+        t_move += self._pull_over_stay(self.lane, s, v_end, pull_over)
         target_free = is_free(traffic[self.lane], v, p.occupancy, v_end, under_way=True,
                               t_move=t_move) or not self._can_plan(self.origin, ego)
         return replace(x, target_free=target_free,
@@ -487,16 +492,32 @@ class MotionLayer:
         return right.behind.gap >= speed * self.params.keep_right_gap
 
     def _free_to_start(self, lt: LaneTraffic, ego: EgoState, s: float, v_low: float,
-                       traffic: dict[int, LaneTraffic]) -> bool:
+                       traffic: dict[int, LaneTraffic], stay: float = 0.0) -> bool:
         """Whether a move into `lt`'s lane may start now (`planner.lane_occupancy.is_free`):
         the rear rules judged at the speed the car will have on the path into it and over
-        the time that path takes (`_rear_move`)."""
+        the time that path takes (`_rear_move`) plus `stay` [s], the time the car stays in
+        the lane after it (`_pull_over_stay`)."""
         behind = lt.behind
         if behind is None or behind.speed <= v_low or lt.lane == SHOULDER:
             return is_free(lt, ego.speed, self.params.occupancy, v_low)
         v_end, t_move = self._rear_move(self._plan_into(lt.lane, ego), traffic, s, ego.speed,
                                         v_low, self.params.pass_margin)
-        return is_free(lt, ego.speed, self.params.occupancy, v_end, t_move=t_move)
+        return is_free(lt, ego.speed, self.params.occupancy, v_end, t_move=t_move + stay)
+
+    def _pull_over_stay(self, lane: int, s: float, v: float, pull_over: bool) -> float:
+        """[s] how long a car pulling over (`pull_over`) stays in driving lane `lane` once
+        it is in it, at speed `v` [m/s]: ``route_keep_time``, then the whole change on
+        toward the shoulder (its body is in the lane until near that path's end), a lane
+        change at `v` (``t_cap`` at a standstill); 0 on the shoulder or when not pulling
+        over. A vehicle coming up behind in the lane that does not brake for the car must
+        stay clear of it all that time: a flat tyre's crawl cannot get away from it."""
+        if not pull_over or lane == SHOULDER:
+            return 0.0
+        lc = self.params.lane_change
+        width = float(self.road.lane(lane).width_at(s))
+        change = path_length(v, plan_duration(width, 0.0, v, lc), lc) / v if v > 0.0 \
+            else lc.t_cap
+        return self.params.motion.route_keep_time + change
 
     def _rear_move(self, path: LaneChangePath, traffic: dict[int, LaneTraffic], s: float,
                    v: float, v_low: float, margin: float) -> tuple[float, float]:

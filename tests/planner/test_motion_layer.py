@@ -150,6 +150,31 @@ def test_a_flat_tyre_pulls_over_lane_by_lane_onto_the_shoulder() -> None:
     assert y == pytest.approx(float(ROAD.shoulder.offset_at(x)))
 
 
+def test_a_pull_over_waits_for_a_car_coming_up_in_the_lane_it_must_cross() -> None:
+    """A flat tyre's crawl (6 m/s) in lane 1, a car at 51 km/h 56 m behind in lane 0 that
+    never brakes: the move into lane 0 alone would be over before it arrives (UN R157's
+    rear rule holds for it), but the car then waits there and crosses on to the shoulder
+    at 6 m/s, and the car behind, keeping its speed, runs into it. It pulls over once the
+    car has gone by, and is never in lane 0 with it closing in behind."""
+    v, u, gap0 = 6.0, 14.2, 56.5  # [m/s], [m/s], [m] from the car's front to the ego's rear
+    m = MotionLayer(ROAD, 1, AccParams(), VEHICLE, MotionLayerParams())
+    t, x, y, first_in_lane0 = 0.0, 200.0, W, None
+    while t < 30.0:
+        behind_x = x - VEHICLE.rear_overhang - gap0 - 2.3 + (u - v) * t  # its centre
+        pose = EgoState(t=t, x=x, y=y, heading=0.0, speed=v, yaw_rate=0.0,
+                        steering_angle=0.0, position_sigma=0.05)
+        man, _ = m.update(pose, v, [car(t, behind_x, 0.0, u, 7)], pull_over=True, v_rear=v)
+        if man.path is not None:
+            y = float(ROAD.lane(man.path.target_index).offset_at(x)) + float(
+                man.path.offset_at(x))
+        if first_in_lane0 is None and man.lane == 0:
+            first_in_lane0 = (t, behind_x)
+        t, x = t + 0.025, x + v * 0.025
+    assert first_in_lane0 is not None and m.lane == SHOULDER  # it did pull over, later
+    t_in, behind_then = first_in_lane0
+    assert behind_then - 2.3 > (x - v * (30.0 - t_in)) + VEHICLE.front_overhang  # gone by
+
+
 @pytest.mark.parametrize(
     ("manoeuvre", "state"),
     [("left", Motion.TURN_LEFT), ("right", Motion.TURN_RIGHT), ("u_turn", Motion.U_TURN)],
@@ -338,11 +363,11 @@ def test_room_left(gap: float, v: float, room: float) -> None:
 
 
 def test_a_flat_tyre_waits_for_the_car_behind_judged_at_the_speed_it_slows_to() -> None:
-    """A flat tyre in lane 1, a car at 65 km/h 30 m behind in lane 0: at the car's speed
+    """A flat tyre in lane 1, a car at 65 km/h 45 m behind in lane 0: at the car's speed
     now (59 km/h) lane 0 is free, but the car slows to a crawl while it moves over
     (`v_rear`): it waits in its lane."""
     m = MotionLayer(ROAD, 1, AccParams(), VEHICLE, MotionLayerParams())
-    rear = car(0.0, 100.0 - 30.0 - 4.7, 0.0, 18.1, 9)
+    rear = car(0.0, 100.0 - 45.0 - 4.7, 0.0, 18.1, 9)
     fast_now = EgoState(t=0.0, x=100.0, y=W, heading=0.0, speed=16.4, yaw_rate=0.0,
                         steering_angle=0.0, position_sigma=0.05)
     assert m.update(fast_now, V, [rear], pull_over=True)[0].motion is \
