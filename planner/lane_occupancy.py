@@ -13,7 +13,10 @@ reaches 60 m behind as ahead), so a vehicle coming up from behind in a lane is i
 A lane is *free* for the ego to move into when nothing is alongside and
 
 - ahead: gap >= d_min(v) + max(v - V_ahead, 0) * ``front_time`` (UN R157's minimum gap, plus
-  the closing during the change);
+  the closing during the change). A change under way goes on behind a vehicle ahead that
+  is not slower than the ego: the gap only grows, and the ego, speeding up toward its set
+  speed, would otherwise give up a change for a d_min(v) that rises with its own speed
+  (going back over the line it has crossed is no safer);
 - behind: the vehicle approaching from behind need not brake harder than a_rear =
   ``rear_decel`` (3 m/s^2) after a reaction time t_B = ``rear_reaction`` (0.4 s) to stay a
   time gap t_G = ``rear_time_gap`` (1 s) behind the ego: `rear_decel_needed`,
@@ -179,7 +182,7 @@ def is_free(lt: LaneTraffic, v: float, p: OccupancyParams, v_rear: float | None 
     0: not judged)."""
     if lt.alongside:
         return False
-    if lt.ahead is not None:
+    if lt.ahead is not None and not (under_way and lt.ahead.speed >= v):
         need = r157_min_gap(v) + max(v - lt.ahead.speed, 0.0) * p.front_time
         if lt.ahead.gap < need:
             return False

@@ -84,6 +84,22 @@ def test_free_ahead_needs_d_min_plus_closing() -> None:
     assert not is_free(LaneTraffic(1, alongside=True), V, P)
 
 
+@pytest.mark.parametrize(("v_ahead", "under_way", "free"), [
+    (V + 2.7, False, False),  # a start needs d_min(v) even behind a faster vehicle
+    (V + 2.7, True, True),  # under way behind one pulling away: the gap only grows
+    (V, True, True),  # ... or holding the ego's speed
+    (V - 0.5, True, False),  # one the ego closes on gives the change up
+])
+def test_a_change_under_way_goes_on_behind_a_vehicle_that_is_not_slower(
+        v_ahead: float, under_way: bool, free: bool) -> None:
+    """A vehicle ahead in the target lane 0.5 m nearer than d_min(v): a pass behind a car
+    pulling away (52 km/h, 16.6 m ahead, the ego speeding up through 42 km/h toward its set
+    speed) was given up over the line it had crossed as d_min(v) rose past the gap, though
+    the gap was growing."""
+    lt = LaneTraffic(1, ahead=Neighbour(1, 1.0, r157_min_gap(V) - 0.5, v_ahead))
+    assert is_free(lt, V, P, under_way=under_way) is free
+
+
 def test_free_behind_is_r157s_approaching_vehicle_rule() -> None:
     dv = 25.0 - V
     need = dv * 0.4 + dv**2 / 6.0 + V * 1.0
