@@ -15,12 +15,13 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from avsim.run.storyboard import geometry as g
 from avsim.run.storyboard.elements import ElementState, TransitionKind, TransitionRecord
 from avsim.run.storyboard.rules import compare, parameter_holds
 from avsim.run.storyboard.snapshot import EntityState, Snapshot
+from avsim.run.storyboard.state import StoryState
 from avsim.scenario.openscenario.conditions import (
     CollisionCondition,
     Condition,
@@ -63,6 +64,7 @@ class ConditionContext:
     log: Sequence[TransitionRecord] = ()  # every transition so far, in order
     since: int = 0  # log[since:] happened since the condition's previous evaluation
     resolve: Resolver = no_resolver  # a position -> (x, y, s, offset)
+    state: StoryState = field(default_factory=StoryState)  # variables, environment (live)
 
 
 _STATES = {s.value: s for s in ElementState}

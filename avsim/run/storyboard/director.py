@@ -55,7 +55,8 @@ class Director:
         self.truth = TruthTracker(program, world)
         self.resolver = Resolver(program.chain)
         osc = program.scenario
-        self.runtime = StoryRuntime(osc.storyboard, osc.parameters, self._resolve)
+        self.runtime = StoryRuntime(osc.storyboard, osc.parameters, self._resolve,
+                                    osc.variables)
         self.commands = Commands(world.road, self.resolver, program.lane_ids)
         self._index = dict(program.actors)
         self._pending: dict[str, set[str]] = {}  # action id -> tags still running
