@@ -41,6 +41,7 @@ from avsim.run.storyboard.elements import (
 )
 from avsim.run.storyboard.snapshot import Snapshot
 from avsim.run.storyboard.state import StoryState
+from avsim.run.storyboard.state_conditions import Lanes, no_lanes
 from avsim.run.storyboard.tree import Node, build, name_index
 from avsim.run.storyboard.triggers import TriggerWatch
 from avsim.scenario.openscenario.actions import (
@@ -97,11 +98,12 @@ class StoryRuntime:
     """One run of a storyboard (module doc). `parameters` are the scenario's values and
     `variables` its declared variables (their values at the start: the state that parameter
     and variable conditions read); `resolve` places a Position (distance and reach
-    conditions)."""
+    conditions); `lanes` counts the route's lanes at a station (clearance conditions)."""
 
     def __init__(self, storyboard: Storyboard, parameters: Mapping[str, ParamValue],
                  resolve: Resolver = no_resolver,
-                 variables: tuple[VariableDeclaration, ...] = ()) -> None:
+                 variables: tuple[VariableDeclaration, ...] = (),
+                 lanes: Lanes = no_lanes) -> None:
         self.storyboard = storyboard
         self.stories = build(storyboard.stories)
         index = name_index(storyboard, self.stories)
@@ -110,7 +112,7 @@ class StoryRuntime:
         for init in storyboard.init_global:
             self.story_state.apply(init, 0.0)
         self._ctx = ConditionContext(self.story_state.parameters, _LiveStates(index),
-                                     self._log, 0, resolve, self.story_state)
+                                     self._log, 0, resolve, self.story_state, lanes)
         self._stop = None if storyboard.stop_trigger is None else TriggerWatch(
             storyboard.stop_trigger)
         self._actions = {n.path: n for root in self.stories for n in root.walk()
