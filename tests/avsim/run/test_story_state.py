@@ -16,6 +16,7 @@ from avsim.record import blueprint as bp
 from avsim.run.result import result_json
 from avsim.run.runner import Runner, RunResult
 from avsim.scenario.load import load_scenario
+from avsim.scenario.openscenario.to_yaml import convert_xosc
 
 ALKS = Path(__file__).parents[2] / "data" / "alks" / "logical_scenarios" / "concrete_scenarios"
 FREE = ALKS / "alks_scenario_4_1_1_free_driving_template.xosc"
@@ -105,3 +106,9 @@ def test_the_recording_has_an_event_line_for_each(run: tuple[RunResult, Path, Pa
     marked = result.storyboard_state[1].t
     assert lines["storyboard: variable marked = true"] == round(1e9 * marked)
     assert lines["storyboard: variable seen = 2"] == round(1e9 * marked)
+
+
+def test_convert_lists_the_global_actions_as_misfits(tmp_path: Path) -> None:
+    conversion = convert_xosc(scenario_file(tmp_path), search_paths=[ALKS])
+    assert "the Init's EnvironmentAction (no YAML counterpart)" in conversion.misfits
+    assert "action MarkAction: VariableAction (no YAML counterpart)" in conversion.misfits
