@@ -5,10 +5,12 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 import pytest
 
 from avsim.run.storyboard.conditions import ConditionContext, holds
 from avsim.run.storyboard.snapshot import EntityState
+from avsim.run.storyboard.truth import TruthTracker
 from avsim.scenario.openscenario.conditions import (
     AccelerationCondition,
     AngleCondition,
@@ -121,3 +123,13 @@ def test_clearance_from_an_oncoming_lane_looks_its_own_way() -> None:
 
 def test_clearance_off_the_lanes_is_false() -> None:
     assert judged(clearance(), ego=entity("Ego", lane=None)) is False
+
+
+def test_the_truth_differences_speed_and_heading_between_checks() -> None:
+    tracker = TruthTracker.__new__(TruthTracker)  # the rates need no world
+    tracker._speed, tracker._yaw = np.zeros(2), np.zeros(2)
+    acc, turn = tracker._rates(0.0, np.array([5.0, 1.0]), np.array([3.1, 0.0]))
+    assert acc.tolist() == [0.0, 0.0] and turn.tolist() == [0.0, 0.0]  # the first: zeros
+    acc, turn = tracker._rates(0.5, np.array([4.0, 2.0]), np.array([-3.1, 0.1]))
+    assert acc == pytest.approx([-2.0, 2.0])
+    assert turn == pytest.approx([(2 * math.pi - 6.2) / 0.5, 0.2])  # across the half turn
