@@ -14,6 +14,7 @@ import math
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from avsim.run.story_state import state_change_json
 from world.sensors.setup import Localisation, Profile, localisation
 
 if TYPE_CHECKING:
@@ -45,6 +46,7 @@ def result_json(result: RunResult, file: str | Path, recording: Path, profile: s
         "criteria": [c.as_json() for c in result.criteria],
         "infractions": [i.as_json() for i in result.infractions],
         "story": [_story_entry(e) for e in result.story],
+        "storyboard_state": [state_change_json(c) for c in result.storyboard_state],
         "metrics": {k: _clean(v) for k, v in result.metrics.items()},
         "state_changes": [
             {"t": round(c.t, 4), "machine": c.machine, "from": c.source, "to": c.target,

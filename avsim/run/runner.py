@@ -57,7 +57,9 @@ from avsim.run.sensor_loop import FrameHook, SensorLoop, sensing_mode
 from avsim.run.spill import SpillFile
 from avsim.run.stack import Stack, StackOutput
 from avsim.run.story import ScriptedStory, StoryboardStory, StoryEntry
+from avsim.run.story_state import state_change_text
 from avsim.run.storyboard.director import Director
+from avsim.run.storyboard.state import StateChange as StoryStateChange
 from avsim.run.verdict import RunError, RunVerdict
 from avsim.scenario.scenario import Scenario
 from planner.messages import MACHINES, AccMode, HazardLights, Motion, Plan, SpeedSource, StateChange
@@ -176,6 +178,8 @@ class RunResult:
     #   are those judged so far (`avsim.criteria.base.judged_so_far`)
     error: RunError | None = None  # the exception that ended the run (verdict error): the
     #   criteria are those judged until then
+    storyboard_state: tuple[StoryStateChange, ...] = ()  # an OpenSCENARIO storyboard's
+    #   variables, parameters and environments set, in time order
 
     @property
     def verdict(self) -> RunVerdict:
@@ -257,6 +261,7 @@ class Runner:
         self.collisions = self.criteria.find(NoCollision)  # its count is a metric
         self.lanes = self.criteria.find(TyresInLane).lanes  # the truth's lane changes
         self.infractions: list[Infraction] = []
+        self._story_logged = 0  # storyboard state changes already in the recording
         self.recorder = Recorder(recording, recording_name=scenario.name) if recording else None
         self.sensors = SensorLoop(w, self.setup, self.stack, mode, self.recorder, frame_hook,
                                   self.watch, worker)
@@ -303,7 +308,14 @@ class Runner:
             renderer=renderer.value if renderer is not None else None,
             stage_times=dict(self.watch.seconds), story=story,
             interrupted=self._stopped, error=self.error,
+            storyboard_state=self._story_state(),
         )
+
+    def _story_state(self) -> tuple[StoryStateChange, ...]:
+        """The storyboard's state changes so far (none without a storyboard)."""
+        if self.director is None:
+            return ()
+        return tuple(self.director.runtime.story_state.changes)
 
     def _loop(self, progress: ProgressCallback | None) -> None:
         """The static recording, then one control period per pass: decide on this
@@ -505,6 +517,15 @@ class Runner:
         if self.recorder is not None:
             for i in infractions:
                 self.recorder.log_infraction(i.t, i.kind, i.message, i.where)
+            self._record_story_state()
+
+    def _record_story_state(self) -> None:
+        """The storyboard's state changes since the last sample, as event lines."""
+        assert self.recorder is not None
+        changes = self._story_state()
+        for change in changes[self._story_logged:]:
+            self.recorder.log_event(change.t, state_change_text(change))
+        self._story_logged = len(changes)
 
     def _flat_fired(self) -> bool:
         """A flat tyre event has happened to the ego (truth, for `completes`)."""

@@ -8,20 +8,25 @@ of them, "all": for every one (the entities it holds for are the ones
 coordinate systems "entity", "lane", "road" and "trajectory" are all taken along the route
 (the route is the lane kept; an entity's own axes are not used). Relative and position
 distances compare their magnitude. An entity missing from the snapshot: false. Notes
-particular to a kind are on its judge below.
+particular to a kind are on its judge below; the conditions on variables, time of day,
+acceleration, angles and clearance are judged in `state_conditions`.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from avsim.run.storyboard import geometry as g
+from avsim.run.storyboard import state_conditions as sc
 from avsim.run.storyboard.elements import ElementState, TransitionKind, TransitionRecord
 from avsim.run.storyboard.rules import compare, parameter_holds
 from avsim.run.storyboard.snapshot import EntityState, Snapshot
+from avsim.run.storyboard.state import StoryState
 from avsim.scenario.openscenario.conditions import (
+    AccelerationCondition,
+    AngleCondition,
     CollisionCondition,
     Condition,
     ConditionKind,
@@ -30,6 +35,8 @@ from avsim.scenario.openscenario.conditions import (
     OffroadCondition,
     ParameterCondition,
     ReachPositionCondition,
+    RelativeAngleCondition,
+    RelativeClearanceCondition,
     RelativeDistanceCondition,
     RelativeDistanceType,
     RelativeSpeedCondition,
@@ -38,8 +45,10 @@ from avsim.scenario.openscenario.conditions import (
     StandStillCondition,
     StoryboardElementStateCondition,
     TimeHeadwayCondition,
+    TimeOfDayCondition,
     TimeToCollisionCondition,
     TraveledDistanceCondition,
+    VariableCondition,
 )
 from avsim.scenario.openscenario.parameters import ParamValue
 from avsim.scenario.openscenario.positions import Position
@@ -63,6 +72,8 @@ class ConditionContext:
     log: Sequence[TransitionRecord] = ()  # every transition so far, in order
     since: int = 0  # log[since:] happened since the condition's previous evaluation
     resolve: Resolver = no_resolver  # a position -> (x, y, s, offset)
+    state: StoryState = field(default_factory=StoryState)  # variables, environment (live)
+    lanes: sc.Lanes = sc.no_lanes  # a station -> the route's lane counts there (clearance)
 
 
 _STATES = {s.value: s for s in ElementState}
@@ -88,6 +99,10 @@ def _by_value(kind: ConditionKind, snap: Snapshot, ctx: ConditionContext) -> boo
         return parameter_holds(kind, ctx.parameters)
     if isinstance(kind, StoryboardElementStateCondition):
         return _element_state(kind, ctx)
+    if isinstance(kind, VariableCondition):
+        return sc.variable(kind, ctx)
+    if isinstance(kind, TimeOfDayCondition):
+        return sc.time_of_day(kind, snap, ctx)
     raise TypeError(f"{type(kind).__name__} needs a triggering entity")
 
 
@@ -231,6 +246,10 @@ _BY_ENTITY: dict[type, EntityJudge] = {
     EndOfRoadCondition: _end_of_road,  # type: ignore[dict-item]
     OffroadCondition: _offroad,  # type: ignore[dict-item]
     CollisionCondition: _collision,  # type: ignore[dict-item]
+    AccelerationCondition: sc.acceleration,  # type: ignore[dict-item]
+    AngleCondition: sc.angle,  # type: ignore[dict-item]
+    RelativeAngleCondition: sc.relative_angle,  # type: ignore[dict-item]
+    RelativeClearanceCondition: sc.clearance,  # type: ignore[dict-item]
 }
 
 

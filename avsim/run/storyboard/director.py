@@ -55,7 +55,8 @@ class Director:
         self.truth = TruthTracker(program, world)
         self.resolver = Resolver(program.chain)
         osc = program.scenario
-        self.runtime = StoryRuntime(osc.storyboard, osc.parameters, self._resolve)
+        self.runtime = StoryRuntime(osc.storyboard, osc.parameters, self._resolve,
+                                    osc.variables, self._lanes)
         self.commands = Commands(world.road, self.resolver, program.lane_ids)
         self._index = dict(program.actors)
         self._pending: dict[str, set[str]] = {}  # action id -> tags still running
@@ -72,6 +73,11 @@ class Director:
         p = self.resolver.resolve(position, poses_of(snap))
         s, d = self.world.road.local_coordinates((p.x, p.y))
         return p.x, p.y, float(s), float(d)
+
+    def _lanes(self, s: float) -> tuple[int, int]:
+        """(lanes of the route's direction, oncoming lanes) at station s [m]."""
+        c = self.world.road.cross_section_at(s)
+        return c.lanes, c.oncoming_lanes
 
     # -- stepping -------------------------------------------------------------------------------
 

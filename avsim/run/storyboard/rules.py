@@ -45,11 +45,16 @@ def _as_type(value: ParamValue, text: str) -> float | int | str:
     return text
 
 
-def parameter_holds(c: ParameterCondition, parameters: Mapping[str, ParamValue]) -> bool:
-    """The parameter's value against the written value read as the parameter's type
-    (booleans as 0 / 1; an unknown parameter: false, as esmini)."""
-    if c.parameter not in parameters:
+def value_holds(name: str, rule: Rule, text: str, values: Mapping[str, ParamValue]) -> bool:
+    """The value of `name` in `values` (a parameter's, a variable's) against the written
+    value `text` read as its type (booleans as 0 / 1; an unknown name: false, as esmini)."""
+    if name not in values:
         return False
-    value = parameters[c.parameter]
+    value = values[name]
     mine = int(value) if isinstance(value, bool) else value
-    return compare(mine, c.rule, _as_type(value, c.value))
+    return compare(mine, rule, _as_type(value, text))
+
+
+def parameter_holds(c: ParameterCondition, parameters: Mapping[str, ParamValue]) -> bool:
+    """The parameter's value against the written value (`value_holds`)."""
+    return value_holds(c.parameter, c.rule, c.value, parameters)

@@ -12,7 +12,10 @@ Each `step(snap)` evaluates, in this order:
    running events of the maneuver first; skip is not started (a skipTransition) while
    another event of the maneuver runs; parallel starts alongside;
 4. the actions the runtime completes itself (`INSTANT`: controller assignment and
-   activation, teleport) end at once.
+   activation, teleport) end at once; global actions (`GLOBAL`: environment, variables,
+   parameters) change the runtime's `story_state` (`state.StoryState`) when they start,
+   are not passed on to the world, and end at once. The Init's global actions are played on the
+   state at t = 0, before the first trigger check.
 A trigger is evaluated only while its element waits for it (standby under a running
 parent; an act's stop trigger while the act runs), as esmini does. An action ends when the
 world says so (`action_done`); an element ends when all its children completed (an event:
@@ -37,6 +40,8 @@ from avsim.run.storyboard.elements import (
     transition,
 )
 from avsim.run.storyboard.snapshot import Snapshot
+from avsim.run.storyboard.state import StoryState
+from avsim.run.storyboard.state_conditions import Lanes, no_lanes
 from avsim.run.storyboard.tree import Node, build, name_index
 from avsim.run.storyboard.triggers import TriggerWatch
 from avsim.scenario.openscenario.actions import (
@@ -45,10 +50,13 @@ from avsim.scenario.openscenario.actions import (
     PrivateAction,
     TeleportAction,
 )
+from avsim.scenario.openscenario.environment import EnvironmentAction
 from avsim.scenario.openscenario.parameters import ParamValue
 from avsim.scenario.openscenario.storyboard import Storyboard
+from avsim.scenario.openscenario.variables import VariableAction, VariableDeclaration
 
 INSTANT = (ActivateControllerAction, AssignControllerAction, TeleportAction)  # end at once
+GLOBAL = (EnvironmentAction, VariableAction)  # played on the runtime's state, end at once
 S, K = ElementState, TransitionKind
 
 
@@ -87,16 +95,24 @@ class _LiveStates(Mapping[tuple[str, str], ElementState]):
 
 
 class StoryRuntime:
-    """One run of a storyboard (module doc). `parameters` are the scenario's values (for the
-    parameter conditions); `resolve` places a Position (distance and reach conditions)."""
+    """One run of a storyboard (module doc). `parameters` are the scenario's values and
+    `variables` its declared variables (their values at the start: the state that parameter
+    and variable conditions read); `resolve` places a Position (distance and reach
+    conditions); `lanes` counts the route's lanes at a station (clearance conditions)."""
 
     def __init__(self, storyboard: Storyboard, parameters: Mapping[str, ParamValue],
-                 resolve: Resolver = no_resolver) -> None:
+                 resolve: Resolver = no_resolver,
+                 variables: tuple[VariableDeclaration, ...] = (),
+                 lanes: Lanes = no_lanes) -> None:
         self.storyboard = storyboard
         self.stories = build(storyboard.stories)
         index = name_index(storyboard, self.stories)
         self._log: list[TransitionRecord] = []
-        self._ctx = ConditionContext(parameters, _LiveStates(index), self._log, 0, resolve)
+        self.story_state = StoryState(parameters, variables)
+        for init in storyboard.init_global:
+            self.story_state.apply(init, 0.0)
+        self._ctx = ConditionContext(self.story_state.parameters, _LiveStates(index),
+                                     self._log, 0, resolve, self.story_state, lanes)
         self._stop = None if storyboard.stop_trigger is None else TriggerWatch(
             storyboard.stop_trigger)
         self._actions = {n.path: n for root in self.stories for n in root.walk()
@@ -219,6 +235,10 @@ class StoryRuntime:
     def _start_action(self, node: Node, entities: tuple[str, ...]) -> None:
         assert node.action is not None
         action = node.action.private_action
+        if isinstance(action, GLOBAL):
+            self.story_state.apply(action, self._t)
+            self._instant.append(node)
+            return
         self._started.append(StartedAction(node.action_id, node.name, entities, action))
         if isinstance(action, INSTANT):
             self._instant.append(node)

@@ -34,6 +34,9 @@ class EntityState:
     standing_for: float  # [s] how long it has been at rest (speed below 0.01 m/s), 0 moving
     off_road_for: float  # [s] how long its reference point has been off the paved road
     end_of_road_for: float  # [s] how long it has been beyond the route's ends
+    acceleration: float = 0.0  # [m/s²] of its speed along its heading, between the last two
+    #   snapshots (0 at the first)
+    yaw_rate: float = 0.0  # [rad/s] of its heading, left +, between the last two snapshots
 
 
 @dataclass(frozen=True, slots=True)

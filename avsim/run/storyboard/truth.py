@@ -4,7 +4,8 @@ Each entity's reference point is its body centre moved back along its heading by
 `centre_ahead` (`StoryProgram`): the car under test's rear axle, the file's bounding box
 reference point for the others. Route coordinates are projected from those points onto the
 ego's route. Running figures (odometer, time at rest, off the road, beyond the road's ends)
-are integrated between snapshots. Contacts are the ego's (the NPC bodies are kinematic and
+are integrated between snapshots, and accelerations and yaw rates differenced between
+them (0 at the first). Contacts are the ego's (the NPC bodies are kinematic and
 do not touch each other in the physics).
 """
 
@@ -48,6 +49,8 @@ class TruthTracker:
         self.off_road = np.zeros(n)
         self.beyond = np.zeros(n)
         self._t: float | None = None
+        self._speed = np.zeros(n)  # [m/s] at the previous snapshot
+        self._yaw = np.zeros(n)  # [rad] at the previous snapshot
 
     def snapshot(self, touching: frozenset[int]) -> Snapshot:
         """The truth now; `touching`: the bodies the ego touches."""
@@ -66,6 +69,7 @@ class TruthTracker:
         y = cy - self.ahead * np.sin(yaw)
         s, d = self.road.local_coordinates(np.column_stack([x, y]))
         self._integrate(dt, speed, s, d)
+        acc, yaw_rate = self._rates(dt, speed, yaw)
         route_heading = self.road.heading_at(s)
         entities = {
             name: EntityState(
@@ -75,12 +79,25 @@ class TruthTracker:
                 route_heading=float(route_heading[k]), length=float(self.lengths[k]),
                 width=float(self.widths[k]), centre_ahead=float(self.ahead[k]),
                 odometer=float(self.odometer[k]), standing_for=float(self.standing[k]),
-                off_road_for=float(self.off_road[k]), end_of_road_for=float(self.beyond[k]))
+                off_road_for=float(self.off_road[k]), end_of_road_for=float(self.beyond[k]),
+                acceleration=float(acc[k]), yaw_rate=float(yaw_rate[k]))
             for k, name in enumerate(self.names)}
         ego = self.program.ego
         contacts = frozenset(frozenset({ego, self.bodies[b]}) for b in touching
                              if b in self.bodies)
         return Snapshot(t, entities, contacts, self.categories)
+
+    def _rates(self, dt: float, speed: np.ndarray,
+               yaw: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """([m/s²] d speed / dt, [rad/s] d yaw / dt wrapped to a half turn) since the last
+        snapshot; zeros at the first."""
+        if dt > 0.0:
+            acc = (speed - self._speed) / dt
+            turn = np.angle(np.exp(1j * (yaw - self._yaw))) / dt
+        else:
+            acc, turn = np.zeros_like(speed), np.zeros_like(speed)
+        self._speed, self._yaw = speed.copy(), yaw.copy()
+        return acc, turn
 
     def _integrate(self, dt: float, speed: np.ndarray, s: np.ndarray, d: np.ndarray) -> None:
         self.odometer += np.abs(speed) * dt

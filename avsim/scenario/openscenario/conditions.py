@@ -12,6 +12,9 @@ Rule = Literal["greaterThan", "lessThan", "equalTo", "greaterOrEqual", "lessOrEq
 Edge = Literal["none", "rising", "falling", "risingOrFalling"]
 RelativeDistanceType = Literal["longitudinal", "lateral", "cartesianDistance", "euclidianDistance"]
 CoordinateSystem = Literal["entity", "lane", "road", "trajectory"]
+AngleCoordinates = Literal["entity", "lane", "road", "world"]  # 1.3 (trajectory refused)
+AngleType = Literal["heading", "pitch", "roll"]
+Direction = Literal["longitudinal", "lateral", "vertical"]
 
 
 @dataclass(frozen=True, slots=True)
@@ -33,6 +36,62 @@ class ParameterCondition:
     parameter: str
     value: str  # as written, compared with the parameter's value
     rule: Rule
+
+
+@dataclass(frozen=True, slots=True)
+class VariableCondition:
+    variable: str
+    value: str  # as written, compared with the variable's value read as its type
+    rule: Rule
+
+
+@dataclass(frozen=True, slots=True)
+class TimeOfDayCondition:
+    date_time: str  # ISO 8601 as written
+    epoch: float  # [s] since 1970-01-01T00:00:00 UTC (no zone written: UTC)
+    rule: Rule
+
+
+@dataclass(frozen=True, slots=True)
+class AccelerationCondition:
+    value: float  # [m/s²]
+    rule: Rule
+    direction: Direction | None  # 1.2; None: the magnitude, signed as the longitudinal part
+
+
+@dataclass(frozen=True, slots=True)
+class AngleCondition:
+    """The triggering entity's angle in a coordinate system is `angle` within `tolerance`."""
+
+    angle_type: AngleType
+    angle: float  # [rad]
+    tolerance: float  # [rad]
+    coordinate_system: AngleCoordinates  # default world
+
+
+@dataclass(frozen=True, slots=True)
+class RelativeAngleCondition:
+    """The triggering entity's angle relative to `entity`'s is `angle` within `tolerance`."""
+
+    entity: str
+    angle_type: AngleType
+    angle: float  # [rad]
+    tolerance: float  # [rad]
+    coordinate_system: AngleCoordinates  # default entity
+
+
+@dataclass(frozen=True, slots=True)
+class RelativeClearanceCondition:
+    """No entity (of `entities`, or any other when empty) in the lanes `lane_ranges` relative
+    to the triggering entity's (left +, in its driving direction) between `distance_backward`
+    behind and `distance_forward` ahead of it, and such a lane exists where it is."""
+
+    entities: tuple[str, ...]
+    distance_forward: float  # [m] default 0
+    distance_backward: float  # [m] default 0
+    freespace: bool
+    opposite_lanes: bool  # lanes of the other driving direction count
+    lane_ranges: tuple[tuple[int | None, int | None], ...]  # (from, to); None: unbounded
 
 
 @dataclass(frozen=True, slots=True)
@@ -142,6 +201,12 @@ ConditionKind = (
     | EndOfRoadCondition
     | OffroadCondition
     | CollisionCondition
+    | VariableCondition
+    | TimeOfDayCondition
+    | AccelerationCondition
+    | AngleCondition
+    | RelativeAngleCondition
+    | RelativeClearanceCondition
 )
 ENTITY_CONDITIONS = (
     RelativeDistanceCondition,
@@ -156,6 +221,10 @@ ENTITY_CONDITIONS = (
     EndOfRoadCondition,
     OffroadCondition,
     CollisionCondition,
+    AccelerationCondition,
+    AngleCondition,
+    RelativeAngleCondition,
+    RelativeClearanceCondition,
 )  # the kinds that come in a ByEntityCondition (with triggering entities)
 
 

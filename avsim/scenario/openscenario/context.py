@@ -8,7 +8,7 @@ from dataclasses import dataclass, replace
 
 from avsim.scenario.openscenario.attributes import Attributes
 from avsim.scenario.openscenario.catalogs import Catalogs
-from avsim.scenario.openscenario.parameters import Scope, evaluate_declarations
+from avsim.scenario.openscenario.parameters import ParameterType, Scope, evaluate_declarations
 from avsim.scenario.openscenario.xmlread import Node
 
 
@@ -19,6 +19,7 @@ class Context:
     entity_names: frozenset[str] | None  # None while the entities are being read
     element_names: Mapping[str, frozenset[str]] | None = None  # storyboard names by type
     declared_for: Node | None = None  # the element whose declarations `attrs` already has
+    variables: Mapping[str, ParameterType] | None = None  # declared variables' types (1.2+)
 
     def in_scope(self, scope: Scope, entry: Node | None = None) -> Context:
         """This context reading attributes in another scope: a catalog entry's (`entry`,

@@ -83,6 +83,7 @@ from avsim.scenario.openscenario.storyboard import (
     Story,
     Storyboard,
 )
+from avsim.scenario.openscenario.variables import VariableDeclaration
 
 
 @dataclass(frozen=True, slots=True)
@@ -95,6 +96,7 @@ class OpenScenario:
     road_network: Path | None  # the OpenDRIVE LogicFile, resolved; None when not given
     entities: tuple[Entity, ...]  # in file order
     storyboard: Storyboard
+    variables: tuple[VariableDeclaration, ...] = ()  # VariableDeclarations (1.2+), in order
 
     def entity(self, name: str) -> Entity:
         """The entity of this name (KeyError when there is none)."""

@@ -21,6 +21,7 @@ from avsim.scenario.openscenario.parameters import (
     parse_declarations,
 )
 from avsim.scenario.openscenario.parse_entities import parse_entities
+from avsim.scenario.openscenario.parse_global import parse_variable_declarations
 from avsim.scenario.openscenario.parse_storyboard import parse_storyboard
 from avsim.scenario.openscenario.references import ReferenceError, Roots, is_file
 from avsim.scenario.openscenario.xmlread import Node, read_xml
@@ -96,7 +97,9 @@ def load_openscenario(path: Path, overrides: Mapping[str, str] = _NO_OVERRIDES,
     ctx = Context(attrs, catalogs, None)
     entities_node = root.child("Entities")
     entities = parse_entities(entities_node, ctx) if entities_node is not None else ()
-    ctx = Context(attrs, catalogs, frozenset(e.name for e in entities))
+    variables = parse_variable_declarations(root.child("VariableDeclarations"), ctx)
+    ctx = Context(attrs, catalogs, frozenset(e.name for e in entities),
+                  variables={v.name: v.variable_type for v in variables})
     storyboard_node = root.child("Storyboard")
     if storyboard_node is None:
         raise ScenarioError(str(path), FILE_KEY, "missing element Storyboard")
@@ -110,6 +113,7 @@ def load_openscenario(path: Path, overrides: Mapping[str, str] = _NO_OVERRIDES,
         road_network=road_network,
         entities=entities,
         storyboard=parse_storyboard(storyboard_node, ctx),
+        variables=variables,
     )
 
 

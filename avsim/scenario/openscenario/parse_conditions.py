@@ -3,10 +3,13 @@ ByValue/ByEntity condition kinds in `conditions`. Others: `not supported yet (<N
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 
 from avsim.scenario.openscenario.attributes import unsupported
 from avsim.scenario.openscenario.conditions import (
+    AccelerationCondition,
+    AngleCondition,
     CollisionCondition,
     Condition,
     ConditionGroup,
@@ -16,6 +19,8 @@ from avsim.scenario.openscenario.conditions import (
     OffroadCondition,
     ParameterCondition,
     ReachPositionCondition,
+    RelativeAngleCondition,
+    RelativeClearanceCondition,
     RelativeDistanceCondition,
     RelativeSpeedCondition,
     SimulationTimeCondition,
@@ -23,12 +28,15 @@ from avsim.scenario.openscenario.conditions import (
     StandStillCondition,
     StoryboardElementStateCondition,
     TimeHeadwayCondition,
+    TimeOfDayCondition,
     TimeToCollisionCondition,
     TraveledDistanceCondition,
     Trigger,
     TriggeringEntities,
+    VariableCondition,
 )
 from avsim.scenario.openscenario.context import Context
+from avsim.scenario.openscenario.environment import epoch_of
 from avsim.scenario.openscenario.limits import MAX_SPEED, MAX_TIME
 from avsim.scenario.openscenario.parse_positions import parse_position
 from avsim.scenario.openscenario.xmlread import Node
@@ -37,6 +45,13 @@ RULES = ("greaterThan", "lessThan", "equalTo", "greaterOrEqual", "lessOrEqual", 
 EDGES = ("none", "rising", "falling", "risingOrFalling")
 DISTANCE_TYPES = ("longitudinal", "lateral", "cartesianDistance", "euclidianDistance")
 COORDINATE_SYSTEMS = ("entity", "lane", "road", "trajectory")
+DIRECTIONS = ("longitudinal", "lateral", "vertical")
+ANGLE_TYPES = ("heading", "pitch", "roll")
+ANGLE_SYSTEMS = ("entity", "lane", "road", "world")  # trajectory is refused
+MAX_ANGLE = 2.0 * math.pi  # [rad] an angle condition's angle and tolerance, in magnitude
+MAX_ACCELERATION = 100.0  # [m/s²] an acceleration condition's value, in magnitude
+MAX_CLEARANCE = 10_000.0  # [m] a clearance condition's distance forward / backward
+MAX_LANES = 100  # [lanes] a relative lane range's bounds, in magnitude
 ELEMENT_TYPES = ("story", "act", "maneuver", "event", "action", "maneuverGroup")
 STATES = (
     "startTransition",
@@ -90,6 +105,80 @@ def _parameter(node: Node, ctx: Context) -> ConditionKind:
     if a.scope.get(parameter) is None:
         raise node.error(f"parameterRef: no parameter {parameter}")
     return ParameterCondition(parameter, a.text(node, "value"), _rule(node, ctx))  # type: ignore[arg-type]
+
+
+def _variable(node: Node, ctx: Context) -> ConditionKind:
+    a = ctx.attrs
+    variable = a.text(node, "variableRef")
+    declared = ctx.variables or {}
+    if variable not in declared:
+        known = ", ".join(sorted(declared)) or "none"
+        raise node.error(f"variableRef: no variable {variable} (variables: {known})")
+    return VariableCondition(variable, a.text(node, "value"), _rule(node, ctx))  # type: ignore[arg-type]
+
+
+def _time_of_day(node: Node, ctx: Context) -> ConditionKind:
+    text = ctx.attrs.text(node, "dateTime")
+    try:
+        epoch = epoch_of(text)
+    except ValueError:
+        raise node.error(f"dateTime: not an ISO 8601 date and time: {text[:40]!r}") from None
+    return TimeOfDayCondition(text, epoch, _rule(node, ctx))  # type: ignore[arg-type]
+
+
+def _acceleration(node: Node, ctx: Context) -> ConditionKind:
+    a = ctx.attrs
+    direction = a.choice(node, "direction", DIRECTIONS) if "direction" in node.attrs else None
+    return AccelerationCondition(
+        a.bounded(node, "value", -MAX_ACCELERATION, MAX_ACCELERATION, "m/s²"),
+        _rule(node, ctx), direction)  # type: ignore[arg-type]
+
+
+def _angle_parts(node: Node, ctx: Context, default: str) -> tuple[str, float, float, str]:
+    a = ctx.attrs
+    if a.opt_text(node, "coordinateSystem") == "trajectory":
+        raise node.error("not supported yet (coordinateSystem trajectory)")
+    return (a.choice(node, "angleType", ANGLE_TYPES),
+            a.bounded(node, "angle", -MAX_ANGLE, MAX_ANGLE, "rad"),
+            a.bounded(node, "angleTolerance", 0.0, MAX_ANGLE, "rad"),
+            a.choice_or(node, "coordinateSystem", ANGLE_SYSTEMS, default))
+
+
+def _angle(node: Node, ctx: Context) -> ConditionKind:
+    return AngleCondition(*_angle_parts(node, ctx, "world"))  # type: ignore[arg-type]
+
+
+def _relative_angle(node: Node, ctx: Context) -> ConditionKind:
+    return RelativeAngleCondition(ctx.entity_ref(node),
+                                  *_angle_parts(node, ctx, "entity"))  # type: ignore[arg-type]
+
+
+def _lane_range(node: Node, ctx: Context) -> tuple[int | None, int | None]:
+    a = ctx.attrs
+    ends = [None if k not in node.attrs else a.integer(node, k) for k in ("from", "to")]
+    for key, end in zip(("from", "to"), ends, strict=True):
+        if end is not None and abs(end) > MAX_LANES:
+            raise node.error(f"{key}: must be in [-{MAX_LANES}, {MAX_LANES}] lanes, got {end}")
+    low, high = ends
+    if low is not None and high is not None and low > high:
+        raise node.error(f"from ({low}) is greater than to ({high})")
+    return low, high
+
+
+def _clearance(node: Node, ctx: Context) -> ConditionKind:
+    a = ctx.attrs
+    for child in node.children:
+        if child.tag not in ("RelativeLaneRange", "EntityRef"):
+            raise unsupported(child)
+    return RelativeClearanceCondition(
+        entities=tuple(ctx.entity_ref(e) for e in node.all("EntityRef")),
+        distance_forward=a.opt_bounded(node, "distanceForward", 0.0, MAX_CLEARANCE, "m") or 0.0,
+        distance_backward=a.opt_bounded(node, "distanceBackward", 0.0, MAX_CLEARANCE, "m")
+        or 0.0,
+        freespace=a.boolean(node, "freeSpace"),
+        opposite_lanes=a.boolean(node, "oppositeLanes"),
+        lane_ranges=tuple(_lane_range(r, ctx) for r in node.all("RelativeLaneRange")),
+    )
 
 
 def _relative_distance(node: Node, ctx: Context) -> ConditionKind:
@@ -186,6 +275,8 @@ _VALUE: dict[str, Callable[[Node, Context], ConditionKind]] = {
     "SimulationTimeCondition": _simulation_time,
     "StoryboardElementStateCondition": _element_state,
     "ParameterCondition": _parameter,
+    "VariableCondition": _variable,
+    "TimeOfDayCondition": _time_of_day,
 }
 _ENTITY: dict[str, Callable[[Node, Context], ConditionKind]] = {
     "RelativeDistanceCondition": _relative_distance,
@@ -200,6 +291,10 @@ _ENTITY: dict[str, Callable[[Node, Context], ConditionKind]] = {
     "EndOfRoadCondition": lambda n, c: EndOfRoadCondition(_duration(n, c)),
     "OffroadCondition": lambda n, c: OffroadCondition(_duration(n, c)),
     "CollisionCondition": _collision,
+    "AccelerationCondition": _acceleration,
+    "AngleCondition": _angle,
+    "RelativeAngleCondition": _relative_angle,
+    "RelativeClearanceCondition": _clearance,
 }
 
 

@@ -7,8 +7,10 @@ from dataclasses import replace
 
 from avsim.scenario.openscenario.attributes import unsupported
 from avsim.scenario.openscenario.context import Context
+from avsim.scenario.openscenario.global_actions import GlobalAction
 from avsim.scenario.openscenario.parse_actions import parse_private_action
 from avsim.scenario.openscenario.parse_conditions import parse_trigger
+from avsim.scenario.openscenario.parse_global import parse_global_action
 from avsim.scenario.openscenario.storyboard import (
     Act,
     Action,
@@ -30,6 +32,8 @@ def parse_init(node: Node | None, ctx: Context) -> tuple[InitAction, ...]:
         return ()
     actions: list[InitAction] = []
     for child in node.need("Actions").children:
+        if child.tag == "GlobalAction":
+            continue  # `parse_init_global`
         if child.tag != "Private":
             raise unsupported(child)
         entity = ctx.entity_ref(child)
@@ -39,11 +43,22 @@ def parse_init(node: Node | None, ctx: Context) -> tuple[InitAction, ...]:
     return tuple(actions)
 
 
+def parse_init_global(node: Node | None, ctx: Context) -> tuple[GlobalAction, ...]:
+    """The Init's GlobalActions, in the file's order."""
+    if node is None:
+        return ()
+    return tuple(parse_global_action(child, ctx) for child in node.need("Actions").children
+                 if child.tag == "GlobalAction")
+
+
 def parse_action(node: Node, ctx: Context) -> Action:
     body = node.only_child()
+    name = ctx.attrs.text(node, "name")
+    if body.tag == "GlobalAction":
+        return Action(name, parse_global_action(body, ctx))
     if body.tag != "PrivateAction":
         raise unsupported(body)
-    return Action(ctx.attrs.text(node, "name"), parse_private_action(body, ctx))
+    return Action(name, parse_private_action(body, ctx))
 
 
 def parse_event(node: Node, ctx: Context) -> Event:
@@ -137,6 +152,7 @@ def parse_storyboard(node: Node, ctx: Context) -> Storyboard:
     ctx = replace(ctx, element_names=element_names(node, ctx))
     return Storyboard(
         init=parse_init(node.child("Init"), ctx),
+        init_global=parse_init_global(node.child("Init"), ctx),
         stories=tuple(parse_story(s, ctx) for s in node.all("Story")),
         stop_trigger=parse_trigger(node.child("StopTrigger"), ctx),
     )

@@ -8,6 +8,7 @@ from typing import Literal
 
 from avsim.scenario.openscenario.actions import PrivateAction
 from avsim.scenario.openscenario.conditions import Trigger
+from avsim.scenario.openscenario.global_actions import GlobalAction
 
 Priority = Literal["overwrite", "override", "skip", "parallel"]  # override is 1.2's overwrite
 
@@ -20,10 +21,11 @@ class InitAction:
 
 @dataclass(frozen=True, slots=True)
 class Action:
-    """An event's action; it applies to each actor of its maneuver group."""
+    """An event's action: a private action applies to each actor of its maneuver group, a
+    global action (environment, variables) to the storyboard's state."""
 
     name: str
-    private_action: PrivateAction
+    private_action: PrivateAction | GlobalAction  # the PrivateAction or GlobalAction held
 
 
 @dataclass(frozen=True, slots=True)
@@ -74,6 +76,7 @@ class Storyboard:
     init: tuple[InitAction, ...]
     stories: tuple[Story, ...]
     stop_trigger: Trigger | None
+    init_global: tuple[GlobalAction, ...] = ()  # the Init's GlobalActions, in order
 
     def story_actions(self) -> Iterator[tuple[ManeuverGroup, Action]]:
         """Every action of the stories with its maneuver group, in the file's order."""

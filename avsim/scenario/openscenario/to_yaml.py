@@ -29,6 +29,7 @@ from pathlib import Path
 from typing import Any
 
 from avsim.scenario.openscenario.convert import load_xosc
+from avsim.scenario.openscenario.environment import EnvironmentAction
 from avsim.scenario.openscenario.model import (
     AbsoluteTargetLane,
     AbsoluteTargetSpeed,
@@ -45,6 +46,7 @@ from avsim.scenario.openscenario.model import (
     StoryboardElementStateCondition,
     Trigger,
 )
+from avsim.scenario.openscenario.variables import VariableAction
 from avsim.scenario.scenario import Scenario
 from world.actors.catalogue import CATALOGUE, VehicleModel
 from world.frames import MPS_PER_KPH
@@ -199,6 +201,8 @@ def _story(scenario: Scenario, names: dict[str, int], actors: list[dict[str, Any
     story = scenario.story
     assert story is not None
     board = story.scenario.storyboard
+    for action in board.init_global:
+        out.misfits.append(f"the Init's {type(action).__name__} (no YAML counterpart)")
     index: dict[str, tuple[str, int]] = {}  # action name -> (actor, its index in actions)
     for s in board.stories:
         for act in s.acts:
@@ -225,6 +229,10 @@ def _event(event: Event, entities: tuple[str, ...], ego: str, names: dict[str, i
         private = action.private_action
         if isinstance(private, ActivateControllerAction | AssignControllerAction):
             continue  # the stack drives the car under test from the start
+        if isinstance(private, EnvironmentAction | VariableAction):
+            out.misfits.append(f"action {action.name}: {type(private).__name__} (no YAML "
+                               "counterpart)")
+            continue
         if len(entities) != 1 or entities[0] == ego or entities[0] not in names:
             out.misfits.append(f"action {action.name}: not on one actor")
             continue

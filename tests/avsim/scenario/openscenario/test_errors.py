@@ -193,10 +193,14 @@ WORLD = '<WorldPosition x="0" y="0" h="0"/>'
         (WORLD, '<GeoPosition latitudeDeg="48" longitudeDeg="11"/>', "GeoPosition"),
         (
             SIM_TIME,
-            '<TimeOfDayCondition dateTime="2024-01-01T00:00:00" rule="lessThan"/>',
-            "TimeOfDayCondition",
+            '<UserDefinedValueCondition name="u" value="1" rule="lessThan"/>',
+            "UserDefinedValueCondition",
         ),
-        ("<Private entityRef", "<GlobalAction/><Private entityRef", "GlobalAction"),
+        (
+            "<Private entityRef",
+            "<GlobalAction><InfrastructureAction/></GlobalAction><Private entityRef",
+            "InfrastructureAction",
+        ),
         (
             "<RoadNetwork>",
             "<RoadNetwork><TrafficSignals><TrafficSignalController name='c'/></TrafficSignals>",

@@ -1,0 +1,9 @@
+"""The GlobalAction choices avsim plays: EnvironmentAction, VariableAction and the
+deprecated ParameterAction (others are refused when the file is read)."""
+
+from __future__ import annotations
+
+from avsim.scenario.openscenario.environment import EnvironmentAction
+from avsim.scenario.openscenario.variables import VariableAction
+
+GlobalAction = EnvironmentAction | VariableAction
