@@ -49,6 +49,7 @@ if TYPE_CHECKING:
     from avsim.run.runner import Runner, RunResult
 
 PROFILES = ("fast", "default", "paper", "none")  # sensor profiles (`world.sensors.setup`)
+EGO_MODES = ("stack", "scripted")  # what drives the car under test (`EgoSpec.scripted`)
 SENSING = ("auto", "inline", "process")  # where the cameras render
 EXIT_FAILED, EXIT_BAD_INPUT = 1, 2  # exit statuses (module doc)
 EXIT_ERROR = 3  # the run ended in `error`
@@ -142,11 +143,18 @@ class SeedType(click.IntRange):
 @click.option("--criteria", "criteria", type=click.Path(path_type=Path), default=None,
               help="An OpenSCENARIO file's criteria (default: NAME.criteria.yaml beside it).")
 @click.option("--no-progress", is_flag=True, help="No progress bar.")
+@click.option("--ego", type=click.Choice(EGO_MODES), default="stack", show_default=True,
+              help="What drives the car under test: avsim's stack, or (scripted, "
+                   "OpenSCENARIO files) the file's own actions as esmini plays them, its "
+                   "controllers not simulated, no sensors (the profile is none).")
 @search_path_option
 def run(scenario: str, out: Path | None, json_path: Path | None, profile: str, sensing: str,
         seed: int | None, sets: tuple[str, ...], plot: str | None, params: tuple[str, ...],
-        criteria: Path | None, no_progress: bool, search_paths: tuple[Path, ...]) -> None:
+        criteria: Path | None, no_progress: bool, ego: str,
+        search_paths: tuple[Path, ...]) -> None:
     """Run SCENARIO (a YAML or OpenSCENARIO file, or a bundled name) and judge it."""
+    scripted = ego == "scripted"
+    profile = "none" if scripted else profile  # a scripted ego reads no sensors
     from avsim.batch.sweep import SweepError, parse_set
 
     overrides: dict[str, object] = {}
@@ -158,7 +166,7 @@ def run(scenario: str, out: Path | None, json_path: Path | None, profile: str, s
             overrides[axis.path] = axis.values[0]
         if seed is not None:
             overrides["seed"] = seed
-        loaded = load_scenario(scenario, overrides, criteria, search_paths)
+        loaded = load_scenario(scenario, overrides, criteria, search_paths, scripted)
         check_profile(loaded, profile, scenario)
     except (ScenarioError, SweepError) as exc:
         _bad_input(str(exc))
@@ -185,7 +193,9 @@ def run(scenario: str, out: Path | None, json_path: Path | None, profile: str, s
         if isinstance(built, RunResult):  # the world could not be built: its result
             result = built
         else:
-            click.echo(f"{loaded.name}: {localisation(setup, loaded.world.sensors.gnss).note}")
+            note = "the car under test is scripted (the file's actions move it)" if scripted \
+                else localisation(setup, loaded.world.sensors.gnss).note
+            click.echo(f"{loaded.name}: {note}")
             stop.on_signal(built.interrupt)
             result = _run_with_progress(built, loaded.duration, not no_progress)
         payload = result_json(result, scenario, out, profile)

@@ -345,6 +345,8 @@ class EgoSpec:
     max_speed: float  # [m/s] vehicle limit
     engaged: bool = True  # the automated driving function's switch at the start (off: the
     #   driver holds the speed until a storyboard activates the car's controller)
+    scripted: bool = False  # the scenario's script moves it as it moves an actor (a
+    #   kinematic body, `world.ego.scripted`), no stack drives it
 
 
 @dataclass(frozen=True, slots=True)

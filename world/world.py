@@ -27,6 +27,7 @@ from world.core.rates import ACTOR_RATE, TRIGGER_RATE
 from world.core.rendering import attach_renderer
 from world.ego.body import EgoBody, EgoParams, EgoTruth
 from world.ego.events import EgoEvents
+from world.ego.scripted import ScriptedEgo
 from world.map.road import build_road_map, light_head
 from world.map.signals import light_colour, route_signals
 from world.map.town import TownLayout
@@ -137,6 +138,9 @@ class World:
         )
         for link in range(-1, self.client.getNumJoints(self.ego.body)):
             self.client.setCollisionFilterGroupMask(self.ego.body, link, EGO_RAY_GROUP, 0xFFFF)
+        self.scripted = ScriptedEgo(self.client, self.ego, self.road, spec.ego.lane,
+                                    spec.ego.s, spec.ego.speed) if spec.ego.scripted else None
+        #   the script moves the ego (`world.ego.scripted`), after each physics step
         self.actors = ActorSet(self.client, self.road, spec.actors, self.shapes)
         self._events = EgoEvents(spec.events)
         self.engaged = spec.ego.engaged  # the automated driving function's switch (the
@@ -450,6 +454,8 @@ class World:
         ego body deflates those, advanced at each check (`EgoBody.update_tyres`).
         """
         self._step_physics()
+        if self.scripted is not None:
+            self.scripted.step(self.clock.t, self.clock.dt)
         self.clock.advance()
         self._truth = None
         self._route = None

@@ -35,6 +35,7 @@ def result_json(result: RunResult, file: str | Path, recording: Path, profile: s
         "file": str(file),
         "seed": scenario.seed,
         "profile": profile,
+        "ego": "scripted" if scenario.world.ego.scripted else "stack",  # what drove the car
         "localisation": run_localisation(result, profile).as_json(),
         "renderer": result.renderer,
         "verdict": result.verdict.value,

@@ -17,6 +17,11 @@ and the plan's `speed_source` as a lane of its own (what set the speed, tick by 
 
 Each control tick decides on one snapshot (the sensor frames of this tick), then the
 command is held on the joints for the control period's physics steps.
+
+A scripted car under test (`EgoSpec.scripted`, `avsim run --ego scripted`) is moved by the
+scenario's script (`world.ego.scripted`): no sensors are simulated and the stack never
+runs; the log's stack columns then say the function is off (ACC off, lane keep, the driver's
+speed source, NaN targets, no commands), its truth columns are the script's car.
 """
 
 from __future__ import annotations
@@ -212,6 +217,9 @@ class Runner:
         or Bullet's own ray test to compare with)."""
         self.scenario = scenario
         spec = scenario.world
+        self.scripted = spec.ego.scripted  # the script moves the ego: no sensors, no stack
+        if self.scripted:
+            profile = None
         self.setup = sensor_setup(profile, spec.sensors.lidar) if profile is not None else None
         mode = sensing_mode(sensing)
         # the sensing worker builds its mirror world while this process builds its own
@@ -407,6 +415,13 @@ class Runner:
         """A control tick: the sensors' frames due now reach the stack, then decide and
         apply."""
         w, watch = self.world, self.watch
+        if self.scripted:
+            with watch("runner"):
+                self._log_scripted()
+            if self.recorder is not None and RECORD_RATE.fires(w.clock.step):
+                with watch("recording"):
+                    self._record_scripted()
+            return
         self.sensors.tick()
         out = self.stack.tick(w.t, CONTROL_RATE.period)
         cmd = out.command
@@ -438,17 +453,54 @@ class Runner:
             #   not a state change
 
     def _log_tick(self, out: StackOutput) -> None:
+        """The tick's row: the truth (against the lane the plan keeps) and the stack's."""
+        truth = self.world.ego_truth
+        pose_error = math.hypot(out.plan.ego.x - float(truth.position[0]),
+                                out.plan.ego.y - float(truth.position[1]))
+        self._log_truth(out.plan.lane)  # computed and appended first: the row whole or absent
+        log = self.log
+        log.target_speed.append(out.plan.target_speed)
+        log.speed_limit.append(out.plan.speed_limit)
+        log.steering.append(out.command.steering_angle)
+        log.drive_torque.append(out.command.drive_torque)
+        log.brake_torque.append(out.command.brake_torque)
+        log.acc_mode.append(out.plan.acc_mode)
+        log.hazard.append(out.plan.hazard is HazardLights.ON)
+        log.motion.append(out.plan.motion)
+        log.speed_source.append(out.plan.speed_source)
+        log.lane.append(out.plan.lane)
+        log.changing.append(out.plan.lane != out.plan.origin_lane)
+        log.pose_error.append(pose_error)
+
+    def _log_scripted(self) -> None:
+        """A scripted ego's row (module doc): the truth against the lane it is in."""
+        w, log = self.world, self.log
+        route = w.ego_route
+        assert w.scripted is not None
+        found = w.road.lane_of(route.station, float(route.offsets[0]))[0]
+        lane = found if found is not None else w.scripted.motion.lane  # off the lanes
+        self._log_truth(lane)
+        for column in (log.target_speed, log.speed_limit, log.drive_torque, log.brake_torque):
+            column.append(math.nan)
+        log.steering.append(0.0)
+        log.acc_mode.append(AccMode.ACC_OFF)
+        log.hazard.append(False)
+        log.motion.append(Motion.LANE_KEEP)
+        log.speed_source.append(SpeedSource.DRIVER)
+        log.lane.append(lane)
+        log.changing.append(False)
+        log.pose_error.append(0.0)  # no estimate: the truth is the script's
+
+    def _log_truth(self, lane_index: int) -> None:
+        """The truth columns of the tick's row; cross-track errors from lane `lane_index`."""
         w, log = self.world, self.log
         truth, route = w.ego_truth, w.ego_route
         s = route.station
-        lane = self.world.road.lane(out.plan.lane)
+        lane = self.world.road.lane(lane_index)
         r, r_fa = (route.offsets[:2] - lane.offset_at(route.stations[:2])).tolist()
         lo, hi = ego_lane_edges(w.road, s, float(route.offsets[0]))
         ahead = vehicles_ahead(w.road, w.actors.poses, s, float(route.offsets[0]),
                                self.car.body_length) if w.actors.bodies else ()
-        # everything computed before the first append: a tick's row is whole or absent
-        pose_error = math.hypot(out.plan.ego.x - float(truth.position[0]),
-                                out.plan.ego.y - float(truth.position[1]))
         actor_station = np.array([m.s for m in w.actors.motions])
         actor_offset = np.array([m.offset for m in w.actors.motions])
         crossing = self.lanes.crossing is not None
@@ -460,20 +512,8 @@ class Runner:
         log.station.append(s)
         log.cross_track.append(r)
         log.front_axle_error.append(r_fa)
-        log.target_speed.append(out.plan.target_speed)
-        log.speed_limit.append(out.plan.speed_limit)
-        log.steering.append(out.command.steering_angle)
-        log.drive_torque.append(out.command.drive_torque)
-        log.brake_torque.append(out.command.brake_torque)
         log.wheel_spin.append(truth.wheel_spin.copy())
-        log.acc_mode.append(out.plan.acc_mode)
-        log.hazard.append(out.plan.hazard is HazardLights.ON)
-        log.motion.append(out.plan.motion)
-        log.speed_source.append(out.plan.speed_source)
-        log.lane.append(out.plan.lane)
-        log.changing.append(out.plan.lane != out.plan.origin_lane)
         log.pedal.append(w.accelerator_pedal)
-        log.pose_error.append(pose_error)
         log.lane_error.append(float(route.offsets[0]) - 0.5 * (lo + hi))
         log.crossing.append(crossing)
         log.actor_station.append(actor_station)
@@ -620,6 +660,26 @@ class Runner:
             "lead_gap": log.lead_gap[-1], "lead_speed": log.lead_speed[-1],  # NaN: no lead
         })
         rec.log_path(w.t, out.plan.path.xy)
+        self._record_actors()
+
+    def _record_scripted(self) -> None:
+        """A scripted ego's tick in the recording: its pose, the truth's scalars, the NPCs
+        (no plan, no commands); the first says the script drives it."""
+        rec, w = self.recorder, self.world
+        assert rec is not None
+        truth, log = w.ego_truth, self.log
+        if len(log.t) == 1:
+            rec.log_event(w.t, "the car under test is scripted: the scenario's actions move "
+                               "it, the stack does not drive", "INFO")
+        rec.log_ego_pose(w.t, truth.position, truth.quaternion)
+        rec.log_scalars(w.t, {"speed": truth.speed, "cross_track_error": log.cross_track[-1],
+                              "lead_gap": log.lead_gap[-1], "lead_speed": log.lead_speed[-1]})
+        self._record_actors()
+
+    def _record_actors(self) -> None:
+        """The NPC boxes, at their recording rate."""
+        rec, w = self.recorder, self.world
+        assert rec is not None
         if ACTOR_RECORD_RATE.fires(w.clock.step):
             p = w.actors.poses
             quats = np.column_stack([np.zeros((len(p.yaws), 2)), np.sin(p.yaws / 2),

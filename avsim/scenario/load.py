@@ -51,6 +51,7 @@ UNSUPPORTED: dict[str, str] = {
 def load_scenario(
     path_or_name: str | Path, overrides: Mapping[str, object] | None = None,
     criteria_file: Path | None = None, search_paths: Sequence[Path] = (),
+    scripted_ego: bool = False,
 ) -> Scenario:
     """Load, validate and convert a scenario file.
 
@@ -64,13 +65,20 @@ def load_scenario(
     references (road, catalogs, sidecar) must resolve inside its own folder tree or one of
     `search_paths` (`avsim run --search-path DIR`); a YAML file references none.
 
+    `scripted_ego` (`avsim run --ego scripted`): the OpenSCENARIO file's own actions move
+    the car under test, as esmini's default controller does (`EgoSpec.scripted`); a YAML
+    scenario has no story for its ego and is refused.
+
     Raises `ScenarioError` with a one-line message `<file>: <key.path>: <problem>`.
     """
     path = scenario_path(path_or_name)
     if path.suffix == ".xosc":
         from avsim.scenario.openscenario.convert import load_xosc
 
-        return load_xosc(path, overrides, criteria_file, search_paths)
+        return load_xosc(path, overrides, criteria_file, search_paths, scripted_ego)
+    if scripted_ego:
+        raise ScenarioError(str(path_or_name), "ego", "--ego scripted is for OpenSCENARIO "
+                            "files (a YAML scenario scripts no actions for its ego)")
     if criteria_file is not None:
         raise ScenarioError(str(path_or_name), FILE_KEY, "--criteria is for OpenSCENARIO "
                             "files (a YAML scenario has its own criteria: section)")

@@ -9,6 +9,8 @@ at each check. Actions on the car under test are its controller's (activation,
 assignment): they complete at once and set the switch of its automated driving function
 (`World.engaged`, `engages`): on, the stack drives it; off (before a storyboard activates
 its controller: `avsim.scenario.openscenario.convert`), the driver holds its Init speed.
+A scripted car under test (`World.scripted`, `world.ego.scripted`) takes every other action
+as an actor does, on its own motion; its controller actions then change nothing.
 """
 
 from __future__ import annotations
@@ -102,12 +104,22 @@ class Director:
         return self.ended
 
     def _motion(self, entity: str) -> NpcMotion | None:
+        """The motion that plays `entity`'s actions: an actor's, or the scripted car under
+        test's; None for the car the stack drives."""
+        scripted = self.world.scripted
+        if entity == self.program.ego and scripted is not None:
+            return scripted.motion
         i = self._index.get(entity)
         return None if i is None else self.world.actors.motions[i]
 
+    def _motions(self) -> list[NpcMotion]:
+        """Every motion the director commands."""
+        scripted = self.world.scripted
+        return [*self.world.actors.motions, *([scripted.motion] if scripted else [])]
+
     def _collect_finished(self, snap: Snapshot) -> None:
         """The commands that reached their goal since the last check end their actions."""
-        for motion in self.world.actors.motions:
+        for motion in self._motions():
             done, motion.finished = motion.finished, []
             self._finish(done, snap.time)
 

@@ -5,12 +5,14 @@ the same world spec, driver settings and criteria as a YAML file gives, plus the
 - The road: the file's OpenDRIVE roads, linked end to end into one, as the route
   (`world.map.opendrive.route`); positions on any of them are placed on it. A dual
   carriageway's far side is drawn as a scenery road (`WorldSpec.scenery_roads`).
-- The car under test: the entity named `Ego` (any case), else the first vehicle. avsim's
-  stack drives it once its controller is activated (`starts_engaged`: from the start,
-  unless a story activates it later; until then its driver holds its Init speed in its
-  lane), its set speed the Init speed (the speed its driver held when the file's
-  controller takes over); avsim's car keeps its own body (4.8 x 1.6 m), not the file's
-  bounding box.
+- The car under test: the entity named `Ego` (any case), else the first vehicle. Scripted
+  (`scripted_ego`, `avsim run --ego scripted`), the file's actions move it as any other
+  entity, its controllers not simulated (esmini's `--disable_controllers`). Else avsim's
+  stack drives it (a motion action on it is refused at load) once its controller is
+  activated (`starts_engaged`: from the start, unless a story activates it later; until
+  then its driver holds its Init speed in its lane), its set speed the Init speed (the
+  speed its driver held when the file's controller takes over); avsim's car keeps its
+  own body (4.8 x 1.6 m), not the file's bounding box.
 - The other entities become the world's actors with the file's bounding boxes: vehicles by
   category (car, van, motorbike, bicycle: a car; truck, bus, trailer, semitrailer: a truck),
   pedestrians, misc objects as obstacles.
@@ -76,12 +78,14 @@ class _Placed:
 
 
 def load_xosc(path: Path, overrides: Mapping[str, object] | None = None,
-              criteria_file: Path | None = None, search_paths: Sequence[Path] = ()) -> Scenario:
+              criteria_file: Path | None = None, search_paths: Sequence[Path] = (),
+              scripted_ego: bool = False) -> Scenario:
     """The scenario of the OpenSCENARIO file `path` (module doc) with `overrides` (the
     file's `parameters.NAME`, the sidecar's keys) and the sidecar `criteria_file` (None:
     `NAME.criteria.yaml` beside it if there is one), its road and catalogs found in its
-    folder tree or `search_paths` (`references`); `ScenarioError` (one line) for anything
-    it cannot run."""
+    folder tree or `search_paths` (`references`); `scripted_ego`: the file's actions move
+    the car under test (module doc); `ScenarioError` (one line) for anything it cannot
+    run."""
     params, rest = split_overrides(overrides or {})
     roots = scenario_roots(path, search_paths)
     side_file = sidecar_path(path, criteria_file, roots)
@@ -97,9 +101,11 @@ def load_xosc(path: Path, overrides: Mapping[str, object] | None = None,
         raise ScenarioError(str(osc.road_network), "(file)", str(e)) from None
     ego = _ego(osc)
     placed, deferred = _init(osc, Resolver(route.chain))
+    if not scripted_ego:
+        _check_stack_ego(osc, ego.name, deferred)
     ahead = {e.name: _centre_ahead(e, e.name == ego.name) for e in osc.entities}
-    ego_spec = _ego_spec(path, road_map, ego.name, placed, ahead[ego.name],
-                         starts_engaged(osc, ego.name))
+    ego_spec = replace(_ego_spec(path, road_map, ego.name, placed, ahead[ego.name],
+                                 starts_engaged(osc, ego.name)), scripted=scripted_ego)
     others = [e for e in osc.entities if e.name != ego.name]
     actors = tuple(_actor_spec(path, road_map, e, placed, ahead[e.name]) for e in others)
     program = StoryProgram(
@@ -114,6 +120,25 @@ def load_xosc(path: Path, overrides: Mapping[str, object] | None = None,
                     duration=side.duration, world=world,
                     driver=DriverSettings(set_speed=ego_spec.speed), criteria=side.criteria,
                     story=program, sources=_sources(path, osc.road_network, side_file))
+
+
+def _check_stack_ego(osc: OpenScenario, ego: str, deferred: Sequence[InitAction]) -> None:
+    """The stack drives the car under test: a motion action on it (Init actions left to
+    run, or a story's) is refused at load; only its controller's actions are played."""
+    controller = ActivateControllerAction | AssignControllerAction
+    for item in deferred:
+        if item.entity == ego:
+            raise ScenarioError(str(osc.path), f"Storyboard.Init.{ego}", _ego_motion(item.action))
+    for group, a in osc.storyboard.story_actions():
+        if ego in group.actors.entities \
+                and not isinstance(a.private_action, controller):
+            raise ScenarioError(str(osc.path), f"Storyboard.Action.{a.name}",
+                                _ego_motion(a.private_action))
+
+
+def _ego_motion(action: object) -> str:
+    return (f"{type(action).__name__} on the car under test: not supported yet (avsim's "
+            "stack drives it; `--ego scripted` plays the file's actions on it)")
 
 
 def _sources(*files: Path | None) -> tuple[Path, ...]:

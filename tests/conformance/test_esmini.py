@@ -1,0 +1,86 @@
+"""avsim plays each file of the esmini reference (`tests/data/esmini_ref/`) as esmini does:
+the car under test scripted (`--ego scripted`), no sensors. Each event starts within
+`EVENT_TOLERANCE` of esmini's start, each non-Ego entity stays within `RMS_TOLERANCE` RMS of
+esmini's path. Every run of the reference is collected; a file that does not load yet is
+skipped with the loader's reason (it turns on when it loads), a run whose Ego esmini gave a
+controller is compared in its `no_controllers/` twin. A known difference is a strict xfail
+naming its reason (`docs/openscenario.md`, "Compared with esmini")."""
+
+from __future__ import annotations
+
+from functools import cache
+
+import pytest
+
+from avsim.scenario.errors import ScenarioError
+from tests.conformance.reference import (
+    EVENT_TOLERANCE,
+    RMS_TOLERANCE,
+    Played,
+    RefRun,
+    event_error,
+    path_rms,
+    play,
+    ref_event_starts,
+    ref_paths,
+    runs,
+    scenario_file,
+)
+
+CONTROLLED = "the Ego has an esmini controller in this run: compared in no_controllers/"
+PEDESTRIAN_PATH = ("a crossing pedestrian: avsim's walk (trapezoidal lateral speed, turning "
+                   "at 180 deg/s) is not esmini's; not yet matched")
+SWERVE_PATH = ("a swerve by a LaneOffsetAction / lane change with a sinusoidal shape: "
+               "avsim's lateral profile is not yet esmini's")
+CUT_IN_PATH = "the cut-in's lane change profile: not yet esmini's (0.29 m RMS)"
+AFTER_END = ("events started by the end of a previous event: avsim starts them one trigger "
+             "check (0.025 s) per link earlier than esmini; not yet matched")
+KNOWN = {
+    ("alks/no_controllers/alks_scenario_4_1_2_swerving_lead_vehicle_template", "events"):
+        AFTER_END,
+    ("alks/no_controllers/alks_scenario_4_2_3_crossing_pedestrian_template", "paths"):
+        PEDESTRIAN_PATH,
+    ("alks/no_controllers/alks_scenario_4_4_2_cut_in_unavoidable_collision_template",
+     "paths"): CUT_IN_PATH,
+    ("alks/no_controllers/alks_scenario_4_6_2_lateral_detection_range_template", "paths"):
+        SWERVE_PATH,
+}
+CONTROLLED_RUNS = {r.output.replace("/no_controllers", "") for r in runs()
+                   if "/no_controllers/" in r.output}  # their default twins
+
+
+def _params(check: str) -> list[object]:
+    out: list[object] = []
+    for run in runs():
+        reason = KNOWN.get((run.output, check))
+        marks = [pytest.mark.xfail(strict=True, reason=reason)] if reason else []
+        out.append(pytest.param(run, id=run.output, marks=marks))
+    return out
+
+
+@cache
+def _played(run: RefRun) -> Played:
+    if run.output in CONTROLLED_RUNS:
+        pytest.skip(CONTROLLED)
+    path, _ = scenario_file(run)
+    if not path.is_file():
+        pytest.skip(f"{path}: not on this machine")
+    try:
+        return play(run)
+    except ScenarioError as e:
+        pytest.skip(f"does not load yet: {e}")
+
+
+@pytest.mark.parametrize("run", _params("events"))
+def test_events_start_when_esmini_starts_them(run: RefRun) -> None:
+    played = _played(run)
+    ref = ref_event_starts(run)
+    assert event_error(ref, played.event_starts) <= EVENT_TOLERANCE + 1e-9, (
+        f"esmini {ref}, avsim {played.event_starts}")
+
+
+@pytest.mark.parametrize("run", _params("paths"))
+def test_entities_follow_esmini_s_paths(run: RefRun) -> None:
+    played = _played(run)
+    rms = {name: path_rms(ref, played.paths[name]) for name, ref in ref_paths(run).items()}
+    assert max(rms.values(), default=0.0) <= RMS_TOLERANCE, rms
