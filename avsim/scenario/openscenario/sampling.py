@@ -49,17 +49,18 @@ Place = Callable[[Position], Pose]
 
 @dataclass(frozen=True)
 class Sampled:
-    """Points (x, y) [m], map frame; `times` [s] (the file's, before any Timing) or None."""
+    """Points (x, y) [m], map frame, the heading [rad] at each (a polyline's: its
+    vertices' own); `times` [s] (the file's, before any Timing) or None."""
 
     x: Floats
     y: Floats
+    heading: Floats
     times: Floats | None
 
     @property
     def arc(self) -> Floats:
         """[m] the arc length at each point."""
-        steps = np.hypot(np.diff(self.x), np.diff(self.y))
-        return np.concatenate(([0.0], np.cumsum(steps)))
+        return _arc(self.x, self.y)
 
     def at(self, s: float, t: float) -> Pose:
         """The pose `s` [m] along the polyline and `t` [m] to its left, heading along it."""
@@ -74,6 +75,10 @@ class Sampled:
         x = self.x[i] + u * (self.x[i + 1] - self.x[i]) - t * math.sin(heading)
         y = self.y[i] + u * (self.y[i + 1] - self.y[i]) + t * math.cos(heading)
         return Pose(float(x), float(y), heading)
+
+
+def _arc(x: Floats, y: Floats) -> Floats:
+    return np.concatenate(([0.0], np.cumsum(np.hypot(np.diff(x), np.diff(y)))))
 
 
 def clothoid_points(start: Pose, k0: float, rate: float, length: float
@@ -117,19 +122,20 @@ def _polyline(shape: Polyline, place: Place) -> Sampled:
     poses = [place(v.position) for v in shape.vertices]
     times = [v.time for v in shape.vertices]
     timed = None if any(t is None for t in times) else np.array(times, dtype=np.float64)
-    return Sampled(np.array([p.x for p in poses]), np.array([p.y for p in poses]), timed)
+    return Sampled(np.array([p.x for p in poses]), np.array([p.y for p in poses]),
+                   np.array([p.heading for p in poses]), timed)
 
 
 def _clothoid(shape: Clothoid, place: Place, start: Pose | None) -> Sampled:
-    x, y, _ = clothoid_points(_start(shape.position, place, start), shape.curvature,
+    x, y, h = clothoid_points(_start(shape.position, place, start), shape.curvature,
                               shape.curvature_rate, shape.length)
-    out = Sampled(x, y, None)
-    return Sampled(x, y, _linear_times(shape.start_time, shape.stop_time, out.arc))
+    return Sampled(x, y, h, _linear_times(shape.start_time, shape.stop_time, _arc(x, y)))
 
 
 def _spline(shape: ClothoidSpline, place: Place, start: Pose | None) -> Sampled:
     xs: list[Floats] = []
     ys: list[Floats] = []
+    hs: list[Floats] = []
     ts: list[Floats | None] = []
     segments = shape.segments
     ends = [s.time_start for s in segments[1:]] + [shape.time_end]
@@ -142,12 +148,13 @@ def _spline(shape: ClothoidSpline, place: Place, start: Pose | None) -> Sampled:
         first = 0 if k == 0 else 1  # the joint once
         xs.append(x[first:])
         ys.append(y[first:])
-        times = _linear_times(seg.time_start, ends[k], Sampled(x, y, None).arc)
+        hs.append(h[first:])
+        times = _linear_times(seg.time_start, ends[k], _arc(x, y))
         ts.append(None if times is None else times[first:])
         pose = Pose(float(x[-1]), float(y[-1]), float(h[-1]))
     timed = None if any(t is None for t in ts) else np.concatenate(
         [t for t in ts if t is not None])
-    return Sampled(np.concatenate(xs), np.concatenate(ys), timed)
+    return Sampled(np.concatenate(xs), np.concatenate(ys), np.concatenate(hs), timed)
 
 
 def _nurbs(shape: Nurbs, place: Place) -> Sampled:
@@ -167,8 +174,9 @@ def _nurbs(shape: Nurbs, place: Place) -> Sampled:
     values = BSpline(knots, coefficients, degree, extrapolate=False)(u)
     values[-1] = BSpline(knots, coefficients, degree)(knots[len(points)] - 1e-12)
     denominator = values[:, 3]
-    return Sampled(values[:, 0] / denominator, values[:, 1] / denominator,
-                   values[:, 2] / denominator if timed else None)
+    x, y = values[:, 0] / denominator, values[:, 1] / denominator
+    heading = np.arctan2(np.gradient(y), np.gradient(x))
+    return Sampled(x, y, heading, values[:, 2] / denominator if timed else None)
 
 
 def sample(shape: TrajectoryShape, place: Place, start: Pose | None = None) -> Sampled:
