@@ -1,7 +1,7 @@
 """The motion actions played on a real world (`--profile none`), one actor each, in one
-run of `data/motion_actions.xosc` (filled in here; the ego drives by in lane -1): a SynchronizeAction brings its actor to
-its target when the master reaches its own and leaves it at the final speed; a
-SpeedProfileAction hits its speeds at their times; a LateralDistanceAction keeps its
+run of `data/motion_actions.xosc` (filled in here; the ego drives by in lane -1): a
+SynchronizeAction brings its actor to its target when the master reaches its own and
+leaves it at the final speed; a SpeedProfileAction hits its speeds at their times; a LateralDistanceAction keeps its
 distance to the ego; a TeleportAction in a story moves a standing actor at once; a
 Clothoid trajectory ends where its closed form says."""
 
@@ -157,7 +157,7 @@ def test_teleport_in_a_story_moves_a_standing_actor_at_once(run: RunResult) -> N
 
 
 def test_a_clothoid_from_the_actors_pose_ends_at_its_closed_form(run: RunResult) -> None:
-    t, s, offset = track(run, "Curve")
+    _t, s, offset = track(run, "Curve")
     a = math.sqrt(math.pi / CURVE_RATE)
     dy, dx = (a * v for v in fresnel(CURVE_LENGTH / a))
     end = 800.0 + 10.0 * 1.0 + dx  # it drove 1 s before the clothoid started
