@@ -1,9 +1,9 @@
 """The motion actions played on a real world (`--profile none`), one actor each, in one
 run of `data/motion_actions.xosc` (filled in here; the ego drives by in lane -1): a
 SynchronizeAction brings its actor to its target when the master reaches its own and
-leaves it at the final speed; a SpeedProfileAction hits its speeds at their times; a LateralDistanceAction keeps its
-distance to the ego; a TeleportAction in a story moves a standing actor at once; a
-Clothoid trajectory ends where its closed form says."""
+leaves it at the final speed; a SpeedProfileAction hits its speeds at their times; a
+LateralDistanceAction keeps its distance to the ego; a TeleportAction in a story moves a
+standing actor at once; a Clothoid trajectory ends where its closed form says."""
 
 from __future__ import annotations
 
