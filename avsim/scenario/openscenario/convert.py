@@ -33,6 +33,7 @@ from pathlib import Path
 from avsim.scenario.checks import check_spawn
 from avsim.scenario.errors import LocatedError, ScenarioError
 from avsim.scenario.openscenario.actions import engages
+from avsim.scenario.openscenario.ego_actions import refuse_on_ego
 from avsim.scenario.openscenario.model import (
     AbsoluteTargetSpeed,
     ActivateControllerAction,
@@ -96,6 +97,7 @@ def load_xosc(path: Path, overrides: Mapping[str, object] | None = None,
     except MapError as e:
         raise ScenarioError(str(osc.road_network), "(file)", str(e)) from None
     ego = _ego(osc)
+    refuse_on_ego(osc, ego.name)
     placed, deferred = _init(osc, Resolver(route.chain))
     ahead = {e.name: _centre_ahead(e, e.name == ego.name) for e in osc.entities}
     ego_spec = _ego_spec(path, road_map, ego.name, placed, ahead[ego.name],
