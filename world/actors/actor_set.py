@@ -314,7 +314,8 @@ class ActorSet:
         for i, (body, m, flip, z, line) in enumerate(zip(
                 self.bodies, self.motions, self._flip_list, self._heights, self._lines,
                 strict=True)):
-            if force or m.speed != 0.0 or m.lateral_speed != 0.0:
+            if force or m.speed != 0.0 or m.lateral_speed != 0.0 or m.jumped:
+                m.jumped = False
                 x, y, heading = line.pose_one(m.s, m.offset)
                 self._xy[i] = (x, y)
                 half = 0.5 * (heading + flip + m.heading_offset)

@@ -28,7 +28,14 @@ import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
-from world.actors.profiles import LateralCommand, PathCommand, SpeedCommand, TrackCommand
+from world.actors.profiles import (
+    LateralCommand,
+    PathCommand,
+    ProfileCommand,
+    SpeedCommand,
+    TeleportCommand,
+    TrackCommand,
+)
 from world.frames import wrap_angle
 from world.spec import (
     ActionSpec,
@@ -49,7 +56,8 @@ PEDESTRIAN_TURN_RATE = math.pi  # [rad/s] a pedestrian turns to face where it wa
 PEDESTRIAN_MOVING = 0.05  # [m/s] a pedestrian slower than this over ground keeps its heading
 CAP_ACCEL = 1.5  # [m/s^2] a capped NPC (a town driver) speeds up again at this
 
-Command = SpeedCommand | TrackCommand | LateralCommand | PathCommand
+SpeedLike = SpeedCommand | TrackCommand | ProfileCommand
+Command = SpeedLike | LateralCommand | PathCommand | TeleportCommand
 LaneOffset = Callable[[int, float], float]
 """(lane index, station) -> lateral offset [m] of that lane's centre from the reference line."""
 
@@ -110,12 +118,13 @@ class NpcMotion:
         self._lateral_max = 0.0  # [m/s] cruise lateral speed of the running lateral move
         self._lateral_action: int | None = None  # index of the running lateral action
         # a director's commands (`world.actors.profiles`), over the actions above while set
-        self._speed_cmd: SpeedCommand | TrackCommand | None = None
+        self._speed_cmd: SpeedLike | None = None
         self._lateral_cmd: LateralCommand | None = None
         self._path_cmd: PathCommand | None = None
         self._path_index = 0  # the vertex an untimed path heads for
         self._path_speed = 0.0  # [m/s] the speed an untimed path is followed at
         self.finished: list[str] = []  # tags of commands that reached their goal, in order
+        self.jumped = False  # teleported since its body was last placed
 
     # -- triggers --------------------------------------------------------------------------
 
@@ -151,14 +160,26 @@ class NpcMotion:
     # -- a director's commands ---------------------------------------------------------------
 
     def command(self, cmd: Command) -> None:
-        """Drive by `cmd` from now on: a speed or track command takes the speed, a lateral
-        command the offset, a path both (each replaces what drove that part before)."""
-        if isinstance(cmd, PathCommand):
+        """Drive by `cmd` from now on: a speed, track or profile command takes the speed (on
+        an untimed path, the speed it is followed at), a lateral command the offset, a path
+        both (each replaces what drove that part before); a teleport moves the actor at
+        once and is done."""
+        if isinstance(cmd, TeleportCommand):
+            self.s, self.offset, self._target_offset = cmd.s, cmd.offset, cmd.offset
+            self._path_cmd = self._lateral_cmd = None
+            self.lateral_speed = 0.0
+            if cmd.lane is not None:
+                self.lane = cmd.lane
+            self.jumped = True
+            self.finished.append(cmd.tag)
+        elif isinstance(cmd, PathCommand):
             self._speed_cmd = self._lateral_cmd = None
             self._path_cmd, self._path_index = cmd, 0
             self._path_speed = self.ground_speed
         elif isinstance(cmd, LateralCommand):
             self._path_cmd, self._lateral_cmd = None, cmd
+        elif self._path_cmd is not None and self._path_cmd.times is None:
+            self._speed_cmd = cmd
         else:
             self._path_cmd, self._speed_cmd = None, cmd
 
@@ -173,6 +194,7 @@ class NpcMotion:
         if self._path_cmd is not None and self._path_cmd.tag == tag:
             self._path_cmd = None
             self._hold_speed()
+            self.lateral_speed = 0.0
 
     def _hold_speed(self) -> None:
         self._planned = self._target_speed = self.speed
@@ -182,6 +204,10 @@ class NpcMotion:
         """Step the director's commands; False if none drives the actor."""
         if self._path_cmd is not None:
             cmd = self._path_cmd
+            if self._speed_cmd is not None:  # the speed an untimed path is followed at
+                self.speed = self._path_speed
+                self._step_speed_cmd(t, dt)
+                self._path_speed = self.speed
             along, across, done, self._path_index = cmd.velocity(
                 t, self.s, self.offset, self._path_speed, dt, self._path_index)
             self.speed, self.lateral_speed = along * self.direction, across
@@ -211,6 +237,13 @@ class NpcMotion:
             change = max(-cmd.max_decel * dt, min(cmd.max_accel * dt, change))
             self.speed = min(cmd.max_speed, max(0.0, self.speed + change))
             self._hold_speed()
+            return
+        if isinstance(cmd, ProfileCommand):
+            self.speed, done = cmd.at(t + dt)
+            self._hold_speed()
+            if done:
+                self._speed_cmd = None
+                self.finished.append(cmd.tag)
             return
         assert cmd is not None
         self.speed, _, done = cmd.transition.at(t + dt - cmd.t0)

@@ -178,3 +178,35 @@ class PathCommand:
                 return speed * ds / dist, speed * do / dist, False, index
             index += 1
         return (self.s[-1] - s) / dt, (self.offset[-1] - offset) / dt, True, index
+
+
+@dataclass(frozen=True, slots=True)
+class ProfileCommand:
+    """Drive the speed through the points (`times` [s] simulation time, `speeds` [m/s]),
+    linearly between them, then hold the last speed; done at the last time."""
+
+    tag: str
+    times: tuple[float, ...]  # [s] increasing (equal neighbours: a step)
+    speeds: tuple[float, ...]  # [m/s]
+
+    def at(self, t: float) -> tuple[float, bool]:
+        """([m/s] the speed at t [s], whether the profile is done)."""
+        if t >= self.times[-1] - SPAN_TOL:
+            return self.speeds[-1], True
+        if t <= self.times[0]:
+            return self.speeds[0], False
+        i = max(k for k in range(len(self.times) - 1) if self.times[k] <= t)
+        span = self.times[i + 1] - self.times[i]
+        u = (t - self.times[i]) / span if span > 0.0 else 1.0
+        return self.speeds[i] + u * (self.speeds[i + 1] - self.speeds[i]), False
+
+
+@dataclass(frozen=True, slots=True)
+class TeleportCommand:
+    """Put the actor's centre at station `s` [m], offset `offset` [m] (lane `lane`) at once;
+    it keeps its speed."""
+
+    tag: str
+    s: float  # [m]
+    offset: float  # [m] from the route's reference line, left +
+    lane: int | None  # the lane it is in now (None: unchanged)

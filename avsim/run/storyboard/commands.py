@@ -12,9 +12,23 @@
   entity's offset plus a value), timed by its peak lateral acceleration (`LANE_OFFSET_ACCEL`
   when the file gives none): sinusoidal T = pi sqrt(d / 2a), cubic T = sqrt(6 d / a),
   linear and step as fast as that acceleration allows from rest to rest, T = 2 sqrt(d / a).
-- FollowTrajectoryAction: a polyline of resolved positions, in route coordinates of the
-  body centre; timed when the action has a time reference (vertex time x scale + offset,
-  plus the start time for the relative domain), else at the actor's speed.
+- FollowTrajectoryAction: the trajectory's shape sampled to a dense polyline
+  (`avsim.scenario.openscenario.sampling`; a polyline: its resolved vertices), in route
+  coordinates of the body centre; timed when the action has a time reference and the shape
+  has times (time x scale + offset, plus the start time for the relative domain), else at
+  the actor's speed (which a speed action may change while it runs).
+- TeleportAction: the actor's body jumps to the position at once, keeping its speed.
+- SpeedProfileAction: speed points, linear in time between them: each entry's speed (plus
+  the referenced entity's speed at the start) its time after the previous one; an entry
+  without a time, or one whose change would exceed the DynamicConstraints' acceleration
+  or deceleration, takes the time that limit needs (`DISTANCE_ACCEL` where none is
+  given). In follow mode a first entry at time 0 is replaced by the actor's speed.
+- LateralDistanceAction: the body centre's lateral offset kept at the distance (plus half
+  of both widths for freespace) left or right of the entity's reference point (the side it
+  is on for `any`), renewed at every check: at once without a maxSpeed, else at that
+  lateral speed.
+- SynchronizeAction: the targets resolved when it starts; the actor's speed at each check
+  by the speed law of `synchronize` (esmini's), until it is done.
 - LongitudinalDistanceAction: keeps a distance (or a time gap at the referenced entity's
   speed) ahead of or behind the entity along the route (`Follow`).
 """
@@ -25,6 +39,7 @@ import math
 from dataclasses import dataclass
 
 from avsim.run.storyboard.snapshot import EntityState, Snapshot
+from avsim.run.storyboard.synchronize import Synchronizer, SyncInput
 from avsim.scenario.openscenario.model import (
     AbsoluteTargetLane,
     AbsoluteTargetLaneOffset,
@@ -32,24 +47,33 @@ from avsim.scenario.openscenario.model import (
     FollowTrajectoryAction,
     LaneChangeAction,
     LaneOffsetAction,
+    LateralDistanceAction,
     LongitudinalDistanceAction,
     RelativeTargetSpeed,
     SpeedAction,
+    SpeedProfileAction,
+    SynchronizeAction,
+    TeleportAction,
     TransitionDynamics,
 )
 from avsim.scenario.openscenario.resolve import Pose, Resolver
+from avsim.scenario.openscenario.sampling import sample
 from world.actors.profiles import (
     LateralCommand,
     PathCommand,
+    ProfileCommand,
     Shape,
     SpeedCommand,
+    TeleportCommand,
     TrackCommand,
     Transition,
     span_by_rate,
     speed_span_by_distance,
 )
+from world.core.rates import ACTOR_RATE
 from world.hdmap import RoadMap
 
+MOTION_STEP = 1.0 / ACTOR_RATE.hz  # [s] an actor's motion step
 LANE_OFFSET_ACCEL = 0.5  # [m/s^2] a lane offset's peak lateral acceleration, if not given
 GAP_GAIN = 0.5  # [1/s] a distance keeper's speed correction per metre of gap error
 DISTANCE_ACCEL = 4.0  # [m/s^2] a distance keeper's limits where the file gives none
@@ -64,9 +88,22 @@ class Follow:
 
     tag: str
     entity: str  # the one it acts on
-    action: SpeedAction | LongitudinalDistanceAction
+    action: SpeedAction | LongitudinalDistanceAction | LateralDistanceAction
     after: float = 0.0  # [s] renewed from this time on (a relative speed: once its
     #   transition to the entity's speed is done)
+
+
+@dataclass(frozen=True, slots=True)
+class Sync:
+    """A running SynchronizeAction: its targets in route coordinates (resolved when it
+    starts) and its speed law's state."""
+
+    tag: str
+    entity: str
+    action: SynchronizeAction
+    target: tuple[float, float]  # [m] (s, offset) of the actor's target
+    master_target: float  # [m] station of the master's target
+    law: Synchronizer
 
 
 class Commands:
@@ -134,25 +171,113 @@ class Commands:
     def trajectory(self, tag: str, action: FollowTrajectoryAction, me: EntityState,
                    snap: Snapshot) -> PathCommand:
         poses = poses_of(snap)
-        points = [self.resolver.resolve(v.position, poses) for v in
-                  action.trajectory.shape.vertices]
+        line = sample(action.trajectory.shape, lambda p: self.resolver.resolve(p, poses),
+                      Pose(me.x, me.y, me.heading))
         ahead = me.centre_ahead
-        xy = [(p.x + ahead * math.cos(p.heading), p.y + ahead * math.sin(p.heading))
-              for p in points]
+        xy = [(float(x + ahead * math.cos(h)), float(y + ahead * math.sin(h)))
+              for x, y, h in zip(line.x, line.y, line.heading, strict=True)]
         s, d = self.road.local_coordinates(xy)
         timing = action.time_reference
         times = None
-        vertices = action.trajectory.shape.vertices
-        if timing is not None and all(v.time is not None for v in vertices):
+        if timing is not None and line.times is not None:
             base = snap.time if timing.domain == "relative" else 0.0
-            times = tuple(base + (v.time or 0.0) * timing.scale + timing.offset
-                          for v in vertices)
+            times = tuple(base + float(t) * timing.scale + timing.offset for t in line.times)
         return PathCommand(tag, tuple(float(x) for x in s), tuple(float(x) for x in d), times)
+
+    def teleport(self, tag: str, action: TeleportAction, me: EntityState,
+                 snap: Snapshot) -> TeleportCommand:
+        """The actor's body centre where the position puts its reference point."""
+        p = self.resolver.resolve(action.position, poses_of(snap))
+        ahead = me.centre_ahead
+        xy = (p.x + ahead * math.cos(p.heading), p.y + ahead * math.sin(p.heading))
+        s, d = self.road.local_coordinates(xy)
+        lane = self.road.lane_at(xy)[0]
+        return TeleportCommand(tag, float(s), float(d), lane)
+
+    def speed_profile(self, tag: str, action: SpeedProfileAction, me: EntityState,
+                      snap: Snapshot) -> ProfileCommand:
+        """The entries as speed points (module doc)."""
+        base = snap.entities[action.entity].speed if action.entity is not None else 0.0
+        c = action.constraints
+        accel = c.max_acceleration if c is not None and c.max_acceleration else None
+        decel = c.max_deceleration if c is not None and c.max_deceleration else None
+        times, speeds = [snap.time], [me.speed]
+        entries = action.entries
+        if action.following_mode == "follow" and entries[0].time == 0.0:
+            entries = entries[1:]  # the first point is the actor's speed now
+        for entry in entries:
+            v = entry.speed + base
+            dv = v - speeds[-1]
+            limit = accel if dv > 0.0 else decel
+            dt = entry.time
+            if dt is None:
+                dt = abs(dv) / (limit or DISTANCE_ACCEL)
+            elif limit is not None and dt > 0.0 and abs(dv) / dt > limit:
+                dt = abs(dv) / limit  # the constraint stretches the entry
+            times.append(times[-1] + dt)
+            speeds.append(v)
+        return ProfileCommand(tag, tuple(times), tuple(speeds))
+
+    def synchronize(self, tag: str, entity: str, action: SynchronizeAction,
+                    snap: Snapshot) -> Sync:
+        """The targets where the positions are when the action starts."""
+        poses = poses_of(snap)
+        target = self.resolver.resolve(action.target, poses)
+        master = self.resolver.resolve(action.master_target, poses)
+        (s, ms), (d, _) = self.road.local_coordinates([(target.x, target.y),
+                                                       (master.x, master.y)])
+        final = action.final_speed
+        steady = final.steady_state if final is not None else None
+        law = Synchronizer(action.tolerance, action.tolerance_master,
+                           steady.distance if steady is not None else None,
+                           steady.time if steady is not None else None)
+        return Sync(tag, entity, action, (float(s), float(d)), float(ms), law)
+
+    def sync_step(self, sync: Sync, snap: Snapshot, dt: float) -> tuple[TrackCommand, bool]:
+        """(the actor's speed until the next check, whether the action is done);
+        `dt` [s] the check period (`synchronize`)."""
+        me = snap.entities[sync.entity]
+        master = snap.entities[sync.action.master]
+        ds = sync.master_target - master.s
+        along = master.speed * math.cos(master.heading - master.route_heading)
+        final = sync.action.final_speed
+        vf = None
+        if final is not None:
+            vf = {"absolute": final.value, "delta": master.speed + final.value,
+                  "factor": master.speed * final.value}[final.relative]
+        speed, done = sync.law.step(SyncInput(
+            dist=math.hypot(sync.target[0] - me.s, sync.target[1] - me.offset),
+            master_dist=abs(ds), speed=me.speed,
+            master_speed=along * math.copysign(1.0, ds), final_speed=vf), dt)
+        return TrackCommand(sync.tag, max(speed, 0.0), math.inf, math.inf), done
+
+    def keep_lateral(self, follow: Follow, me: EntityState, centre_offset: float,
+                     snap: Snapshot) -> tuple[LateralCommand, bool]:
+        """(the command to the lateral distance for this check, whether it is reached);
+        `centre_offset`: the actor's body centre offset from the reference line [m]."""
+        action = follow.action
+        assert isinstance(action, LateralDistanceAction)
+        ref = snap.entities[action.entity]
+        want = action.distance or 0.0
+        if action.freespace:
+            want += 0.5 * (me.width + ref.width)
+        side = {"leftToReferencedEntity": 1.0, "rightToReferencedEntity": -1.0}.get(
+            action.displacement, 1.0 if me.offset >= ref.offset else -1.0)
+        goal = ref.offset + side * want
+        c = action.constraints
+        speed = c.max_speed if c is not None and c.max_speed else None
+        span = 0.0 if speed is None else abs(goal - centre_offset) / speed
+        # the motion was stepped at the check's time already: its offset is one motion step
+        # later's, so the renewed transition starts there
+        cmd = LateralCommand(follow.tag, Transition(centre_offset, goal, Shape.LINEAR, span),
+                             snap.time + MOTION_STEP, me.s)
+        return cmd, abs(goal - centre_offset) < GAP_REACHED
 
     def follow(self, follow: Follow, me: EntityState, snap: Snapshot,
                max_speed: float) -> tuple[TrackCommand, bool]:
         """(the command for this step, whether the follow's goal is reached)."""
         action = follow.action
+        assert not isinstance(action, LateralDistanceAction)
         if isinstance(action, SpeedAction):
             target = _speed_target(action, snap)
             return TrackCommand(follow.tag, target, DISTANCE_ACCEL, DISTANCE_ACCEL,

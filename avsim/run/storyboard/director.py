@@ -17,10 +17,10 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 
-from avsim.run.storyboard.commands import Commands, Follow, poses_of
+from avsim.run.storyboard.commands import Commands, Follow, Sync, poses_of
 from avsim.run.storyboard.conditions import Resolved
 from avsim.run.storyboard.runtime import StartedAction, StoryRuntime
-from avsim.run.storyboard.snapshot import Snapshot
+from avsim.run.storyboard.snapshot import EntityState, Snapshot
 from avsim.run.storyboard.truth import TruthTracker
 from avsim.scenario.openscenario.actions import engages
 from avsim.scenario.openscenario.model import (
@@ -29,19 +29,26 @@ from avsim.scenario.openscenario.model import (
     FollowTrajectoryAction,
     LaneChangeAction,
     LaneOffsetAction,
+    LateralDistanceAction,
     LongitudinalDistanceAction,
     Position,
     PrivateAction,
     SpeedAction,
+    SpeedProfileAction,
+    SynchronizeAction,
+    TeleportAction,
 )
 from avsim.scenario.openscenario.program import StoryProgram
 from avsim.scenario.openscenario.resolve import Resolver
-from world.actors.behaviour import NpcMotion
+from world.actors.behaviour import Command, NpcMotion
+from world.actors.profiles import LateralCommand, TrackCommand
+from world.core.rates import TRIGGER_RATE
 from world.world import World
 
 CONTROLLER_ACTIONS = (ActivateControllerAction, AssignControllerAction)
 WALKING_TOP = 3.0  # [m/s] a pedestrian's or object's top speed when it keeps a distance
 INIT = "Init"  # the action id prefix of the Init actions the director starts itself
+CHECK_PERIOD = 1.0 / TRIGGER_RATE.hz  # [s] between two trigger checks
 
 
 class DirectorError(RuntimeError):
@@ -63,6 +70,7 @@ class Director:
         self._index = dict(program.actors)
         self._pending: dict[str, set[str]] = {}  # action id -> tags still running
         self._follows: dict[str, Follow] = {}  # tag -> a command renewed every check
+        self._syncs: dict[str, Sync] = {}  # tag -> a synchronization renewed every check
         self._tag_action: dict[str, str] = {}  # tag -> action id
         self.ended = False
         self.ended_at: float | None = None  # [s] when the StopTrigger fired
@@ -141,6 +149,7 @@ class Director:
         for tag in self._pending.pop(action_id, set()):
             self._tag_action.pop(tag, None)
             self._follows.pop(tag, None)
+            self._syncs.pop(tag, None)
             entity = tag.rpartition("@")[2]
             motion = self._motion(entity)
             if motion is not None:
@@ -174,18 +183,30 @@ class Director:
                 if cmd.continuous:
                     self._follows[tag] = Follow(tag, entity, action,
                                                 after=snap.time + cmd.transition.span)
-            elif isinstance(action, LaneChangeAction):
-                motion.command(self.commands.lane_change(tag, action, me, motion.offset, snap))
-            elif isinstance(action, LaneOffsetAction):
-                motion.command(self.commands.lane_offset(tag, action, me, motion.offset, snap))
-            elif isinstance(action, FollowTrajectoryAction):
-                motion.command(self.commands.trajectory(tag, action, me, snap))
-            elif isinstance(action, LongitudinalDistanceAction):
+            elif isinstance(action, LongitudinalDistanceAction | LateralDistanceAction):
                 self._follows[tag] = Follow(tag, entity, action)
+            elif isinstance(action, SynchronizeAction):
+                self._syncs[tag] = self.commands.synchronize(tag, entity, action, snap)
             else:
-                raise DirectorError(f"not supported yet ({type(action).__name__} in a story)")
+                motion.command(self._once(tag, action, me, motion, snap))
         except ValueError as e:
             raise DirectorError(f"{tag}: {e}") from None
+
+    def _once(self, tag: str, action: PrivateAction, me: EntityState, motion: NpcMotion,
+              snap: Snapshot) -> Command:
+        """The command of an action that needs no renewal."""
+        c = self.commands
+        if isinstance(action, LaneChangeAction):
+            return c.lane_change(tag, action, me, motion.offset, snap)
+        if isinstance(action, LaneOffsetAction):
+            return c.lane_offset(tag, action, me, motion.offset, snap)
+        if isinstance(action, FollowTrajectoryAction):
+            return c.trajectory(tag, action, me, snap)
+        if isinstance(action, TeleportAction):
+            return c.teleport(tag, action, me, snap)
+        if isinstance(action, SpeedProfileAction):
+            return c.speed_profile(tag, action, me, snap)
+        raise DirectorError(f"not supported yet ({type(action).__name__} in a story)")
 
     def _renew(self, snap: Snapshot) -> None:
         """The commands the truth steers every check (module doc)."""
@@ -195,10 +216,23 @@ class Director:
             if snap.time < follow.after:
                 continue  # its transition runs first
             me = snap.entities[follow.entity]
-            cmd, reached = self.commands.follow(follow, me, snap, self._top[follow.entity])
-            motion.command(cmd)
             action = follow.action
-            if reached and isinstance(action, LongitudinalDistanceAction) \
-                    and not action.continuous:
+            cmd: TrackCommand | LateralCommand
+            if isinstance(action, LateralDistanceAction):
+                cmd, reached = self.commands.keep_lateral(follow, me, motion.offset, snap)
+            else:
+                cmd, reached = self.commands.follow(follow, me, snap, self._top[follow.entity])
+            motion.command(cmd)
+            if reached and isinstance(action, LongitudinalDistanceAction
+                                      | LateralDistanceAction) and not action.continuous:
                 del self._follows[tag]
+                self._finish([tag], snap.time)
+        for tag, sync in list(self._syncs.items()):
+            motion = self._motion(sync.entity)
+            assert motion is not None
+            track, done = self.commands.sync_step(sync, snap, CHECK_PERIOD)
+            motion.command(track)
+            if done:
+                del self._syncs[tag]
+                motion.cancel(tag)  # it holds the final speed
                 self._finish([tag], snap.time)

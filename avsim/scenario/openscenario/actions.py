@@ -8,6 +8,7 @@ from typing import Literal
 
 from avsim.scenario.openscenario.entities import Controller
 from avsim.scenario.openscenario.positions import Position
+from avsim.scenario.openscenario.trajectories import Trajectory
 
 DynamicsShape = Literal["step", "linear", "sinusoidal", "cubic"]
 DynamicsDimension = Literal["rate", "time", "distance"]
@@ -73,6 +74,66 @@ class LongitudinalDistanceAction:
 
 
 @dataclass(frozen=True, slots=True)
+class SteadyState:
+    """Where the actor of a SynchronizeAction reaches its final speed: `distance` [m] or
+    `time` [s] before its target (exactly one is set)."""
+
+    distance: float | None  # [m]
+    time: float | None  # [s]
+
+
+@dataclass(frozen=True, slots=True)
+class FinalSpeed:
+    """A SynchronizeAction's speed at the target: absolute [m/s], or the master's speed
+    plus a delta [m/s] / times a factor [-]."""
+
+    value: float  # [m/s] | [-]
+    relative: Literal["absolute", "delta", "factor"]
+    steady_state: SteadyState | None
+
+
+@dataclass(frozen=True, slots=True)
+class SynchronizeAction:
+    """The actor reaches `target` when the master entity reaches `master_target`."""
+
+    master: str
+    master_target: Position
+    target: Position
+    final_speed: FinalSpeed | None
+    tolerance_master: float  # [m] (1.1+; 0 when not written)
+    tolerance: float  # [m]
+
+
+@dataclass(frozen=True, slots=True)
+class LateralDistanceAction:
+    """Keep a lateral distance to `entity` (None: the entity's lateral place, 0 m)."""
+
+    entity: str
+    distance: float | None  # [m]
+    freespace: bool  # between bounding boxes (True) or reference points (False)
+    continuous: bool
+    coordinate_system: str  # entity, lane, road, trajectory (1.1+; default entity)
+    displacement: str  # any, leftToReferencedEntity, rightToReferencedEntity (1.1+)
+    constraints: DynamicConstraints | None  # max_acceleration, max_speed: lateral
+
+
+@dataclass(frozen=True, slots=True)
+class SpeedProfileEntry:
+    speed: float  # [m/s] (plus the entity's speed when the action names one)
+    time: float | None  # [s] to reach it after the previous entry; None: at the limits
+
+
+@dataclass(frozen=True, slots=True)
+class SpeedProfileAction:
+    """Speeds to reach one after the other (1.2)."""
+
+    entity: str | None  # speeds relative to this entity's speed when the action starts
+    following_mode: FollowingMode
+    entries: tuple[SpeedProfileEntry, ...]
+    constraints: DynamicConstraints | None
+
+
+@dataclass(frozen=True, slots=True)
 class AbsoluteTargetLane:
     value: str  # OpenDRIVE lane id
 
@@ -112,25 +173,6 @@ class LaneOffsetAction:
     continuous: bool
     dynamics: LaneOffsetDynamics
     target: AbsoluteTargetLaneOffset | RelativeTargetLaneOffset
-
-
-@dataclass(frozen=True, slots=True)
-class Vertex:
-    time: float | None  # [s] when the vertex is reached, None when not timed
-    position: Position
-
-
-@dataclass(frozen=True, slots=True)
-class Polyline:
-    vertices: tuple[Vertex, ...]
-
-
-@dataclass(frozen=True, slots=True)
-class Trajectory:
-    name: str
-    closed: bool
-    shape: Polyline  # Clothoid and Nurbs are not supported yet
-    parameters: dict[str, int | float | bool | str]  # its own ParameterDeclarations
 
 
 @dataclass(frozen=True, slots=True)
@@ -184,6 +226,9 @@ PrivateAction = (
     TeleportAction
     | SpeedAction
     | LongitudinalDistanceAction
+    | SynchronizeAction
+    | SpeedProfileAction
+    | LateralDistanceAction
     | LaneChangeAction
     | LaneOffsetAction
     | FollowTrajectoryAction

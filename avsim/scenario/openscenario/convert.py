@@ -35,6 +35,8 @@ from pathlib import Path
 from avsim.scenario.checks import check_spawn
 from avsim.scenario.errors import LocatedError, ScenarioError
 from avsim.scenario.openscenario.actions import engages
+from avsim.scenario.openscenario.ego_actions import refuse_on_ego
+from avsim.scenario.openscenario.global_actions import GlobalAction
 from avsim.scenario.openscenario.model import (
     AbsoluteTargetSpeed,
     ActivateControllerAction,
@@ -100,6 +102,7 @@ def load_xosc(path: Path, overrides: Mapping[str, object] | None = None,
     except MapError as e:
         raise ScenarioError(str(osc.road_network), "(file)", str(e)) from None
     ego = _ego(osc)
+    refuse_on_ego(osc, ego.name)
     placed, deferred = _init(osc, Resolver(route.chain))
     if not scripted_ego:
         _check_stack_ego(osc, ego.name, deferred)
@@ -124,14 +127,15 @@ def load_xosc(path: Path, overrides: Mapping[str, object] | None = None,
 
 def _check_stack_ego(osc: OpenScenario, ego: str, deferred: Sequence[InitAction]) -> None:
     """The stack drives the car under test: a motion action on it (Init actions left to
-    run, or a story's) is refused at load; only its controller's actions are played."""
-    controller = ActivateControllerAction | AssignControllerAction
+    run, or a story's) is refused at load; only its controller's actions are played (and
+    global actions, in a maneuver group of any actors)."""
+    played = ActivateControllerAction | AssignControllerAction | GlobalAction
     for item in deferred:
         if item.entity == ego:
             raise ScenarioError(str(osc.path), f"Storyboard.Init.{ego}", _ego_motion(item.action))
     for group, a in osc.storyboard.story_actions():
         if ego in group.actors.entities \
-                and not isinstance(a.private_action, controller):
+                and not isinstance(a.private_action, played):
             raise ScenarioError(str(osc.path), f"Storyboard.Action.{a.name}",
                                 _ego_motion(a.private_action))
 

@@ -14,3 +14,11 @@ MAX_BOX_WIDTH = 5.0  # [m] a bounding box's width
 MAX_BOX_HEIGHT = 5.0  # [m] a bounding box's height
 MAX_NAME_CHARS = 100  # [characters] a name: of an entity, a parameter, a storyboard element,
 #   a catalog entry
+MAX_TRAJECTORY_POINTS = 10_000  # a trajectory's vertices, control points or spline segments
+MAX_NURBS_ORDER = 16  # [-] a NURBS's order (its degree + 1)
+MAX_TRAJECTORY_LENGTH = 20_000.0  # [m] a clothoid's or a spline's length (the YAML format's
+#   longest route, `avsim.scenario.bounds.MAX_ROUTE_LENGTH`)
+MAX_CURVATURE = 10.0  # [1/m] a clothoid's curvature (a 0.1 m radius)
+MAX_CURVATURE_RATE = 100.0  # [1/m^2] a clothoid's curvature change per metre
+MAX_PROFILE_ENTRIES = 1000  # a SpeedProfileAction's entries
+MAX_DISTANCE = 1000.0  # [m] a lateral distance, a synchronize tolerance

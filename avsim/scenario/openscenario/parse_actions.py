@@ -11,13 +11,11 @@ from avsim.scenario.openscenario.actions import (
     AbsoluteTargetSpeed,
     ActivateControllerAction,
     AssignControllerAction,
-    DynamicConstraints,
     FollowTrajectoryAction,
     LaneChangeAction,
     LaneOffsetAction,
     LaneOffsetDynamics,
     LongitudinalDistanceAction,
-    Polyline,
     PrivateAction,
     RelativeTargetLane,
     RelativeTargetLaneOffset,
@@ -25,15 +23,15 @@ from avsim.scenario.openscenario.actions import (
     SpeedAction,
     TeleportAction,
     Timing,
-    Trajectory,
     TransitionDynamics,
-    Vertex,
 )
 from avsim.scenario.openscenario.attributes import unsupported
 from avsim.scenario.openscenario.context import Context
 from avsim.scenario.openscenario.limits import MAX_SPEED, MAX_TIME
 from avsim.scenario.openscenario.parse_entities import parse_controller
+from avsim.scenario.openscenario.parse_motion import MOTION_READERS, parse_constraints
 from avsim.scenario.openscenario.parse_positions import parse_position
+from avsim.scenario.openscenario.parse_trajectories import parse_trajectory_ref
 from avsim.scenario.openscenario.xmlread import Node
 
 SHAPES = ("step", "linear", "sinusoidal", "cubic")
@@ -83,19 +81,6 @@ def _speed(node: Node, ctx: Context) -> PrivateAction:
     return SpeedAction(parse_dynamics(node.need("SpeedActionDynamics"), ctx), speed_target)
 
 
-def _constraints(node: Node | None, ctx: Context) -> DynamicConstraints | None:
-    if node is None:
-        return None
-    a = ctx.attrs
-    return DynamicConstraints(
-        max_acceleration=a.opt_number(node, "maxAcceleration"),
-        max_deceleration=a.opt_number(node, "maxDeceleration"),
-        max_speed=a.opt_bounded(node, "maxSpeed", 0.0, MAX_SPEED, "m/s"),
-        max_acceleration_rate=a.opt_number(node, "maxAccelerationRate"),
-        max_deceleration_rate=a.opt_number(node, "maxDecelerationRate"),
-    )
-
-
 def _longitudinal_distance(node: Node, ctx: Context) -> PrivateAction:
     a = ctx.attrs
     distance = a.opt_number(node, "distance")
@@ -115,7 +100,7 @@ def _longitudinal_distance(node: Node, ctx: Context) -> PrivateAction:
             ("any", "leadingReferencedEntity", "trailingReferencedEntity"),
             "any",
         ),
-        constraints=_constraints(node.child("DynamicConstraints"), ctx),
+        constraints=parse_constraints(node.child("DynamicConstraints"), ctx),
     )
 
 
@@ -157,43 +142,8 @@ def _lane_offset(node: Node, ctx: Context) -> PrivateAction:
     )
 
 
-def parse_trajectory(node: Node, ctx: Context) -> Trajectory:
-    """A Trajectory element, or a CatalogReference to one (Polyline shapes only)."""
-    if node.tag == "CatalogReference":
-        entry = ctx.catalogs.resolve(node, ctx.attrs, ("Trajectory",))
-        return parse_trajectory(entry.node, ctx.in_scope(entry.scope, entry.node))
-    if node.tag != "Trajectory":
-        raise unsupported(node)
-    ctx = ctx.with_declarations(node)
-    a = ctx.attrs
-    shape = node.need("Shape").only_child()
-    if shape.tag != "Polyline":
-        raise unsupported(shape)
-    vertices = tuple(
-        Vertex(a.opt_number(v, "time"), parse_position(v.need("Position"), ctx))
-        for v in shape.all("Vertex")
-    )
-    if len(vertices) < 2:
-        raise shape.error("a Polyline needs at least two vertices")
-    params = ctx.attrs.scope.values if node.child("ParameterDeclarations") is not None else {}
-    return Trajectory(
-        name=a.text(node, "name"),
-        closed=a.boolean(node, "closed"),
-        shape=Polyline(vertices),
-        parameters=dict(params),
-    )
-
-
 def _follow_trajectory(node: Node, ctx: Context) -> PrivateAction:
     a = ctx.attrs
-    holder = node.child("TrajectoryRef")
-    if holder is not None:
-        trajectory_node = holder.only_child()
-    else:  # 1.0 (deprecated in 1.1): the Trajectory or its CatalogReference directly
-        found = node.child("Trajectory") or node.child("CatalogReference")
-        if found is None:
-            raise node.error("missing element TrajectoryRef")
-        trajectory_node = found
     time_ref = node.need("TimeReference").only_child()
     timing: Timing | None
     if time_ref.tag == "None":
@@ -208,7 +158,7 @@ def _follow_trajectory(node: Node, ctx: Context) -> PrivateAction:
         raise unsupported(time_ref)
     mode = node.need("TrajectoryFollowingMode")
     return FollowTrajectoryAction(
-        trajectory=parse_trajectory(trajectory_node, ctx),
+        trajectory=parse_trajectory_ref(node, ctx),
         time_reference=timing,
         following_mode=a.choice(mode, "followingMode", FOLLOWING_MODES),  # type: ignore[arg-type]
         initial_distance_offset=a.opt_number(node, "initialDistanceOffset"),
@@ -263,6 +213,7 @@ _READERS: dict[str, Callable[[Node, Context], PrivateAction]] = {
     "FollowTrajectoryAction": _follow_trajectory,
     "ActivateControllerAction": _activate_controller,
     "AssignControllerAction": _assign_controller,
+    **MOTION_READERS,
 }
 
 

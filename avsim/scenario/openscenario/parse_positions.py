@@ -1,5 +1,5 @@
 """Reading a Position element (World, RelativeWorld, RelativeObject, Road, RelativeRoad,
-Lane, RelativeLane; Route, Geo and Trajectory positions are not supported yet)."""
+Lane, RelativeLane, Trajectory; Route and Geo positions are not supported yet)."""
 
 from __future__ import annotations
 
@@ -16,6 +16,7 @@ from avsim.scenario.openscenario.positions import (
     RelativeRoadPosition,
     RelativeWorldPosition,
     RoadPosition,
+    TrajectoryPosition,
     WorldPosition,
 )
 from avsim.scenario.openscenario.xmlread import Node
@@ -115,6 +116,19 @@ def _relative_lane(node: Node, ctx: Context) -> Position:
     )
 
 
+def _trajectory(node: Node, ctx: Context) -> Position:
+    # a trajectory's vertices are positions: its reader imports this module
+    from avsim.scenario.openscenario.parse_trajectories import parse_trajectory_ref
+
+    a = ctx.attrs
+    return TrajectoryPosition(
+        trajectory=parse_trajectory_ref(node, ctx),
+        s=a.number(node, "s"),
+        t=a.number_or(node, "t", 0.0),
+        orientation=parse_orientation(node.child("Orientation"), ctx),
+    )
+
+
 _READERS: dict[str, Callable[[Node, Context], Position]] = {
     "WorldPosition": _world,
     "RelativeWorldPosition": _relative_world,
@@ -123,6 +137,7 @@ _READERS: dict[str, Callable[[Node, Context], Position]] = {
     "RelativeRoadPosition": _relative_road,
     "LanePosition": _lane,
     "RelativeLanePosition": _relative_lane,
+    "TrajectoryPosition": _trajectory,
 }
 
 

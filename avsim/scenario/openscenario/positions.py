@@ -3,7 +3,10 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Literal
+from typing import TYPE_CHECKING, Literal
+
+if TYPE_CHECKING:  # a trajectory's vertices are positions
+    from avsim.scenario.openscenario.trajectories import Trajectory
 
 ReferenceContext = Literal["relative", "absolute"]
 
@@ -84,6 +87,16 @@ class RelativeLanePosition:
     orientation: Orientation | None
 
 
+@dataclass(frozen=True, slots=True)
+class TrajectoryPosition:
+    """A point of a trajectory: `s` along it from its start, `t` to its left."""
+
+    trajectory: Trajectory
+    s: float  # [m]
+    t: float  # [m] left positive
+    orientation: Orientation | None
+
+
 Position = (
     WorldPosition
     | RelativeWorldPosition
@@ -92,4 +105,5 @@ Position = (
     | RelativeRoadPosition
     | LanePosition
     | RelativeLanePosition
+    | TrajectoryPosition
 )

@@ -13,6 +13,9 @@ a relative road position adds (ds, dt) to its road coordinates; a relative world
 adds (dx, dy) in map axes, a relative object position in the entity's axes. Relative
 positions work on the merged road, so they run on across a road's end into the next road.
 
+A trajectory position is `s` along the trajectory's sampled shape (`sampling`) and `t` to
+its left, headed along it.
+
 The heading of a position on the road is the road's at s (right-hand lanes travel along it,
 left-hand lanes against it) unless an orientation says otherwise: a relative orientation
 adds its h, an absolute one replaces it.
@@ -35,6 +38,7 @@ from avsim.scenario.openscenario.model import (
     RelativeRoadPosition,
     RelativeWorldPosition,
     RoadPosition,
+    TrajectoryPosition,
     WorldPosition,
 )
 from world.map.opendrive import Chain, lane_borders
@@ -121,6 +125,8 @@ class Resolver:
         if isinstance(position, RoadPosition):
             s = self.station(position.road_id, position.s)
             return self.road_pose(s, position.t, None, position.orientation)
+        if isinstance(position, TrajectoryPosition):
+            return self._on_trajectory(position, entities)
         base = _entity(entities, position.entity)
         if isinstance(position, RelativeWorldPosition):
             return Pose(base.x + position.dx, base.y + position.dy,
@@ -135,6 +141,15 @@ class Resolver:
             return self.road_pose(s0 + position.ds, t0 + position.dt, None,
                                   position.orientation)
         return self._relative_lane(position, s0, t0)
+
+    def _on_trajectory(self, position: TrajectoryPosition,
+                       entities: Mapping[str, Pose]) -> Pose:
+        # the sampler resolves the trajectory's own positions through this resolver
+        from avsim.scenario.openscenario.sampling import sample
+
+        shape = position.trajectory.shape
+        pose = sample(shape, lambda p: self.resolve(p, entities)).at(position.s, position.t)
+        return Pose(pose.x, pose.y, _oriented(pose.heading, position.orientation))
 
     def _relative_lane(self, position: RelativeLanePosition, s0: float, t0: float) -> Pose:
         lane0 = self.lane_id(s0, t0)

@@ -21,6 +21,7 @@ from avsim.scenario.openscenario.model import (
     LongitudinalDistanceAction,
     OpenScenario,
     Pedestrian,
+    Polyline,
     RelativeDistanceCondition,
     RelativeLanePosition,
     RelativeTargetLane,
@@ -158,6 +159,7 @@ def test_crossing_pedestrian() -> None:
     assert follow.following_mode == "position"
     assert follow.time_reference is not None
     assert follow.time_reference.domain == "relative" and follow.time_reference.scale == 1.0
+    assert isinstance(follow.trajectory.shape, Polyline)
     first, last = follow.trajectory.shape.vertices
     assert first.time == 0.0 and last.time == pytest.approx(2 * 5.0 / (5.0 / 3.6))
     assert isinstance(first.position, LanePosition) and isinstance(last.position, LanePosition)

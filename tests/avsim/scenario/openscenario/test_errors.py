@@ -158,18 +158,6 @@ WORLD = '<WorldPosition x="0" y="0" h="0"/>'
 @pytest.mark.parametrize(
     ("old", "new", "name"),
     [
-        (SPEED_ACTION, '<SynchronizeAction masterEntityRef="Ego"/>', "SynchronizeAction"),
-        (
-            SPEED_ACTION,
-            "<LongitudinalAction><SpeedProfileAction followingMode='follow'/></LongitudinalAction>",
-            "SpeedProfileAction",
-        ),
-        (
-            SPEED_ACTION,
-            "<LateralAction><LateralDistanceAction entityRef='Ego' continuous='true' "
-            "freespace='true'/></LateralAction>",
-            "LateralDistanceAction",
-        ),
         (
             SPEED_ACTION,
             "<RoutingAction><AcquirePositionAction><Position>" + WORLD + "</Position>"
@@ -181,15 +169,8 @@ WORLD = '<WorldPosition x="0" y="0" h="0"/>'
             "<ControllerAction><OverrideControllerValueAction/></ControllerAction>",
             "OverrideControllerValueAction",
         ),
-        (
-            SPEED_ACTION,
-            "<RoutingAction><FollowTrajectoryAction><TrajectoryRef>"
-            "<Trajectory name='t' closed='false'><Shape><Clothoid curvature='0' length='1'>"
-            "</Clothoid></Shape></Trajectory></TrajectoryRef><TimeReference><None/>"
-            "</TimeReference><TrajectoryFollowingMode followingMode='follow'/>"
-            "</FollowTrajectoryAction></RoutingAction>",
-            "Clothoid",
-        ),
+        (WORLD, "<RoutePosition><RouteRef/><InRoutePosition/></RoutePosition>",
+         "RoutePosition"),
         (WORLD, '<GeoPosition latitudeDeg="48" longitudeDeg="11"/>', "GeoPosition"),
         (
             SIM_TIME,

@@ -29,6 +29,7 @@ from avsim.scenario.openscenario.model import (
     Orientation,
     ParameterCondition,
     Pedestrian,
+    Polyline,
     ReachPositionCondition,
     RelativeDistanceCondition,
     RelativeLanePosition,
@@ -135,6 +136,7 @@ def test_inline_actions(scenario: OpenScenario) -> None:
     assert follow.time_reference is None and follow.following_mode == "follow"
     assert follow.initial_distance_offset == 2.0
     assert follow.trajectory.name == "diagonal" and follow.trajectory.parameters == {"End": 20.0}
+    assert isinstance(follow.trajectory.shape, Polyline)
     last = follow.trajectory.shape.vertices[-1]
     assert last.time is None
     assert last.position == WorldPosition(20.0, 20.0, 0.5, 0.785, None, None)
