@@ -16,6 +16,7 @@ import re
 import subprocess
 import sys
 import time
+import warnings
 from collections.abc import Callable, Sequence
 from contextlib import AbstractContextManager, ExitStack
 from pathlib import Path
@@ -94,6 +95,22 @@ def _writable(outputs: Sequence[Output], inputs: Sequence[Path]) -> None:
 def main(ctx: click.Context) -> None:
     """avsim: a headless 3D driving sandbox for classical autonomous-driving stacks."""
     ctx.with_resource(ExitAtOnce())  # a signal while a command starts: exit 130 / 143
+    warnings.showwarning = _show_warning
+
+
+def _show_warning(message: Warning | str, category: type[Warning], filename: str,
+                  lineno: int, file: Any = None, line: str | None = None) -> None:
+    """A scenario's load warning as one line `avsim: warning: <file>: <key>: <problem>` on
+    stderr; any other warning as Python shows it."""
+    from avsim.scenario.openscenario.parameters import DeclarationWarning
+
+    if issubclass(category, DeclarationWarning):
+        click.echo(f"avsim: warning: {message}", err=True)
+    else:
+        _SHOW_WARNING(message, category, filename, lineno, file, line)
+
+
+_SHOW_WARNING = warnings.showwarning  # Python's own
 
 
 search_path_option = click.option(
