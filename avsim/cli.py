@@ -12,9 +12,11 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import subprocess
 import sys
 import time
+import warnings
 from collections.abc import Callable, Sequence
 from contextlib import AbstractContextManager, ExitStack
 from pathlib import Path
@@ -94,6 +96,22 @@ def _writable(outputs: Sequence[Output], inputs: Sequence[Path]) -> None:
 def main(ctx: click.Context) -> None:
     """avsim: a headless 3D driving sandbox for classical autonomous-driving stacks."""
     ctx.with_resource(ExitAtOnce())  # a signal while a command starts: exit 130 / 143
+    warnings.showwarning = _show_warning
+
+
+def _show_warning(message: Warning | str, category: type[Warning], filename: str,
+                  lineno: int, file: Any = None, line: str | None = None) -> None:
+    """A scenario's load warning as one line `avsim: warning: <file>: <key>: <problem>` on
+    stderr; any other warning as Python shows it."""
+    from avsim.scenario.openscenario.parameters import DeclarationWarning
+
+    if issubclass(category, DeclarationWarning):
+        click.echo(f"avsim: warning: {message}", err=True)
+    else:
+        _SHOW_WARNING(message, category, filename, lineno, file, line)
+
+
+_SHOW_WARNING = warnings.showwarning  # Python's own
 
 
 search_path_option = click.option(
@@ -147,25 +165,31 @@ class SeedType(click.IntRange):
               help="What drives the car under test: avsim's stack, or (scripted, "
                    "OpenSCENARIO files) the file's own actions as esmini plays them, its "
                    "controllers not simulated, no sensors (the profile is none).")
+@click.option("--permutation", type=click.IntRange(min=0), default=None, metavar="K",
+              help="An OpenSCENARIO ParameterValueDistribution file's run K (0-based, as "
+                   "esmini's --param_permutation); without it every run, into the folder "
+                   "--out (default runs/<name>), as a suite.")
 @search_path_option
-def run(scenario: str, out: Path | None, json_path: Path | None, profile: str, sensing: str,
-        seed: int | None, sets: tuple[str, ...], plot: str | None, params: tuple[str, ...],
-        criteria: Path | None, no_progress: bool, ego: str,
-        search_paths: tuple[Path, ...]) -> None:
+@click.pass_context
+def run(ctx: click.Context, scenario: str, out: Path | None, json_path: Path | None,
+        profile: str, sensing: str, seed: int | None, sets: tuple[str, ...], plot: str | None,
+        params: tuple[str, ...], criteria: Path | None, no_progress: bool, ego: str,
+        permutation: int | None, search_paths: tuple[Path, ...]) -> None:
     """Run SCENARIO (a YAML or OpenSCENARIO file, or a bundled name) and judge it."""
+    from avsim.batch.distributions import is_distribution_file
+    from avsim.batch.sweep import SweepError
+
     scripted = ego == "scripted"
     profile = "none" if scripted else profile  # a scripted ego reads no sensors
-    from avsim.batch.sweep import SweepError, parse_set
 
-    overrides: dict[str, object] = {}
+    if is_distribution_file(scenario) and permutation is None:
+        _run_distribution(ctx, scenario, out, json_path is not None or plot is not None)
     try:
-        for text in sets + tuple(PARAMETER_PREFIX + p for p in params):
-            axis = parse_set(text)
-            if len(axis.values) != 1:
-                raise SweepError(f"--set {text}: run takes one value (sweep takes several)")
-            overrides[axis.path] = axis.values[0]
-        if seed is not None:
-            overrides["seed"] = seed
+        chosen: dict[str, object] = {}
+        if permutation is not None:
+            scenario, chosen = _permutation(scenario, permutation, search_paths)
+        overrides = chosen | _run_overrides(sets + tuple(PARAMETER_PREFIX + p for p in params),
+                                            seed)
         loaded = load_scenario(scenario, overrides, criteria, search_paths, scripted)
         check_profile(loaded, profile, scenario)
     except (ScenarioError, SweepError) as exc:
@@ -209,6 +233,58 @@ def run(scenario: str, out: Path | None, json_path: Path | None, profile: str, s
             click.echo(f"avsim: {result.error.line()}", err=True)
     status = _exit_status(result, stop)
     _exit(unwritten, status)
+
+
+def _run_overrides(texts: Sequence[str], seed: int | None) -> dict[str, object]:
+    """`run`'s `PATH=VALUE` texts (one value each) and `--seed` as overrides."""
+    from avsim.batch.sweep import SweepError, parse_set
+
+    overrides: dict[str, object] = {}
+    for text in texts:
+        axis = parse_set(text)
+        if len(axis.values) != 1:
+            raise SweepError(f"--set {text}: run takes one value (sweep takes several)")
+        overrides[axis.path] = axis.values[0]
+    if seed is not None:
+        overrides["seed"] = seed
+    return overrides
+
+
+def _permutation(scenario: str, k: int,
+                 search_paths: Sequence[Path]) -> tuple[str, dict[str, object]]:
+    """`run --permutation K`: the distribution file's scenario file and its run K's
+    parameters as overrides (the user's own --set / --param replace them)."""
+    from avsim.batch.distributions import is_distribution_file
+    from avsim.scenario.openscenario.distribution import load_distribution
+
+    if not is_distribution_file(scenario):
+        raise ScenarioError(scenario, "--permutation", "is for a ParameterValueDistribution "
+                            "file (this is not one)")
+    dist = load_distribution(Path(scenario), search_paths)
+    if k >= len(dist.runs):
+        raise ScenarioError(scenario, "--permutation",
+                            f"{k}: the file describes {len(dist.runs)} runs (0 to "
+                            f"{len(dist.runs) - 1})")
+    click.echo(f"{scenario}: run {k} of {len(dist.runs)}: {dist.runs[k].label()}", err=True)
+    return str(dist.scenario), dist.runs[k].overrides()
+
+
+def _run_distribution(ctx: click.Context, scenario: str, out: Path | None,
+                      single_files: bool) -> NoReturn:
+    """`run DIST.xosc` without --permutation: every run of the distribution, as `suite`
+    runs it (same options), into the folder `out` (default runs/<name>)."""
+    if single_files:
+        _bad_input(f"{scenario}: --json / --plot: a distribution file makes several runs "
+                   "(each writes its own into --out; --permutation K runs one)")
+    if ctx.params["ego"] != "stack":
+        _bad_input(f"{scenario}: --ego scripted: a distribution file's runs are a suite, "
+                   "which the stack drives (--permutation K plays one scripted)")
+    name = re.sub(r"[^a-z0-9_]+", "_", Path(scenario).stem.lower()).strip("_")
+    options = ctx.params
+    ctx.invoke(suite, paths=(scenario,), out=out or Path("runs") / name, sets=options["sets"],
+               params=options["params"], criteria=options["criteria"],
+               profile=options["profile"], search_paths=options["search_paths"])
+    sys.exit(0)  # pragma: no cover - suite exits with the batch's status
 
 
 def _exit_status(result: RunResult, stop: Interrupts) -> int:

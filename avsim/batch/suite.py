@@ -80,16 +80,28 @@ def collect_scenarios(args: Sequence[str]) -> list[str]:
 def suite_entries(scenarios: Sequence[str], overrides: Mapping[str, object] | None = None,
                   search_paths: Sequence[Path] = (),
                   ) -> list[tuple[str | None, str, dict[str, object]]]:
-    """The runs of a suite over `scenarios` (`plan`'s entries): one per scenario, or one per
-    point of its file's `grid` (named ``<name>_<k:03d>``, as a sweep names its runs), each
+    """The runs of a suite over `scenarios` (`plan`'s entries): one per scenario, one per
+    point of its file's `grid` (named ``<name>_<k:03d>``, as a sweep names its runs), or one
+    per concrete run of an OpenSCENARIO distribution file (`avsim.batch.distributions`), each
     with `overrides` (`--set`, `--param`) besides its point; `search_paths` as
     `load_scenario` takes them. A key both set and swept by the file's grid is a
     `BatchError`: the grid's points would all be the same run."""
+    from avsim.batch.distributions import (
+        DistributionError,
+        distribution_entries,
+        is_distribution_file,
+    )
     from avsim.batch.sweep import Axis, grid
 
     given = dict(overrides or {})
     entries: list[tuple[str | None, str, dict[str, object]]] = []
     for scenario in scenarios:
+        if is_distribution_file(scenario):
+            try:
+                entries += distribution_entries(scenario, given, search_paths)
+            except DistributionError as exc:
+                raise BatchError(str(exc)) from None
+            continue
         loaded = load_scenario(scenario, search_paths=search_paths)
         if not loaded.grid:
             entries.append((None, scenario, dict(given)))

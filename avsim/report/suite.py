@@ -36,6 +36,7 @@ from rich.text import Text
 from avsim.batch.jobs import RunOutcome, Status
 
 DASH = "—"  # a value that is absent (None) or not a number
+PARAMETERS = "parameters."  # an OpenSCENARIO parameter's override key: `parameters.NAME`
 DECIMALS = 3  # numbers are shown to this many decimals, trailing zeros dropped
 VERDICTS: dict[Status, tuple[str, str]] = {  # status -> (word, rich style)
     Status.PASSED: ("PASS", "bold green"),
@@ -303,8 +304,9 @@ def _header(outcomes: Sequence[RunOutcome], title: str) -> list[str]:
     ]
 
 
-def _run_row(outcome: RunOutcome, out_dir: Path) -> str:
-    """A run's row of the runs table: verdict, times [s], links to its files."""
+def _run_row(outcome: RunOutcome, out_dir: Path, values: bool = False) -> str:
+    """A run's row of the runs table: verdict, times [s], links to its files; with
+    `values`, its overrides (an OpenSCENARIO parameter by its name)."""
     job = outcome.job
     if outcome.result is None:
         files = [DASH, DASH]
@@ -315,15 +317,19 @@ def _run_row(outcome: RunOutcome, out_dir: Path) -> str:
     sim = format_value(_sim_time(outcome)) if outcome.result is not None else DASH
     cells = [_md_code(job.name), f"**{_verdict(outcome)}**", sim,
              format_value(outcome.wall_time), *files, plot]
+    if values:
+        given = ", ".join(f"{k.removeprefix(PARAMETERS)}={v}" for k, v in job.overrides.items())
+        cells.append(_md_code(given) if given else DASH)
     return "| " + " | ".join(cells) + " |"
 
 
 def _runs_table(outcomes: Sequence[RunOutcome], out_dir: Path) -> list[str]:
     """The table of runs, a row each."""
+    values = any(o.job.overrides for o in outcomes)  # a sweep's, a distribution's runs
     lines = ["| run | verdict | sim time [s] | wall time [s] | recording | result | "
-             "speeds + margins |",
-             "|---|---|--:|--:|---|---|---|"]
-    lines += [_run_row(o, out_dir) for o in outcomes]
+             "speeds + margins |" + (" values |" if values else ""),
+             "|---|---|--:|--:|---|---|---|" + ("---|" if values else "")]
+    lines += [_run_row(o, out_dir, values) for o in outcomes]
     return [*lines, ""]
 
 

@@ -22,6 +22,8 @@ MAX_INT_DIGITS = 20  # digits of an integer in a file or a `--set` value (2**64 
 MAX_NAME_LENGTH = 100  # characters of `name` (it names the run's files: runs/<name>.rrd)
 MAX_DURATION = 7200.0  # [s] `duration`, and every time in the file (triggers, delays, lights)
 MAX_SEED = 2**32 - 1  # `seed` (numpy's seed range)
+MAX_DISTRIBUTION_RUNS = 1000  # the runs an OpenSCENARIO ParameterValueDistribution file
+#   describes (its permutations, or its stochastic numberOfTestRuns)
 MAX_LANES = 6  # driving lanes per direction on a road, oncoming lanes
 MAX_TOWN_LANES = 3  # lanes per direction on a town's streets
 MAX_LANE_WIDTH = 6.0  # [m] a lane's width

@@ -11,7 +11,13 @@ Grammar (lowest precedence first)::
     sum     := product (("+" | "-") product)*
     product := unary (("*" | "/" | "%") unary)*
     unary   := "-" unary | primary
-    primary := NUMBER | "true" | "false" | "$"NAME | FUNC "(" expr ("," expr)* ")" | "(" expr ")"
+    primary := NUMBER | "true" | "false" | CONST | "$"NAME | FUNC "(" expr ("," expr)* ")"
+             | "(" expr ")"
+
+FUNC is one of `FUNCTIONS`: the standard's round, floor, ceil, sqrt, pow, and esmini's
+additions sin, cos, tan, asin, acos, atan, sign, abs, max, min. CONST is `pi` or `e`
+(`CONSTANTS`): not in the standard, but esmini defines them and published files use them
+(Euro NCAP's `${$Trajectory_alpha_deg * pi / 180}`, `${-pi/2}`).
 
 Numbers are doubles; `and`/`or`/`not` take and give booleans; `%` is the remainder with
 the sign of the dividend (C's fmod), as the standard's reference implementations do.
@@ -31,6 +37,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 
 Value = float | bool  # what an expression gives
+CONSTANTS: dict[str, float] = {"pi": math.pi, "e": math.e}  # names an expression may use
 Lookup = Callable[[str], Value]  # a parameter's value by name; raises ExpressionError
 
 
@@ -84,6 +91,9 @@ def _space_end(text: str, pos: int) -> int:
     return found.end()
 
 
+_WORD_VALUES = ("true", "false", *CONSTANTS)  # words that are a value by themselves
+
+
 def check_nesting(tokens: list[Token]) -> None:
     """`ExpressionError` when parentheses, unary minus or `not` nest over MAX_DEPTH, counted
     on the tokens before evaluating, as the evaluator counts them: the expression itself
@@ -104,12 +114,12 @@ def check_nesting(tokens: list[Token]) -> None:
             pending = 0
         elif tok.kind == "op" and tok.text == ")" and opened:
             depth -= 1 + opened.pop()
-        elif tok.kind in ("num", "param") or tok.text in ("true", "false"):
+        elif tok.kind in ("num", "param") or tok.text in _WORD_VALUES:
             depth -= pending
             pending = 0
         if depth > MAX_DEPTH:
             raise ExpressionError(f"nested more than {MAX_DEPTH} deep")
-        previous_is_value = tok.kind in ("num", "param") or tok.text in (")", "true", "false")
+        previous_is_value = tok.kind in ("num", "param") or tok.text in (")", *_WORD_VALUES)
 
 
 def _cut(text: str) -> str:
@@ -325,6 +335,8 @@ class _Evaluator:
         if tok.kind == "word":
             if tok.text in ("true", "false"):
                 return tok.text == "true"
+            if tok.text in CONSTANTS:
+                return CONSTANTS[tok.text]
             if tok.text in FUNCTIONS:
                 return self.call(tok.text)
             raise ExpressionError(f"unknown name {_cut(tok.text)!r} at {tok.pos}")

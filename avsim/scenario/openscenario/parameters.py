@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import math
 import re
+import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass
 from datetime import datetime
@@ -243,8 +244,14 @@ def convert(value: ParamValue, ptype: ParameterType) -> ParamValue:
     return to_str(value)
 
 
+class DeclarationWarning(UserWarning):
+    """A declaration esmini accepts and avsim follows, but which is likely a mistake (a
+    parameter declared twice); the message is one line `<file>: <key>: <problem>`."""
+
+
 def parse_declarations(node: Node | None) -> tuple[ParameterInfo, ...]:
-    """The ParameterDeclaration children of a ParameterDeclarations element, as written."""
+    """The ParameterDeclaration children of a ParameterDeclarations element, as written; a
+    name declared again replaces the earlier declaration (`DeclarationWarning`)."""
     if node is None:
         return ()
     infos: list[ParameterInfo] = []
@@ -260,8 +267,11 @@ def parse_declarations(node: Node | None) -> tuple[ParameterInfo, ...]:
         if ptype not in PARAMETER_TYPES:
             known = ", ".join(PARAMETER_TYPES)
             raise decl.error(f"parameterType {brief(ptype)} is not one of {known}")
-        if any(i.name == name for i in infos):
-            raise decl.error(f"parameter {name} declared twice")
+        if any(i.name == name for i in infos):  # esmini's own catalogs do this
+            infos = [i for i in infos if i.name != name]
+            warnings.warn(DeclarationWarning(
+                f"{decl.file}: {decl.key}: parameter {name} declared twice: the later "
+                "declaration is used"), stacklevel=2)
         groups: list[ConstraintGroup] = []
         for group in decl.all("ConstraintGroup"):
             constraints: list[ValueConstraint] = []
@@ -351,8 +361,10 @@ def evaluate_declarations(
             raise ScenarioError(file, f"({overrides_from}s)", problem)
     scope = Scope({}, parent, budget)
     assert node is not None or not infos
-    decls = node.all("ParameterDeclaration") if node is not None else []
-    for info, decl in zip(infos, decls, strict=True):
+    found = node.all("ParameterDeclaration") if node is not None else []
+    decls = {d.attrs.get("name"): d for d in found}
+    for info in infos:  # each name's last declaration: `parse_declarations`
+        decl = decls[info.name]
         raw = overrides.get(info.name, info.default)
         source = f" ({overrides_from} {brief(raw)})" if info.name in overrides else ""
         try:
@@ -360,6 +372,6 @@ def evaluate_declarations(
         except ResolveError as exc:
             raise decl.error(f"parameter {info.name}{source}: {exc}") from None
         scope.values[info.name] = value
-    for info, decl in zip(infos, decls, strict=True):
-        check_constraints(info, scope.values[info.name], scope, decl)
+    for info in infos:
+        check_constraints(info, scope.values[info.name], scope, decls[info.name])
     return scope

@@ -42,10 +42,13 @@ def _read_root(path: Path) -> tuple[Node, int, int]:
         raise header.error("revMajor and revMinor must be integers") from None
     if major != 1 or minor not in SUPPORTED_MINOR:
         raise header.error(f"not supported yet (OpenSCENARIO {major}.{minor})")
-    for kind in ("Catalog", "ParameterValueDistribution"):
-        found = root.child(kind)
-        if found is not None:
-            raise found.error(f"not supported yet ({kind}): this is not a scenario file")
+    catalog = root.child("Catalog")
+    if catalog is not None:
+        raise catalog.error("not supported yet (Catalog): this is not a scenario file")
+    distribution = root.child("ParameterValueDistribution")
+    if distribution is not None:  # `distribution.load_distribution` reads it
+        raise distribution.error("a parameter distribution, not one scenario: `avsim run` "
+                                 "runs each of its runs (--permutation K one), as `suite`")
     return root, major, minor
 
 

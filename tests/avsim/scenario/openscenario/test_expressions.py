@@ -231,3 +231,27 @@ def test_precedence_without_parentheses(tree: Tree) -> None:
     if not math.isfinite(expected):
         return
     assert ev(text) == pytest.approx(expected, rel=1e-9, abs=1e-9)
+
+
+@pytest.mark.parametrize(
+    ("text", "expected"),
+    [
+        ("pi", math.pi),
+        ("-pi/2", -math.pi / 2),
+        ("$speed_kph * pi / 180", 36.0 * math.pi / 180),
+        ("2 * pi", 2 * math.pi),
+        ("e", math.e),
+        ("-e", -math.e),
+        ("cos(pi)", -1.0),
+        ("round(pi * 100) / 100", 3.14),
+        ("pi > 3 and e < 3", True),
+    ],
+)
+def test_constants_pi_and_e_as_esmini_defines_them(text: str, expected: Value) -> None:
+    assert ev(text) == expected
+
+
+@pytest.mark.parametrize("text", ["pie", "PI", "pi(1)", "pi pi", "tau"])
+def test_other_names_are_still_refused(text: str) -> None:
+    with pytest.raises(ExpressionError):
+        ev(text)

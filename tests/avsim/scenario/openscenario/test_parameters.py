@@ -7,6 +7,7 @@ import pytest
 
 from avsim.scenario.errors import ScenarioError
 from avsim.scenario.openscenario.parameters import (
+    DeclarationWarning,
     ResolveError,
     Scope,
     evaluate_declarations,
@@ -194,3 +195,14 @@ def test_to_int_rounds_expression_results_half_away_from_zero() -> None:
     assert to_int(2.4999) == 2
     with pytest.raises(ResolveError):
         to_int("2.0")
+
+
+def test_a_parameter_declared_twice_takes_the_later_declaration_with_a_warning() -> None:
+    body = (decl("mass", "double", "1000") + decl("length", "double", "4")
+            + decl("mass", "double", "2000", '<ConstraintGroup><ValueConstraint '
+                   'rule="greaterThan" value="1500"/></ConstraintGroup>')
+            + decl("load", "double", "${$mass / 4}"))
+    with pytest.warns(DeclarationWarning, match=r"t\.xosc: line \d+: .*: parameter mass "
+                      "declared twice: the later declaration is used"):
+        values = declarations(body)
+    assert values == {"length": 4.0, "mass": 2000.0, "load": 500.0}
