@@ -33,11 +33,7 @@ PEDESTRIAN_PATH = ("a crossing pedestrian: avsim's walk (trapezoidal lateral spe
 SWERVE_PATH = ("a swerve by a LaneOffsetAction / lane change with a sinusoidal shape: "
                "avsim's lateral profile is not yet esmini's")
 CUT_IN_PATH = "the cut-in's lane change profile: not yet esmini's (0.29 m RMS)"
-AFTER_END = ("events started by the end of a previous event: avsim starts them one trigger "
-             "check (0.025 s) per link earlier than esmini; not yet matched")
 KNOWN = {
-    ("alks/no_controllers/alks_scenario_4_1_2_swerving_lead_vehicle_template", "events"):
-        AFTER_END,
     ("alks/no_controllers/alks_scenario_4_2_3_crossing_pedestrian_template", "paths"):
         PEDESTRIAN_PATH,
     ("alks/no_controllers/alks_scenario_4_4_2_cut_in_unavoidable_collision_template",
