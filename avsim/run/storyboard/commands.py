@@ -10,9 +10,10 @@
   rate is the peak lateral speed.
 - LaneOffsetAction: a lateral transition to an offset from the actor's lane centre (or to
   an entity's lateral position plus a value, to its left when it drives along the route:
-  esmini's reading of a relative target), timed by its peak lateral acceleration (`LANE_OFFSET_ACCEL`
-  when the file gives none): sinusoidal T = pi sqrt(d / 2a), cubic T = sqrt(6 d / a),
-  linear and step as fast as that acceleration allows from rest to rest, T = 2 sqrt(d / a).
+  esmini's reading of a relative target), timed by its peak lateral acceleration
+  (`LANE_OFFSET_ACCEL` when the file gives none): sinusoidal T = pi sqrt(d / 2a), cubic
+  T = sqrt(6 d / a), linear and step as fast as that acceleration allows from rest to
+  rest, T = 2 sqrt(d / a).
 - FollowTrajectoryAction: a polyline of resolved positions, in route coordinates of the
   body centre; timed when the action has a time reference (vertex time x scale + offset,
   plus the start time for the relative domain), else at the actor's speed.
