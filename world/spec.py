@@ -235,6 +235,8 @@ class ActorSpec:
     size: tuple[float, float, float] | None = None  # [m] length, width, height of a
     #   pedestrian's or an obstacle's box (a scenario file's bounding box); None: the type's
     #   (`world.actors.bodies.SIZES`)
+    against: bool = False  # drives against its lane's direction of travel (a scenario
+    #   file's heading turned half a turn from the lane's)
 
 
 @dataclass(frozen=True, slots=True)

@@ -30,20 +30,15 @@ from tests.conformance.reference import (
 CONTROLLED = "the Ego has an esmini controller in this run: compared in no_controllers/"
 PEDESTRIAN_PATH = ("a crossing pedestrian: avsim's walk (trapezoidal lateral speed, turning "
                    "at 180 deg/s) is not esmini's; not yet matched")
-SWERVE_PATH = ("a swerve by a LaneOffsetAction / lane change with a sinusoidal shape: "
-               "avsim's lateral profile is not yet esmini's")
-CUT_IN_PATH = "the cut-in's lane change profile: not yet esmini's (0.29 m RMS)"
-AFTER_END = ("events started by the end of a previous event: avsim starts them one trigger "
-             "check (0.025 s) per link earlier than esmini; not yet matched")
+CUT_IN_PATH = ("the cut-in's lane change: esmini keeps the speed over ground (the progress "
+               "along the road slows while it moves across) and moves the reference point "
+               "along the shape; avsim moves the body centre at the full speed along the "
+               "road (0.28 m RMS); not yet matched")
 KNOWN = {
-    ("alks/no_controllers/alks_scenario_4_1_2_swerving_lead_vehicle_template", "events"):
-        AFTER_END,
     ("alks/no_controllers/alks_scenario_4_2_3_crossing_pedestrian_template", "paths"):
         PEDESTRIAN_PATH,
     ("alks/no_controllers/alks_scenario_4_4_2_cut_in_unavoidable_collision_template",
      "paths"): CUT_IN_PATH,
-    ("alks/no_controllers/alks_scenario_4_6_2_lateral_detection_range_template", "paths"):
-        SWERVE_PATH,
 }
 CONTROLLED_RUNS = {r.output.replace("/no_controllers", "") for r in runs()
                    if "/no_controllers/" in r.output}  # their default twins

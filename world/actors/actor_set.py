@@ -102,7 +102,8 @@ class ActorSet:
             lane = own_map.lane(spec.lane)
             offset = float(lane.offset_at(spec.s)) + spec.offset
             self.motions.append(
-                NpcMotion(spec.s, offset, spec.speed, lane.direction, spec.actions,
+                NpcMotion(spec.s, offset, spec.speed,
+                          -lane.direction if spec.against else lane.direction, spec.actions,
                           lane=spec.lane, pedestrian=spec.type is ActorType.PEDESTRIAN)
             )
         sizes = [body_size(a) for a in specs]

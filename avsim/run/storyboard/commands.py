@@ -8,10 +8,12 @@
 - LaneChangeAction: a lateral transition to the target lane's centre (plus its target
   offset); the target lane is an OpenDRIVE id, or lanes to the left of an entity's lane; a
   rate is the peak lateral speed.
-- LaneOffsetAction: a lateral transition to an offset from the actor's lane centre (or an
-  entity's offset plus a value), timed by its peak lateral acceleration (`LANE_OFFSET_ACCEL`
-  when the file gives none): sinusoidal T = pi sqrt(d / 2a), cubic T = sqrt(6 d / a),
-  linear and step as fast as that acceleration allows from rest to rest, T = 2 sqrt(d / a).
+- LaneOffsetAction: a lateral transition to an offset from the actor's lane centre (or to
+  an entity's lateral position plus a value, to its left when it drives along the route:
+  esmini's reading of a relative target), timed by its peak lateral acceleration
+  (`LANE_OFFSET_ACCEL` when the file gives none): sinusoidal T = pi sqrt(d / 2a), cubic
+  T = sqrt(6 d / a), linear and step as fast as that acceleration allows from rest to
+  rest, T = 2 sqrt(d / a).
 - FollowTrajectoryAction: the trajectory's shape sampled to a dense polyline
   (`avsim.scenario.openscenario.sampling`; a polyline: its resolved vertices), in route
   coordinates of the body centre; timed when the action has a time reference and the shape
@@ -159,9 +161,8 @@ class Commands:
             goal = centre + target.value
         else:
             ref = snap.entities[target.entity]
-            ref_lane = ref.lane if ref.lane is not None else lane
-            goal = centre + (ref.offset - float(self.road.lane(ref_lane).offset_at(ref.s))
-                             + target.value)
+            along = math.cos(ref.heading - ref.route_heading) >= 0.0
+            goal = ref.offset + (target.value if along else -target.value)
         accel = action.dynamics.max_lateral_acc or LANE_OFFSET_ACCEL
         shape = Shape(action.dynamics.shape)
         span = _offset_span(shape, abs(goal - centre_offset), accel)

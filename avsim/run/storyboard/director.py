@@ -1,9 +1,11 @@
 """The director: plays an OpenSCENARIO storyboard on a world, step by step.
 
 At each trigger check (`world.core.rates.TRIGGER_RATE`) it takes the truth's snapshot
-(`truth.TruthTracker`), reports the actions whose commands reached their goal, steps the
-storyboard (`runtime.StoryRuntime`: which actions start and stop now), and turns each
-started action into a command on each of its actors' motions (`commands`). Commands the
+(`truth.TruthTracker`), steps the storyboard (`runtime.StoryRuntime`: which actions start
+and stop now), then reports the actions whose commands reached their goal since the last
+check (they end now, after this check's triggers: a condition on their end sees it at the
+next check, as esmini evaluates the triggers of a step before it steps the actions), and
+turns each started action into a command on each of its actors' motions (`commands`). Commands the
 truth must steer every step (a distance to keep, a continuous relative speed) are renewed
 at each check. Actions on the car under test are its controller's (activation,
 assignment): they complete at once and set the switch of its automated driving function
@@ -94,7 +96,6 @@ class Director:
     def step(self, touching: frozenset[int]) -> bool:
         """One trigger check; True once the storyboard's StopTrigger has fired."""
         snap = self.truth.snapshot(touching)
-        self._collect_finished(snap)
         if self._first:
             self._first = False
             for i, item in enumerate(self.program.init_commands):
@@ -104,6 +105,7 @@ class Director:
         result = self.runtime.step(snap)
         for action_id in result.stopped:
             self._stop(action_id)
+        self._collect_finished(snap)
         for started in result.started:
             self._start(started, snap)
         self._renew(snap)

@@ -142,8 +142,9 @@ class StoryRuntime:
 
     def action_done(self, action_id: str, t: float) -> None:
         """The world reports the action reached its goal at `t` [s]: it ends (and what it
-        completes with it). Ignored unless that execution of the action is running. Report
-        before the `step` of the same time, so its conditions see it at that step."""
+        completes with it). Ignored unless that execution of the action is running. The
+        director reports after the `step` of the same time, so conditions on the end see it
+        at the next step (esmini's order: triggers, then the actions)."""
         path, _, _n = action_id.rpartition("#")
         node = self._actions.get(path)
         if node is None:

@@ -67,10 +67,17 @@ def _add(parent: Node | None, node: Node) -> Node:
     return node
 
 
+def _start_watch(trigger: Trigger | None) -> TriggerWatch:
+    """A start trigger's watch: one without a condition group (`<StartTrigger/>`) starts
+    its element at once, as none does (esmini's default for start triggers; an empty stop
+    trigger never fires)."""
+    return TriggerWatch(trigger if trigger is not None and trigger.groups else None)
+
+
 def _event(parent: Node, e: Event) -> Node:
     node = _add(parent, Node("event", e.name, f"{parent.path}/{e.name}", parent,
                              max_executions=e.maximum_execution_count,
-                             start=TriggerWatch(e.start_trigger), event=e))
+                             start=_start_watch(e.start_trigger), event=e))
     for a in e.actions:
         _add(node, Node("action", a.name, f"{node.path}/{a.name}", node, action=a))
     return node
@@ -94,7 +101,7 @@ def _group(parent: Node, mg: ManeuverGroup) -> Node:
 def _act(parent: Node, a: Act) -> Node:
     stop = None if a.stop_trigger is None else TriggerWatch(a.stop_trigger)
     node = _add(parent, Node("act", a.name, f"{parent.path}/{a.name}", parent,
-                             start=TriggerWatch(a.start_trigger), stop=stop))
+                             start=_start_watch(a.start_trigger), stop=stop))
     for mg in a.maneuver_groups:
         _group(node, mg)
     return node

@@ -2,7 +2,8 @@
 
 Each entity's reference point is its body centre moved back along its heading by its
 `centre_ahead` (`StoryProgram`): the car under test's rear axle, the file's bounding box
-reference point for the others. Route coordinates are projected from those points onto the
+reference point for the others (and for a scripted car under test, whose box is then the
+file's too: `StoryProgram.ego_box`). Route coordinates are projected from those points onto the
 ego's route. Running figures (odometer, time at rest, off the road, beyond the road's ends)
 are integrated between snapshots, and accelerations and yaw rates differenced between
 them (0 at the first). Contacts are the ego's (the NPC bodies are kinematic and
@@ -39,8 +40,9 @@ class TruthTracker:
         self.categories = {program.ego: "vehicle"} | {
             name: CATEGORIES[kind] for (name, _), kind in zip(program.actors, kinds, strict=True)}
         sizes = world.actors.half_sizes * 2.0
-        self.lengths = np.concatenate([[g.body_length], sizes[:, 0]])
-        self.widths = np.concatenate([[g.body_width], sizes[:, 1]])
+        length, width = program.ego_box or (g.body_length, g.body_width)
+        self.lengths = np.concatenate([[length], sizes[:, 0]])
+        self.widths = np.concatenate([[width], sizes[:, 1]])
         self.bodies = {world.ego.body: program.ego} | {
             world.actors.bodies[i]: name for name, i in program.actors}
         n = len(self.names)

@@ -106,7 +106,8 @@ def load_xosc(path: Path, overrides: Mapping[str, object] | None = None,
     placed, deferred = _init(osc, Resolver(route.chain))
     if not scripted_ego:
         _check_stack_ego(osc, ego.name, deferred)
-    ahead = {e.name: _centre_ahead(e, e.name == ego.name) for e in osc.entities}
+    ahead = {e.name: _centre_ahead(e, e.name == ego.name and not scripted_ego)
+             for e in osc.entities}
     ego_spec = replace(_ego_spec(path, road_map, ego.name, placed, ahead[ego.name],
                                  starts_engaged(osc, ego.name)), scripted=scripted_ego)
     others = [e for e in osc.entities if e.name != ego.name]
@@ -115,7 +116,8 @@ def load_xosc(path: Path, overrides: Mapping[str, object] | None = None,
         scenario=osc, chain=route.chain, ego=ego.name,
         actors=tuple((e.name, i) for i, e in enumerate(others)),
         centre_ahead=tuple(ahead.items()), lane_ids=route.layout.lane_ids,
-        init_commands=tuple(deferred))
+        init_commands=tuple(deferred),
+        ego_box=(ego.object.bbox.length, ego.object.bbox.width) if scripted_ego else None)
     world = spec.WorldSpec(road=route.spec, ego=ego_spec, actors=actors, seed=side.seed,
                            sensors=side.sensors, scenery_roads=route.scenery)
     _check_spawn(path, world, ego.name, [e.name for e in others])
@@ -303,7 +305,9 @@ def _actor_spec(path: Path, road_map: RoadMap, entity: Entity,
         lane, r = _nearest_lane(road_map, s, r)
     obj = entity.object
     base = spec.ActorSpec(id=_actor_id(entity.name), type=spec.ActorType.OBSTACLE, lane=lane,
-                          s=s, offset=r, speed=placed[entity.name].speed)
+                          s=s, offset=r, speed=placed[entity.name].speed,
+                          against=isinstance(obj, Vehicle) and _against(
+                              road_map, lane, s, placed[entity.name].pose))
     if isinstance(obj, Vehicle):
         kind = spec.ActorType.TRUCK if obj.category in TRUCKS else spec.ActorType.CAR
         return replace(base, type=kind, model=_model(obj))
@@ -312,6 +316,17 @@ def _actor_spec(path: Path, road_map: RoadMap, entity: Entity,
         return replace(base, type=spec.ActorType.PEDESTRIAN, size=size)
     assert isinstance(obj, MiscObject)
     return replace(base, size=size)
+
+
+def _against(road_map: RoadMap, lane: int, s: float, pose: Pose | None) -> bool:
+    """Whether a vehicle placed with `pose` heads against its lane's direction of travel
+    (a heading more than a quarter turn from it, e.g. a relative orientation of half a turn
+    in a lane position: relative to the lane's direction, as esmini reads it)."""
+    if pose is None:
+        return False
+    travel = float(road_map.heading_at(s)) + (0.0 if road_map.lane(lane).direction > 0
+                                              else math.pi)
+    return math.cos(pose.heading - travel) < 0.0
 
 
 def _nearest_lane(road_map: RoadMap, s: float, d: float) -> tuple[int, float]:
