@@ -48,6 +48,7 @@ class Need(enum.Enum):
     STORY = "story"  # the scenario's required actions and events (`story_label`s)
     ACTOR_BODIES = "actor_bodies"  # which actor each NPC body is (body id -> actor id)
     TOWN = "town"  # the town's layout (`world.spec.TownSpec`; None on a road)
+    PARAMETERS = "parameters"  # an OpenSCENARIO file's global parameters (name -> value)
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -123,6 +124,8 @@ class CriterionResult:
     note: str | None = None  # why it failed when the value does not say, what never
     #   happened (not applicable), or what qualifies a verdict (a contact a rule excuses,
     #   samples left out, the judging ended early)
+    details: tuple[tuple[str, str | float | bool | None], ...] = ()  # (key, value) of a
+    #   verdict that is more than a value (the Euro NCAP test, its speeds and points)
 
     def __post_init__(self) -> None:
         for what, x in (("value", self.value), ("threshold", self.threshold)):
@@ -159,6 +162,9 @@ class CriterionResult:
             out["first_failure"] = round(self.first_failure, 3)
         if self.note is not None:
             out["note"] = self.note
+        if self.details:
+            out["details"] = {k: _round(v) if isinstance(v, float) else v
+                              for k, v in self.details}
         return out
 
 

@@ -46,6 +46,8 @@ class RunInputs:
     actor_bodies: Mapping[int, str] = field(default_factory=dict)  # NPC body id -> its
     #   actor's id
     town: TownSpec | None = None  # the town's layout and signal timing (None: a road)
+    parameters: Mapping[str, int | float | bool | str] = field(default_factory=dict)  # an
+    #   OpenSCENARIO file's global parameters, resolved (none for a YAML scenario)
 
 
 @dataclass(frozen=True, slots=True)

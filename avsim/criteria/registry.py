@@ -24,6 +24,7 @@ from avsim.criteria.declaration import Declaration, RunInputs
 from avsim.criteria.following import FOLLOWING_GAP, MIN_GAP, RESUME_WITHIN, STANDSTILL_GAP
 from avsim.criteria.jerk import MAX_JERK
 from avsim.criteria.lane import LANE_CHANGE, TYRES_IN_LANE
+from avsim.criteria.ncap import NCAP
 from avsim.criteria.right_of_way import MAX_WAIT_WITH_RIGHT_OF_WAY
 from avsim.criteria.road_rules import CROSSWALKS, RED_LIGHTS, SPEED_BUMPS, STOP_SIGNS
 from avsim.criteria.route import COMPLETES, MINIMUM_RISK_STOP
@@ -52,6 +53,7 @@ DECLARATIONS: tuple[Declaration[Any], ...] = (
     MAX_JERK,  # `max_jerk`
     COMFORT,  # `comfort`
     MAX_WAIT_WITH_RIGHT_OF_WAY,  # `max_wait_with_right_of_way`
+    NCAP,  # `ncap`
 )
 
 

@@ -8,7 +8,8 @@ scenario or writes a file; the caller writes the text they return.
   its note as `<system-out>`); a run that did not finish or ended in error has a
   `<testcase name="run">` with an `<error>` (a run that ended in error also keeps its
   criteria judged so far). Attributes follow the common (Jenkins / Surefire) JUnit schema.
-- `summary_markdown`: the counts, a table of scenarios (pass rate, worst margins, every
+- `summary_markdown`: the counts, the Euro NCAP scorecard when runs have an `ncap` verdict
+  (`avsim.report.ncap`), a table of scenarios (pass rate, worst margins, every
   contact with those a rule excused), a table of runs with links to their files, a table
   of criteria per run (and its contacts), and the snapshot of each failed run at its first
   failure.
@@ -34,6 +35,7 @@ from rich.table import Table
 from rich.text import Text
 
 from avsim.batch.jobs import RunOutcome, Status
+from avsim.report.ncap import junit_properties, scorecard_markdown
 
 DASH = "—"  # a value that is absent (None) or not a number
 PARAMETERS = "parameters."  # an OpenSCENARIO parameter's override key: `parameters.NAME`
@@ -164,10 +166,12 @@ def _criterion_case(suite: ET.Element, outcome: RunOutcome,
     case = ET.SubElement(suite, "testcase", classname=f"avsim.{outcome.job.name}",
                          name=str(criterion["name"]))
     first = criterion.get("first_failure")
-    if first is not None:
+    facts = ({} if first is None else {"first_failure_sim_time": f"{first}"}) \
+        | junit_properties(criterion)
+    if facts:
         properties = ET.SubElement(case, "properties")
-        ET.SubElement(properties, "property", name="first_failure_sim_time",
-                      value=f"{first}")
+        for name, value in facts.items():
+            ET.SubElement(properties, "property", name=name, value=value)
     if criterion["passed"] is None:
         ET.SubElement(case, "skipped", message=str(criterion.get("note") or "not applicable"))
     elif criterion["passed"] and criterion.get("note"):
@@ -446,7 +450,8 @@ def summary_markdown(outcomes: Sequence[RunOutcome], *, title: str, out_dir: Pat
     run with a snapshot in `snapshots` (job name -> PNG), the image, titled with its first
     failure's time.
     """
-    lines = _header(outcomes, title) + _scenario_table(outcomes) + _runs_table(outcomes, out_dir)
+    lines = (_header(outcomes, title) + scorecard_markdown(outcomes)
+             + _scenario_table(outcomes) + _runs_table(outcomes, out_dir))
     for outcome in outcomes:
         lines += _run_section(outcome)
     lines += _snapshots(outcomes, out_dir, snapshots)
