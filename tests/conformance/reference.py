@@ -1,9 +1,8 @@
 """The vendored esmini reference (`tests/data/esmini_ref/`) and avsim's play of the same
 file with a scripted car under test, side by side.
 
-`runs()` lists every run of the reference; `play(run)` loads its scenario file (the ALKS
-set from `tests/data/alks/`, the others from the machine's copy of the public sets, skipped
-where absent) with `scripted_ego`, runs it without sensors and keeps every storyboard
+`runs()` lists every run of the reference; `play(run)` loads its scenario file (vendored
+unchanged in `tests/data/`: `alks/`, `ncap/`, `asam_examples/`) with `scripted_ego`, runs it without sensors and keeps every storyboard
 transition and every entity's reference point at each trigger check (the director's
 snapshots). `event_starts` and `path_rms` compare.
 """
@@ -26,7 +25,6 @@ from avsim.scenario.load import load_scenario
 
 DATA = Path(__file__).resolve().parents[1] / "data"
 REF = DATA / "esmini_ref"
-SHARED = Path("/work/shared/standards")  # the full public sets, where this machine has them
 ALKS_PREFIX = "shared/standards/alks/"
 EVENT_TOLERANCE = 0.05  # [s] an event starts within this of esmini's start
 RMS_TOLERANCE = 0.2  # [m] an entity's path within this RMS of esmini's
@@ -58,8 +56,8 @@ def scenario_file(run: RefRun) -> tuple[Path, list[Path]]:
     if run.source.startswith(ALKS_PREFIX):
         return DATA / "alks" / run.source.removeprefix(ALKS_PREFIX), []
     rel = run.source.removeprefix("shared/standards/")
-    root = SHARED / rel.split("/")[0]
-    return SHARED / rel, [root]
+    root = DATA / rel.split("/")[0]
+    return DATA / rel, [root]
 
 
 def _read_gz(path: Path) -> list[dict[str, str]]:
