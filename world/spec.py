@@ -418,6 +418,22 @@ class SensorsSpec:
 
 
 @dataclass(frozen=True, slots=True)
+class SceneryObjectSpec:
+    """A static solid of the scenery in the map frame (an OpenDRIVE road object): a box, an
+    upright cylinder or the prism of an outline. The cameras and the LiDAR see it, and
+    touching it is a collision."""
+
+    type: str  # the file's object type ("pole", "tree", "railing", ...): names its colour
+    centre: tuple[float, float, float]  # [m] map frame, the solid's middle
+    yaw: float  # [rad] of its x axis (length), ccw from map +x
+    half_extents: tuple[float, float, float]  # [m] box: along, across, up; a cylinder:
+    #   (radius, radius, half its height); a prism: its points' bounding box's
+    round: bool = False  # an upright cylinder of radius half_extents[0]
+    hull: tuple[tuple[float, float, float], ...] = ()  # [m] a prism's corner points
+    #   relative to `centre` (map axes, yaw 0): the solid is their convex hull
+
+
+@dataclass(frozen=True, slots=True)
 class WorldSpec:
     """A whole world: `World(spec)` builds it (`world.world`)."""
 
@@ -431,3 +447,5 @@ class WorldSpec:
     scenery_roads: tuple[RoadSpec, ...] = ()  # roads drawn in the world (surface and paint)
     #   but not on the HD map the stack reads, with no traffic and no traffic rules from them
     #   (an OpenDRIVE dual carriageway's far side: `world.map.opendrive.far_side`)
+    scenery_objects: tuple[SceneryObjectSpec, ...] = ()  # static solids beside the roads
+    #   (an OpenDRIVE file's road objects: `world.map.opendrive.object_layout`)

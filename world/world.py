@@ -52,6 +52,7 @@ from world.scene.scenery import (
     speed_limit_sign_image,
     stop_sign_image,
 )
+from world.scene.scenery_objects import object_rgb, object_shape
 from world.scene.scenery_roads import build_scenery_roads
 from world.scene.texture_rows import aligned_texture
 from world.scene.town_scene import Pavement, build_town_scene
@@ -63,7 +64,13 @@ from world.sensors.odometry import OdometrySensor
 from world.sensors.rig import SensorRig
 from world.sensors.sensor import Sensor
 from world.sensors.setup import LIDAR, SensorSetup
-from world.spec import SensorFault, TownSpec, TrafficLightSpec, WorldSpec
+from world.spec import (
+    SceneryObjectSpec,
+    SensorFault,
+    TownSpec,
+    TrafficLightSpec,
+    WorldSpec,
+)
 from world.truth import RouteTruth, route_truth
 
 SIGN_POLE_RADIUS = 0.04  # [m]
@@ -81,7 +88,8 @@ class StaticScene:
     buildings: tuple[BuildingBox, ...]
     signs: tuple[SignPlacement, ...]  # speed-limit signs
     ground: int  # body id
-    obstacle_bodies: frozenset[int]  # buildings and sign poles: touching one is a collision
+    obstacle_bodies: frozenset[int]  # buildings, sign poles and scenery objects: touching
+    #   one is a collision
     stop_signs: tuple[StopSignPlacement, ...] = ()
     bumps: tuple[BumpPlacement, ...] = ()
     bump_bodies: frozenset[int] = frozenset()  # speed bumps: driven over, not collisions
@@ -205,6 +213,7 @@ class World:
         obstacles |= {self._add_stop_sign(i, sign) for i, sign in enumerate(stop_signs)}
         lights = self.signals
         obstacles |= self._add_lights(lights)
+        obstacles |= self._add_scenery_objects(self.spec.scenery_objects)
         return StaticScene(meshes, buildings, signs, ground, frozenset(obstacles),
                            stop_signs, tuple(bump for bump, _ in bumps), bump_bodies,
                            lights=lights)
@@ -340,6 +349,35 @@ class World:
         quat = c.getQuaternionFromEuler([0.0, 0.0, b.yaw])
         return self.shapes.placed(int(c.createMultiBody(0.0, shape, visual, list(b.centre),
                                                         quat, useMaximalCoordinates=True)), shape)
+
+    def _add_scenery_objects(self, objects: tuple[SceneryObjectSpec, ...]) -> set[int]:
+        """A static body with collision for each scenery object; alike objects (same shape
+        and colour) share one collision shape and one visual. A prism's visual is its
+        bounding box (a visual mesh would go through a file: `_mesh_visual`)."""
+        c = self.client
+        shapes: dict[tuple[object, ...], tuple[int, int]] = {}
+        bodies: set[int] = set()
+        for obj in objects:
+            key = (obj.round, obj.half_extents, obj.hull, obj.type)
+            if key not in shapes:
+                rgba = [*object_rgb(obj), 1.0]
+                shape = self.shapes.create(c, Part(object_shape(obj)))
+                if obj.round:
+                    visual = c.createVisualShape(pybullet.GEOM_CYLINDER,
+                                                 radius=obj.half_extents[0],
+                                                 length=2.0 * obj.half_extents[2],
+                                                 rgbaColor=rgba)
+                else:
+                    visual = c.createVisualShape(pybullet.GEOM_BOX,
+                                                 halfExtents=list(obj.half_extents),
+                                                 rgbaColor=rgba)
+                shapes[key] = (shape, int(visual))
+            shape, visual = shapes[key]
+            quat = c.getQuaternionFromEuler([0.0, 0.0, obj.yaw])
+            bodies.add(self.shapes.placed(int(c.createMultiBody(
+                0.0, shape, visual, list(obj.centre), quat, useMaximalCoordinates=True)),
+                shape))
+        return bodies
 
     def _add_pole(self, xy: tuple[float, float], top: float) -> int:
         """A sign pole standing on the ground up to `top` [m], with collision."""

@@ -4,7 +4,8 @@ the same world spec, driver settings and criteria as a YAML file gives, plus the
 
 - The road: the file's OpenDRIVE roads, linked end to end into one, as the route
   (`world.map.opendrive.route`); positions on any of them are placed on it. A dual
-  carriageway's far side is drawn as a scenery road (`WorldSpec.scenery_roads`).
+  carriageway's far side is drawn as a scenery road (`WorldSpec.scenery_roads`); the road
+  objects stand as static solids (`WorldSpec.scenery_objects`).
 - The car under test: the entity named `Ego` (any case), else the first vehicle. Scripted
   (`scripted_ego`, `avsim run --ego scripted`), the file's actions move it as any other
   entity, its controllers not simulated (esmini's `--disable_controllers`). Else avsim's
@@ -119,7 +120,8 @@ def load_xosc(path: Path, overrides: Mapping[str, object] | None = None,
         init_commands=tuple(deferred),
         ego_box=(ego.object.bbox.length, ego.object.bbox.width) if scripted_ego else None)
     world = spec.WorldSpec(road=route.spec, ego=ego_spec, actors=actors, seed=side.seed,
-                           sensors=side.sensors, scenery_roads=route.scenery)
+                           sensors=side.sensors, scenery_roads=route.scenery,
+                           scenery_objects=route.objects)
     _check_spawn(path, world, ego.name, [e.name for e in others])
     return Scenario(name=_name(path), description=osc.description, situation="openscenario",
                     duration=side.duration, world=world,

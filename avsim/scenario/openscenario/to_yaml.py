@@ -158,12 +158,16 @@ def _road(road: RoadSpec, out: Conversion) -> dict[str, Any]:
 
 
 def _scenery(scenario: Scenario, out: Conversion) -> None:
-    """The scenery roads (a dual carriageway's far side): the YAML has none."""
+    """The scenery roads (a dual carriageway's far side) and objects: the YAML has none."""
     for road in scenario.world.scenery_roads:
         lanes = road.segments[0].lanes
         out.misfits.append(f"the road's far carriageway ({lanes} lanes beyond the median, "
                            "drawn as scenery): the YAML road has no scenery roads, it is "
                            "not drawn")
+    if scenario.world.scenery_objects:
+        out.misfits.append(f"the road's {len(scenario.world.scenery_objects)} static objects "
+                           "(poles, trees, guard rails: solids the car may hit): the YAML "
+                           "road has none, they are not built")
 
 
 def _actor(actor: ActorSpec, out: Conversion) -> dict[str, Any]:

@@ -15,6 +15,7 @@ from numpy.typing import ArrayLike, NDArray
 
 if TYPE_CHECKING:
     from world.map.opendrive.geometry import PlanView
+    from world.map.opendrive.objects import RoadObject
 
 FloatArray = NDArray[np.float64]
 
@@ -191,6 +192,8 @@ class Road:
     lane_offsets: tuple[Poly3, ...]  # [m] of the centre lane from the reference line
     lane_sections: tuple[LaneSection, ...]  # ascending s, the first at 0
     speeds: tuple[SpeedRecord, ...]  # ascending s
+    objects: tuple[RoadObject, ...] = ()  # its <objects> (s on this road; none on a merged
+    #   road: `chain` keeps them on the file's roads)
 
 
 @dataclass(frozen=True, slots=True)

@@ -2,9 +2,9 @@
 
 Supported: header (its geoReference ignored, an all-zero <offset>), roads with their links,
 types and speeds, planView records (line, arc, spiral, poly3, paramPoly3), lanes (see
-`parse_lanes`), flat elevation and lateral profiles (every coefficient 0), empty objects,
-signals and surface; userData anywhere is skipped. Everything else - junctions, objects,
-signals, elevation, superelevation, any other element - is refused as "not supported yet
+`parse_lanes`), flat elevation and lateral profiles (every coefficient 0), objects (see
+`parse_objects`), empty signals and surface; userData anywhere is skipped. Everything else -
+junctions, signals, elevation, superelevation, any other element - is refused as "not supported yet
 (...)" naming the element, as are bad numbers and files beyond the size limits. Checked on
 the geometry, in this order and all before any curve is evaluated: the counts (roads,
 planView records in the file), every number (finite, at most 64 characters, within 1e9),
@@ -41,6 +41,7 @@ from world.map.opendrive.model import (
     Spiral,
 )
 from world.map.opendrive.parse_lanes import lanes, speed
+from world.map.opendrive.parse_objects import count_objects, road_objects
 from world.map.opendrive.shapes import PolyCurve
 from world.map.opendrive.xmltree import Node, parse_xml
 
@@ -102,6 +103,7 @@ def _check_counts(roads: list[Node]) -> None:
                 count += sum(1 for g in view.children if g.tag == "geometry")
         if count > MAX_GEOMETRIES:
             raise node.error(f"more than {MAX_GEOMETRIES} geometry records in the file")
+    count_objects(roads)
 
 
 def _header(node: Node) -> tuple[int, int, str]:
@@ -265,7 +267,7 @@ def _road(node: Node) -> Road:
         "signals",
         "surface",
     )
-    for tag in ("objects", "signals", "surface"):
+    for tag in ("signals", "surface"):
         for n in kids[tag]:
             if any(c.tag != "userData" for c in n.children):
                 raise n.unsupported(tag)
@@ -289,4 +291,5 @@ def _road(node: Node) -> Road:
         lane_offsets=offsets,
         lane_sections=sections,
         speeds=_speeds(kids["type"]),
+        objects=road_objects(kids["objects"]),
     )

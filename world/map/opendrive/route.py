@@ -67,8 +67,9 @@ from world.map.opendrive.lanes import (
     lane_width,
 )
 from world.map.opendrive.model import LaneSection, OdrLane, OpenDrive, Road
+from world.map.opendrive.object_layout import layout_objects
 from world.map.opendrive.offset_spline import CurvePiece
-from world.spec import RoadSpec, SegmentSpec
+from world.spec import RoadSpec, SceneryObjectSpec, SegmentSpec
 
 TOLERANCE = 1e-3  # [m] the route's pieces keep this close to the file's exact reference line
 TYPE_LIMITS = {  # [km/h] a road type's limit where the file posts none (German rules)
@@ -114,6 +115,8 @@ class OdrRoute:
     layout: Layout
     scenery: tuple[RoadSpec, ...] = ()  # drawn, not on the map: the far carriageway of a
     #   dual carriageway (`far_side`), at most one
+    objects: tuple[SceneryObjectSpec, ...] = ()  # the file's road objects as static solids
+    #   (`object_layout`)
 
     @property
     def road(self) -> Road:
@@ -173,7 +176,7 @@ def _build_route(odr: OpenDrive) -> OdrRoute:
     first = segments[0]
     assert first.start is not None and first.speed_limit is not None
     return OdrRoute(RoadSpec(tuple(segments), first.speed_limit, origin=first.start), chain,
-                    layout, scenery)
+                    layout, scenery, layout_objects(odr))
 
 
 def posted_once(segments: list[SegmentSpec]) -> list[SegmentSpec]:

@@ -149,8 +149,8 @@ def variant(tmp_path: Path, old: str, new: str) -> Path:
         ),
         (
             "<objects/>",
-            '<objects><object id="9" s="1" t="0"/></objects>',
-            "/OpenDRIVE/road[id=1]/objects: not supported yet (objects)",
+            '<objects><tunnel id="9" s="1" length="4"/></objects>',
+            "/OpenDRIVE/road[id=1]/objects/tunnel[id=9]: not supported yet (tunnel)",
         ),
         (
             "<signals></signals>",
