@@ -18,9 +18,11 @@ the same world spec, driver settings and criteria as a YAML file gives, plus the
   category (car, van, motorbike, bicycle: a car; truck, bus, trailer, semitrailer: a truck),
   pedestrians, misc objects as obstacles.
 - Init: teleports place the entities in order (relative positions refer to entities placed
-  before); a speed action with a step sets the starting speed; a longitudinal distance
-  action without dynamic constraints places its entity at the distance (as esmini jumps);
-  every other Init action starts at t = 0 (`StoryProgram.init_commands`).
+  before); an entity no teleport places starts where its Init FollowTrajectoryAction's
+  trajectory starts (at its initial distance offset); a speed action with a step sets the
+  starting speed; a longitudinal distance action without dynamic constraints places its
+  entity at the distance (as esmini jumps); every other Init action starts at t = 0
+  (`StoryProgram.init_commands`).
 - The run lasts until the StopTrigger fires, at most the sidecar's `duration`; the criteria,
   seed and sensor noise come from the sidecar (`sidecar`).
 """
@@ -43,6 +45,7 @@ from avsim.scenario.openscenario.model import (
     ActivateControllerAction,
     AssignControllerAction,
     Entity,
+    FollowTrajectoryAction,
     InitAction,
     LongitudinalDistanceAction,
     MiscObject,
@@ -55,6 +58,7 @@ from avsim.scenario.openscenario.model import (
 from avsim.scenario.openscenario.parse import load_openscenario, scenario_roots
 from avsim.scenario.openscenario.program import StoryProgram
 from avsim.scenario.openscenario.resolve import Pose, PositionError, Resolver
+from avsim.scenario.openscenario.sampling import sample
 from avsim.scenario.openscenario.sidecar import load_sidecar, sidecar_path, split_overrides
 from avsim.scenario.scenario import DriverSettings, Scenario
 from vehicle_urdf.geometry import read_geometry
@@ -211,9 +215,21 @@ def _init(osc: OpenScenario, resolver: Resolver) -> tuple[dict[str, _Placed],
                 state.pose = _at_distance(action, placed, osc, resolver)
             elif not isinstance(action, ActivateControllerAction | AssignControllerAction):
                 deferred.append(item)
+                if isinstance(action, FollowTrajectoryAction) and state.pose is None:
+                    state.pose = _trajectory_start(action, placed, resolver)
         except PositionError as e:
             raise ScenarioError(str(osc.path), f"Storyboard.Init.{item.entity}", str(e)) from None
     return placed, deferred
+
+
+def _trajectory_start(action: FollowTrajectoryAction, placed: Mapping[str, _Placed],
+                      resolver: Resolver) -> Pose:
+    """Where an Init FollowTrajectoryAction puts an entity no teleport has placed: on its
+    trajectory at the initial distance offset (0: the start), heading along it, as esmini
+    places it when the action starts."""
+    poses = {n: p.pose for n, p in placed.items() if p.pose is not None}
+    path = sample(action.trajectory.shape, lambda p: resolver.resolve(p, poses))
+    return path.at(action.initial_distance_offset or 0.0, 0.0)
 
 
 def _target_speed(action: SpeedAction, placed: Mapping[str, _Placed]) -> float:
@@ -342,12 +358,21 @@ def _actor_id(name: str) -> str:
     return re.sub(r"[^a-z0-9_]+", "_", name.lower()).strip("_") or "entity"
 
 
+def _wheelbase(vehicle: Vehicle) -> float:
+    """[m] front axle to rear axle; with no front axle (a trailer) the rear axle to the
+    box's front end, where a trailer's drawbar pivots."""
+    if vehicle.front_axle is not None:
+        return vehicle.front_axle.position_x - vehicle.rear_axle.position_x
+    box = vehicle.bbox
+    return box.center_x + box.length / 2.0 - vehicle.rear_axle.position_x
+
+
 def _model(vehicle: Vehicle) -> VehicleModel:
     """A vehicle's body from the file: its bounding box and axles."""
     box = vehicle.bbox
     return VehicleModel(
         name=vehicle.name, cls=CLASSES.get(vehicle.category, VehicleClass.CAR),
         length=box.length, width=box.width, height=box.height,
-        wheelbase=vehicle.front_axle.position_x - vehicle.rear_axle.position_x,
+        wheelbase=_wheelbase(vehicle),
         mass=vehicle.mass if vehicle.mass is not None else 0.0,
         source=f"OpenSCENARIO vehicle {vehicle.name} ({vehicle.category})")

@@ -39,7 +39,7 @@ class Vehicle:
     max_decel: float  # [m/s²] (positive)
     max_accel_rate: float | None  # [m/s³] (1.2 Performance attribute), None when not given
     max_decel_rate: float | None  # [m/s³] (1.2)
-    front_axle: Axle
+    front_axle: Axle | None  # None: none (a trailer's, 1.3)
     rear_axle: Axle
     additional_axles: tuple[Axle, ...]
     mass: float | None  # [kg] (OpenSCENARIO 1.1+ attribute), None when not given

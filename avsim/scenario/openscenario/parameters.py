@@ -249,6 +249,12 @@ class DeclarationWarning(UserWarning):
     parameter declared twice); the message is one line `<file>: <key>: <problem>`."""
 
 
+def declared_name(raw: str | None) -> str | None:
+    """A declaration's parameter name: a leading `$` (as 1.0-era files write `name="$owner"`)
+    is not part of it, so `$owner` refers to it, as esmini reads it."""
+    return raw[1:] if raw is not None and raw.startswith("$") else raw
+
+
 def parse_declarations(node: Node | None) -> tuple[ParameterInfo, ...]:
     """The ParameterDeclaration children of a ParameterDeclarations element, as written; a
     name declared again replaces the earlier declaration (`DeclarationWarning`)."""
@@ -256,7 +262,7 @@ def parse_declarations(node: Node | None) -> tuple[ParameterInfo, ...]:
         return ()
     infos: list[ParameterInfo] = []
     for decl in node.all("ParameterDeclaration"):
-        name = decl.attrs.get("name")
+        name = declared_name(decl.attrs.get("name"))
         ptype = decl.attrs.get("parameterType")
         default = decl.attrs.get("value")
         if name is None or ptype is None or default is None:
@@ -362,7 +368,7 @@ def evaluate_declarations(
     scope = Scope({}, parent, budget)
     assert node is not None or not infos
     found = node.all("ParameterDeclaration") if node is not None else []
-    decls = {d.attrs.get("name"): d for d in found}
+    decls = {declared_name(d.attrs.get("name")): d for d in found}
     for info in infos:  # each name's last declaration: `parse_declarations`
         decl = decls[info.name]
         raw = overrides.get(info.name, info.default)

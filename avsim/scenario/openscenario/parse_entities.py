@@ -56,8 +56,19 @@ def parse_axle(node: Node, ctx: Context) -> Axle:
     )
 
 
+def _front_axle(axles: Node, ctx: Context) -> Axle | None:
+    """The FrontAxle, None if none (optional in 1.3's schema: a trailer has none)."""
+    node = axles.child("FrontAxle")
+    return None if node is None else parse_axle(node, ctx)
+
+
 def parse_vehicle(node: Node, ctx: Context) -> Vehicle:
+    """A Vehicle; its 1.3 TrailerHitch / TrailerCoupler are read past (they matter only to
+    a trailer connection), a Trailer (one connected from the start) is refused."""
     ctx = ctx.with_declarations(node)
+    trailer = node.child("Trailer")
+    if trailer is not None:
+        raise unsupported(trailer)
     a = ctx.attrs
     perf = node.need("Performance")
     axles = node.need("Axles")
@@ -70,7 +81,7 @@ def parse_vehicle(node: Node, ctx: Context) -> Vehicle:
         max_decel=a.number(perf, "maxDeceleration"),
         max_accel_rate=a.opt_number(perf, "maxAccelerationRate"),
         max_decel_rate=a.opt_number(perf, "maxDecelerationRate"),
-        front_axle=parse_axle(axles.need("FrontAxle"), ctx),
+        front_axle=_front_axle(axles, ctx),
         rear_axle=parse_axle(axles.need("RearAxle"), ctx),
         additional_axles=tuple(parse_axle(x, ctx) for x in axles.all("AdditionalAxle")),
         mass=a.opt_number(node, "mass"),
@@ -152,9 +163,9 @@ def parse_entities(node: Node, ctx: Context) -> tuple[Entity, ...]:
                 "needs exactly one of CatalogReference, Vehicle, Pedestrian, MiscObject"
             )
         controller_node = obj.child("ObjectController")
-        controller = (
+        controller = (  # an empty ObjectController: no controller (esmini reads it so)
             parse_controller(controller_node.only_child(), ctx)
-            if controller_node is not None
+            if controller_node is not None and controller_node.children
             else None
         )
         entities.append(Entity(name, parse_object(kinds[0], ctx), controller))
