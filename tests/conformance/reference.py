@@ -2,9 +2,10 @@
 file with a scripted car under test, side by side.
 
 `runs()` lists every run of the reference; `play(run)` loads its scenario file (vendored
-unchanged in `tests/data/`: `alks/`, `ncap/`, `asam_examples/`) with `scripted_ego`, runs it without sensors and keeps every storyboard
-transition and every entity's reference point at each trigger check (the director's
-snapshots). `event_starts` and `path_rms` compare.
+unchanged in `tests/data/`: `alks/`, `ncap/`, `asam_examples/`) with `scripted_ego`, runs
+it without sensors and keeps every storyboard transition and every entity's reference
+point at each trigger check (the director's snapshots). `event_starts` and `path_rms`
+compare.
 """
 
 from __future__ import annotations
