@@ -168,7 +168,7 @@ class Director:
 
     def _start(self, started: StartedAction, snap: Snapshot) -> None:
         action = started.action
-        if isinstance(action, CONTROLLER_ACTIONS | OverrideControllerValueAction):
+        if isinstance(action, (*CONTROLLER_ACTIONS, OverrideControllerValueAction)):
             self._control(started)  # the runtime completes these itself
             return
         tags = set()
