@@ -5,8 +5,9 @@ from __future__ import annotations
 import enum
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
+from world.frames import DriverControls
 from world.hdmap import LightColour
 
 
@@ -249,5 +250,7 @@ class PlannerInput:
     pedal: float = 0.0  # [-] 0..1, the driver's accelerator pedal position
     engaged: bool = True  # the automated driving function is switched on (off: the driver
     #   holds the speed, `planner.planner`)
+    driver: DriverControls = field(default_factory=DriverControls)  # the driver's set
+    #   speed, turn-signal stalk and brake pedal (`planner.planner`)
     flat_tyre: bool = False  # a flat tyre is detected (from the wheel speeds)
     health: SensorHealth = SensorHealth()  # the sensor faults noticed now

@@ -25,7 +25,8 @@ shoulder). Per tick:
    that speed); the route needs the car to move right when
    the lane kept does not go on to max(``prepare_distance``, ``prepare_time`` v) ahead (a
    lane that ends at an exit or a lane drop is left in time); the route's turn at a
-   junction; during a change, whether the target lane is still free, whether the car's
+   junction; the lane the driver's turn-signal stalk asks for (one lane at a time towards
+   it); during a change, whether the target lane is still free, whether the car's
    centre is inside it (committed) and whether the path is done;
 3. the motion FSM steps once.
 
@@ -249,11 +250,12 @@ class MotionLayer:
 
     def update(self, ego: EgoState, v_want: float, tracks: Sequence[Track],
                pull_over: bool = False, v_rear: float | None = None,
+               lane_request: int | None = None,
                ) -> tuple[Manoeuvre, tuple[StateChange, ...]]:
         """Step with the ego estimate, the speed it wants [m/s], the confirmed tracks,
-        whether to pull over onto the shoulder (a flat tyre) and the lowest speed [m/s] the
+        whether to pull over onto the shoulder (a flat tyre), the lowest speed [m/s] the
         car plans during a lane change (the rear traffic is judged at it; default: its
-        speed now)."""
+        speed now) and the lane the driver's turn-signal stalk asks for (None: at rest)."""
         s, d = (float(a) for a in self.road.local_coordinates((ego.x, ego.y), self._station))
         self._station = s
         lanes = self._lanes_around(s, ego.speed, pull_over)
@@ -265,6 +267,8 @@ class MotionLayer:
         self._v_want = v_want
         v_low = ego.speed if v_rear is None else min(ego.speed, v_rear)
         x = self._input(ego, s, d, v_want, v_low, traffic, pull_over)
+        if lane_request is not None and lane_request != self.lane:
+            x = replace(x, driver_lane=1 if lane_request > self.lane else -1)
         change = transition(self.machine.state, x, self.params.motion)
         if change is not None:
             self._passing = is_pass(self.machine.state, x, self.params.motion)

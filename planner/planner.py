@@ -41,9 +41,13 @@ reference line, speeds [m/s]. Steps:
    `perception.health` noticed it) and the emergency stop; the plan's `speed_source` is the
    link that set the speed;
 6. while the automated driving function is not engaged (`PlannerInput.engaged`: an
-   OpenSCENARIO file's car under test before its controller is activated) the ACC is off
-   (ACC_OFF) and the driver holds the set speed (`SpeedSource.DRIVER`) in the lane kept,
-   whatever is ahead; the emergency stop below stays on;
+   OpenSCENARIO file's car under test before its controller is activated; or overridden
+   by the driver's brake until he switches it on again) the ACC is off (ACC_OFF) and the
+   driver drives (`SpeedSource.DRIVER`) in the lane kept, whatever is ahead: his brake, or
+   the speed he holds, moved to his set speed at a comfortable rate
+   (`planner.driver_inputs`); the emergency stop below stays on. The set speed is the
+   driver's last choice (`PlannerInput.driver`), else the configured one; his turn-signal
+   stalk asks the motion FSM for a lane (step 3);
 7. the control FSM (`planner.control_layer`) names the control action and, in an
    emergency, asks for the emergency stop's deceleration instead; the hazard lights go on
    with a flat tyre, and during a minimum-risk stop in lane after a sensor fault (off again
@@ -62,6 +66,7 @@ from perception.messages import EgoState, LaneView, PlannerInput, Track
 from planner.acc_layer import AccLayer, AccLayerParams
 from planner.camera_lane import camera_lane_path
 from planner.control_layer import ControlLayer
+from planner.driver_inputs import DriverInputs, DriverParams
 from planner.driver_override import DriverOverride, OverrideParams
 from planner.events import EventMonitor, EventParams
 from planner.fsm import hazard, lane_source, sensing
@@ -113,6 +118,7 @@ class PlannerParams:
     acc: AccLayerParams = field(default_factory=AccLayerParams)
     motion: MotionLayerParams = field(default_factory=MotionLayerParams)
     override: OverrideParams = field(default_factory=OverrideParams)
+    driver: DriverParams = field(default_factory=DriverParams)
     events: EventParams = field(default_factory=EventParams)
     junctions: JunctionParams = field(default_factory=JunctionParams)
     shoulder_line: ShoulderLineParams = field(default_factory=ShoulderLineParams)
@@ -172,6 +178,7 @@ class Planner:
         self.lead_accel = LeadAccel()
         self.leads = LeadSelector(self.params.lead, self.params.acc.control)
         self.driver = DriverOverride(p.override)
+        self.inputs = DriverInputs(p.set_speed, p.max_speed, p.driver)
         self.events = EventMonitor(self.road, p.vehicle, p.events)
         self._waiting: frozenset[float] = frozenset()  # [m] the crosswalks ahead where a
         #   pedestrian waits this tick (`EventMonitor.waiting`: a lower crossing speed)
@@ -211,9 +218,8 @@ class Planner:
         [m/s], by default the driver's set speed), never above the sight cap (its binding
         SIGHT where the cap is what limits it); slower towards a crosswalk where a
         pedestrian waits (this tick's `EventMonitor.waiting`)."""
-        p = self.params
         return self.speed_planner.target(
-            station, set_speed=p.set_speed if set_speed is None else set_speed,
+            station, set_speed=self.inputs.set_speed if set_speed is None else set_speed,
             max_speed=self.max_speed, sight_speed=self.sight_speed, waiting=self._waiting)
 
     def update(self, inp: PlannerInput) -> Plan:
@@ -225,13 +231,16 @@ class Planner:
             self.events.see_signs(inp.signs.signs, inp.signs.pose)
         if inp.lights:
             self.junctions.see_lights(inp.lights)
+        self.inputs.update(inp.driver, ego.speed, dt)
+        engaged = inp.engaged and not self.inputs.overridden
         station, lateral = self.localise(ego)
         self._waiting = self.events.waiting(station, float(self.lane.offset_at(station)),
                                             float(self.lane.width_at(station)), tracks)
         target = self.speed_for(station)
-        want = min(self.params.set_speed, target.limit_at_front)
+        want = min(self.inputs.set_speed, target.limit_at_front)
         manoeuvre, motion_changes = self.motion.update(ego, want, tracks,
                                                        pull_over=inp.flat_tyre,
+                                                       lane_request=inp.driver.lane_request,
                                                        v_rear=self._lowest_speed(ego.speed,
                                                                                  inp.flat_tyre))
         if manoeuvre.lane != self.lane_index:  # a lane change began, ended or was aborted
@@ -267,15 +276,15 @@ class Planner:
         events = replace(events, active=events.active | junction.active,
                          stop_distance=min(events.stop_distance, junction.stop_distance))
         lead_accel = self.lead_accel.update(lead)
-        set_speed = self.params.set_speed if inp.engaged else 0.0  # off: ACC_OFF
+        set_speed = self.inputs.set_speed if engaged else 0.0  # off: ACC_OFF
         acc, acc_changes = self.acc.update(ego.t, dt, ego.speed, set_speed,
                                            target.limit_at_front, planned,
                                            _with_room(lead, manoeuvre),
                                            driver_gap=self.params.override.gap_margin
                                            if driver else None, events=events,
                                            lead_accel=lead_accel)
-        speed = self._degraded_cap(acc.speed, ego.speed, dt) if inp.engaged else \
-            PlannedSpeed(SpeedRef(self.params.set_speed, 0.0), SpeedSource.DRIVER)
+        speed = self._degraded_cap(acc.speed, ego.speed, dt) if engaged else \
+            self.inputs.driving(inp.driver, ego.speed)
         control, control_changes = self.control.update(
             ego.t, ego.speed, speed.ref.speed, speed.ref.accel,
             acc.lead_gap + (manoeuvre.room if _with_room(lead, manoeuvre) is not lead else 0.0),

@@ -30,7 +30,7 @@ import enum
 import functools
 import importlib
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from types import ModuleType
 from typing import TypeAlias
 
@@ -109,6 +109,22 @@ class GnssFix:
 
 
 @dataclass(frozen=True, slots=True)
+class DriverControls:
+    """The driver's controls that the stack reads as vehicle signals besides the accelerator
+    pedal: the cruise set speed buttons, the turn-signal stalk and the brake pedal. The car
+    is drive-by-wire: none of them moves the car by itself; the stack arbitrates them
+    (`planner.planner`)."""
+
+    set_speed: float | None = None  # [m/s] the set speed the driver last chose (None: none
+    #   chosen, the configured one holds)
+    lane_request: int | None = None  # [-] the lane the stalk asks for (ego-direction index,
+    #   0 rightmost), held until released; None: the stalk at rest
+    brake: float = 0.0  # [-] 0..1, the brake pedal position
+    activations: int = 0  # [-] how often the driver has switched the function on (a press
+    #   after a brake override turns it back on)
+
+
+@dataclass(frozen=True, slots=True)
 class Odometry:
     """The vehicle signals sampled together: wheel encoders, steering encoder, yaw-rate
     gyro, the accelerator pedal sensor (drive-by-wire: the driver's, or an external control
@@ -124,6 +140,8 @@ class Odometry:
     engaged: bool = True  # the driver's switch of the automated driving function: on, the
     #   stack drives; off, the driver holds the speed (an OpenSCENARIO file's car under test
     #   before its ActivateControllerAction)
+    driver: DriverControls = field(default_factory=DriverControls)  # the driver's other
+    #   controls
 
     @property
     def speed(self) -> float:

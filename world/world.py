@@ -28,6 +28,7 @@ from world.core.rendering import attach_renderer
 from world.ego.body import EgoBody, EgoParams, EgoTruth
 from world.ego.events import EgoEvents
 from world.ego.scripted import ScriptedEgo
+from world.frames import DriverControls
 from world.map.road import build_road_map, light_head
 from world.map.signals import light_colour, route_signals
 from world.map.town import TownLayout
@@ -153,6 +154,9 @@ class World:
         self._events = EgoEvents(spec.events)
         self.engaged = spec.ego.engaged  # the automated driving function's switch (the
         #   odometry's `engaged`): a storyboard's ActivateControllerAction turns it on
+        self.driver = DriverControls()  # the driver's other controls (the odometry's
+        #   `driver`): a storyboard's actions on the car under test set them
+        self.throttle = 0.0  # [-] 0..1, the accelerator pedal a storyboard's override holds
         self.rig = self._build_rig(sensors, lidar, seeds, lidar_backend)
         self._truth: EgoTruth | None = None
         self._route: RouteTruth | None = None
@@ -182,11 +186,12 @@ class World:
                            self.actors.bodies, self.scene.ground,
                            sorted(self.scene.static_bodies), self.shapes, backend)
             sensors.append(LidarSensor(caster, setup.timing(LIDAR), ride_height))
-        events = self._events
         sensors += [GnssSensor(self.spec.sensors.gnss, np.random.default_rng(seeds[1])),
                     OdometrySensor(self.ego.geometry.wheel_radius,
-                                   np.random.default_rng(seeds[2]), pedal=lambda: events.pedal,
-                                   engaged=lambda: self.engaged)]
+                                   np.random.default_rng(seeds[2]),
+                                   pedal=lambda: self.accelerator_pedal,
+                                   engaged=lambda: self.engaged,
+                                   driver=lambda: self.driver)]
         return SensorRig(sensors)
 
     def _build_scene(self, rng: np.random.Generator) -> StaticScene:
@@ -455,9 +460,10 @@ class World:
 
     @property
     def accelerator_pedal(self) -> float:
-        """[-] 0..1, the accelerator pedal position an ego event holds now (0: released), as
-        of the last trigger check; what `odometry` measures. No force comes with it."""
-        return self._events.pedal
+        """[-] 0..1, the accelerator pedal position an ego event or a storyboard's override
+        (`throttle`) holds now, the further pressed (0: released), as of the last trigger
+        check; what `odometry` measures. No force comes with it."""
+        return max(self._events.pedal, self.throttle)
 
     @property
     def event_fired_at(self) -> tuple[float | None, ...]:

@@ -51,6 +51,7 @@ from world.ego.body import vehicle_info
 from world.frames import (
     CameraFrame,
     CameraInfo,
+    DriverControls,
     Frame,
     GnssFix,
     LidarScan,
@@ -140,6 +141,7 @@ class Stack:
         self._lights: tuple[LightDetection, ...] = ()  # the last frame's lights, likewise
         self._pedal = 0.0  # [-] the driver's accelerator pedal, from the odometry
         self._engaged = True  # the function's switch, from the odometry
+        self._driver = DriverControls()  # the driver's other controls, from the odometry
 
     def on_frames(self, t: float, frames: Sequence[Frame]) -> PerceptionOutput | None:
         """One delivery: the frames captured together at time `t` [s], each to its
@@ -173,6 +175,7 @@ class Stack:
             self.localizer.on_odometry(odo)
         self._pedal = odo.accelerator_pedal
         self._engaged = odo.engaged
+        self._driver = odo.driver
         with self.watch("perception flat tyre"):
             self.flat_detector.update(odo)
 
@@ -271,6 +274,7 @@ class Stack:
             plan = self.planner.update(PlannerInput(
                 ego=ego, lane=self._view, tracks=self._tracks, signs=self._signs,
                 lights=self._lights, pedal=self._pedal, engaged=self._engaged,
+                driver=self._driver,
                 flat_tyre=self.flat_detector.state is not None, health=self.health.health(t)))
         self._signs, self._lights = None, ()
         with self.watch("control"):

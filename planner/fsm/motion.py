@@ -13,7 +13,8 @@ keeping right), whether a pass path to either side would clear the vehicle ahead
 the whole pass (out, past and back in) would be over before a vehicle coming up behind in
 that lane, not braking, is nearer than the rear rule's distance (`planner.rear_pass`), the
 lanes the route needs the car to move, the route's turn at a junction, a flat tyre's
-pull-over, whether a pass through the oncoming lane is safe (`planner.oncoming_pass`),
+pull-over, the lane the driver's turn-signal stalk asks for, whether a pass through the
+oncoming lane is safe (`planner.oncoming_pass`),
 whether the car keeps the oncoming lane and may take its own lane back, and the progress of
 the manoeuvre in hand.
 
@@ -34,25 +35,29 @@ tried in this order and the first that holds is taken:
 5. lane_keep -> u_turn: the route turns back there
 6. lane_keep -> lane_change_right: the route needs a lane to the right and it is free
 7. lane_keep -> lane_change_left: the route needs a lane to the left and it is free
-8. lane_keep -> lane_change_left: overtaking allowed, the lane blocked, the left free, a
-   pass path into it clears the vehicle ahead and the whole pass outruns every vehicle
-   coming up behind in the left lane, `keep_time` since the last change, and the route needs
-   no other lane
-9. lane_keep -> lane_change_right: overtaking allowed, the lane blocked, only the right
-   free, clearing and outrun (as above)
-10. lane_keep -> lane_change_left: overtaking allowed, the lane blocked, the only way past
+8. lane_keep -> lane_change_right: the driver's turn signal asks for a lane to the right, it
+   is free, the route needs no other lane and `route_keep_time` has passed
+9. lane_keep -> lane_change_left: the driver's turn signal asks for a lane to the left (as
+   above)
+10. lane_keep -> lane_change_left: overtaking allowed, the lane blocked, the left free, a
+    pass path into it clears the vehicle ahead and the whole pass outruns every vehicle
+    coming up behind in the left lane, `keep_time` since the last change, and neither the
+    route nor the driver asks for another lane
+11. lane_keep -> lane_change_right: overtaking allowed, the lane blocked, only the right
+    free, clearing and outrun (as above)
+12. lane_keep -> lane_change_left: overtaking allowed, the lane blocked, the only way past
     the oncoming lane and a pass through it safe (`planner.oncoming_pass`) on a path that
-    clears the vehicle ahead, `keep_time` since the last change, and the route needs no
-    other lane
-11. lane_keep -> lane_change_right: keep right: overtaking allowed, the lane not blocked,
+    clears the vehicle ahead, `keep_time` since the last change, and neither the route nor
+    the driver asks for another lane
+13. lane_keep -> lane_change_right: keep right: overtaking allowed, the lane not blocked,
     the right free and clear (nothing slower ahead in it to block it), `keep_time` since the
-    last change (none when a faster vehicle comes up behind), and the route needs no other
-    lane
-12. lane_change_left, lane_change_right -> lane_keep: the change is done (in the target
+    last change (none when a faster vehicle comes up behind), and neither the route nor the
+    driver asks for another lane
+14. lane_change_left, lane_change_right -> lane_keep: the change is done (in the target
     lane)
-13. lane_change_left, lane_change_right -> lane_keep: abort: the target lane is no longer
+15. lane_change_left, lane_change_right -> lane_keep: abort: the target lane is no longer
     free, not yet committed
-14. turn_right, turn_left, u_turn -> lane_keep: the turn is done (in the exit lane)
+16. turn_right, turn_left, u_turn -> lane_keep: the turn is done (in the exit lane)
 
 In the oncoming lane (after a pass through it on a road with one lane each way) nothing
 but the way back is taken, and it is taken as soon as it may be: the car never stays there
@@ -132,6 +137,8 @@ class MotionInput:
     #   UN R157's rear distance back (`planner.rear_pass`)
     outruns_right: bool = True  # ... into the right lane
     route_lane: int = 0  # [lanes] the route needs the car to move: > 0 left, < 0 right
+    driver_lane: int = 0  # [lanes] the driver's turn-signal stalk asks the car to move:
+    #   > 0 left, < 0 right (the stack changes lanes when its own rules allow)
     target_free: bool = True  # the target lane of the change in hand is still free
     committed: bool = False  # the car's centre is in the target lane of the change
     change_done: bool = False  # the lane change's path is finished
@@ -185,9 +192,24 @@ def _route_left(_m: Motion, x: MotionInput, p: MotionParams) -> bool:
     return _free_to_choose(x) and _route_holds(x, p) and x.route_lane > 0 and x.left_free
 
 
+def _driver_asks(x: MotionInput, p: MotionParams) -> bool:
+    """The driver's stalk asks for another lane, the route needs none, no flat tyre, turn
+    or pass in the oncoming lane, and `route_keep_time` has passed since the last change."""
+    return (_free_to_choose(x) and not _route_holds(x, p) and bool(x.driver_lane)
+            and _waited(x) >= p.route_keep_time)
+
+
+def _driver_right(_m: Motion, x: MotionInput, p: MotionParams) -> bool:
+    return _driver_asks(x, p) and x.driver_lane < 0 and x.right_free
+
+
+def _driver_left(_m: Motion, x: MotionInput, p: MotionParams) -> bool:
+    return _driver_asks(x, p) and x.driver_lane > 0 and x.left_free
+
+
 def _may_overtake(x: MotionInput, p: MotionParams) -> bool:
-    return (_free_to_choose(x) and not _route_holds(x, p) and x.overtake and x.blocked
-            and _waited(x) >= p.keep_time)
+    return (_free_to_choose(x) and not _route_holds(x, p) and not x.driver_lane
+            and x.overtake and x.blocked and _waited(x) >= p.keep_time)
 
 
 def _overtake_left(_m: Motion, x: MotionInput, p: MotionParams) -> bool:
@@ -203,8 +225,8 @@ def _overtake_oncoming(_m: Motion, x: MotionInput, p: MotionParams) -> bool:
 
 
 def _keep_right(_m: Motion, x: MotionInput, p: MotionParams) -> bool:
-    return (_free_to_choose(x) and not _route_holds(x, p) and x.overtake and not x.blocked
-            and x.right_free and x.right_clear
+    return (_free_to_choose(x) and not _route_holds(x, p) and not x.driver_lane
+            and x.overtake and not x.blocked and x.right_free and x.right_clear
             and (_waited(x) >= p.keep_time or x.yield_behind))
 
 
@@ -243,10 +265,18 @@ TABLE: Table[Motion, MotionInput, MotionParams] = Table(Motion, (
     Row(_KEEP, M.LANE_CHANGE_LEFT, _route_left,
         "the route needs a lane to the left and it is free",
         "the route needs a lane to the left"),
+    Row(_KEEP, M.LANE_CHANGE_RIGHT, _driver_right,
+        "the driver's turn signal asks for a lane to the right, it is free, the route needs "
+        "no other lane and `route_keep_time` has passed",
+        "the driver asks for a lane to the right"),
+    Row(_KEEP, M.LANE_CHANGE_LEFT, _driver_left,
+        "the driver's turn signal asks for a lane to the left (as above)",
+        "the driver asks for a lane to the left"),
     Row(_KEEP, M.LANE_CHANGE_LEFT, _overtake_left,
         "overtaking allowed, the lane blocked, the left free, a pass path into it clears "
         "the vehicle ahead and the whole pass outruns every vehicle coming up behind in the "
-        "left lane, `keep_time` since the last change, and the route needs no other lane",
+        "left lane, `keep_time` since the last change, and neither the route nor the "
+        "driver asks for another lane",
         "a slower vehicle ahead, the left lane free"),
     Row(_KEEP, M.LANE_CHANGE_RIGHT, _overtake_right,
         "overtaking allowed, the lane blocked, only the right free, clearing and outrun "
@@ -255,12 +285,14 @@ TABLE: Table[Motion, MotionInput, MotionParams] = Table(Motion, (
     Row(_KEEP, M.LANE_CHANGE_LEFT, _overtake_oncoming,
         "overtaking allowed, the lane blocked, the only way past the oncoming lane and a "
         "pass through it safe (`planner.oncoming_pass`) on a path that clears the vehicle "
-        "ahead, `keep_time` since the last change, and the route needs no other lane",
+        "ahead, `keep_time` since the last change, and neither the route nor the "
+        "driver asks for another lane",
         "a slower vehicle ahead, a pass through the oncoming lane is safe"),
     Row(_KEEP, M.LANE_CHANGE_RIGHT, _keep_right,
         "keep right: overtaking allowed, the lane not blocked, the right free and clear "
         "(nothing slower ahead in it to block it), `keep_time` since the last change (none "
-        "when a faster vehicle comes up behind), and the route needs no other lane",
+        "when a faster vehicle comes up behind), and neither the route nor the "
+        "driver asks for another lane",
         "keep right: the right lane is free"),
     Row(LANE_CHANGES, M.LANE_KEEP, _change_done, "the change is done (in the target lane)",
         "in the target lane"),

@@ -3,7 +3,8 @@
 Wheel spin rates (encoders, with a relative scale noise), gyro yaw rate, the steering
 encoder (each with white noise: `WHEEL_SPEED_NOISE`, `GYRO_NOISE`, `STEERING_NOISE`) and the
 accelerator pedal sensor (exact: a position the world's ego events
-hold, `world.ego.events`), sampled together at the odometry rate
+hold, `world.ego.events`, or a storyboard's override) and the driver's other controls
+(`world.frames.DriverControls`, exact), sampled together at the odometry rate
 (`world.core.rates.ODOMETRY`), delivered at once. Noise is drawn from the sensor's own seeded
 generator, so a run is reproducible.
 """
@@ -17,7 +18,7 @@ import numpy as np
 
 from world.core.rates import ODOMETRY, Rate
 from world.ego.body import EgoTruth
-from world.frames import Odometry
+from world.frames import DriverControls, Odometry
 from world.sensors.sensor import Reading
 
 WHEEL_SPEED_NOISE = 0.005  # [-] relative 1-sigma noise of the wheel encoders
@@ -33,12 +34,17 @@ def _on() -> bool:
     return True
 
 
+def _at_rest() -> DriverControls:
+    return DriverControls()
+
+
 @dataclass(frozen=True, slots=True)
 class OdometrySensor:
     wheel_radius: float  # [m]
     rng: np.random.Generator
     pedal: Callable[[], float] = _released  # [-] 0..1, the accelerator pedal position now
     engaged: Callable[[], bool] = _on  # the automated driving function's switch now
+    driver: Callable[[], DriverControls] = _at_rest  # the driver's other controls now
 
     @property
     def name(self) -> str:
@@ -66,4 +72,5 @@ class OdometrySensor:
             steering_angle=truth.steering_angle + STEERING_NOISE * float(noise[5]),
             accelerator_pedal=self.pedal(),
             engaged=self.engaged(),
+            driver=self.driver(),
         )

@@ -11,6 +11,7 @@ at each check. Actions on the car under test are its controller's (activation,
 assignment): they complete at once and set the switch of its automated driving function
 (`World.engaged`, `engages`): on, the stack drives it; off (before a storyboard activates
 its controller: `avsim.scenario.openscenario.convert`), the driver holds its Init speed.
+Its speed and lane changes and pedal overrides are its driver's inputs (`driver`).
 A scripted car under test (`World.scripted`, `world.ego.scripted`) takes every other action
 as an actor does, on its own motion; its controller actions then change nothing.
 """
@@ -21,6 +22,7 @@ from collections.abc import Iterable
 
 from avsim.run.storyboard.commands import Commands, Follow, Sync, poses_of
 from avsim.run.storyboard.conditions import Resolved
+from avsim.run.storyboard.driver import Driver
 from avsim.run.storyboard.runtime import StartedAction, StoryRuntime
 from avsim.run.storyboard.snapshot import EntityState, Snapshot
 from avsim.run.storyboard.truth import TruthTracker
@@ -33,6 +35,7 @@ from avsim.scenario.openscenario.model import (
     LaneOffsetAction,
     LateralDistanceAction,
     LongitudinalDistanceAction,
+    OverrideControllerValueAction,
     Position,
     PrivateAction,
     SpeedAction,
@@ -79,6 +82,7 @@ class Director:
         self._first = True
         self._top = {e.name: getattr(e.object, "max_speed", WALKING_TOP)
                      for e in osc.entities}  # [m/s] each entity's top speed
+        self.driver = Driver(world, program.ego, program.lane_ids)  # the stack's car's
 
     def _resolve(self, position: Position, snap: Snapshot) -> Resolved:
         """Where a condition's position is now: map (x, y), route (s, offset)."""
@@ -132,6 +136,9 @@ class Director:
         for motion in self._motions():
             done, motion.finished = motion.finished, []
             self._finish(done, snap.time)
+        lane_done = self.driver.check(snap, CHECK_PERIOD)
+        if lane_done is not None:
+            self._finish([lane_done], snap.time)
 
     def _finish(self, tags: Iterable[str], t: float) -> None:
         for tag in tags:
@@ -156,24 +163,60 @@ class Director:
             motion = self._motion(entity)
             if motion is not None:
                 motion.cancel(tag)
+            else:
+                self.driver.release_lane(tag)
 
     def _start(self, started: StartedAction, snap: Snapshot) -> None:
         action = started.action
-        if isinstance(action, CONTROLLER_ACTIONS):  # the runtime completes these itself
-            if self.program.ego in started.entities:
-                self.world.engaged = engages(action, self.world.engaged)
+        if isinstance(action, (*CONTROLLER_ACTIONS, OverrideControllerValueAction)):
+            self._control(started)  # the runtime completes these itself
             return
         tags = set()
         for entity in started.entities:
-            motion = self._motion(entity)
-            if motion is None:
-                raise DirectorError(f"{started.name}: {type(action).__name__} on the car "
-                                    "under test: not supported yet (avsim's stack drives it)")
             tag = f"{started.action_id}@{entity}"
+            motion = self._motion(entity)
+            if motion is None and entity != self.program.ego:
+                raise DirectorError(f"{started.name}: {entity} has no motion")
+            if motion is None and not self._drive(tag, action, snap):
+                continue  # done as given
             tags.add(tag)
             self._tag_action[tag] = started.action_id
-            self._command(tag, entity, motion, action, snap)
-        self._pending[started.action_id] = tags
+            if motion is not None:
+                self._command(tag, entity, motion, action, snap)
+        if tags:
+            self._pending[started.action_id] = tags
+        elif not started.action_id.startswith(INIT):
+            self.runtime.action_done(started.action_id, snap.time)
+
+    def _control(self, started: StartedAction) -> None:
+        """A controller action on the car under test: its function's switch, or its
+        driver's pedals (`driver`); on a scripted one they change nothing."""
+        action = started.action
+        if self.program.ego not in started.entities or self.world.scripted is not None:
+            return
+        if isinstance(action, OverrideControllerValueAction):
+            self.driver.override(action)
+            return
+        assert isinstance(action, CONTROLLER_ACTIONS)
+        if engages(action, False):
+            self.driver.switched_on()
+        self.world.engaged = engages(action, self.world.engaged)
+
+    def _drive(self, tag: str, action: PrivateAction, snap: Snapshot) -> bool:
+        """An action on the car the stack drives, as its driver's input (`driver`): True
+        while it runs (a lane change until the car is in the target lane), False when it
+        is done as given (a set speed)."""
+        try:
+            if isinstance(action, SpeedAction):
+                self.driver.set_speed(action, snap)
+                return False
+            if isinstance(action, LaneChangeAction):
+                self.driver.lane_change(tag, action, snap)
+                return True
+        except ValueError as e:
+            raise DirectorError(f"{tag}: {e}") from None
+        raise DirectorError(f"{tag}: {type(action).__name__} on the car under test: not "
+                            "supported (avsim's stack drives it)")
 
     def _command(self, tag: str, entity: str, motion: NpcMotion, action: PrivateAction,
                  snap: Snapshot) -> None:

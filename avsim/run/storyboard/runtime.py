@@ -47,6 +47,7 @@ from avsim.run.storyboard.triggers import TriggerWatch
 from avsim.scenario.openscenario.actions import (
     ActivateControllerAction,
     AssignControllerAction,
+    OverrideControllerValueAction,
     PrivateAction,
     TeleportAction,
 )
@@ -55,7 +56,8 @@ from avsim.scenario.openscenario.parameters import ParamValue
 from avsim.scenario.openscenario.storyboard import Storyboard
 from avsim.scenario.openscenario.variables import VariableAction, VariableDeclaration
 
-INSTANT = (ActivateControllerAction, AssignControllerAction, TeleportAction)  # end at once
+INSTANT = (ActivateControllerAction, AssignControllerAction, OverrideControllerValueAction,
+           TeleportAction)  # end at once
 GLOBAL = (EnvironmentAction, VariableAction)  # played on the runtime's state, end at once
 S, K = ElementState, TransitionKind
 

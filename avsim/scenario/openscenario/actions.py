@@ -207,6 +207,25 @@ class AssignControllerAction:
     activate_animation: bool | None  # 1.2
 
 
+@dataclass(frozen=True, slots=True)
+class PedalOverride:
+    """One pedal of an OverrideControllerValueAction: the driver's throttle or brake."""
+
+    pedal: Literal["throttle", "brake"]
+    active: bool  # False: the pedal is released (the override ends)
+    value: float  # [-] 0..1, the pedal position
+    max_rate: float | None  # [1/s] the pedal moves at most this fast (1.2+); None: at once
+
+
+@dataclass(frozen=True, slots=True)
+class OverrideControllerValueAction:
+    """The driver's pedals on the car under test (`avsim.run.storyboard.driver`); the
+    file's other controls (clutch, parking brake, steering wheel, gear) may only be written
+    inactive."""
+
+    pedals: tuple[PedalOverride, ...]
+
+
 def engages(action: ActivateControllerAction | AssignControllerAction, now: bool) -> bool:
     """The switch of the car under test's automated driving function (`World.engaged`: on,
     avsim's stack drives it) after its controller `action`, `now` before it: on where it
@@ -234,4 +253,5 @@ PrivateAction = (
     | FollowTrajectoryAction
     | ActivateControllerAction
     | AssignControllerAction
+    | OverrideControllerValueAction
 )

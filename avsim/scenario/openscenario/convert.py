@@ -9,7 +9,9 @@ the same world spec, driver settings and criteria as a YAML file gives, plus the
 - The car under test: the entity named `Ego` (any case), else the first vehicle. Scripted
   (`scripted_ego`, `avsim run --ego scripted`), the file's actions move it as any other
   entity, its controllers not simulated (esmini's `--disable_controllers`). Else avsim's
-  stack drives it (a motion action on it is refused at load) once its controller is
+  stack drives it (its speed and lane changes and pedal overrides are its driver's inputs,
+  `avsim.run.storyboard.driver`; any other motion action on it is refused at load,
+  `ego_actions`) once its controller is
   activated (`starts_engaged`: from the start, unless a story activates it later; until
   then its driver holds its Init speed in its lane), its set speed the Init speed (the
   speed its driver held when the file's controller takes over); avsim's car keeps its
@@ -38,8 +40,7 @@ from pathlib import Path
 from avsim.scenario.checks import check_spawn
 from avsim.scenario.errors import LocatedError, ScenarioError
 from avsim.scenario.openscenario.actions import engages
-from avsim.scenario.openscenario.ego_actions import refuse_on_ego
-from avsim.scenario.openscenario.global_actions import GlobalAction
+from avsim.scenario.openscenario.ego_actions import driver_input, refuse_on_ego
 from avsim.scenario.openscenario.model import (
     AbsoluteTargetSpeed,
     ActivateControllerAction,
@@ -107,7 +108,7 @@ def load_xosc(path: Path, overrides: Mapping[str, object] | None = None,
     except MapError as e:
         raise ScenarioError(str(osc.road_network), "(file)", str(e)) from None
     ego = _ego(osc)
-    refuse_on_ego(osc, ego.name)
+    refuse_on_ego(osc, ego.name, scripted_ego)
     placed, deferred = _init(osc, Resolver(route.chain))
     if not scripted_ego:
         _check_stack_ego(osc, ego.name, deferred)
@@ -134,23 +135,17 @@ def load_xosc(path: Path, overrides: Mapping[str, object] | None = None,
 
 
 def _check_stack_ego(osc: OpenScenario, ego: str, deferred: Sequence[InitAction]) -> None:
-    """The stack drives the car under test: a motion action on it (Init actions left to
-    run, or a story's) is refused at load; only its controller's actions are played (and
-    global actions, in a maneuver group of any actors)."""
-    played = ActivateControllerAction | AssignControllerAction | GlobalAction
+    """The stack drives the car under test: of the motion actions on it (Init actions left
+    to run, or a story's) only its driver's inputs are played (`driver_input`), besides its
+    controller's actions (and global actions, in a maneuver group of any actors); any other
+    is refused at load."""
     for item in deferred:
-        if item.entity == ego:
-            raise ScenarioError(str(osc.path), f"Storyboard.Init.{ego}", _ego_motion(item.action))
+        if item.entity == ego and (problem := driver_input(item.action)) is not None:
+            raise ScenarioError(str(osc.path), f"Storyboard.Init.{ego}", problem)
     for group, a in osc.storyboard.story_actions():
         if ego in group.actors.entities \
-                and not isinstance(a.private_action, played):
-            raise ScenarioError(str(osc.path), f"Storyboard.Action.{a.name}",
-                                _ego_motion(a.private_action))
-
-
-def _ego_motion(action: object) -> str:
-    return (f"{type(action).__name__} on the car under test: not supported yet (avsim's "
-            "stack drives it; `--ego scripted` plays the file's actions on it)")
+                and (problem := driver_input(a.private_action)) is not None:
+            raise ScenarioError(str(osc.path), f"Storyboard.Action.{a.name}", problem)
 
 
 def _sources(*files: Path | None) -> tuple[Path, ...]:

@@ -16,6 +16,8 @@ from avsim.scenario.openscenario.actions import (
     LaneOffsetAction,
     LaneOffsetDynamics,
     LongitudinalDistanceAction,
+    OverrideControllerValueAction,
+    PedalOverride,
     PrivateAction,
     RelativeTargetLane,
     RelativeTargetLaneOffset,
@@ -189,11 +191,50 @@ def _assign_controller(node: Node, ctx: Context) -> PrivateAction:
     )
 
 
+_CONTROLLER_CHILDREN = ("AssignControllerAction", "ActivateControllerAction",
+                        "OverrideControllerValueAction")
+_OTHER_CONTROLS = ("Clutch", "ParkingBrake", "SteeringWheel", "Gear")  # only inactive
+MAX_PEDAL_RATE = 1000.0  # [1/s] a pedal's maxRate at most (above: at once, to rounding)
+
+
 def _controller(node: Node, ctx: Context) -> PrivateAction:
-    for child in node.children:  # 1.0 has a sequence; an override action is refused
-        if child.tag not in ("AssignControllerAction", "ActivateControllerAction"):
+    for child in node.children:  # 1.0 has a sequence of them: one at a time is read
+        if child.tag not in _CONTROLLER_CHILDREN:
             raise unsupported(child)
     return _dispatch(node.only_child(), ctx)
+
+
+def _pedal(node: Node, ctx: Context, pedal: str) -> PedalOverride:
+    """A Throttle or Brake override: `value` and 1.2's `maxRate` on the element, or (1.2's
+    Brake) in its BrakePercent child; a BrakeForce is refused (avsim's pedals are
+    positions)."""
+    a = ctx.attrs
+    source = node
+    if pedal == "brake" and node.children:
+        source = node.only_child()
+        if source.tag != "BrakePercent":
+            raise node.error(f"{source.tag}: not supported (the brake pedal's position is "
+                             "read: BrakePercent)")
+    return PedalOverride(
+        pedal=pedal,  # type: ignore[arg-type]
+        active=a.boolean(node, "active"),
+        value=a.bounded(source, "value", 0.0, 1.0, "(pedal position)"),
+        max_rate=a.opt_bounded(source, "maxRate", 0.0, MAX_PEDAL_RATE, "1/s"))
+
+
+def _override(node: Node, ctx: Context) -> PrivateAction:
+    """The driver's pedals (throttle, brake); the other controls only inactive."""
+    pedals = []
+    for child in node.children:
+        if child.tag in ("Throttle", "Brake"):
+            pedals.append(_pedal(child, ctx, child.tag.lower()))
+        elif child.tag in _OTHER_CONTROLS:
+            if ctx.attrs.boolean(child, "active"):
+                raise child.error("not supported (an active override of the "
+                                  f"{child.tag}: avsim's driver works the pedals only)")
+        else:
+            raise unsupported(child)
+    return OverrideControllerValueAction(tuple(pedals))
 
 
 def _wrapper(node: Node, ctx: Context) -> PrivateAction:
@@ -213,6 +254,7 @@ _READERS: dict[str, Callable[[Node, Context], PrivateAction]] = {
     "FollowTrajectoryAction": _follow_trajectory,
     "ActivateControllerAction": _activate_controller,
     "AssignControllerAction": _assign_controller,
+    "OverrideControllerValueAction": _override,
     **MOTION_READERS,
 }
 

@@ -1,6 +1,6 @@
 """`--ego scripted`: the file's own actions move the car under test (a kinematic body,
-`world.ego.scripted`), no stack drives it; with the stack a motion action on it is refused
-at load, never mid-run."""
+`world.ego.scripted`), no stack drives it; with the stack a motion action on it that is not
+its driver's input is refused at load, never mid-run."""
 
 from __future__ import annotations
 
@@ -40,12 +40,27 @@ def _ego_slows_down(tmp: Path) -> Path:
     return path
 
 
-def test_a_speed_action_on_the_stack_s_ego_is_refused_at_load(tmp_path: Path) -> None:
-    path = _ego_slows_down(tmp_path)
+OFFSET = """<LateralAction>
+                    <LaneOffsetAction continuous="false">
+                      <LaneOffsetActionDynamics dynamicsShape="linear" maxLateralAcc="0.5" />
+                      <LaneOffsetTarget><AbsoluteTargetLaneOffset value="0.5" /></LaneOffsetTarget>
+                    </LaneOffsetAction>
+                  </LateralAction>"""
+
+
+def test_a_lane_offset_on_the_stack_s_ego_is_refused_at_load(tmp_path: Path) -> None:
+    path = tmp_path / "ego_offset.xosc"
+    path.write_text(CUT_IN.read_text().replace(ACTIVATE, OFFSET))
     with pytest.raises(ScenarioError) as info:
         load_scenario(path, search_paths=[ALKS])
-    assert "SpeedAction on the car under test" in str(info.value)
+    assert "LaneOffsetAction on the car under test: not supported" in str(info.value)
     assert "ActivateALKSControllerAction" in str(info.value)
+
+
+def test_a_speed_action_on_the_stack_s_ego_loads_as_its_driver_s_set_speed(
+        tmp_path: Path) -> None:
+    scenario = load_scenario(_ego_slows_down(tmp_path), search_paths=[ALKS])
+    assert scenario.story is not None and not scenario.world.ego.scripted
 
 
 def test_a_scripted_ego_plays_its_speed_action(tmp_path: Path) -> None:
