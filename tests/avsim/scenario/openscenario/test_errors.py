@@ -166,8 +166,8 @@ WORLD = '<WorldPosition x="0" y="0" h="0"/>'
         ),
         (
             SPEED_ACTION,
-            "<ControllerAction><OverrideControllerValueAction/></ControllerAction>",
-            "OverrideControllerValueAction",
+            '<VisibilityAction graphics="true" traffic="true" sensors="false"/>',
+            "VisibilityAction",
         ),
         (WORLD, "<RoutePosition><RouteRef/><InRoutePosition/></RoutePosition>",
          "RoutePosition"),
