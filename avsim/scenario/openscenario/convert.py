@@ -11,9 +11,9 @@ the same world spec, driver settings and criteria as a YAML file gives, plus the
   entity, its controllers not simulated (esmini's `--disable_controllers`). Else avsim's
   stack drives it (its speed and lane changes and pedal overrides are its driver's inputs,
   `avsim.run.storyboard.driver`; any other motion action on it is refused at load,
-  `ego_actions`) once its controller is
-  activated (`starts_engaged`: from the start, unless a story activates it later; until
-  then its driver holds its Init speed in its lane), its set speed the Init speed (the
+  `ego_actions`) once its controller is activated (`starts_engaged`: from the start,
+  unless a story activates it later or the sidecar's `function: off` says it starts off;
+  until then its driver holds its Init speed in its lane), its set speed the Init speed (the
   speed its driver held when the file's controller takes over); avsim's car keeps its
   own body (4.8 x 1.6 m), not the file's bounding box.
 - The other entities become the world's actors with the file's bounding boxes: vehicles by
@@ -114,8 +114,9 @@ def load_xosc(path: Path, overrides: Mapping[str, object] | None = None,
         _check_stack_ego(osc, ego.name, deferred)
     ahead = {e.name: _centre_ahead(e, e.name == ego.name and not scripted_ego)
              for e in osc.entities}
-    ego_spec = replace(_ego_spec(path, road_map, ego.name, placed, ahead[ego.name],
-                                 starts_engaged(osc, ego.name)), scripted=scripted_ego)
+    engaged = starts_engaged(osc, ego.name) and not side.function_off
+    ego_spec = replace(_ego_spec(path, road_map, ego.name, placed, ahead[ego.name], engaged),
+                       scripted=scripted_ego)
     others = [e for e in osc.entities if e.name != ego.name]
     actors = tuple(_actor_spec(path, road_map, e, placed, ahead[e.name]) for e in others)
     program = StoryProgram(

@@ -4,7 +4,11 @@ file of the YAML format's keys.
 The sidecar is `NAME.criteria.yaml` beside `NAME.xosc`, or the file `--criteria` names, or a
 bundled set by its name (`--criteria r157`: `sets/r157.criteria.yaml`, UN R157's). It
 may set `criteria` (the YAML format's `criteria:` section, the same keys), `seed`,
-`sensors` and `duration` (the time limit [s] when the StopTrigger does not fire). Left out,
+`sensors`, `duration` (the time limit [s] when the StopTrigger does not fire) and `function`
+(`file`: the car under test's automated driving function is on from the start unless a
+story activates its controller later; `off`: it starts off whatever the file's Init says,
+the driver holding the Init speed with the car's emergency braking on, as the Euro NCAP AEB
+tests drive the VUT; a story that activates the controller still switches it on). Left out,
 the defaults apply: the criteria that always apply, with route completion off (the
 StopTrigger ends the run), seed 0, the default sensors, `MAX_DURATION`.
 
@@ -17,7 +21,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 from pydantic import Field
 
@@ -47,6 +51,10 @@ class SidecarModel(FormatModel):
                                   description="Sensor noise, as in the YAML format.")
     duration: PosFloat = Field(default=MAX_DURATION,
                                description="[s] time limit if the StopTrigger never fires.")
+    function: Literal["file", "off"] = Field(
+        default="file", description="The car under test's automated driving function at the "
+        "start: `file` (on unless a story activates its controller later) or `off` (the "
+        "driver holds the Init speed, emergency braking on). Default `file`.")
 
 
 @dataclass(frozen=True, slots=True)
@@ -58,6 +66,7 @@ class Sidecar:
     sensors: SensorsSpec
     duration: float  # [s]
     file: Path | None  # the sidecar read, None: the defaults
+    function_off: bool = False  # the automated driving function starts off (`function: off`)
 
 
 SETS = Path(__file__).with_name("sets")  # the bundled criteria sets (`r157`)
@@ -121,4 +130,4 @@ def load_sidecar(path: Path | None, overrides: Mapping[str, object]) -> Sidecar:
     if values.get("completes") is None and values.get("reach_s") is None:
         values["completes"] = False  # the StopTrigger ends the run
     return Sidecar(CriteriaSettings.of(values), model.seed, sensors_spec(model.sensors),
-                   float(model.duration), path)
+                   float(model.duration), path, model.function == "off")

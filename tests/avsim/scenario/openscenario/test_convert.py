@@ -20,7 +20,7 @@ from avsim.scenario.openscenario.actions import (
 from avsim.scenario.openscenario.convert import starts_engaged
 from avsim.scenario.openscenario.entities import Controller
 from avsim.scenario.openscenario.sidecar import MAX_DURATION, bundled_sets
-from world.spec import ActorType
+from world.spec import GNSS_PRESETS, ActorType
 
 ALKS = Path(__file__).parents[3] / "data" / "alks" / "logical_scenarios" / "concrete_scenarios"
 FILES = sorted(ALKS.glob("alks_scenario_*.xosc"))
@@ -117,6 +117,23 @@ def test_the_sidecar_beside_the_file_and_a_named_set(tmp_path: Path) -> None:
     r157 = load_scenario(CUT_IN, criteria_file=Path("r157"))
     assert r157.criteria.get("unavoidable") == "r157"
     assert r157.criteria.get("following_gap") == "r157"
+
+
+NCAP = Path(__file__).parents[3] / "data" / "ncap"
+CCR = NCAP / "OpenSCENARIO" / "NCAP" / "AEB_C2C_2023" / "NCAP_AEB_C2C_CCR_2023.xosc"
+
+
+def test_the_ncap_set_drives_the_vut_as_the_protocol_does() -> None:
+    plain = load_scenario(CCR, search_paths=(NCAP,))
+    assert plain.world.ego.engaged  # the file gives it no controller: on from the start
+    ncap = load_scenario(CCR, criteria_file=Path("ncap"), search_paths=(NCAP,))
+    assert not ncap.world.ego.engaged  # the AEB under test: the driver holds the speed
+    assert ncap.world.sensors.gnss == GNSS_PRESETS["rtk"]  # on the test path within cm
+    assert ncap.criteria.get("ncap") is not None
+    on = load_scenario(CCR, {"function": "file"}, Path("ncap"), (NCAP,))
+    assert on.world.ego.engaged
+    with pytest.raises(ScenarioError, match="function"):
+        load_scenario(CCR, {"function": "maybe"}, Path("ncap"), (NCAP,))
 
 
 @pytest.mark.parametrize(("overrides", "criteria", "message"), [
