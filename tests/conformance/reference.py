@@ -2,9 +2,10 @@
 file with a scripted car under test, side by side.
 
 `runs()` lists every run of the reference; `play(run)` loads its scenario file (vendored
-unchanged in `tests/data/`: `alks/`, `ncap/`, `asam_examples/`) with `scripted_ego`, runs it without sensors and keeps every storyboard
-transition and every entity's reference point at each trigger check (the director's
-snapshots). `event_starts` and `path_rms` compare.
+unchanged in `tests/data/`: `alks/`, `ncap/`, `asam_examples/`; a distribution file's
+permutation K with its parameter values, `concrete`) with `scripted_ego`, runs it without
+sensors and keeps every storyboard transition and every entity's reference point at each
+trigger check (the director's snapshots). `event_starts` and `path_rms` compare.
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ from numpy.typing import NDArray
 from avsim.run.runner import Runner
 from avsim.run.storyboard.snapshot import Snapshot
 from avsim.scenario.load import load_scenario
+from avsim.scenario.openscenario.distribution import load_distribution
 
 DATA = Path(__file__).resolve().parents[1] / "data"
 REF = DATA / "esmini_ref"
@@ -39,6 +41,8 @@ class RefRun:
     run: str  # default / --disable_controllers
     set: str
     time_limit_added: bool  # esmini was given a copy with a 60 s time limit
+    permutation: int | None  # a distribution file's 0-based run (esmini's --param_permutation)
+    parameters: str  # the values that permutation set, as esmini listed them (`N=V; ...`)
 
     @property
     def id(self) -> str:
@@ -48,16 +52,36 @@ class RefRun:
 def runs() -> list[RefRun]:
     with (REF / "index.csv").open() as f:
         return [RefRun(r["output"], r["source_file"], r["run"], r["set"],
-                       bool(r["time_limit_added_s"])) for r in csv.DictReader(f)]
+                       bool(r["time_limit_added_s"]),
+                       int(r["permutation"]) if r["permutation"] else None,
+                       r["parameters"]) for r in csv.DictReader(f)]
 
 
 def scenario_file(run: RefRun) -> tuple[Path, list[Path]]:
-    """(the scenario file, its search paths) for `run` on this machine."""
+    """(the file esmini was given, its search paths) for `run` on this machine: a scenario
+    file, or for a permutation run the ParameterValueDistribution file."""
     if run.source.startswith(ALKS_PREFIX):
         return DATA / "alks" / run.source.removeprefix(ALKS_PREFIX), []
     rel = run.source.removeprefix("shared/standards/")
     root = DATA / rel.split("/")[0]
     return DATA / rel, [root]
+
+
+def concrete(run: RefRun) -> tuple[Path, dict[str, object], list[Path]]:
+    """(the scenario file, its parameter overrides, its search paths) that `run` plays: a
+    permutation run's distribution file is expanded as `avsim run --permutation K` does
+    (`avsim.scenario.openscenario.distribution`) and its run K's values set."""
+    path, search = scenario_file(run)
+    if run.permutation is None:
+        return path, {}, search
+    dist = load_distribution(path, search)
+    return dist.scenario, dist.runs[run.permutation].overrides(), search
+
+
+def esmini_parameters(run: RefRun) -> dict[str, str]:
+    """The parameter values esmini set in a permutation run (index.csv's `parameters`)."""
+    pairs = (item.split("=", 1) for item in run.parameters.split("; ") if item)
+    return {name: value for name, value in pairs}
 
 
 def _read_gz(path: Path) -> list[dict[str, str]]:
@@ -93,8 +117,8 @@ class Played:
 
 def play(run: RefRun) -> Played:
     """Play `run`'s file with a scripted car under test, no sensors (module doc)."""
-    path, search = scenario_file(run)
-    scenario = load_scenario(path, {"duration": 400.0}, search_paths=search,
+    path, overrides, search = concrete(run)
+    scenario = load_scenario(path, {"duration": 400.0, **overrides}, search_paths=search,
                              scripted_ego=True)
     runner = Runner(scenario, profile=None)
     director = runner.director
