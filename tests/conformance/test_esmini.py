@@ -37,15 +37,11 @@ from tests.conformance.reference import (
 )
 
 CONTROLLED = "the Ego has an esmini controller in this run: compared in no_controllers/"
-PEDESTRIAN_PATH = ("a crossing pedestrian: avsim's walk (trapezoidal lateral speed, turning "
-                   "at 180 deg/s) is not esmini's; not yet matched")
 CUT_IN_PATH = ("the cut-in's lane change: esmini keeps the speed over ground (the progress "
                "along the road slows while it moves across) and moves the reference point "
                "along the shape; avsim moves the body centre at the full speed along the "
                "road (0.28 m RMS); not yet matched")
 KNOWN = {
-    ("alks/no_controllers/alks_scenario_4_2_3_crossing_pedestrian_template", "paths"):
-        PEDESTRIAN_PATH,
     ("alks/no_controllers/alks_scenario_4_4_2_cut_in_unavoidable_collision_template",
      "paths"): CUT_IN_PATH,
 }
