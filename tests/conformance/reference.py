@@ -89,12 +89,18 @@ def _read_gz(path: Path) -> list[dict[str, str]]:
         return list(csv.DictReader(f))
 
 
-def ref_event_starts(run: RefRun) -> dict[str, list[float]]:
-    """Event name -> esmini's start times [s] (every start, in order)."""
+def ref_event_starts(run: RefRun, events: frozenset[str] = frozenset(),
+                     acts: frozenset[str] = frozenset()) -> dict[str, list[float]]:
+    """Event name -> esmini's start times [s] (every start, in order): its changes from
+    standby to running. A row typed Event counts; so does one typed otherwise whose name is
+    one of the scenario's `events` and none of its `acts` (the reference's types were looked
+    up by name: README.md)."""
     starts: dict[str, list[float]] = {}
     for r in _read_gz(REF / f"{run.output}_events.csv.gz"):
-        if r["element_type"] == "Event" and r["to_state"] == "runningState":
-            starts.setdefault(r["element_name"], []).append(float(r["time"]))
+        name = r["element_name"]
+        event = r["element_type"] == "Event" or (name in events and name not in acts)
+        if event and r["from_state"] == "standbyState" and r["to_state"] == "runningState":
+            starts.setdefault(name, []).append(float(r["time"]))
     return starts
 
 
@@ -111,6 +117,8 @@ class Played:
     """avsim's play of one file: event starts and the entities' reference points."""
 
     event_starts: dict[str, list[float]]  # event name -> start times [s]
+    events: frozenset[str]  # the names of the scenario's events
+    acts: frozenset[str]  # the names of its acts
     paths: dict[str, NDArray[np.float64]]  # entity name -> (N, 3) t [s], x, y [m]
     end: float  # [s] when the run ended
 
@@ -140,7 +148,10 @@ def play(run: RefRun) -> Played:
             starts.setdefault(name, []).append(t)
     paths = {name: np.array([(s.time, s.entities[name].x, s.entities[name].y)
                              for s in snaps]) for name in snaps[0].entities}
-    return Played(starts, paths, result.sim_time)
+    nodes = [n for root in director.runtime.stories for n in root.walk()]
+    return Played(starts, frozenset(n.name for n in nodes if n.element_type == "event"),
+                  frozenset(n.name for n in nodes if n.element_type == "act"), paths,
+                  result.sim_time)
 
 
 def event_error(ref: dict[str, list[float]], got: dict[str, list[float]]) -> float:
