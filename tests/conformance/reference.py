@@ -30,6 +30,7 @@ REF = DATA / "esmini_ref"
 ALKS_PREFIX = "shared/standards/alks/"
 EVENT_TOLERANCE = 0.05  # [s] an event starts within this of esmini's start
 RMS_TOLERANCE = 0.2  # [m] an entity's path within this RMS of esmini's
+END_MARGIN = 1.0  # [s] avsim plays this beyond esmini's end (an event starting there counts)
 
 
 @dataclass(frozen=True, slots=True)
@@ -43,6 +44,7 @@ class RefRun:
     time_limit_added: bool  # esmini was given a copy with a 60 s time limit
     permutation: int | None  # a distribution file's 0-based run (esmini's --param_permutation)
     parameters: str  # the values that permutation set, as esmini listed them (`N=V; ...`)
+    t_end: float  # [s] when esmini's run ended
 
     @property
     def id(self) -> str:
@@ -54,7 +56,7 @@ def runs() -> list[RefRun]:
         return [RefRun(r["output"], r["source_file"], r["run"], r["set"],
                        bool(r["time_limit_added_s"]),
                        int(r["permutation"]) if r["permutation"] else None,
-                       r["parameters"]) for r in csv.DictReader(f)]
+                       r["parameters"], float(r["t_end_s"])) for r in csv.DictReader(f)]
 
 
 def scenario_file(run: RefRun) -> tuple[Path, list[Path]]:
@@ -126,7 +128,9 @@ class Played:
 def play(run: RefRun) -> Played:
     """Play `run`'s file with a scripted car under test, no sensors (module doc)."""
     path, overrides, search = concrete(run)
-    scenario = load_scenario(path, {"duration": 400.0, **overrides}, search_paths=search,
+    # no longer than esmini's run and a margin: beyond its end there is nothing to compare
+    duration = run.t_end + END_MARGIN
+    scenario = load_scenario(path, {"duration": duration, **overrides}, search_paths=search,
                              scripted_ego=True)
     runner = Runner(scenario, profile=None)
     director = runner.director

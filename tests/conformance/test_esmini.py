@@ -41,7 +41,17 @@ CUT_IN_PATH = ("the cut-in's lane change: esmini keeps the speed over ground (th
                "along the road slows while it moves across) and moves the reference point "
                "along the shape; avsim moves the body centre at the full speed along the "
                "road (0.28 m RMS); not yet matched")
+SYNC_START = ("NCAP CCFhol's GVT: esmini holds it still for the first step of its "
+              "SynchronizeAction (TargetTimeSteadyState; speed 0 until 0.025 s) and then runs "
+              "its speed law; avsim moves it at its Init speed from the start and starts the "
+              "law at 0.025 s: up to 0.94 m apart in the first 3 s, 0.3 m RMS (the SOV keeps "
+              "its distance to it); not yet matched")
+CCFHOL = ("ncap/AEB_C2C_2023/NCAP_AEB_C2C_CCFhol_2023",
+          "ncap/AEB_C2C_2023/Variations/NCAP_AEB_C2C_CCFhol_50kph_2023__p0",
+          "ncap/AEB_C2C_2023/Variations/NCAP_AEB_C2C_CCFhol_Variation_2023__p0",
+          "ncap/AEB_C2C_2023/Variations/NCAP_AEB_C2C_CCFhol_Variation_2023__p1")
 KNOWN = {
+    **{(output, "paths"): SYNC_START for output in CCFHOL},
     ("alks/no_controllers/alks_scenario_4_4_2_cut_in_unavoidable_collision_template",
      "paths"): CUT_IN_PATH,
 }
