@@ -41,9 +41,11 @@ test-quick: lint
 	$(BIN)/pytest -n 2 --dist loadfile --no-loadscope-reorder -m "not slow" $(PYTEST_ARGS)
 
 # The acceptance set (scenarios/acceptance: Euro NCAP, UN R157, ISO 22179 grids), one test
-# per run, each asserting its situation happened and its verdicts; too long for `make test`.
+# per run, each asserting its situation happened and its verdicts, and the esmini
+# conformance runs of every permutation of a distribution file but the first; too long for
+# `make test`.
 acceptance: $(STAMP)
-	$(BIN)/pytest -n 2 --dist load -m acceptance tests/scenarios $(PYTEST_ARGS)
+	$(BIN)/pytest -n 2 --dist load -m acceptance tests/scenarios tests/conformance $(PYTEST_ARGS)
 
 # The fuzzers (tests marked `fuzz`) with many more inputs than `make test` tries, on a fresh
 # seed each time unless AVSIM_FUZZ_SEED is given (a failure prints the seed to replay).

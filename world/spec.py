@@ -237,6 +237,8 @@ class ActorSpec:
     #   (`world.actors.bodies.SIZES`)
     against: bool = False  # drives against its lane's direction of travel (a scenario
     #   file's heading turned half a turn from the lane's)
+    facing: float = 0.0  # [rad] a pedestrian's initial heading from its lane's direction of
+    #   travel, left positive (a scenario file's orientation; it turns to where it walks)
 
 
 @dataclass(frozen=True, slots=True)

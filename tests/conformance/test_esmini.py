@@ -4,20 +4,29 @@ the car under test scripted (`--ego scripted`), no sensors. Each event starts wi
 esmini's path. Every run of the reference is collected; a file that does not load yet is
 skipped with the loader's reason (it turns on when it loads), a run whose Ego esmini gave a
 controller is compared in its `no_controllers/` twin. A known difference is a strict xfail
-naming its reason (`docs/openscenario.md`, "Compared with esmini")."""
+naming its reason (`docs/openscenario.md`, "Compared with esmini").
+
+A run of a ParameterValueDistribution file plays its permutation (the distribution expanded
+as `avsim run --permutation K` expands it, with the values esmini set: checked here too).
+`make test` plays every base scenario and the first permutation of each distribution file;
+the other permutations are `acceptance` runs (`make acceptance`)."""
 
 from __future__ import annotations
 
+import math
 from functools import cache
 
 import pytest
 
 from avsim.scenario.errors import ScenarioError
+from avsim.scenario.openscenario.expressions import ExpressionError, evaluate
 from tests.conformance.reference import (
     EVENT_TOLERANCE,
     RMS_TOLERANCE,
     Played,
     RefRun,
+    concrete,
+    esmini_parameters,
     event_error,
     path_rms,
     play,
@@ -28,15 +37,21 @@ from tests.conformance.reference import (
 )
 
 CONTROLLED = "the Ego has an esmini controller in this run: compared in no_controllers/"
-PEDESTRIAN_PATH = ("a crossing pedestrian: avsim's walk (trapezoidal lateral speed, turning "
-                   "at 180 deg/s) is not esmini's; not yet matched")
 CUT_IN_PATH = ("the cut-in's lane change: esmini keeps the speed over ground (the progress "
                "along the road slows while it moves across) and moves the reference point "
                "along the shape; avsim moves the body centre at the full speed along the "
                "road (0.28 m RMS); not yet matched")
+SYNC_START = ("NCAP CCFhol's GVT: esmini holds it still for the first step of its "
+              "SynchronizeAction (TargetTimeSteadyState; speed 0 until 0.025 s) and then runs "
+              "its speed law; avsim moves it at its Init speed from the start and starts the "
+              "law at 0.025 s: up to 0.94 m apart in the first 3 s, 0.3 m RMS (the SOV keeps "
+              "its distance to it); not yet matched")
+CCFHOL = ("ncap/AEB_C2C_2023/NCAP_AEB_C2C_CCFhol_2023",
+          "ncap/AEB_C2C_2023/Variations/NCAP_AEB_C2C_CCFhol_50kph_2023__p0",
+          "ncap/AEB_C2C_2023/Variations/NCAP_AEB_C2C_CCFhol_Variation_2023__p0",
+          "ncap/AEB_C2C_2023/Variations/NCAP_AEB_C2C_CCFhol_Variation_2023__p1")
 KNOWN = {
-    ("alks/no_controllers/alks_scenario_4_2_3_crossing_pedestrian_template", "paths"):
-        PEDESTRIAN_PATH,
+    **{(output, "paths"): SYNC_START for output in CCFHOL},
     ("alks/no_controllers/alks_scenario_4_4_2_cut_in_unavoidable_collision_template",
      "paths"): CUT_IN_PATH,
 }
@@ -49,8 +64,31 @@ def _params(check: str) -> list[object]:
     for run in runs():
         reason = KNOWN.get((run.output, check))
         marks = [pytest.mark.xfail(strict=True, reason=reason)] if reason else []
+        if run.permutation:  # the first permutation of a distribution runs in `make test`
+            marks.append(pytest.mark.acceptance)
         out.append(pytest.param(run, id=run.output, marks=marks))
     return out
+
+
+def _permutation_runs() -> list[object]:
+    return [pytest.param(run, id=run.output) for run in runs() if run.permutation is not None]
+
+
+def _no_lookup(name: str) -> float:
+    raise ExpressionError(f"${name}: a permutation's value references a parameter")
+
+
+def _same_value(ours: str, esmini: str) -> bool:
+    """Whether a parameter value as the distribution gives it (text, maybe an expression
+    `${...}`) is esmini's (which lists numbers evaluated, without trailing zeros)."""
+    if ours == esmini:
+        return True
+    text = ours[2:-1] if ours.startswith("${") and ours.endswith("}") else ours
+    try:
+        value = evaluate(text, _no_lookup)
+        return math.isclose(float(value), float(esmini), abs_tol=1e-9)
+    except (ExpressionError, ValueError, TypeError):
+        return False
 
 
 @cache
@@ -65,10 +103,22 @@ def _played(run: RefRun) -> Played:
         pytest.skip(f"does not load yet: {e}")
 
 
+@pytest.mark.parametrize("run", _permutation_runs())
+def test_permutations_set_the_values_esmini_set(run: RefRun) -> None:
+    """The distribution file expanded as avsim expands it gives run K the parameter values
+    esmini's `--param_permutation K` set (index.csv), in no other order."""
+    _, overrides, _ = concrete(run)
+    ours = {key.removeprefix("parameters."): str(v) for key, v in overrides.items()}
+    esmini = esmini_parameters(run)
+    assert ours.keys() == esmini.keys(), (ours, esmini)
+    wrong = {k: (ours[k], esmini[k]) for k in ours if not _same_value(ours[k], esmini[k])}
+    assert not wrong, wrong
+
+
 @pytest.mark.parametrize("run", _params("events"))
 def test_events_start_when_esmini_starts_them(run: RefRun) -> None:
     played = _played(run)
-    ref = ref_event_starts(run)
+    ref = ref_event_starts(run, played.events, played.acts)
     assert event_error(ref, played.event_starts) <= EVENT_TOLERANCE + 1e-9, (
         f"esmini {ref}, avsim {played.event_starts}")
 

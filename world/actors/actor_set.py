@@ -104,7 +104,8 @@ class ActorSet:
             self.motions.append(
                 NpcMotion(spec.s, offset, spec.speed,
                           -lane.direction if spec.against else lane.direction, spec.actions,
-                          lane=spec.lane, pedestrian=spec.type is ActorType.PEDESTRIAN)
+                          lane=spec.lane, pedestrian=spec.type is ActorType.PEDESTRIAN,
+                          facing=spec.facing)
             )
         sizes = [body_size(a) for a in specs]
         self.bodies = [self._make_body(a.type, size)

@@ -19,7 +19,9 @@ first holds; it ends when it reaches its target, or when a later action of the s
 Headings: a vehicle's body points along its velocity while it moves faster than 0.1 m/s
 (along its lane at rest). A pedestrian faces where it walks, also straight across the road
 (no longitudinal speed), turning towards it at `PEDESTRIAN_TURN_RATE`, and keeps the last
-heading it walked in while it stands.
+heading it walked in while it stands. Once a director's path ends, an actor goes on along
+its lane at the path's last speed over ground (a pedestrian keeping its heading, until its
+next command), as esmini moves an entity on along the road after its trajectory.
 """
 
 from __future__ import annotations
@@ -54,6 +56,7 @@ LATERAL_ACCEL = 1.5  # [m/s^2] ramp of the lateral speed at the start and end of
 ARRIVED = 1e-3  # [m] lateral distance that counts as arrived
 PEDESTRIAN_TURN_RATE = math.pi  # [rad/s] a pedestrian turns to face where it walks (90 deg: 0.5 s)
 PEDESTRIAN_MOVING = 0.05  # [m/s] a pedestrian slower than this over ground keeps its heading
+ALONG_EPS = 1e-9  # [m/s] a path's last segment slower than this along the route runs across it
 CAP_ACCEL = 1.5  # [m/s^2] a capped NPC (a town driver) speeds up again at this
 
 SpeedLike = SpeedCommand | TrackCommand | ProfileCommand
@@ -95,9 +98,12 @@ class NpcMotion:
     def __init__(
         self, s: float, offset: float, speed: float, direction: int,
         actions: tuple[ActionSpec, ...], *, lane: int = 0, pedestrian: bool = False,
+        facing: float = 0.0,
     ) -> None:
         """`lane`: the lane whose centre `walk` offsets are measured from (a `lane_change`
-        moves it); `pedestrian`: face the walking direction (module doc)."""
+        moves it); `pedestrian`: face the walking direction (module doc), from `facing`
+        [rad] (its heading from its lane's direction of travel, left positive) at the
+        start."""
         self.s = s  # [m] station of the actor's centre
         self.offset = offset  # [m] lateral offset of its centre from the reference line, left +
         self.speed = speed  # [m/s] along its lane's direction of travel
@@ -105,7 +111,8 @@ class NpcMotion:
         self.direction = direction  # +1 with the route, -1 against
         self.lane = lane  # the lane `walk` offsets are measured from
         self.pedestrian = pedestrian  # faces where it walks
-        self._facing = 0.0  # [rad] a pedestrian's heading relative to its lane's direction
+        self._facing = facing if pedestrian else 0.0  # [rad] a pedestrian's heading
+        #   relative to its lane's direction
         self.actions = actions
         self.fired_at: list[float | None] = [None] * len(actions)  # [s]
         self.ended_at: list[float | None] = [None] * len(actions)  # [s]
@@ -123,6 +130,7 @@ class NpcMotion:
         self._path_cmd: PathCommand | None = None
         self._path_index = 0  # the vertex an untimed path heads for
         self._path_speed = 0.0  # [m/s] the speed an untimed path is followed at
+        self._keep_facing = False  # a pedestrian moving on after a path keeps its heading
         self.finished: list[str] = []  # tags of commands that reached their goal, in order
         self.jumped = False  # teleported since its body was last placed
 
@@ -164,6 +172,7 @@ class NpcMotion:
         an untimed path, the speed it is followed at), a lateral command the offset, a path
         both (each replaces what drove that part before); a teleport moves the actor at
         once and is done."""
+        self._keep_facing = False
         if isinstance(cmd, TeleportCommand):
             self.s, self.offset, self._target_offset = cmd.s, cmd.offset, cmd.offset
             self._path_cmd = self._lateral_cmd = None
@@ -213,8 +222,8 @@ class NpcMotion:
             self.speed, self.lateral_speed = along * self.direction, across
             if done:  # then on along the route at its last segment's speed along it
                 self._path_cmd = None
-                self._planned = self._target_speed = (
-                    cmd.along_speed_at_end(self._path_speed) * self.direction)
+                self._planned = self._target_speed = self._speed_after(cmd)
+                self._keep_facing = self.pedestrian
                 self._speed_action = None
                 self.finished.append(cmd.tag)
             return True
@@ -229,6 +238,15 @@ class NpcMotion:
         else:
             self._step_lateral_cmd(t, dt, curvature)
         return True
+
+    def _speed_after(self, cmd: PathCommand) -> float:
+        """[m/s] the speed along its lane an actor goes on at once `cmd` ends: its last
+        segment's speed over ground, forwards unless that segment led back along the route
+        (or, straight across the road, a pedestrian faces backwards)."""
+        along, ground = cmd.speeds_at_end(self._path_speed)
+        if abs(along) > ALONG_EPS:
+            return math.copysign(ground, along) * self.direction
+        return -ground if math.cos(self._facing) < 0.0 else ground
 
     def _step_speed_cmd(self, t: float, dt: float) -> None:
         cmd = self._speed_cmd
@@ -285,7 +303,7 @@ class NpcMotion:
 
     def _turn(self, dt: float) -> None:
         """A pedestrian turns towards its direction of travel, at most at the turn rate."""
-        if math.hypot(self.speed, self.lateral_speed) < PEDESTRIAN_MOVING:
+        if self._keep_facing or math.hypot(self.speed, self.lateral_speed) < PEDESTRIAN_MOVING:
             return
         course = math.atan2(self.lateral_speed, self.direction * self.speed)  # route frame
         wanted = course if self.direction > 0 else course - math.pi  # from its lane's direction

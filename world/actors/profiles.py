@@ -133,15 +133,18 @@ class PathCommand:
     offset: tuple[float, ...]  # [m]
     times: tuple[float, ...] | None  # [s] simulation time at each vertex, increasing
 
-    def along_speed_at_end(self, speed: float) -> float:
-        """[m/s] the speed along the route of the path's last segment (timed: its own;
-        untimed: `speed` [m/s] along it): what the actor goes on at once the path ends."""
+    def speeds_at_end(self, speed: float) -> tuple[float, float]:
+        """([m/s] along the route, [m/s] over ground) of the path's last segment (timed: its
+        own; untimed: `speed` [m/s] along it). An actor goes on along its lane at the speed
+        over ground once the path ends, as esmini's entities move on along the road at the
+        speed the trajectory gave them."""
         ds = self.s[-1] - self.s[-2] if len(self.s) > 1 else 0.0
-        if self.times is not None and len(self.times) > 1:
-            return ds / max(self.times[-1] - self.times[-2], 1e-9)
         do = self.offset[-1] - self.offset[-2] if len(self.s) > 1 else 0.0
         length = math.hypot(ds, do)
-        return speed * ds / length if length > 0.0 else 0.0
+        if self.times is not None and len(self.times) > 1:
+            span = max(self.times[-1] - self.times[-2], 1e-9)
+            return ds / span, length / span
+        return (speed * ds / length, abs(speed)) if length > 0.0 else (0.0, 0.0)
 
     def velocity(self, t: float, s: float, offset: float, speed: float, dt: float,
                  index: int) -> tuple[float, float, bool, int]:

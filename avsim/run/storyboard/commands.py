@@ -32,7 +32,11 @@
 - SynchronizeAction: the targets resolved when it starts; the actor's speed at each check
   by the speed law of `synchronize` (esmini's), until it is done.
 - LongitudinalDistanceAction: keeps a distance (or a time gap at the referenced entity's
-  speed) ahead of or behind the entity along the route (`Follow`).
+  speed) ahead of or behind the entity along its direction of travel on the route
+  (`Follow`): without acceleration limits reached by the next check and then held at the
+  entity's speed (esmini places the actor at the distance each step), else at the speed
+  `GAP_GAIN` gives within the DynamicConstraints' limits (`DISTANCE_ACCEL` where one is
+  missing).
 """
 
 from __future__ import annotations
@@ -274,9 +278,11 @@ class Commands:
                              snap.time + MOTION_STEP, me.s)
         return cmd, abs(goal - centre_offset) < GAP_REACHED
 
-    def follow(self, follow: Follow, me: EntityState, snap: Snapshot,
-               max_speed: float) -> tuple[TrackCommand, bool]:
-        """(the command for this step, whether the follow's goal is reached)."""
+    def follow(self, follow: Follow, me: EntityState, snap: Snapshot, max_speed: float,
+               period: float) -> tuple[TrackCommand, bool]:
+        """(the command for this step, whether the follow's goal is reached); `period` [s]
+        until the next check (module doc: a distance without acceleration limits is
+        reached within it)."""
         action = follow.action
         assert not isinstance(action, LateralDistanceAction)
         if isinstance(action, SpeedAction):
@@ -287,16 +293,24 @@ class Commands:
         want = action.distance if action.distance is not None else (
             (action.time_gap or 0.0) * max(ref.speed, 0.0))
         sign = -1.0 if action.displacement == "trailingReferencedEntity" else 1.0
-        gap = sign * (me.s - ref.s)
+        gap = sign * _travel(ref) * (me.s - ref.s)  # ahead of it along its way (trailing: behind)
         if action.freespace:
             gap -= 0.5 * (me.length + ref.length)
-        target = max(0.0, ref.speed + GAP_GAIN * sign * (gap - want))
         c = action.constraints
-        accel = c.max_acceleration if c is not None and c.max_acceleration else DISTANCE_ACCEL
-        decel = c.max_deceleration if c is not None and c.max_deceleration else DISTANCE_ACCEL
-        top = c.max_speed if c is not None and c.max_speed else max_speed
         reached = abs(gap - want) < GAP_REACHED and abs(me.speed - ref.speed) < SPEED_MATCHED
+        if c is None or not (c.max_acceleration or c.max_deceleration):
+            target = max(0.0, ref.speed - sign * (gap - want) / period)
+            return TrackCommand(follow.tag, target, math.inf, math.inf), reached
+        target = max(0.0, ref.speed + GAP_GAIN * sign * (gap - want))
+        accel = c.max_acceleration or DISTANCE_ACCEL
+        decel = c.max_deceleration or DISTANCE_ACCEL
+        top = c.max_speed if c.max_speed else max_speed
         return TrackCommand(follow.tag, min(target, top), accel, decel, top), reached
+
+
+def _travel(entity: EntityState) -> float:
+    """+1 if `entity` heads along the route, -1 against it."""
+    return 1.0 if math.cos(entity.heading - entity.route_heading) >= 0.0 else -1.0
 
 
 def poses_of(snap: Snapshot) -> dict[str, Pose]:

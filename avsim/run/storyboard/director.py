@@ -266,7 +266,8 @@ class Director:
             if isinstance(action, LateralDistanceAction):
                 cmd, reached = self.commands.keep_lateral(follow, me, motion.offset, snap)
             else:
-                cmd, reached = self.commands.follow(follow, me, snap, self._top[follow.entity])
+                cmd, reached = self.commands.follow(follow, me, snap, self._top[follow.entity],
+                                                    CHECK_PERIOD)
             motion.command(cmd)
             if reached and isinstance(action, LongitudinalDistanceAction
                                       | LateralDistanceAction) and not action.continuous:

@@ -327,7 +327,8 @@ def _actor_spec(path: Path, road_map: RoadMap, entity: Entity,
         return replace(base, type=kind, model=_model(obj))
     size = (obj.bbox.length, obj.bbox.width, obj.bbox.height)
     if isinstance(obj, Pedestrian):
-        return replace(base, type=spec.ActorType.PEDESTRIAN, size=size)
+        return replace(base, type=spec.ActorType.PEDESTRIAN, size=size,
+                       facing=_facing(road_map, lane, s, placed[entity.name].pose))
     assert isinstance(obj, MiscObject)
     return replace(base, size=size)
 
@@ -341,6 +342,16 @@ def _against(road_map: RoadMap, lane: int, s: float, pose: Pose | None) -> bool:
     travel = float(road_map.heading_at(s)) + (0.0 if road_map.lane(lane).direction > 0
                                               else math.pi)
     return math.cos(pose.heading - travel) < 0.0
+
+
+def _facing(road_map: RoadMap, lane: int, s: float, pose: Pose | None) -> float:
+    """[rad] the heading of `pose` from the direction of travel of `lane` at station `s`
+    [m], left positive, within a half turn (0 without a pose)."""
+    if pose is None:
+        return 0.0
+    travel = float(road_map.heading_at(s)) + (0.0 if road_map.lane(lane).direction > 0
+                                              else math.pi)
+    return math.remainder(pose.heading - travel, math.tau)
 
 
 def _nearest_lane(road_map: RoadMap, s: float, d: float) -> tuple[int, float]:

@@ -4,9 +4,9 @@ Usage: python tests/data/esmini_ref/build.py SOURCE_DIR
 (SOURCE_DIR: the full reference, one `<output>.csv` and `<output>_events.csv` per run and
 its `index.csv`.) Writes, per run of the index, `<output>.csv.gz`: every non-Ego entity's
 `time,name,x,y,h` at the samples whose time is a multiple of `STEP` (and the last one),
-and `<output>_events.csv.gz`: `time,element_type,element_name,to_state`, every state change
-esmini logged; and `index.csv`: the index's columns the tests read. Output is deterministic
-(gzip without a timestamp).
+and `<output>_events.csv.gz`: `time,element_type,element_name,from_state,to_state`, every
+state change esmini logged; and `index.csv`: the index's columns the tests read. Output is
+deterministic (gzip without a timestamp).
 """
 
 from __future__ import annotations
@@ -51,7 +51,8 @@ def _trajectories(src: Path) -> list[list[str]]:
 
 def _events(src: Path) -> list[list[str]]:
     with src.open() as f:
-        return [[r["time"], r["element_type"], r["element_name"], r["to_state"]]
+        return [[r["time"], r["element_type"], r["element_name"], r["from_state"],
+                 r["to_state"]]
                 for r in csv.DictReader(f)]
 
 
@@ -63,7 +64,7 @@ def build(source: Path, out: Path = HERE) -> None:
         _write_gz(out / f"{name}.csv.gz", ["time", "name", "x", "y", "h"],
                   _trajectories(source / f"{name}.csv"))
         _write_gz(out / f"{name}_events.csv.gz",
-                  ["time", "element_type", "element_name", "to_state"],
+                  ["time", "element_type", "element_name", "from_state", "to_state"],
                   _events(source / f"{name}_events.csv"))
     with (out / "index.csv").open("w", newline="") as f:
         writer = csv.writer(f, lineterminator="\n")

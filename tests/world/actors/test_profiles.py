@@ -137,8 +137,28 @@ def test_a_timed_path_is_at_each_vertex_at_its_time() -> None:
 
 
 def test_an_untimed_path_is_walked_at_the_speed_held() -> None:
+    """14 m of path at 2 m/s (7 s), its last segment straight across; then on along the
+    lane at that speed over ground (as esmini moves an entity on after its trajectory)."""
     motion = NpcMotion(0.0, 0.0, 2.0, 1, ())
     motion.command(PathCommand("p", (10.0, 10.0), (0.0, 4.0), None))
-    trace = run(motion, 8.0)
+    trace = run(motion, 7.0)
     assert motion.finished == ["p"]
     assert (trace[-1][1], trace[-1][2]) == pytest.approx((10.0, 4.0), abs=0.05)
+    trace = run(motion, 8.0, t0=7.0)
+    assert (trace[-1][1], trace[-1][2]) == pytest.approx((12.0, 4.0), abs=0.05)
+    assert motion.speed == pytest.approx(2.0)
+
+
+def test_a_pedestrian_starts_facing_as_placed_and_keeps_it_on_along_its_lane() -> None:
+    """Placed facing across (a file's orientation), a pedestrian walks a timed path across
+    the road and then goes on along its lane at the path's speed over ground, still facing
+    across (esmini moves it on along the road keeping its heading)."""
+    motion = NpcMotion(100.0, -5.0, 0.0, 1, (), pedestrian=True, facing=math.pi / 2)
+    assert motion.heading_offset == pytest.approx(math.pi / 2)
+    motion.command(PathCommand("walk", (100.0, 100.0), (-5.0, 5.0), (0.0, 5.0)))
+    run(motion, 5.0)
+    assert motion.finished == ["walk"]
+    assert (motion.s, motion.offset) == pytest.approx((100.0, 5.0), abs=1e-6)
+    trace = run(motion, 7.0, t0=5.0)
+    assert (trace[-1][1], trace[-1][2]) == pytest.approx((104.0, 5.0), abs=1e-6)
+    assert motion.heading_offset == pytest.approx(math.pi / 2)
