@@ -2,8 +2,10 @@
 
 Whatever the junction's control and the car's manoeuvre, a vehicle track in or near the
 junction's box (its centre within ``near`` of the box, map frame) that moves (faster than
-``moving``) across the car's path is watched: its constant-velocity prediction
-``x(t) = x0 + v t``, sampled every ``step`` for t in [0, ``horizon``] [s], is checked
+``moving``) across the car's path is watched: its prediction at constant speed and turn
+rate (the rate its velocity's heading turned at between the car's last two looks at it,
+`TurnRates`; straight when not known), sampled every ``step`` for t in [0, ``horizon``]
+[s], is checked
 against the car's path ahead (the route's line from the front bumper to ``beyond`` past the
 junction's exit, sampled every ``path_step``). A predicted position within ``clearance``
 of a path point (the two half widths and a margin), where the track's heading crosses the
@@ -53,12 +55,13 @@ class CrossingParams:
 
 
 def crossing_stop(road: RoadMap, j: Junction, front: float, v: float, xy: FloatArray,
-                  vel: FloatArray, p: CrossingParams, offset: float = 0.0) -> float | None:
+                  vel: FloatArray, p: CrossingParams, offset: float = 0.0,
+                  rate: FloatArray | None = None) -> float | None:
     """[m] from the front bumper (station `front`, speed `v` [m/s]) to where the car must
     stand for a vehicle crossing its path at junction `j` (module doc), or None; `xy` (N, 2)
     [m] and `vel` (N, 2) [m/s] the vehicle tracks' centres and velocities (map frame);
     `offset` [m] the kept lane's centre from the route's line (left +)."""
-    s = conflict_station(road, j, front, v, xy, vel, p, offset)
+    s = conflict_station(road, j, front, v, xy, vel, p, offset, rate)
     if s is None:
         return None
     room = j.s_stop - front
@@ -68,9 +71,12 @@ def crossing_stop(road: RoadMap, j: Junction, front: float, v: float, xy: FloatA
 
 
 def conflict_station(road: RoadMap, j: Junction, front: float, v: float, xy: FloatArray,
-                     vel: FloatArray, p: CrossingParams, offset: float = 0.0) -> float | None:
+                     vel: FloatArray, p: CrossingParams, offset: float = 0.0,
+                     rate: FloatArray | None = None) -> float | None:
     """[m] the station of the nearest conflict on the car's path ahead of `front` at `j`
-    (module doc), or None."""
+    (module doc), or None; `rate` (N,) [rad/s] the tracks' turn rates (None: straight)."""
+    if rate is None:
+        rate = np.zeros(len(xy))
     watched = _watched(j, xy, vel, p)
     end = j.s_exit + p.beyond
     if not watched.any() or front >= end:
@@ -80,8 +86,8 @@ def conflict_station(road: RoadMap, j: Junction, front: float, v: float, xy: Flo
     path = np.column_stack([px, py])  # (M, 2)
     times = np.arange(0.0, p.horizon + 0.5 * p.step, p.step)  # (K,)
     best: float | None = None
-    for x0, v0 in zip(xy[watched], vel[watched], strict=True):
-        s = _first_conflict(path, heading, stations, front, v, x0, v0, times, p)
+    for x0, v0, w in zip(xy[watched], vel[watched], rate[watched], strict=True):
+        s = _first_conflict(path, heading, stations, front, v, x0, v0, float(w), times, p)
         if s is not None and (best is None or s < best):
             best = s
     return best
@@ -99,23 +105,61 @@ def _watched(j: Junction, xy: FloatArray, vel: FloatArray, p: CrossingParams,
 
 
 def _first_conflict(path: FloatArray, heading: FloatArray, stations: FloatArray,
-                    front: float, v: float, x0: FloatArray, v0: FloatArray,
+                    front: float, v: float, x0: FloatArray, v0: FloatArray, rate: float,
                     times: FloatArray, p: CrossingParams) -> float | None:
     """[m] the nearest station of the path (`path` (M, 2) at `stations`, `heading` [rad])
-    the track at `x0` moving at `v0` crosses in time for the car to meet it, or None."""
-    predicted = x0[None, :] + times[:, None] * v0[None, :]  # (K, 2)
+    the track at `x0` moving at `v0` and turning at `rate` [rad/s] crosses in time for the
+    car to meet it, or None."""
+    predicted, h = predict(x0, v0, rate, times)  # (K, 2), (K,)
     d2 = ((predicted[:, None, :] - path[None, :, :]) ** 2).sum(axis=2)  # (K, M)
     close = d2 < p.clearance ** 2
     if not close.any():
         return None
-    speed = math.hypot(float(v0[0]), float(v0[1]))
-    sine = np.abs(np.cos(heading) * v0[1] - np.sin(heading) * v0[0]) / speed  # (M,)
-    close &= (sine > p.across)[None, :]
+    sine = np.abs(np.sin(h[:, None] - heading[None, :]))  # (K, M)
+    close &= sine > p.across
     for m in np.flatnonzero(close.any(axis=0)):  # path points, nearest first
         gone = float(times[np.flatnonzero(close[:, m])[-1]]) + p.step + p.after  # [s]
         if _reach_time(float(stations[m]) - front, v, p.pull_away) <= gone:
             return float(stations[m])
     return None
+
+
+def predict(x0: FloatArray, v0: FloatArray, rate: float,
+            times: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """Positions [m] (K, 2) and headings [rad] (K,) at `times` [s] of a vehicle at `x0`
+    with velocity `v0` [m/s] turning at `rate` [rad/s] at constant speed."""
+    speed = math.hypot(float(v0[0]), float(v0[1]))
+    h0 = math.atan2(float(v0[1]), float(v0[0]))
+    h = h0 + rate * times
+    if abs(rate) < 1e-3:
+        return x0[None, :] + times[:, None] * v0[None, :], h
+    r = speed / rate
+    x = x0[0] + r * (np.sin(h) - math.sin(h0))
+    y = x0[1] - r * (np.cos(h) - math.cos(h0))
+    return np.column_stack([x, y]), h
+
+
+class TurnRates:
+    """[rad/s] each track's turn rate: its velocity's heading change between two looks."""
+
+    def __init__(self, moving: float) -> None:
+        self.moving = moving  # [m/s] slower than this, a heading is not trusted
+        self._last: dict[int, tuple[float, float]] = {}  # track id -> ([s] t, [rad] heading)
+
+    def update(self, t: float, ids: list[int], vel: FloatArray) -> FloatArray:
+        """(N,) the turn rates of the tracks `ids` with velocities `vel` (N, 2) at `t` [s]."""
+        rates = np.zeros(len(ids))
+        seen: dict[int, tuple[float, float]] = {}
+        for i, (tid, (vx, vy)) in enumerate(zip(ids, vel.tolist(), strict=True)):
+            if math.hypot(vx, vy) <= self.moving:
+                continue
+            h = math.atan2(vy, vx)
+            seen[tid] = (t, h)
+            last = self._last.get(tid)
+            if last is not None and t > last[0]:
+                rates[i] = math.remainder(h - last[1], 2.0 * math.pi) / (t - last[0])
+        self._last = seen
+        return rates
 
 
 def _reach_time(distance: float, v: float, a: float) -> float:

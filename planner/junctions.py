@@ -100,7 +100,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from perception.messages import LightDetection, ObjectClass, Track
-from planner.crossing import CrossingParams, crossing_stop
+from planner.crossing import CrossingParams, TurnRates, crossing_stop
 from planner.fsm.acc import NO_EVENTS, AccEvent
 from planner.limits import A_COMF, A_FIRM
 from planner.queue import queued
@@ -180,6 +180,7 @@ class JunctionMonitor:
         self._order_at: int | None = None  # the junction (route order) `_order` is for
         # [m] each junction's centre to its stop line (the car's approach; every arm's)
         self._line_out = [self._line_distance(j) for j in road.junctions]
+        self._turn_rates = TurnRates(self.params.crossing.moving)
 
     def see_lights(self, detections: Sequence[LightDetection]) -> None:
         """Take the camera's colours: red or yellow at once; green, which lets the car go,
@@ -212,7 +213,7 @@ class JunctionMonitor:
         way_stop = self._give_way(t, front, v, approach, tracks,
                                   lambda: queued(self.road, station, front, offset, width,
                                                  tracks))
-        cross_stop = self._crossing(front, v, approach, offset, tracks)
+        cross_stop = self._crossing(t, front, v, approach, offset, tracks)
         if cross_stop is not None:
             way_stop = cross_stop if way_stop is None else min(way_stop, cross_stop)
         stops = [d for d in (light_stop, way_stop) if d is not None]
@@ -255,16 +256,18 @@ class JunctionMonitor:
 
     # -- giving way ------------------------------------------------------------------------
 
-    def _crossing(self, front: float, v: float, approach: float, offset: float,
+    def _crossing(self, t: float, front: float, v: float, approach: float, offset: float,
                   tracks: Sequence[Track]) -> float | None:
         """[m] to where the car must stand for a vehicle crossing its path at the junction
         it approaches (within `approach` [m]) or is in (`planner.crossing`), or None."""
         c = self.params.crossing
+        xy, vel = _vehicles(tracks)
+        ids = [tr.id for tr in tracks if tr.cls in (ObjectClass.CAR, ObjectClass.TRUCK)]
+        rate = self._turn_rates.update(t, ids, vel)
         j = next((j for j in self.road.junctions if j.s_exit + c.beyond > front), None)
         if j is None or j.s_stop - front > approach:
             return None
-        xy, vel = _vehicles(tracks)
-        return crossing_stop(self.road, j, front, v, xy, vel, c, offset)
+        return crossing_stop(self.road, j, front, v, xy, vel, c, offset, rate)
 
     def _line_distance(self, j: Junction) -> float:
         """[m] from `j`'s centre back to the car's stop line, along its approach."""

@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from planner.crossing import CrossingParams, conflict_station, crossing_stop
+from planner.crossing import CrossingParams, TurnRates, conflict_station, crossing_stop
 from world.hdmap import Manoeuvre, RoadMap
 from world.map.road import build_road_map
 from world.map.town import TownLayout, compile_route
@@ -106,3 +106,22 @@ def test_the_path_is_the_cars_own_turn() -> None:
     xy, vel = one(j.x + 1.75, j.y - 9.0, 0.0, 3.0)
     s = conflict_station(r, j, front, 0.0, xy, vel, P, float(r.lanes[0].offset_at(front)))
     assert s is not None and j.s_enter < s < j.s_exit
+
+
+def test_a_car_starting_its_left_turn_is_predicted_by_its_turn_rate() -> None:
+    """An oncoming car just into the box, still heading almost west but turning left at
+    0.6 rad/s: straight ahead it passes in its own lane, along its turn it crosses the
+    car's lane; the turn rate comes from two looks at its velocity (`TurnRates`)."""
+    r = road()
+    j = r.junctions[0]
+    front = at_line(r)
+    off = float(r.lanes[0].offset_at(front))
+    h = math.radians(185.0)
+    xy, vel = one(j.x + 3.0, j.y + 1.75, 6.0 * math.cos(h), 6.0 * math.sin(h))
+    assert conflict_station(r, j, front, 0.0, xy, vel, P, off) is None
+    rates = TurnRates(P.moving)
+    before = h - 0.06  # [rad] 0.1 s earlier
+    rates.update(0.0, [7], np.array([[6.0 * math.cos(before), 6.0 * math.sin(before)]]))
+    rate = rates.update(0.1, [7], vel)
+    assert rate[0] == pytest.approx(0.6)
+    assert conflict_station(r, j, front, 0.0, xy, vel, P, off, rate) is not None
