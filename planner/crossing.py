@@ -3,7 +3,7 @@
 Whatever the junction's control and the car's manoeuvre, a vehicle track in or near the
 junction's box (its centre within ``near`` of the box, map frame) that moves (faster than
 ``moving``) across the car's path is watched: its prediction at constant speed and turn
-rate (the rate its velocity's heading turned at between the car's last two looks at it,
+rate (the rate its velocity's heading turned at between the track's last two states,
 `TurnRates`; straight when not known), sampled every ``step`` for t in [0, ``horizon``]
 [s], is checked
 against the car's path ahead (the route's line from the front bumper to ``beyond`` past the
@@ -140,24 +140,31 @@ def predict(x0: FloatArray, v0: FloatArray, rate: float,
 
 
 class TurnRates:
-    """[rad/s] each track's turn rate: its velocity's heading change between two looks."""
+    """[rad/s] each track's turn rate: its velocity's heading change between two of its
+    states (the tracker's own times: a state seen again between scans changes nothing)."""
 
     def __init__(self, moving: float) -> None:
         self.moving = moving  # [m/s] slower than this, a heading is not trusted
-        self._last: dict[int, tuple[float, float]] = {}  # track id -> ([s] t, [rad] heading)
+        # track id -> ([s] state time, [rad] heading, [rad/s] rate)
+        self._last: dict[int, tuple[float, float, float]] = {}
 
-    def update(self, t: float, ids: list[int], vel: FloatArray) -> FloatArray:
-        """(N,) the turn rates of the tracks `ids` with velocities `vel` (N, 2) at `t` [s]."""
+    def update(self, times: list[float], ids: list[int], vel: FloatArray) -> FloatArray:
+        """(N,) the turn rates of the tracks `ids` with velocities `vel` (N, 2) at their
+        state `times` [s]."""
         rates = np.zeros(len(ids))
-        seen: dict[int, tuple[float, float]] = {}
-        for i, (tid, (vx, vy)) in enumerate(zip(ids, vel.tolist(), strict=True)):
+        seen: dict[int, tuple[float, float, float]] = {}
+        for i, (t, tid, (vx, vy)) in enumerate(zip(times, ids, vel.tolist(), strict=True)):
             if math.hypot(vx, vy) <= self.moving:
                 continue
             h = math.atan2(vy, vx)
-            seen[tid] = (t, h)
             last = self._last.get(tid)
-            if last is not None and t > last[0]:
-                rates[i] = math.remainder(h - last[1], 2.0 * math.pi) / (t - last[0])
+            if last is not None and t <= last[0]:
+                seen[tid] = last
+            else:
+                rate = 0.0 if last is None else \
+                    math.remainder(h - last[1], 2.0 * math.pi) / (t - last[0])
+                seen[tid] = (t, h, rate)
+            rates[i] = seen[tid][2]
         self._last = seen
         return rates
 

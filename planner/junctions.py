@@ -262,8 +262,9 @@ class JunctionMonitor:
         it approaches (within `approach` [m]) or is in (`planner.crossing`), or None."""
         c = self.params.crossing
         xy, vel = _vehicles(tracks)
-        ids = [tr.id for tr in tracks if tr.cls in (ObjectClass.CAR, ObjectClass.TRUCK)]
-        rate = self._turn_rates.update(t, ids, vel)
+        vehicles = [tr for tr in tracks if tr.cls in (ObjectClass.CAR, ObjectClass.TRUCK)]
+        rate = self._turn_rates.update([tr.t for tr in vehicles], [tr.id for tr in vehicles],
+                                       vel)
         j = next((j for j in self.road.junctions if j.s_exit + c.beyond > front), None)
         if j is None or j.s_stop - front > approach:
             return None

@@ -121,7 +121,8 @@ def test_a_car_starting_its_left_turn_is_predicted_by_its_turn_rate() -> None:
     assert conflict_station(r, j, front, 0.0, xy, vel, P, off) is None
     rates = TurnRates(P.moving)
     before = h - 0.06  # [rad] 0.1 s earlier
-    rates.update(0.0, [7], np.array([[6.0 * math.cos(before), 6.0 * math.sin(before)]]))
-    rate = rates.update(0.1, [7], vel)
+    rates.update([0.0], [7], np.array([[6.0 * math.cos(before), 6.0 * math.sin(before)]]))
+    rate = rates.update([0.1], [7], vel)
     assert rate[0] == pytest.approx(0.6)
+    assert rates.update([0.1], [7], vel)[0] == pytest.approx(0.6)  # the same state again
     assert conflict_station(r, j, front, 0.0, xy, vel, P, off, rate) is not None
