@@ -57,6 +57,14 @@ the line:
   heading), until that vehicle no longer waits at its line. It never waits for a vehicle
   that arrived after it, nor for one queued behind another.
 
+**Crossing paths** (also ``give_way``), at a junction of any control and for any
+manoeuvre, even with the right of way: a moving vehicle track in or near the box whose
+constant-velocity prediction crosses the car's path ahead in time for the car to meet it
+(`planner.crossing`, ``crossing``) keeps the car at its line when it can still stop there
+at ``commit_decel``, else stops it short of the conflict point (as hard as the stop law
+must); already in the box, too. It holds while the prediction crosses, without the gap
+hysteresis below.
+
 Like the yellow rule, the decision to give way is taken only while the car can still stop
 before the line at ``commit_decel`` (at an all-way stop, where it stops at the line
 anyway, not before it has arrived there): once it is moving (faster than ``moving``) and cannot
@@ -87,11 +95,12 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from perception.messages import LightDetection, ObjectClass, Track
+from planner.crossing import CrossingParams, TurnRates, crossing_stop
 from planner.fsm.acc import NO_EVENTS, AccEvent
 from planner.limits import A_COMF, A_FIRM
 from planner.queue import queued
@@ -128,6 +137,8 @@ class JunctionParams:
     tie: float = 1.0  # [s] arrivals this close in time are a tie (the right goes first)
     gap_confirm: float = 0.6  # [s] a gap is taken once nothing was waited for this long: the
     #   tracker's confirmation window (5 LiDAR scans at 10 Hz) and one scan more
+    crossing: CrossingParams = field(default_factory=CrossingParams)  # vehicles crossing
+    #   the car's path at the junction (`planner.crossing`)
 
 
 @dataclass(frozen=True, slots=True)
@@ -169,6 +180,7 @@ class JunctionMonitor:
         self._order_at: int | None = None  # the junction (route order) `_order` is for
         # [m] each junction's centre to its stop line (the car's approach; every arm's)
         self._line_out = [self._line_distance(j) for j in road.junctions]
+        self._turn_rates = TurnRates(self.params.crossing.moving)
 
     def see_lights(self, detections: Sequence[LightDetection]) -> None:
         """Take the camera's colours: red or yellow at once; green, which lets the car go,
@@ -201,6 +213,9 @@ class JunctionMonitor:
         way_stop = self._give_way(t, front, v, approach, tracks,
                                   lambda: queued(self.road, station, front, offset, width,
                                                  tracks))
+        cross_stop = self._crossing(t, front, v, approach, offset, tracks)
+        if cross_stop is not None:
+            way_stop = cross_stop if way_stop is None else min(way_stop, cross_stop)
         stops = [d for d in (light_stop, way_stop) if d is not None]
         happening = {AccEvent.RED_LIGHT: light_stop is not None,
                      AccEvent.GIVE_WAY: way_stop is not None}
@@ -240,6 +255,20 @@ class JunctionMonitor:
         return (room if i in self._stopping else None), colour
 
     # -- giving way ------------------------------------------------------------------------
+
+    def _crossing(self, t: float, front: float, v: float, approach: float, offset: float,
+                  tracks: Sequence[Track]) -> float | None:
+        """[m] to where the car must stand for a vehicle crossing its path at the junction
+        it approaches (within `approach` [m]) or is in (`planner.crossing`), or None."""
+        c = self.params.crossing
+        xy, vel = _vehicles(tracks)
+        vehicles = [tr for tr in tracks if tr.cls in (ObjectClass.CAR, ObjectClass.TRUCK)]
+        rate = self._turn_rates.update([tr.t for tr in vehicles], [tr.id for tr in vehicles],
+                                       vel)
+        j = next((j for j in self.road.junctions if j.s_exit + c.beyond > front), None)
+        if j is None or j.s_stop - front > approach:
+            return None
+        return crossing_stop(self.road, j, front, v, xy, vel, c, offset, rate)
 
     def _line_distance(self, j: Junction) -> float:
         """[m] from `j`'s centre back to the car's stop line, along its approach."""

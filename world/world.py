@@ -520,7 +520,7 @@ class World:
             if self.actors.town_drivers:  # they keep their distance to the ego too
                 x, y, _ = self.client.getBasePositionAndOrientation(self.ego.body)[0]
                 ego = (x, y, 0.5 * self.ego.geometry.body_length)
-            self.actors.step(self.clock.t, ACTOR_RATE.every * self.clock.dt, ego)
+            self.actors.step(self.clock.t, ACTOR_RATE.every * self.clock.dt, ego, self.ego_s)
 
     def snapshot(self) -> WorldSnapshot:
         """The moving bodies' poses now (for a mirror world that only renders).

@@ -378,3 +378,20 @@ def test_at_an_all_way_stop_the_car_does_not_commit_before_it_has_stood() -> Non
     m = stop_monitor()
     assert m.update(0.0, front_at(m, 10.0), 9.0, []).active == frozenset()
     assert at_stop(m, 3.0, [at_arm("south", 4)])  # it stood: the earlier car goes first
+
+
+@pytest.mark.parametrize(("vx", "vy", "gives_way"), [
+    (-3.5, -3.5, True),  # an oncoming car half way through its left turn, across the lane
+    (-5.0, 0.0, False),  # an oncoming car going straight through, in its own lane
+])
+def test_going_straight_on_green_the_car_waits_for_a_car_turning_across(
+        vx: float, vy: float, gives_way: bool) -> None:
+    """Straight on, with right of way at a green light, the car at its line does not enter
+    while a vehicle in the box moves across its path (`planner.crossing`)."""
+    m = JunctionMonitor(route(LIGHTS, Manoeuvre.STRAIGHT), VEHICLE, P)
+    green(m)
+    j = m.road.junctions[0]
+    turning = car(j.x + 1.0, j.y + 1.75, vx, vy)
+    out = m.update(0.0, front_at(m, 0.6), 0.0, [turning])
+    assert out.holds(GIVE_WAY) is gives_way
+    assert not m.update(0.1, front_at(m, 0.6), 0.0, []).holds(GIVE_WAY)

@@ -37,8 +37,8 @@ from world.actors.all_way_stop import AllWayStop
 from world.actors.behaviour import NpcMotion, TriggerContext
 from world.actors.bodies import VEHICLES, BoxSize, body_size, vehicle_of
 from world.actors.catalogue import CATALOGUE, DEFAULT_MODEL, VehicleClass
-from world.actors.town_traffic import STOP_SPEED, Others, StopZones, TownDriver
-from world.hdmap import RoadMap
+from world.actors.town_traffic import STOP_MARGIN, STOP_SPEED, Others, StopZones, TownDriver
+from world.hdmap import Manoeuvre, RoadMap
 from world.map.road import build_road_map
 from world.map.signals import route_signals
 from world.scene.collision import Box, CollisionShapes, Part
@@ -192,25 +192,30 @@ class ActorSet:
             started += [(spec.id, i) for i in motion.fire_due(ctx, lane_offset)]
         return started
 
-    def step(self, t: float, dt: float, ego: tuple[float, float, float] | None = None) -> None:
+    def step(self, t: float, dt: float, ego: tuple[float, float, float] | None = None,
+             ego_s: float | None = None) -> None:
         """Advance every motion by dt [s] and move the moving bodies to their new poses.
-        `ego`: (x, y, half length) of the ego, for town drivers to keep their distance."""
+        `ego`: (x, y, half length) of the ego, for town drivers to keep their distance;
+        `ego_s` [m] its centre's station on its route (where it turns next)."""
         self._last_speed = self._speeds()
         self._dt = dt
-        self._cap_town_drivers(t, dt, ego)
+        self._cap_town_drivers(t, dt, ego, ego_s)
         for motion, line in zip(self.motions, self._lines, strict=True):
             motion.step(t, dt, line.curvature_one(motion.s))
         self._poses = None
         self._place(force=False)
 
-    def _cap_town_drivers(self, t: float, dt: float,
-                          ego: tuple[float, float, float] | None) -> None:
-        """Each town driver's speed cap from its rules and the other vehicles' centres and
-        velocities (those over the last step); the ego's place in the all-way-stop order."""
+    def _cap_town_drivers(self, t: float, dt: float, ego: tuple[float, float, float] | None,
+                          ego_s: float | None) -> None:
+        """Each town driver's speed cap from its rules and the other vehicles' centres,
+        velocities (those over the last step) and turns at their next junctions; the ego's
+        place in the all-way-stop order."""
         if not self._own.any():
             return
         vehicles = np.array([k in VEHICLES for k in self._kinds]) & ~self.gone
         xy, half = self._xy[vehicles], self.half_sizes[vehicles, 0]
+        across = np.array([d is not None and d.turns_across_next() for d in self._drivers],
+                          dtype=bool)[vehicles]
         velocity = (self._xy - self._xy_prev)[vehicles] / dt
         self._xy_prev = self._xy.copy()
         if ego is not None:
@@ -221,6 +226,8 @@ class ActorSet:
             xy = np.vstack([xy, [ego[:2]]])
             velocity = np.vstack([velocity, [ego_v]])
             half = np.append(half, ego[2])
+            across = np.append(across, ego_s is not None and
+                               self._ego_turns_across(ego_s + ego[2]))
         index = np.cumsum(vehicles) - 1  # row of each vehicle actor in xy
         for i, (driver, motion) in enumerate(zip(self._drivers, self.motions, strict=True)):
             if driver is None or self.gone[i]:
@@ -228,9 +235,16 @@ class ActorSet:
             others = np.ones(len(xy), dtype=bool)
             others[index[i]] = False
             motion.cap = driver.speed_cap(
-                t, motion.s, motion.speed, Others(xy[others], velocity[others], half[others]))
+                t, motion.s, motion.speed,
+                Others(xy[others], velocity[others], half[others], across[others]))
             if driver.arrived:
                 self._leave(i)
+
+    def _ego_turns_across(self, front: float) -> bool:
+        """Whether the ego's route turns left or makes a U-turn at the first junction whose
+        stop line its front bumper (station `front` [m]) is not over."""
+        j = next((j for j in self._road.junctions if j.s_stop > front - STOP_MARGIN), None)
+        return j is not None and j.manoeuvre in (Manoeuvre.LEFT, Manoeuvre.U_TURN)
 
     def _ego_order(self, t: float, ego: tuple[float, float, float], speed: float) -> None:
         """The ego arrives at an all-way stop when it stands at its line (slower than the

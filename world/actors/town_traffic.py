@@ -7,7 +7,12 @@ An NPC in a town drives its route road (`world.map.town.compile_route`) at its s
   it stop with its front bumper ``STOP_MARGIN`` before the line, along the braking curve
   ``v = sqrt(2 b d)``, b = ``STOP_DECEL``, d the distance left. Turning left (or a U-turn)
   on green, it also stops at the line while an oncoming vehicle will reach the junction's
-  box within ``LEFT_GAP`` at its speed, or is in the box coming its way;
+  box within ``LEFT_GAP``, or is in the box coming its way. The time to the box is the
+  sooner of its own speed's and a pull-away's from rest at ``PULL_AWAY``: a vehicle
+  standing at the opposing line, or queued behind it within ``PULL_AWAY LEFT_GAP^2 / 2``
+  of the box, goes on the same green and has the priority (oncoming straight traffic goes
+  first), so it is waited for too; not one that itself turns across at its next junction
+  (`Others.turns_across`: opposing left turns pass each other);
 - **stop signs** (all-way stops): it stops at the line (slower than ``STOP_SPEED`` with
   its front within 1 m of its stop point), which makes it arrive there
   (`world.actors.all_way_stop`: first to stop, first to go, ties to the right; the ego
@@ -37,7 +42,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
@@ -65,6 +70,8 @@ FOLLOW_REACH = LOOK_AHEAD + FOLLOW_LANE_HALF + 20.0  # [m] a vehicle farther tha
 #   the NPC's centre cannot be within FOLLOW_LANE_HALF of its line within LOOK_AHEAD (the
 #   route between two stations is no shorter than the straight line between them)
 LEFT_GAP = 6.0  # [s] an oncoming vehicle this near the box in time is waited for
+PULL_AWAY = 1.5  # [m/s^2] a standing oncoming vehicle's pull-away to the box (as a town
+#   driver's own, `world.actors.behaviour.CAP_ACCEL`)
 ONCOMING_REACH = 80.0  # [m] beyond the box, how far out oncoming vehicles count
 MOVING = 0.5  # [m/s] slower than this, a vehicle is not moving
 ARRIVED = 1.0  # [m] the front this near the route's end, standing: it has arrived
@@ -90,6 +97,14 @@ class Others:
     xy: FloatArray  # [m] (N, 2) centres
     velocity: FloatArray  # [m/s] (N, 2) velocities over ground
     half_length: FloatArray  # [m] (N,) centre to bumper
+    # (N,) whether it turns left or makes a U-turn at its next junction; empty: none does
+    turns_across: NDArray[np.bool_] = field(default_factory=lambda: np.zeros(0, dtype=bool))
+
+    def across(self) -> NDArray[np.bool_]:
+        """(N,) `turns_across`, all False when not given."""
+        if len(self.turns_across) == len(self.xy):
+            return self.turns_across
+        return np.zeros(len(self.xy), dtype=bool)
 
 
 def no_others() -> Others:
@@ -136,6 +151,12 @@ class TownDriver:
         cap = min(self._line_cap(t, front, speed, others), self._turn_cap(s),
                   _braking_speed(end))
         return min(cap, self._follow_cap(s, speed, others))
+
+    def turns_across_next(self) -> bool:
+        """Whether it turns left or makes a U-turn at the next junction it has not passed."""
+        j = next((line.junction for line in self._lines
+                  if not line.passed and line.junction is not None), None)
+        return j is not None and _turns_across(j)
 
     def _line_cap(self, t: float, front: float, speed: float, others: Others) -> float:
         """[m/s] the braking speed to the first line ahead it must stop at (signals, signs)."""
@@ -275,8 +296,9 @@ def _junction_frame(j: Junction, xy: FloatArray) -> tuple[FloatArray, FloatArray
 
 
 def _oncoming(j: Junction, others: Others) -> bool:
-    """Whether an oncoming vehicle will reach `j`'s box within LEFT_GAP, or is in the box
-    coming this way (module doc)."""
+    """Whether an oncoming vehicle will reach `j`'s box within LEFT_GAP (at its speed, or
+    pulling away from rest at PULL_AWAY: standing at or queued behind its line; not one
+    that turns across itself), or is in the box coming this way (module doc)."""
     if len(others.xy) == 0:
         return False
     along, left = _junction_frame(j, others.xy)
@@ -285,9 +307,13 @@ def _oncoming(j: Junction, others: Others) -> bool:
     far_arm = (along > j.half_width) & (along < j.half_width + ONCOMING_REACH) & \
         (left > 0.0) & (left < j.half_width)
     soon = (along - j.half_width) < LEFT_GAP * towards
+    to_box = along - j.half_width - others.half_length  # [m] its front to the box
+    pulls_away = (towards > -MOVING) & (to_box < 0.5 * PULL_AWAY * LEFT_GAP ** 2) & \
+        ~others.across()
     in_box = (np.abs(along) <= j.half_width) & (np.abs(left) <= j.half_width)
     coming = towards > MOVING
-    return bool(np.any(coming & ((far_arm & soon) | in_box)))
+    return bool(np.any(far_arm & ((coming & soon) | pulls_away)) or
+                np.any(coming & in_box))
 
 
 def _box_occupied(j: Junction, others: FloatArray) -> bool:

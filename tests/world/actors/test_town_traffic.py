@@ -171,14 +171,19 @@ def test_an_npc_does_not_wait_for_a_car_behind_it_or_queued() -> None:
     assert d.speed_cap(town_traffic.STOP_DWELL + 0.1, s, 0.0, still(behind)) > 0.0
 
 
-@pytest.mark.parametrize(("oncoming_at", "speed", "waits"), [
-    (30.0, 8.0, True),  # coming, 30 m beyond the box at 8 m/s: there within the gap
-    (120.0, 8.0, False),  # too far to count
-    (30.0, 0.0, False),  # standing (at its own line): not coming
-    (-1.0, 5.0, True),  # in the box, coming this way
+@pytest.mark.parametrize(("oncoming_at", "speed", "across", "waits"), [
+    (30.0, 8.0, False, True),  # coming, 30 m beyond the box at 8 m/s: there within the gap
+    (120.0, 8.0, False, False),  # too far to count
+    (HALF + 1.0, 0.0, False, True),  # standing at its line: goes on the same green, first
+    (15.0, 0.0, False, True),  # queued behind the line: pulls away into the box in time
+    (15.0, 1.0, False, True),  # creeping up the queue: the pull-away, not its speed, counts
+    (40.0, 0.0, False, False),  # standing farther back: out of the gap from rest
+    (HALF + 1.0, 0.0, True, False),  # standing to turn left itself: the turns pass
+    (30.0, 8.0, True, True),  # coming at speed, whatever it means to do
+    (-1.0, 5.0, False, True),  # in the box, coming this way
 ])
 def test_a_left_turn_on_green_waits_for_oncoming_traffic(oncoming_at: float, speed: float,
-                                                        waits: bool) -> None:
+                                                        across: bool, waits: bool) -> None:
     layout = town("traffic_lights")
     d = driver(layout, (0, 1, "east"), [Manoeuvre.LEFT], "npc", AllWayStop())
     j = d.road.junctions[0]
@@ -187,9 +192,20 @@ def test_a_left_turn_on_green_waits_for_oncoming_traffic(oncoming_at: float, spe
     # the oncoming lane: left of the approach's axis, heading west towards the box
     x = j.x + j.half_width + oncoming_at if oncoming_at >= 0.0 else j.x + 1.0
     y = j.y + 1.75
-    others = Others(np.array([[x, y]]), np.array([[-speed, 0.0]]), np.array([HALF]))
+    others = Others(np.array([[x, y]]), np.array([[-speed, 0.0]]), np.array([HALF]),
+                    np.array([across]))
     cap = d.speed_cap(float(green), at_line(d), 0.0, others)
     assert (cap == 0.0) is waits
+
+
+def test_which_npcs_turn_across_next() -> None:
+    """A driver knows its own next turn, and it is no longer the one behind it."""
+    layout = town("traffic_lights")
+    left = driver(layout, (0, 1, "east"), [Manoeuvre.LEFT], "left", AllWayStop())
+    ahead = driver(layout, (0, 1, "east"), [Manoeuvre.STRAIGHT], "ahead", AllWayStop())
+    assert left.turns_across_next() and not ahead.turns_across_next()
+    left.speed_cap(0.0, left.road.junctions[0].s_exit, 5.0, town_traffic.no_others())
+    assert not left.turns_across_next()
 
 
 def test_at_its_route_end_an_npc_arrives() -> None:
