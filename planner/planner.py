@@ -286,9 +286,7 @@ class Planner:
         speed = self._degraded_cap(acc.speed, ego.speed, dt) if engaged else \
             self.inputs.driving(inp.driver, ego.speed)
         control, control_changes = self.control.update(
-            ego.t, ego.speed, speed.ref.speed, speed.ref.accel,
-            acc.lead_gap + (manoeuvre.room if _with_room(lead, manoeuvre) is not lead else 0.0),
-            lead, lead_accel)
+            ego.t, ego.speed, speed.ref.speed, speed.ref.accel, lead, lead_accel)
         if control.emergency:
             speed = PlannedSpeed(SpeedRef(0.0, -self.control.decel), SpeedSource.EMERGENCY)
         hazard_changes = self.hazard.apply(ego.t, hazard.transition(
@@ -413,7 +411,7 @@ class Planner:
                 return None
             n = min(manoeuvre.leads, key=lambda n: n.gap)
             gap = n.gap - (n.speed - ego.speed) * max(ego.t - n.t, 0.0)  # at the track's time
-            lead = Lead(n.track_id, n.t, gap, max(n.speed, 0.0))
+            lead = Lead(n.track_id, n.t, gap, max(n.speed, 0.0), n.speed)
             self.leads.take(lead)
             return lead
         p = self.params
