@@ -7,8 +7,9 @@ An action the OpenSCENARIO file switches off by its own configuration (an Act or
 started only by parameter or variable values that nothing changes and that are false:
 `avsim.run.story_switches`) is no part of the story: the note says so ("not applicable:
 switched off by parameter X"), and with nothing else scripted the verdict is not
-applicable. An act started by the run (a time to collision, a distance, a time) that never
-starts still fails: the situation did not happen."""
+applicable. So is an action that only reacts to a collision, when none happened. An act
+started by the run (a time to collision, a distance, a time) that never starts still
+fails: the situation did not happen."""
 
 from __future__ import annotations
 
@@ -54,7 +55,8 @@ class Story(Criterion):
         """"not applicable: switched off by parameter X (its actions)", one per reason."""
         by_why: dict[str, list[str]] = {}
         for label, why in self.off.items():
-            by_why.setdefault(why, []).append(label)
+            if label not in self.fired:
+                by_why.setdefault(why, []).append(label)
         return "; ".join(f"not applicable: {why} ({', '.join(labels)})"
                          for why, labels in by_why.items()) or None
 

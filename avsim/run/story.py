@@ -4,8 +4,8 @@ Two kinds of scenario script their story. A YAML scenario's actors' actions and 
 events fire in the world (`ScriptedStory`: `World.action_fired_at`, `event_fired_at`). An
 OpenSCENARIO file's storyboard is played by the director (`StoryboardStory`): its entries
 are the storyboard's actions (by name) and its StopTrigger, fired when they first started;
-the actions of an Act or Event the file switches off by configuration are optional, with
-the reason (`avsim.run.story_switches`).
+the actions of an Act or Event the file switches off by configuration, or that only react
+to a collision, are optional, with the reason (`avsim.run.story_switches`).
 The `story` criterion judges the labels fired; the result lists the entries.
 """
 
@@ -14,7 +14,7 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 from avsim.criteria.story import story_label
-from avsim.run.story_switches import switched_off
+from avsim.run.story_switches import collision_reactions, switched_off
 from avsim.run.storyboard.director import Director
 from avsim.scenario.scenario import Scenario
 from world.world import World
@@ -90,7 +90,7 @@ class StoryboardStory:
         self.director = director
         board = director.program.scenario.storyboard
         osc = director.program.scenario
-        off = switched_off(board, osc.parameters, osc.variables)
+        off = collision_reactions(board) | switched_off(board, osc.parameters, osc.variables)
         names = [(action.name, kind_of(action.private_action))
                  for _, action in board.story_actions()]
         if board.stop_trigger is not None:

@@ -13,14 +13,20 @@ ParameterAction / VariableAction), and the trigger is false with their values at
 the run, so the trigger never fires. A trigger with any other condition (a time, a
 distance, a time to collision, another element's state) depends on the run: its act is
 counted, and fails `story` if it never fires.
+
+One kind of run-dependent trigger is no stimulus either: an Act or Event started only by
+CollisionConditions reacts to a collision (the Euro NCAP files' ``AtCollision`` event sets
+their ``collisionDetected`` variable, for the StopTrigger). It records the test's outcome:
+a collision avoided is no part of the story missing (`collision_reactions`).
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping
 
 from avsim.run.storyboard.rules import value_holds
 from avsim.scenario.openscenario.conditions import (
+    CollisionCondition,
     Condition,
     ParameterCondition,
     Trigger,
@@ -92,13 +98,43 @@ def switched_off(board: Storyboard, parameters: Mapping[str, ParamValue],
 def _off_actions(board: Storyboard, fixed: frozenset[Setting],
                  parameters: Mapping[str, ParamValue],
                  variables: Mapping[str, ParamValue]) -> Iterator[tuple[str, str]]:
+    def off(trigger: Trigger | None) -> str | None:
+        return switched_off_by(trigger, fixed, parameters, variables)
+    yield from _judged_actions(board, off)
+
+
+COLLISION_REACTION = "reacts to a collision (CollisionCondition), which did not happen"
+
+
+def reacts_to_collision(trigger: Trigger | None) -> str | None:
+    """`COLLISION_REACTION` when `trigger` is made only of CollisionConditions, else None."""
+    if trigger is None or not trigger.groups:
+        return None
+    conditions = [c for g in trigger.groups for c in g.conditions]
+    if conditions and all(isinstance(c.kind, CollisionCondition) for c in conditions):
+        return COLLISION_REACTION
+    return None
+
+
+def collision_reactions(board: Storyboard) -> dict[str, str]:
+    """Action name -> `COLLISION_REACTION`, for each action of an Act or Event started only
+    by collisions (module doc)."""
+    out: dict[str, str] = {}
+    for why, name in _judged_actions(board, reacts_to_collision):
+        out.setdefault(name, why)
+    return out
+
+
+def _judged_actions(board: Storyboard, judge: Callable[[Trigger | None], str | None],
+                    ) -> Iterator[tuple[str, str]]:
+    """(why, action name) for each action whose Act's or Event's start trigger `judge`
+    gives a reason for."""
     for story in board.stories:
         for act in story.acts:
-            act_off = switched_off_by(act.start_trigger, fixed, parameters, variables)
+            act_why = judge(act.start_trigger)
             for group in act.maneuver_groups:
                 for maneuver in group.maneuvers:
                     for event in maneuver.events:
-                        why = act_off or switched_off_by(event.start_trigger, fixed,
-                                                         parameters, variables)
+                        why = act_why or judge(event.start_trigger)
                         if why is not None:
                             yield from ((why, a.name) for a in event.actions)

@@ -8,8 +8,15 @@ from __future__ import annotations
 import pytest
 
 from avsim.criteria.story import Story
-from avsim.run.story_switches import switched_off, switched_off_by
+from avsim.run.story_switches import (
+    COLLISION_REACTION,
+    collision_reactions,
+    reacts_to_collision,
+    switched_off,
+    switched_off_by,
+)
 from avsim.scenario.openscenario.conditions import (
+    CollisionCondition,
     Condition,
     ConditionGroup,
     ConditionKind,
@@ -125,3 +132,28 @@ def test_story_with_every_action_switched_off_is_not_applicable_and_says_why() -
     assert result.note == ("not applicable: switched off by parameter isCCRbraking "
                            "(storyboard.brake)")
     assert result.passed is None  # not applicable
+
+
+HIT = CollisionCondition("GVT", None)
+
+
+@pytest.mark.parametrize(("trig", "reacts"), [
+    (trigger((HIT,)), True),  # the NCAP files' AtCollision: records the outcome
+    (trigger((HIT,), (HIT,)), True),
+    (trigger((HIT, LATE)), False),  # a time too: part of the story
+    (trigger((LATE,)), False),
+    (None, False),
+    (Trigger(()), False),
+])
+def test_an_act_or_event_started_only_by_a_collision_reacts_to_it(trig: Trigger | None,
+                                                                  reacts: bool) -> None:
+    assert (reacts_to_collision(trig) == COLLISION_REACTION) is reacts
+    assert collision_reactions(board(None, trig)) == ({"brake": COLLISION_REACTION}
+                                                      if reacts else {})
+
+
+def test_story_lists_only_the_actions_not_required_that_did_not_fire() -> None:
+    """A collision happened: its reaction fired and is no 'not applicable'."""
+    story = Story(("storyboard.go",), {"storyboard.hit": COLLISION_REACTION})
+    story.fired = frozenset({"storyboard.go", "storyboard.hit"})
+    assert (story.result().passed, story.result().note) == (True, None)
