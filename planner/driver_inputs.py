@@ -15,6 +15,13 @@
   ``horizon``); the function is off from the first press until the driver switches it on
   again (`DriverControls.activations` grows), and after the release he holds the speed he
   released the pedal at, until he chooses another set speed.
+- After an emergency stop (the AEB braked the car to a standstill while he drove): the
+  AEB's standstill hold keeps the car stopped, and the driver, who has just been stopped
+  short of a vehicle, holds 0 until the way ahead is clear (`way_clear`: no vehicle ahead
+  in the lane, or the one ahead moving away at ``clear_speed`` or more); then he moves off
+  towards his set speed at ``rate``. Driving off at once into the car the AEB stopped for
+  would only make it brake again (a Euro NCAP CCRb run never reached its standstill stop
+  trigger). With the function engaged the ACC's own stop-and-go law moves off instead.
 """
 
 from __future__ import annotations
@@ -33,6 +40,8 @@ class DriverParams:
     a_full: float = 8.0  # [m/s^2] the deceleration the full brake pedal asks for (a
     #   passenger car's full braking on dry asphalt)
     horizon: float = 0.5  # [s] braking, the reference leads the speed by a_brake * horizon
+    clear_speed: float = 1.0  # [m/s] after an emergency stop, the vehicle ahead moving away
+    #   at this or faster clears the way (a car moving off in a queue: 1 m/s within ~1 s)
 
 
 class DriverInputs:
@@ -49,6 +58,7 @@ class DriverInputs:
         self._activations = 0  # the switch presses seen
         self.overridden = False  # a brake press turned the function off
         self._braked = False  # the brake was pressed at the last tick
+        self.aeb_hold = False  # the AEB stopped the car: held at 0 until the way is clear
 
     def update(self, controls: DriverControls, v: float, dt: float) -> None:
         """Read the controls at speed `v`, `dt` since the last tick."""
@@ -67,6 +77,19 @@ class DriverInputs:
             return
         step = self.params.rate * dt
         self.held = min(max(self._want, self.held - step), self.held + step)
+
+    def emergency_stopped(self) -> None:
+        """The AEB has braked the car to a standstill: hold it there (module doc)."""
+        self.aeb_hold = True
+        self.held = self._want = 0.0
+
+    def way_clear(self, lead_speed: float | None) -> None:
+        """After an emergency stop, the vehicle ahead in the lane moves at `lead_speed`
+        [m/s] along the car's direction (None: none ahead): a clear way ends the hold and
+        the driver moves off towards his set speed."""
+        if self.aeb_hold and (lead_speed is None or lead_speed >= self.params.clear_speed):
+            self.aeb_hold = False
+            self._want = self.set_speed
 
     def braking(self, controls: DriverControls) -> bool:
         """Whether the driver's brake overrides the system now."""

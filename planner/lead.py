@@ -9,9 +9,13 @@ with its gap, speed and lateral offset from the lane's centre line.
   the car's heading to it and bent as the map's lane bends: the camera's curvature, fitted
   on 30 m of paint, can be 7e-4 1/m on a straight road: 1.4 m at 65 m); the gap [m]
   is bumper to bumper along the ego's heading, the speed [m/s] the track's over ground along
-  the ego's heading (>= 0), both at the track's time; a pedestrian's offset is the one
-  nearest the centre line on its way until the car reaches it (at the closing speed, at most
-  ``CROSSING_HORIZON`` ahead, its velocity across the lane where it is; `crossing_lateral`):
+  the ego's heading, both at the track's time: signed as `Lead.velocity` (an oncoming car's
+  < 0: the emergency braking's time to collision is the gap over the ego's speed plus the
+  car's, half of the gap over the ego's speed alone at equal speeds), and at least 0 as
+  `Lead.speed`, the ACC's V_l (an ACC follows no oncoming vehicle, ISO 15622); a
+  pedestrian's offset is the one nearest the centre line on its way until the car reaches
+  it (at the closing speed, at most ``CROSSING_HORIZON`` ahead, its velocity across the
+  lane where it is; `crossing_lateral`):
   a walker crossing the road is in the car's path before it steps into the lane (a track
   classed a pedestrian but faster than ``WALKER_SPEED`` is taken as a vehicle); a vehicle
   of the ego's direction (not ``ONCOMING``) moving across the lane towards its
@@ -24,7 +28,7 @@ with its gap, speed and lateral offset from the lane's centre line.
   20 km/h slower becomes the lead 0.8 s after its intrusion, too late);
 - `route_candidates`, through a town junction, where the lane is the map's turn path: the
   tracks (map frame) up to ``path_reach`` ahead along the map lane kept; the gap is along the
-  lane, the speed along the lane's heading where the track is.
+  lane, the speed (and the signed velocity) along the lane's heading where the track is.
 
 Then `LeadSelector` picks the lead, as a production ACC's target selection does, so that a
 car in the next lane that strays near the line for a moment, or a lane's centre drawn a
@@ -197,7 +201,7 @@ def lane_candidates(tracks: Sequence[Track], centre_y: Callable[[float], float],
             continue
         gap = tr.rel_x - front_overhang - 0.5 * tr.length
         along = tr.vx * math.cos(ego_heading) + tr.vy * math.sin(ego_heading)
-        lead = Lead(tr.id, tr.t, gap, max(0.0, along))
+        lead = Lead(tr.id, tr.t, gap, max(0.0, along), along)
         lateral = tr.rel_y - centre_y(tr.rel_x)
         slope = 0.5 * (centre_y(tr.rel_x + 1.0) - centre_y(tr.rel_x - 1.0))
         lane = ego_heading + math.atan(slope)  # the lane's heading where the track is
@@ -230,9 +234,9 @@ def route_candidates(tracks: Sequence[Track], lane: Lane, station: float, p: Lea
         if not 0.0 < ahead <= p.path_reach:
             continue
         heading = float(lane.heading_at(float(s_tr)))
-        speed = max(0.0, tr.vx * math.cos(heading) + tr.vy * math.sin(heading))
+        along = tr.vx * math.cos(heading) + tr.vy * math.sin(heading)
         gap = ahead - front_overhang - 0.5 * tr.length
-        out.append(Candidate(Lead(tr.id, tr.t, gap, speed), float(r_tr)))
+        out.append(Candidate(Lead(tr.id, tr.t, gap, max(0.0, along), along), float(r_tr)))
     return out
 
 
@@ -338,7 +342,7 @@ class LeadSelector:
         waited = t - self._since[i]
         if waited >= p.confirm - 1e-9:
             return True
-        closing = ego_speed - c.lead.speed
+        closing = ego_speed - c.lead.along  # an oncoming car's speed closes too
         return closing > 0.0 and (c.lead.gap < p.urgent_ttc * closing or costly_wait(
             ego_speed, c.lead, max(t - c.lead.t, 0.0), p.confirm - waited, self.acc))
 

@@ -9,6 +9,7 @@ constraint set the target speed.
 from __future__ import annotations
 
 import enum
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -61,7 +62,16 @@ class Lead:
     t: float  # [s] time of the track it comes from
     gap: float  # [m] ego front bumper to the lead's rear, along the ego's heading (along the
     #   route or the map lane during a lane change or through a junction)
-    speed: float  # [m/s] the lead's speed over ground along that same direction, >= 0
+    speed: float  # [m/s] the lead's speed over ground along that same direction, >= 0: the
+    #   ACC's V_l (an oncoming vehicle is taken as standing: an ACC follows none, ISO 15622)
+    velocity: float = math.nan  # [m/s] its velocity along that direction, signed (< 0:
+    #   oncoming), for the time to collision and the emergency braking; NaN: `speed`
+
+    @property
+    def along(self) -> float:
+        """[m/s] the lead's velocity along the ego's direction, signed (< 0: coming towards
+        the ego): the closing speed is the ego's speed less it."""
+        return self.speed if math.isnan(self.velocity) else self.velocity
 
 
 @dataclass(frozen=True, slots=True, eq=False)

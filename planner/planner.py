@@ -45,9 +45,10 @@ reference line, speeds [m/s]. Steps:
    by the driver's brake until he switches it on again) the ACC is off (ACC_OFF) and the
    driver drives (`SpeedSource.DRIVER`) in the lane kept, whatever is ahead: his brake, or
    the speed he holds, moved to his set speed at a comfortable rate
-   (`planner.driver_inputs`); the emergency stop below stays on. The set speed is the
-   driver's last choice (`PlannerInput.driver`), else the configured one; his turn-signal
-   stalk asks the motion FSM for a lane (step 3);
+   (`planner.driver_inputs`); the emergency stop below stays on, and once it has stopped
+   the car the driver holds it until the way ahead is clear (the AEB's standstill hold).
+   The set speed is the driver's last choice (`PlannerInput.driver`), else the configured
+   one; his turn-signal stalk asks the motion FSM for a lane (step 3);
 7. the control FSM (`planner.control_layer`) names the control action and, in an
    emergency, asks for the emergency stop's deceleration instead; the hazard lights go on
    with a flat tyre, and during a minimum-risk stop in lane after a sensor fault (off again
@@ -71,6 +72,7 @@ from planner.driver_override import DriverOverride, OverrideParams
 from planner.events import EventMonitor, EventParams
 from planner.fsm import hazard, lane_source, sensing
 from planner.fsm.acc import sight_speed
+from planner.fsm.control import ControlState
 from planner.fsm.hazard import HazardInput, HazardLights
 from planner.fsm.lane_source import LaneSource, LaneSourceInput, LaneSourceParams
 from planner.fsm.machine import Machine, StateChange
@@ -283,14 +285,16 @@ class Planner:
                                            driver_gap=self.params.override.gap_margin
                                            if driver else None, events=events,
                                            lead_accel=lead_accel)
+        self.inputs.way_clear(None if lead is None else lead.along)
         speed = self._degraded_cap(acc.speed, ego.speed, dt) if engaged else \
             self.inputs.driving(inp.driver, ego.speed)
         control, control_changes = self.control.update(
-            ego.t, ego.speed, speed.ref.speed, speed.ref.accel,
-            acc.lead_gap + (manoeuvre.room if _with_room(lead, manoeuvre) is not lead else 0.0),
-            lead, lead_accel)
+            ego.t, ego.speed, speed.ref.speed, speed.ref.accel, lead, lead_accel)
         if control.emergency:
             speed = PlannedSpeed(SpeedRef(0.0, -self.control.decel), SpeedSource.EMERGENCY)
+        elif not engaged and _emergency_stopped(control_changes):  # AEB standstill hold
+            self.inputs.emergency_stopped()
+            speed = self.inputs.driving(inp.driver, ego.speed)
         hazard_changes = self.hazard.apply(ego.t, hazard.transition(
             self.hazard.state, HazardInput(inp.flat_tyre, self._stopping(health.lidar))))
         return Plan(
@@ -413,7 +417,7 @@ class Planner:
                 return None
             n = min(manoeuvre.leads, key=lambda n: n.gap)
             gap = n.gap - (n.speed - ego.speed) * max(ego.t - n.t, 0.0)  # at the track's time
-            lead = Lead(n.track_id, n.t, gap, max(n.speed, 0.0))
+            lead = Lead(n.track_id, n.t, gap, max(n.speed, 0.0), n.speed)
             self.leads.take(lead)
             return lead
         p = self.params
@@ -481,3 +485,10 @@ def _with_room(lead: Lead | None, manoeuvre: Manoeuvre) -> Lead | None:
 def _straight_ahead(_x: float) -> float:
     """The lane centre when the camera's lane is not available: straight ahead."""
     return 0.0
+
+
+def _emergency_stopped(changes: tuple[StateChange, ...]) -> bool:
+    """Whether the control machine went from EMERGENCY_STOP to STOP in `changes`: the
+    emergency braking has stopped the car."""
+    return any(c.machine == "control" and c.source == ControlState.EMERGENCY_STOP.value
+               and c.target == ControlState.STOP.value for c in changes)

@@ -46,6 +46,7 @@ class Need(enum.Enum):
     ACTORS = "actors"  # the NPCs' true poses in every sample (costly: only when needed)
     LANE_CHANGE = "lane_change_max"  # [s] how long a lane change may take
     STORY = "story"  # the scenario's required actions and events (`story_label`s)
+    STORY_OFF = "story_off"  # the actions the file switches off by configuration, and why
     ACTOR_BODIES = "actor_bodies"  # which actor each NPC body is (body id -> actor id)
     TOWN = "town"  # the town's layout (`world.spec.TownSpec`; None on a road)
     PARAMETERS = "parameters"  # an OpenSCENARIO file's global parameters (name -> value)

@@ -43,6 +43,8 @@ class RunInputs:
     #   scenario's `lane_change.max_duration`)
     story: tuple[str, ...] = ()  # the actions and events that must fire
     #   (`avsim.criteria.story.story_label`)
+    story_off: Mapping[str, str] = field(default_factory=dict)  # label -> why the file
+    #   switches that action off by configuration (not in `story`)
     actor_bodies: Mapping[int, str] = field(default_factory=dict)  # NPC body id -> its
     #   actor's id
     town: TownSpec | None = None  # the town's layout and signal timing (None: a road)

@@ -94,5 +94,6 @@ def _story_entry(e: StoryEntry) -> dict[str, object]:
         where = {"actor": e.actor, "action": e.index}
     else:
         where = {"event": e.index}
+    off = {} if e.off is None else {"off": e.off}  # switched off by the file's configuration
     return where | {"kind": e.kind, "optional": e.optional,
-                    "fired_at": None if e.fired_at is None else round(e.fired_at, 4)}
+                    "fired_at": None if e.fired_at is None else round(e.fired_at, 4)} | off

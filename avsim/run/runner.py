@@ -262,6 +262,7 @@ class Runner:
             actor_bodies={b: a.id for b, a in zip(w.actors.bodies, spec.actors, strict=True)},
             lane_change_max=getattr(lane_change, "max_duration", MAX_LANE_CHANGE),
             story=tuple(e.label for e in self.story.entries if not e.optional),
+            story_off={e.label: e.off for e in self.story.entries if e.off is not None},
             town=spec.town,
             parameters=scenario.story.scenario.parameters if scenario.story else {}))
         self.completes = next((c for c in self.criteria.items if isinstance(c, Completes)),

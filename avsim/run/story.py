@@ -3,15 +3,18 @@
 Two kinds of scenario script their story. A YAML scenario's actors' actions and ego
 events fire in the world (`ScriptedStory`: `World.action_fired_at`, `event_fired_at`). An
 OpenSCENARIO file's storyboard is played by the director (`StoryboardStory`): its entries
-are the storyboard's actions (by name) and its StopTrigger, fired when they first started.
+are the storyboard's actions (by name) and its StopTrigger, fired when they first started;
+the actions of an Act or Event the file switches off by configuration, or that only react
+to a collision, are optional, with the reason (`avsim.run.story_switches`).
 The `story` criterion judges the labels fired; the result lists the entries.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from avsim.criteria.story import story_label
+from avsim.run.story_switches import collision_reactions, switched_off
 from avsim.run.storyboard.director import Director
 from avsim.scenario.scenario import Scenario
 from world.world import World
@@ -31,6 +34,8 @@ class StoryEntry:
     optional: bool  # the run may end without it
     fired_at: float | None  # [s] None: it never fired
     element: str | None = None  # an OpenSCENARIO storyboard element's name
+    off: str | None = None  # why the file switches it off by configuration (then optional;
+    #   `avsim.run.story_switches`), None: it is part of the story
 
     @property
     def label(self) -> str:
@@ -84,11 +89,14 @@ class StoryboardStory:
     def __init__(self, director: Director) -> None:
         self.director = director
         board = director.program.scenario.storyboard
+        osc = director.program.scenario
+        off = collision_reactions(board) | switched_off(board, osc.parameters, osc.variables)
         names = [(action.name, kind_of(action.private_action))
                  for _, action in board.story_actions()]
         if board.stop_trigger is not None:
             names.append((STOP_TRIGGER, "stop_trigger"))
-        self.entries = tuple(StoryEntry(None, i, kind, False, None, element=name)
+        self.entries = tuple(StoryEntry(None, i, kind, name in off, None, element=name,
+                                        off=off.get(name))
                              for i, (name, kind) in enumerate(names))
         self.fired: frozenset[str] = frozenset()
         self._at: dict[str, float] = {}
@@ -104,6 +112,4 @@ class StoryboardStory:
             self.fired = frozenset(f"storyboard.{name}" for name in self._at)
 
     def now(self) -> tuple[StoryEntry, ...]:
-        return tuple(StoryEntry(e.actor, e.index, e.kind, e.optional,
-                                self._at.get(e.element or ""), e.element)
-                     for e in self.entries)
+        return tuple(replace(e, fired_at=self._at.get(e.element or "")) for e in self.entries)

@@ -62,3 +62,27 @@ def test_a_light_touch_below_the_threshold_does_not_override() -> None:
     d = DriverInputs(20.0, 50.0)
     d.update(DriverControls(brake=P.threshold), 20.0, DT)
     assert not d.overridden
+
+
+@pytest.mark.parametrize(("lead_speed", "holds"), [
+    (0.0, True),  # the car the AEB stopped for still stands there
+    (0.5, True),  # creeping: not yet clear
+    (-3.0, True),  # coming towards the car
+    (P.clear_speed, False),  # moving away
+    (None, False),  # no vehicle ahead in the lane
+])
+def test_after_an_emergency_stop_the_driver_holds_the_car_until_the_way_is_clear(
+        lead_speed: float | None, holds: bool) -> None:
+    d = DriverInputs(20.0, 50.0)
+    d.update(DriverControls(), 0.0, DT)
+    d.emergency_stopped()
+    assert d.driving(DriverControls(), 0.0).ref.speed == 0.0
+    for _ in range(40):  # 1 s
+        d.way_clear(lead_speed)
+        d.update(DriverControls(), 0.0, DT)
+    out = d.driving(DriverControls(), 0.0)
+    assert d.aeb_hold is holds
+    if holds:
+        assert (out.ref.speed, out.ref.accel) == (0.0, 0.0)
+    else:  # moving off towards the set speed at the comfortable rate
+        assert out.ref.speed == pytest.approx(P.rate * 1.0) and out.ref.accel == P.rate

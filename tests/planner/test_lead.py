@@ -23,6 +23,7 @@ from planner.lead import (
     far_centre,
     lane_candidates,
     map_bend,
+    route_candidates,
 )
 from planner.messages import Lead
 from tests.roads import arc, make_map, seg
@@ -329,3 +330,34 @@ def test_a_new_track_moving_in_is_taken_on_its_velocity() -> None:
     c = _moving(1, 0.0, 5.0, 2.5, -1.0)  # 1.5 s later: 1.0 m, closing fast: urgent
     lead = selector.select(0.0, 20.0, [c])
     assert lead is not None and lead.track_id == 1
+
+
+def oncoming_car(vx: float) -> Track:
+    """A car 50 m ahead in the ego's lane moving along the ego's heading at `vx` [m/s]."""
+    return Track(id=9, t=1.0, x=50.0, y=0.0, vx=vx, vy=0.0, rel_x=50.0, rel_y=0.0,
+                 rel_vx=vx - 16.7, rel_vy=0.0, length=4.8, width=1.9, height=1.5, yaw=math.pi,
+                 cls=ObjectClass.CAR, hits=5, misses=0, position_sigma=0.1)
+
+
+@pytest.mark.parametrize("vx", [-19.4, -2.5, 0.0, 13.9])
+def test_a_lead_carries_its_signed_velocity_and_the_acc_its_speed_of_at_least_0(
+        vx: float) -> None:
+    """The emergency braking's time to collision needs an oncoming car's speed (`along`);
+    the ACC's V_l (`speed`) takes it as standing: it follows no oncoming vehicle."""
+    (c,) = lane_candidates([oncoming_car(vx)], lambda x: 0.0, 0.0, 2.4)
+    assert c.lead.along == pytest.approx(vx) and c.lead.speed == pytest.approx(max(vx, 0.0))
+    lane = make_map(seg(200.0, lanes=1, oncoming=0)).lane(0)  # along +x from the origin
+    (r,) = route_candidates([oncoming_car(vx)], lane, 0.0, P, 2.4)
+    assert r.lead.along == pytest.approx(vx) and r.lead.speed == pytest.approx(max(vx, 0.0))
+
+
+def test_a_lead_without_a_signed_velocity_reads_its_speed() -> None:
+    assert Lead(1, 0.0, 30.0, 12.0).along == 12.0
+
+
+def test_an_oncoming_car_closing_within_the_urgent_ttc_is_the_lead_at_once() -> None:
+    """60 km/h each way, 45 m apart: 1.35 s to collision (taken as standing: 2.7 s)."""
+    head_on = Candidate(Lead(5, 0.0, 45.0, 0.0, -V60), 0.2)
+    assert run([[head_on]] * 3, ego_speed=V60)[0] == 5
+    standing = Candidate(Lead(5, 0.0, 45.0, 0.0), 0.2)
+    assert run([[standing]] * 3, ego_speed=V60)[0] is None

@@ -173,3 +173,26 @@ def test_the_sight_cap_is_its_own_speed_source(set_kph: float, source: SpeedSour
     assert plan.speed_source is source
     assert p.speed_for(200.0).binding is (Binding.SIGHT if source is SpeedSource.SIGHT
                                           else Binding.SET_SPEED)
+
+
+def test_not_engaged_after_the_aeb_stops_the_car_the_driver_holds_it_until_the_way_is_clear(
+        ) -> None:
+    """The driver holds his set speed whatever is ahead; the AEB stops the car short of a
+    standing car; he does not drive off into it, only once it moves away."""
+    road = straight_road("real", 1000.0, 100.0)
+    p = planner(road, set_kph=50.0)
+
+    def tick(t: float, s: float, v: float, car_s: float, car_v: float) -> Plan:
+        ego = ego_on(road, 1, s, 0.0, v, t)
+        return p.update(PlannerInput(ego, tracks=(_car_ahead(road, car_s, car_v, ego),),
+                                     engaged=False))
+
+    plan = tick(1.0, 100.0, 10.0, 112.0, 0.0)  # 7.4 m gap at 10 m/s: the AEB brakes
+    assert plan.speed_source is SpeedSource.EMERGENCY
+    for k in range(40):  # stopped 1.5 m short of it, for 2 s
+        plan = tick(1.1 + 0.05 * k, 104.0, 0.0, 112.0, 0.0)
+        assert plan.target_speed == 0.0 and plan.speed_source is SpeedSource.DRIVER, k
+    assert "acceleration" not in [c.target for c in plan.changes if c.machine == "control"]
+    for k in range(20):  # it moves off at 2 m/s: so does the driver, at his rate
+        plan = tick(3.1 + 0.05 * k, 104.0, 0.0, 112.0 + 0.1 * k, 2.0)
+    assert plan.target_speed > 0.0

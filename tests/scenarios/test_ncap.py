@@ -18,6 +18,7 @@ import pytest
 from click.testing import CliRunner
 
 from avsim.cli import main
+from planner.fsm.control import ControlParams
 
 NCAP = Path(__file__).parents[1] / "data" / "ncap"
 C2C = NCAP / "OpenSCENARIO" / "NCAP" / "AEB_C2C_2023"
@@ -62,17 +63,9 @@ def test_ccrs_at_20_kph_is_avoided_by_the_aeb_through_the_suite(tmp_path: Path) 
     assert "| ncap_aeb_c2c_ccr_2023 | CCRs | 20 | 0 | 100 % | yes |" in summary
 
 
-HEAD_ON = pytest.mark.xfail(strict=True, reason="the AEB takes an oncoming car as standing "
-                            "(`planner.lead`: a track's speed along the ego's heading, >= 0): "
-                            "its time to collision is twice the true one and the brake "
-                            "comes too late")
-
-
 @pytest.mark.acceptance
 @pytest.mark.parametrize(("file", "test", "speed", "target"), [
     (C2C / "NCAP_AEB_C2C_CCR_2023.xosc", "CCRs", 20.0, 0.0),
-    pytest.param(C2C / "NCAP_AEB_C2C_CCFhos_2023.xosc", "CCFhol", 70.0, 70.0, marks=HEAD_ON),
-    pytest.param(C2C / "NCAP_AEB_C2C_CCFhol_2023.xosc", "CCFhol", 70.0, 70.0, marks=HEAD_ON),
     (VRU / "NCAP_AEB_VRU_CBLA_2023.xosc", "CBLA", 25.0, 15.0),
 ], ids=lambda v: v.stem if isinstance(v, Path) else None)
 def test_a_base_file_at_its_defaults(file: Path, test: str, speed: float, target: float,
@@ -85,3 +78,22 @@ def test_a_base_file_at_its_defaults(file: Path, test: str, speed: float, target
     assert run["metrics"]["max_speed"] == pytest.approx(speed * KPH, abs=0.3)
     assert changes(run, "acc") == []
     assert verdict["passed"] and details["avoided"], verdict["note"]
+
+
+@pytest.mark.acceptance
+@pytest.mark.parametrize("file", [C2C / "NCAP_AEB_C2C_CCFhos_2023.xosc",
+                                  C2C / "NCAP_AEB_C2C_CCFhol_2023.xosc"], ids=lambda v: v.stem)
+def test_a_head_on_base_file_brakes_at_the_true_time_to_collision(file: Path,
+                                                                  tmp_path: Path) -> None:
+    """A target at 70 km/h coming at the car in its lane cannot be avoided by braking: the
+    protocol scores the speed reduction (SA-CA 10.4.1 3.3.5: 0.25 points from 20 km/h).
+    The AEB takes the oncoming car's speed into its time to collision, so it brakes at
+    least `ttc_emergency` before the impact (braking only delays the impact)."""
+    run = next(iter(suite([file], tmp_path, "default").values()))
+    details = ncap(run)["details"]
+    assert (details["test_speed_kph"], details["target_speed_kph"]) == (70.0, 70.0)
+    assert changes(run, "acc") == []
+    braked = next(c["t"] for c in run["state_changes"]
+                  if c["machine"] == "control" and c["to"] == "emergency_stop")
+    assert details["impact_t"] - braked >= ControlParams().ttc_emergency
+    assert details["speed_reduction_kph"] >= 20.0 and details["points"] == 0.25
