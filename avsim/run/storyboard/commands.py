@@ -297,10 +297,13 @@ class Commands:
         if action.freespace:
             gap -= 0.5 * (me.length + ref.length)
         c = action.constraints
-        reached = abs(gap - want) < GAP_REACHED and abs(me.speed - ref.speed) < SPEED_MATCHED
         if c is None or not (c.max_acceleration or c.max_deceleration):
+            if abs(gap - want) < GAP_REACHED:  # placed: on at the entity's speed (esmini
+                #   ends such an action once the actor is at its distance)
+                return TrackCommand(follow.tag, max(0.0, ref.speed), math.inf, math.inf), True
             target = max(0.0, ref.speed - sign * (gap - want) / period)
-            return TrackCommand(follow.tag, target, math.inf, math.inf), reached
+            return TrackCommand(follow.tag, target, math.inf, math.inf), False
+        reached = abs(gap - want) < GAP_REACHED and abs(me.speed - ref.speed) < SPEED_MATCHED
         target = max(0.0, ref.speed + GAP_GAIN * sign * (gap - want))
         accel = c.max_acceleration or DISTANCE_ACCEL
         decel = c.max_deceleration or DISTANCE_ACCEL
