@@ -227,3 +227,19 @@ def test_a_distribution_file_expands_within_its_bound_or_is_one_line(
         assert "\n" not in str(exc)
         return
     assert 1 <= len(distribution.runs) <= MAX_RUNS
+
+
+@pytest.mark.parametrize("kind", ["NormalDistribution", "LogNormalDistribution"])
+def test_a_variance_of_minus_zero_draws_the_expected_value(tmp_path: Path, kind: str) -> None:
+    """-0.0 is >= 0: no spread (numpy's sigma must not be -0.0)."""
+    (tmp_path / "base.xosc").write_text(MINIMAL, encoding="utf-8")
+    path = tmp_path / "dist.xosc"
+    path.write_text('<?xml version="1.0"?><OpenSCENARIO><FileHeader revMajor="1" '
+                    'revMinor="2"/><ParameterValueDistribution><ScenarioFile '
+                    'filepath="base.xosc"/><Stochastic numberOfTestRuns="3" randomSeed="1">'
+                    f'<StochasticDistribution parameterName="Speed"><{kind} '
+                    f'expectedValue="2" variance="-0.0"/></StochasticDistribution>'
+                    '</Stochastic></ParameterValueDistribution></OpenSCENARIO>',
+                    encoding="utf-8")
+    runs = load_distribution(path).runs
+    assert [float(run.parameters[0][1]) for run in runs] == pytest.approx([2.0] * 3)
