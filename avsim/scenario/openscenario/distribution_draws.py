@@ -129,7 +129,7 @@ def _spread(node: Node) -> tuple[float, float]:
     mean, variance = number(node, "expectedValue"), number(node, "variance")
     if variance < 0:
         raise node.error(f"variance must be >= 0, got {variance:g}")
-    return mean, abs(variance)  # -0.0 passes the check; numpy refuses a sigma of -0.0
+    return mean, variance
 
 
 def _normal(node: Node) -> Draw:

@@ -243,3 +243,17 @@ def test_a_variance_of_minus_zero_draws_the_expected_value(tmp_path: Path, kind:
                     encoding="utf-8")
     runs = load_distribution(path).runs
     assert [float(run.parameters[0][1]) for run in runs] == pytest.approx([2.0] * 3)
+
+
+def test_a_uniform_range_up_to_minus_zero_draws_zero(tmp_path: Path) -> None:
+    """[0, -0.0] is not reversed: every draw is 0 (numpy's uniform refused high - low < 0)."""
+    (tmp_path / "base.xosc").write_text(MINIMAL, encoding="utf-8")
+    path = tmp_path / "dist.xosc"
+    path.write_text('<?xml version="1.0"?><OpenSCENARIO><FileHeader revMajor="1" '
+                    'revMinor="2"/><ParameterValueDistribution><ScenarioFile '
+                    'filepath="base.xosc"/><Stochastic numberOfTestRuns="2" randomSeed="1">'
+                    '<StochasticDistribution parameterName="Speed"><UniformDistribution>'
+                    '<Range lowerLimit="0" upperLimit="-0.0"/></UniformDistribution>'
+                    '</StochasticDistribution></Stochastic></ParameterValueDistribution>'
+                    '</OpenSCENARIO>', encoding="utf-8")
+    assert [float(run.parameters[0][1]) for run in load_distribution(path).runs] == [0.0, 0.0]
