@@ -30,7 +30,7 @@ from __future__ import annotations
 
 import itertools
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -163,11 +163,16 @@ def _axis(node: Node) -> list[Assignments]:
         raise node.error(f"not supported yet ({node.tag})")
     name = _attr(node, "parameterName")
     dist = node.only_child()
-    if dist.tag == "DistributionSet":
-        return [((name, _attr(e, "value")),) for e in dist.all("Element")]
-    if dist.tag == "DistributionRange":
-        return [((name, value),) for value in range_values(dist)]
-    raise dist.error(f"not supported yet ({dist.tag})")
+    values = SINGLE_DISTRIBUTIONS.get(dist.tag)
+    if values is None:
+        raise dist.error(f"not supported yet ({dist.tag})")
+    return [((name, value),) for value in values(dist)]
+
+
+SINGLE_DISTRIBUTIONS: dict[str, Callable[[Node], list[str]]] = {  # the values, as text
+    "DistributionSet": lambda dist: [_attr(e, "value") for e in dist.all("Element")],
+    "DistributionRange": lambda dist: list(range_values(dist)),
+}
 
 
 def _attr(node: Node, name: str) -> str:

@@ -70,15 +70,7 @@ def stochastic_runs(node: Node) -> list[Assignments]:
 
 def _draw(node: Node) -> Draw:
     """How to draw a value of the distribution element `node`."""
-    makers: dict[str, Callable[[Node], Draw]] = {
-        "ProbabilityDistributionSet": _weighted_set,
-        "NormalDistribution": _normal,
-        "LogNormalDistribution": _log_normal,
-        "PoissonDistribution": _poisson,
-        "UniformDistribution": _uniform,
-        "Histogram": _histogram,
-    }
-    maker = makers.get(node.tag)
+    maker = DRAWS.get(node.tag)
     if maker is None:
         raise node.error(f"not supported yet ({node.tag})")
     return maker(node)
@@ -177,3 +169,13 @@ def _histogram(node: Node) -> Draw:
         return repr(float(rng.uniform(low, high)))
 
     return draw
+
+
+DRAWS: dict[str, Callable[[Node], Draw]] = {  # a StochasticDistribution's kinds
+    "ProbabilityDistributionSet": _weighted_set,
+    "NormalDistribution": _normal,
+    "LogNormalDistribution": _log_normal,
+    "PoissonDistribution": _poisson,
+    "UniformDistribution": _uniform,
+    "Histogram": _histogram,
+}

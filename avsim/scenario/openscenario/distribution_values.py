@@ -32,7 +32,7 @@ def number(node: Node, name: str) -> float:
         raise node.error(f"{name}: expected a number, got {text(written)}") from None
     if not math.isfinite(value):
         raise node.error(f"{name}: expected a finite number, got {text(written)}")
-    return value
+    return value + 0.0  # -0.0 as 0.0: numpy refuses a sigma or a range of -0.0
 
 
 def optional_number(node: Node, name: str, default: float) -> float:

@@ -269,3 +269,6 @@ def _dispatch(node: Node, ctx: Context) -> PrivateAction:
 def parse_private_action(node: Node, ctx: Context) -> PrivateAction:
     """The action a PrivateAction element holds."""
     return _dispatch(node.only_child(), ctx)
+
+
+PRIVATE_ACTION_READERS = _READERS  # the PrivateAction elements read (`coverage`)

@@ -344,3 +344,7 @@ def parse_trigger(node: Node | None, ctx: Context) -> Trigger | None:
             for g in node.all("ConditionGroup")
         )
     )
+
+
+VALUE_CONDITION_READERS = _VALUE  # the ByValueCondition elements read (`coverage`)
+ENTITY_CONDITION_READERS = _ENTITY  # the EntityCondition elements read (`coverage`)

@@ -3,6 +3,8 @@ a catalog) and their ObjectController."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 from avsim.scenario.errors import fmt
 from avsim.scenario.openscenario.attributes import unsupported
 from avsim.scenario.openscenario.context import Context
@@ -134,18 +136,26 @@ def parse_controller(node: Node, ctx: Context) -> Controller:
     )
 
 
+def _catalog_object(node: Node, ctx: Context) -> EntityObject:
+    entry = ctx.catalogs.resolve(node, ctx.attrs, OBJECT_KINDS)
+    return parse_object(entry.node, ctx.in_scope(entry.scope, entry.node))
+
+
+OBJECT_READERS: dict[str, Callable[[Node, Context], EntityObject]] = {
+    "CatalogReference": _catalog_object,
+    "Vehicle": parse_vehicle,
+    "Pedestrian": parse_pedestrian,
+    "MiscObject": parse_misc_object,
+}
+
+
 def parse_object(node: Node, ctx: Context) -> EntityObject:
-    """A Vehicle, Pedestrian or MiscObject element, or a CatalogReference to one."""
-    if node.tag == "CatalogReference":
-        entry = ctx.catalogs.resolve(node, ctx.attrs, OBJECT_KINDS)
-        return parse_object(entry.node, ctx.in_scope(entry.scope, entry.node))
-    if node.tag == "Vehicle":
-        return parse_vehicle(node, ctx)
-    if node.tag == "Pedestrian":
-        return parse_pedestrian(node, ctx)
-    if node.tag == "MiscObject":
-        return parse_misc_object(node, ctx)
-    raise unsupported(node)
+    """A Vehicle, Pedestrian or MiscObject element, or a CatalogReference to one
+    (`OBJECT_READERS`)."""
+    reader = OBJECT_READERS.get(node.tag)
+    if reader is None:
+        raise unsupported(node)
+    return reader(node, ctx)
 
 
 def parse_entities(node: Node, ctx: Context) -> tuple[Entity, ...]:

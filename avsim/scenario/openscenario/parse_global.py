@@ -8,7 +8,7 @@ and a modification needs a numeric one, all when the file is read."""
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 
 from avsim.scenario.openscenario.attributes import unsupported
 from avsim.scenario.openscenario.context import Context
@@ -112,13 +112,17 @@ def _variable_action(node: Node, ctx: Context, target: str) -> VariableAction:
     return VariableAction(target, name, vtype, _change(node, ctx, name, vtype))  # type: ignore[arg-type]
 
 
+GLOBAL_READERS: dict[str, Callable[[Node, Context], GlobalAction]] = {
+    "EnvironmentAction": parse_environment_action,
+    "VariableAction": lambda n, c: _variable_action(n, c, "variable"),
+    "ParameterAction": lambda n, c: _variable_action(n, c, "parameter"),
+}
+
+
 def parse_global_action(node: Node, ctx: Context) -> GlobalAction:
-    """The action a GlobalAction element holds."""
+    """The action a GlobalAction element holds (`GLOBAL_READERS`)."""
     body = node.only_child()
-    if body.tag == "EnvironmentAction":
-        return parse_environment_action(body, ctx)
-    if body.tag == "VariableAction":
-        return _variable_action(body, ctx, "variable")
-    if body.tag == "ParameterAction":
-        return _variable_action(body, ctx, "parameter")
-    raise unsupported(body)
+    reader = GLOBAL_READERS.get(body.tag)
+    if reader is None:
+        raise unsupported(body)
+    return reader(body, ctx)

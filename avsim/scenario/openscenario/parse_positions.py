@@ -148,3 +148,6 @@ def parse_position(node: Node, ctx: Context) -> Position:
     if reader is None:
         raise unsupported(inner)
     return reader(inner, ctx)
+
+
+POSITION_READERS = _READERS  # the Position elements read (`coverage`)

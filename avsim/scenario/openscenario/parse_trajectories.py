@@ -163,3 +163,6 @@ def parse_trajectory_ref(node: Node, ctx: Context) -> Trajectory:
     if found is None:
         raise node.error("missing element TrajectoryRef")
     return parse_trajectory(found, ctx)
+
+
+SHAPE_READERS = _SHAPES  # the trajectory Shape elements read (`coverage`)

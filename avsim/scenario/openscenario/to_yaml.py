@@ -23,11 +23,12 @@ else is listed as not fitting (the YAML is then an approximation, and says so).
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from avsim.scenario.bounds import MAX_LANE_WIDTH
 from avsim.scenario.openscenario.convert import load_xosc
 from avsim.scenario.openscenario.environment import EnvironmentAction
 from avsim.scenario.openscenario.model import (
@@ -62,13 +63,20 @@ class Conversion:
 
     document: dict[str, Any]
     misfits: list[str] = field(default_factory=list)
+    converted: list[str] = field(default_factory=list)  # the actions written, by name
 
 
 def convert_xosc(path: Path, criteria_file: Path | None = None,
-                 search_paths: Sequence[Path] = ()) -> Conversion:
-    """The `avsim/1` YAML of an OpenSCENARIO file (module doc), its references found in
-    its folder tree or `search_paths`; `ScenarioError` if it does not load."""
-    scenario = load_xosc(path, None, criteria_file, search_paths)
+                 search_paths: Sequence[Path] = (),
+                 overrides: Mapping[str, object] | None = None) -> Conversion:
+    """The `avsim/1` YAML of an OpenSCENARIO file (module doc) with `overrides` (its
+    `parameters.NAME`, as `load_xosc` takes them), its references found in its folder tree
+    or `search_paths`; `ScenarioError` if it does not load."""
+    return convert_scenario(load_xosc(path, overrides, criteria_file, search_paths), path)
+
+
+def convert_scenario(scenario: Scenario, path: Path) -> Conversion:
+    """The `avsim/1` YAML of the scenario `load_xosc` made of the file at `path`."""
     out = Conversion({})
     story = scenario.story
     assert story is not None
@@ -152,8 +160,13 @@ def _road(road: RoadSpec, out: Conversion) -> dict[str, Any]:
     if first.start is not None and any(first.start):
         out.misfits.append("the road's place in the map frame (the YAML road starts at the "
                            "origin, heading +x)")
+    width = first.lane_width
+    if width > MAX_LANE_WIDTH:
+        out.misfits.append(f"the road's lane width {width:g} m (a test track's: the YAML's "
+                           f"lanes are at most {MAX_LANE_WIDTH:g} m wide, written as that)")
+        width = MAX_LANE_WIDTH
     return {"lanes": first.lanes, "oncoming_lanes": first.oncoming_lanes,
-            "lane_width": _r(first.lane_width), "shoulder": _r(first.shoulder),
+            "lane_width": _r(width), "shoulder": _r(first.shoulder),
             "speed_limit_kph": _kph(road.speed_limit), "segments": segments}
 
 
@@ -248,6 +261,7 @@ def _event(event: Event, entities: tuple[str, ...], ego: str, names: dict[str, i
         actions = actor.setdefault("actions", [])
         index[action.name] = (actor["id"], len(actions))
         actions.append({"trigger": trigger, **body})
+        out.converted.append(action.name)
 
 
 def _trigger(event: Event, actor: str, ego: str, index: dict[str, tuple[str, int]],
@@ -308,19 +322,27 @@ def _speed(action: SpeedAction, name: str, actor: dict[str, Any], scenario: Scen
         return None
     d = action.dynamics
     body: dict[str, Any] = {"kph": _kph(speed)}
-    change = abs(speed - actor["speed_kph"] * MPS_PER_KPH)
+    change = speed - _speed_before(actor) * MPS_PER_KPH  # [m/s]
     if d.shape == "step" or change == 0.0:
         return {"speed": body}
     if d.shape != "linear":
         out.misfits.append(f"action {name}: its {d.shape} shape, as linear")
+    # the YAML's accel is signed: negative when it slows (a deceleration's rate is not)
     if d.dimension == "rate" and d.value > 0.0:
-        body["accel"] = _r(d.value)
+        body["accel"] = _r(math.copysign(d.value, change))
     elif d.dimension == "time" and d.value > 0.0:
         body["accel"] = _r(change / d.value)
     else:
         out.misfits.append(f"action {name}: its dynamics ({d.dimension} {d.value:g})")
         return None
     return {"speed": body}
+
+
+def _speed_before(actor: dict[str, Any]) -> float:
+    """[km/h] the actor's speed before its next action, as the YAML format takes it: the
+    target of its last speed action so far, else its starting speed."""
+    speeds = [a["speed"]["kph"] for a in actor.get("actions", ()) if "speed" in a]
+    return float(speeds[-1]) if speeds else float(actor["speed_kph"])
 
 
 def _lane_change(action: LaneChangeAction, name: str, actor: dict[str, Any],
