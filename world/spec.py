@@ -351,6 +351,8 @@ class EgoSpec:
     #   driver holds the speed until a storyboard activates the car's controller)
     scripted: bool = False  # the scenario's script moves it as it moves an actor (a
     #   kinematic body, `world.ego.scripted`), no stack drives it
+    offset: float = 0.0  # [m] its centre's start left of its lane's centre (an OpenSCENARIO
+    #   file's lane offset); the stack, driving, steers for the centre
 
 
 @dataclass(frozen=True, slots=True)

@@ -139,7 +139,7 @@ class World:
         self.scene = self._build_scene(np.random.default_rng(seeds[0]))
         self._light_lamps()
         lane = self.road.lane(spec.ego.lane)
-        xy = lane.position(spec.ego.s, 0.0)
+        xy = lane.position(spec.ego.s, spec.ego.offset)
         yaw = float(lane.heading_at(spec.ego.s))
         self.ego = EgoBody(
             self.client, float(xy[0]), float(xy[1]), yaw, spec.ego.speed,
@@ -148,7 +148,8 @@ class World:
         for link in range(-1, self.client.getNumJoints(self.ego.body)):
             self.client.setCollisionFilterGroupMask(self.ego.body, link, EGO_RAY_GROUP, 0xFFFF)
         self.scripted = ScriptedEgo(self.client, self.ego, self.road, spec.ego.lane,
-                                    spec.ego.s, spec.ego.speed) if spec.ego.scripted else None
+                                    spec.ego.s, spec.ego.speed,
+                                    spec.ego.offset) if spec.ego.scripted else None
         #   the script moves the ego (`world.ego.scripted`), after each physics step
         self.actors = ActorSet(self.client, self.road, spec.actors, self.shapes)
         self._events = EgoEvents(spec.events)

@@ -72,7 +72,8 @@ def check_spawn(world: spec.WorldSpec) -> None:
         return
     road = build_road_map(world.road)
     car = CarDimensions()
-    boxes = [("the ego", world.ego.s, road.lane(world.ego.lane).offset_at(world.ego.s),
+    boxes = [("the ego", world.ego.s,
+              road.lane(world.ego.lane).offset_at(world.ego.s) + world.ego.offset,
               car.body_length, car.body_width)]
     for index, actor in enumerate(world.actors):
         if actor.road is not None:  # in a town: on its own route

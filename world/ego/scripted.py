@@ -24,13 +24,13 @@ class ScriptedEgo:
     """The ego body placed on its motion after each physics step (module doc)."""
 
     def __init__(self, client: BulletClient, body: EgoBody, road: RoadMap, lane: int,
-                 s: float, speed: float) -> None:
-        """`body`: the ego in `client`; `lane`: the route lane it starts in (centred),
-        `s` [m] its centre's station, `speed` [m/s] its Init speed."""
+                 s: float, speed: float, offset: float = 0.0) -> None:
+        """`body`: the ego in `client`; `lane`: the route lane it starts in, `offset` [m]
+        left of its centre; `s` [m] its centre's station, `speed` [m/s] its Init speed."""
         self._body = body
         self._road = road
         start = road.lane(lane)
-        self.motion = NpcMotion(s, float(start.offset_at(s)), speed, start.direction, (),
+        self.motion = NpcMotion(s, float(start.offset_at(s)) + offset, speed, start.direction, (),
                                 lane=lane)
         self._reset_pose = client.resetBasePositionAndOrientation  # bound once: every step
         self._reset_velocity = client.resetBaseVelocity

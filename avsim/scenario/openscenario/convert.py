@@ -58,7 +58,7 @@ from avsim.scenario.openscenario.model import (
 )
 from avsim.scenario.openscenario.parse import load_openscenario, scenario_roots
 from avsim.scenario.openscenario.program import StoryProgram
-from avsim.scenario.openscenario.resolve import Pose, PositionError, Resolver
+from avsim.scenario.openscenario.resolve import Pose, PositionError, Resolver, UnplacedError
 from avsim.scenario.openscenario.sampling import sample
 from avsim.scenario.openscenario.sidecar import load_sidecar, sidecar_path, split_overrides
 from avsim.scenario.scenario import DriverSettings, Scenario
@@ -71,6 +71,7 @@ from world.map.opendrive.route import OdrRoute, build_route
 from world.map.road import MapError, build_road_map
 
 EGO_NAMES = ("ego",)  # the car under test's entity name, compared in lower case
+OFFSET_EPS = 1e-3  # [m] a start this close to its lane's centre is on it
 TRUCKS = frozenset({"truck", "bus", "trailer", "semitrailer"})
 CLASSES = {"truck": VehicleClass.TRUCK, "trailer": VehicleClass.TRUCK,
            "semitrailer": VehicleClass.TRUCK, "bus": VehicleClass.BUS,
@@ -195,27 +196,52 @@ def _ego(osc: OpenScenario) -> Entity:
 
 def _init(osc: OpenScenario, resolver: Resolver) -> tuple[dict[str, _Placed],
                                                          list[InitAction]]:
-    """Each entity's start as the Init actions place it, and the actions left to run."""
+    """Each entity's start as the Init actions place it, and the actions left to run.
+
+    A placement relative to an entity not yet placed waits until that entity is (esmini
+    places the entities a position refers to first: a file's Ego teleported 200 m behind
+    an entity whose Init comes after it starts there); what still waits when nothing more
+    can be placed (a loop, an entity never placed) is refused."""
     placed = {e.name: _Placed() for e in osc.entities}
     deferred: list[InitAction] = []
+    waiting: list[tuple[InitAction, UnplacedError]] = []
     for item in osc.storyboard.init:
-        state, action = placed[item.entity], item.action
-        try:
-            if isinstance(action, TeleportAction):
-                poses = {n: p.pose for n, p in placed.items() if p.pose is not None}
-                state.pose = resolver.resolve(action.position, poses)
-            elif isinstance(action, SpeedAction) and action.dynamics.shape == "step":
-                state.speed = _target_speed(action, placed)
-            elif (isinstance(action, LongitudinalDistanceAction)
-                  and action.constraints is None and not action.continuous):
-                state.pose = _at_distance(action, placed, osc, resolver)
-            elif not isinstance(action, ActivateControllerAction | AssignControllerAction):
-                deferred.append(item)
-                if isinstance(action, FollowTrajectoryAction) and state.pose is None:
-                    state.pose = _trajectory_start(action, placed, resolver)
-        except PositionError as e:
-            raise ScenarioError(str(osc.path), f"Storyboard.Init.{item.entity}", str(e)) from None
+        if (problem := _apply(item, placed, osc, resolver, deferred)) is not None:
+            waiting.append((item, problem))
+    while waiting:
+        left = [(item, p) for item, _ in waiting
+                if (p := _apply(item, placed, osc, resolver, deferred)) is not None]
+        if len(left) == len(waiting):
+            item, problem = left[0]
+            raise ScenarioError(str(osc.path), f"Storyboard.Init.{item.entity}", str(problem))
+        waiting = left
     return placed, deferred
+
+
+def _apply(item: InitAction, placed: dict[str, _Placed], osc: OpenScenario,
+           resolver: Resolver, deferred: list[InitAction]) -> UnplacedError | None:
+    """Apply one Init action (`_init`); its `UnplacedError` if it must wait."""
+    state, action = placed[item.entity], item.action
+    try:
+        if isinstance(action, TeleportAction):
+            poses = {n: p.pose for n, p in placed.items() if p.pose is not None}
+            state.pose = resolver.resolve(action.position, poses)
+        elif isinstance(action, SpeedAction) and action.dynamics.shape == "step":
+            state.speed = _target_speed(action, placed)
+        elif (isinstance(action, LongitudinalDistanceAction)
+              and action.constraints is None and not action.continuous):
+            state.pose = _at_distance(action, placed, osc, resolver)
+        elif not isinstance(action, ActivateControllerAction | AssignControllerAction):
+            deferred.append(item)
+            if isinstance(action, FollowTrajectoryAction) and state.pose is None:
+                state.pose = _trajectory_start(action, placed, resolver)
+    except UnplacedError as e:
+        if isinstance(action, TeleportAction | LongitudinalDistanceAction):
+            return e
+        raise ScenarioError(str(osc.path), f"Storyboard.Init.{item.entity}", str(e)) from None
+    except PositionError as e:
+        raise ScenarioError(str(osc.path), f"Storyboard.Init.{item.entity}", str(e)) from None
+    return None
 
 
 def _trajectory_start(action: FollowTrajectoryAction, placed: Mapping[str, _Placed],
@@ -243,7 +269,7 @@ def _at_distance(action: LongitudinalDistanceAction, placed: Mapping[str, _Place
     `trailingReferencedEntity`, along the road, keeping its own lateral place."""
     ref = placed[action.entity]
     if ref.pose is None:
-        raise PositionError(f"entity {action.entity} has no position yet")
+        raise UnplacedError(f"entity {action.entity} has no position yet")
     gap = action.distance if action.distance is not None else (action.time_gap or 0.0) * ref.speed
     if action.freespace:
         gap += 0.5 * (_length(osc.entity(action.entity)) + _length(_owner(osc, action)))
@@ -304,12 +330,9 @@ def _ego_spec(path: Path, road_map: RoadMap, name: str, placed: Mapping[str, _Pl
     if lane is None or lane < 0:
         raise ScenarioError(str(path), f"Storyboard.Init.{name}", "the car under test must "
                             "start in a driving lane of the road's right-hand carriageway")
-    if abs(r) > 0.05:
-        raise ScenarioError(str(path), f"Storyboard.Init.{name}", "not supported yet (the "
-                            f"car under test starting {r:+.2f} m off its lane's centre)")
     return spec.EgoSpec(lane=lane, s=s, speed=placed[name].speed,
                         max_speed=max(placed[name].speed, 180.0 / 3.6),
-                        engaged=engaged)
+                        engaged=engaged, offset=r if abs(r) > OFFSET_EPS else 0.0)
 
 
 def _actor_spec(path: Path, road_map: RoadMap, entity: Entity,

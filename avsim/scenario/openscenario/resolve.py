@@ -57,6 +57,10 @@ class PositionError(ValueError):
     """A position that is not on the road (a lane that does not exist there, ...)."""
 
 
+class UnplacedError(PositionError):
+    """A relative position whose entity has no position yet."""
+
+
 class Resolver:
     """Positions on the OpenDRIVE roads linked end to end (module doc)."""
 
@@ -178,7 +182,7 @@ def _entity(entities: Mapping[str, Pose], name: str) -> Pose:
     try:
         return entities[name]
     except KeyError:
-        raise PositionError(f"entity {name} has no position yet") from None
+        raise UnplacedError(f"entity {name} has no position yet") from None
 
 
 def _oriented(heading: float, orientation: Orientation | None) -> float:

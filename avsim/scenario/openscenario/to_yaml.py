@@ -90,6 +90,9 @@ def convert_scenario(scenario: Scenario, path: Path) -> Conversion:
                 "set_speed_kph": _kph(scenario.driver.set_speed),
                 "max_speed_kph": _kph(ego.max_speed)},
     }
+    if ego.offset != 0.0:
+        out.misfits.append(f"the ego starts {ego.offset:+.2f} m off its lane's centre: the "
+                           "YAML ego starts on it")
     _scenery(scenario, out)
     actors = [_actor(a, out) for a in scenario.world.actors]
     names = {name: i for name, i in story.actors}

@@ -16,6 +16,7 @@ from numpy.typing import ArrayLike, NDArray
 if TYPE_CHECKING:
     from world.map.opendrive.geometry import PlanView
     from world.map.opendrive.objects import RoadObject
+    from world.map.opendrive.signals import RoadSignal
 
 FloatArray = NDArray[np.float64]
 
@@ -194,6 +195,8 @@ class Road:
     speeds: tuple[SpeedRecord, ...]  # ascending s
     objects: tuple[RoadObject, ...] = ()  # its <objects> (s on this road; none on a merged
     #   road: `chain` keeps them on the file's roads)
+    signals: tuple[RoadSignal, ...] = ()  # its <signals> (s on this road; none on a merged
+    #   road, as objects)
 
 
 @dataclass(frozen=True, slots=True)

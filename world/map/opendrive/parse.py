@@ -3,9 +3,11 @@
 Supported: header (its geoReference ignored, an all-zero <offset>), roads with their links,
 types and speeds, planView records (line, arc, spiral, poly3, paramPoly3), lanes (see
 `parse_lanes`), flat elevation and lateral profiles (every coefficient 0), objects (see
-`parse_objects`), empty signals and surface; userData anywhere is skipped. Everything else -
-junctions, signals, elevation, superelevation, any other element - is refused as "not supported yet
-(...)" naming the element, as are bad numbers and files beyond the size limits. Checked on
+`parse_objects`), signals (see `parse_signals`: static speed-limit signs), empty surface;
+userData anywhere is skipped. Everything else - junctions, elevation, superelevation, any
+other element - is refused as "not supported yet (...)" naming the element (a non-flat
+elevation record by its road and station), as are bad numbers and files beyond the size
+limits. Checked on
 the geometry, in this order and all before any curve is evaluated: the counts (roads,
 planView records in the file), every number (finite, at most 64 characters, within 1e9),
 each road's length (above 0, the file's roads together at most `MAX_ROUTE_LENGTH`), each
@@ -42,6 +44,7 @@ from world.map.opendrive.model import (
 )
 from world.map.opendrive.parse_lanes import lanes, speed
 from world.map.opendrive.parse_objects import count_objects, road_objects
+from world.map.opendrive.parse_signals import count_signals, road_signals
 from world.map.opendrive.shapes import PolyCurve
 from world.map.opendrive.xmltree import Node, parse_xml
 
@@ -104,6 +107,7 @@ def _check_counts(roads: list[Node]) -> None:
         if count > MAX_GEOMETRIES:
             raise node.error(f"more than {MAX_GEOMETRIES} geometry records in the file")
     count_objects(roads)
+    count_signals(roads)
 
 
 def _header(node: Node) -> tuple[int, int, str]:
@@ -243,7 +247,8 @@ def _flat(node: Node | None, *tags: str) -> None:
         for n in kids[tag]:
             n.only()
             if any(n.num(c) != 0.0 for c in "abcd"):
-                raise n.unsupported(FLAT_PROFILES[tag])
+                raise n.unsupported(f"{FLAT_PROFILES[tag]} other than flat, from s = "
+                                    f"{n.num('s', 0.0):g} m")
 
 
 def _rule(node: Node) -> Literal["RHT", "LHT"]:
@@ -267,10 +272,9 @@ def _road(node: Node) -> Road:
         "signals",
         "surface",
     )
-    for tag in ("signals", "surface"):
-        for n in kids[tag]:
-            if any(c.tag != "userData" for c in n.children):
-                raise n.unsupported(tag)
+    for n in kids["surface"]:
+        if any(c.tag != "userData" for c in n.children):
+            raise n.unsupported("surface")
     _flat(node.at_most_one(kids["elevationProfile"], "elevationProfile"), "elevation")
     _flat(node.at_most_one(kids["lateralProfile"], "lateralProfile"), "superelevation", "shape")
     length = node.num("length")
@@ -292,4 +296,5 @@ def _road(node: Node) -> Road:
         lane_sections=sections,
         speeds=_speeds(kids["type"]),
         objects=road_objects(kids["objects"]),
+        signals=road_signals(kids["signals"]),
     )

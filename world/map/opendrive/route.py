@@ -32,8 +32,12 @@ Across, from each lane section:
 - the paint: each lane's road mark lies on its outer border (OpenDRIVE); a boundary between
   the route's lanes takes the mark of the lane nearer the reference line (`lane_paint`).
 
-The speed limit: a lane's `<speed max>`, else the road type record's, else the type's
-default (`TYPE_LIMITS`: the German rules, the motorway's advisory 130 km/h).
+The speed limit: a lane's `<speed max>`, else the latest posting before the station: a
+static speed-limit sign's for the route's direction (`sign_limits`: a sign wins over a type
+record at the same station) or a road type record's limit (its `<speed>`, else its type's
+default, `TYPE_LIMITS`: the German rules, the motorway's advisory 130 km/h). The route is
+split where each posting stands, so the map posts it there (and a sign of the route's own
+look stands at the roadside: `world.scene.scenery`).
 
 What does not fit this yet is refused with `OpenDriveError` "not supported yet (...)":
 lane sections whose route lanes differ (lanes that begin or end), widths or a lane offset
@@ -69,6 +73,7 @@ from world.map.opendrive.lanes import (
 from world.map.opendrive.model import LaneSection, OdrLane, OpenDrive, Road
 from world.map.opendrive.object_layout import layout_objects
 from world.map.opendrive.offset_spline import CurvePiece
+from world.map.opendrive.sign_limits import SignPost, latest_sign, sign_posts
 from world.spec import RoadSpec, SceneryObjectSpec, SegmentSpec
 
 TOLERANCE = 1e-3  # [m] the route's pieces keep this close to the file's exact reference line
@@ -160,17 +165,18 @@ def _build_route(odr: OpenDrive) -> OdrRoute:
         raise _refuse(odr, "lane sections with different route lanes: lanes that begin or "
                            "end")
     layout = layouts[0]
+    signs = sign_posts(odr, chain)
     offsets = any(p.a != 0.0 or p.b != 0.0 or p.c != 0.0 or p.d != 0.0
                   for p in road.lane_offsets)
     scenery: tuple[RoadSpec, ...] = ()
     if offsets or len(set(layouts)) != 1 or not layout.uniform:
-        segments = _fitted_segments(odr, road, layouts)
+        segments = _fitted_segments(odr, road, layouts, signs)
     else:
         pieces = _split(arc_spline(road.plan_view, TOLERANCE),
-                        [r.s for r in road.speeds if 0.0 < r.s < road.plan_view.length])
-        segments = _offset_segments(odr, road, layout, pieces)
+                        [s for s in _postings(road, signs) if 0.0 < s < road.plan_view.length])
+        segments = _offset_segments(odr, road, layout, pieces, signs)
         far = None if layout.oncoming_ids else far_side(
-            odr, road, pieces, [_limit(road, layout, p.s0) for p in pieces])
+            odr, road, pieces, [_limit(road, layout, p.s0, signs) for p in pieces])
         scenery = (far,) if far is not None else ()
     segments = posted_once(segments)
     first = segments[0]
@@ -194,8 +200,13 @@ def posted_once(segments: list[SegmentSpec]) -> list[SegmentSpec]:
     return out
 
 
-def _offset_segments(odr: OpenDrive, road: Road, layout: Layout,
-                     pieces: list[ArcPiece]) -> list[SegmentSpec]:
+def _postings(road: Road, signs: tuple[SignPost, ...]) -> list[float]:
+    """[m] the stations where a type record or a speed-limit sign posts a limit."""
+    return sorted({r.s for r in road.speeds} | {s for s, _ in signs})
+
+
+def _offset_segments(odr: OpenDrive, road: Road, layout: Layout, pieces: list[ArcPiece],
+                     signs: tuple[SignPost, ...]) -> list[SegmentSpec]:
     """The segments of a road whose every lane is constant (one `uniform` layout, no lane
     offset): the reference line's arc spline `pieces` (split at the speed records) offset
     by `ref_t`, exactly (module doc)."""
@@ -208,7 +219,7 @@ def _offset_segments(odr: OpenDrive, road: Road, layout: Layout,
         heading = piece.heading0
         start = (piece.x0 - layout.ref_t * math.sin(heading),
                  piece.y0 + layout.ref_t * math.cos(heading), heading)
-        limit, zone = _limit(road, layout, piece.s0)
+        limit, zone = _limit(road, layout, piece.s0, signs)
         segments.append(SegmentSpec(
             length=piece.length * scale, curvature=piece.curvature / scale,
             lanes=len(layout.lane_ids), oncoming_lanes=len(layout.oncoming_ids),
@@ -227,13 +238,14 @@ def _borders(layout: Layout) -> tuple[int, ...]:
     return (right, ids[0], *(i + 1 for i in ids), *layout.oncoming_ids)
 
 
-def _fitted_segments(odr: OpenDrive, road: Road,
-                     layouts: list[Layout]) -> list[SegmentSpec]:
+def _fitted_segments(odr: OpenDrive, road: Road, layouts: list[Layout],
+                     signs: tuple[SignPost, ...]) -> list[SegmentSpec]:
     """The segments of a road whose lanes change along it (module doc): lane 0's centre
     as an arc spline, the other boundaries as cubics per piece (`lane_fit`)."""
     view = road.plan_view
     fits = fit_lanes(road, [_borders(lay) for lay in layouts],
-                     [r.s for r in road.speeds if view.start < r.s < view.end], TOLERANCE)
+                     [s for s in _postings(road, signs) if view.start < s < view.end],
+                     TOLERANCE)
     segments = []
     for k, fit in enumerate(fits):
         piece = fit.piece
@@ -241,7 +253,7 @@ def _fitted_segments(odr: OpenDrive, road: Road,
             _check_joint(odr, fits[k - 1].piece, piece)
         layout = layouts[lane_section_index(road, 0.5 * (piece.s0 + piece.s1))]
         section = _fitted_section(odr, layout, fit)
-        limit, zone = _limit(road, layout, piece.s0)
+        limit, zone = _limit(road, layout, piece.s0, signs)
         segments.append(SegmentSpec(
             length=piece.length, curvature=piece.curvature, lanes=section.lanes,
             oncoming_lanes=section.oncoming_lanes, lane_width=section.lane_width,
@@ -295,14 +307,18 @@ def _split(pieces: list[ArcPiece], stations: list[float]) -> list[ArcPiece]:
     return out
 
 
-def _limit(road: Road, layout: Layout, s: float) -> tuple[float, Zone]:
+def _limit(road: Road, layout: Layout, s: float,
+           signs: tuple[SignPost, ...]) -> tuple[float, Zone]:
     """([m/s] the limit in force at station s, the zone) (module doc)."""
     records = [r for r in road.speeds if r.s <= s + 1e-9]
     record = records[-1] if records else None
     road_type = record.road_type if record is not None else "unknown"
     zone = ZONES.get(road_type, Zone.CITY)
+    sign = latest_sign(signs, s)
     if layout.speed is not None:
         return layout.speed, zone
+    if sign is not None and (record is None or sign[0] >= record.s):
+        return sign[1], zone
     if record is not None and record.max_speed is not None:
         return record.max_speed, zone
     return TYPE_LIMITS.get(road_type, TYPE_LIMITS["unknown"]) * MPS_PER_KPH, zone

@@ -140,12 +140,14 @@ def variant(tmp_path: Path, old: str, new: str) -> Path:
         (
             '<elevation s="0" a="0" b="0"',
             '<elevation s="0" a="0" b="0.01"',
-            "/elevationProfile/elevation: not supported yet (elevation)",
+            "/elevationProfile/elevation: not supported yet (elevation other than flat, from "
+            "s = 0 m)",
         ),
         (
             '<superelevation s="0" a="0"',
             '<superelevation s="0" a="0.02"',
-            "/lateralProfile/superelevation: not supported yet (superelevation)",
+            "/lateralProfile/superelevation: not supported yet (superelevation other than flat, "
+            "from s = 0 m)",
         ),
         (
             "<objects/>",
@@ -154,8 +156,9 @@ def variant(tmp_path: Path, old: str, new: str) -> Path:
         ),
         (
             "<signals></signals>",
-            '<signals><signal id="4" s="1" t="0"/></signals>',
-            "/OpenDRIVE/road[id=1]/signals: not supported yet (signals)",
+            '<signals><signal id="4" s="1" t="0" dynamic="yes"/></signals>',
+            "/OpenDRIVE/road[id=1]/signals/signal[id=4]: not supported yet (dynamic signal (a "
+            "traffic light) on a road)",
         ),
         (
             '<width sOffset="0" a="2" b="0" c="0" d="0"/>',
