@@ -64,12 +64,21 @@ def _front_axle(axles: Node, ctx: Context) -> Axle | None:
     return None if node is None else parse_axle(node, ctx)
 
 
+def _no_trailer(trailer: Node, ctx: Context) -> bool:
+    """Whether a Trailer element connects nothing: a TrailerRef whose entityRef is empty."""
+    ref = trailer.child("TrailerRef")
+    return ref is not None and len(trailer.children) == 1 \
+        and ctx.attrs.opt_text(ref, "entityRef") == ""
+
+
 def parse_vehicle(node: Node, ctx: Context) -> Vehicle:
     """A Vehicle; its 1.3 TrailerHitch / TrailerCoupler are read past (they matter only to
-    a trailer connection), a Trailer (one connected from the start) is refused."""
+    a trailer connection), a Trailer (one connected from the start) is refused unless it
+    names none (a `TrailerRef` to the empty name, as esmini's own catalog writes "no
+    trailer")."""
     ctx = ctx.with_declarations(node)
     trailer = node.child("Trailer")
-    if trailer is not None:
+    if trailer is not None and not _no_trailer(trailer, ctx):
         raise unsupported(trailer)
     a = ctx.attrs
     perf = node.need("Performance")

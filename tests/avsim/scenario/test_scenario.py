@@ -26,7 +26,8 @@ def test_the_world_spec_is_what_a_world_is_built_from() -> None:
     assert fields(spec.WorldSpec) == ["road", "ego", "seed", "actors", "sensors", "events",
                                       "town", "scenery_roads", "scenery_objects"]
     # the car (and the state of its automated driving function's switch), not the driver
-    assert fields(spec.EgoSpec) == ["lane", "s", "speed", "max_speed", "engaged", "scripted"]
+    assert fields(spec.EgoSpec) == ["lane", "s", "speed", "max_speed", "engaged", "scripted",
+                                    "offset"]
     assert not hasattr(spec, "CriteriaSpec") and not hasattr(spec, "ScenarioSpec")
     assert fields(Scenario) == ["name", "description", "situation", "duration", "world",
                                 "driver", "criteria", "story", "grid", "sources"]
