@@ -278,6 +278,26 @@ class Commands:
                              snap.time + MOTION_STEP, me.s)
         return cmd, abs(goal - centre_offset) < GAP_REACHED
 
+    def place(self, tag: str, action: LongitudinalDistanceAction, me: EntityState,
+              offset: float, snap: Snapshot) -> tuple[TeleportCommand, TrackCommand]:
+        """An action `placed_at_once`: the actor's centre where the distance (or the time gap
+        at the entity's speed) puts it ahead of or behind the referenced entity along the
+        entity's way - between the reference points, or bumper to bumper for `freespace` -
+        at its lateral `offset` [m], and its speed the entity's (esmini places it so and
+        ends the action)."""
+        ref = snap.entities[action.entity]
+        want = action.distance if action.distance is not None else (
+            (action.time_gap or 0.0) * max(ref.speed, 0.0))
+        way = (-1.0 if action.displacement == "trailingReferencedEntity" else 1.0) \
+            * _travel(ref)
+        if action.freespace:
+            centre = ref.s + _travel(ref) * ref.centre_ahead \
+                + way * (want + 0.5 * (me.length + ref.length))
+        else:
+            centre = ref.s + way * want + _travel(me) * me.centre_ahead
+        return (TeleportCommand(tag, centre, offset, None),
+                TrackCommand(tag, max(0.0, ref.speed), math.inf, math.inf))
+
     def follow(self, follow: Follow, me: EntityState, snap: Snapshot, max_speed: float,
                period: float) -> tuple[TrackCommand, bool]:
         """(the command for this step, whether the follow's goal is reached); `period` [s]
@@ -311,6 +331,15 @@ class Commands:
         return TrackCommand(follow.tag, min(target, top), accel, decel, top), reached
 
 
+def placed_at_once(action: LongitudinalDistanceAction) -> bool:
+    """Whether a distance action puts its actor at the distance at once and ends
+    (`Commands.place`): it does not go on (`continuous` false) and has no acceleration
+    limits, as NCAP files use it to set a gap right after Init."""
+    c = action.constraints
+    return not action.continuous and (c is None or not (c.max_acceleration
+                                                        or c.max_deceleration))
+
+
 def _travel(entity: EntityState) -> float:
     """+1 if `entity` heads along the route, -1 against it."""
     return 1.0 if math.cos(entity.heading - entity.route_heading) >= 0.0 else -1.0
@@ -339,9 +368,10 @@ def _speed_span(d: TransitionDynamics, start: float, target: float) -> float:
         return speed_span_by_distance(start, target, d.value)
     if abs(target - start) < SPEED_MATCHED * 1e-3 or shape is Shape.STEP:
         return 0.0  # nothing to change (to rounding: an entity's speed read back)
-    if d.value <= 0.0:
+    if d.value == 0.0:
         raise ValueError(f"a speed change at rate {d.value:g} m/s^2 never ends")
-    return span_by_rate(shape, target - start, d.value)
+    return span_by_rate(shape, target - start, abs(d.value))  # the sign is the change's
+    #   (ASAM's 1.2 examples write a braking rate negative; esmini plays its magnitude)
 
 
 def _offset_span(shape: Shape, distance: float, accel: float) -> float:

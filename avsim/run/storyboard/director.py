@@ -20,7 +20,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 
-from avsim.run.storyboard.commands import Commands, Follow, Sync, poses_of
+from avsim.run.storyboard.commands import Commands, Follow, Sync, placed_at_once, poses_of
 from avsim.run.storyboard.conditions import Resolved
 from avsim.run.storyboard.driver import Driver
 from avsim.run.storyboard.runtime import StartedAction, StoryRuntime
@@ -228,6 +228,9 @@ class Director:
                 if cmd.continuous:
                     self._follows[tag] = Follow(tag, entity, action,
                                                 after=snap.time + cmd.transition.span)
+            elif isinstance(action, LongitudinalDistanceAction) and placed_at_once(action):
+                for placed in self.commands.place(tag, action, me, motion.offset, snap):
+                    motion.command(placed)  # the teleport ends the action
             elif isinstance(action, LongitudinalDistanceAction | LateralDistanceAction):
                 self._follows[tag] = Follow(tag, entity, action)
             elif isinstance(action, SynchronizeAction):
