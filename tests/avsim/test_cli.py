@@ -130,7 +130,8 @@ def _openscenario_inputs(directory: Path) -> dict[str, Case]:
             'entryName="$CutInVehicle_Model"', 'entryName="$Nope"'), "$Nope"),
         "xosc_unsupported_action": (text.replace(
             "<ActivateControllerAction lateral=\"true\" longitudinal=\"true\" />",
-            "<OverrideControllerValueAction/>"), "not supported yet"),
+            '<VisibilityAction graphics="true" traffic="true" sensors="false"/>'),
+            "not supported yet"),
         "xosc_missing_road": (text.replace("alks_road_straight.xodr", "no_road.xodr"),
                               "no_road.xodr"),
         "xosc_missing_catalog": (text.replace("catalogs/vehicles", "catalogs/no_vehicles"),

@@ -223,7 +223,11 @@ def _pedal(node: Node, ctx: Context, pedal: str) -> PedalOverride:
 
 
 def _override(node: Node, ctx: Context) -> PrivateAction:
-    """The driver's pedals (throttle, brake); the other controls only inactive."""
+    """The driver's pedals (throttle, brake); the other controls only inactive. An
+    override of nothing is refused."""
+    if not node.children:
+        raise node.error("overrides no control (Throttle, Brake, Clutch, ParkingBrake, "
+                         "SteeringWheel or Gear)")
     pedals = []
     for child in node.children:
         if child.tag in ("Throttle", "Brake"):

@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from avsim.scenario.bounds import MAX_LANE_WIDTH
+from avsim.scenario.bounds import MAX_LANE_WIDTH, MAX_RADIUS
 from avsim.scenario.openscenario.convert import load_xosc
 from avsim.scenario.openscenario.environment import EnvironmentAction
 from avsim.scenario.openscenario.model import (
@@ -136,11 +136,16 @@ def _duration(scenario: Scenario, out: Conversion) -> float:
     return _r(scenario.duration)
 
 
-def _road(road: RoadSpec, out: Conversion) -> dict[str, Any]:
-    first = road.segments[0]
+def _segments(road: RoadSpec) -> tuple[list[dict[str, Any]], float]:
+    """The road's segments as the YAML writes them, and how far [m] at most a curve too
+    gentle for its arcs (radius over MAX_RADIUS, written straight) strays: its sagitta."""
     segments: list[dict[str, Any]] = []
+    flattened = 0.0
     for seg in road.segments:
-        if seg.curvature == 0.0:
+        gentle = seg.curvature != 0.0 and 1.0 / abs(seg.curvature) > MAX_RADIUS
+        if gentle:
+            flattened = max(flattened, abs(seg.curvature) * seg.length ** 2 / 8.0)
+        if seg.curvature == 0.0 or gentle:
             if segments and "straight" in segments[-1]:
                 segments[-1]["straight"] = _r(segments[-1]["straight"] + seg.length)
             else:
@@ -151,6 +156,15 @@ def _road(road: RoadSpec, out: Conversion) -> dict[str, Any]:
                                      "angle_deg": _r(angle)}})
         if seg.speed_limit is not None and seg.speed_limit != road.speed_limit:
             segments[-1]["speed_limit_kph"] = _kph(seg.speed_limit)
+    return segments, flattened
+
+
+def _road(road: RoadSpec, out: Conversion) -> dict[str, Any]:
+    first = road.segments[0]
+    segments, flattened = _segments(road)
+    if flattened > 0.0:
+        out.misfits.append(f"curves of radius over {MAX_RADIUS:.0f} m (the YAML's largest arc) "
+                           f"written straight: at most {flattened:.2f} m off the road's line")
     if any(seg.curvature != 0.0 for seg in road.segments):
         out.misfits.append(f"the road's curves: {len(segments)} straight and arc segments, "
                            "an OpenDRIVE clothoid or cubic as arcs within 1 mm of it")

@@ -198,3 +198,13 @@ def test_unsupported_elements_are_named(tmp_path: Path, old: str, new: str, name
         load_openscenario(path)
     assert str(info.value).startswith(f"{path}: line ")
     assert re.search(rf"/{name}(\[\w+\])?: not supported yet \({name}\)$", str(info.value))
+
+
+def test_an_override_of_no_control_is_refused(tmp_path: Path) -> None:
+    path = tmp_path / "empty_override.xosc"
+    path.write_text(_MINIMAL.replace(
+        SPEED_ACTION, "<ControllerAction><OverrideControllerValueAction/></ControllerAction>",
+        1))
+    with pytest.raises(ScenarioError, match="OverrideControllerValueAction: overrides no "
+                                            r"control \(Throttle, Brake"):
+        load_openscenario(path)
