@@ -46,7 +46,7 @@ def road_objects(nodes: list[Node]) -> tuple[RoadObject, ...]:
     return tuple(out)
 
 
-def _size(node: Node, name: str) -> float | None:
+def optional_size(node: Node, name: str) -> float | None:
     """The size attribute `name` [m] if given (at least 0)."""
     if name not in node.attrib:
         return None
@@ -72,9 +72,9 @@ def _object(node: Node) -> RoadObject:
     return RoadObject(
         id=node.get("id"), type=node.get("type", "none"), name=node.get("name", ""),
         s=node.num("s"), t=node.num("t"), z_offset=node.num("zOffset", 0.0),
-        hdg=node.num("hdg", 0.0), height=_size(node, "height") or 0.0,
-        length=_size(node, "length"), width=_size(node, "width"),
-        radius=_size(node, "radius"),
+        hdg=node.num("hdg", 0.0), height=optional_size(node, "height") or 0.0,
+        length=optional_size(node, "length"), width=optional_size(node, "width"),
+        radius=optional_size(node, "radius"),
         repeats=tuple(_repeat(n, node) for n in kids["repeat"]),
         outlines=tuple(_outline(n) for n in outlines),
     )
@@ -82,20 +82,22 @@ def _object(node: Node) -> RoadObject:
 
 def _repeat(node: Node, obj: Node) -> ObjectRepeat:
     node.only()
-    length, distance = _size(node, "length"), _size(node, "distance")
+    length, distance = optional_size(node, "length"), optional_size(node, "distance")
     if length is None or distance is None:
         raise node.error("missing attribute length or distance")
-    height = _size(obj, "height") or 0.0
+    height = optional_size(obj, "height") or 0.0
     z = obj.num("zOffset", 0.0)
     return ObjectRepeat(
         s=node.num("s"), length=length, distance=distance,
         t_start=node.num("tStart"), t_end=node.num("tEnd"),
         z_offset_start=node.num("zOffsetStart", z), z_offset_end=node.num("zOffsetEnd", z),
-        height_start=_or(_size(node, "heightStart"), height),
-        height_end=_or(_size(node, "heightEnd"), height),
-        width_start=_size(node, "widthStart"), width_end=_size(node, "widthEnd"),
-        length_start=_size(node, "lengthStart"), length_end=_size(node, "lengthEnd"),
-        radius_start=_size(node, "radiusStart"), radius_end=_size(node, "radiusEnd"),
+        height_start=_or(optional_size(node, "heightStart"), height),
+        height_end=_or(optional_size(node, "heightEnd"), height),
+        width_start=optional_size(node, "widthStart"), width_end=optional_size(node, "widthEnd"),
+        length_start=optional_size(node, "lengthStart"),
+        length_end=optional_size(node, "lengthEnd"),
+        radius_start=optional_size(node, "radiusStart"),
+        radius_end=optional_size(node, "radiusEnd"),
     )
 
 
@@ -118,8 +120,8 @@ def _outline(node: Node) -> Outline:
         c.only()
         if local:
             out.append(OutlineCorner(c.num("u"), c.num("v"), c.num("z", 0.0),
-                                     _size(c, "height") or 0.0))
+                                     optional_size(c, "height") or 0.0))
         else:
             out.append(OutlineCorner(c.num("s"), c.num("t"), c.num("dz", 0.0),
-                                     _size(c, "height") or 0.0))
+                                     optional_size(c, "height") or 0.0))
     return Outline(road_frame=bool(road), corners=tuple(out))

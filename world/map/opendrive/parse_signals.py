@@ -15,6 +15,7 @@ from __future__ import annotations
 from typing import Literal
 
 from world.map.opendrive.parse_lanes import SPEED_UNITS
+from world.map.opendrive.parse_objects import optional_size
 from world.map.opendrive.signals import SPEED_LIMIT_TYPE, RoadSignal
 from world.map.opendrive.xmltree import Node
 
@@ -47,15 +48,6 @@ def road_signals(nodes: list[Node]) -> tuple[RoadSignal, ...]:
     return tuple(out)
 
 
-def _size(node: Node, name: str) -> float | None:
-    if name not in node.attrib:
-        return None
-    value = node.num(name)
-    if value < 0.0:
-        raise node.error(f"{name} must be >= 0, got {value:g}")
-    return value
-
-
 def _signal(node: Node) -> RoadSignal:
     kids = node.only(*SIGNAL_CHILDREN)
     for tag in SIGNAL_CHILDREN:
@@ -77,7 +69,8 @@ def _signal(node: Node) -> RoadSignal:
         id=node.get("id"), name=node.get("name", ""), s=node.num("s"), t=node.num("t"),
         z_offset=node.num("zOffset", 0.0), orientation=orientation,
         country=node.get("country", ""), type=kind, subtype=node.get("subtype", "-1"),
-        value=_limit(node), height=_size(node, "height"), width=_size(node, "width"))
+        value=_limit(node), height=optional_size(node, "height"),
+        width=optional_size(node, "width"))
 
 
 def _limit(node: Node) -> float:
