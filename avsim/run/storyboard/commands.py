@@ -132,19 +132,7 @@ class Commands:
     def lane_change(self, tag: str, action: LaneChangeAction, me: EntityState,
                     centre_offset: float, snap: Snapshot) -> LateralCommand:
         """`centre_offset`: the actor's body centre offset from the reference line [m]."""
-        target = action.target
-        if isinstance(target, AbsoluteTargetLane):
-            lane_id = int(target.value)
-            if lane_id not in self.lane_ids:
-                raise ValueError(f"lane {lane_id} is not a lane of the route")
-            lane = self.lane_ids.index(lane_id)
-        else:
-            ref = snap.entities[target.entity]
-            if ref.lane is None:
-                raise ValueError(f"entity {target.entity} is in no lane")
-            lane = ref.lane + target.value
-        if not 0 <= lane < self.road.lanes_at(me.s):
-            raise ValueError(f"the target lane (route lane {lane}) does not exist here")
+        lane = target_route_lane(action, self.lane_ids, self.road.lanes_at(me.s), snap)
         goal = float(self.road.lane(lane).offset_at(me.s)) + (action.target_lane_offset or 0.0)
         d = action.dynamics
         shape = Shape(d.shape)
@@ -383,3 +371,24 @@ def _offset_span(shape: Shape, distance: float, accel: float) -> float:
     if shape is Shape.CUBIC:
         return math.sqrt(6.0 * distance / accel)
     return 2.0 * math.sqrt(distance / accel)
+
+
+def target_route_lane(action: LaneChangeAction, lane_ids: tuple[int, ...], lanes_here: int,
+                      snap: Snapshot) -> int:
+    """The route lane (0 = rightmost) a lane change goes to: an OpenDRIVE lane id of the
+    route, or lanes to the left of an entity's lane. `lanes_here`: the route's lane count
+    at the actor; `ValueError` for a lane the route does not have there."""
+    target = action.target
+    if isinstance(target, AbsoluteTargetLane):
+        lane_id = int(target.value)
+        if lane_id not in lane_ids:
+            raise ValueError(f"lane {lane_id} is not a lane of the route")
+        lane = lane_ids.index(lane_id)
+    else:
+        ref = snap.entities[target.entity]
+        if ref.lane is None:
+            raise ValueError(f"entity {target.entity} is in no lane")
+        lane = ref.lane + target.value
+    if not 0 <= lane < lanes_here:
+        raise ValueError(f"the target lane (route lane {lane}) does not exist here")
+    return lane

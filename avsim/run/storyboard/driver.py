@@ -25,9 +25,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
+from avsim.run.storyboard.commands import target_route_lane
 from avsim.run.storyboard.snapshot import Snapshot
 from avsim.scenario.openscenario.model import (
-    AbsoluteTargetLane,
     AbsoluteTargetSpeed,
     LaneChangeAction,
     OverrideControllerValueAction,
@@ -73,20 +73,8 @@ class Driver:
     def lane_change(self, tag: str, action: LaneChangeAction, snap: Snapshot) -> int:
         """Hold the stalk towards the target route lane (returned); `ValueError` for a lane
         the route does not have there."""
-        target = action.target
         me = snap.entities[self.ego]
-        if isinstance(target, AbsoluteTargetLane):
-            lane_id = int(target.value)
-            if lane_id not in self.lane_ids:
-                raise ValueError(f"lane {lane_id} is not a lane of the route")
-            lane = self.lane_ids.index(lane_id)
-        else:
-            ref = snap.entities[target.entity]
-            if ref.lane is None:
-                raise ValueError(f"entity {target.entity} is in no lane")
-            lane = ref.lane + target.value
-        if not 0 <= lane < self.world.road.lanes_at(me.s):
-            raise ValueError(f"the target lane (route lane {lane}) does not exist here")
+        lane = target_route_lane(action, self.lane_ids, self.world.road.lanes_at(me.s), snap)
         self._lane = (tag, lane)
         self.world.driver = replace(self.world.driver, lane_request=lane)
         return lane
