@@ -31,7 +31,8 @@ bumper f, its axles); tracks are in the map frame. Each tick
   1-sigma): the tracks are placed on the map with the same error, so a pedestrian on the
   crosswalk may appear up to ``station_sigmas`` x that before or beyond it. Along the route
   the crosswalk's reach is widened by that much on each side, and the car stops that much
-  earlier, so that where it truly stands is still before the crosswalk.
+  before it in its estimate (at least ``crossing_stop``), so that where it truly stands is
+  still the law's margin before the crosswalk.
 - a pedestrian waiting (`EventMonitor.waiting`, no event: the speed plan's lower crossing
   speed, `planner.speed_planning`): a crosswalk ahead of the front bumper with a pedestrian
   track on it or within ``crossing_margin`` of it along the route (widened by the station's
@@ -80,7 +81,7 @@ class EventParams:
     look_ahead: float = 2.0  # [s] a pedestrian walking into the lane within this counts
     crossing_stop: float = 1.0  # [m] stop this much (+ the law's margin) before a crosswalk
     station_sigmas: float = 2.5  # [-] a crosswalk's reach along the route is widened, and its
-    #   stop moved back, by this many 1-sigmas of the car's station (one-sided 99.4 %): under
+    #   stop is at least, this many 1-sigmas of the car's station (one-sided 99.4 %): under
     #   a consumer receiver (1.2 m 1-sigma) the estimate may be 2.4 m off along the route,
     #   and a pedestrian on the crosswalk's near edge then appears 1.2 m short of it
     waiting_reach: float = 6.0  # [m] across, a pedestrian at a crosswalk this far beyond the
@@ -226,7 +227,7 @@ class EventMonitor:
         crossing_between = np.sign(d_now - lane_offset) != np.sign(d_next - lane_offset)
         if not np.any(on & (lateral | crossing_between)):
             return None
-        return cw.s - front - p.crossing_stop - slack
+        return cw.s - front - max(p.crossing_stop, slack)
 
     def waiting(self, station: float, lane_offset: float, lane_width: float,
                 tracks: Sequence[Track], station_sigma: float = 0.0) -> frozenset[float]:

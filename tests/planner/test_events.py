@@ -200,7 +200,8 @@ def test_a_pedestrian_at_the_crossing_counts_within_the_stations_uncertainty() -
     the tracks placed with it by as much: a walker truly on the crosswalk's near edge (400.2
     m) stepping into the lane appears 2.4 m short of it under a consumer receiver (1.2 m
     1-sigma, the car 2.4 m further on than it believes). That walker counts, and the car
-    stops 2.5 x 1.2 m earlier, so that where it truly stands is still before the crosswalk."""
+    stops 2.5 x 1.2 m before the crosswalk in its estimate (not `crossing_stop`), so that
+    where it truly stands is still before the crosswalk."""
     m = EventMonitor(ROAD, VEHICLE, P)
     seen = walker(400.2 - 2.4, -4.5, vy=1.2)
     sure = m.update(0.0, 370.0, 8.0, 0.0, W, (seen,))
@@ -208,9 +209,10 @@ def test_a_pedestrian_at_the_crossing_counts_within_the_stations_uncertainty() -
     unsure = m.update(0.0, 370.0, 8.0, 0.0, W, (seen,), station_sigma=1.2)
     assert unsure.holds(PEDESTRIAN)
     slack = P.station_sigmas * 1.2
-    assert unsure.stop_distance == pytest.approx(400.0 - 372.4 - P.crossing_stop - slack)
+    assert slack > P.crossing_stop
+    assert unsure.stop_distance == pytest.approx(400.0 - 372.4 - slack)
     truly = 370.0 + 2.4 + VEHICLE.front_overhang + unsure.stop_distance  # [m] front bumper
-    assert truly < 400.0 - P.crossing_stop  # truly before the crosswalk
+    assert truly < 400.0  # truly before the crosswalk
     far = walker(400.0 - P.crossing_margin - slack - 0.01, -4.5, vy=1.2)  # beyond the slack
     assert not m.update(0.0, 370.0, 8.0, 0.0, W, (far,), station_sigma=1.2).holds(PEDESTRIAN)
     assert m.waiting(370.0, 0.0, W, (seen,)) == frozenset()
