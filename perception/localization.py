@@ -48,7 +48,15 @@ Steps:
    a truck beside hiding the other) whose frame's detection the lane filter took, its noise
    scaled up by ``lane_confidence`` / confidence. The lane is the HD map's
    ego-direction lane that puts the car nearest the estimate (before the first match: the
-   lane the car starts in, since a GNSS bias may exceed half a lane). The pseudo-measurement
+   lane the car starts in, since a GNSS bias may exceed half a lane). The first match is
+   not gated by the receiver's accuracy: the car is in its start lane, wherever the first fix
+   put it (a bias the receiver does not state, 4.6 m across under a degraded receiver, is
+   beyond the gate of a bias of 1 m 1-sigma, and the car would steer out of its lane to
+   bring the biased estimate into it): where the gate rejects it, the bias's variance
+   across the car is opened to the innovation's square (the position's with it, their sum
+   kept: `gnss_consistent`) and it is applied; not against a receiver stating RTK
+   accuracy, which is taken at its word until `perception.health` finds it off.
+   The pseudo-measurement
    is the estimate projected onto that lane (its station kept) with the camera's lateral
    offset and heading in place of its own; the innovation is taken against the pose the
    stack had at the frame's time (the frame arrives late) and applied now. It is gated by
@@ -359,6 +367,10 @@ class Localizer:
         h[1, IPSI] = 1.0
         weight = min(1.0, lane.confidence / p.lane_confidence)
         match = self._gated_update(h, nu, self._r_lane / weight**2, p.lane_gate, index)
+        if not match.accepted and not self.matched and self._bias_sigma > p.rtk_sigma:
+            #   in the start lane, however far off the fix says (module doc)
+            self._open_across(abs(float(nu[0])))
+            match = self._gated_update(h, nu, self._r_lane / weight**2, p.lane_gate, index)
         self.matched = self.matched or match.accepted
         if lane.confidence < p.lane_confidence or not self._fixes:
             return match
@@ -383,11 +395,16 @@ class Localizer:
         self.gnss_trusted = consistent
         if consistent or not self._initialised:
             return
+        self._open_across(max(self.params.gnss_bias_floor, abs(self._fix_offset)))
+
+    def _open_across(self, sigma: float) -> None:
+        """Open the bias's variance across the car to at least ``sigma``^2 [m^2], the
+        position's by as much, their covariance lowered by as much: the sum x + b, what a fix
+        measures, keeps its variance; along the car nothing changes."""
         n2 = self._across()
         pos, bias = [IX, IY], [IBX, IBY]
         cov = self._ekf.P.copy()
-        wanted = max(self.params.gnss_bias_floor, abs(self._fix_offset)) ** 2
-        more = n2 * max(wanted - float(np.sum(n2 * cov[np.ix_(bias, bias)])), 0.0)
+        more = n2 * max(sigma**2 - float(np.sum(n2 * cov[np.ix_(bias, bias)])), 0.0)
         cov[np.ix_(pos, pos)] += more
         cov[np.ix_(bias, bias)] += more
         cov[np.ix_(pos, bias)] -= more

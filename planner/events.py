@@ -26,9 +26,17 @@ bumper f, its axles); tracks are in the map frame. Each tick
   it along the route whose centre is inside the lane kept widened by ``lane_margin`` on each
   side, now or ``look_ahead`` ahead at its velocity, or crosses the lane's centre line in
   between; the car stops ``crossing_stop`` before the crosswalk and waits until it is clear.
+  The car's station is known only to its pose estimate's 1-sigma (``station_sigma``: a
+  consumer receiver's bias along the route, which the camera's lane does not correct, 1.2 m
+  1-sigma): the tracks are placed on the map with the same error, so a pedestrian on the
+  crosswalk may appear up to ``station_sigmas`` x that before or beyond it. Along the route
+  the crosswalk's reach is widened by that much on each side, and the car stops that much
+  before it in its estimate (at least ``crossing_stop``), so that where it truly stands is
+  still the law's margin before the crosswalk.
 - a pedestrian waiting (`EventMonitor.waiting`, no event: the speed plan's lower crossing
   speed, `planner.speed_planning`): a crosswalk ahead of the front bumper with a pedestrian
-  track on it or within ``crossing_margin`` of it along the route, and across no farther
+  track on it or within ``crossing_margin`` of it along the route (widened by the station's
+  uncertainty as above), and across no farther
   than ``waiting_reach`` beyond the lane kept's edges (at the kerb, or crossing the other
   lanes): it may step into the lane, and its track shows a walk only some 0.9 s after the
   first step.
@@ -72,6 +80,10 @@ class EventParams:
     lane_margin: float = 1.5  # [m] across, a pedestrian this far beyond the lane's edges counts
     look_ahead: float = 2.0  # [s] a pedestrian walking into the lane within this counts
     crossing_stop: float = 1.0  # [m] stop this much (+ the law's margin) before a crosswalk
+    station_sigmas: float = 2.5  # [-] a crosswalk's reach along the route is widened, and its
+    #   stop is at least, this many 1-sigmas of the car's station (one-sided 99.4 %): under
+    #   a consumer receiver (1.2 m 1-sigma) the estimate may be 2.4 m off along the route,
+    #   and a pedestrian on the crosswalk's near edge then appears 1.2 m short of it
     waiting_reach: float = 6.0  # [m] across, a pedestrian at a crosswalk this far beyond the
     #   lane's edges waits to cross: from the far kerb of a road of one lane each way (3.5 m
     #   lanes, 2 m shoulders: 5.5 m) it walks into the lane in under 3 s at 8 km/h
@@ -139,13 +151,15 @@ class EventMonitor:
 
     def update(self, t: float, station: float, v: float, lane_offset: float, lane_width: float,
                tracks: Sequence[Track] = (), flat: bool = False,
-               pulled_over: bool = False, limit_station: float | None = None) -> Events:
+               pulled_over: bool = False, limit_station: float | None = None,
+               station_sigma: float = 0.0) -> Events:
         """The events at time `t` [s] for the car's centre at `station` [m] with speed `v`
         [m/s]; `lane_offset` [m] of the lane kept's centre from the reference line there
         (left +) and its `lane_width` [m]; `tracks` the confirmed tracks (map frame); `flat`
         a flat tyre detected, `pulled_over` the car on the shoulder; `limit_station` [m]
         where the speed plan reads the posted limit (its front bumper; by default `station`
-        + the front overhang)."""
+        + the front overhang); `station_sigma` [m] the 1-sigma of `station` (the pose
+        estimate's, `perception.messages.EgoState.position_sigma`)."""
         p = self.params
         front = station + self.vehicle.front_overhang
         self._station = station
@@ -154,7 +168,8 @@ class EventMonitor:
         stop = self._stop_sign(t, front, v, approach,
                                lambda: queued(self.road, station, front, lane_offset, lane_width,
                                               tracks))
-        crossing = self._crossing(front, approach, lane_offset, lane_width, tracks)
+        crossing = self._crossing(front, approach, lane_offset, lane_width, tracks,
+                                  p.station_sigmas * station_sigma)
         bump = self._bump(station, approach)
         zone = self.road.cross_section_at(limit_station).zone
         happening = {AccEvent.OFF_RAMP: zone is Zone.RAMP, AccEvent.STOP_SIGN: stop is not None,
@@ -191,9 +206,13 @@ class EventMonitor:
         return line - front - p.stop_margin
 
     def _crossing(self, front: float, approach: float, lane_offset: float, lane_width: float,
-                  tracks: Sequence[Track]) -> float | None:
+                  tracks: Sequence[Track], slack: float) -> float | None:
+        """[m] from the front bumper to where the car must stand for a pedestrian at the next
+        crosswalk, or None (module doc); `slack` [m] how far off along the route the car's
+        station (and the tracks placed with it) may be."""
         p = self.params
-        cw = next((c for c in self.crosswalks if front < c.s and c.s - front <= approach), None)
+        cw = next((c for c in self.crosswalks
+                   if front < c.s and c.s - front - slack <= approach), None)
         walkers = [tr for tr in tracks if tr.cls is ObjectClass.PEDESTRIAN]
         if cw is None or not walkers:
             return None
@@ -201,21 +220,23 @@ class EventMonitor:
         ahead = xy + p.look_ahead * np.array([[tr.vx, tr.vy] for tr in walkers])
         s_now, d_now = self.road.local_coordinates(xy)
         _, d_next = self.road.local_coordinates(ahead)
-        on = (s_now >= cw.s - p.crossing_margin) & (s_now <= cw.s + cw.width + p.crossing_margin)
+        reach = p.crossing_margin + slack
+        on = (s_now >= cw.s - reach) & (s_now <= cw.s + cw.width + reach)
         half = 0.5 * lane_width + p.lane_margin
         lateral = np.minimum(np.abs(d_now - lane_offset), np.abs(d_next - lane_offset)) <= half
         crossing_between = np.sign(d_now - lane_offset) != np.sign(d_next - lane_offset)
         if not np.any(on & (lateral | crossing_between)):
             return None
-        return cw.s - front - p.crossing_stop
+        return cw.s - front - max(p.crossing_stop, slack)
 
     def waiting(self, station: float, lane_offset: float, lane_width: float,
-                tracks: Sequence[Track]) -> frozenset[float]:
+                tracks: Sequence[Track], station_sigma: float = 0.0) -> frozenset[float]:
         """The stations [m] of the crosswalks ahead of the front bumper of a car whose centre
         is at `station` [m] where a pedestrian track waits (module doc): on the crosswalk or
         within ``crossing_margin`` of it along the route, and across within ``waiting_reach``
         of the edges of the lane kept (centre `lane_offset` [m] from the reference line, left
-        +, `lane_width` [m]); `tracks` in the map frame."""
+        +, `lane_width` [m]); `tracks` in the map frame; `station_sigma` [m] the 1-sigma of
+        `station` (`update`)."""
         p = self.params
         front = station + self.vehicle.front_overhang
         ahead = [c for c in self.crosswalks if front < c.s]
@@ -225,9 +246,9 @@ class EventMonitor:
         s_now, d_now = self.road.local_coordinates(np.array([[tr.x, tr.y] for tr in walkers]))
         near = np.abs(np.asarray(d_now) - lane_offset) <= 0.5 * lane_width + p.waiting_reach
         s_near = np.asarray(s_now)[near]
+        reach = p.crossing_margin + p.station_sigmas * station_sigma
         return frozenset(c.s for c in ahead
-                         if np.any((s_near >= c.s - p.crossing_margin)
-                                   & (s_near <= c.s + c.width + p.crossing_margin)))
+                         if np.any((s_near >= c.s - reach) & (s_near <= c.s + c.width + reach)))
 
     def _bump(self, station: float, approach: float) -> tuple[float, float] | None:
         p = self.params

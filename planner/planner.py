@@ -237,7 +237,8 @@ class Planner:
         engaged = inp.engaged and not self.inputs.overridden
         station, lateral = self.localise(ego)
         self._waiting = self.events.waiting(station, float(self.lane.offset_at(station)),
-                                            float(self.lane.width_at(station)), tracks)
+                                            float(self.lane.width_at(station)), tracks,
+                                            ego.position_sigma)
         target = self.speed_for(station)
         want = min(self.inputs.set_speed, target.limit_at_front)
         manoeuvre, motion_changes = self.motion.update(ego, want, tracks,
@@ -271,7 +272,8 @@ class Planner:
                                     float(self.lane.width_at(station)), tracks, inp.flat_tyre,
                                     pulled_over=manoeuvre.lane == SHOULDER
                                     and manoeuvre.path is None,
-                                    limit_station=self.speed_planner.front_station(station))
+                                    limit_station=self.speed_planner.front_station(station),
+                                    station_sigma=ego.position_sigma)
         junction = self.junctions.update(ego.t, station, ego.speed, tracks,
                                          (float(self.lane.offset_at(station)),
                                           float(self.lane.width_at(station))))

@@ -117,6 +117,18 @@ def test_a_bias_beyond_half_a_lane_matches_the_start_lane() -> None:
     assert float(np.max(np.abs(err[t >= 2.0]))) < 0.15
 
 
+@pytest.mark.parametrize("bias", [(0.78, -4.56), (0.0, 4.0)])
+def test_an_unstated_bias_of_more_than_a_lane_is_taken_out_at_the_first_frame(
+        bias: tuple[float, float]) -> None:
+    """A degraded receiver stating 0.71 m but 4.6 m off across the lane (beyond the gate of
+    the bias's 1 m floor): the first frame is matched with the start lane all the same, and
+    the estimate is in the car's lane from then on (gated, it stayed 4.6 m off for 3 s and
+    the car steered out of its lane to bring it into the lane)."""
+    loc, t, err = drive(ROAD, 10.0, bias, stated=0.71, noise=0.34)
+    assert loc.matched
+    assert float(np.max(np.abs(err[t >= 0.5]))) < 0.15
+
+
 def test_a_wrong_lane_reading_is_gated_out() -> None:
     """Once matched, a reading that puts the car 1.6 m off the estimate (no lane has its
     centre there) is rejected and changes nothing; one of the lane next to it that agrees

@@ -193,3 +193,27 @@ def test_a_pedestrian_waits_at_a_crossing_ahead_from_the_kerb_or_the_far_side() 
         == frozenset({400.0})  # just past its far edge, within the margin
     assert m.waiting(397.7, 0.0, W, (kerb,)) == frozenset()  # the front bumper on it
     assert m.waiting(370.0, 0.0, W, ()) == frozenset()
+
+
+def test_a_pedestrian_at_the_crossing_counts_within_the_stations_uncertainty() -> None:
+    """The car's station is off by up to `station_sigmas` x its 1-sigma along the route, and
+    the tracks placed with it by as much: a walker truly on the crosswalk's near edge (400.2
+    m) stepping into the lane appears 2.4 m short of it under a consumer receiver (1.2 m
+    1-sigma, the car 2.4 m further on than it believes). That walker counts, and the car
+    stops 2.5 x 1.2 m before the crosswalk in its estimate (not `crossing_stop`), so that
+    where it truly stands is still before the crosswalk."""
+    m = EventMonitor(ROAD, VEHICLE, P)
+    seen = walker(400.2 - 2.4, -4.5, vy=1.2)
+    sure = m.update(0.0, 370.0, 8.0, 0.0, W, (seen,))
+    assert not sure.holds(PEDESTRIAN)  # the station taken as exact: not at the crossing
+    unsure = m.update(0.0, 370.0, 8.0, 0.0, W, (seen,), station_sigma=1.2)
+    assert unsure.holds(PEDESTRIAN)
+    slack = P.station_sigmas * 1.2
+    assert slack > P.crossing_stop
+    assert unsure.stop_distance == pytest.approx(400.0 - 372.4 - slack)
+    truly = 370.0 + 2.4 + VEHICLE.front_overhang + unsure.stop_distance  # [m] front bumper
+    assert truly < 400.0  # truly before the crosswalk
+    far = walker(400.0 - P.crossing_margin - slack - 0.01, -4.5, vy=1.2)  # beyond the slack
+    assert not m.update(0.0, 370.0, 8.0, 0.0, W, (far,), station_sigma=1.2).holds(PEDESTRIAN)
+    assert m.waiting(370.0, 0.0, W, (seen,)) == frozenset()
+    assert m.waiting(370.0, 0.0, W, (seen,), station_sigma=1.2) == frozenset({400.0})
