@@ -338,6 +338,9 @@ class Runner:
                 self._record_static()
         steps = round(self.scenario.duration * PHYSICS_RATE)
         done_at: float | None = None
+        if self.director is not None:
+            with self.watch("runner"):
+                self.director.step(self._touching)  # the storyboard's first check, t = 0
         while w.clock.step < steps:
             if self._interrupted:
                 self._stopped = True
