@@ -340,7 +340,7 @@ class Runner:
         done_at: float | None = None
         if self.director is not None:
             with self.watch("runner"):
-                self.director.step(self._touching)  # the storyboard's first check, t = 0
+                self.director.step()  # the storyboard's first check, t = 0
         while w.clock.step < steps:
             if self._interrupted:
                 self._stopped = True
@@ -399,7 +399,7 @@ class Runner:
                 w.step()
             if self.director is not None and TRIGGER_RATE.fires(w.clock.step):
                 with watch("runner"):
-                    self.director.step(self._touching)
+                    self.director.step()
             if w.clock.step % CONTACT_RATE.every == 0:
                 with watch("criteria"):
                     self._watch(w.clock.step)
