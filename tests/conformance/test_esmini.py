@@ -60,8 +60,8 @@ CCRB = ("NCAP CCRb's GVT: its braking starts one check after esmini's (the place
         "the LongitudinalDistanceAction ends at the next check, esmini's at once), and its "
         "path is 1.3 to 3.1 m RMS off esmini's; cause of the rest not yet found")
 ASAM_12_PATHS = ("ASAM 1.2 EndofTrafficJamNeighboringLaneOccupied: its events start as "
-                 "esmini's, but an entity's path is still beyond 0.2 m RMS from esmini's "
-                 "(its lane offsets are 2.0 m, the 1.3 file's 0.5 m); cause not yet found")
+                 "esmini's, but A1 is 2.4 m RMS from esmini's path (its lane offsets are "
+                 "2.0 m, the 1.3 file's 0.5 m); cause not yet found")
 KNOWN = {
     **{(output, "paths"): SYNC_START for output in CCFHOL},
     **{(output, check): CYCLIST for check in ("events", "paths") for output in (
