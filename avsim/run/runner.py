@@ -338,6 +338,9 @@ class Runner:
                 self._record_static()
         steps = round(self.scenario.duration * PHYSICS_RATE)
         done_at: float | None = None
+        if self.director is not None:
+            with self.watch("runner"):
+                self.director.step()  # the storyboard's first check, t = 0
         while w.clock.step < steps:
             if self._interrupted:
                 self._stopped = True
@@ -396,7 +399,7 @@ class Runner:
                 w.step()
             if self.director is not None and TRIGGER_RATE.fires(w.clock.step):
                 with watch("runner"):
-                    self.director.step(self._touching)
+                    self.director.step()
             if w.clock.step % CONTACT_RATE.every == 0:
                 with watch("criteria"):
                     self._watch(w.clock.step)

@@ -136,10 +136,10 @@ def play(run: RefRun) -> Played:
     director = runner.director
     assert director is not None
     snaps: list[Snapshot] = []
-    take: Callable[[frozenset[int]], Snapshot] = director.truth.snapshot
+    take: Callable[[], Snapshot] = director.truth.snapshot
 
-    def keep(touching: frozenset[int]) -> Snapshot:
-        snap = take(touching)
+    def keep() -> Snapshot:
+        snap = take()
         snaps.append(snap)
         return snap
 

@@ -225,11 +225,15 @@ def _offroad(c: OffroadCondition, e: EntityState, _snap: Snapshot,
 
 def _collision(c: CollisionCondition, e: EntityState, snap: Snapshot,
                _ctx: ConditionContext) -> bool:
-    """Touching the named entity, or any entity of the category `by_type`."""
-    others = {n for pair in snap.contacts if e.name in pair for n in pair if n != e.name}
+    """The entity's bounding box overlaps (or touches) the named entity's, or that of any
+    other entity of the category `by_type`: the boxes in the map's plane (the standard's
+    collision between bounding boxes, as esmini judges it), not the physics bodies' contacts."""
     if c.entity is not None:
-        return c.entity in others
-    return any(snap.categories.get(n) == c.by_type for n in others)
+        others = [snap.entities[c.entity]] if c.entity in snap.entities else []
+    else:
+        others = [o for n, o in snap.entities.items()
+                  if n != e.name and snap.categories.get(n) == c.by_type]
+    return any(g.boxes_meet(e, o) for o in others if o.name != e.name)
 
 
 EntityJudge = Callable[[ConditionKind, EntityState, Snapshot, ConditionContext], bool]

@@ -97,9 +97,9 @@ class Director:
 
     # -- stepping -------------------------------------------------------------------------------
 
-    def step(self, touching: frozenset[int]) -> bool:
+    def step(self) -> bool:
         """One trigger check; True once the storyboard's StopTrigger has fired."""
-        snap = self.truth.snapshot(touching)
+        snap = self.truth.snapshot()
         if self._first:
             self._first = False
             for i, item in enumerate(self.program.init_commands):

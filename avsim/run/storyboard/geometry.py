@@ -5,7 +5,8 @@ freespace subtracts the two boxes' half extents (half length along the route, ha
 across it; a box's extent is taken along its own axes, not projected for its yaw to the
 route), clipped at 0. Cartesian: between the reference points, or (freespace) between the
 two boxes' rectangles in the map frame: 0 when they overlap (separating axes), else the
-smallest distance of a corner of one to an edge of the other.
+smallest distance of a corner of one to an edge of the other. Two boxes meet (a collision)
+when they overlap or touch.
 """
 
 from __future__ import annotations
@@ -53,6 +54,11 @@ def corners(e: EntityState) -> Corners:
     c, s = math.cos(e.heading), math.sin(e.heading)
     cx, cy = e.x + e.centre_ahead * c, e.y + e.centre_ahead * s
     return rectangle(cx, cy, e.heading, e.length, e.width)
+
+
+def boxes_meet(a: EntityState, b: EntityState) -> bool:
+    """Whether the two boxes overlap or touch in the map's plane (separating axes)."""
+    return overlap(corners(a), corners(b), touching=True)
 
 
 def _point_segment(p: NDArray[np.float64], q0: NDArray[np.float64],

@@ -41,9 +41,8 @@ class EntityState:
 
 @dataclass(frozen=True, slots=True)
 class Snapshot:
-    """Every entity's true state at one step, and the contacts between bodies."""
+    """Every entity's true state at one step."""
 
     time: float  # [s] simulation time
     entities: Mapping[str, EntityState]  # by entity name
-    contacts: frozenset[frozenset[str]]  # pairs of entity names whose bodies touch now
     categories: Mapping[str, str]  # entity name -> "vehicle" | "pedestrian" | "miscellaneous"

@@ -6,8 +6,8 @@ reference point for the others (and for a scripted car under test, whose box is 
 file's too: `StoryProgram.ego_box`). Route coordinates are projected from those points onto the
 ego's route. Running figures (odometer, time at rest, off the road, beyond the road's ends)
 are integrated between snapshots, and accelerations and yaw rates differenced between
-them (0 at the first). Contacts are the ego's (the NPC bodies are kinematic and
-do not touch each other in the physics).
+them (0 at the first). Collisions are judged on the boxes (`geometry.boxes_meet`), not on
+the physics bodies' contacts.
 """
 
 from __future__ import annotations
@@ -43,8 +43,6 @@ class TruthTracker:
         length, width = program.ego_box or (g.body_length, g.body_width)
         self.lengths = np.concatenate([[length], sizes[:, 0]])
         self.widths = np.concatenate([[width], sizes[:, 1]])
-        self.bodies = {world.ego.body: program.ego} | {
-            world.actors.bodies[i]: name for name, i in program.actors}
         n = len(self.names)
         self.odometer = np.zeros(n)
         self.standing = np.zeros(n)
@@ -54,8 +52,8 @@ class TruthTracker:
         self._speed = np.zeros(n)  # [m/s] at the previous snapshot
         self._yaw = np.zeros(n)  # [rad] at the previous snapshot
 
-    def snapshot(self, touching: frozenset[int]) -> Snapshot:
-        """The truth now; `touching`: the bodies the ego touches."""
+    def snapshot(self) -> Snapshot:
+        """The truth now."""
         w = self.world
         t = w.t
         dt = 0.0 if self._t is None else t - self._t
@@ -84,10 +82,7 @@ class TruthTracker:
                 off_road_for=float(self.off_road[k]), end_of_road_for=float(self.beyond[k]),
                 acceleration=float(acc[k]), yaw_rate=float(yaw_rate[k]))
             for k, name in enumerate(self.names)}
-        ego = self.program.ego
-        contacts = frozenset(frozenset({ego, self.bodies[b]}) for b in touching
-                             if b in self.bodies)
-        return Snapshot(t, entities, contacts, self.categories)
+        return Snapshot(t, entities, self.categories)
 
     def _rates(self, dt: float, speed: np.ndarray,
                yaw: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

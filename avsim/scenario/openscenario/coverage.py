@@ -108,7 +108,6 @@ PARTLY: dict[str, str] = {
                                                       "test; the other controls only "
                                                       "inactive; `BrakeForce` not yet",
     "GlobalAction.EnvironmentAction": "recorded, not rendered; `DomeImage` not yet",
-    "EntityCondition.CollisionCondition": "sees the car under test's contacts",
     "EntityCondition.AngleCondition": "`coordinateSystem` trajectory not yet",
     "EntityObject.Vehicle": "`Trailer` not yet",
 }

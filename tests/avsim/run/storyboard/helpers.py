@@ -50,11 +50,9 @@ def entity(name: str = "Ego", **changes: float | int | None) -> EntityState:
 
 
 def snapshot(*entities: EntityState, t: float = 0.0,
-             contacts: tuple[tuple[str, str], ...] = (),
              categories: Mapping[str, str] | None = None) -> Snapshot:
     cats = categories or {e.name: "vehicle" for e in entities}
-    return Snapshot(t, {e.name: e for e in entities}, frozenset(frozenset(c) for c in contacts),
-                    cats)
+    return Snapshot(t, {e.name: e for e in entities}, cats)
 
 
 def context(parameters: Mapping[str, int | float | bool | str] | None = None,

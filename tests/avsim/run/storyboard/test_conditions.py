@@ -199,7 +199,10 @@ def test_entity_state_kinds() -> None:
 
 
 def test_collision() -> None:
-    snap = snapshot(entity("Ego"), entity("Car"), entity("Ped"), contacts=(("Ego", "Ped"),),
+    """The file's boxes meet (not the bodies' contacts): Ego's box (4 m x 2 m, centre 1.5 m
+    ahead of its reference point) spans x -0.5 to 3.5, y -1 to 1; Ped's box starts at x 3.5
+    (touching), Car's beside it at y 1.1 (0.1 m apart)."""
+    snap = snapshot(entity("Ego"), entity("Car", y=2.1), entity("Ped", x=4.0),
                     categories={"Ego": "vehicle", "Car": "vehicle", "Ped": "pedestrian"})
     assert holds(CollisionCondition("Ped", None), "Ego", snap, CTX)
     assert holds(CollisionCondition("Ego", None), "Ped", snap, CTX)

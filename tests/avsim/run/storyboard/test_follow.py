@@ -27,7 +27,7 @@ def _target(me_s: float, ref_s: float, heading: float, displacement: str) -> flo
     action = LongitudinalDistanceAction("GVT", 10.0, None, True, True, "road", displacement,
                                         None)
     me, ref = _entity("SOV", me_s, heading), _entity("GVT", ref_s, heading)
-    snap = Snapshot(0.0, {"SOV": me, "GVT": ref}, frozenset(), {})
+    snap = Snapshot(0.0, {"SOV": me, "GVT": ref}, {})
     commands = Commands.__new__(Commands)  # `follow` reads only the snapshot
     cmd, _ = commands.follow(Follow("keep", "SOV", action), me, snap, 70.0, PERIOD)
     assert math.isinf(cmd.max_accel) and math.isinf(cmd.max_decel)
