@@ -18,6 +18,16 @@ which the colour test finds, is `STOP_FIELD_WIDTH` across.
    (``close_kernel`` square) mends the one-pixel gaps that the letters or a pole drawn through
    a distant plate leave; then the external contours of the closed mask.
 
+1b. **Split**: a plate in front of a facade of a red-brown in the hue band (a brick's
+   jittered hue falls on either side of ``hue_low_max``) joins it in one blob, too large or
+   of the wrong shape. A blob rejected so (too large, or failing the tests of step 2 with a
+   saturated core and the red fill of a plate) is taken again within its box with only the
+   pixels of saturation ``split_saturation`` and more: the plate's red stays, the facade's
+   duller red goes; the parts are measured as in step 2 (their red fill against that
+   stricter mask). A blob found whole is never split, so a plate seen alone is measured as
+   before; nor one that fails for its colour (red over less than ``min_red_fill`` of it, as a
+   speed-limit sign's ring around its white disc): a plate joined to a facade is all red.
+
 2. **Per blob** (a contour and its filled inside, the "plate"):
 
    - size: the bounding box's smaller side >= ``min_size_px`` and larger side <=
@@ -96,6 +106,8 @@ class StopSignParams:
     min_saturation: int = 100  # [0..255] anti-aliased edge pixels fall below: a true outline
     min_value: int = 60  # [0..255] also the white letters' floor
     close_kernel: int = 3  # [px] square structuring element of the morphological close
+    split_saturation: int = 170  # [0..255] a rejected blob is split again at this floor: a
+    #   plate's red (about 235) standing against a dull red facade (a brick's about 120)
     # -- size, from the intrinsics
     min_range: float = 3.0  # [m] nearest plate looked for (sets the largest blob)
     max_range: float = 50.0  # [m] farthest plate looked for (sets the smallest blob)
@@ -174,18 +186,47 @@ class StopSignDetector:
         return np.asarray(cv2.bitwise_or(low, high), dtype=np.uint8)
 
     def measure(self, rgb: UInt8Array) -> list[BlobMeasure]:
-        """Every red blob of a plausible size in an (H, W, 3) RGB image, measured."""
+        """Every red blob of a plausible size in an (H, W, 3) RGB image, measured; a blob
+        too large, or of a plausible size but rejected with a saturated core, is split
+        again at ``split_saturation`` and its parts measured too (step 1b: not one red over
+        too little of it)."""
+        p = self.params
         hsv = np.asarray(cv2.cvtColor(rgb, cv2.COLOR_RGB2HSV), dtype=np.uint8)
         mask = self.red_mask(hsv)
+        blobs = []
+        for contour, rect in self._contours(mask):
+            if max(rect[2], rect[3]) <= self.max_size_px:
+                blob = self._measure_blob(contour, hsv, mask, rect)
+                blobs.append(blob)
+                if blob.core < p.core_saturation or blob.red_fill < p.min_red_fill or \
+                        self.score(blob) > 0.0:
+                    continue
+            blobs.extend(self._split(hsv, mask, rect))
+        return blobs
+
+    def _contours(self, mask: UInt8Array) -> list[tuple[MatLike, tuple[int, int, int, int]]]:
+        """The external contours of the closed `mask` and their bounding boxes [px] (u0,
+        v0, w, h), those whose box's smaller side reaches ``min_size_px``."""
         closed = cv2.morphologyEx(mask, cv2.MORPH_CLOSE, self._kernel)
         contours, _ = cv2.findContours(closed, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_SIMPLE)
-        blobs = []
+        out = []
         for contour in contours:
             u0, v0, w, h = cv2.boundingRect(contour)
-            if min(w, h) < self.min_size_px or max(w, h) > self.max_size_px:
-                continue
-            blobs.append(self._measure_blob(contour, hsv, mask, (u0, v0, w, h)))
-        return blobs
+            if min(w, h) >= self.min_size_px:
+                out.append((contour, (u0, v0, w, h)))
+        return out
+
+    def _split(self, hsv: UInt8Array, mask: UInt8Array,
+               rect: tuple[int, int, int, int]) -> list[BlobMeasure]:
+        """The blobs of plausible size within box `rect` [px] of `mask` once its pixels
+        below ``split_saturation`` are left out, measured on that stricter mask."""
+        u0, v0, w, h = rect
+        rows, cols = slice(v0, v0 + h), slice(u0, u0 + w)
+        strict = np.zeros_like(mask)
+        saturated = hsv[rows, cols, 1] >= self.params.split_saturation
+        strict[rows, cols] = np.where(saturated, mask[rows, cols], 0)
+        return [self._measure_blob(contour, hsv, strict, r)
+                for contour, r in self._contours(strict) if max(r[2], r[3]) <= self.max_size_px]
 
     def _measure_blob(self, contour: MatLike, hsv: UInt8Array, mask: UInt8Array,
                       rect: tuple[int, int, int, int]) -> BlobMeasure:

@@ -34,7 +34,13 @@ the line:
   track (on the far arm, in the lanes heading towards the car, up to ``oncoming_reach``
   beyond the box) that will reach the box within ``gap_time`` at its speed towards it, or
   is within ``near_box`` of it whatever its speed (e.g. at its own stop line, about to go
-  when the light turns green, as the car's does), or for any vehicle track in the box
+  when the light turns green, as the car's does); at a stop-sign junction, only for one
+  that can no longer stop at its own line (moving towards the box with
+  v^2 > 2 commit_decel d, d from its front bumper, its centre less half its length, to
+  the line): one standing at its line, or still able to stop there, must stop and take its
+  turn in the order of arrival (below), which decides between it and the car (waiting for
+  it as for a gap, the car would wait for a car that itself waits for the car, first to
+  stop); or for any vehicle track in the box
   (inside it, or past its own stop line and moving towards the centre: on its way in)
   that is not moving the car's way;
 - at a stop-sign junction, also going straight or turning right: for a vehicle track in
@@ -344,14 +350,35 @@ class JunctionMonitor:
             bool(np.any(self._in_box(j, self._line_out[k], xy, vel)))
 
     def _must_wait(self, k: int, tracks: Sequence[Track]) -> bool:
+        """Whether a vehicle in junction `k`'s box, or an oncoming one before a left turn
+        or U-turn, keeps the car at its line (module doc, giving way)."""
         j = self.road.junctions[k]
         xy, vel = _vehicles(tracks)
         if not len(xy) or not self._box_rules(j):
             return False
         wait = bool(np.any(self._in_box(j, self._line_out[k], xy, vel)))
         if j.manoeuvre in (Manoeuvre.LEFT, Manoeuvre.U_TURN):
-            wait = wait or bool(np.any(self._oncoming_soon(j, xy, vel)))
+            soon = self._oncoming_soon(j, xy, vel)
+            if j.control is Control.STOP_SIGNS:
+                soon &= self._runs_its_line(j, self._line_out[k], xy, vel,
+                                            _half_lengths(tracks))
+            wait = wait or bool(np.any(soon))
         return wait
+
+    def _runs_its_line(self, j: Junction, line_out: float, xy: np.ndarray, vel: np.ndarray,
+                       half_length: np.ndarray) -> np.ndarray:
+        """The oncoming tracks (on the far arm) that can no longer stop at their own stop
+        line, `line_out` [m] from the centre, at ``commit_decel``: moving towards the box
+        faster than v = sqrt(2 commit_decel d), d [m] from the front bumper (the centre less
+        `half_length` [m]) to the line (0 once over it). The others stop there and go in
+        the order of arrival."""
+        p = self.params
+        along, _, v_along, _ = self._frame(j, xy, vel)
+        towards = -v_along  # [m/s]
+        room = np.maximum(along - half_length - line_out, 0.0)  # [m] front to its line
+        out: np.ndarray = (towards > p.moving) & \
+            (towards * towards > 2.0 * p.commit_decel * room)
+        return out
 
     def _frame(self, j: Junction, xy: np.ndarray,
                vel: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -440,6 +467,12 @@ def _vehicles(tracks: Sequence[Track]) -> tuple[np.ndarray, np.ndarray]:
     vehicles = [tr for tr in tracks if tr.cls in (ObjectClass.CAR, ObjectClass.TRUCK)]
     return (np.array([[tr.x, tr.y] for tr in vehicles]).reshape(-1, 2),
             np.array([[tr.vx, tr.vy] for tr in vehicles]).reshape(-1, 2))
+
+
+def _half_lengths(tracks: Sequence[Track]) -> np.ndarray:
+    """[m] (N,) half the length of the vehicle tracks, in `_vehicles`' order."""
+    return np.array([0.5 * tr.length for tr in tracks
+                     if tr.cls in (ObjectClass.CAR, ObjectClass.TRUCK)], dtype=float)
 
 
 def waits_at_line(j: Junction, line_out: float, tr: Track, p: JunctionParams) -> bool:

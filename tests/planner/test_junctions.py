@@ -395,3 +395,38 @@ def test_going_straight_on_green_the_car_waits_for_a_car_turning_across(
     out = m.update(0.0, front_at(m, 0.6), 0.0, [turning])
     assert out.holds(GIVE_WAY) is gives_way
     assert not m.update(0.1, front_at(m, 0.6), 0.0, []).holds(GIVE_WAY)
+
+
+@pytest.mark.parametrize(
+    ("back", "speed", "waits"),
+    [
+        (2.9, 0.0, False),  # stands at its line, arrived after the car: the car's turn
+        (20.0, 8.0, False),  # 2.8 s from the box, but it can stop at its line (1.8 m/s^2)
+        (3.0, 8.0, True),  # 3.6 m from its line at 8 m/s (8.9 m/s^2): it will not stop
+        (-3.0, 3.0, True),  # over its line, coming in: the box's rule
+    ],
+)
+def test_a_left_turn_at_an_all_way_stop_waits_only_for_an_oncoming_car_that_will_not_stop(
+        back: float, speed: float, waits: bool) -> None:
+    """town_0020's wait of 20 s: the car stood first at its line to turn left; the
+    oncoming car came and stood at its own line after it, waiting for the car's turn, and
+    the car waited for it as for a gap (standing near the box). At an all-way stop an
+    oncoming car that stops at its line takes its turn in the order of arrival."""
+    m = JunctionMonitor(route(STOPS, Manoeuvre.LEFT), VEHICLE, P)
+    assert not at_stop(m, 0.0, [])  # the car stands at its line from 0 s: it arrived
+    far = at_arm("east", 7, back=60.0, moving=8.0)  # 7.9 s from the box: not soon
+    assert not at_stop(m, 2.0, [far])
+    there = at_arm("east", 7, back=back, moving=speed)
+    assert at_stop(m, 3.0, [there]) is waits
+    assert at_stop(m, 3.0 + P.gap_confirm, [there]) is waits
+
+
+def test_a_left_turn_at_an_all_way_stop_waits_for_an_oncoming_car_that_stood_first() -> None:
+    m = JunctionMonitor(route(STOPS, Manoeuvre.LEFT), VEHICLE, P)
+    m.update(0.0, front_at(m, 20.0), 5.0, [at_arm("east", 7, back=30.0, moving=5.0)])
+    first = at_arm("east", 7)
+    m.update(1.0, front_at(m, 6.0), 2.0, [first])  # stands at its line before the car
+    assert at_stop(m, 3.0, [first])  # the car stands 2 s after it: it goes first
+    assert at_stop(m, 5.0, [first])
+    assert at_stop(m, 6.0, [])  # it has gone: the car's turn, once the gap is confirmed
+    assert not at_stop(m, 6.0 + P.gap_confirm, [])

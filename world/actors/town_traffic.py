@@ -17,8 +17,12 @@ An NPC in a town drives its route road (`world.map.town.compile_route`) at its s
   its front within 1 m of its stop point), which makes it arrive there
   (`world.actors.all_way_stop`: first to stop, first to go, ties to the right; the ego
   arrives too when it stands at its line, `StopZones`); it stands at least
-  ``STOP_DWELL``, then goes on when it is its turn and no other vehicle's centre is inside
-  the junction's box. It leaves the order when its front is over the line. A car queued
+  ``STOP_DWELL``, then goes on when it is its turn and the box is clear: no other vehicle's
+  centre inside the junction's box, nor one on its way in (moving towards the box's centre
+  faster than ``STOP_SPEED``, its front bumper over its own stop line or within
+  ``STOP_ZONE`` before it: one that has just taken its turn and moved off its line, which
+  left the order, but is not in the box yet). It leaves the order when its front is over
+  the line. A car queued
   behind another stops behind it (the vehicle ahead, below), moves up when it leaves,
   and makes its own stop at the line;
 - **turns**: ``v = sqrt(TURN_LATERAL_ACCEL / curvature)`` on a turn's arc, braked for ahead
@@ -86,6 +90,8 @@ class _StopLine:
     s: float  # [m] station of the line on the NPC's route
     light: TrafficLightSpec | None  # its signal plan; None: a stop sign
     junction: Junction | None  # the junction it guards (None: a line without one)
+    line_out: float = 0.0  # [m] the junction's centre to the line (every arm's: the town
+    #   is symmetric)
     stood_since: float | None = None  # [s] when it came to a stop at a stop sign
     passed: bool = False  # the front bumper is over the line
 
@@ -130,7 +136,7 @@ class TownDriver:
         plans = {light.s: light for light in signals}
         self._lines = [
             _StopLine(f.s, plans[f.s] if isinstance(f, TrafficLight) else None,
-                      junctions.get(f.s))
+                      junctions.get(f.s), _line_out(road, f.s, junctions.get(f.s)))
             for f in road.features if isinstance(f, StopSign | TrafficLight)
         ]
         # the turn arcs: (start station, end station, curvature)
@@ -198,7 +204,8 @@ class TownDriver:
             return True
         if j is None:
             return False
-        return not self.order.may_go(j.index, self.key, t) or _box_occupied(j, others.xy)
+        return not self.order.may_go(j.index, self.key, t) or \
+            _box_occupied(j, others, line.line_out)
 
     def _turn_cap(self, s: float) -> float:
         """[m/s] the lowest turn speed ahead, each braked for from its arc's start."""
@@ -316,12 +323,30 @@ def _oncoming(j: Junction, others: Others) -> bool:
                 np.any(coming & in_box))
 
 
-def _box_occupied(j: Junction, others: FloatArray) -> bool:
-    """Whether any centre of `others` (N, 2) [m] is inside `j`'s box (the square where
-    the streets cross)."""
-    if len(others) == 0:
+def _line_out(road: RoadMap, s: float, j: Junction | None) -> float:
+    """[m] from junction `j`'s centre back to the stop line at station `s` of `road`, along
+    its approach (0 without a junction)."""
+    if j is None:
+        return 0.0
+    x, y, _ = road.line.pose_one(s, 0.0)
+    return -((x - j.x) * math.cos(j.heading) + (y - j.y) * math.sin(j.heading))
+
+
+def _box_occupied(j: Junction, others: Others, line_out: float) -> bool:
+    """Whether another vehicle is inside `j`'s box (its centre in the square where the
+    streets cross), or on its way in: moving towards the box's centre faster than
+    STOP_SPEED with its front bumper within `line_out` [m] + STOP_ZONE of the centre along
+    both axes (over its stop line, or within STOP_ZONE before it; every arm's line is
+    `line_out` out)."""
+    if len(others.xy) == 0:
         return False
-    inside = (np.abs(others[:, 0] - j.x) < j.half_width) & \
-        (np.abs(others[:, 1] - j.y) < j.half_width)
-    return bool(inside.any())
+    rel = others.xy - np.array([j.x, j.y])
+    inside = np.all(np.abs(rel) < j.half_width, axis=1)
+    speed = np.hypot(others.velocity[:, 0], others.velocity[:, 1])
+    heading = others.velocity / np.maximum(speed, 1e-9)[:, None]
+    front = rel + others.half_length[:, None] * heading
+    near = np.all(np.abs(front) <= line_out + STOP_ZONE, axis=1)
+    inwards = (rel * others.velocity).sum(axis=1) < 0.0
+    coming = (speed > STOP_SPEED) & inwards & near
+    return bool(np.any(inside | coming))
 

@@ -19,7 +19,7 @@ from world.actors.all_way_stop import AllWayStop
 from world.actors.town_traffic import FOLLOW_LANE_HALF, LOOK_AHEAD, Others, TownDriver
 from world.hdmap import LightColour, Manoeuvre
 from world.map.road import build_road_map
-from world.map.signals import route_signals
+from world.map.signals import light_colour, route_signals
 from world.map.town import TownLayout, compile_route
 from world.spec import TownSpec
 from world.world import World
@@ -138,6 +138,33 @@ def test_an_all_way_stop_goes_in_order_of_arrival() -> None:
     assert south.speed_cap(t + 6.0, ss, 0.0, still(centre(west, in_box + 40.0))) > 0.0
 
 
+@pytest.mark.parametrize(("over_line", "speed", "waits"), [
+    (1.0, 2.0, True),  # its front 1 m over its line, moving in: taking its turn
+    (-1.0, 1.0, True),  # pulling off its line (the ego leaves the order at STOP_SPEED)
+    (-1.0, 0.0, False),  # standing there: not coming (it waits its own turn)
+    (1.0, -2.0, False),  # backing away from the box
+])
+def test_an_npc_waits_for_a_car_on_its_way_into_the_box(over_line: float, speed: float,
+                                                         waits: bool) -> None:
+    """town_0020: the car first to stop moved off its line and left the order; the next
+    NPC got the turn and went while that car, not yet in the box, was driving into it."""
+    order = AllWayStop()
+    layout = town("stop_signs")
+    west = driver(layout, (0, 1, "east"), [Manoeuvre.STRAIGHT], "west", order)
+    south = driver(layout, (1, 0, "north"), [Manoeuvre.STRAIGHT], "south", order)
+    ss = at_line(south)
+    nobody = town_traffic.no_others()
+    assert south.speed_cap(0.0, ss, 0.0, nobody) == 0.0  # arrives: the only one, its turn
+    s = west.road.junctions[0].s_stop - HALF + over_line  # [m] west's centre
+    j = south.road.junctions[0]
+    xy = centre(west, s)
+    assert abs(xy[0, 0] - j.x) > j.half_width  # not in the box
+    coming = Others(xy, np.array([[speed, 0.0]]), np.full(1, HALF))  # eastbound
+    t = town_traffic.STOP_DWELL + 0.1
+    assert (south.speed_cap(t, ss, 0.0, coming) == 0.0) is waits
+    assert south.speed_cap(t + 0.1, ss, 0.0, nobody) > 0.0
+
+
 def test_a_queued_car_moves_up_and_stops_at_the_line_itself() -> None:
     """A car queued behind one at the line is held by it, not by the line; when it leaves,
     it moves up, and must stand at the line for its own stop before it may go."""
@@ -187,8 +214,10 @@ def test_a_left_turn_on_green_waits_for_oncoming_traffic(oncoming_at: float, spe
     layout = town("traffic_lights")
     d = driver(layout, (0, 1, "east"), [Manoeuvre.LEFT], "npc", AllWayStop())
     j = d.road.junctions[0]
+    plan = d._lines[0].light
+    assert plan is not None
     green = next(t for t in np.arange(0.0, 40.0, 0.5)
-                 if town_traffic.light_colour(d._lines[0].light, t) is LightColour.GREEN)
+                 if light_colour(plan, t) is LightColour.GREEN)
     # the oncoming lane: left of the approach's axis, heading west towards the box
     x = j.x + j.half_width + oncoming_at if oncoming_at >= 0.0 else j.x + 1.0
     y = j.y + 1.75
