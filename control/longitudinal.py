@@ -32,7 +32,12 @@ Steps of `SpeedController.update`:
    for more than ``comfort_plan`` but no more than ``iso_plan`` (no comfortable stop left,
    but one within ISO's limits) gets ISO's own envelope: floor -``iso_decel``, rise at most
    ``iso_jerk``. A plan asking for more is urgent: the envelope is off and the actuator
-   limits below apply.
+   limits below apply. ISO judges the rise as an average over ``jerk_window`` (1 s): an
+   envelope also keeps the deceleration at most its jerk times ``jerk_window`` above the
+   request ``jerk_window`` ago (holding it, never releasing it, where an urgent rise just
+   before took more): without it, an urgent plan that built 2.5 m/s^2 in 0.25 s and then
+   eased back into ISO's envelope went on rising at its jerk, 2.8 m/s^3 over the second.
+   While the envelope was on throughout the window, the per-step rise already keeps it.
 4. Jerk limit: the request moves by at most ``max_jerk`` dt per step (in a comfortable
    plan, a request at or below 0 falls by at most ``comfort_jerk`` dt, ``iso_jerk`` dt in
    one within ISO's limits: the deceleration
@@ -51,6 +56,7 @@ below ``standstill_speed``. Afterwards the jerk limit takes the request on from 
 
 from __future__ import annotations
 
+from collections import deque
 from dataclasses import dataclass
 
 from control.pid import Pid, PidParams
@@ -96,6 +102,8 @@ class SpeedParams:
     #   3.5 m/s^2)
     iso_jerk: float = 2.4  # [m/s^3] in such a plan, the most the deceleration rises per
     #   second (under ISO 15622's 2.5 m/s^3; `planner.limits.J_ISO_PLAN`)
+    jerk_window: float = 1.0  # [s] an envelope's rise, jerk times this at most over this
+    #   span (ISO 15622's average of the rise of deceleration)
 
     @property
     def pid(self) -> PidParams:
@@ -120,6 +128,7 @@ class SpeedController:
         self._accel = 0.0  # [m/s^2] previous request, for the jerk limit
         self._excess = 0.0  # [m/s^2] previous desired minus limited request
         self._pressing = 0.0  # [s] asked to speed up, still below stall_speed (stall test)
+        self._past = RequestWindow(self.params.jerk_window)  # the requests of the window
 
     def reset(self) -> None:
         """Clear the PID and start the jerk limit from 0 m/s^2."""
@@ -127,6 +136,7 @@ class SpeedController:
         self._accel = 0.0
         self._excess = 0.0
         self._pressing = 0.0
+        self._past = RequestWindow(self.params.jerk_window)
 
     def _envelope(self, target_accel: float, hold: bool) -> tuple[float, float] | None:
         """(floor [m/s^2], jerk [m/s^3]) of the comfort envelope for a plan whose
@@ -153,6 +163,7 @@ class SpeedController:
             step = p.emergency_jerk * dt
             accel = max(self._accel - step, target_accel)
             self._accel, self._excess = accel, 0.0
+            self._past.push(dt, accel)
             return SpeedCommand(accel=accel, hold=speed < p.standstill_speed)
         stop_requested = target_speed <= p.stop_target_speed and target_accel <= 0.0
         at_standstill = speed < p.standstill_speed
@@ -172,10 +183,46 @@ class SpeedController:
         max_step = p.max_jerk * dt
         low = self._accel - max_step  # the braking part of a drop, at the envelope's jerk:
         if envelope is not None:
-            low = max(low, min(self._accel, 0.0) - envelope[1] * dt)
+            low = max(low, min(self._accel, 0.0) - envelope[1] * dt,
+                      min(self._accel, min(self._past.start(dt), 0.0)
+                          - envelope[1] * p.jerk_window))
         accel = min(max(clamped, low), self._accel + max_step)
+        self._past.push(dt, accel)
         self._excess = desired - accel
         pressing = accel >= p.stall_rise and speed < p.stall_speed and not hold
         self._pressing = self._pressing + dt if pressing else 0.0
         self._accel = accel
         return SpeedCommand(accel=accel, hold=hold)
+
+
+class RequestWindow:
+    """The requests [m/s^2] of the last `span` [s], one per step, for the envelope's rise
+    over ISO's window: `start` is the request at the window's start."""
+
+    def __init__(self, span: float) -> None:
+        self.span = span  # [s]
+        self._t = 0.0  # [s] since the first step
+        self._steps: deque[tuple[float, float]] = deque([(0.0, 0.0)])  # (time [s], request)
+
+    def start(self, dt: float) -> float:
+        """[m/s^2] the request at the start of the window that ends dt [s] from the last
+        step: the newest at least `span` before then (the first, 0 after a reset, while the
+        window is not yet full)."""
+        self._drop(self._t + dt - self.span)
+        return self._steps[0][1]
+
+    def push(self, dt: float, accel: float) -> None:
+        """Record the request `accel` [m/s^2] of the step dt [s] after the last (keeping
+        only the steps a window from now on reads: at most one per step of the span)."""
+        self._t += dt
+        self._steps.append((self._t, accel))
+        self._drop(self._t - self.span)
+
+    def __len__(self) -> int:
+        return len(self._steps)
+
+    def _drop(self, end: float) -> None:
+        """Drop the steps older than the newest at or before `end` [s]."""
+        steps = self._steps
+        while len(steps) > 1 and steps[1][0] <= end:
+            steps.popleft()

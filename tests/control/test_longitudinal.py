@@ -189,3 +189,43 @@ def test_a_stalled_car_presses_on_until_it_moves() -> None:
     assert _against_a_bump(SpeedParams(), target, 10.0) < 3.0
     # without the stall rule the speed error is beyond the integration band: it stays put
     assert _against_a_bump(replace(SpeedParams(), stall_speed=0.0), target, 10.0) == float("inf")
+
+
+@pytest.mark.parametrize(("plan", "jerk"), [(-3.3, 2.4), (-2.9, 2.0)])
+def test_after_an_urgent_rise_the_envelope_keeps_iso_s_one_second_rise(plan: float,
+                                                                       jerk: float) -> None:
+    """A plan urgent for 0.25 s (feed-forward -5 m/s^2: no envelope, the request's
+    deceleration rises at max_jerk to 2.5 m/s^2), then within ISO's limits or comfortable:
+    over any jerk_window (1 s, ISO's average) the deceleration rises at most the envelope's
+    jerk times the window, or holds where the urgent rise took more, and is never released
+    for it; once the window has passed the urgent rise, it rises at the envelope's jerk
+    again. Without the window it went on rising at the jerk from 2.5 m/s^2: 2.5 + jerk 0.75
+    in the first second."""
+    p = SpeedParams()
+    controller = SpeedController()
+    speed, target = 16.7, 16.7
+    accel = []
+    for k in range(round(3.0 / CONTROL_DT)):
+        t = k * CONTROL_DT
+        target -= 5.0 * CONTROL_DT
+        a_ff = -5.0 if t < 0.25 - 1e-9 else plan
+        accel.append(controller.update(target, a_ff, speed, CONTROL_DT).accel)
+    braking = np.maximum(-np.array(accel), 0.0)
+    window = 1.0  # [s] ISO 15622's average of the rise
+    span = round(window / CONTROL_DT)
+    urgent = round(0.25 / CONTROL_DT)
+    assert braking[urgent - 1] == pytest.approx(10 * p.max_jerk * CONTROL_DT)  # 2.5 m/s^2
+    assert np.all(np.diff(braking[urgent - 1:span]) >= -1e-12)  # held, not released
+    rises = braking[span:] - braking[:-span]
+    assert rises.max() <= max(jerk * window, braking[urgent - 1]) + 1e-9
+    assert np.all(braking[urgent:span] <= braking[urgent - 1] + 1e-12)
+    assert braking[span + 4] - braking[span + 3] == pytest.approx(jerk * CONTROL_DT)
+
+
+def test_the_request_window_keeps_one_span_of_steps() -> None:
+    """The window keeps the steps one span back and no more, however long the run (a car
+    holding at a stop for minutes)."""
+    controller = SpeedController()
+    for _ in range(round(600.0 / CONTROL_DT)):
+        controller.update(0.0, 0.0, 0.0, CONTROL_DT)
+    assert len(controller._past) <= round(SpeedParams().jerk_window / CONTROL_DT) + 2
