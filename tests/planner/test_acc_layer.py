@@ -76,17 +76,19 @@ def test_lead_brakes_to_a_stop_waits_and_drives_off() -> None:
     assert v[-1] == pytest.approx(12.0, abs=0.1)
 
 
-def test_cut_in_close_ahead_brakes_comfortably_then_recovers() -> None:
-    """A car 20 km/h slower appears 15 m ahead (inside d_min): BRAKE plans the comfortable
-    stop of the closing (a comfortable stop is left: 1.7 m/s^2 would stop it 2.5 m short
-    after the ramp-in that the speed loop's comfort jerk gives), and the gap is back above
+def test_cut_in_close_ahead_brakes_at_once_then_recovers() -> None:
+    """A car 20 km/h slower appears 15 m ahead (inside d_min, and inside d_min at its own
+    speed): BRAKE ends the closing at once at up to a_hard (the d_min guard,
+    `planner.acc_control.restore_decel`: no room is left to end it above d_min), not at
+    the comfortable stop of the closing 2.5 m short of the lead, and the gap is back above
     d_min."""
     v0 = 60 / 3.6
     run = drive([v0 - 20 / 3.6] * 1200, v0=v0, gap0=15.0, set_speed=v0)
     assert run["modes"][0] == "brake"  # engaged with it inside d_min: braking at once
     decel = -run["a"]
-    assert float(decel.max()) <= 3.0 + 1e-9  # within comfort (planner.limits.A_COMF_MAX)
-    assert float(run["gap"].min()) > 4.0  # the closing stopped short of the floor
+    assert float(decel[0]) == pytest.approx(5.0)  # at once (planner.limits.A_HARD)
+    assert float(decel.max()) <= 5.0 + 1e-9
+    assert float(run["gap"].min()) > 11.0  # the closing ended near where it was found
     late = run["t"] > 10.0
     v, gap = run["v"][late], run["gap"][late]
     assert np.all(gap >= np.array([r157_min_gap(x) for x in v]) - 0.5)
@@ -109,3 +111,47 @@ def test_a_lead_lost_for_a_moment_is_not_sped_up_into() -> None:
     for k in range(41, 41 + round(1.5 / DT)):  # past lead_hold: the plan again
         out, _ = acc.update(k * DT, DT, v, set_speed, 30.0, plan, None)
     assert out.speed.ref.speed == set_speed
+
+
+def envelope_jerk(accel: float) -> float:
+    """[m/s^3] the most the speed loop's deceleration rises on a plan whose feed-forward is
+    `accel` [m/s^2] (`control.longitudinal`: comfort, ISO's, none but the request's)."""
+    if accel >= -3.0:
+        return 2.0
+    return 2.4 if accel >= -3.45 else 10.0
+
+
+def drive_jerk_limited(lead_speed: float, v0: float, gap0: float, set_speed: float,
+                       ticks: int) -> dict[str, np.ndarray]:
+    """`drive` behind a lead at a constant speed, with the speed loop's deceleration rising
+    at most at the envelope's jerk (`envelope_jerk`)."""
+    acc = AccLayer()
+    v, gap, a = v0, gap0, 0.0
+    out: dict[str, list[float]] = {"v": [], "gap": [], "a": []}
+    for k in range(ticks):
+        t = k * DT
+        lead = Lead(track_id=1, t=t - 0.1, gap=gap - (lead_speed - v) * 0.1, speed=lead_speed)
+        plan = PlannedSpeed(SpeedRef(set_speed, 0.0), SpeedSource.SET_SPEED)
+        ref = acc.update(t, DT, v, set_speed, 30.0, plan, lead)[0].speed.ref
+        want = float(np.clip(ref.accel + (ref.speed - v - ref.accel * DT) / TAU, -6.0, 3.0))
+        a = max(want, a - envelope_jerk(ref.accel) * DT) if want < a else want
+        v = max(v + a * DT, 0.0)
+        gap += (lead_speed - v) * DT
+        for key, val in (("v", v), ("gap", gap), ("a", a)):
+            out[key].append(val)
+    return {k: np.array(x) for k, x in out.items()}
+
+
+def test_a_slower_lead_first_found_at_d_min_is_answered_at_once() -> None:
+    """A car 30 km/h ahead first tracked at UN R157's d_min (23.3 m) of the ego at 54 km/h
+    (the pedal_override family's start, 50 km/h behind it at 27 m, after the 0.6 s the
+    LiDAR takes to confirm it): the approach to d_des at the comfortable cap, built at the
+    comfort jerk, and then the stop of the closing at d_floor let the gap fall to 7.0 m,
+    6.5 m under d_min. The d_min guard answers at once at a_hard: under d_min by at most
+    1 m (the ramp-in), and back above it."""
+    run = drive_jerk_limited(8.52, v0=15.1, gap0=23.3, set_speed=16.67, ticks=800)
+    margin = run["gap"] - np.array([r157_min_gap(x) for x in run["v"]])
+    assert float(margin.min()) > -1.0
+    assert float(run["gap"].min()) > 16.0
+    assert float(-run["a"].min()) <= 5.0 + 1e-9  # planner.limits.A_HARD
+    assert float(margin[-1]) > 5.0  # following at d_des
