@@ -51,7 +51,18 @@ pedal). `planner.acc_layer` picks the law for the mode.
   car's speed, `planner.fsm.acc.r157_min_gap`), which ends the closing d_keep above d_min;
   d_min falls as the car slows, so the bound is on the safe side. It holds in full within
   d_near (2 m) of d_min and tapers to nothing at d_far (3 m), so following further out is
-  the laws' alone; above v_guard d_des keeps tau_margin v above d_min.
+  the laws' alone. Above v_guard, d_min(v) - d_min(v_l) is large (1 + 2 v / 100 km/h s of
+  speed: 13 m at 55 km/h behind a lead at 30 km/h) and that bound would brake hard for any
+  closing at d_min; there the guard is `restore_decel`: at least ``(v - v_l) / d_min'(v)``,
+  at which the margin d - d_min(v) stops falling (it rises after: the closing falls faster
+  than d_min'(v) does), and at least ``(v - v_l)^2 / (2 (d - d_min(v_l) - d_keep))``, which
+  ends the closing d_keep above d_min at the lead's speed (no room: +inf). Steady following
+  there never meets it (d_des is 3.2 m or more above d_min above v_guard, beyond d_far); a
+  lead first found near or under d_min with a closing speed does (a slower car found 24 m
+  ahead at 55 km/h, 30 km/h slower: the comfortable plan to d_des and, inside d_des, the stop
+  of the closing at d_floor let the gap fall to 7 m, d_min being 16 m). What the guard asks
+  is `need` too for the approach's cap (`follow`): over a_comf_max it is planned within
+  ISO's limits, and over a_iso_max at a_hard, with the speed loop's comfort envelope off.
 - The approach (`approach`, every law behind a lead and every stop or pass point; ISO 15622
   / ISO 22179 comfort: at most 3.5 m/s^2 over 2 s, its rise at most 2.5 m/s^3 over 1 s). A
   speed law's reference below the car's speed would make the speed loop brake at ``(v -
@@ -129,11 +140,21 @@ allows. FLAT's ramp starts from the plan's speed and then falls without looking 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from planner.fsm.acc import r157_min_gap
-from planner.limits import A_COMF, A_COMF_MAX, A_FLAT, A_HARD, A_ISO_MAX, A_ISO_PLAN, J_COMF
+from planner.limits import (
+    A_COMF,
+    A_COMF_MAX,
+    A_FLAT,
+    A_HARD,
+    A_ISO_MAX,
+    A_ISO_PLAN,
+    J_COMF,
+    J_ISO_PLAN,
+)
 from planner.speed import SpeedRef
+from world.frames import to_kph
 
 
 @dataclass(frozen=True, slots=True)
@@ -150,6 +171,8 @@ class AccControlParams:
     #   reaction to it is no harder than this (a lead slowing down is followed as it slows)
     tau_loop: float = 0.8  # [s] the speed loop's time constant (`control.longitudinal`):
     #   it brakes at (v - v_ref) / tau_loop on a reference below the speed
+    j_iso: float = J_ISO_PLAN  # [m/s^3] the speed loop builds a plan within ISO's limits at
+    #   this (`restore_decel`: the ramp-in that costs)
     j_comf: float = J_COMF  # [m/s^3] the speed loop eases a comfortable plan in at this
     #   (`control.longitudinal`: comfort_jerk): the ramp-in `need` allows for
     d_floor: float = 2.5  # [m] `need` stops the closing this far behind the lead (UN R157
@@ -169,9 +192,13 @@ class AccControlParams:
     track_lag: float = 0.4  # [s] a lead's track speed lags its true speed by about this
     #   while it brakes (`perception.tracking`'s constant-velocity filter: 1.7 m/s behind a
     #   car braking at 4 m/s^2, measured; `lead_speed_now`)
-    v_guard: float = 10.0  # [m/s] `guard_decel` holds up to this speed (above it d_des's own
-    #   margin over d_min, tau_margin v, holds the gap)
+    v_guard: float = 10.0  # [m/s] up to this speed `guard_decel` ends the closing above
+    #   d_min at the car's speed now; above it, above d_min at the lead's (`restore_decel`)
     d_keep: float = 0.75  # [m] `guard_decel` ends the closing this far above d_min
+    d_lose: float = 1.0  # [m] `restore_decel` holds d_min at up to a_hard until the gap is
+    #   this far under d_min + d_keep (a hard braking's ramp-in may lose that much) ...
+    f_under: float = 0.5  # [-] ... further under, `restore_decel` ends the closing this
+    #   fraction of d_min at the lead's speed behind it
     d_near: float = 2.0  # [m] `guard_decel` holds in full within this of d_min ...
     d_far: float = 3.0  # [m] ... tapering to nothing this far above it
 
@@ -229,19 +256,61 @@ def guard_decel(v: float, v_l: float, d: float, a_lead: float, p: AccControlPara
     """[m/s^2] >= 0: the constant deceleration that ends the closing speed v - v_l [m/s] on
     a lead braking at `lead_braking(a_lead)` before the gap d [m] falls to UN R157's d_min
     at the car's speed now plus d_keep (d_min falls as the car slows: the bound is on the
-    safe side), ``b + (v - v_l)^2 / (2 (d - d_min(v) - d_keep))``, +inf with no room; in
-    full within d_near of d_min, tapering linearly to 0 at d_far above it; 0 when not
-    closing or faster than v_guard (module doc)."""
+    safe side), ``b + (v - v_l)^2 / (2 (d - d_min(v) - d_keep))``, +inf with no room;
+    faster than v_guard, ``b + restore_decel``; in full within d_near of d_min, tapering
+    linearly to 0 at d_far above it; 0 when not closing (module doc)."""
     closing = v - max(v_l, 0.0)
-    if closing <= 0.0 or v > p.v_guard:
+    if closing <= 0.0:
         return 0.0
     above = d - r157_min_gap(v)
     weight = min(max((p.d_far - above) / (p.d_far - p.d_near), 0.0), 1.0)
-    room = above - p.d_keep
     if weight <= 0.0:
         return 0.0
     b = lead_braking(a_lead, p)
+    if v > p.v_guard:
+        return weight * (b + restore_decel(v, v_l, d, p))
+    room = above - p.d_keep
     return weight * (b + closing * closing / (2.0 * room)) if room > 0.0 else math.inf
+
+
+def d_min_slope(v: float) -> float:
+    """[s] d(d_min)/dv, UN R157's d_min (`planner.fsm.acc.r157_min_gap`) at ego speed v
+    [m/s]: 1 + 2 v / (100 km/h) where its time gap grows with the speed (above 10 km/h),
+    else the constant time gap 1.1 s (d_min's floor of 2 m: 0)."""
+    if r157_min_gap(v) <= 2.0:
+        return 0.0
+    kph = to_kph(v)
+    return 1.0 + 2.0 * kph / 100.0 if kph > 10.0 else 1.1
+
+
+def restore_decel(v: float, v_l: float, d: float, p: AccControlParams) -> float:
+    """[m/s^2] >= 0: the deceleration that holds the margin d - d_min(v) [m] to UN R157's
+    d_min at the car's speed v [m/s] from falling while it closes on a lead at v_l [m/s],
+    ``(v - v_l) / d_min'(v)`` (at a constant deceleration the margin is convex in time: it
+    rises from there on), and that ends the closing d_keep above d_min at the lead's speed,
+    ``(v - v_l)^2 / (2 (d - d_min(v_l) - d_keep))`` (+inf with no room); +inf where the
+    ramp-in to the first at j_iso, which loses about (v - v_l) T / 2 of the margin (T the
+    ramp's time), leaves less than d_keep of it (answered at a_hard, `follow`); 0 when not
+    closing. More than d_lose under d_min + d_keep already (a cut-in close ahead) no margin
+    is left to keep (UN R157 gives a cut-in time to restore d_min): the closing is ended at
+    a constant deceleration, after the
+    ramp-in at j_iso, f_under d_min(v_l) (at least d_floor) behind the lead, a buffer over
+    `need`'s d_floor that the lead's speed alone sets (so the plan holds as the car
+    brakes); +inf (a_hard) if that is beyond a_iso_max."""
+    closing = v - max(v_l, 0.0)
+    if closing <= 0.0:
+        return 0.0
+    slope = d_min_slope(v)
+    hold = closing / slope if slope > 0.0 else 0.0
+    margin = d - r157_min_gap(v) - p.d_keep
+    if margin < -p.d_lose:  # well under d_min already (doc)
+        target = max(p.f_under * r157_min_gap(max(v_l, 0.0)), p.d_floor)
+        end = ramped(closing, 0.0, d - target, 0.0, replace(p, j_comf=p.j_iso))
+        return math.inf if end > p.a_iso_max else end
+    if closing * hold / (2.0 * p.j_iso) > margin:
+        return math.inf  # the ramp-in to `hold` at ISO's jerk would take the margin
+    room = d - r157_min_gap(max(v_l, 0.0)) - p.d_keep
+    return max(hold, closing * closing / (2.0 * room) if room > 0.0 else math.inf)
 
 
 def stop_speed(distance: float, v_plan: float, p: AccControlParams) -> float:
@@ -335,8 +404,9 @@ def follow(v: float, law: SpeedRef, d: float, v_l: float, d_end: float, dt: floa
     at d_end [m] (`closing_plan`; a braking lead that comes to rest first: the car stands
     d_rest [m] behind it), at least `a_min` [m/s^2] while the car is faster than the law;
     `a_now` [m/s^2] the deceleration the car brakes at (`need`); a_min at least the d_min
-    guard's (`guard_decel`)."""
-    a_min = max(a_min, guard_decel(v, v_l, d, a_lead, p))
+    guard's (`guard_decel`), which the approach's cap also counts as needed."""
+    guard = guard_decel(v, v_l, d, a_lead, p)
+    a_min = max(a_min, guard)
     closing = v - max(v_l, 0.0)
     b = lead_braking(a_lead, p)
     if (closing > 0.0 or b > 0.0) and d - d_end > p.arrived:  # the approach to d_end
@@ -348,7 +418,7 @@ def follow(v: float, law: SpeedRef, d: float, v_l: float, d_end: float, dt: floa
                      p.a_open)
     else:  # not closing: the law, or opening the gap at a_min
         a_plan = a_min if a_min > 0.0 else math.inf
-    return approach(v, law, a_plan, need(v, v_l, d, p, a_now, a_lead), dt, p)
+    return approach(v, law, a_plan, max(need(v, v_l, d, p, a_now, a_lead), guard), dt, p)
 
 
 def ramped(v: float, v_end: float, room: float, a_now: float, p: AccControlParams) -> float:

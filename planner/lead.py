@@ -43,7 +43,11 @@ little off far ahead, does not make the car brake and release:
   the gap now and beyond it at the gap the wait leaves; a stopped car first found 60 m
   ahead at 60 km/h: the wait is 5 m of a room the stop needs all of), or the stop within
   ISO's limits left now (a_iso likewise: a stopped car revealed by a cut-out 59 m ahead at
-  60 km/h needs 3.16 m/s^2 now and 3.56 after the wait);
+  60 km/h needs 3.16 m/s^2 now and 3.56 after the wait), or the wait would leave the gap
+  within d_far of UN R157's d_min, where the ACC's d_min guard answers it
+  (`planner.acc_control.guard_decel`; a car 30 km/h slower first tracked 26 m ahead at
+  52 km/h, 3.6 m above d_min: waiting out the confirmation while the car sped on to its
+  set speed left 0.2 m, and the gap fell 2.4 m under d_min before the braking built up);
 - a cut-in is taken on the track's velocity across the lane only where the vehicle's
   offset from the lane's centre line over the last ``rate_window`` moves the same way (the
   slower of the two is taken; a new track's velocity alone): a constant-velocity track's
@@ -70,6 +74,7 @@ import numpy as np
 
 from perception.messages import ObjectClass, Track
 from planner.acc_control import AccControlParams, need
+from planner.fsm.acc import r157_min_gap
 from planner.messages import Lead
 from world.hdmap import Lane
 
@@ -265,14 +270,17 @@ def costly_wait(v: float, lead: Lead, age: float, wait: float,
                 acc: AccControlParams) -> bool:
     """Whether waiting `wait` [s] before taking `lead` (its track `age` [s] old) as the
     lead, the ego at `v` [m/s], would cost the comfortable stop left now, or the stop within
-    ISO's limits (`AccControlParams.a_iso`) left now (module doc; `need` from no braking
-    yet)."""
+    ISO's limits (`AccControlParams.a_iso`) left now, or would leave the gap within d_far
+    of UN R157's d_min at `v` (module doc; `need` from no braking yet)."""
     closing = v - lead.speed
     if closing <= 0.0:
         return False
     now = lead.gap - closing * age  # [m] the gap carried to now
+    after_gap = now - closing * wait  # [m] the gap the wait leaves
+    if after_gap - r157_min_gap(v) < acc.d_far:  # the d_min guard's band
+        return True
     before = need(v, lead.speed, now, acc)
-    after = need(v, lead.speed, now - closing * wait, acc)
+    after = need(v, lead.speed, after_gap, acc)
     return any(before <= limit < after for limit in (acc.a_comf_max, acc.a_iso))
 
 

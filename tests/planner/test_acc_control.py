@@ -13,12 +13,14 @@ from planner.acc_control import (
     bump,
     closing_plan,
     comfortable,
+    d_min_slope,
     follow,
     guard_decel,
     lead_braking,
     lead_feed_forward,
     need,
     pass_speed,
+    restore_decel,
     stop,
     stop_speed,
     trail,
@@ -123,9 +125,18 @@ def test_follow_approaches_a_slower_lead_at_about_1_m_s2() -> None:
     # 25 m ahead: no comfortable stop, up to a_hard
     late = follow(v, trail(v, 25.0, 25.0, 0.0, 4.0, P), 25.0, 0.0, 5.0, 0.025, P)
     assert -late.accel == P.a_hard
-    # inside d_end but closing: the closing is stopped before the floor, not at once
-    inside = follow(v, trail(v, 15.0, 25.0, v - 2.0, 4.0, P), 15.0, v - 2.0, 20.0, 0.025, P)
+    # inside d_end but closing, d_far or more above d_min: the closing is stopped before
+    # the floor, not at once
+    inside = follow(v, trail(v, 25.0, 30.0, v - 2.0, 4.0, P), 25.0, v - 2.0, 30.0, 0.025, P)
     assert 0.0 < -inside.accel <= P.a_comf_max
+    # ... 6 m under d_min already (a cut-in), closing at 2 m/s: no margin left to keep; the
+    # closing is ended within ISO's limits, not at a_hard
+    under = follow(v, trail(v, 15.0, 25.0, v - 2.0, 4.0, P), 15.0, v - 2.0, 20.0, 0.025, P)
+    assert 0.0 < -under.accel <= P.a_iso_max
+    # ... closing at 9 m/s 15 m behind it: ending it 2.5 m behind needs 3.2 m/s^2 at once,
+    # more than a ramp within ISO's limits gives: a_hard
+    fast = follow(v, trail(v, 15.0, 25.0, v - 9.0, 4.0, P), 15.0, v - 9.0, 20.0, 0.025, P)
+    assert -fast.accel == P.a_hard
     # a lead pulling away: the law
     law = trail(v, 30.0, 25.0, v + 1.0, 4.0, P)
     assert follow(v, law, 30.0, v + 1.0, 25.0, 0.025, P) == law
@@ -318,9 +329,33 @@ def test_the_d_min_guards_deceleration() -> None:
     assert guard_decel(6.0, 5.0, 9.0, -1.0, P) == pytest.approx(1.0 + 1.0 / (2.0 * room))
     assert guard_decel(6.0, 5.0, 9.0, 0.0, P) == pytest.approx(1.0 / (2.0 * room))
     assert guard_decel(6.0, 6.5, 9.0, -1.0, P) == 0.0  # not closing
-    assert guard_decel(12.0, 11.0, 18.0, -1.0, P) == 0.0  # above v_guard
+    assert guard_decel(12.0, 11.0, 18.0 + 3.0, -1.0, P) == 0.0  # above v_guard, d_far
     assert guard_decel(6.0, 5.0, r157_min_gap(6.0), -1.0, P) == math.inf  # no room
     half = r157_min_gap(6.0) + 2.5  # halfway from d_near to d_far
     assert guard_decel(6.0, 5.0, half, -1.0, P) == pytest.approx(
         0.5 * (1.0 + 1.0 / (2.0 * (2.5 - P.d_keep))))
     assert guard_decel(6.0, 5.0, r157_min_gap(6.0) + 3.0, -1.0, P) == 0.0  # d_far
+
+
+def test_the_d_min_guard_above_v_guard_restores_d_min() -> None:
+    """Above v_guard: b + the larger of (v - v_l) / d_min'(v), which holds the margin to
+    d_min(v), and (v - v_l)^2 / (2 (d - d_min(v_l) - d_keep)), which ends the closing
+    above d_min at the lead's speed; +inf where the ramp-in to the first at j_iso would
+    take the margin, or with no room; in full within d_near of d_min."""
+    v, v_l = 15.0, 12.0
+    slope = 1.0 + 2.0 * 15.0 * 3.6 / 100.0  # [s] d_min'(v) at 54 km/h
+    assert d_min_slope(v) == pytest.approx(slope)
+    d = r157_min_gap(v) + 2.0  # the ramp-in costs 3 (3 / 2.08) / (2 j_iso) = 0.90 m
+    hold = 3.0 / slope
+    end = 9.0 / (2.0 * (d - r157_min_gap(v_l) - P.d_keep))
+    assert hold > end
+    assert restore_decel(v, v_l, d, P) == pytest.approx(hold)
+    assert guard_decel(v, v_l, d, -1.0, P) == pytest.approx(1.0 + hold)
+    assert restore_decel(v, v_l, r157_min_gap(v) + 1.5, P) == math.inf  # 0.6 m after it
+    assert restore_decel(15.0, 8.5, r157_min_gap(15.0), P) == math.inf  # at d_min
+    # well under d_min (a cut-in): ended within ISO's limits at half of d_min(v_l) ...
+    assert 0.0 < restore_decel(15.0, 11.0, 15.0, P) <= P.a_iso_max
+    # ... unless that takes more
+    assert restore_decel(15.0, 5.0, 15.0, P) == math.inf
+    assert restore_decel(v, v_l + 4.0, d, P) == 0.0  # not closing
+    assert guard_decel(v, v_l, r157_min_gap(v) + 3.0, -1.0, P) == 0.0  # d_far

@@ -64,7 +64,8 @@ def test_a_car_in_the_next_lane_straying_near_the_line_for_a_moment_is_no_lead()
     (24.0, 10.0, True),  # 2.4 s
     (26.0, 10.0, True),  # 2.6 s, not urgent, but the wait would cost the stop within
     #   ISO's limits (`costly_wait`: 3.13 -> 3.85 m/s^2)
-    (30.0, 10.0, False),  # 3.0 s (2.50 -> 2.94 m/s^2): confirmed first
+    (30.0, 10.0, True),  # 3.0 s (2.50 -> 2.94 m/s^2), but under UN R157's d_min (34.4 m)
+    (45.0, 10.0, False),  # 4.5 s (1.4 -> 1.6 m/s^2), 42 m after the wait: confirmed first
     (10.0, 20.0, False),  # not closing
 ])
 def test_an_urgent_cut_in_is_the_lead_at_once(gap: float, lead_speed: float,
@@ -93,6 +94,20 @@ def test_a_stopped_car_found_far_ahead_is_the_lead_at_once_when_waiting_costs_th
     ids = run([[car(4, gap, 0.2, lead_speed)]] * 8, ego_speed=V60)
     assert (ids[0] == 4) is at_once
     assert ids[-1] == 4
+
+
+@pytest.mark.parametrize(("gap", "at_once"), [
+    (25.4, True),  # 3.6 m above d_min (21.8 m): the 0.3 s wait leaves 1.8 m, in the guard's
+    #   band (d_far, 3 m)
+    (28.0, False),  # 6.2 m above: 4.4 m after the wait, confirmed first
+])
+def test_a_slower_car_found_near_d_min_is_the_lead_at_once(gap: float, at_once: bool) -> None:
+    """A car at 31 km/h first tracked ahead of the ego at 52 km/h (the pedal_override
+    family's start): waiting out the confirmation takes 1.8 m of the margin to UN R157's
+    d_min, into the band where the ACC's d_min guard answers it."""
+    ids = run([[car(5, gap, 0.0, 8.5)]] * 8, ego_speed=14.35)
+    assert (ids[0] == 5) is at_once
+    assert ids[-1] == 5
 
 
 def test_a_costly_wait_reads_the_gap_the_track_has_now() -> None:
@@ -311,10 +326,11 @@ def test_a_cut_in_by_the_tracks_velocity_alone_is_not_taken_while_its_offset_hol
 
 
 def test_a_cut_in_that_its_offset_confirms_is_taken() -> None:
-    """A car 20 m ahead moving in at 1 m/s (its offset falls as its velocity says): taken
-    where it will be, as the velocity's prediction, once confirmed."""
+    """A car 40 m ahead moving in at 1 m/s (its offset falls as its velocity says): taken
+    where it will be, as the velocity's prediction, once confirmed (beyond UN R157's d_min
+    and the d_min guard's band: `costly_wait`)."""
     offsets = [3.5 - 1.0 * round(k / 2) * 2 * DT for k in range(30)]
-    ids = run(_frames(offsets, -1.0, gap=20.0), ego_speed=20.0)
+    ids = run(_frames(offsets, -1.0, gap=40.0), ego_speed=20.0)
     assert ids[-1] == 1
     first = ids.index(1)
     offset_then = offsets[first]
