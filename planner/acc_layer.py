@@ -12,7 +12,9 @@ Per tick:
    leaves a comfortable stop (and with the FSM's hysteresis to spare), the time to
    collision, and whether a lead was lost within the FSM's ``lead_hold``;
 2. the FSM steps once;
-3. the mode's law gives the reference: ACC_OFF 0; CRUISE and SPEED_LIMIT the speed plan;
+3. the mode's law gives the reference: ACC_OFF 0; CRUISE and SPEED_LIMIT the speed plan
+   (for the first ``t_acquire`` after the ACC engages, the car's speed at most: no speeding
+   up before the sensors' first confirmed tracks);
    TRAIL and BRAKE their laws behind the lead (TRAIL with its lead lost within the FSM's
    ``lead_hold``: the car's own speed, at most the plan's; the plan would speed it up into
    a lead whose track dropped for a moment, closing on it at 5 m/s when it was found again
@@ -60,12 +62,17 @@ NO_EVENTS = Events()
 STOP_LAWS = frozenset({AccMode.STOP_SIGN, AccMode.PEDESTRIAN, AccMode.RED_LIGHT,
                        AccMode.YIELD})  # a stop at `Events.stop_distance`
 EVENT_LAWS = frozenset({AccMode.OFF_RAMP, AccMode.SPEED_BUMP, AccMode.FLAT}) | STOP_LAWS
+ACQUIRING = frozenset({AccMode.CRUISE, AccMode.SPEED_LIMIT})  # hold for t_acquire (params)
 
 
 @dataclass(frozen=True, slots=True)
 class AccLayerParams:
     modes: AccParams = field(default_factory=AccParams)  # the mode FSM's gaps
     control: AccControlParams = field(default_factory=AccControlParams)  # the modes' laws
+    t_acquire: float = 0.5  # [s] after the ACC engages, CRUISE and SPEED_LIMIT hold the
+    #   car's speed (at most the plan's) this long: a vehicle ahead is a confirmed track
+    #   only after the LiDAR's first scans (three at 10 Hz), and the car does not speed up
+    #   towards its set speed before it could know the lane ahead is clear
 
 
 @dataclass(frozen=True, slots=True)
@@ -86,6 +93,7 @@ class AccLayer:
         self._braking = BrakeModel()  # the deceleration the car brakes at (`need`)
         self._lead_seen = -math.inf  # [s] when a lead was last seen
         self._a_lead = 0.0  # [m/s^2] the lead's acceleration this tick (signed)
+        self._engaged: float | None = None  # [s] when the ACC last left ACC_OFF
 
     @property
     def mode(self) -> AccMode:
@@ -119,10 +127,16 @@ class AccLayer:
                      relaxed=comfortable(a_need + self.params.modes.a_hysteresis, c),
                      lead_lost=lead is None and t - self._lead_seen <= self.params.modes.lead_hold)
         changes = self.machine.apply(t, transition(self.mode, x, self.params.modes))
+        engaged = self.mode is not AccMode.ACC_OFF
+        self._engaged = (self._engaged if self._engaged is not None else t) if engaged \
+            else None
         if self.mode in EVENT_LAWS:
             speed = self._event(x, dt, plan, events)
         else:
             speed = self._control(x, dt, plan, driver_gap)
+            since = t - self._engaged if self._engaged is not None else 0.0  # [s]
+            if self.mode in ACQUIRING and since < self.params.t_acquire:
+                speed = PlannedSpeed(SpeedRef(min(speed.ref.speed, v), 0.0), speed.source)
         self._braking.step(speed.ref.accel, dt, c)
         return AccOutput(speed, d), changes
 

@@ -156,3 +156,17 @@ def test_a_slower_lead_first_found_near_d_min_is_answered_at_once() -> None:
     assert float(run["gap"].min()) > 16.0
     assert float(-run["a"].min()) <= 5.0 + 1e-9  # planner.limits.A_HARD
     assert float(margin[-1]) > 5.0  # following at d_des
+
+
+def test_the_car_does_not_speed_up_before_its_first_tracks_are_confirmed() -> None:
+    """Engaged at 50 km/h with its set speed at 60 km/h: for t_acquire (0.5 s) the car
+    holds its speed (a car ahead is a confirmed LiDAR track only after three scans); then
+    the plan, the set speed."""
+    acc, v, set_speed = AccLayer(), 50 / 3.6, 60 / 3.6
+    plan = PlannedSpeed(SpeedRef(set_speed, 0.0), SpeedSource.SET_SPEED)
+    held = [acc.update(k * DT, DT, v, set_speed, 30.0, plan, None)[0].speed.ref
+            for k in range(round(0.5 / DT))]
+    assert acc.mode.value == "cruise"
+    assert all(ref.speed == v and ref.accel == 0.0 for ref in held)
+    out, _ = acc.update(0.5, DT, v, set_speed, 30.0, plan, None)
+    assert out.speed.ref.speed == set_speed

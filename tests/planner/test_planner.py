@@ -65,7 +65,8 @@ def test_plan_on_an_arc() -> None:
 def test_plan_on_a_straight(kind: str) -> None:
     road = straight_road(kind, 1000.0, 50.0, ((400.0, 30.0),))
     p = planner(road, lane=0)
-    plan = p.update(PlannerInput(ego_on(road, 0, 200.0, -0.25, 3.0)))
+    p.update(PlannerInput(ego_on(road, 0, 200.0, -0.25, 3.0, t=0.0)))  # engaged at 0 s ...
+    plan = p.update(PlannerInput(ego_on(road, 0, 200.0, -0.25, 3.0, t=1.0)))  # ... 1 s on
     assert plan.station == pytest.approx(200.0)
     assert plan.lateral_error == pytest.approx(-0.25)
     assert plan.path.xy[0, 0] == pytest.approx(195.0)
@@ -73,7 +74,7 @@ def test_plan_on_a_straight(kind: str) -> None:
     assert plan.target_speed == pytest.approx(49.7 * KPH)
     assert plan.speed_limit == pytest.approx(50.0 * KPH)
     assert plan.speed_source is SpeedSource.LIMIT
-    ahead = p.update(PlannerInput(ego_on(road, 0, 400.0 - 2.4 - 20.0, 0.0, 13.8)))
+    ahead = p.update(PlannerInput(ego_on(road, 0, 400.0 - 2.4 - 20.0, 0.0, 13.8, t=2.0)))
     assert ahead.target_accel == -1.5
     assert ahead.speed_source is SpeedSource.LIMIT  # braking towards the lower posting
     assert ahead.speed_limit == pytest.approx(50.0 * KPH)
@@ -167,7 +168,8 @@ def test_the_sight_cap_is_its_own_speed_source(set_kph: float, source: SpeedSour
     speed binds."""
     road = straight_road("real", 2000.0, 130.0)
     p = planner(road, lane=0, set_kph=set_kph)
-    plan = p.update(PlannerInput(ego_on(road, 0, 200.0, 0.0, 25.0)))
+    p.update(PlannerInput(ego_on(road, 0, 200.0, 0.0, 25.0, t=0.0)))  # engaged at 0 s ...
+    plan = p.update(PlannerInput(ego_on(road, 0, 200.0, 0.0, 25.0, t=1.0)))  # ... 1 s on
     assert plan.target_speed == pytest.approx(min(set_kph * KPH, p.sight_speed))
     assert 90.0 * KPH < p.sight_speed < 92.0 * KPH
     assert plan.speed_source is source
