@@ -140,7 +140,7 @@ allows. FLAT's ramp starts from the plan's speed and then falls without looking 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 from planner.fsm.acc import r157_min_gap
 from planner.limits import (
@@ -196,9 +196,8 @@ class AccControlParams:
     #   d_min at the car's speed now; above it, above d_min at the lead's (`restore_decel`)
     d_keep: float = 0.75  # [m] `guard_decel` ends the closing this far above d_min
     d_lose: float = 1.0  # [m] `restore_decel` holds d_min at up to a_hard until the gap is
-    #   this far under d_min + d_keep (a hard braking's ramp-in may lose that much) ...
-    f_under: float = 0.5  # [-] ... further under, `restore_decel` ends the closing this
-    #   fraction of d_min at the lead's speed behind it
+    #   this far under d_min + d_keep (a hard braking's ramp-in may lose that much); further
+    #   under (a cut-in), the guard steps aside
     d_near: float = 2.0  # [m] `guard_decel` holds in full within this of d_min ...
     d_far: float = 3.0  # [m] ... tapering to nothing this far above it
 
@@ -292,11 +291,8 @@ def restore_decel(v: float, v_l: float, d: float, p: AccControlParams) -> float:
     ramp-in to the first at j_iso, which loses about (v - v_l) T / 2 of the margin (T the
     ramp's time), leaves less than d_keep of it (answered at a_hard, `follow`); 0 when not
     closing. More than d_lose under d_min + d_keep already (a cut-in close ahead) no margin
-    is left to keep (UN R157 gives a cut-in time to restore d_min): the closing is ended at
-    a constant deceleration, after the
-    ramp-in at j_iso, f_under d_min(v_l) (at least d_floor) behind the lead, a buffer over
-    `need`'s d_floor that the lead's speed alone sets (so the plan holds as the car
-    brakes); +inf (a_hard) if that is beyond a_iso_max."""
+    is left to keep (UN R157 gives a cut-in time to restore d_min): 0, the guard steps
+    aside and `need` and the approach end the closing within ISO's limits where they can."""
     closing = v - max(v_l, 0.0)
     if closing <= 0.0:
         return 0.0
@@ -304,9 +300,7 @@ def restore_decel(v: float, v_l: float, d: float, p: AccControlParams) -> float:
     hold = closing / slope if slope > 0.0 else 0.0
     margin = d - r157_min_gap(v) - p.d_keep
     if margin < -p.d_lose:  # well under d_min already (doc)
-        target = max(p.f_under * r157_min_gap(max(v_l, 0.0)), p.d_floor)
-        end = ramped(closing, 0.0, d - target, 0.0, replace(p, j_comf=p.j_iso))
-        return math.inf if end > p.a_iso_max else end
+        return 0.0
     if closing * hold / (2.0 * p.j_iso) > margin:
         return math.inf  # the ramp-in to `hold` at ISO's jerk would take the margin
     room = d - r157_min_gap(max(v_l, 0.0)) - p.d_keep
