@@ -251,13 +251,15 @@ def gap_rate(a_lead: float, p: AccControlParams) -> float:
     return lead_feed_forward(a_lead, p)
 
 
-def guard_decel(v: float, v_l: float, d: float, a_lead: float, p: AccControlParams) -> float:
+def guard_decel(v: float, v_l: float, d: float, a_lead: float, p: AccControlParams,
+                entered: bool = False) -> float:
     """[m/s^2] >= 0: the constant deceleration that ends the closing speed v - v_l [m/s] on
     a lead braking at `lead_braking(a_lead)` before the gap d [m] falls to UN R157's d_min
     at the car's speed now plus d_keep (d_min falls as the car slows: the bound is on the
     safe side), ``b + (v - v_l)^2 / (2 (d - d_min(v) - d_keep))``, +inf with no room;
-    faster than v_guard, ``b + restore_decel``; in full within d_near of d_min, tapering
-    linearly to 0 at d_far above it; 0 when not closing (module doc)."""
+    faster than v_guard, ``b + restore_decel`` (`b` alone for a lead that `entered` the
+    lane ahead: UN R157 gives a cut-in time to restore d_min); in full within d_near of
+    d_min, tapering linearly to 0 at d_far above it; 0 when not closing (module doc)."""
     closing = v - max(v_l, 0.0)
     if closing <= 0.0:
         return 0.0
@@ -266,8 +268,8 @@ def guard_decel(v: float, v_l: float, d: float, a_lead: float, p: AccControlPara
     if weight <= 0.0:
         return 0.0
     b = lead_braking(a_lead, p)
-    if v > p.v_guard:
-        return weight * (b + restore_decel(v, v_l, d, p))
+    if v > p.v_guard:  # a lead that entered the lane: UN R157's cut-in grace, no restore
+        return weight * (b + (0.0 if entered else restore_decel(v, v_l, d, p)))
     room = above - p.d_keep
     return weight * (b + closing * closing / (2.0 * room)) if room > 0.0 else math.inf
 
@@ -392,14 +394,14 @@ def approach(v: float, law: SpeedRef, a_plan: float, a_need: float, dt: float,
 
 def follow(v: float, law: SpeedRef, d: float, v_l: float, d_end: float, dt: float,
            p: AccControlParams, a_min: float = 0.0, a_now: float = 0.0,
-           a_lead: float = 0.0, d_rest: float = 0.0) -> SpeedRef:
+           a_lead: float = 0.0, d_rest: float = 0.0, entered: bool = False) -> SpeedRef:
     """The approach behind a lead at gap d [m], speed v_l [m/s] and acceleration `a_lead`
     [m/s^2] (signed) on the trail law `law`: the constant deceleration that ends the closing
     at d_end [m] (`closing_plan`; a braking lead that comes to rest first: the car stands
     d_rest [m] behind it), at least `a_min` [m/s^2] while the car is faster than the law;
     `a_now` [m/s^2] the deceleration the car brakes at (`need`); a_min at least the d_min
     guard's (`guard_decel`), which the approach's cap also counts as needed."""
-    guard = guard_decel(v, v_l, d, a_lead, p)
+    guard = guard_decel(v, v_l, d, a_lead, p, entered)
     a_min = max(a_min, guard)
     closing = v - max(v_l, 0.0)
     b = lead_braking(a_lead, p)

@@ -94,6 +94,7 @@ class AccLayer:
         self._lead_seen = -math.inf  # [s] when a lead was last seen
         self._a_lead = 0.0  # [m/s^2] the lead's acceleration this tick (signed)
         self._engaged: float | None = None  # [s] when the ACC last left ACC_OFF
+        self._entered = False  # the lead entered the lane ahead (`planner.messages.Lead`)
 
     @property
     def mode(self) -> AccMode:
@@ -113,6 +114,7 @@ class AccLayer:
         acceleration, signed (`planner.lead.LeadAccel`)."""
         c = self.params.control
         self._a_lead = lead_accel if lead is not None else 0.0
+        self._entered = lead is not None and lead.entered
         d, v_l = math.inf, math.inf
         if lead is not None:
             age = max(t - lead.t, 0.0)
@@ -193,7 +195,7 @@ class AccLayer:
         if driver_gap is not None and not stopped:  # d_min at the faster of the two: a
             end = min(end, r157_min_gap(max(x.v, x.v_l)) + driver_gap)  # closing car's
         return follow(x.v, law, x.d, x.v_l, end, dt, c, a_min, self._braking.a,
-                      self._a_lead, rest)
+                      self._a_lead, rest, self._entered)
 
     def _control(self, x: AccInput, dt: float, planned: PlannedSpeed,
                  driver_gap: float | None) -> PlannedSpeed:

@@ -294,6 +294,7 @@ class LeadSelector:
         self._since: dict[int, float] = {}  # [s] track id -> when it entered the lane
         self._offsets: dict[int, dict[float, float]] = {}  # track id -> {track time [s]:
         #   its offset from the lane's centre line [m]} over the last `rate_window`
+        self._outside: set[int] = set()  # track ids seen outside the lane (`Lead.entered`)
 
     def select(self, t: float, ego_speed: float, candidates: Sequence[Candidate],
                ) -> Lead | None:
@@ -304,6 +305,10 @@ class LeadSelector:
         self._offsets = {c.lead.track_id: self._offsets.get(c.lead.track_id, {})
                          for c in candidates if not math.isnan(c.now)}
         inside = {c.lead.track_id for c in candidates if abs(c.lateral) <= p.half_width}
+        present = {c.lead.track_id for c in candidates}
+        self._outside = {i for i in self._outside if i in present} | {
+            c.lead.track_id for c in candidates
+            if abs(c.lateral if math.isnan(c.now) else c.now) > p.half_width}
         self._since = {i: self._since.get(i, t) for i in inside}
         qualified = [c for c in candidates if self._qualifies(c, t, ego_speed)]
         if any(abs(c.lateral) <= p.half_width for c in qualified):  # a lead held by the keep
@@ -311,6 +316,8 @@ class LeadSelector:
             #   yields to a vehicle in the lane: the lead leaving it reveals another
         lead = _nearest(qualified)
         self.lead_id = None if lead is None else lead.track_id
+        if lead is not None and lead.track_id in self._outside:
+            lead = replace(lead, entered=True)
         return lead
 
     def _confirmed_cut_in(self, c: Candidate) -> Candidate:

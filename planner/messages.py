@@ -66,6 +66,8 @@ class Lead:
     #   ACC's V_l (an oncoming vehicle is taken as standing: an ACC follows none, ISO 15622)
     velocity: float = math.nan  # [m/s] its velocity along that direction, signed (< 0:
     #   oncoming), for the time to collision and the emergency braking; NaN: `speed`
+    entered: bool = False  # its track was outside the ego's lane before it became the lead
+    #   (a cut-in, a lane change ahead): UN R157 gives the ego time to restore d_min to it
 
     @property
     def along(self) -> float:

@@ -353,3 +353,14 @@ def test_the_d_min_guard_above_v_guard_restores_d_min() -> None:
     assert restore_decel(15.0, 5.0, r157_min_gap(15.0) - 1.0, P) == 0.0
     assert restore_decel(v, v_l + 4.0, d, P) == 0.0  # not closing
     assert guard_decel(v, v_l, r157_min_gap(v) + 3.0, -1.0, P) == 0.0  # d_far
+
+
+def test_the_d_min_guard_leaves_a_lead_that_entered_the_lane_to_the_approach() -> None:
+    """Near d_min at 54 km/h closing at 3 m/s: a lead in the lane since it was first seen
+    is held off d_min (`restore_decel`); one that cut in is not (UN R157's cut-in grace),
+    only its own braking is answered."""
+    v, v_l = 15.0, 12.0
+    d = r157_min_gap(v) + 1.0
+    assert guard_decel(v, v_l, d, 0.0, P) == math.inf
+    assert guard_decel(v, v_l, d, 0.0, P, entered=True) == 0.0
+    assert guard_decel(v, v_l, d, -2.0, P, entered=True) > 0.0

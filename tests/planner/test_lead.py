@@ -377,3 +377,17 @@ def test_an_oncoming_car_closing_within_the_urgent_ttc_is_the_lead_at_once() -> 
     assert run([[head_on]] * 3, ego_speed=V60)[0] == 5
     standing = Candidate(Lead(5, 0.0, 45.0, 0.0), 0.2)
     assert run([[standing]] * 3, ego_speed=V60)[0] is None
+
+
+def test_a_lead_that_was_seen_outside_the_lane_has_entered_it() -> None:
+    """A car tracked in the next lane (3.5 m) that moves into the ego's lane is a lead that
+    `entered` (a cut-in: UN R157 gives the ego time to restore d_min); a car tracked in the
+    lane from its first sight did not."""
+    def leads(frames: list[list[Candidate]]) -> list[Lead | None]:
+        selector = LeadSelector(P)
+        return [selector.select(k * DT, 20.0, frame) for k, frame in enumerate(frames)]
+
+    cut_in = leads([[car(3, 25.0, 3.5)]] * 4 + [[car(3, 25.0, 0.3)]] * 10)
+    assert cut_in[-1] is not None and cut_in[-1].entered
+    in_lane = leads([[car(4, 25.0, 0.3)]] * 10)
+    assert in_lane[-1] is not None and not in_lane[-1].entered
