@@ -177,6 +177,8 @@ class AccControlParams:
     #   (`control.longitudinal`: comfort_jerk): the ramp-in `need` allows for
     d_floor: float = 2.5  # [m] `need` stops the closing this far behind the lead (UN R157
     #   4.2.1's least standstill gap, 2 m, and a margin)
+    d_floor_iso: float = 2.0  # [m] ... and its last resort before an urgent plan, on ISO's
+    #   envelope (`follow_need`): UN R157 4.2.1's 2 m
     a_flat: float = A_FLAT  # [m/s^2] DECS's bound on FLAT's deceleration (no law reads it)
     a_flat_plan: float = 2.0  # [m/s^2] the deceleration FLAT plans: a gentle stop
     v_pull_over: float = 6.0  # [m/s] FLAT's crawl while the car pulls onto the shoulder (slow
@@ -323,21 +325,25 @@ def pass_speed(distance: float, v_pass: float, v_plan: float, p: AccControlParam
 
 
 def need(v: float, v_l: float, d: float, p: AccControlParams, a_now: float = 0.0,
-         a_lead: float = 0.0) -> float:
+         a_lead: float = 0.0, iso: bool = False) -> float:
     """[m/s^2] >= 0: the least deceleration that still stops the closing speed v - v_l [m/s]
     at d_floor (module doc) from the gap d [m], after the ramp-in from the deceleration
-    `a_now` [m/s^2] the car brakes at (`BrakeModel`), and, while the lead brakes
-    (`lead_braking` of its acceleration `a_lead` [m/s^2]), that stops the car d_floor behind
-    where the lead will stop; +inf with no room left."""
+    `a_now` [m/s^2] the car brakes at (`BrakeModel`; to a_comf_max at j_comf, or with `iso`
+    to a_iso_max at j_iso, the envelope of a plan within ISO's limits, stopping d_floor_iso
+    short), and, while the lead
+    brakes (`lead_braking` of its acceleration `a_lead` [m/s^2]), that stops the car d_floor
+    behind where the lead will stop; +inf with no room left."""
     closing = v - max(v_l, 0.0)
-    t_ramp = max(p.a_comf_max - a_now, 0.0) ** 2 / (2.0 * p.j_comf * p.a_comf_max)
+    top, jerk = (p.a_iso_max, p.j_iso) if iso else (p.a_comf_max, p.j_comf)
+    floor = p.d_floor_iso if iso else p.d_floor
+    t_ramp = max(top - a_now, 0.0) ** 2 / (2.0 * jerk * top)
     a = 0.0
     if closing > 0.0:
-        room = d - p.d_floor - closing * t_ramp
+        room = d - floor - closing * t_ramp
         a = closing * closing / (2.0 * room) if room > 0.0 else math.inf
     b = lead_braking(a_lead, p)
     if b > 0.0:
-        room = d - p.d_floor + max(v_l, 0.0) ** 2 / (2.0 * b) - v * t_ramp
+        room = d - floor + max(v_l, 0.0) ** 2 / (2.0 * b) - v * t_ramp
         a = max(a, v * v / (2.0 * room) if room > 0.0 else math.inf)
     return a
 
@@ -414,7 +420,20 @@ def follow(v: float, law: SpeedRef, d: float, v_l: float, d_end: float, dt: floa
                      p.a_open)
     else:  # not closing: the law, or opening the gap at a_min
         a_plan = a_min if a_min > 0.0 else math.inf
-    return approach(v, law, a_plan, max(need(v, v_l, d, p, a_now, a_lead), guard), dt, p)
+    return approach(v, law, a_plan, max(follow_need(v, v_l, d, p, a_now, a_lead), guard),
+                    dt, p)
+
+
+def follow_need(v: float, v_l: float, d: float, p: AccControlParams, a_now: float,
+                a_lead: float) -> float:
+    """[m/s^2] `need` behind the lead, judged for a plan within ISO's limits on ISO's own
+    envelope: where the comfortable ramp-in leaves more than a_iso_max but the ramp-in at
+    j_iso to a_iso_max stops the closing, a_iso_max (a plan within ISO's limits, not an
+    urgent one at a_hard)."""
+    a = need(v, v_l, d, p, a_now, a_lead)
+    if a > p.a_iso_max and need(v, v_l, d, p, a_now, a_lead, iso=True) <= p.a_iso_max:
+        return p.a_iso_max
+    return a
 
 
 def ramped(v: float, v_end: float, room: float, a_now: float, p: AccControlParams) -> float:

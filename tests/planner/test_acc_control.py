@@ -15,6 +15,7 @@ from planner.acc_control import (
     comfortable,
     d_min_slope,
     follow,
+    follow_need,
     guard_decel,
     lead_braking,
     lead_feed_forward,
@@ -364,3 +365,17 @@ def test_the_d_min_guard_leaves_a_lead_that_entered_the_lane_to_the_approach() -
     assert guard_decel(v, v_l, d, 0.0, P) == math.inf
     assert guard_decel(v, v_l, d, 0.0, P, entered=True) == 0.0
     assert guard_decel(v, v_l, d, -2.0, P, entered=True) > 0.0
+
+
+def test_a_closing_that_iso_s_own_envelope_still_ends_is_no_urgent_plan() -> None:
+    """A cut-in tracked 20.2 m ahead closing at 9 m/s from 60 km/h: the comfortable ramp-in
+    (to 3 m/s^2 at 2 m/s^3) leaves 3.65 m/s^2 to stop it 2.5 m short, beyond a_iso_max, but
+    the ramp-in on ISO's envelope (to 3.45 m/s^2 at 2.4 m/s^3) stops it 2 m short: a plan
+    within ISO's limits at a_iso_max, not an urgent one at a_hard. Closer, urgent."""
+    v, v_l = 16.62, 7.66
+    assert need(v, v_l, 20.23, P) > P.a_iso_max
+    assert follow_need(v, v_l, 20.23, P, 0.0, 0.0) == P.a_iso_max
+    law = trail(v, 20.23, 30.0, v_l, 4.0, P)
+    assert -follow(v, law, 20.23, v_l, 12.0, 0.025, P).accel == pytest.approx(P.a_iso_max)
+    assert follow_need(v, v_l, 17.0, P, 0.0, 0.0) > P.a_iso_max
+    assert -follow(v, law, 17.0, v_l, 12.0, 0.025, P).accel == P.a_hard
