@@ -259,9 +259,10 @@ def guard_decel(v: float, v_l: float, d: float, a_lead: float, p: AccControlPara
     a lead braking at `lead_braking(a_lead)` before the gap d [m] falls to UN R157's d_min
     at the car's speed now plus d_keep (d_min falls as the car slows: the bound is on the
     safe side), ``b + (v - v_l)^2 / (2 (d - d_min(v) - d_keep))``, +inf with no room;
-    faster than v_guard, ``b + restore_decel`` (`b` alone for a lead that `entered` the
-    lane ahead: UN R157 gives a cut-in time to restore d_min); in full within d_near of
-    d_min, tapering linearly to 0 at d_far above it; 0 when not closing (module doc)."""
+    faster than v_guard, ``b + restore_decel``; `b` alone for a lead that `entered` the
+    lane ahead at any speed (UN R157 gives a cut-in time to restore d_min: its closing is
+    the approach's); in full within d_near of d_min, tapering linearly to 0 at d_far above
+    it; 0 when not closing (module doc)."""
     closing = v - max(v_l, 0.0)
     if closing <= 0.0:
         return 0.0
@@ -270,8 +271,10 @@ def guard_decel(v: float, v_l: float, d: float, a_lead: float, p: AccControlPara
     if weight <= 0.0:
         return 0.0
     b = lead_braking(a_lead, p)
-    if v > p.v_guard:  # a lead that entered the lane: UN R157's cut-in grace, no restore
-        return weight * (b + (0.0 if entered else restore_decel(v, v_l, d, p)))
+    if entered:  # a lead that entered the lane ahead: UN R157's cut-in grace
+        return weight * b
+    if v > p.v_guard:
+        return weight * (b + restore_decel(v, v_l, d, p))
     room = above - p.d_keep
     return weight * (b + closing * closing / (2.0 * room)) if room > 0.0 else math.inf
 

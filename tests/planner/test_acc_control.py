@@ -365,6 +365,10 @@ def test_the_d_min_guard_leaves_a_lead_that_entered_the_lane_to_the_approach() -
     assert guard_decel(v, v_l, d, 0.0, P) == math.inf
     assert guard_decel(v, v_l, d, 0.0, P, entered=True) == 0.0
     assert guard_decel(v, v_l, d, -2.0, P, entered=True) > 0.0
+    # ... also under v_guard: 3 m under d_min at 36 km/h, closing at 3 m/s
+    slow = r157_min_gap(10.0) - 3.0
+    assert guard_decel(10.0, 7.0, slow, 0.0, P) == math.inf
+    assert guard_decel(10.0, 7.0, slow, 0.0, P, entered=True) == 0.0
 
 
 def test_a_closing_that_iso_s_own_envelope_still_ends_is_no_urgent_plan() -> None:
