@@ -430,11 +430,13 @@ def follow(v: float, law: SpeedRef, d: float, v_l: float, d_end: float, dt: floa
 def follow_need(v: float, v_l: float, d: float, p: AccControlParams, a_now: float,
                 a_lead: float) -> float:
     """[m/s^2] `need` behind the lead, judged for a plan within ISO's limits on ISO's own
-    envelope: where the comfortable ramp-in leaves more than a_iso_max but the ramp-in at
-    j_iso to a_iso_max stops the closing, a_iso_max (a plan within ISO's limits, not an
-    urgent one at a_hard)."""
+    envelope: where the lead does not brake, the comfortable ramp-in leaves more than
+    a_iso_max but the ramp-in at j_iso to a_iso_max stops the closing, a_iso_max (a plan
+    within ISO's limits, not an urgent one at a_hard). A braking lead's deceleration is
+    known late (`track_lag`): its plan stays urgent."""
     a = need(v, v_l, d, p, a_now, a_lead)
-    if a > p.a_iso_max and need(v, v_l, d, p, a_now, a_lead, iso=True) <= p.a_iso_max:
+    if (a > p.a_iso_max and lead_braking(a_lead, p) <= 0.0
+            and need(v, v_l, d, p, a_now, a_lead, iso=True) <= p.a_iso_max):
         return p.a_iso_max
     return a
 
