@@ -114,12 +114,6 @@ def test_same_seed_gives_bitwise_equal_trajectories(
 # ---- issue B: the camera and the LiDAR in the loop ------------------------------------------
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "car_b, in lane 1 on the straight after the R 50 m bend, gets a new LiDAR track at "
-    "45.3 s whose velocity across the lane reads -4.2 to -3.1 m/s and whose offsets fall "
-    "4.96 -> 2.88 m while it settles (by 46.1 s): LeadSelector takes it as cutting in at "
-    "45.6 s and TRAIL lasts to 46.95 s. A new track's settling is not yet told from a "
-    "cut-in"))
 def test_the_acc_layer_never_trails_a_car_in_the_other_lane(result: RunResult) -> None:
     """The ACC layer: engaged, the 30 km/h zone below the 50 km/h set speed, no lead in lane
     (both cars keep the other lane; a track is in the lane for `confirm` before it can be
