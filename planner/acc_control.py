@@ -28,7 +28,9 @@ pedal). `planner.acc_layer` picks the law for the mode.
   followed tau_loop behind, and a car following at 90 km/h behind a lead braking at
   2 m/s^2 fell 2 m under UN R157's d_min. Where the first binds and the lead
   pulls away (its acceleration a_l over `lead_brakes`), its acceleration up to `a_pull` is
-  the feed-forward: the gap law's reference rises with the lead's speed, and without it the
+  the feed-forward, less k_gap (v - v_l) while the car closes on it (the law's own rate;
+  fed in full, a car closing from far behind sped up through the law's reference and past
+  the plan's): the gap law's reference rises with the lead's speed, and without it the
   speed loop's integrator takes up the pull-away (0.9 m/s^2 behind a lead pulling away at
   1 m/s^2) and holds it against the braking that follows when the lead brakes again at
   once (ISO 22179 stop and go): the car brakes that much less than its plan. And as
@@ -228,18 +230,23 @@ def lead_speed_now(v_l: float, a_lead: float, age: float, p: AccControlParams) -
 
 
 def trail(v_plan: float, d: float, d_des: float, v_l: float, d0: float,
-          p: AccControlParams, a_lead: float = 0.0, d_des_slope: float = 0.0) -> SpeedRef:
+          p: AccControlParams, a_lead: float = 0.0, d_des_slope: float = 0.0,
+          closing: float = 0.0) -> SpeedRef:
     """TRAIL's law (module doc): the reference behind a lead at bumper gap d [m] with speed
     v_l [m/s] and acceleration `a_lead` [m/s^2] (signed), for the desired gap d_des and
     standstill gap d0 [m], at most v_plan [m/s]; `d_des_slope` [s] is d(d_des)/dv at the
-    car's speed (the gap law's shrink term)."""
+    car's speed (the gap law's shrink term); `closing` [m/s] the car's speed less the
+    lead's (the pull-away's feed-forward is the law's own rate while it closes)."""
     if v_l < p.v_standstill:
         approach = math.sqrt(2.0 * p.a_final * max(d - d0 - p.stop_band, 0.0))
         return SpeedRef(min(approach, v_plan), 0.0)
     gap_law = v_l - d_des_slope * gap_rate(a_lead, p) + p.k_gap * (d - d_des)
     stop_law = math.sqrt(max(v_l, 0.0) ** 2 + 2.0 * p.a_comf * max(d - d0, 0.0))
     speed = min(max(min(gap_law, stop_law), 0.0), v_plan)
-    return SpeedRef(speed, lead_feed_forward(a_lead, p) if 0.0 < speed == gap_law else 0.0)
+    feed = lead_feed_forward(a_lead, p)
+    if feed > 0.0:  # the gap law's rate, a_l - k_gap (v - v_l), while the car closes
+        feed = max(feed - p.k_gap * max(closing, 0.0), 0.0)
+    return SpeedRef(speed, feed if 0.0 < speed == gap_law else 0.0)
 
 
 def gap_rate(a_lead: float, p: AccControlParams) -> float:

@@ -188,7 +188,8 @@ class AccLayer:
         d_des = g.d_des if driver_gap is None else min(g.d_des, g.d_min + driver_gap)
         slope = (g.d_des - gaps(max(x.v - 0.1, 0.0), x.v_l, m).d_des) / 0.1 \
             if driver_gap is None else 0.0  # [s] d(d_des)/dv
-        law = trail(plan.speed, x.d, d_des, x.v_l, m.d0, c, self._a_lead, slope)
+        law = trail(plan.speed, x.d, d_des, x.v_l, m.d0, c, self._a_lead, slope,
+                    x.v - x.v_l)
         stopped = x.v_l < c.v_standstill
         rest = m.d0 + c.stop_band
         end = rest if stopped else gaps(x.v_l, x.v_l, m).d_des

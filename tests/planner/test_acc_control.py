@@ -383,3 +383,27 @@ def test_a_closing_that_iso_s_own_envelope_still_ends_is_no_urgent_plan() -> Non
     assert -follow(v, law, 20.23, v_l, 12.0, 0.025, P).accel == pytest.approx(P.a_iso_max)
     assert follow_need(v, v_l, 17.0, P, 0.0, 0.0) > P.a_iso_max
     assert -follow(v, law, 17.0, v_l, 12.0, 0.025, P).accel == P.a_hard
+
+
+def test_a_lead_pulling_away_far_ahead_is_not_fed_forward_past_the_plan() -> None:
+    """A car at 30 km/h (the plan's limit) 52 m behind a lead pulling away at 1.5 m/s^2 from
+    a crawl: the gap law's reference is below the car's speed and rises more slowly than the
+    lead's speed (the gap shrinks). The feed-forward is the law's own rate, a_l - k_gap
+    (v - v_l): fed the lead's 1.5 m/s^2 in full, the speed loop sped the car up through the
+    law's reference and past the plan's speed (town, 30 km/h limit: 2 km/h over)."""
+    m, dt, v_plan = AccParams(), 0.05, 8.25
+    loop = SpeedController()
+    v, v_l, d, a_lead = 8.3, 0.3, 52.0, 1.5
+    fastest = 0.0
+    for _ in range(round(8.0 / dt)):
+        if v_l >= 7.0:
+            a_lead = 0.0
+        slope = (gaps(v, v_l, m).d_des - gaps(max(v - 0.1, 0.0), v_l, m).d_des) / 0.1
+        law = trail(v_plan, d, gaps(v, v_l, m).d_des, v_l, m.d0, P, a_lead, slope, v - v_l)
+        v = max(v + loop.update(law.speed, law.accel, v, dt).accel * dt, 0.0)
+        v_l += a_lead * dt
+        d += (v_l - v) * dt
+        fastest = max(fastest, v)
+    assert fastest <= v_plan + 0.1
+    assert trail(v_plan, 36.0, 16.0, 2.1, m.d0, P, 1.5, closing=5.8).accel == pytest.approx(
+        1.5 - P.k_gap * 5.8)
