@@ -25,6 +25,7 @@ from starting a long run while the others idle.
 from __future__ import annotations
 
 import contextlib
+import math
 import multiprocessing as mp
 import os
 import queue
@@ -96,7 +97,9 @@ def _in_job_order(jobs: Sequence[RunJob], outcomes: Sequence[RunOutcome]) -> lis
 
 
 class _QueueProgress:
-    """A worker's progress callback: a message per `PROGRESS_EVERY` of simulated time."""
+    """A worker's progress callback: a message per `PROGRESS_EVERY` of simulated time.
+    Progress is for the display only: a sink that is gone (the batch's manager process
+    ended: a pipe broken, a connection reset or closed) stops the messages, never the run."""
 
     def __init__(self, name: str, sink: Any) -> None:
         self.name, self.sink, self.next = name, sink, 0.0
@@ -104,7 +107,10 @@ class _QueueProgress:
     def __call__(self, t: float, duration: float) -> None:
         if t >= self.next:
             self.next = t + PROGRESS_EVERY
-            self.sink.put(Progress(self.name, t, duration))
+            try:
+                self.sink.put(Progress(self.name, t, duration))
+            except (OSError, EOFError):
+                self.next = math.inf
 
 
 def _ignore_sigint() -> None:

@@ -18,6 +18,7 @@ from avsim.batch.executors import (
     LocalExecutor,
     Progress,
     RayExecutor,
+    _QueueProgress,
     longest_first,
 )
 from avsim.batch.jobs import RunJob, RunOutcome, Status, not_run
@@ -122,3 +123,25 @@ def test_a_stopped_batch_ends_its_runs_at_their_tick_and_starts_no_more() -> Non
     not_started = [o for o in outcomes[1:] if o.result is None]
     assert not_started and all(o.error is not None and o.error.endswith(
         "not run (the batch was interrupted)") for o in not_started)
+
+
+class _GoneSink:
+    """A manager queue proxy whose manager process has ended."""
+
+    def __init__(self) -> None:
+        self.puts = 0
+
+    def put(self, _item: object) -> None:
+        self.puts += 1
+        raise BrokenPipeError(32, "Broken pipe")
+
+
+def test_a_progress_sink_that_is_gone_stops_the_messages_not_the_run() -> None:
+    """A campaign stopped from outside ends its manager process while the workers still run:
+    the progress message raised BrokenPipeError inside the run's loop, and the run was
+    written as an `error`."""
+    sink = _GoneSink()
+    progress = _QueueProgress("run", sink)
+    for k in range(50):
+        progress(0.1 * k, 5.0)  # no exception
+    assert sink.puts == 1  # the first failure ends the messages
