@@ -26,6 +26,11 @@ bumper f, its axles); tracks are in the map frame. Each tick
   it along the route whose centre is inside the lane kept widened by ``lane_margin`` on each
   side, now or ``look_ahead`` ahead at its velocity, or crosses the lane's centre line in
   between; the car stops ``crossing_stop`` before the crosswalk and waits until it is clear.
+  It also yields to a pedestrian on the crosswalk who walks across the road towards the
+  lane kept (at ``walk_in`` or faster, from within ``waiting_reach`` beyond its edges) while
+  a stop at ``a_comf`` is still left, and goes on yielding while one walks in: a pedestrian
+  who steps off the far kerb enters the lane's band only a few seconds later, when the stop
+  left is a hard one (or none), and the car would brake hard or pass close in front.
   The car's station is known only to its pose estimate's 1-sigma (``station_sigma``: a
   consumer receiver's bias along the route, which the camera's lane does not correct, 1.2 m
   1-sigma): the tracks are placed on the map with the same error, so a pedestrian on the
@@ -59,6 +64,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import NDArray
 
 from perception.messages import EgoState, ObjectClass, SignDetection, Track
 from planner.fsm.acc import NO_EVENTS, AccEvent
@@ -84,6 +90,10 @@ class EventParams:
     #   stop is at least, this many 1-sigmas of the car's station (one-sided 99.4 %): under
     #   a consumer receiver (1.2 m 1-sigma) the estimate may be 2.4 m off along the route,
     #   and a pedestrian on the crosswalk's near edge then appears 1.2 m short of it
+    law_margin: float = 1.0  # [m] the stop law's margin before the stop point
+    #   (`planner.acc_control.AccControlParams.margin`)
+    walk_in: float = 0.5  # [m/s] a pedestrian walking towards the lane kept at least this
+    #   fast across the road, within ``waiting_reach`` of it, is crossing (the yield)
     waiting_reach: float = 6.0  # [m] across, a pedestrian at a crosswalk this far beyond the
     #   lane's edges waits to cross: from the far kerb of a road of one lane each way (3.5 m
     #   lanes, 2 m shoulders: 5.5 m) it walks into the lane in under 3 s at 8 km/h
@@ -122,6 +132,8 @@ class EventMonitor:
         self.confirmed: set[float] = set()  # stop lines whose sign perception saw
         self.done: set[float] = set()  # stop lines stopped at, not yet passed
         self._standing_since: float | None = None
+        self._yield_at: float | None = None  # [m] the crosswalk yielded at to a pedestrian
+        #   walking in, held while one walks in (`_yields`)
         self._bump_at: float | None = None  # [m] the station of the bump approached: held
         #   until it is passed, the approach shrinking with the speed it sheds
         self._station: float | None = None  # [m] the car's centre at the last update: the
@@ -168,7 +180,7 @@ class EventMonitor:
         stop = self._stop_sign(t, front, v, approach,
                                lambda: queued(self.road, station, front, lane_offset, lane_width,
                                               tracks))
-        crossing = self._crossing(front, approach, lane_offset, lane_width, tracks,
+        crossing = self._crossing(front, v, approach, lane_offset, lane_width, tracks,
                                   p.station_sigmas * station_sigma)
         bump = self._bump(station, approach)
         zone = self.road.cross_section_at(limit_station).zone
@@ -205,16 +217,17 @@ class EventMonitor:
             self._standing_since = None
         return line - front - p.stop_margin
 
-    def _crossing(self, front: float, approach: float, lane_offset: float, lane_width: float,
-                  tracks: Sequence[Track], slack: float) -> float | None:
+    def _crossing(self, front: float, v: float, approach: float, lane_offset: float,
+                  lane_width: float, tracks: Sequence[Track], slack: float) -> float | None:
         """[m] from the front bumper to where the car must stand for a pedestrian at the next
-        crosswalk, or None (module doc); `slack` [m] how far off along the route the car's
-        station (and the tracks placed with it) may be."""
+        crosswalk, or None (module doc); `v` [m/s] the car's speed; `slack` [m] how far off
+        along the route the car's station (and the tracks placed with it) may be."""
         p = self.params
         cw = next((c for c in self.crosswalks
                    if front < c.s and c.s - front - slack <= approach), None)
         walkers = [tr for tr in tracks if tr.cls is ObjectClass.PEDESTRIAN]
         if cw is None or not walkers:
+            self._yield_at = None
             return None
         xy = np.array([[tr.x, tr.y] for tr in walkers])
         ahead = xy + p.look_ahead * np.array([[tr.vx, tr.vy] for tr in walkers])
@@ -225,9 +238,34 @@ class EventMonitor:
         half = 0.5 * lane_width + p.lane_margin
         lateral = np.minimum(np.abs(d_now - lane_offset), np.abs(d_next - lane_offset)) <= half
         crossing_between = np.sign(d_now - lane_offset) != np.sign(d_next - lane_offset)
-        if not np.any(on & (lateral | crossing_between)):
-            return None
-        return cw.s - front - max(p.crossing_stop, slack)
+        stand = cw.s - front - max(p.crossing_stop, slack)
+        if np.any(on & (lateral | crossing_between)) or self._yields(
+                cw.s, v, stand, on & self._walking_in(d_now, d_next, lane_offset, lane_width)):
+            return stand
+        return None
+
+    def _walking_in(self, d_now: NDArray[np.float64], d_next: NDArray[np.float64],
+                    lane_offset: float, lane_width: float) -> NDArray[np.bool_]:
+        """Which pedestrians, `d_now` [m] across now and `d_next` ``look_ahead`` ahead, walk
+        towards the lane kept (centre `lane_offset` [m], `lane_width` [m]) at ``walk_in`` or
+        faster from within ``waiting_reach`` beyond its edges: crossing the road towards it."""
+        p = self.params
+        towards = np.sign(lane_offset - d_now) * (d_next - d_now) / p.look_ahead
+        near = np.abs(d_now - lane_offset) <= 0.5 * lane_width + p.waiting_reach
+        return near & (towards >= p.walk_in)
+
+    def _yields(self, cw_s: float, v: float, stand: float, walking_in: NDArray[np.bool_]) -> bool:
+        """Whether the car yields at the crosswalk at `cw_s` [m] to a pedestrian crossing the
+        road towards its lane (`walking_in`, module doc) while a comfortable stop, at most
+        ``a_comf`` from the speed v [m/s] within `stand` [m] (less the stop law's margin),
+        is left; once it yields it goes on yielding while one walks in."""
+        if not np.any(walking_in):
+            self._yield_at = None
+            return False
+        p = self.params
+        if self._yield_at != cw_s and v * v <= 2.0 * p.a_comf * max(stand - p.law_margin, 0.0):
+            self._yield_at = cw_s
+        return self._yield_at == cw_s
 
     def waiting(self, station: float, lane_offset: float, lane_width: float,
                 tracks: Sequence[Track], station_sigma: float = 0.0) -> frozenset[float]:

@@ -195,6 +195,32 @@ def test_a_pedestrian_waits_at_a_crossing_ahead_from_the_kerb_or_the_far_side() 
     assert m.waiting(370.0, 0.0, W, ()) == frozenset()
 
 
+def test_the_car_yields_to_a_pedestrian_crossing_towards_its_lane_while_it_can_stop() -> None:
+    """A walker stepping off the far kerb (6.5 m left of the lane's centre) at 1.1 m/s is in
+    the lane's band (its half width + `lane_margin`) only some 2.5 s later, when the stop
+    left from 20 km/h is a hard one. The car yields as soon as it walks in while a stop at
+    `a_comf` is left, holds the yield while it walks in (the stop no longer comfortable as
+    the car brakes late in a test), and not for a walker who stands or walks away, nor when
+    the stop left is no longer comfortable as the walker starts."""
+    v = 20.0 * KPH
+    far_kerb = walker(402.0, 6.5, vy=-1.1)
+    m = EventMonitor(ROAD, VEHICLE, P)
+    assert 6.5 - P.look_ahead * 1.1 > 0.5 * W + P.lane_margin  # the band rule alone: none
+    yielding = at(m, 370.0, v, tracks=(far_kerb,))
+    assert yielding.holds(PEDESTRIAN)
+    assert yielding.stop_distance == pytest.approx(400.0 - 372.4 - P.crossing_stop)
+    assert at(m, 392.0, v, tracks=(walker(402.0, 5.0, vy=-1.1),)).holds(PEDESTRIAN)  # held
+    assert not at(m, 392.0, v, tracks=(walker(402.0, 5.0),)).holds(PEDESTRIAN)  # it stopped
+    late = EventMonitor(ROAD, VEHICLE, P)
+    assert not at(late, 392.0, v, tracks=(far_kerb,)).holds(PEDESTRIAN)  # no comfortable stop
+    other = EventMonitor(ROAD, VEHICLE, P)
+    assert not at(other, 370.0, v, tracks=(walker(402.0, 6.5),)).holds(PEDESTRIAN)  # stands
+    assert not at(other, 370.0, v, tracks=(walker(402.0, 6.5, vy=1.1),)).holds(PEDESTRIAN)
+    assert not at(other, 370.0, v, tracks=(walker(402.0, 6.5, vy=-0.4),)).holds(PEDESTRIAN)
+    beyond = 0.5 * W + P.waiting_reach + 0.5  # [m] farther out than a walker waiting
+    assert not at(other, 370.0, v, tracks=(walker(402.0, beyond, vy=-1.1),)).holds(PEDESTRIAN)
+
+
 def test_a_pedestrian_at_the_crossing_counts_within_the_stations_uncertainty() -> None:
     """The car's station is off by up to `station_sigmas` x its 1-sigma along the route, and
     the tracks placed with it by as much: a walker truly on the crosswalk's near edge (400.2
