@@ -5,6 +5,11 @@ Imports only `planner.messages`; returns a plain `VehicleCommand`.
 
 from __future__ import annotations
 
+# First: the `world` package holds numpy's SIMD dispatch at x86-64-v3 before numpy is
+# imported (the same numbers whichever package a program imports first).
+import world.frames  # noqa: F401
+
+# isort: split
 from control.actuation import VehicleParams, WheelTorques, longitudinal_force, wheel_torques
 from control.command import VehicleCommand
 from control.longitudinal import SpeedCommand, SpeedController, SpeedParams

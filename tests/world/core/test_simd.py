@@ -29,7 +29,9 @@ def dispatched(first_import: str, env: dict[str, str]) -> str:
     return out.stdout
 
 
-@pytest.mark.parametrize("first_import", ["avsim.cli", "world.frames", "bench"])
+@pytest.mark.parametrize("first_import", [
+    "avsim.cli", "world.frames", "bench", "control", "control.longitudinal", "planner",
+    "planner.acc_layer", "perception", "perception.lanes"])
 def test_no_avx512_kernel_whichever_package_comes_first(first_import: str) -> None:
     env = {k: v for k, v in os.environ.items() if k != NUMPY_ENV}
     env["PYTHONPATH"] = str(REPO)
