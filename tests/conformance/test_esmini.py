@@ -44,15 +44,6 @@ CUT_IN_PATH = ("the cut-in's lane change: esmini keeps the speed over ground (th
                "along the road slows while it moves across) and moves the reference point "
                "along the shape; avsim moves the body centre at the full speed along the "
                "road (0.28 m RMS); not yet matched")
-SYNC_START = ("NCAP CCFhol's GVT: esmini holds it still for the first step of its "
-              "SynchronizeAction (TargetTimeSteadyState; speed 0 until 0.025 s) and then runs "
-              "its speed law; avsim moves it at its Init speed from the start and starts the "
-              "law at 0.025 s: up to 0.94 m apart in the first 3 s, 0.3 m RMS (the SOV keeps "
-              "its distance to it); not yet matched")
-CCFHOL = ("ncap/AEB_C2C_2023/NCAP_AEB_C2C_CCFhol_2023",
-          "ncap/AEB_C2C_2023/Variations/NCAP_AEB_C2C_CCFhol_50kph_2023__p0",
-          "ncap/AEB_C2C_2023/Variations/NCAP_AEB_C2C_CCFhol_Variation_2023__p0",
-          "ncap/AEB_C2C_2023/Variations/NCAP_AEB_C2C_CCFhol_Variation_2023__p1")
 CYCLIST = ("NCAP CBLA's cyclist (VRU along the lane, SynchronizeAction to the Ego): 0.6 to "
            "1.0 m RMS from esmini's path and AtCollision 0.175 to 0.25 s late; cause not "
            "yet found")
@@ -63,7 +54,6 @@ ASAM_12_PATHS = ("ASAM 1.2 EndofTrafficJamNeighboringLaneOccupied: its events st
                  "esmini's, but A1 is 2.4 m RMS from esmini's path (its lane offsets are "
                  "2.0 m, the 1.3 file's 0.5 m); cause not yet found")
 KNOWN = {
-    **{(output, "paths"): SYNC_START for output in CCFHOL},
     **{(output, check): CYCLIST for check in ("events", "paths") for output in (
         "ncap/AEB_VRU_2023/NCAP_AEB_VRU_CBLA_2023",
         "ncap/AEB_VRU_2023/Variations/NCAP_AEB_VRU_CBLA-25_50kph_2023__p0",

@@ -33,8 +33,9 @@
   by the speed law of `synchronize` (esmini's), until it is done.
 - LongitudinalDistanceAction: keeps a distance (or a time gap at the referenced entity's
   speed) ahead of or behind the entity along its direction of travel on the route
-  (`Follow`): without acceleration limits reached by the next check and then held at the
-  entity's speed (esmini places the actor at the distance each step), else at the speed
+  (`Follow`; freespace between the boxes, about their centres): without acceleration
+  limits its whole error closed by the next check, at every check (esmini places the actor
+  at the distance each step), else at the speed
   `GAP_GAIN` gives within the DynamicConstraints' limits (`DISTANCE_ACCEL` where one is
   missing).
 """
@@ -212,8 +213,9 @@ class Commands:
         return ProfileCommand(tag, tuple(times), tuple(speeds))
 
     def synchronize(self, tag: str, entity: str, action: SynchronizeAction,
-                    snap: Snapshot) -> Sync:
-        """The targets where the positions are when the action starts."""
+                    snap: Snapshot, *, opening: bool = False) -> Sync:
+        """The targets where the positions are when the action starts; `opening`: it
+        starts at the storyboard's first check (`synchronize`)."""
         poses = poses_of(snap)
         target = self.resolver.resolve(action.target, poses)
         master = self.resolver.resolve(action.master_target, poses)
@@ -223,7 +225,7 @@ class Commands:
         steady = final.steady_state if final is not None else None
         law = Synchronizer(action.tolerance, action.tolerance_master,
                            steady.distance if steady is not None else None,
-                           steady.time if steady is not None else None)
+                           steady.time if steady is not None else None, opening=opening)
         return Sync(tag, entity, action, (float(s), float(d)), float(ms), law)
 
     def sync_step(self, sync: Sync, snap: Snapshot, dt: float) -> tuple[TrackCommand, bool]:
@@ -302,15 +304,18 @@ class Commands:
             (action.time_gap or 0.0) * max(ref.speed, 0.0))
         sign = -1.0 if action.displacement == "trailingReferencedEntity" else 1.0
         gap = sign * _travel(ref) * (me.s - ref.s)  # ahead of it along its way (trailing: behind)
-        if action.freespace:
-            gap -= 0.5 * (me.length + ref.length)
+        if action.freespace:  # bumper to bumper: between the boxes, about their centres
+            centres = (me.s + _travel(me) * me.centre_ahead) - (ref.s + _travel(ref)
+                                                                 * ref.centre_ahead)
+            gap = sign * _travel(ref) * centres - 0.5 * (me.length + ref.length)
         c = action.constraints
         if c is None or not (c.max_acceleration or c.max_deceleration):
-            if abs(gap - want) < GAP_REACHED:  # placed: on at the entity's speed (esmini
-                #   ends such an action once the actor is at its distance)
-                return TrackCommand(follow.tag, max(0.0, ref.speed), math.inf, math.inf), True
+            # the whole gap error closed within the period at every check, as esmini moves
+            # the actor onto the distance at every step; it ends such an action once the
+            # actor is within GAP_REACHED of its distance
             target = max(0.0, ref.speed - sign * (gap - want) / period)
-            return TrackCommand(follow.tag, target, math.inf, math.inf), False
+            return (TrackCommand(follow.tag, target, math.inf, math.inf),
+                    abs(gap - want) < GAP_REACHED)
         reached = abs(gap - want) < GAP_REACHED and abs(me.speed - ref.speed) < SPEED_MATCHED
         target = max(0.0, ref.speed + GAP_GAIN * sign * (gap - want))
         accel = c.max_acceleration or DISTANCE_ACCEL

@@ -80,6 +80,7 @@ class Director:
         self.ended = False
         self.ended_at: float | None = None  # [s] when the StopTrigger fired
         self._first = True
+        self._opening = False  # this check is the storyboard's first
         self._top = {e.name: getattr(e.object, "max_speed", WALKING_TOP)
                      for e in osc.entities}  # [m/s] each entity's top speed
         self.driver = Driver(world, program.ego, program.lane_ids)  # the stack's car's
@@ -100,6 +101,7 @@ class Director:
     def step(self) -> bool:
         """One trigger check; True once the storyboard's StopTrigger has fired."""
         snap = self.truth.snapshot()
+        self._opening = self._first
         if self._first:
             self._first = False
             for i, item in enumerate(self.program.init_commands):
@@ -234,7 +236,8 @@ class Director:
             elif isinstance(action, LongitudinalDistanceAction | LateralDistanceAction):
                 self._follows[tag] = Follow(tag, entity, action)
             elif isinstance(action, SynchronizeAction):
-                self._syncs[tag] = self.commands.synchronize(tag, entity, action, snap)
+                self._syncs[tag] = self.commands.synchronize(tag, entity, action, snap,
+                                                             opening=self._opening)
             else:
                 motion.command(self._once(tag, action, me, motion, snap))
         except ValueError as e:

@@ -5,7 +5,9 @@ of period `dt`.
 Distances: the master's to its target along the route (|ds|), the actor's straight to its
 target in route coordinates (hypot(ds, d offset), so that a pedestrian crossing the road
 on a path counts its walk). The master's time to its target is its distance over its speed
-along the route; while the master stands, the actor stands (waiting). The action is done
+along the route; when the master stands, the actor stops (waiting) and the law goes on
+from rest in the same check (a steady state's time taken off an endless master time leaves
+a finite one: the profile is chosen then). The action is done
 when either is within its tolerance of its target, when either distance grows (passed),
 or when the master arrives within the next check; the actor then takes the final speed (or
 keeps its own) and holds it.
@@ -20,6 +22,13 @@ speed, slows to a stop, waits, and starts again in time. A steady state (a dista
 time at vf) takes its share off both the distance and the time: the actor reaches vf that
 far before its target and holds it. Without a final speed, the acceleration is the
 constant one that makes the average speed s / t.
+
+An action that starts at the storyboard's first check (`opening`) is stepped twice then,
+as esmini steps it in its opening frame (a step of 0 s before any entity has moved, where
+every velocity reads 0: the master stands) and again in its first step of the period,
+from rest: the actor waits, and its profile is chosen against an endless master time
+(concave; with a convex need the first real step finds it at the apex at once: the actor
+stands for the first check and is linear from the next).
 """
 
 from __future__ import annotations
@@ -59,7 +68,9 @@ class Synchronizer:
     """The state of one running SynchronizeAction (module doc)."""
 
     def __init__(self, tolerance: float, tolerance_master: float,
-                 steady_distance: float | None, steady_time: float | None) -> None:
+                 steady_distance: float | None, steady_time: float | None, *,
+                 opening: bool = False) -> None:
+        """`opening`: the action starts at the storyboard's first check (module doc)."""
         self.tolerance = tolerance  # [m]
         self.tolerance_master = tolerance_master  # [m]
         self.steady_distance = steady_distance  # [m]
@@ -67,9 +78,20 @@ class Synchronizer:
         self.mode = Mode.NONE
         self.convex = False  # the non-linear profile speeds up first
         self._last = (LARGE, LARGE)  # [m] the distances at the last check
+        self.opening = opening  # its first step is preceded by esmini's opening frame
 
     def step(self, x: SyncInput, dt: float) -> tuple[float, bool]:
         """([m/s] the actor's speed until the next check, whether the action is done)."""
+        if self.opening:
+            self.opening = False
+            speed, done = self._step(SyncInput(x.dist, x.master_dist, 0.0, 0.0,
+                                               x.final_speed), 0.0)
+            if done:
+                return speed, True
+            x = SyncInput(x.dist, x.master_dist, speed, x.master_speed, x.final_speed)
+        return self._step(x, dt)
+
+    def _step(self, x: SyncInput, dt: float) -> tuple[float, bool]:
         dist, master_dist = x.dist, x.master_dist
         done = (dist < self.tolerance + SMALL or master_dist < self.tolerance_master + SMALL
                 or dist > self._last[0] or master_dist > self._last[1])
@@ -77,20 +99,21 @@ class Synchronizer:
         dist = max(dist - self.tolerance, SMALL)
         master_dist = max(master_dist - self.tolerance_master, SMALL)
         t = LARGE
+        speed = x.speed
         if x.master_speed > SMALL:
             t = master_dist / x.master_speed
             done = done or t < dt
-        elif self.mode is not Mode.WAITING and not done:
-            self.mode = Mode.WAITING
-            return 0.0, False
+        elif self.mode is not Mode.WAITING:
+            self.mode = Mode.WAITING  # the actor stops and the law goes on from rest
+            speed = 0.0
         if done:
-            return (x.final_speed if x.final_speed is not None else x.speed), True
+            return (x.final_speed if x.final_speed is not None else speed), True
         if x.final_speed is None:
             if t >= LARGE:
-                return x.speed, False
+                return speed, False
             self.mode = Mode.LINEAR
-            return x.speed + (2.0 * dist / t - 2.0 * x.speed) / t * dt, False
-        return self._with_final_speed(x.speed, dist, t, x.final_speed, dt), False
+            return speed + (2.0 * dist / t - 2.0 * speed) / t * dt, False
+        return self._with_final_speed(speed, dist, t, x.final_speed, dt), False
 
     def _steady(self, dist: float, t: float, vf: float) -> tuple[float, float]:
         """(distance, time) left before the steady state, or the mode set to it."""

@@ -76,3 +76,35 @@ def test_the_actor_waits_while_the_master_stands() -> None:
     law = Synchronizer(0.0, 0.0, None, None)
     assert law.step(SyncInput(50.0, 80.0, 6.0, 0.0, 8.0), DT) == (0.0, False)
     assert law.mode is Mode.WAITING
+
+
+def test_a_standing_master_stops_the_actor_and_the_law_goes_on_from_rest() -> None:
+    """With a steady state, the endless master time less the steady state's time is a
+    finite one: the profile is chosen in the same check (esmini), not at the next."""
+    law = Synchronizer(0.0, 0.0, None, 4.0)
+    assert law.step(SyncInput(155.0, 150.0, 19.0, 0.0, 19.0), DT) == (0.0, False)
+    assert law.mode is Mode.NON_LINEAR
+    assert not law.convex  # against an endless time: concave
+
+
+def test_an_action_opening_the_storyboard_holds_its_actor_for_the_first_check() -> None:
+    """esmini's opening frame (every velocity 0): the actor stands for the first check,
+    reaches the apex at once and goes on linear: 2 s / t - vf at the next check, s and t
+    less the steady state's share."""
+    law = Synchronizer(0.0, 0.0, None, 4.0, opening=True)
+    d, m, v, vm, vf = 155.6, 151.9, 19.4, 19.4, 19.4
+    assert law.step(SyncInput(d, m, v, vm, vf), DT) == (0.0, False)
+    assert law.mode is Mode.LINEAR
+    m -= vm * DT
+    v, done = law.step(SyncInput(d, m, 0.0, vm, vf), DT)
+    s, t = d - 4.0 * vf, m / vm - 4.0
+    assert not done
+    assert v == pytest.approx(2.0 * s / t - vf)
+    assert v > vf
+
+
+def test_without_the_opening_the_actor_keeps_moving_from_its_speed() -> None:
+    law = Synchronizer(0.0, 0.0, None, 4.0)
+    v, _ = law.step(SyncInput(155.6, 151.9, 19.4, 19.4, 19.4), DT)
+    assert v > 19.4
+    assert law.mode is Mode.NON_LINEAR
