@@ -120,6 +120,13 @@ search_path_option = click.option(
     "in, besides the file's own folder tree (repeatable; tried in order).")
 
 
+ego_option = click.option(
+    "--ego", type=click.Choice(EGO_MODES), default="stack", show_default=True,
+    help="What drives the car under test: avsim's stack, or (scripted, OpenSCENARIO files) "
+         "the file's own actions as esmini plays them, its controllers not simulated, no "
+         "sensors (the profile is none).")
+
+
 class SeedType(click.IntRange):
     """`--seed`: an integer in 0..MAX_SEED (numpy's seed range); a text too long to be one
     is refused by its length, not echoed back."""
@@ -161,10 +168,7 @@ class SeedType(click.IntRange):
 @click.option("--criteria", "criteria", type=click.Path(path_type=Path), default=None,
               help="An OpenSCENARIO file's criteria (default: NAME.criteria.yaml beside it).")
 @click.option("--no-progress", is_flag=True, help="No progress bar.")
-@click.option("--ego", type=click.Choice(EGO_MODES), default="stack", show_default=True,
-              help="What drives the car under test: avsim's stack, or (scripted, "
-                   "OpenSCENARIO files) the file's own actions as esmini plays them, its "
-                   "controllers not simulated, no sensors (the profile is none).")
+@ego_option
 @click.option("--permutation", type=click.IntRange(min=0), default=None, metavar="K",
               help="An OpenSCENARIO ParameterValueDistribution file's run K (0-based, as "
                    "esmini's --param_permutation); without it every run, into the folder "
@@ -276,14 +280,12 @@ def _run_distribution(ctx: click.Context, scenario: str, out: Path | None,
     if single_files:
         _bad_input(f"{scenario}: --json / --plot: a distribution file makes several runs "
                    "(each writes its own into --out; --permutation K runs one)")
-    if ctx.params["ego"] != "stack":
-        _bad_input(f"{scenario}: --ego scripted: a distribution file's runs are a suite, "
-                   "which the stack drives (--permutation K plays one scripted)")
     name = re.sub(r"[^a-z0-9_]+", "_", Path(scenario).stem.lower()).strip("_")
     options = ctx.params
     ctx.invoke(suite, paths=(scenario,), out=out or Path("runs") / name, sets=options["sets"],
                params=options["params"], criteria=options["criteria"],
-               profile=options["profile"], search_paths=options["search_paths"])
+               profile=options["profile"], search_paths=options["search_paths"],
+               ego=options["ego"])
     sys.exit(0)  # pragma: no cover - suite exits with the batch's status
 
 
@@ -401,6 +403,7 @@ _batch_options = [
     click.option("--dry-run", is_flag=True,
                  help="Load and check every run, print each as its `avsim run` command "
                       "line, and run none."),
+    ego_option,
 ]
 
 
@@ -428,7 +431,8 @@ def batch_options(f: Callable[..., None]) -> Callable[..., None]:
 @search_path_option
 def suite(paths: tuple[str, ...], out: Path, sets: tuple[str, ...], params: tuple[str, ...],
           criteria: Path | None, jobs: int | None, executor: str, address: str | None,
-          profile: str, snapshots: bool, dry_run: bool, search_paths: tuple[Path, ...]) -> None:
+          profile: str, snapshots: bool, dry_run: bool, ego: str,
+          search_paths: tuple[Path, ...]) -> None:
     """Run scenarios in parallel: files, folders or bundled names (default: every scenario
     in scenarios/). Writes each run's .rrd, .json and .png, junit.xml, summary.md."""
     from avsim.batch import suite as batch
@@ -437,8 +441,9 @@ def suite(paths: tuple[str, ...], out: Path, sets: tuple[str, ...], params: tupl
     try:
         overrides = _one_value_each(sets + tuple(PARAMETER_PREFIX + p for p in params))
         batch.validate_out_dir(out)
-        entries = batch.suite_entries(batch.collect_scenarios(paths), overrides, search_paths)
-        planned = batch.plan(entries, out, profile, criteria, search_paths)
+        entries = batch.suite_entries(batch.collect_scenarios(paths), overrides, search_paths,
+                                      ego)
+        planned = batch.plan(entries, out, profile, criteria, search_paths, ego)
     except (ScenarioError, SweepError, batch.BatchError) as exc:
         _bad_input(str(exc))
     if dry_run:
@@ -446,9 +451,14 @@ def suite(paths: tuple[str, ...], out: Path, sets: tuple[str, ...], params: tupl
     with _held(batch_lock(out)), Interrupts() as stop:  # Ctrl-C / SIGTERM: what finished is kept
         outcomes = _execute(planned, executor, jobs, address, stop)
         unwritten = batch.reports_written(outcomes, out, lambda: _report(
-            outcomes, out, f"avsim suite ({len(outcomes)} runs)", snapshots))
+            outcomes, out, f"avsim suite ({len(outcomes)} runs{_ego_note(ego)})", snapshots))
     status = batch.exit_status(outcomes, stop.exit_status)
     _exit(unwritten, status)
+
+
+def _ego_note(ego: str) -> str:
+    """A batch's title's note of what drove the car under test: none for the stack."""
+    return "" if ego == "stack" else f", ego {ego}"
 
 
 def _held(lock: AbstractContextManager[None]) -> ExitStack:
@@ -502,7 +512,7 @@ def _print_plan(planned: Sequence[RunJob]) -> NoReturn:
 @search_path_option
 def sweep(scenario: str, sets: tuple[str, ...], params: tuple[str, ...], out: Path | None,
           metric: str, jobs: int | None, executor: str, address: str | None, profile: str,
-          snapshots: bool, dry_run: bool, search_paths: tuple[Path, ...]) -> None:
+          snapshots: bool, dry_run: bool, ego: str, search_paths: tuple[Path, ...]) -> None:
     """Run SCENARIO over the grid of --set values (default: the file's own `grid`), like a
     suite; write sweep.csv, sweep.md and, over two swept keys, heatmap.png of --metric."""
     from avsim.batch import suite as batch
@@ -510,7 +520,8 @@ def sweep(scenario: str, sets: tuple[str, ...], params: tuple[str, ...], out: Pa
 
     try:
         axes = [parse_set(s) for s in sets + tuple(PARAMETER_PREFIX + p for p in params)]
-        loaded = load_scenario(scenario, search_paths=search_paths)
+        loaded = load_scenario(scenario, search_paths=search_paths,
+                               scripted_ego=ego == "scripted")
         axes = axes or [Axis(path, values) for path, values in loaded.grid]
         if not axes:
             raise SweepError("give at least one --set or --param to sweep (the file has "
@@ -520,7 +531,7 @@ def sweep(scenario: str, sets: tuple[str, ...], params: tuple[str, ...], out: Pa
         out = out if out is not None else Path("runs") / f"sweep_{name}"
         batch.validate_out_dir(out)
         entries = [(f"{name}_{k:03d}", scenario, overrides) for k, overrides in enumerate(runs)]
-        planned = batch.plan(entries, out, profile, search_paths=search_paths)
+        planned = batch.plan(entries, out, profile, search_paths=search_paths, ego=ego)
     except (ScenarioError, SweepError, batch.BatchError) as exc:
         _bad_input(str(exc))
     if dry_run:
@@ -529,7 +540,8 @@ def sweep(scenario: str, sets: tuple[str, ...], params: tuple[str, ...], out: Pa
         outcomes = _execute(planned, executor, jobs, address, stop)
 
         def reports() -> None:
-            _report(outcomes, out, f"avsim sweep {name} ({len(outcomes)} runs)", snapshots)
+            _report(outcomes, out, f"avsim sweep {name} ({len(outcomes)} runs{_ego_note(ego)})",
+                    snapshots)
             _sweep_report(outcomes, out, [a.path for a in axes if len(a.values) > 1],
                           [a.path for a in axes], metric, name)
 
@@ -595,7 +607,7 @@ def _options(options: Sequence[Callable[..., Any]]) -> Callable[..., Any]:
     return decorate
 
 
-_campaign_options = [_batch_options[k] for k in (0, 1, 2, 3, 5)]  # no snapshots
+_campaign_options = [_batch_options[k] for k in (0, 1, 2, 3, 5, 6)]  # no snapshots
 
 
 @main.command()
@@ -628,7 +640,8 @@ _campaign_options = [_batch_options[k] for k in (0, 1, 2, 3, 5)]  # no snapshots
 def campaign(files: tuple[str, ...], n: int, seed: int, out: Path | None,
              sets: tuple[str, ...], record: str, shrink: bool, metric: str | None,
              iterations: int, population: int, resume: bool, jobs: int | None,
-             executor: str, address: str | None, profile: str, dry_run: bool) -> None:
+             executor: str, address: str | None, profile: str, dry_run: bool,
+             ego: str) -> None:
     """Run N scenarios drawn from each campaign FILE (a scenario file with a `vary:`
     section) like a suite; write a repro file of each failure, campaign.json, summary.md,
     junit.xml (docs/cli.md, "Campaigns")."""
@@ -639,7 +652,7 @@ def campaign(files: tuple[str, ...], n: int, seed: int, out: Path | None,
 
     try:
         settings, families, planned, drawn = _campaign_plan(files, n, seed, out, sets,
-                                                            metric, profile)
+                                                            metric, profile, ego)
     except (ScenarioError, SweepError, batch.BatchError) as exc:
         _bad_input(str(exc))
     if dry_run:
@@ -680,21 +693,23 @@ def _campaign_runs(planned: list[RunJob], resume: bool,
 
 
 def _campaign_plan(files: Sequence[str], n: int, seed: int, out: Path | None,
-                   sets: Sequence[str], metric: str | None, profile: str) -> tuple[Any, ...]:
+                   sets: Sequence[str], metric: str | None, profile: str,
+                   ego: str) -> tuple[Any, ...]:
     """The campaign's settings, families, checked jobs and drawn values (bad input raises)."""
     import re
 
     from avsim.batch import campaign as c
     from avsim.batch import suite as batch
+    from avsim.batch.jobs import ego_profile
 
     fixed = _one_value_each(sets)
-    families = [c.load_family(file, index) for index, file in enumerate(files)]
+    families = [c.load_family(file, index, ego) for index, file in enumerate(files)]
     if metric is not None and not re.fullmatch(r"[a-z0-9_]{1,64}", metric):
         raise batch.BatchError(f"--search: {metric[:64]!r} is not a metric's name ([a-z0-9_]+)")
     name = families[0].name if len(families) == 1 else "all"
     out = out if out is not None else Path("runs") / f"campaign_{name}"
     batch.validate_out_dir(out)
-    settings = c.Settings(out, profile, fixed, seed)
+    settings = c.Settings(out, ego_profile(ego, profile), fixed, seed, ego)
     planned, drawn = c.draw_plan(families, n, settings)
     return settings, families, planned, drawn
 

@@ -23,7 +23,7 @@ from typing import Any
 
 import yaml
 
-from avsim.batch.jobs import RunJob, RunOutcome, Status
+from avsim.batch.jobs import SCRIPTED, STACK, RunJob, RunOutcome, Status
 from avsim.batch.sampling import SEED_KEY, Law, draw_run, laws_of
 from avsim.batch.suite import BatchError, overrides_of, plan
 from avsim.scenario.errors import LocatedError, ScenarioError
@@ -79,6 +79,7 @@ class Settings:
     profile: str = "default"
     fixed: Mapping[str, object] = field(default_factory=dict)  # `--set`: every run's
     seed: int = 0  # `--seed`: the campaign's draws
+    ego: str = STACK  # what drives the car under test (`RunJob.ego`, `--ego`)
 
 
 def _value_at(raw: Mapping[str, Any], path: str) -> object:
@@ -94,13 +95,14 @@ def _value_at(raw: Mapping[str, Any], path: str) -> object:
     return node
 
 
-def load_family(file: str, index: int) -> Family:
-    """A campaign file, loaded and checked; `ScenarioError` for a bad one, `BatchError`
-    for a file without `vary:` or an OpenSCENARIO file."""
+def load_family(file: str, index: int, ego: str = STACK) -> Family:
+    """A campaign file, loaded and checked for `ego` (`RunJob.ego`); `ScenarioError` for a
+    bad one (a YAML file's car under test cannot be scripted), `BatchError` for a file
+    without `vary:` or an OpenSCENARIO file."""
     path = scenario_path(file)
     if path.suffix == ".xosc":
         raise BatchError(f"{file}: (file): a campaign file is an avsim/1 YAML file with vary:")
-    loaded = load_scenario(file)
+    loaded = load_scenario(file, scripted_ego=ego == SCRIPTED)
     try:
         raw = read_raw(path)
         model = validate(raw, {})
@@ -136,7 +138,7 @@ def draw_plan(families: Sequence[Family], runs: int, settings: Settings,
 def jobs_of(entries: Sequence[tuple[str | None, str, Mapping[str, object]]],
             settings: Settings, out_dir: Path | None = None) -> list[RunJob]:
     """Checked jobs (`plan`) into `out_dir` (default the campaign's), without plots."""
-    planned = plan(entries, out_dir or settings.out_dir, settings.profile)
+    planned = plan(entries, out_dir or settings.out_dir, settings.profile, ego=settings.ego)
     return [replace(job, plot=False) for job in planned]
 
 

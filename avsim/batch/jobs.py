@@ -29,6 +29,15 @@ if TYPE_CHECKING:
 
 
 KEY_SUFFIX = ".key"  # a campaign run's key file, beside its result JSON (`resume_key`)
+STACK, SCRIPTED = "stack", "scripted"  # what drives the car under test (`RunJob.ego`)
+EGO_MODES = (STACK, SCRIPTED)
+NO_SENSORS = "none"  # the profile of a scripted car under test: it reads no sensors
+
+
+def ego_profile(ego: str, profile: str) -> str:
+    """The sensor profile a run of `ego` has: `NO_SENSORS` when the file's actions move the
+    car under test (`SCRIPTED`), else `profile`."""
+    return NO_SENSORS if ego == SCRIPTED else profile
 
 
 class Status(Enum):
@@ -60,6 +69,13 @@ class RunJob:
     criteria: Path | None = None  # an OpenSCENARIO file's sidecar (`--criteria`), else None
     resume_key: str | None = None  # a campaign run's key (`avsim.batch.resume.run_key`),
     #   written to <out_dir>/<name>.key once its result JSON is (None: no key file)
+    ego: str = STACK  # what drives the car under test: avsim's stack, or (`SCRIPTED`, an
+    #   OpenSCENARIO file) the file's own actions, no sensors (`EgoSpec.scripted`)
+
+    @property
+    def scripted(self) -> bool:
+        """Whether the file's own actions move the car under test (`ego` is `SCRIPTED`)."""
+        return self.ego == SCRIPTED
 
     @property
     def recording(self) -> Path:
@@ -172,7 +188,7 @@ def run_job(job: RunJob, into: Path | None = None,
     start = time.perf_counter()
     try:
         scenario = load_scenario(job.scenario, dict(job.overrides), job.criteria,
-                                 search_paths=job.search_paths)
+                                 search_paths=job.search_paths, scripted_ego=job.scripted)
         check_profile(scenario, job.profile, job.scenario)
     except ScenarioError as exc:
         return RunOutcome(job, Status.BAD_INPUT, error=str(exc),

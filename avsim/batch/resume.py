@@ -1,14 +1,15 @@
 """Resuming a campaign: which of its runs already finished, on the same input and code.
 
 A run is a pure function of its input (the scenario file, its drawn and `--set` values,
-the sensor profile) and of the simulator's code: same input and seed, same result, bit for
-bit. So a finished run need not run again while none of those changed. Each campaign run
-carries its key (`run_key`): a SHA-256 over the scenario file's bytes, the job's name,
-overrides and profile, and the code's fingerprint (`code_fingerprint`). When the run has
-written its result JSON, the worker writes the key beside it (`<run>.key`, after the
-result: a run cut off between the two has no key and runs again). `avsim campaign
---resume` takes the result of each run whose key file holds its key and whose result says
-it finished (not interrupted), and runs the others.
+the sensor profile, what drives the car under test) and of the simulator's code: same
+input and seed, same result, bit for bit. So a finished run need not run again while none
+of those changed. Each campaign run carries its key (`run_key`): a SHA-256 over the
+scenario file's bytes, the job's name, overrides, profile and car under test (`RunJob.ego`:
+a stack run and a scripted run of one file are different runs), and the code's fingerprint
+(`code_fingerprint`). When the run has written its result JSON, the worker writes the key
+beside it (`<run>.key`, after the result: a run cut off between the two has no key and runs
+again). `avsim campaign --resume` takes the result of each run whose key file holds its key
+and whose result says it finished (not interrupted), and runs the others.
 
 Not compared: files the scenario file itself names (a road or catalog beside it); a
 campaign whose files name such a file and that has changed must not be resumed.
@@ -64,12 +65,13 @@ def code_fingerprint() -> str:
 
 def run_key(job: RunJob, fingerprint: str) -> str:
     """The key of `job`'s run: SHA-256 over its scenario file's bytes, name, overrides,
-    profile, sidecar and the code's `fingerprint`."""
+    profile, car under test (`RunJob.ego`), sidecar and the code's `fingerprint`."""
     scenario = hashlib.sha256(scenario_path(job.scenario).read_bytes()).hexdigest()
     sidecar = (hashlib.sha256(job.criteria.read_bytes()).hexdigest()
                if job.criteria is not None else None)
     text = json.dumps({"name": job.name, "scenario": scenario, "overrides": job.overrides,
-                       "profile": job.profile, "sidecar": sidecar, "code": fingerprint},
+                       "profile": job.profile, "ego": job.ego, "sidecar": sidecar,
+                       "code": fingerprint},
                       sort_keys=True, default=repr)
     return hashlib.sha256(text.encode()).hexdigest()
 

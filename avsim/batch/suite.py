@@ -25,7 +25,7 @@ from rich.progress import BarColumn, TaskID, TextColumn, TimeElapsedColumn
 from rich.progress import Progress as RichProgress
 
 from avsim.batch.executors import Executor, Progress
-from avsim.batch.jobs import RunJob, RunOutcome, Status
+from avsim.batch.jobs import SCRIPTED, STACK, RunJob, RunOutcome, Status, ego_profile
 from avsim.files import write_atomic
 from avsim.outputs import (
     Output,
@@ -78,14 +78,15 @@ def collect_scenarios(args: Sequence[str]) -> list[str]:
 
 
 def suite_entries(scenarios: Sequence[str], overrides: Mapping[str, object] | None = None,
-                  search_paths: Sequence[Path] = (),
+                  search_paths: Sequence[Path] = (), ego: str = STACK,
                   ) -> list[tuple[str | None, str, dict[str, object]]]:
     """The runs of a suite over `scenarios` (`plan`'s entries): one per scenario, one per
     point of its file's `grid` (named ``<name>_<k:03d>``, as a sweep names its runs), or one
     per concrete run of an OpenSCENARIO distribution file (`avsim.batch.distributions`), each
     with `overrides` (`--set`, `--param`) besides its point; `search_paths` as
-    `load_scenario` takes them. A key both set and swept by the file's grid is a
-    `BatchError`: the grid's points would all be the same run."""
+    `load_scenario` takes them, each file loaded for `ego` (`RunJob.ego`). A key both set
+    and swept by the file's grid is a `BatchError`: the grid's points would all be the
+    same run."""
     from avsim.batch.distributions import (
         DistributionError,
         distribution_entries,
@@ -102,7 +103,8 @@ def suite_entries(scenarios: Sequence[str], overrides: Mapping[str, object] | No
             except DistributionError as exc:
                 raise BatchError(str(exc)) from None
             continue
-        loaded = load_scenario(scenario, search_paths=search_paths)
+        loaded = load_scenario(scenario, search_paths=search_paths,
+                               scripted_ego=ego == SCRIPTED)
         if not loaded.grid:
             entries.append((None, scenario, dict(given)))
             continue
@@ -132,20 +134,23 @@ def overrides_of(point: Mapping[str, object]) -> dict[str, object]:
 
 def plan(entries: Sequence[tuple[str | None, str, Mapping[str, object]]], out_dir: Path,
          profile: str, criteria: Path | None = None, search_paths: Sequence[Path] = (),
-         ) -> list[RunJob]:
+         ego: str = STACK) -> list[RunJob]:
     """Validate each (job name or None for the scenario's own, scenario, overrides) and make
-    its job, which carries `search_paths` to its worker; `criteria` is the sidecar of the
-    OpenSCENARIO files among them (`--criteria`). Raises `ScenarioError` (naming the
+    its job, which carries `search_paths` and `ego` (`RunJob.ego`: a scripted car under
+    test runs at profile none, `ego_profile`) to its worker; `criteria` is the sidecar of
+    the OpenSCENARIO files among them (`--criteria`). Raises `ScenarioError` (naming the
     scenario) for the first bad one, `BatchError` for two runs that would write the same
     files, a run named like a report (`REPORT_NAMES`) or a run's file that is an input of the
     batch (a scenario file, an OpenSCENARIO file's road or sidecar)."""
     planned: list[RunJob] = []
     names: dict[str, str] = {}
     sources: set[Path] = set()
+    profile = ego_profile(ego, profile)
     for name, scenario, overrides in entries:
         sidecar = criteria if scenario_path(scenario).suffix == ".xosc" else None
         try:
-            loaded = load_scenario(scenario, dict(overrides), sidecar, search_paths=search_paths)
+            loaded = load_scenario(scenario, dict(overrides), sidecar, search_paths=search_paths,
+                                   scripted_ego=ego == SCRIPTED)
         except ScenarioError as exc:  # a sidecar's override problem names no file
             if exc.file != OVERRIDES_FILE:
                 raise
@@ -162,7 +167,7 @@ def plan(entries: Sequence[tuple[str | None, str, Mapping[str, object]]], out_di
         sources.update(loaded.sources)
         planned.append(RunJob(job_name, scenario, out_dir, dict(overrides), profile,
                               duration=loaded.duration, criteria=sidecar,
-                              search_paths=tuple(search_paths)))
+                              search_paths=tuple(search_paths), ego=ego))
     _check_not_inputs(planned, sorted(sources))
     return planned
 
@@ -185,7 +190,8 @@ def _check_not_inputs(jobs: Sequence[RunJob], sources: Sequence[Path]) -> None:
 def run_command(job: RunJob) -> str:
     """The `avsim run` command line that makes `job`'s run (`--dry-run` prints them): its
     scenario, overrides as `--set PATH=VALUE` (JSON, which YAML reads the same), sidecar,
-    search paths, profile and files, quoted for a POSIX shell."""
+    search paths, car under test (`--ego scripted`), profile and files, quoted for a POSIX
+    shell."""
     words = ["avsim", "run", job.scenario]
     for key, value in job.overrides.items():
         words += ["--set", f"{key}={json.dumps(value)}"]
@@ -193,6 +199,8 @@ def run_command(job: RunJob) -> str:
         words += ["--criteria", str(job.criteria)]
     for folder in job.search_paths:
         words += ["--search-path", str(folder)]
+    if job.scripted:
+        words += ["--ego", SCRIPTED]
     words += ["--profile", job.profile, "--out", str(job.recording)]
     return shlex.join(words)
 
@@ -326,10 +334,11 @@ def reports_written(outcomes: Sequence[RunOutcome], out_dir: Path,
 
 
 def results_json(outcomes: Sequence[RunOutcome]) -> list[dict[str, object]]:
-    """Every run of the batch: its name, overrides, status, error and result."""
+    """Every run of the batch: its name, overrides, car under test (`RunJob.ego`), status,
+    error and result."""
     return [{"name": o.job.name, "scenario": o.job.scenario,
-             "overrides": dict(o.job.overrides), "status": o.status.value, "error": o.error,
-             "result": o.result} for o in outcomes]
+             "overrides": dict(o.job.overrides), "ego": o.job.ego, "status": o.status.value,
+             "error": o.error, "result": o.result} for o in outcomes]
 
 
 def comparable(outcome: RunOutcome) -> dict[str, object]:

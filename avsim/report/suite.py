@@ -140,13 +140,15 @@ def _sanitize(root: ET.Element) -> None:
 
 
 def _properties(outcome: RunOutcome) -> dict[str, str]:
-    """The run's facts: scenario, file, seed (if known), profile, status, overrides."""
+    """The run's facts: scenario, file, seed (if known), profile, what drove the car under
+    test (stack or scripted), status, overrides."""
     result = outcome.result or {}
     props = {
         "scenario": str(result.get("scenario", outcome.job.scenario)),
         "file": str(result.get("file", outcome.job.scenario)),
         "seed": format_value(result.get("seed")),
         "profile": str(result.get("profile", outcome.job.profile)),
+        "ego": str(result.get("ego", outcome.job.ego)),
         "status": outcome.status.value,
     }
     if "seed" not in result:  # a run that did not finish: its seed is not known here
@@ -239,7 +241,8 @@ def junit_xml(outcomes: Sequence[RunOutcome], suite_name: str) -> str:
     """The batch as a JUnit XML document (UTF-8 text with its declaration).
 
     `<testsuites name=suite_name>` holds one `<testsuite name=job name>` per run, with
-    `<properties>` (scenario, file, seed, profile, status, `override.<key>` per swept key)
+    `<properties>` (scenario, file, seed, profile, ego, status, `override.<key>` per swept
+    key)
     and one `<testcase classname="avsim.<job name>" name=<criterion>>` per criterion; a
     failed criterion's `<failure message="at T s: <its first infraction>; value V unit
     (threshold T)">` (no infraction: the numbers only) has as text the numbers, its first
@@ -402,9 +405,10 @@ def _run_section(outcome: RunOutcome) -> list[str]:
     job = outcome.job
     lines = [f"## {job.name}: {_verdict(outcome)}", ""]
     props = _properties(outcome)
+    values = "".join(f", {_inline_code(k)} = {_inline_code(v)}"
+                     for k, v in job.overrides.items())
     lines += [f"Scenario `{props['file']}`, seed {props.get('seed', DASH)}, profile "
-              f"{props['profile']}" + "".join(f", {_inline_code(k)} = {_inline_code(v)}"
-                                              for k, v in job.overrides.items()) + ".", ""]
+              f"{props['profile']}, ego {props['ego']}{values}.", ""]
     if _in_error(outcome):
         lines += [f"> {_md_text(outcome.error or outcome.status.value)}", ""]
     if outcome.result is None:
@@ -445,7 +449,8 @@ def summary_markdown(outcomes: Sequence[RunOutcome], *, title: str, out_dir: Pat
     contact, those a rule excused too); a table
     with a row per run
     (verdict, times, links to its .rrd and .json, and its speed-profile .png if that file
-    exists); a section per run with its scenario, seed, profile, overrides, its contacts
+    exists); a section per run with its scenario, seed, profile, car under test (ego stack
+    or scripted), overrides, its contacts
     (when it had any) and a row per criterion (or its error line); then, for each failed
     run with a snapshot in `snapshots` (job name -> PNG), the image, titled with its first
     failure's time.

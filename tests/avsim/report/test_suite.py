@@ -179,7 +179,7 @@ def test_junit_properties(tmp_path: Path) -> None:
     props = {p.attrib["name"]: p.attrib["value"]
              for p in suites["cut_in_fail"].findall("properties/property")}
     assert props == {"scenario": "cut_in", "file": "scenarios/cut_in.yaml", "seed": "3",
-                     "profile": "fast", "status": "failed",
+                     "profile": "fast", "ego": "stack", "status": "failed",
                      "override.actors.0.speed_kph": "40", "override.actors.0.s": "10"}
     typo = {p.attrib["name"]: p.attrib["value"] for p in suites["typo"].iter("property")}
     assert typo["file"] == "typo.yaml" and typo["status"] == "bad_input"
