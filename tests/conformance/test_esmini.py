@@ -40,10 +40,6 @@ from tests.conformance.reference import (
 )
 
 CONTROLLED = "the Ego has an esmini controller in this run: compared in no_controllers/"
-CUT_IN_PATH = ("the cut-in's lane change: esmini keeps the speed over ground (the progress "
-               "along the road slows while it moves across) and moves the reference point "
-               "along the shape; avsim moves the body centre at the full speed along the "
-               "road (0.28 m RMS); not yet matched")
 SYNC_START = ("NCAP CCFhol's GVT: esmini holds it still for the first step of its "
               "SynchronizeAction (TargetTimeSteadyState; speed 0 until 0.025 s) and then runs "
               "its speed law; avsim moves it at its Init speed from the start and starts the "
@@ -74,8 +70,6 @@ KNOWN = {
        for name in ("CCRb_40m_2ms2_2023", "CCRb_Variation_2023")},
     ("asam_examples/exampleFilesVersion1_2/EndofTrafficJamNeighboringLaneOccupied",
      "paths"): ASAM_12_PATHS,
-    ("alks/no_controllers/alks_scenario_4_4_2_cut_in_unavoidable_collision_template",
-     "paths"): CUT_IN_PATH,
 }
 CONTROLLED_RUNS = {r.output.replace("/no_controllers", "") for r in runs()
                    if "/no_controllers/" in r.output}  # their default twins

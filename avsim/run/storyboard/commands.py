@@ -5,8 +5,9 @@
   referenced entity's speed now plus a delta / times a factor), shaped and timed by its
   dynamics (`profiles`: a rate is the peak acceleration); a continuous relative target
   keeps following the entity's speed afterwards (`Follow`).
-- LaneChangeAction: a lateral transition to the target lane's centre (plus its target
-  offset); the target lane is an OpenDRIVE id, or lanes to the left of an entity's lane; a
+- LaneChangeAction: a lateral transition of the reference point to the target lane's centre
+  (plus its target offset) by esmini's law (`world.actors.profiles`: the speed kept over
+  ground); the target lane is an OpenDRIVE id, or lanes to the left of an entity's lane; a
   rate is the peak lateral speed.
 - LaneOffsetAction: a lateral transition to an offset from the actor's lane centre (or to
   an entity's lateral position plus a value, to its left when it drives along the route:
@@ -130,19 +131,18 @@ class Commands:
                                             span), snap.time, continuous=continuous)
 
     def lane_change(self, tag: str, action: LaneChangeAction, me: EntityState,
-                    centre_offset: float, snap: Snapshot) -> LateralCommand:
-        """`centre_offset`: the actor's body centre offset from the reference line [m]."""
+                    snap: Snapshot) -> LateralCommand:
+        """The reference point from its offset to the target lane's centre plus the target
+        offset, by esmini's law (`world.actors.profiles`)."""
         lane = target_route_lane(action, self.lane_ids, self.road.lanes_at(me.s), snap)
         goal = float(self.road.lane(lane).offset_at(me.s)) + (action.target_lane_offset or 0.0)
         d = action.dynamics
         shape = Shape(d.shape)
-        if d.dimension == "distance":
-            return LateralCommand(tag, Transition(centre_offset, goal, shape, d.value),
-                                  snap.time, me.s, by_distance=True, lane=lane)
-        span = d.value if d.dimension == "time" else span_by_rate(shape, goal - centre_offset,
-                                                                   d.value)
-        return LateralCommand(tag, Transition(centre_offset, goal, shape, span), snap.time,
-                              me.s, lane=lane)
+        by_distance = d.dimension == "distance"
+        span = d.value if d.dimension != "rate" else span_by_rate(shape, goal - me.offset,
+                                                                  d.value)
+        return LateralCommand(tag, Transition(me.offset, goal, shape, span), snap.time, me.s,
+                              by_distance=by_distance, lane=lane, ahead=me.centre_ahead)
 
     def lane_offset(self, tag: str, action: LaneOffsetAction, me: EntityState,
                     centre_offset: float, snap: Snapshot) -> LateralCommand:

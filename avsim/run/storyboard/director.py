@@ -245,7 +245,7 @@ class Director:
         """The command of an action that needs no renewal."""
         c = self.commands
         if isinstance(action, LaneChangeAction):
-            return c.lane_change(tag, action, me, motion.offset, snap)
+            return c.lane_change(tag, action, me, snap)
         if isinstance(action, LaneOffsetAction):
             return c.lane_offset(tag, action, me, motion.offset, snap)
         if isinstance(action, FollowTrajectoryAction):
