@@ -55,9 +55,11 @@ CYCLIST = ("NCAP CBLA's cyclist (VRU along the lane, SynchronizeAction to the Eg
 CCRB = ("NCAP CCRb's GVT: its braking starts one check after esmini's (the placement by "
         "the LongitudinalDistanceAction ends at the next check, esmini's at once), and its "
         "path is 1.3 to 3.1 m RMS off esmini's; cause of the rest not yet found")
-ASAM_12_PATHS = ("ASAM 1.2 EndofTrafficJamNeighboringLaneOccupied: its events start as "
-                 "esmini's, but A1 is 2.4 m RMS from esmini's path (its lane offsets are "
-                 "2.0 m, the 1.3 file's 0.5 m); cause not yet found")
+ASAM_12_PATHS = ("ASAM 1.2 EndofTrafficJamNeighboringLaneOccupied: A1 (placed in lane -4 "
+                 "2.0 m left of its centre, its lane change to lane -3 as esmini's) brakes "
+                 "at 10 m/s^2 while it changes lanes; esmini moves it each 0.025 s step at "
+                 "the speed of the step's start, avsim each 1/120 s step: A1 stops 0.49 m "
+                 "short of esmini's, 0.21 m RMS; not yet matched")
 KNOWN = {
     **{(output, "paths"): SYNC_START for output in CCFHOL},
     **{(output, check): CYCLIST for check in ("events", "paths") for output in (

@@ -136,6 +136,7 @@ class NpcMotion:
         #   reference point (station [m], offset [m]), the body's heading from the route's
         #   direction [rad] (left +) and where the step puts the body centre
         self._lc_x = 0.0  # [s] or [m]
+        self._speed_before = speed  # [m/s] at the start of the step (a lane change's)
         self._ref: tuple[float, float] | None = None
         self._yaw: float | None = None
         self._place: tuple[float, float] | None = None
@@ -248,10 +249,13 @@ class NpcMotion:
                 self._planned = self._target_speed = self._speed_after(cmd)
                 self._keep_facing = self.pedestrian
                 self._speed_action = None
+                if cmd.lane is not None:
+                    self.lane = cmd.lane
                 self.finished.append(cmd.tag)
             return True
         if self._speed_cmd is None and self._lateral_cmd is None:
             return False
+        self._speed_before = self.speed
         if self._speed_cmd is None:
             self._step_speed(t, dt)
         else:
@@ -318,7 +322,7 @@ class NpcMotion:
         """One step of esmini's lane change law: the reference point moves, the body centre
         `ahead` [m] in front of it along the step's heading (0 once done)."""
         assert self._ref is not None
-        step = lane_change_step(cmd.transition, self._lc_x, cmd.by_distance, self.speed, dt)
+        step = lane_change_step(cmd.transition, self._lc_x, cmd.by_distance, self._speed_before, dt)
         self._lc_x = step.x
         scale = max(1.0 - curvature * step.offset, 1e-3)  # station rate at that offset
         s_ref = self._ref[0] + self.direction * step.along / scale

@@ -17,7 +17,9 @@ lateral move runs over the distance travelled. esmini times a speed change by di
 same way; it reads a lateral `rate` as the peak lateral speed as well.
 
 A lane change (`LateralCommand` with `ahead`) moves the entity's reference point by
-esmini's law, each step of dt from progress x: the speed v is kept over ground; timed
+esmini's law, each step of dt from progress x: the speed v is kept over ground (the speed
+at the step's start: esmini steps the lane change before a speed action of the same
+step); timed
 (time or rate), the lateral step is |f'(x)| dt (the shape's slope before the step), the
 progress along the lane sqrt((v dt)^2 - (f'(x) dt)^2) and x advances by dt (a lateral step
 longer than v dt: no progress along, x advances by v dt on the linear shape); by distance,
@@ -185,6 +187,7 @@ class PathCommand:
     s: tuple[float, ...]  # [m]
     offset: tuple[float, ...]  # [m]
     times: tuple[float, ...] | None  # [s] simulation time at each vertex, increasing
+    lane: int | None = None  # the lane its end is in (None: unchanged)
 
     def speeds_at_end(self, speed: float) -> tuple[float, float]:
         """([m/s] along the route, [m/s] over ground) of the path's last segment (timed: its

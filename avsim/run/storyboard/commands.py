@@ -43,6 +43,7 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 from avsim.run.storyboard.snapshot import EntityState, Snapshot
@@ -131,10 +132,11 @@ class Commands:
                                             span), snap.time, continuous=continuous)
 
     def lane_change(self, tag: str, action: LaneChangeAction, me: EntityState,
-                    snap: Snapshot) -> LateralCommand:
+                    snap: Snapshot, lanes: Mapping[str, int]) -> LateralCommand:
         """The reference point from its offset to the target lane's centre plus the target
-        offset, by esmini's law (`world.actors.profiles`)."""
-        lane = target_route_lane(action, self.lane_ids, self.road.lanes_at(me.s), snap)
+        offset, by esmini's law (`world.actors.profiles`); `lanes`: the entities' lanes as
+        their positions and lane changes named them (`target_route_lane`)."""
+        lane = target_route_lane(action, self.lane_ids, self.road.lanes_at(me.s), snap, lanes)
         goal = float(self.road.lane(lane).offset_at(me.s)) + (action.target_lane_offset or 0.0)
         d = action.dynamics
         shape = Shape(d.shape)
@@ -175,7 +177,8 @@ class Commands:
         if timing is not None and line.times is not None:
             base = snap.time if timing.domain == "relative" else 0.0
             times = tuple(base + float(t) * timing.scale + timing.offset for t in line.times)
-        return PathCommand(tag, tuple(float(x) for x in s), tuple(float(x) for x in d), times)
+        return PathCommand(tag, tuple(float(x) for x in s), tuple(float(x) for x in d), times,
+                           self.road.lane_at(xy[-1])[0])
 
     def teleport(self, tag: str, action: TeleportAction, me: EntityState,
                  snap: Snapshot) -> TeleportCommand:
@@ -184,7 +187,8 @@ class Commands:
         ahead = me.centre_ahead
         xy = (p.x + ahead * math.cos(p.heading), p.y + ahead * math.sin(p.heading))
         s, d = self.road.local_coordinates(xy)
-        lane = self.road.lane_at(xy)[0]
+        lane = (self.lane_ids.index(p.lane_id) if p.lane_id in self.lane_ids
+                else self.road.lane_at(xy)[0])  # a lane position's lane, as it names it
         return TeleportCommand(tag, float(s), float(d), lane)
 
     def speed_profile(self, tag: str, action: SpeedProfileAction, me: EntityState,
@@ -374,10 +378,13 @@ def _offset_span(shape: Shape, distance: float, accel: float) -> float:
 
 
 def target_route_lane(action: LaneChangeAction, lane_ids: tuple[int, ...], lanes_here: int,
-                      snap: Snapshot) -> int:
+                      snap: Snapshot, lanes: Mapping[str, int] | None = None) -> int:
     """The route lane (0 = rightmost) a lane change goes to: an OpenDRIVE lane id of the
-    route, or lanes to the left of an entity's lane. `lanes_here`: the route's lane count
-    at the actor; `ValueError` for a lane the route does not have there."""
+    route, or lanes to the left of an entity's lane: its lane in `lanes` (as its position
+    or its last lane change named it: esmini keeps a lane position's lane even where the
+    offset puts the entity over the border), else the lane its reference point is in.
+    `lanes_here`: the route's lane count at the actor; `ValueError` for a lane the route
+    does not have there."""
     target = action.target
     if isinstance(target, AbsoluteTargetLane):
         lane_id = int(target.value)
@@ -385,10 +392,10 @@ def target_route_lane(action: LaneChangeAction, lane_ids: tuple[int, ...], lanes
             raise ValueError(f"lane {lane_id} is not a lane of the route")
         lane = lane_ids.index(lane_id)
     else:
-        ref = snap.entities[target.entity]
-        if ref.lane is None:
+        ref_lane = (lanes or {}).get(target.entity, snap.entities[target.entity].lane)
+        if ref_lane is None:
             raise ValueError(f"entity {target.entity} is in no lane")
-        lane = ref.lane + target.value
+        lane = ref_lane + target.value
     if not 0 <= lane < lanes_here:
         raise ValueError(f"the target lane (route lane {lane}) does not exist here")
     return lane
