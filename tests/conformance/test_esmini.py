@@ -40,19 +40,17 @@ from tests.conformance.reference import (
 )
 
 CONTROLLED = "the Ego has an esmini controller in this run: compared in no_controllers/"
-CUT_IN_PATH = ("the cut-in's lane change: esmini keeps the speed over ground (the progress "
-               "along the road slows while it moves across) and moves the reference point "
-               "along the shape; avsim moves the body centre at the full speed along the "
-               "road (0.28 m RMS); not yet matched")
 CYCLIST = ("NCAP CBLA's cyclist (VRU along the lane, SynchronizeAction to the Ego): 0.6 to "
            "1.0 m RMS from esmini's path and AtCollision 0.175 to 0.25 s late; cause not "
            "yet found")
 CCRB = ("NCAP CCRb's GVT: its braking starts one check after esmini's (the placement by "
         "the LongitudinalDistanceAction ends at the next check, esmini's at once), and its "
         "path is 1.3 to 3.1 m RMS off esmini's; cause of the rest not yet found")
-ASAM_12_PATHS = ("ASAM 1.2 EndofTrafficJamNeighboringLaneOccupied: its events start as "
-                 "esmini's, but A1 is 2.4 m RMS from esmini's path (its lane offsets are "
-                 "2.0 m, the 1.3 file's 0.5 m); cause not yet found")
+ASAM_12_PATHS = ("ASAM 1.2 EndofTrafficJamNeighboringLaneOccupied: A1 (placed in lane -4 "
+                 "2.0 m left of its centre, its lane change to lane -3 as esmini's) brakes "
+                 "at 10 m/s^2 while it changes lanes; esmini moves it each 0.025 s step at "
+                 "the speed of the step's start, avsim each 1/120 s step: A1 stops 0.49 m "
+                 "short of esmini's, 0.21 m RMS; not yet matched")
 KNOWN = {
     **{(output, check): CYCLIST for check in ("events", "paths") for output in (
         "ncap/AEB_VRU_2023/NCAP_AEB_VRU_CBLA_2023",
@@ -64,8 +62,6 @@ KNOWN = {
        for name in ("CCRb_40m_2ms2_2023", "CCRb_Variation_2023")},
     ("asam_examples/exampleFilesVersion1_2/EndofTrafficJamNeighboringLaneOccupied",
      "paths"): ASAM_12_PATHS,
-    ("alks/no_controllers/alks_scenario_4_4_2_cut_in_unavoidable_collision_template",
-     "paths"): CUT_IN_PATH,
 }
 CONTROLLED_RUNS = {r.output.replace("/no_controllers", "") for r in runs()
                    if "/no_controllers/" in r.output}  # their default twins

@@ -37,6 +37,7 @@ from world.actors.profiles import (
     SpeedCommand,
     TeleportCommand,
     TrackCommand,
+    lane_change_step,
 )
 from world.frames import wrap_angle
 from world.spec import (
@@ -131,6 +132,14 @@ class NpcMotion:
         self._path_index = 0  # the vertex an untimed path heads for
         self._path_speed = 0.0  # [m/s] the speed an untimed path is followed at
         self._keep_facing = False  # a pedestrian moving on after a path keeps its heading
+        # a lane change by esmini's law (`world.actors.profiles`): its progress, its
+        #   reference point (station [m], offset [m]), the body's heading from the route's
+        #   direction [rad] (left +) and where the step puts the body centre
+        self._lc_x = 0.0  # [s] or [m]
+        self._speed_before = speed  # [m/s] at the start of the step (a lane change's)
+        self._ref: tuple[float, float] | None = None
+        self._yaw: float | None = None
+        self._place: tuple[float, float] | None = None
         self.finished: list[str] = []  # tags of commands that reached their goal, in order
         self.jumped = False  # teleported since its body was last placed
 
@@ -173,6 +182,8 @@ class NpcMotion:
         both (each replaces what drove that part before); a teleport moves the actor at
         once and is done."""
         self._keep_facing = False
+        if not isinstance(cmd, SpeedLike):
+            self._ref = self._yaw = None
         if isinstance(cmd, TeleportCommand):
             self.s, self.offset, self._target_offset = cmd.s, cmd.offset, cmd.offset
             self._path_cmd = self._lateral_cmd = None
@@ -187,6 +198,7 @@ class NpcMotion:
             self._path_speed = self.ground_speed
         elif isinstance(cmd, LateralCommand):
             self._path_cmd, self._lateral_cmd = None, cmd
+            self._start_reference(cmd)
         elif self._path_cmd is not None and self._path_cmd.times is None:
             self._speed_cmd = cmd
         else:
@@ -200,10 +212,22 @@ class NpcMotion:
             self._hold_speed()
         if self._lateral_cmd is not None and self._lateral_cmd.tag == tag:
             self._lateral_cmd = None
+            self._ref = self._yaw = None
         if self._path_cmd is not None and self._path_cmd.tag == tag:
             self._path_cmd = None
             self._hold_speed()
             self.lateral_speed = 0.0
+
+    def _start_reference(self, cmd: LateralCommand) -> None:
+        """A lane change by esmini's law starts from the reference point `cmd.ahead` behind
+        the body centre along its heading, the body aligned with its lane (esmini resets
+        the heading when a lane change starts)."""
+        if cmd.ahead is None:
+            return
+        yaw = self.heading_offset * self.direction  # from the route's direction, left +
+        self._ref = (self.s - self.direction * cmd.ahead * math.cos(yaw),
+                     self.offset - cmd.ahead * math.sin(yaw))
+        self._lc_x, self._yaw = 0.0, 0.0
 
     def _hold_speed(self) -> None:
         self._planned = self._target_speed = self.speed
@@ -225,10 +249,13 @@ class NpcMotion:
                 self._planned = self._target_speed = self._speed_after(cmd)
                 self._keep_facing = self.pedestrian
                 self._speed_action = None
+                if cmd.lane is not None:
+                    self.lane = cmd.lane
                 self.finished.append(cmd.tag)
             return True
         if self._speed_cmd is None and self._lateral_cmd is None:
             return False
+        self._speed_before = self.speed
         if self._speed_cmd is None:
             self._step_speed(t, dt)
         else:
@@ -273,6 +300,9 @@ class NpcMotion:
     def _step_lateral_cmd(self, t: float, dt: float, curvature: float) -> None:
         cmd = self._lateral_cmd
         assert cmd is not None
+        if cmd.ahead is not None:
+            self._step_lane_change(cmd, cmd.ahead, dt, curvature)
+            return
         if cmd.by_distance:
             scale = max(1.0 - curvature * self.offset, 1e-3)
             x = abs(self.s + self.direction * self.speed * dt / scale - cmd.s0)
@@ -287,6 +317,29 @@ class NpcMotion:
                 self.lane = cmd.lane
             self.finished.append(cmd.tag)
 
+    def _step_lane_change(self, cmd: LateralCommand, ahead: float, dt: float,
+                          curvature: float) -> None:
+        """One step of esmini's lane change law: the reference point moves, the body centre
+        `ahead` [m] in front of it along the step's heading (0 once done)."""
+        assert self._ref is not None
+        step = lane_change_step(cmd.transition, self._lc_x, cmd.by_distance, self._speed_before, dt)
+        self._lc_x = step.x
+        scale = max(1.0 - curvature * step.offset, 1e-3)  # station rate at that offset
+        s_ref = self._ref[0] + self.direction * step.along / scale
+        self._ref = (s_ref, step.offset)
+        yaw = 0.0 if step.done else step.heading
+        centre = (s_ref + self.direction * ahead * math.cos(yaw) / scale,
+                  step.offset + ahead * math.sin(yaw))
+        self.lateral_speed = (centre[1] - self.offset) / dt
+        self._place, self._yaw = centre, yaw
+        if step.done:
+            self._lateral_cmd = None
+            self._ref = self._yaw = None
+            self._target_offset = centre[1]
+            if cmd.lane is not None:
+                self.lane = cmd.lane
+            self.finished.append(cmd.tag)
+
     # -- motion ------------------------------------------------------------------------------
 
     def step(self, t: float, dt: float, curvature: float) -> None:
@@ -297,6 +350,9 @@ class NpcMotion:
             self._step_lateral(t, dt)
         if self.pedestrian:
             self._turn(dt)
+        if self._place is not None:  # a lane change by esmini's law placed the body
+            (self.s, self.offset), self._place = self._place, None
+            return
         scale = 1.0 - curvature * self.offset
         self.s += self.direction * self.speed * dt / max(scale, 1e-3)
         self.offset += self.lateral_speed * dt
@@ -356,6 +412,8 @@ class NpcMotion:
         """[rad] the body's yaw relative to its lane's direction of travel (module doc)."""
         if self.pedestrian:
             return self._facing
+        if self._yaw is not None:  # a lane change by esmini's law
+            return self._yaw * self.direction
         if self.speed <= 0.1:
             return 0.0
         return math.atan2(self.lateral_speed, self.speed) * self.direction

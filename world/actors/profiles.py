@@ -16,6 +16,17 @@ timed by the mean speed of the symmetric shapes, span = 2 distance / (start + ta
 lateral move runs over the distance travelled. esmini times a speed change by distance the
 same way; it reads a lateral `rate` as the peak lateral speed as well.
 
+A lane change (`LateralCommand` with `ahead`) moves the entity's reference point by
+esmini's law, each step of dt from progress x: the speed v is kept over ground (the speed
+at the step's start: esmini steps the lane change before a speed action of the same
+step); timed
+(time or rate), the lateral step is |f'(x)| dt (the shape's slope before the step), the
+progress along the lane sqrt((v dt)^2 - (f'(x) dt)^2) and x advances by dt (a lateral step
+longer than v dt: no progress along, x advances by v dt on the linear shape); by distance,
+the progress along the lane is v dt / sqrt(1 + f'(x)^2) and x advances by it. The body's
+heading from its lane's direction is the step's direction, atan2(lateral, along); 0 once
+the change is done.
+
 Commands (a director gives them: `avsim.run.storyboard`) override the actor's own scripted
 actions while they run; each carries a `tag` that the motion reports in `finished` once the
 command reached its goal.
@@ -72,6 +83,47 @@ class Transition:
         return self.start + delta * f, delta * slope / self.span, False
 
 
+@dataclass(frozen=True, slots=True)
+class LaneChangeStep:
+    """One step of a lane change's reference point (module doc)."""
+
+    x: float  # [s] or [m] the transition's progress after the step
+    offset: float  # [m] the reference point's lateral offset after the step
+    along: float  # [m] its progress along the lane this step (>= 0)
+    heading: float  # [rad] the body's heading from the lane's direction, left +
+    done: bool
+
+
+HEADING_ACROSS = 0.5 * math.pi - 1e-9  # [rad] a step with no progress along points across
+
+
+def lane_change_step(transition: Transition, x: float, by_distance: bool, speed: float,
+                     dt: float) -> LaneChangeStep:
+    """The step of dt [s] at `speed` [m/s] over ground from progress `x` along `transition`
+    (of the lateral offset [m], in time [s] or, `by_distance`, in distance along [m])."""
+    step_len = abs(speed) * dt
+    if step_len <= 0.0:  # at rest nothing moves (esmini: no lateral motion at rest)
+        offset = transition.at(x)[0] if x > 0.0 else transition.start
+        return LaneChangeStep(x, offset, 0.0, 0.0, False)
+    _, rate, _ = transition.at(x)
+    if by_distance:
+        along = step_len / math.sqrt(1.0 + rate * rate)
+        offset, _, done = transition.at(x + along)
+        return LaneChangeStep(x + along, offset, along, math.atan(rate), done)
+    lateral = abs(rate) * dt
+    if lateral < step_len:
+        along = math.sqrt(step_len * step_len - lateral * lateral)
+        offset, _, done = transition.at(x + dt)
+        return LaneChangeStep(x + dt, offset, along,
+                              math.atan2(math.copysign(lateral, rate), along), done)
+    # faster across than the speed allows: straight across, linearly, at the speed
+    change = abs(transition.target - transition.start)
+    x_new = x + step_len * transition.span / change
+    linear = Transition(transition.start, transition.target, Shape.LINEAR, transition.span)
+    offset, _, done = linear.at(x_new)
+    return LaneChangeStep(x_new, offset, 0.0, math.copysign(HEADING_ACROSS, rate), done)
+
+
 def span_by_rate(shape: Shape, change: float, rate: float) -> float:
     """[s] the span of a change of |change| whose peak rate is `rate` (> 0)."""
     if shape is Shape.STEP or change == 0.0:
@@ -121,6 +173,9 @@ class LateralCommand:
     s0: float  # [m] the station when it started (travelled distance = |s - s0|)
     by_distance: bool = False
     lane: int | None = None  # the lane it ends in (a lane change), None: unchanged
+    ahead: float | None = None  # [m] a lane change: the transition moves the reference
+    #   point, this far behind the body centre, by esmini's law (module doc); None: it moves
+    #   the body centre at the full speed along the route
 
 
 @dataclass(frozen=True, slots=True)
@@ -132,6 +187,7 @@ class PathCommand:
     s: tuple[float, ...]  # [m]
     offset: tuple[float, ...]  # [m]
     times: tuple[float, ...] | None  # [s] simulation time at each vertex, increasing
+    lane: int | None = None  # the lane its end is in (None: unchanged)
 
     def speeds_at_end(self, speed: float) -> tuple[float, float]:
         """([m/s] along the route, [m/s] over ground) of the path's last segment (timed: its

@@ -5,8 +5,9 @@
   referenced entity's speed now plus a delta / times a factor), shaped and timed by its
   dynamics (`profiles`: a rate is the peak acceleration); a continuous relative target
   keeps following the entity's speed afterwards (`Follow`).
-- LaneChangeAction: a lateral transition to the target lane's centre (plus its target
-  offset); the target lane is an OpenDRIVE id, or lanes to the left of an entity's lane; a
+- LaneChangeAction: a lateral transition of the reference point to the target lane's centre
+  (plus its target offset) by esmini's law (`world.actors.profiles`: the speed kept over
+  ground); the target lane is an OpenDRIVE id, or lanes to the left of an entity's lane; a
   rate is the peak lateral speed.
 - LaneOffsetAction: a lateral transition to an offset from the actor's lane centre (or to
   an entity's lateral position plus a value, to its left when it drives along the route:
@@ -43,6 +44,7 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 from avsim.run.storyboard.snapshot import EntityState, Snapshot
@@ -131,19 +133,19 @@ class Commands:
                                             span), snap.time, continuous=continuous)
 
     def lane_change(self, tag: str, action: LaneChangeAction, me: EntityState,
-                    centre_offset: float, snap: Snapshot) -> LateralCommand:
-        """`centre_offset`: the actor's body centre offset from the reference line [m]."""
-        lane = target_route_lane(action, self.lane_ids, self.road.lanes_at(me.s), snap)
+                    snap: Snapshot, lanes: Mapping[str, int]) -> LateralCommand:
+        """The reference point from its offset to the target lane's centre plus the target
+        offset, by esmini's law (`world.actors.profiles`); `lanes`: the entities' lanes as
+        their positions and lane changes named them (`target_route_lane`)."""
+        lane = target_route_lane(action, self.lane_ids, self.road.lanes_at(me.s), snap, lanes)
         goal = float(self.road.lane(lane).offset_at(me.s)) + (action.target_lane_offset or 0.0)
         d = action.dynamics
         shape = Shape(d.shape)
-        if d.dimension == "distance":
-            return LateralCommand(tag, Transition(centre_offset, goal, shape, d.value),
-                                  snap.time, me.s, by_distance=True, lane=lane)
-        span = d.value if d.dimension == "time" else span_by_rate(shape, goal - centre_offset,
-                                                                   d.value)
-        return LateralCommand(tag, Transition(centre_offset, goal, shape, span), snap.time,
-                              me.s, lane=lane)
+        by_distance = d.dimension == "distance"
+        span = d.value if d.dimension != "rate" else span_by_rate(shape, goal - me.offset,
+                                                                  d.value)
+        return LateralCommand(tag, Transition(me.offset, goal, shape, span), snap.time, me.s,
+                              by_distance=by_distance, lane=lane, ahead=me.centre_ahead)
 
     def lane_offset(self, tag: str, action: LaneOffsetAction, me: EntityState,
                     centre_offset: float, snap: Snapshot) -> LateralCommand:
@@ -176,7 +178,8 @@ class Commands:
         if timing is not None and line.times is not None:
             base = snap.time if timing.domain == "relative" else 0.0
             times = tuple(base + float(t) * timing.scale + timing.offset for t in line.times)
-        return PathCommand(tag, tuple(float(x) for x in s), tuple(float(x) for x in d), times)
+        return PathCommand(tag, tuple(float(x) for x in s), tuple(float(x) for x in d), times,
+                           self.road.lane_at(xy[-1])[0])
 
     def teleport(self, tag: str, action: TeleportAction, me: EntityState,
                  snap: Snapshot) -> TeleportCommand:
@@ -185,7 +188,8 @@ class Commands:
         ahead = me.centre_ahead
         xy = (p.x + ahead * math.cos(p.heading), p.y + ahead * math.sin(p.heading))
         s, d = self.road.local_coordinates(xy)
-        lane = self.road.lane_at(xy)[0]
+        lane = (self.lane_ids.index(p.lane_id) if p.lane_id in self.lane_ids
+                else self.road.lane_at(xy)[0])  # a lane position's lane, as it names it
         return TeleportCommand(tag, float(s), float(d), lane)
 
     def speed_profile(self, tag: str, action: SpeedProfileAction, me: EntityState,
@@ -379,10 +383,13 @@ def _offset_span(shape: Shape, distance: float, accel: float) -> float:
 
 
 def target_route_lane(action: LaneChangeAction, lane_ids: tuple[int, ...], lanes_here: int,
-                      snap: Snapshot) -> int:
+                      snap: Snapshot, lanes: Mapping[str, int] | None = None) -> int:
     """The route lane (0 = rightmost) a lane change goes to: an OpenDRIVE lane id of the
-    route, or lanes to the left of an entity's lane. `lanes_here`: the route's lane count
-    at the actor; `ValueError` for a lane the route does not have there."""
+    route, or lanes to the left of an entity's lane: its lane in `lanes` (as its position
+    or its last lane change named it: esmini keeps a lane position's lane even where the
+    offset puts the entity over the border), else the lane its reference point is in.
+    `lanes_here`: the route's lane count at the actor; `ValueError` for a lane the route
+    does not have there."""
     target = action.target
     if isinstance(target, AbsoluteTargetLane):
         lane_id = int(target.value)
@@ -390,10 +397,10 @@ def target_route_lane(action: LaneChangeAction, lane_ids: tuple[int, ...], lanes
             raise ValueError(f"lane {lane_id} is not a lane of the route")
         lane = lane_ids.index(lane_id)
     else:
-        ref = snap.entities[target.entity]
-        if ref.lane is None:
+        ref_lane = (lanes or {}).get(target.entity, snap.entities[target.entity].lane)
+        if ref_lane is None:
             raise ValueError(f"entity {target.entity} is in no lane")
-        lane = ref.lane + target.value
+        lane = ref_lane + target.value
     if not 0 <= lane < lanes_here:
         raise ValueError(f"the target lane (route lane {lane}) does not exist here")
     return lane

@@ -128,6 +128,14 @@ class Director:
         i = self._index.get(entity)
         return None if i is None else self.world.actors.motions[i]
 
+    def _entity_lanes(self) -> dict[str, int]:
+        """Each commanded entity's route lane as its position or lane change named it."""
+        lanes = {name: self.world.actors.motions[i].lane for name, i in self._index.items()}
+        scripted = self.world.scripted
+        if scripted is not None:
+            lanes[self.program.ego] = scripted.motion.lane
+        return lanes
+
     def _motions(self) -> list[NpcMotion]:
         """Every motion the director commands."""
         scripted = self.world.scripted
@@ -248,7 +256,7 @@ class Director:
         """The command of an action that needs no renewal."""
         c = self.commands
         if isinstance(action, LaneChangeAction):
-            return c.lane_change(tag, action, me, motion.offset, snap)
+            return c.lane_change(tag, action, me, snap, self._entity_lanes())
         if isinstance(action, LaneOffsetAction):
             return c.lane_offset(tag, action, me, motion.offset, snap)
         if isinstance(action, FollowTrajectoryAction):

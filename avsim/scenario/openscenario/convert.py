@@ -119,7 +119,8 @@ def load_xosc(path: Path, overrides: Mapping[str, object] | None = None,
     ego_spec = replace(_ego_spec(path, road_map, ego.name, placed, ahead[ego.name], engaged),
                        scripted=scripted_ego)
     others = [e for e in osc.entities if e.name != ego.name]
-    actors = tuple(_actor_spec(path, road_map, e, placed, ahead[e.name]) for e in others)
+    actors = tuple(_actor_spec(path, road_map, e, placed, ahead[e.name],
+                               route.layout.lane_ids) for e in others)
     program = StoryProgram(
         scenario=osc, chain=route.chain, ego=ego.name,
         actors=tuple((e.name, i) for i, e in enumerate(others)),
@@ -336,10 +337,15 @@ def _ego_spec(path: Path, road_map: RoadMap, name: str, placed: Mapping[str, _Pl
 
 
 def _actor_spec(path: Path, road_map: RoadMap, entity: Entity,
-                placed: Mapping[str, _Placed], ahead: float) -> spec.ActorSpec:
+                placed: Mapping[str, _Placed], ahead: float,
+                lane_ids: tuple[int, ...]) -> spec.ActorSpec:
     lane, s, r = _centre(path, road_map, entity.name, placed, ahead)
     if lane is None:  # off the lanes (a pedestrian on the verge): from the nearest lane
         lane, r = _nearest_lane(road_map, s, r)
+    named = _named_lane(placed[entity.name].pose, lane_ids)
+    if named is not None and named != lane:  # its lane as the position named it (esmini's)
+        r += float(road_map.lane(lane).offset_at(s) - road_map.lane(named).offset_at(s))
+        lane = named
     obj = entity.object
     base = spec.ActorSpec(id=_actor_id(entity.name), type=spec.ActorType.OBSTACLE, lane=lane,
                           s=s, offset=r, speed=placed[entity.name].speed,
@@ -354,6 +360,14 @@ def _actor_spec(path: Path, road_map: RoadMap, entity: Entity,
                        facing=_facing(road_map, lane, s, placed[entity.name].pose))
     assert isinstance(obj, MiscObject)
     return replace(base, size=size)
+
+
+def _named_lane(pose: Pose | None, lane_ids: tuple[int, ...]) -> int | None:
+    """The route lane a lane position placed the entity in (its OpenDRIVE lane, even where
+    the offset puts it over the border), None for other positions or a lane off the route."""
+    if pose is None or pose.lane_id is None or pose.lane_id not in lane_ids:
+        return None
+    return lane_ids.index(pose.lane_id)
 
 
 def _against(road_map: RoadMap, lane: int, s: float, pose: Pose | None) -> bool:

@@ -51,6 +51,8 @@ class Pose:
     x: float  # [m]
     y: float  # [m]
     heading: float  # [rad]
+    lane_id: int | None = None  # the OpenDRIVE lane a lane position names: the entity's lane,
+    #   as esmini keeps it, even where the offset puts the point over its border
 
 
 class PositionError(ValueError):
@@ -115,7 +117,7 @@ class Resolver:
         px, py = float(x[0]) - t * math.sin(heading), float(y[0]) + t * math.cos(heading)
         against = lane_id is not None and (lane_id > 0) == (self.road.rule == "RHT")
         travel = heading + (math.pi if against else 0.0)
-        return Pose(px, py, _oriented(travel, orientation))
+        return Pose(px, py, _oriented(travel, orientation), lane_id)
 
     def resolve(self, position: Position, entities: Mapping[str, Pose]) -> Pose:
         """The map-frame pose of `position`; relative ones refer to `entities` (module doc)."""

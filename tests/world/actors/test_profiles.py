@@ -18,6 +18,7 @@ from world.actors.profiles import (
     TrackCommand,
     Transition,
     fraction,
+    lane_change_step,
     span_by_rate,
     speed_span_by_distance,
 )
@@ -94,6 +95,72 @@ def test_a_lateral_command_by_distance_runs_over_the_distance_travelled() -> Non
     trace = run(motion, 6.0)
     first = next(s for _, s, o in trace if o == pytest.approx(-3.5))
     assert first == pytest.approx(50.0, abs=10.0 * DT)
+
+
+def test_a_timed_lane_change_moves_across_by_its_shape_and_keeps_the_speed_over_ground(
+) -> None:
+    """esmini's law: the offset is the shape at x + dt, the progress along the lane is
+    what the speed leaves of the step after the shape's slope at x, the heading the step's."""
+    transition = Transition(0.0, 3.5, Shape.SINUSOIDAL, 2.0)
+    x = 0.0
+    for _ in range(120):  # to 1 s, the middle of the move
+        rate = 3.5 * 0.5 * math.pi / 2.0 * math.sin(math.pi * x / 2.0)
+        step = lane_change_step(transition, x, False, 10.0, DT)
+        assert step.offset == pytest.approx(1.75 * (1.0 - math.cos(math.pi * (x + DT) / 2.0)))
+        assert step.along == pytest.approx(math.sqrt((10.0 * DT) ** 2 - (rate * DT) ** 2))
+        assert step.heading == pytest.approx(math.atan2(rate, step.along / DT))
+        x = step.x
+    assert x == pytest.approx(1.0)
+    assert step.offset == pytest.approx(1.75) and not step.done
+    assert step.along < 10.0 * DT  # slower along the lane while it moves across
+
+
+def test_a_lane_change_by_distance_runs_over_the_progress_along_the_lane() -> None:
+    transition = Transition(0.0, -3.5, Shape.CUBIC, 50.0)
+    step = lane_change_step(transition, 25.0, True, 10.0, DT)
+    slope = -3.5 * 1.5 / 50.0  # the cubic's peak slope d offset / d distance, at mid-way
+    assert step.along == pytest.approx(10.0 * DT / math.sqrt(1.0 + slope * slope))
+    assert step.x == pytest.approx(25.0 + step.along)
+    assert step.heading == pytest.approx(math.atan(slope), abs=1e-6)
+
+
+def test_a_lane_change_faster_across_than_the_speed_goes_straight_across() -> None:
+    transition = Transition(0.0, 3.5, Shape.SINUSOIDAL, 0.5)  # 11 m/s across at 2 m/s
+    step = lane_change_step(transition, 0.25, False, 2.0, DT)
+    assert step.along == 0.0
+    assert step.x == pytest.approx(0.25 + 2.0 * DT * 0.5 / 3.5)
+    assert step.offset == pytest.approx(3.5 * step.x / 0.5)  # linear
+    assert step.heading == pytest.approx(0.5 * math.pi)
+
+
+def test_a_lane_change_at_rest_does_not_move() -> None:
+    step = lane_change_step(Transition(0.0, 3.5, Shape.LINEAR, 2.0), 0.5, False, 0.0, DT)
+    assert (step.x, step.along, step.done) == (0.5, 0.0, False)
+    assert step.offset == pytest.approx(0.875)
+
+
+def test_a_lane_change_moves_the_reference_point_behind_the_body_centre() -> None:
+    """With `ahead`, the reference point (the centre `ahead` back along the heading) follows
+    the law, the station advances by the progress along the lane, the speed is kept."""
+    ahead = 1.4  # [m]
+    motion = NpcMotion(0.0, 0.0, 10.0, 1, ())
+    span = span_by_rate(Shape.SINUSOIDAL, 3.5, 3.0)
+    transition = Transition(0.0, 3.5, Shape.SINUSOIDAL, span)
+    motion.command(LateralCommand("lc", transition, 0.0, -ahead, lane=1, ahead=ahead))
+    x, s_ref = 0.0, -ahead
+    for k in range(120):
+        motion.step(k * DT, DT, 0.0)
+        step = lane_change_step(transition, x, False, 10.0, DT)
+        x, s_ref = step.x, s_ref + step.along
+        yaw = motion.heading_offset
+        assert yaw == pytest.approx(step.heading)
+        assert motion.s - ahead * math.cos(yaw) == pytest.approx(s_ref)
+        assert motion.offset - ahead * math.sin(yaw) == pytest.approx(step.offset)
+    assert motion.speed == 10.0
+    assert s_ref < 10.0 * 1.0 - ahead - 0.1  # behind where the full speed along would be
+    run(motion, 3.0, 1.0)
+    assert motion.finished == ["lc"] and motion.lane == 1 and motion.heading_offset == 0.0
+    assert motion.offset == pytest.approx(3.5)
 
 
 def test_a_speed_command_then_holds_its_target() -> None:
