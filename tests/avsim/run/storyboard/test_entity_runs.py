@@ -81,8 +81,8 @@ def changes(result: RunResult, kind: str) -> list[StateChange]:
 def test_an_entity_no_init_places_enters_when_added(run: tuple[RunResult, Runner]) -> None:
     _t, s = track(run[0], "Late")
     assert s == pytest.approx(300.0, abs=1e-6)  # built there, standing: it never had a speed
-    assert [(c.t, c.value) for c in changes(run[0], "entity")
-            if c.name == "Late"] == [(pytest.approx(2.0), "added")]
+    [added] = [c for c in changes(run[0], "entity") if c.name == "Late"]
+    assert added.t == pytest.approx(2.0) and added.value == "added"
     world = run[1].world
     assert not world.actors.gone[0]
     x, _, z = world.actors.poses.centres[0]  # the truth at the end
@@ -96,8 +96,8 @@ def test_a_deleted_entity_leaves_the_world(run: tuple[RunResult, Runner]) -> Non
     world = run[1].world
     assert world.actors.gone[1]
     assert world.actors.poses.centres[1, 2] < -5.0  # the truth: below the ground
-    assert [(c.t, c.value) for c in changes(run[0], "entity")
-            if c.name == "Leaver"] == [(pytest.approx(1.0), "deleted")]
+    [deleted] = [c for c in changes(run[0], "entity") if c.name == "Leaver"]
+    assert deleted.t == pytest.approx(1.0) and deleted.value == "deleted"
 
 
 def test_a_hidden_actor_is_out_of_the_sensors_only(run: tuple[RunResult, Runner]) -> None:
