@@ -113,6 +113,7 @@ class WorldSnapshot:
     ego_quat: tuple[float, ...]  # x, y, z, w
     ego_joints: list[float]  # joint positions in joint order (wheel spin, steering hinges)
     actors: tuple[tuple[tuple[float, ...], tuple[float, ...]], ...]  # (position, quaternion)
+    camera_hidden: tuple[int, ...] = ()  # the actors the cameras do not draw (by index)
 
 
 class World:
@@ -159,6 +160,8 @@ class World:
         #   `driver`): a storyboard's actions on the car under test set them
         self.throttle = 0.0  # [-] 0..1, the accelerator pedal a storyboard's override holds
         self.rig = self._build_rig(sensors, lidar, seeds, lidar_backend)
+        self.camera_hidden: set[int] = set()  # actors the cameras do not draw (by index)
+        self.lidar_hidden: set[int] = set()  # actors the LiDAR's rays pass through
         self._truth: EgoTruth | None = None
         self._route: RouteTruth | None = None
         self._route_station: float | None = spec.ego.s  # [m] the ego's station when last
@@ -530,7 +533,26 @@ class World:
         is drawn or ray-cast, and a mirror world is never stepped, so it never needs it."""
         com, quat, joints = self.ego.base_state()
         actors = tuple(self.client.getBasePositionAndOrientation(b) for b in self.actors.bodies)
-        return WorldSnapshot(self.clock.step, com, quat, joints, actors)
+        return WorldSnapshot(self.clock.step, com, quat, joints, actors,
+                             tuple(sorted(self.camera_hidden)))
+
+    def set_actor_visibility(self, i: int, cameras: bool, lidar: bool) -> None:
+        """Whether the cameras draw actor `i` and the LiDAR's rays meet it. Its body stays
+        in the physics (contacts) and in the truth either way."""
+        for hidden, seen in ((self.camera_hidden, cameras), (self.lidar_hidden, lidar)):
+            if seen:
+                hidden.discard(i)
+            else:
+                hidden.add(i)
+        self._hide_from_sensors()
+
+    def _hide_from_sensors(self) -> None:
+        bodies = self.actors.bodies
+        for sensor in self.rig:
+            if isinstance(sensor, CameraSensor):
+                sensor.camera.hidden = frozenset(bodies[i] for i in self.camera_hidden)
+            elif isinstance(sensor, LidarSensor):
+                sensor.lidar.hide(frozenset(bodies[i] for i in self.lidar_hidden))
 
     def apply_snapshot(self, snap: WorldSnapshot) -> None:
         """Pose this world as `snap` says: for a MIRROR world, never one being simulated."""
@@ -538,6 +560,9 @@ class World:
         self.ego.set_base_state(snap.ego_com, snap.ego_quat, snap.ego_joints)
         for body, (position, quat) in zip(self.actors.bodies, snap.actors, strict=True):
             self.client.resetBasePositionAndOrientation(body, position, quat)
+        if set(snap.camera_hidden) != self.camera_hidden:
+            self.camera_hidden = set(snap.camera_hidden)
+            self._hide_from_sensors()
         self.client.performCollisionDetection()  # bring the ray-test broadphase up to date
         self._light_lamps()
         self._truth = None

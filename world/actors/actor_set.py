@@ -20,7 +20,8 @@ In a town, each NPC car has a town driver (`world.actors.town_traffic`); the dri
 one all-way-stop order (`world.actors.all_way_stop`), which the ego joins when it stands at
 its line (`StopZones`). A driver that has arrived at its route's end is taken out of the
 world (`gone`): its body and its pose far away below the ground (`GONE_XY`), no longer
-minded by the others.
+minded by the others. A storyboard takes an actor out (`withdraw`: deleted, or not yet
+added) and puts it back (`restore`) the same way.
 """
 
 from __future__ import annotations
@@ -200,8 +201,10 @@ class ActorSet:
         self._last_speed = self._speeds()
         self._dt = dt
         self._cap_town_drivers(t, dt, ego, ego_s)
-        for motion, line in zip(self.motions, self._lines, strict=True):
-            motion.step(t, dt, line.curvature_one(motion.s))
+        for motion, line, gone in zip(self.motions, self._lines, self.gone.tolist(),
+                                      strict=True):
+            if not gone:  # out of the world: held where it left, at its speed
+                motion.step(t, dt, line.curvature_one(motion.s))
         self._poses = None
         self._place(force=False)
 
@@ -264,11 +267,25 @@ class ActorSet:
 
     def _leave(self, i: int) -> None:
         """Take actor i out of the world: it has arrived at its route's end."""
-        self.gone[i] = True
         self.motions[i].speed = 0.0
         self.motions[i].cap = 0.0
+        self.withdraw(i)
+
+    def withdraw(self, i: int) -> None:
+        """Take actor i out of the world (`gone`): its body far away below the ground (no
+        contacts, unseen), its motion held (not stepped) until it is `restore`d."""
+        self.gone[i] = True
         self._xy[i] = GONE_XY
+        self._poses = None
         self._reset_pose(self.bodies[i], (*GONE_XY, -10.0), (0.0, 0.0, 0.0, 1.0))
+
+    def restore(self, i: int) -> None:
+        """Put actor i back into the world where its motion is (placed at the next step,
+        or now when its motion is moved there first)."""
+        self.gone[i] = False
+        self.motions[i].jumped = True
+        self._poses = None
+        self._place(force=False)
 
     def _speeds(self) -> NDArray[np.float64]:
         """[m/s] (N,) `ActorPoses.speeds` now."""
@@ -327,9 +344,11 @@ class ActorSet:
     def _place(self, force: bool) -> None:
         """Move the bodies of the actors that move (all of them with `force`): one scalar
         map lookup each, the hot path of the NPCs."""
-        for i, (body, m, flip, z, line) in enumerate(zip(
+        for i, (body, m, flip, z, line, gone) in enumerate(zip(
                 self.bodies, self.motions, self._flip_list, self._heights, self._lines,
-                strict=True)):
+                self.gone.tolist(), strict=True)):
+            if gone:
+                continue
             if force or m.speed != 0.0 or m.lateral_speed != 0.0 or m.jumped:
                 m.jumped = False
                 x, y, heading = line.pose_one(m.s, m.offset)

@@ -19,7 +19,12 @@ from world.sensors.ray_culling import Box, ground_distance, rays_to_cast
 
 MAX_BATCH = 16_383  # rays per rayTestBatch call
 EGO_RAY_GROUP = 0x40  # collision group of the ego's links; the rays' mask leaves it out
-RAY_MASK = 0xFFFF & ~EGO_RAY_GROUP
+HIDDEN_RAY_GROUP = 0x80  # collision group of an actor hidden from the LiDAR (`hide`)
+RAY_MASK = 0xFFFF & ~EGO_RAY_GROUP & ~HIDDEN_RAY_GROUP
+# a static body's collision filter as PyBullet makes it (Bullet's StaticFilter group, every
+# group but StaticFilter in its mask): what an actor shown again gets back
+STATIC_GROUP, STATIC_MASK = 0x2, -1 ^ 0x2
+HIDDEN_MASK = STATIC_MASK  # a hidden actor still touches what it touched (the ego)
 
 
 class BulletCaster:
@@ -36,6 +41,16 @@ class BulletCaster:
         self._actors = list(actor_bodies)
         self._static_boxes = [_aabb(client, b) for b in static_bodies]
         self.threads = 0  # rayTestBatch threads: 0 = Bullet's choice (all cores)
+        self._hidden: frozenset[int] = frozenset()
+
+    def hide(self, bodies: frozenset[int]) -> None:
+        """The actor bodies the rays pass through: their collision group is one the rays'
+        mask leaves out (contacts unchanged: their mask is kept)."""
+        for body in self._hidden | bodies:
+            group = HIDDEN_RAY_GROUP if body in bodies else STATIC_GROUP
+            mask = HIDDEN_MASK if body in bodies else STATIC_MASK
+            self._c.setCollisionFilterGroupMask(body, -1, group, mask)
+        self._hidden = bodies
 
     def cast(self, origin: NDArray[np.float64], directions: NDArray[np.float64],
              heading: float) -> tuple[NDArray[np.int32], NDArray[np.float64]]:
@@ -45,7 +60,8 @@ class BulletCaster:
         max_range = self._max_range
         ground = ground_distance(origin, directions, max_range)
         reach = np.minimum(ground, max_range)
-        boxes = self._static_boxes + [_aabb(self._c, b) for b in self._actors]
+        boxes = self._static_boxes + [_aabb(self._c, b) for b in self._actors
+                                      if b not in self._hidden]
         shape = (len(directions) // self._columns, self._columns)
         need = rays_to_cast(origin, directions.reshape(*shape, 3), reach.reshape(shape),
                             boxes, heading, self._columns).reshape(-1)

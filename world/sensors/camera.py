@@ -7,6 +7,8 @@ The camera's world pose is the body's pose (from the physics, pitch and roll inc
 composed with the mount; the view matrix looks along the mount's x axis with its z axis up,
 and the projection has the camera's vertical field of view and aspect. Lighting is Bullet's
 default (no shadows: they triple TinyRenderer's cost and add nothing the lane finder needs).
+Bodies the camera is told not to draw (`Camera.hidden`: a storyboard's VisibilityAction) are
+moved far below the ground for the frame and put back where they were right after.
 """
 
 from __future__ import annotations
@@ -27,6 +29,8 @@ from world.ego.body import EgoTruth
 from world.frames import CameraFrame, CameraInfo
 from world.sensors.sensor import Reading, vehicle_pose
 
+AWAY = (1.0e5, 1.0e5, -10.0)  # [m] where a body the camera does not draw is for a frame
+
 
 class Camera:
     """Renders one `CameraInfo` in one client."""
@@ -42,6 +46,7 @@ class Camera:
         m = info.mount
         self._mount_xyz = np.array([m.x, m.y, m.z])  # [m] vehicle frame
         self._mount_rot = m.rotation()
+        self.hidden: frozenset[int] = frozenset()  # bodies not drawn (still in the physics)
 
     def render(self, t: float, vehicle_origin: NDArray[np.float64],
                vehicle_rotation: NDArray[np.float64]) -> CameraFrame:
@@ -52,11 +57,16 @@ class Camera:
         view = self._c.computeViewMatrix(eye.tolist(), (eye + axes[:, 0]).tolist(),
                                          axes[:, 2].tolist())
         info = self.info
+        poses = [(b, *self._c.getBasePositionAndOrientation(b)) for b in sorted(self.hidden)]
+        for body, _, _ in poses:  # out of sight for this frame only (a draw reads no contacts)
+            self._c.resetBasePositionAndOrientation(body, AWAY, (0.0, 0.0, 0.0, 1.0))
         with quiet_c_output():  # the EGL plugin reports its GL vendor on the first frame
             _, _, rgba, _, _ = self._c.getCameraImage(
                 info.width, info.height, view, self._projection, renderer=self._renderer,
                 flags=pybullet.ER_NO_SEGMENTATION_MASK, shadow=0,
             )
+        for body, position, quat in poses:
+            self._c.resetBasePositionAndOrientation(body, position, quat)
         rgba = np.asarray(rgba, dtype=np.uint8).reshape(info.height, info.width, 4)
         # OpenCV drops the alpha in one vectorised pass, 25x faster than numpy's strided copy
         rgb = np.asarray(cv2.cvtColor(rgba, cv2.COLOR_RGBA2RGB), dtype=np.uint8)

@@ -33,6 +33,7 @@ from world.sensors.box_rays import OrientedBox, nearest_box_hits
 from world.sensors.ray_culling import ground_distance
 from world.sensors.tessellate import body_triangles
 
+HIDDEN_AT = (1.0e5, 1.0e5, -10.0)  # [m] where a hidden actor's box is cast: out of range
 NO_GEOMETRY = 0xFFFFFFFF  # Open3D's INVALID_ID for a ray that met nothing
 
 
@@ -66,6 +67,7 @@ class EmbreeCaster:
         self._rays = np.empty((0, 6), np.float32)  # origin and direction per ray: the cast's
         #   input, filled in place each scan (Open3D copies it into its tensor)
         self.threads = 0  # Embree cast threads: 0 = Open3D's choice (all cores)
+        self._hidden: frozenset[int] = frozenset()  # actor bodies the rays pass through
         self._cast_static(np.array([[0, 0, 0, 1, 0, 0]], np.float32))  # commits (builds BVH)
 
     def cast(self, origin: NDArray[np.float64], directions: NDArray[np.float64],
@@ -99,10 +101,16 @@ class EmbreeCaster:
         return (out["t_hit"].numpy().astype(np.float64),
                 out["geometry_ids"].numpy().astype(np.int64))
 
+    def hide(self, bodies: frozenset[int]) -> None:
+        """The actor bodies the rays pass through (their boxes are cast far away)."""
+        self._hidden = bodies
+
     def _actor_boxes(self) -> list[OrientedBox]:
         boxes = []
         for body, half in zip(self._actors, self._actor_half, strict=True):
             position, rotation = _pose(self._c, body)
+            if body in self._hidden:
+                position = np.array(HIDDEN_AT)
             boxes.append(OrientedBox(position, rotation, half))
         return boxes
 

@@ -95,6 +95,10 @@ class Lidar:
             BulletCaster(client, info.max_range, info.azimuth_steps, actor_bodies, ground,
                          static_bodies))
 
+    def hide(self, bodies: frozenset[int]) -> None:
+        """The actor bodies the rays pass through from now on (none: every one is met)."""
+        self.caster.hide(bodies)
+
     @property
     def threads(self) -> int:
         """Threads the caster casts on (0: its library's choice, all cores)."""

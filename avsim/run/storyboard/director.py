@@ -13,7 +13,8 @@ assignment): they complete at once and set the switch of its automated driving f
 its controller: `avsim.scenario.openscenario.convert`), the driver holds its Init speed.
 Its speed and lane changes and pedal overrides are its driver's inputs (`driver`).
 A scripted car under test (`World.scripted`, `world.ego.scripted`) takes every other action
-as an actor does, on its own motion; its controller actions then change nothing.
+as an actor does, on its own motion; its controller actions then change nothing. Entity
+actions (add, delete, visibility, lights) are played at once (`entity_player`).
 """
 
 from __future__ import annotations
@@ -23,6 +24,7 @@ from collections.abc import Iterable
 from avsim.run.storyboard.commands import Commands, Follow, Sync, placed_at_once, poses_of
 from avsim.run.storyboard.conditions import Resolved
 from avsim.run.storyboard.driver import Driver
+from avsim.run.storyboard.entity_player import ENTITY_ACTIONS, EntityPlayer
 from avsim.run.storyboard.runtime import StartedAction, StoryRuntime
 from avsim.run.storyboard.snapshot import EntityState, Snapshot
 from avsim.run.storyboard.truth import TruthTracker
@@ -84,6 +86,8 @@ class Director:
         self._top = {e.name: getattr(e.object, "max_speed", WALKING_TOP)
                      for e in osc.entities}  # [m/s] each entity's top speed
         self.driver = Driver(world, program.ego, program.lane_ids)  # the stack's car's
+        self.entities = EntityPlayer(program, world, self.commands,
+                                     self.runtime.story_state)  # add, delete, looks
 
     def _resolve(self, position: Position, snap: Snapshot) -> Resolved:
         """Where a condition's position is now: map (x, y), route (s, offset)."""
@@ -180,6 +184,10 @@ class Director:
         action = started.action
         if isinstance(action, (*CONTROLLER_ACTIONS, OverrideControllerValueAction)):
             self._control(started)  # the runtime completes these itself
+            return
+        if isinstance(action, ENTITY_ACTIONS):  # so are these (`entity_player`)
+            for entity in started.entities:
+                self.entities.play(f"{started.action_id}@{entity}", entity, action, snap)
             return
         tags = set()
         for entity in started.entities:

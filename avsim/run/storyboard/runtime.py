@@ -12,10 +12,11 @@ Each `step(snap)` evaluates, in this order:
    running events of the maneuver first; skip is not started (a skipTransition) while
    another event of the maneuver runs; parallel starts alongside;
 4. the actions the runtime completes itself (`INSTANT`: controller assignment and
-   activation, teleport) end at once; global actions (`GLOBAL`: environment, variables,
-   parameters) change the runtime's `story_state` (`state.StoryState`) when they start,
-   are not passed on to the world, and end at once. The Init's global actions are played on the
-   state at t = 0, before the first trigger check.
+   activation, teleport, entity actions: add, delete, visibility, lights) end at once;
+   global actions (`GLOBAL`: environment, variables, parameters) change the runtime's
+   `story_state` (`state.StoryState`) when they start, are not passed on to the world,
+   and end at once (an EntityAction is: its entity is the started action's). The Init's
+   global actions are played on the state at t = 0, before the first trigger check.
 A trigger is evaluated only while its element waits for it (standby under a running
 parent; an act's stop trigger while the act runs), as esmini does. An action ends when the
 world says so (`action_done`); an element ends when all its children completed (an event:
@@ -51,13 +52,21 @@ from avsim.scenario.openscenario.actions import (
     PrivateAction,
     TeleportAction,
 )
+from avsim.scenario.openscenario.entity_actions import (
+    AddEntityAction,
+    DeleteEntityAction,
+    EntityAction,
+    LightStateAction,
+    VisibilityAction,
+)
 from avsim.scenario.openscenario.environment import EnvironmentAction
 from avsim.scenario.openscenario.parameters import ParamValue
 from avsim.scenario.openscenario.storyboard import Storyboard
 from avsim.scenario.openscenario.variables import VariableAction, VariableDeclaration
 
 INSTANT = (ActivateControllerAction, AssignControllerAction, OverrideControllerValueAction,
-           TeleportAction)  # end at once
+           TeleportAction, AddEntityAction, DeleteEntityAction, VisibilityAction,
+           LightStateAction)  # end at once
 GLOBAL = (EnvironmentAction, VariableAction)  # played on the runtime's state, end at once
 S, K = ElementState, TransitionKind
 
@@ -68,8 +77,9 @@ class StartedAction:
 
     action_id: str  # "Story/Act/MG/Maneuver/Event/Action#<n>", n = its n-th start
     name: str
-    entities: tuple[str, ...]  # the group's actors (and the triggering entities if selected)
-    action: PrivateAction
+    entities: tuple[str, ...]  # the group's actors (and the triggering entities if selected);
+    #   an EntityAction's: its entity
+    action: PrivateAction | EntityAction
 
 
 @dataclass(frozen=True, slots=True)
@@ -111,8 +121,9 @@ class StoryRuntime:
         index = name_index(storyboard, self.stories)
         self._log: list[TransitionRecord] = []
         self.story_state = StoryState(parameters, variables)
-        for init in storyboard.init_global:
-            self.story_state.apply(init, 0.0)
+        for init in storyboard.init_global:  # no EntityAction: refused in Init at load
+            if isinstance(init, GLOBAL):
+                self.story_state.apply(init, 0.0)
         self._ctx = ConditionContext(self.story_state.parameters, _LiveStates(index),
                                      self._log, 0, resolve, self.story_state, lanes)
         self._stop = None if storyboard.stop_trigger is None else TriggerWatch(
@@ -242,6 +253,8 @@ class StoryRuntime:
             self.story_state.apply(action, self._t)
             self._instant.append(node)
             return
+        if isinstance(action, AddEntityAction | DeleteEntityAction):
+            entities = (action.entity,)
         self._started.append(StartedAction(node.action_id, node.name, entities, action))
         if isinstance(action, INSTANT):
             self._instant.append(node)

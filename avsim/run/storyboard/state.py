@@ -14,7 +14,6 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 
 from avsim.scenario.openscenario.environment import Environment, EnvironmentAction, time_of_day_at
-from avsim.scenario.openscenario.global_actions import GlobalAction
 from avsim.scenario.openscenario.parameters import ParamValue
 from avsim.scenario.openscenario.variables import VariableAction, VariableDeclaration, apply_change
 
@@ -42,7 +41,7 @@ class StoryState:
         self.environment_set_at = 0.0  # [s] when the environment in effect was set
         self.changes: list[StateChange] = []
 
-    def apply(self, action: GlobalAction, t: float) -> None:
+    def apply(self, action: EnvironmentAction | VariableAction, t: float) -> None:
         """Play a global action at simulation time `t` [s]."""
         if isinstance(action, EnvironmentAction):
             self.environment, self.environment_set_at = action.environment, t

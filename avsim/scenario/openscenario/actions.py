@@ -7,6 +7,7 @@ from dataclasses import dataclass
 from typing import Literal
 
 from avsim.scenario.openscenario.entities import Controller
+from avsim.scenario.openscenario.entity_actions import LightStateAction, VisibilityAction
 from avsim.scenario.openscenario.positions import Position
 from avsim.scenario.openscenario.trajectories import Trajectory
 
@@ -254,4 +255,6 @@ PrivateAction = (
     | ActivateControllerAction
     | AssignControllerAction
     | OverrideControllerValueAction
+    | VisibilityAction
+    | LightStateAction
 )

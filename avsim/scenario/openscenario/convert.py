@@ -41,6 +41,7 @@ from avsim.scenario.checks import check_spawn
 from avsim.scenario.errors import LocatedError, ScenarioError
 from avsim.scenario.openscenario.actions import engages
 from avsim.scenario.openscenario.ego_actions import driver_input, refuse_on_ego
+from avsim.scenario.openscenario.entity_actions import AddEntityAction
 from avsim.scenario.openscenario.model import (
     AbsoluteTargetSpeed,
     ActivateControllerAction,
@@ -111,6 +112,7 @@ def load_xosc(path: Path, overrides: Mapping[str, object] | None = None,
     ego = _ego(osc)
     refuse_on_ego(osc, ego.name, scripted_ego)
     placed, deferred = _init(osc, Resolver(route.chain))
+    held = _place_added(osc, placed, Resolver(route.chain))
     if not scripted_ego:
         _check_stack_ego(osc, ego.name, deferred)
     ahead = {e.name: _centre_ahead(e, e.name == ego.name and not scripted_ego)
@@ -125,12 +127,12 @@ def load_xosc(path: Path, overrides: Mapping[str, object] | None = None,
         scenario=osc, chain=route.chain, ego=ego.name,
         actors=tuple((e.name, i) for i, e in enumerate(others)),
         centre_ahead=tuple(ahead.items()), lane_ids=route.layout.lane_ids,
-        init_commands=tuple(deferred),
+        init_commands=tuple(deferred), held_out=held,
         ego_box=(ego.object.bbox.length, ego.object.bbox.width) if scripted_ego else None)
     world = spec.WorldSpec(road=route.spec, ego=ego_spec, actors=actors, seed=side.seed,
                            sensors=side.sensors, scenery_roads=route.scenery,
                            scenery_objects=route.objects)
-    _check_spawn(path, world, ego.name, [e.name for e in others])
+    _check_spawn(path, world, ego.name, [e.name for e in others], held)
     return Scenario(name=_name(path), description=osc.description, situation="openscenario",
                     duration=side.duration, world=world,
                     driver=DriverSettings(set_speed=ego_spec.speed), criteria=side.criteria,
@@ -157,9 +159,14 @@ def _sources(*files: Path | None) -> tuple[Path, ...]:
     return tuple(f for f in files if f is not None)
 
 
-def _check_spawn(path: Path, world: spec.WorldSpec, ego: str, others: list[str]) -> None:
-    """No two bodies overlap at t = 0, by the YAML format's rule (`checks.check_spawn`: boxes
-    along the lane, the ego's avsim body), refused at the later entity by its name."""
+def _check_spawn(path: Path, world: spec.WorldSpec, ego: str, others: list[str],
+                 held: Sequence[str] = ()) -> None:
+    """No two bodies in the world at t = 0 (`held` entities are not) overlap, by the YAML
+    format's rule (`checks.check_spawn`: boxes along the lane, the ego's avsim body),
+    refused at the later entity by its name."""
+    kept = [k for k, name in enumerate(others) if name not in held]
+    world = replace(world, actors=tuple(world.actors[k] for k in kept))
+    others = [others[k] for k in kept]
     try:
         check_spawn(world)
     except LocatedError as e:
@@ -217,6 +224,26 @@ def _init(osc: OpenScenario, resolver: Resolver) -> tuple[dict[str, _Placed],
             raise ScenarioError(str(osc.path), f"Storyboard.Init.{item.entity}", str(problem))
         waiting = left
     return placed, deferred
+
+
+def _place_added(osc: OpenScenario, placed: dict[str, _Placed],
+                 resolver: Resolver) -> tuple[str, ...]:
+    """The entities no Init action places that a story adds (AddEntityAction): each is
+    built where its first AddEntityAction puts it and held out of the world until added (as
+    esmini, whose entities without an Init are inactive until then)."""
+    held = []
+    for _, action in osc.storyboard.story_actions():
+        add = action.private_action
+        if not isinstance(add, AddEntityAction) or placed[add.entity].pose is not None:
+            continue
+        poses = {n: p.pose for n, p in placed.items() if p.pose is not None}
+        try:
+            placed[add.entity].pose = resolver.resolve(add.position, poses)
+        except (UnplacedError, PositionError) as e:
+            raise ScenarioError(str(osc.path), f"Storyboard.Action[{action.name}]",
+                                f"AddEntityAction: {e}") from None
+        held.append(add.entity)
+    return tuple(held)
 
 
 def _apply(item: InitAction, placed: dict[str, _Placed], osc: OpenScenario,

@@ -108,6 +108,12 @@ PARTLY: dict[str, str] = {
                                                       "test; the other controls only "
                                                       "inactive; `BrakeForce` not yet",
     "GlobalAction.EnvironmentAction": "recorded, not rendered; `DomeImage` not yet",
+    "GlobalAction.EntityAction": "not in Init, not on the car under test; conditions on a "
+                                 "deleted entity read it far away, esmini skips it",
+    "PrivateAction.VisibilityAction": "`traffic` recorded only; `SensorReferenceSet` not yet",
+    "PrivateAction.AppearanceAction": "`LightStateAction` recorded, not drawn (actor bodies "
+                                      "have no lamps); `AnimationAction` not yet",
+    "AppearanceAction.LightStateAction": "recorded, not drawn (actor bodies have no lamps)",
     "EntityCondition.AngleCondition": "`coordinateSystem` trajectory not yet",
     "EntityObject.Vehicle": "`Trailer` not yet",
 }

@@ -10,11 +10,19 @@ action), never mid-run.
   centre: no targetLaneOffset), an OverrideControllerValueAction (its pedals).
 - An OverrideControllerValueAction only on the car under test (the other entities have no
   driver avsim simulates).
+- Never an EntityAction (add, delete) on it: the run is about it. Its VisibilityAction and
+  LightStateAction are recorded (its own sensors never see it).
 """
 
 from __future__ import annotations
 
 from avsim.scenario.errors import ScenarioError
+from avsim.scenario.openscenario.entity_actions import (
+    AddEntityAction,
+    DeleteEntityAction,
+    LightStateAction,
+    VisibilityAction,
+)
 from avsim.scenario.openscenario.global_actions import GlobalAction
 from avsim.scenario.openscenario.model import (
     ActivateControllerAction,
@@ -33,7 +41,8 @@ from avsim.scenario.openscenario.model import (
 NOT_ON_EGO = (SynchronizeAction, SpeedProfileAction, LateralDistanceAction)
 PROBLEM = "not supported on the car under test ({}: avsim's stack drives it)"
 PLAYED = (ActivateControllerAction, AssignControllerAction, OverrideControllerValueAction,
-          GlobalAction)  # on the stack's car: its controller's, its pedals, global actions
+          GlobalAction, VisibilityAction, LightStateAction)  # on the stack's car: its
+#   controller's, its pedals, global actions, its looks (recorded)
 
 
 def refuse_on_ego(osc: OpenScenario, ego: str, scripted: bool = False) -> None:
@@ -50,6 +59,10 @@ def refuse_on_ego(osc: OpenScenario, ego: str, scripted: bool = False) -> None:
                                 _no_driver(item.entity, ego, scripted))
     for group, action in osc.storyboard.story_actions():
         inner = action.private_action
+        if isinstance(inner, AddEntityAction | DeleteEntityAction) and inner.entity == ego:
+            raise ScenarioError(str(osc.path), f"Storyboard.Action[{action.name}]",
+                                f"{type(inner).__name__} on the car under test: not "
+                                "supported (the run is about it: it is always in the world)")
         if ego in group.actors.entities and isinstance(inner, (*NOT_ON_EGO, TeleportAction)):
             raise ScenarioError(str(osc.path), f"Storyboard.Action[{action.name}]",
                                 PROBLEM.format(type(inner).__name__))

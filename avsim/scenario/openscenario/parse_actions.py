@@ -31,6 +31,7 @@ from avsim.scenario.openscenario.attributes import unsupported
 from avsim.scenario.openscenario.context import Context
 from avsim.scenario.openscenario.limits import MAX_SPEED, MAX_TIME
 from avsim.scenario.openscenario.parse_entities import parse_controller
+from avsim.scenario.openscenario.parse_entity_actions import APPEARANCE_READERS
 from avsim.scenario.openscenario.parse_motion import MOTION_READERS, parse_constraints
 from avsim.scenario.openscenario.parse_positions import parse_position
 from avsim.scenario.openscenario.parse_trajectories import parse_trajectory_ref
@@ -260,6 +261,7 @@ _READERS: dict[str, Callable[[Node, Context], PrivateAction]] = {
     "AssignControllerAction": _assign_controller,
     "OverrideControllerValueAction": _override,
     **MOTION_READERS,
+    **APPEARANCE_READERS,
 }
 
 

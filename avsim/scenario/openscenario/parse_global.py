@@ -1,6 +1,7 @@
 """Reading VariableDeclarations and GlobalAction elements: EnvironmentAction
-(`parse_environment`), VariableAction and the deprecated ParameterAction (SetAction,
-ModifyAction with AddValue or MultiplyByValue). Other GlobalActions are refused.
+(`parse_environment`), EntityAction (`parse_entity_actions`), VariableAction and the
+deprecated ParameterAction (SetAction, ModifyAction with AddValue or MultiplyByValue).
+Other GlobalActions are refused.
 
 A variable or parameter an action or a condition names must be declared (variables in the
 file's VariableDeclarations, parameters in scope); a value set is converted to its type
@@ -21,6 +22,7 @@ from avsim.scenario.openscenario.parameters import (
     convert,
     resolve,
 )
+from avsim.scenario.openscenario.parse_entity_actions import parse_entity_action
 from avsim.scenario.openscenario.parse_environment import parse_environment_action
 from avsim.scenario.openscenario.variables import (
     NUMERIC_TYPES,
@@ -114,6 +116,7 @@ def _variable_action(node: Node, ctx: Context, target: str) -> VariableAction:
 
 GLOBAL_READERS: dict[str, Callable[[Node, Context], GlobalAction]] = {
     "EnvironmentAction": parse_environment_action,
+    "EntityAction": parse_entity_action,
     "VariableAction": lambda n, c: _variable_action(n, c, "variable"),
     "ParameterAction": lambda n, c: _variable_action(n, c, "parameter"),
 }

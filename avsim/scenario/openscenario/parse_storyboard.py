@@ -47,8 +47,15 @@ def parse_init_global(node: Node | None, ctx: Context) -> tuple[GlobalAction, ..
     """The Init's GlobalActions, in the file's order."""
     if node is None:
         return ()
-    return tuple(parse_global_action(child, ctx) for child in node.need("Actions").children
-                 if child.tag == "GlobalAction")
+    found = []
+    for child in node.need("Actions").children:
+        if child.tag != "GlobalAction":
+            continue
+        if child.child("EntityAction") is not None:  # Init's entities are its Private ones
+            raise child.error("EntityAction in Init: not supported (an entity the Init "
+                              "places is in the world from the start)")
+        found.append(parse_global_action(child, ctx))
+    return tuple(found)
 
 
 def parse_action(node: Node, ctx: Context) -> Action:

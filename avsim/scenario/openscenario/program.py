@@ -24,6 +24,8 @@ class StoryProgram:
     lane_ids: tuple[int, ...]  # the OpenDRIVE id of each route lane (index 0 first)
     init_commands: tuple[InitAction, ...]  # Init actions that take time (a speed change
     #   with dynamics, a continuous distance to keep): started at t = 0 by the director
+    held_out: tuple[str, ...] = ()  # entities out of the world until a story adds them
+    #   (no Init action places them: `AddEntityAction`)
     ego_box: tuple[float, float] | None = None  # [m] the length and width conditions give
     #   the car under test: the file's bounding box when it is scripted (as esmini measures
     #   it; its reference point is then the file's too), None: avsim's car body

@@ -69,6 +69,36 @@ def test_car_ahead_ground_and_truth(world: World) -> None:
     assert np.min(np.linalg.norm(s.points[:, :2], axis=1)) > 2.5
 
 
+def test_a_hidden_actor_is_passed_through_by_both_backends(world: World) -> None:
+    """`World.set_actor_visibility(lidar=False)`: no return on the parked car (Embree, the
+    world's caster; Bullet, by the collision group the rays skip), and the rays reach
+    what is behind it; shown again, it is seen again."""
+    parked = len(world.spec.actors) - 1
+    lidar = world.rig.sensor("lidar").lidar  # type: ignore[attr-defined]
+    bullet = BulletCaster(world.client, lidar.info.max_range, lidar.info.azimuth_steps,
+                          world.actors.bodies, world.scene.ground,
+                          sorted(world.scene.static_bodies))
+    origin, rotation = vehicle_pose(world.ego_truth, world.ego.geometry.ride_height)
+    r = rotation @ lidar._mount_rot
+    o, dirs = origin + rotation @ lidar._mount_xyz, lidar._dirs @ r.T
+    body = world.actors.bodies[parked]
+
+    def bullet_hits() -> int:
+        hit, _ = bullet.cast(o, dirs, math.atan2(r[1, 0], r[0, 0]))
+        return int((hit == body).sum())
+
+    seen = bullet_hits()
+    assert seen > 50
+    world.set_actor_visibility(parked, cameras=True, lidar=False)
+    bullet.hide(frozenset({body}))
+    _, (_, truth) = scan(world)
+    assert not (truth.actor == parked).any() and bullet_hits() == 0
+    world.set_actor_visibility(parked, cameras=True, lidar=True)
+    bullet.hide(frozenset())
+    _, (_, truth) = scan(world)
+    assert (truth.actor == parked).sum() > 50 and bullet_hits() == seen
+
+
 def test_culled_cast_equals_casting_every_ray(world: World) -> None:
     """At several poses along the route, buildings, signs and the parked car in view (the
     Bullet backend, whose culling this is)."""

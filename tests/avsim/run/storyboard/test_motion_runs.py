@@ -46,7 +46,10 @@ def lane(lane_id: str, s: float) -> str:
 
 
 def init(name: str) -> str:
-    lane_id, s, v = START[name]
+    return init_at(name, *START[name])
+
+
+def init_at(name: str, lane_id: str, s: float, v: float) -> str:
     return f"""<Private entityRef="{name}">
       <PrivateAction><TeleportAction><Position>{lane(lane_id, s)}</Position></TeleportAction>
       </PrivateAction>

@@ -1,6 +1,7 @@
 """Fuzzers of the OpenSCENARIO elements read since 1.2/1.3: parameter distribution files,
 variables and their actions and conditions, environments, SynchronizeAction,
-SpeedProfileAction, LateralDistanceAction, the trajectory shapes (clothoid, clothoid
+SpeedProfileAction, LateralDistanceAction, the entity actions (add, delete, visibility,
+lights), the trajectory shapes (clothoid, clothoid
 spline, NURBS), the driver's pedal overrides, and the elements not read yet (traffic
 signals, routes, trailers). Each is generated well formed, then maybe malformed (an
 attribute set to a hostile value or removed, a child removed or repeated, an element not of
@@ -62,6 +63,12 @@ ACTIONS = [  # (wrapper or "", the element) of a PrivateAction
     'routeStrategy="shortest">' + POS.format(0) + '</Waypoint></Route></AssignRouteAction>'
     '</RoutingAction>',
     '<TrailerAction><ConnectTrailerAction trailerRef="Ego"/></TrailerAction>',
+    '<VisibilityAction graphics="false" traffic="true" sensors="false"/>',
+    '<AppearanceAction><LightStateAction transitionTime="0.5"><LightType><VehicleLight '
+    'vehicleLightType="warningLights"/></LightType><LightState mode="flashing" '
+    'luminousIntensity="100" flashingOnDuration="0.5" flashingOffDuration="0.5"><Color '
+    'colorType="yellow"><ColorRgb red="1" green="0.8" blue="0"/></Color></LightState>'
+    '</LightStateAction></AppearanceAction>',
 ]
 SHAPES = [
     '<Polyline><Vertex time="0">' + POS.format(0) + '</Vertex><Vertex time="2">'
@@ -89,6 +96,9 @@ GLOBALS = [
     '<VariableAction variableRef="b"><SetAction value="true"/></VariableAction>',
     '<ParameterAction parameterRef="Speed"><ModifyAction><Rule><MultiplyByValue value="2"/>'
     '</Rule></ModifyAction></ParameterAction>',
+    '<EntityAction entityRef="Ego"><AddEntityAction>' + POS.format(5)
+    + '</AddEntityAction></EntityAction>',
+    '<EntityAction entityRef="Ego"><DeleteEntityAction/></EntityAction>',
     '<InfrastructureAction><TrafficSignalAction><TrafficSignalStateAction name="1" '
     'state="red"/></TrafficSignalAction></InfrastructureAction>',
 ]
