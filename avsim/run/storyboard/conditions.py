@@ -7,7 +7,12 @@ of them, "all": for every one (the entities it holds for are the ones
 `selectTriggeringEntities` adds). Distances (`geometry`) are along the ego's route:
 coordinate systems "entity", "lane", "road" and "trajectory" are all taken along the route
 (the route is the lane kept; an entity's own axes are not used). Relative and position
-distances compare their magnitude. An entity missing from the snapshot: false. Notes
+distances compare their magnitude. An entity missing from the snapshot: false. An entity
+out of the world (deleted, or not yet added: `Snapshot.inactive`) is skipped as esmini
+skips an inactive one: as a triggering entity it neither holds nor counts for rule "all"
+(which holds when every entity in the world does, and one at least is); as a condition's
+reference entity, or as another entity a collision or clearance looks for, it is absent
+(false, nothing to meet). Notes
 particular to a kind are on its judge below; the conditions on variables, time of day,
 acceleration, angles and clearance are judged in `state_conditions`.
 """
@@ -284,6 +289,8 @@ def judge(condition: Condition, snap: Snapshot,
     te = condition.triggering_entities
     if te is None:
         return holds(condition.kind, None, snap, ctx), ()
-    hits = tuple(n for n in te.entities if holds(condition.kind, n, snap, ctx))
-    ok = bool(hits) if te.rule == "any" else len(hits) == len(te.entities) > 0
+    present = tuple(n for n in te.entities if n not in snap.inactive)
+    snap = snap.active()
+    hits = tuple(n for n in present if holds(condition.kind, n, snap, ctx))
+    ok = bool(hits) if te.rule == "any" else len(hits) == len(present) > 0
     return ok, hits

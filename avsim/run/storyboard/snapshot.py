@@ -4,6 +4,8 @@ Truth, from the world (`world.truth`), never the stack's view. Positions are of 
 entity's OpenSCENARIO reference point (a vehicle's rear axle centre, else its bounding box
 centre projected to the ground), in the map frame; route coordinates are along the ego's
 route (`world.hdmap.RoadMap`: station s along lane 0's centre, lateral offset left +).
+An entity out of the world (deleted, or not yet added) is in `entities` (where it left, its
+motion held) and named in `inactive`; conditions judge `active()`, without it.
 """
 
 from __future__ import annotations
@@ -46,3 +48,11 @@ class Snapshot:
     time: float  # [s] simulation time
     entities: Mapping[str, EntityState]  # by entity name
     categories: Mapping[str, str]  # entity name -> "vehicle" | "pedestrian" | "miscellaneous"
+    inactive: frozenset[str] = frozenset()  # entities out of the world now
+
+    def active(self) -> Snapshot:
+        """This snapshot without the entities out of the world (itself when none is)."""
+        if not self.inactive:
+            return self
+        entities = {n: e for n, e in self.entities.items() if n not in self.inactive}
+        return Snapshot(self.time, entities, self.categories)

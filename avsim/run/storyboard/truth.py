@@ -5,7 +5,8 @@ Each entity's reference point is its body centre moved back along its heading by
 reference point for the others (and for a scripted car under test, whose box is then the
 file's too: `StoryProgram.ego_box`). Route coordinates are projected from those points onto the
 ego's route. Running figures (odometer, time at rest, off the road, beyond the road's ends)
-are integrated between snapshots, and accelerations and yaw rates differenced between
+are integrated between snapshots (an entity out of the world counts as standing where it
+left: its held speed is not integrated), and accelerations and yaw rates differenced between
 them (0 at the first). Collisions are judged on the boxes (`geometry.boxes_meet`), not on
 the physics bodies' contacts.
 """
@@ -68,7 +69,8 @@ class TruthTracker:
         x = cx - self.ahead * np.cos(yaw)
         y = cy - self.ahead * np.sin(yaw)
         s, d = self.road.local_coordinates(np.column_stack([x, y]))
-        self._integrate(dt, speed, s, d)
+        present = np.concatenate([[True], ~w.actors.gone[order]])
+        self._integrate(dt, speed, s, d, present)
         acc, yaw_rate = self._rates(dt, speed, yaw)
         route_heading = self.road.heading_at(s)
         entities = {
@@ -82,7 +84,9 @@ class TruthTracker:
                 off_road_for=float(self.off_road[k]), end_of_road_for=float(self.beyond[k]),
                 acceleration=float(acc[k]), yaw_rate=float(yaw_rate[k]))
             for k, name in enumerate(self.names)}
-        return Snapshot(t, entities, self.categories)
+        gone = w.actors.gone
+        inactive = frozenset(name for name, i in self.program.actors if gone[i])
+        return Snapshot(t, entities, self.categories, inactive)
 
     def _rates(self, dt: float, speed: np.ndarray,
                yaw: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -96,7 +100,11 @@ class TruthTracker:
         self._speed, self._yaw = speed.copy(), yaw.copy()
         return acc, turn
 
-    def _integrate(self, dt: float, speed: np.ndarray, s: np.ndarray, d: np.ndarray) -> None:
+    def _integrate(self, dt: float, speed: np.ndarray, s: np.ndarray, d: np.ndarray,
+                   present: np.ndarray) -> None:
+        """Advance the running figures by dt [s]; an entity not `present` (out of the world)
+        counts as standing where it left."""
+        speed = np.where(present, speed, 0.0)
         self.odometer += np.abs(speed) * dt
         self.standing = np.where(np.abs(speed) < AT_REST, self.standing + dt, 0.0)
         right, left = self.road.paved_edges(s)

@@ -108,8 +108,7 @@ PARTLY: dict[str, str] = {
                                                       "test; the other controls only "
                                                       "inactive; `BrakeForce` not yet",
     "GlobalAction.EnvironmentAction": "recorded, not rendered; `DomeImage` not yet",
-    "GlobalAction.EntityAction": "not in Init, not on the car under test; conditions on a "
-                                 "deleted entity read it far away, esmini skips it",
+    "GlobalAction.EntityAction": "not in Init, not on the car under test",
     "PrivateAction.VisibilityAction": "`traffic` recorded only; `SensorReferenceSet` not yet",
     "PrivateAction.AppearanceAction": "`LightStateAction` recorded, not drawn (actor bodies "
                                       "have no lamps); `AnimationAction` not yet",

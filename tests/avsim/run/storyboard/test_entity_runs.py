@@ -34,6 +34,22 @@ def group(name: str, body: str, at: float, kind: str = "PrivateAction") -> str:
         </StartTrigger></Event></Maneuver></ManeuverGroup>"""
 
 
+def light(name: str, light_type: str, rule: str, refs: tuple[str, ...], kind: str) -> str:
+    """A group that turns Ghost's `light_type` on when the entity condition `kind` holds
+    for the triggering entities `refs` (rule `rule`)."""
+    body = f"""<AppearanceAction><LightStateAction><LightType><VehicleLight
+        vehicleLightType="{light_type}"/></LightType><LightState mode="on"/>
+        </LightStateAction></AppearanceAction>"""
+    text = group(name, body, 0.0).replace(f'<EntityRef entityRef="{name}"/>',
+                                          '<EntityRef entityRef="Ghost"/>')
+    refs_xml = "".join(f'<EntityRef entityRef="{r}"/>' for r in refs)
+    by_entity = f"""<ByEntityCondition><TriggeringEntities triggeringEntitiesRule="{rule}">
+        {refs_xml}</TriggeringEntities><EntityCondition>{kind}</EntityCondition>
+        </ByEntityCondition>"""
+    return text.replace("""<ByValueCondition><SimulationTimeCondition value="0.0"
+          rule="greaterOrEqual"/></ByValueCondition>""", by_entity)
+
+
 GROUPS = (
     group("Add", f"""<EntityAction entityRef="Late"><AddEntityAction><Position>
         {lane("-2", 300.0)}</Position></AddEntityAction></EntityAction>""", 2.0,
@@ -46,6 +62,12 @@ GROUPS = (
         mode="flashing" flashingOnDuration="0.5" flashingOffDuration="0.4"><Color
         colorType="orange"/></LightState></LightStateAction></AppearanceAction>""", 0.5)
     .replace('<EntityRef entityRef="Ghost2"/>', '<EntityRef entityRef="Ghost"/>'),
+    # Leaver is deleted at 1 s having travelled 10 m: its held 10 m/s must not count
+    light("Far", "fogLights", "any", ("Leaver",),
+          '<TraveledDistanceCondition value="15"/>'),
+    # Late, standing out of the world until 2 s, is skipped: Ghost alone decides "all"
+    light("Both", "highBeam", "all", ("Late", "Ghost"),
+          '<SpeedCondition value="5" rule="greaterThan"/>'),
 )
 
 
@@ -109,8 +131,18 @@ def test_a_hidden_actor_is_out_of_the_sensors_only(run: tuple[RunResult, Runner]
     assert (seen.name, seen.value) == ("Ghost", "graphics=true traffic=true sensors=false")
 
 
+def test_conditions_skip_an_entity_out_of_the_world(run: tuple[RunResult, Runner]) -> None:
+    """esmini's inactive entities: a deleted one never triggers (its held speed is neither
+    judged nor travelled), one not yet added does not count for rule "all"."""
+    lights = {c.name: c for c in changes(run[0], "light")}
+    assert "Ghost.fogLights" not in lights
+    assert lights["Ghost.highBeam"].t == pytest.approx(0.0)
+    _t, s = track(run[0], "Late")
+    assert s == pytest.approx(300.0, abs=1e-6)  # the situation: Late stands once added
+
+
 def test_a_light_state_is_recorded(run: tuple[RunResult, Runner]) -> None:
-    [light] = changes(run[0], "light")
+    [light] = [c for c in changes(run[0], "light") if c.name == "Ghost.indicatorLeft"]
     assert light.t == pytest.approx(0.5)
     assert (light.name, light.value) == (
         "Ghost.indicatorLeft", "flashing, on 0.5 s, off 0.4 s, orange, over 0.2 s")
