@@ -6,10 +6,13 @@ add or delete of the car under test."""
 from __future__ import annotations
 
 import re
+import shutil
 from pathlib import Path
 
 import pytest
+from click.testing import CliRunner
 
+from avsim.cli import EXIT_BAD_INPUT, main
 from avsim.scenario.errors import ScenarioError
 from avsim.scenario.openscenario.entity_actions import (
     AddEntityAction,
@@ -20,8 +23,11 @@ from avsim.scenario.openscenario.entity_actions import (
 )
 from avsim.scenario.openscenario.parse import load_openscenario
 from avsim.scenario.openscenario.positions import WorldPosition
+from tests.avsim.run.storyboard.test_entity_runs import group
+from tests.avsim.run.storyboard.test_motion_runs import init_at, lane, vehicle
 
 DATA = Path(__file__).parent / "data"
+RUNS = Path(__file__).parents[3] / "avsim" / "run" / "storyboard" / "data"
 MINIMAL = (DATA / "minimal.xosc").read_text()
 EVENT_ACTION = re.compile(r"<PrivateAction>\s*<LongitudinalAction>.*?</LongitudinalAction>"
                           r"\s*</PrivateAction>", re.DOTALL)
@@ -118,3 +124,30 @@ def test_an_entity_action_in_init_is_refused(tmp_path: Path) -> None:
         '<DeleteEntityAction/></EntityAction></GlobalAction><Private entityRef="Ego">', 1))
     with pytest.raises(ScenarioError, match="EntityAction in Init: not supported"):
         load_openscenario(path)
+
+
+@pytest.mark.parametrize("inner", [
+    f"<AddEntityAction><Position>{lane('-1', 50.0)}</Position></AddEntityAction>",
+    "<DeleteEntityAction/>",
+])
+def test_cli_refuses_adding_or_deleting_the_car_under_test(tmp_path: Path, inner: str) -> None:
+    """`avsim run` on a file that adds or deletes the car under test: one line on stderr,
+    exit 2, nothing written."""
+    text = (RUNS / "motion_actions.xosc").read_text()
+    text = text.replace("ENTITIES", vehicle("Ego") + vehicle("Car"))
+    text = text.replace("INIT", init_at("Ego", "-1", 20.0, 10.0) + init_at("Car", "-2", 50.0,
+                                                                          10.0))
+    body = f'<EntityAction entityRef="Ego">{inner}</EntityAction>'
+    text = text.replace("GROUPS", group("Gone", body, 1.0, "GlobalAction"))
+    shutil.copy(RUNS / "straight.xodr", tmp_path / "straight.xodr")
+    path = tmp_path / "s.xosc"
+    path.write_text(text)
+    out = tmp_path / "out.json"
+    result = CliRunner().invoke(main, ["run", str(path), "--profile", "none", "--json",
+                                       str(out)])
+    assert result.exit_code == EXIT_BAD_INPUT, result.output
+    kind = "AddEntityAction" if "Add" in inner else "DeleteEntityAction"
+    assert result.stderr.splitlines() == [
+        f"avsim: error: {path}: Storyboard.Action[GoneAction]: {kind} on the car under "
+        "test: not supported (the run is about it: it is always in the world)"]
+    assert not out.exists()
