@@ -44,9 +44,6 @@ CUT_IN_PATH = ("the cut-in's lane change: esmini keeps the speed over ground (th
                "along the road slows while it moves across) and moves the reference point "
                "along the shape; avsim moves the body centre at the full speed along the "
                "road (0.28 m RMS); not yet matched")
-CYCLIST = ("NCAP CBLA's cyclist (VRU along the lane, SynchronizeAction to the Ego): 0.6 to "
-           "1.0 m RMS from esmini's path and AtCollision 0.175 to 0.25 s late; cause not "
-           "yet found")
 CCRB = ("NCAP CCRb's GVT: its braking starts one check after esmini's (the placement by "
         "the LongitudinalDistanceAction ends at the next check, esmini's at once), and its "
         "path is 1.3 to 3.1 m RMS off esmini's; cause of the rest not yet found")
@@ -54,12 +51,6 @@ ASAM_12_PATHS = ("ASAM 1.2 EndofTrafficJamNeighboringLaneOccupied: its events st
                  "esmini's, but A1 is 2.4 m RMS from esmini's path (its lane offsets are "
                  "2.0 m, the 1.3 file's 0.5 m); cause not yet found")
 KNOWN = {
-    **{(output, check): CYCLIST for check in ("events", "paths") for output in (
-        "ncap/AEB_VRU_2023/NCAP_AEB_VRU_CBLA_2023",
-        "ncap/AEB_VRU_2023/Variations/NCAP_AEB_VRU_CBLA-25_50kph_2023__p0",
-        "ncap/AEB_VRU_2023/Variations/NCAP_AEB_VRU_CBLA-25_Variation_2023__p0",
-        "ncap/AEB_VRU_2023/Variations/NCAP_AEB_VRU_CBLA-50_50kph_2023__p0",
-        "ncap/AEB_VRU_2023/Variations/NCAP_AEB_VRU_CBLA-50_Variation_2023__p0")},
     **{(f"ncap/AEB_C2C_2023/Variations/NCAP_AEB_C2C_{name}__p0", "paths"): CCRB
        for name in ("CCRb_40m_2ms2_2023", "CCRb_Variation_2023")},
     ("asam_examples/exampleFilesVersion1_2/EndofTrafficJamNeighboringLaneOccupied",

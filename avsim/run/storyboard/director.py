@@ -20,7 +20,14 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 
-from avsim.run.storyboard.commands import Commands, Follow, Sync, placed_at_once, poses_of
+from avsim.run.storyboard.commands import (
+    Commands,
+    Follow,
+    Limits,
+    Sync,
+    placed_at_once,
+    poses_of,
+)
 from avsim.run.storyboard.conditions import Resolved
 from avsim.run.storyboard.driver import Driver
 from avsim.run.storyboard.runtime import StartedAction, StoryRuntime
@@ -42,6 +49,7 @@ from avsim.scenario.openscenario.model import (
     SpeedProfileAction,
     SynchronizeAction,
     TeleportAction,
+    Vehicle,
 )
 from avsim.scenario.openscenario.program import StoryProgram
 from avsim.scenario.openscenario.resolve import Resolver
@@ -83,6 +91,9 @@ class Director:
         self._opening = False  # this check is the storyboard's first
         self._top = {e.name: getattr(e.object, "max_speed", WALKING_TOP)
                      for e in osc.entities}  # [m/s] each entity's top speed
+        self._limits = {e.name: Limits(e.object.max_speed, e.object.max_accel,
+                                       e.object.max_decel)
+                        for e in osc.entities if isinstance(e.object, Vehicle)}
         self.driver = Driver(world, program.ego, program.lane_ids)  # the stack's car's
 
     def _resolve(self, position: Position, snap: Snapshot) -> Resolved:
@@ -225,7 +236,7 @@ class Director:
         me = snap.entities[entity]
         try:
             if isinstance(action, SpeedAction):
-                cmd = self.commands.speed(tag, action, me, snap)
+                cmd = self.commands.speed(tag, action, me, snap, self._limits.get(entity))
                 motion.command(cmd)
                 if cmd.continuous:
                     self._follows[tag] = Follow(tag, entity, action,
