@@ -44,15 +44,18 @@ CUT_IN_PATH = ("the cut-in's lane change: esmini keeps the speed over ground (th
                "along the road slows while it moves across) and moves the reference point "
                "along the shape; avsim moves the body centre at the full speed along the "
                "road (0.28 m RMS); not yet matched")
-CCRB = ("NCAP CCRb's GVT: its braking starts one check after esmini's (the placement by "
-        "the LongitudinalDistanceAction ends at the next check, esmini's at once), and its "
-        "path is 1.3 to 3.1 m RMS off esmini's; cause of the rest not yet found")
+CCRB = ("NCAP CCRb's GVT is placed by a LongitudinalDistanceAction at t = 0: esmini's row "
+        "at 0 s is after its opening frame (placed), avsim's sample at 0 s is the truth "
+        "before the first check's actions (the Init position, 29 to 53 m back); placed from "
+        "the first step on, within 0.004 m RMS of esmini's path without that sample (1.2 to "
+        "3.4 m RMS with it)")
 ASAM_12_PATHS = ("ASAM 1.2 EndofTrafficJamNeighboringLaneOccupied: its events start as "
                  "esmini's, but A1 is 2.4 m RMS from esmini's path (its lane offsets are "
                  "2.0 m, the 1.3 file's 0.5 m); cause not yet found")
 KNOWN = {
-    **{(f"ncap/AEB_C2C_2023/Variations/NCAP_AEB_C2C_{name}__p0", "paths"): CCRB
-       for name in ("CCRb_40m_2ms2_2023", "CCRb_Variation_2023")},
+    **{(f"ncap/AEB_C2C_2023/Variations/NCAP_AEB_C2C_{name}", "paths"): CCRB
+       for name in ("CCRb_40m_2ms2_2023__p0", *(f"CCRb_Variation_2023__p{k}"
+                                                for k in range(4)))},
     ("asam_examples/exampleFilesVersion1_2/EndofTrafficJamNeighboringLaneOccupied",
      "paths"): ASAM_12_PATHS,
     ("alks/no_controllers/alks_scenario_4_4_2_cut_in_unavoidable_collision_template",

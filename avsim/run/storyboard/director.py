@@ -5,7 +5,8 @@ At each trigger check (`world.core.rates.TRIGGER_RATE`) it takes the truth's sna
 and stop now), then reports the actions whose commands reached their goal since the last
 check (they end now, after this check's triggers: a condition on their end sees it at the
 next check, as esmini evaluates the triggers of a step before it steps the actions), and
-turns each started action into a command on each of its actors' motions (`commands`). Commands the
+turns each started action into a command on each of its actors' motions (`commands`); a
+distance action that places its actor at once ends in the check it starts (esmini's). Commands the
 truth must steer every step (a distance to keep, a continuous relative speed) are renewed
 at each check. Actions on the car under test are its controller's (activation,
 assignment): they complete at once and set the switch of its automated driving function
@@ -198,6 +199,10 @@ class Director:
                 self._command(tag, entity, motion, action, snap)
         if tags:
             self._pending[started.action_id] = tags
+            if isinstance(action, LongitudinalDistanceAction) and placed_at_once(action):
+                # esmini places the actor and ends the action in the step it starts: an
+                # element waiting on its end sees it at the next check
+                self._finish(sorted(tags), snap.time)
         elif not started.action_id.startswith(INIT):
             self.runtime.action_done(started.action_id, snap.time)
 
