@@ -4,7 +4,10 @@
 - SpeedAction: a speed transition from the actor's speed to the target (absolute, or the
   referenced entity's speed now plus a delta / times a factor), shaped and timed by its
   dynamics (`profiles`: a rate is the peak acceleration); a continuous relative target
-  keeps following the entity's speed afterwards (`Follow`).
+  keeps following the entity's speed afterwards (`Follow`). A vehicle's Performance
+  bounds it as esmini does: the target to its maxSpeed, and a transition whose peak
+  acceleration exceeds its maxAcceleration (speeding up) or maxDeceleration (slowing
+  down) stretched in time until the peak is that limit (same shape, longer span).
 - LaneChangeAction: a lateral transition of the reference point to the target lane's centre
   (plus its target offset) by esmini's law (`world.actors.profiles`: the speed kept over
   ground); the target lane is an OpenDRIVE id, or lanes to the left of an entity's lane; a
@@ -91,6 +94,20 @@ SPEED_MATCHED = 0.1  # [m/s] ... at the entity's speed within this
 
 
 @dataclass(frozen=True, slots=True)
+class Limits:
+    """A vehicle's Performance: what its speed actions may ask of it."""
+
+    max_speed: float  # [m/s] (its magnitude: files write some limits signed)
+    max_accel: float  # [m/s^2] (its magnitude)
+    max_decel: float  # [m/s^2] (its magnitude)
+
+    def bound(self, speed: float) -> float:
+        """[m/s] `speed` within +-max_speed."""
+        top = abs(self.max_speed)
+        return max(-top, min(top, speed))
+
+
+@dataclass(frozen=True, slots=True)
 class Follow:
     """A command the director refreshes every step from the truth: a continuous relative
     speed, or a distance to keep."""
@@ -123,11 +140,17 @@ class Commands:
         self.resolver = resolver
         self.lane_ids = lane_ids
 
-    def speed(self, tag: str, action: SpeedAction, me: EntityState,
-              snap: Snapshot) -> SpeedCommand:
-        """A speed transition; a continuous one never reports finished."""
-        target = _speed_target(action, snap)
-        span = _speed_span(action.dynamics, me.speed, target)
+    def speed(self, tag: str, action: SpeedAction, me: EntityState, snap: Snapshot,
+              limits: Limits | None = None) -> SpeedCommand:
+        """A speed transition; a continuous one never reports finished. `limits`: the
+        actor's Performance (a vehicle's; None: unbounded), module doc."""
+        wanted = _speed_target(action, snap)
+        target = wanted if limits is None else limits.bound(wanted)
+        d = action.dynamics
+        # a distance is converted to a time with the target asked for (esmini's order)
+        span = _speed_span(d, me.speed, wanted if d.dimension == "distance" else target)
+        if limits is not None:
+            span = _stretched(limits, Shape(d.shape), me.speed, target, span)
         continuous = isinstance(action.target, RelativeTargetSpeed) and action.target.continuous
         return SpeedCommand(tag, Transition(me.speed, target, Shape(action.dynamics.shape),
                                             span), snap.time, continuous=continuous)
@@ -369,6 +392,19 @@ def _speed_span(d: TransitionDynamics, start: float, target: float) -> float:
         raise ValueError(f"a speed change at rate {d.value:g} m/s^2 never ends")
     return span_by_rate(shape, target - start, abs(d.value))  # the sign is the change's
     #   (ASAM's 1.2 examples write a braking rate negative; esmini plays its magnitude)
+
+
+def _stretched(limits: Limits, shape: Shape, start: float, target: float,
+               span: float) -> float:
+    """[s] a speed transition's span stretched so that the peak acceleration of its shape
+    is at most the vehicle's maxAcceleration when speeding up, its maxDeceleration when
+    slowing down (a step, or a span of 0, changes at once: unbounded, as esmini's)."""
+    if span <= 0.0 or shape is Shape.STEP:
+        return span
+    limit = abs(limits.max_accel if target > start else limits.max_decel)
+    if limit == 0.0:
+        return math.inf  # a vehicle that cannot change its speed keeps it
+    return max(span, span_by_rate(shape, target - start, limit))
 
 
 def _offset_span(shape: Shape, distance: float, accel: float) -> float:

@@ -5,7 +5,8 @@ At each trigger check (`world.core.rates.TRIGGER_RATE`) it takes the truth's sna
 and stop now), then reports the actions whose commands reached their goal since the last
 check (they end now, after this check's triggers: a condition on their end sees it at the
 next check, as esmini evaluates the triggers of a step before it steps the actions), and
-turns each started action into a command on each of its actors' motions (`commands`). Commands the
+turns each started action into a command on each of its actors' motions (`commands`); a
+distance action that places its actor at once ends in the check it starts (esmini's). Commands the
 truth must steer every step (a distance to keep, a continuous relative speed) are renewed
 at each check. Actions on the car under test are its controller's (activation,
 assignment): they complete at once and set the switch of its automated driving function
@@ -21,7 +22,14 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 
-from avsim.run.storyboard.commands import Commands, Follow, Sync, placed_at_once, poses_of
+from avsim.run.storyboard.commands import (
+    Commands,
+    Follow,
+    Limits,
+    Sync,
+    placed_at_once,
+    poses_of,
+)
 from avsim.run.storyboard.conditions import Resolved
 from avsim.run.storyboard.driver import Driver
 from avsim.run.storyboard.entity_player import ENTITY_ACTIONS, EntityPlayer
@@ -44,6 +52,7 @@ from avsim.scenario.openscenario.model import (
     SpeedProfileAction,
     SynchronizeAction,
     TeleportAction,
+    Vehicle,
 )
 from avsim.scenario.openscenario.program import StoryProgram
 from avsim.scenario.openscenario.resolve import Resolver
@@ -85,6 +94,9 @@ class Director:
         self._opening = False  # this check is the storyboard's first
         self._top = {e.name: getattr(e.object, "max_speed", WALKING_TOP)
                      for e in osc.entities}  # [m/s] each entity's top speed
+        self._limits = {e.name: Limits(e.object.max_speed, e.object.max_accel,
+                                       e.object.max_decel)
+                        for e in osc.entities if isinstance(e.object, Vehicle)}
         self.driver = Driver(world, program.ego, program.lane_ids)  # the stack's car's
         self.entities = EntityPlayer(program, world, self.commands,
                                      self.runtime.story_state)  # add, delete, looks
@@ -203,6 +215,10 @@ class Director:
                 self._command(tag, entity, motion, action, snap)
         if tags:
             self._pending[started.action_id] = tags
+            if isinstance(action, LongitudinalDistanceAction) and placed_at_once(action):
+                # esmini places the actor and ends the action in the step it starts: an
+                # element waiting on its end sees it at the next check
+                self._finish(sorted(tags), snap.time)
         elif not started.action_id.startswith(INIT):
             self.runtime.action_done(started.action_id, snap.time)
 
@@ -241,7 +257,7 @@ class Director:
         me = snap.entities[entity]
         try:
             if isinstance(action, SpeedAction):
-                cmd = self.commands.speed(tag, action, me, snap)
+                cmd = self.commands.speed(tag, action, me, snap, self._limits.get(entity))
                 motion.command(cmd)
                 if cmd.continuous:
                     self._follows[tag] = Follow(tag, entity, action,
