@@ -201,6 +201,20 @@ class Director:
             for entity in started.entities:
                 self.entities.play(f"{started.action_id}@{entity}", entity, action, snap)
             return
+        tags = self._start_on_entities(started, action, snap)
+        if tags:
+            self._pending[started.action_id] = tags
+            if isinstance(action, LongitudinalDistanceAction) and placed_at_once(action):
+                # esmini places the actor and ends the action in the step it starts: an
+                # element waiting on its end sees it at the next check
+                self._finish(sorted(tags), snap.time)
+        elif not started.action_id.startswith(INIT):
+            self.runtime.action_done(started.action_id, snap.time)
+
+    def _start_on_entities(self, started: StartedAction, action: PrivateAction,
+                           snap: Snapshot) -> set[str]:
+        """Start the motion `action` of `started` on each of its entities (an actor's
+        motion, or the driver of the car the stack drives); the tags of those it runs on."""
         tags = set()
         for entity in started.entities:
             tag = f"{started.action_id}@{entity}"
@@ -213,14 +227,7 @@ class Director:
             self._tag_action[tag] = started.action_id
             if motion is not None:
                 self._command(tag, entity, motion, action, snap)
-        if tags:
-            self._pending[started.action_id] = tags
-            if isinstance(action, LongitudinalDistanceAction) and placed_at_once(action):
-                # esmini places the actor and ends the action in the step it starts: an
-                # element waiting on its end sees it at the next check
-                self._finish(sorted(tags), snap.time)
-        elif not started.action_id.startswith(INIT):
-            self.runtime.action_done(started.action_id, snap.time)
+        return tags
 
     def _control(self, started: StartedAction) -> None:
         """A controller action on the car under test: its function's switch, or its
