@@ -6,6 +6,8 @@ step, NPC behaviours, the ego's events). Ground truth for criteria and the recor
 `world.truth`; the stack only ever sees what the sensor rig (`world.sensors`) measures (the
 accelerator pedal an ego event holds is one of the odometry's signals: the world applies no
 force for it; a flat tyre an ego event makes is physical, and no signal says it).
+The environment (`world.environment`: light, fog, precipitation, the road's friction) is
+`CLEAR` until the scenario sets another (`World.set_environment`).
 """
 
 from __future__ import annotations
@@ -28,6 +30,7 @@ from world.core.rendering import attach_renderer
 from world.ego.body import EgoBody, EgoParams, EgoTruth
 from world.ego.events import EgoEvents
 from world.ego.scripted import ScriptedEgo
+from world.environment import CLEAR, SceneEnvironment
 from world.frames import DriverControls
 from world.map.road import build_road_map, light_head
 from world.map.signals import light_colour, route_signals
@@ -114,6 +117,7 @@ class WorldSnapshot:
     ego_joints: list[float]  # joint positions in joint order (wheel spin, steering hinges)
     actors: tuple[tuple[tuple[float, ...], tuple[float, ...]], ...]  # (position, quaternion)
     camera_hidden: tuple[int, ...] = ()  # the actors the cameras do not draw (by index)
+    environment: SceneEnvironment = CLEAR  # the environment in effect
 
 
 class World:
@@ -131,6 +135,7 @@ class World:
         cameras = cameras and sensors is not None
         self.renderer = attach_renderer(self.client) if cameras else None
         self.clock = Clock()
+        self.environment = CLEAR  # the environment in effect (`set_environment`)
         self._step_physics = self.client.stepSimulation  # bound once: called every step
         self.road = build_road_map(spec.road)
         self.signals = route_signals(spec.road, self.road)  # the route's lights (truth)
@@ -178,13 +183,16 @@ class World:
                    seeds: list[np.random.SeedSequence], backend: RayBackend) -> SensorRig:
         """The car's sensors in this client: the profile's cameras (with a renderer) and
         LiDAR (with `lidar`), GNSS and odometry; each draws its noise from its own child of
-        the scenario's seed (LiDAR 3, GNSS 1, odometry 2)."""
+        the scenario's seed (LiDAR 3, GNSS 1, odometry 2); a camera's noise (in fog, rain or
+        darkness only) from the seed, the stream 4 and the camera's index, and each frame's
+        time (`world.sensors.camera_weather`), wherever it renders."""
         ride_height = self.ego.geometry.ride_height
         sensors: list[Sensor] = []
         if setup is not None and self.renderer is not None:
-            sensors += [CameraSensor(Camera(self.client, info, self.renderer),
+            sensors += [CameraSensor(Camera(self.client, info, self.renderer,
+                                            (self.spec.seed % (1 << 64), 4, index)),
                                      setup.timing(info.name), ride_height)
-                        for info in setup.cameras]
+                        for index, info in enumerate(setup.cameras)]
         if setup is not None and lidar:
             caster = Lidar(self.client, setup.lidar, np.random.default_rng(seeds[3]),
                            self.actors.bodies, self.scene.ground,
@@ -534,7 +542,23 @@ class World:
         com, quat, joints = self.ego.base_state()
         actors = tuple(self.client.getBasePositionAndOrientation(b) for b in self.actors.bodies)
         return WorldSnapshot(self.clock.step, com, quat, joints, actors,
-                             tuple(sorted(self.camera_hidden)))
+                             tuple(sorted(self.camera_hidden)), self.environment)
+
+    def set_environment(self, env: SceneEnvironment) -> None:
+        """The environment in effect from now on: the cameras and the LiDAR see through it,
+        and the road's surfaces (the ground, speed bumps, kerbed slabs) take its friction,
+        `GROUND_FRICTION` x `friction_scale` (Bullet multiplies it with the tyre's)."""
+        if env.friction_scale != self.environment.friction_scale:
+            friction = GROUND_FRICTION * env.friction_scale
+            for body in (self.scene.ground, *sorted(self.scene.bump_bodies),
+                         *sorted(self.scene.kerb_bodies)):
+                self.client.changeDynamics(body, -1, lateralFriction=friction)
+        self.environment = env
+        for sensor in self.rig:
+            if isinstance(sensor, CameraSensor):
+                sensor.camera.environment = env
+            elif isinstance(sensor, LidarSensor):
+                sensor.lidar.extinction = env.extinction
 
     def set_actor_visibility(self, i: int, cameras: bool, lidar: bool) -> None:
         """Whether the cameras draw actor `i` and the LiDAR's rays meet it. Its body stays
@@ -563,6 +587,8 @@ class World:
         if set(snap.camera_hidden) != self.camera_hidden:
             self.camera_hidden = set(snap.camera_hidden)
             self._hide_from_sensors()
+        if snap.environment != self.environment:
+            self.set_environment(snap.environment)
         self.client.performCollisionDetection()  # bring the ray-test broadphase up to date
         self._light_lamps()
         self._truth = None

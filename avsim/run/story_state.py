@@ -4,8 +4,8 @@ the result file's `storyboard_state` entries and as the recording's event lines.
 
 The environment is recorded as the file sets it (SI units: angles [rad], illuminance [lx],
 lengths [m], temperature [K], pressure [Pa], precipitation [mm/h], wind [m/s], the time of
-day as written and as seconds since 1970-01-01T00:00:00 UTC); avsim does not render it
-and does not change the road's friction by it."""
+day as written and as seconds since 1970-01-01T00:00:00 UTC); what the world renders of it
+is `avsim.run.environment`'s."""
 
 from __future__ import annotations
 

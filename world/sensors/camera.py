@@ -9,6 +9,9 @@ and the projection has the camera's vertical field of view and aspect. Lighting 
 default (no shadows: they triple TinyRenderer's cost and add nothing the lane finder needs).
 Bodies the camera is told not to draw (`Camera.hidden`: a storyboard's VisibilityAction) are
 moved far below the ground for the frame and put back where they were right after.
+The environment in effect (`Camera.environment`, `world.environment`) is applied to each
+image from its depth buffer: fog, rain, darkness and the sensor's noise
+(`world.sensors.camera_weather`); clear daylight leaves the image as Bullet drew it.
 """
 
 from __future__ import annotations
@@ -26,7 +29,9 @@ from world.core.quiet import quiet_c_output
 from world.core.rates import Rate, SensorTiming
 from world.core.rendering import Renderer
 from world.ego.body import EgoTruth
+from world.environment import CLEAR, SceneEnvironment
 from world.frames import CameraFrame, CameraInfo
+from world.sensors.camera_weather import CameraWeather, frame_key
 from world.sensors.sensor import Reading, vehicle_pose
 
 AWAY = (1.0e5, 1.0e5, -10.0)  # [m] where a body the camera does not draw is for a frame
@@ -35,7 +40,10 @@ AWAY = (1.0e5, 1.0e5, -10.0)  # [m] where a body the camera does not draw is for
 class Camera:
     """Renders one `CameraInfo` in one client."""
 
-    def __init__(self, client: BulletClient, info: CameraInfo, renderer: Renderer) -> None:
+    def __init__(self, client: BulletClient, info: CameraInfo, renderer: Renderer,
+                 seed: tuple[int, ...] = (0,)) -> None:
+        """`seed`: the entropy of its noise (the run's seed and the camera's index): each
+        frame's noise is drawn from it and the frame's time."""
         self.info = info
         self.renderer = renderer
         self._c = client
@@ -47,6 +55,9 @@ class Camera:
         self._mount_xyz = np.array([m.x, m.y, m.z])  # [m] vehicle frame
         self._mount_rot = m.rotation()
         self.hidden: frozenset[int] = frozenset()  # bodies not drawn (still in the physics)
+        self.environment: SceneEnvironment = CLEAR  # what the image is seen through
+        self._weather = CameraWeather(info)
+        self._seed = seed
 
     def render(self, t: float, vehicle_origin: NDArray[np.float64],
                vehicle_rotation: NDArray[np.float64]) -> CameraFrame:
@@ -61,7 +72,7 @@ class Camera:
         for body, _, _ in poses:  # out of sight for this frame only (a draw reads no contacts)
             self._c.resetBasePositionAndOrientation(body, AWAY, (0.0, 0.0, 0.0, 1.0))
         with quiet_c_output():  # the EGL plugin reports its GL vendor on the first frame
-            _, _, rgba, _, _ = self._c.getCameraImage(
+            _, _, rgba, depth, _ = self._c.getCameraImage(
                 info.width, info.height, view, self._projection, renderer=self._renderer,
                 flags=pybullet.ER_NO_SEGMENTATION_MASK, shadow=0,
             )
@@ -70,6 +81,10 @@ class Camera:
         rgba = np.asarray(rgba, dtype=np.uint8).reshape(info.height, info.width, 4)
         # OpenCV drops the alpha in one vectorised pass, 25x faster than numpy's strided copy
         rgb = np.asarray(cv2.cvtColor(rgba, cv2.COLOR_RGBA2RGB), dtype=np.uint8)
+        if self.environment is not CLEAR:
+            buffer = np.asarray(depth, dtype=np.float32).reshape(info.height, info.width)
+            rgb = self._weather.apply(rgb, buffer, self.environment,
+                                      (*self._seed, frame_key(t)))
         return CameraFrame(t=t, info=info, rgb=rgb)
 
 

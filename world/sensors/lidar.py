@@ -13,8 +13,21 @@ the ground).
 
 Returns: range = hit fraction x max range, plus Gaussian range noise (``range_sigma``), and a
 ``dropout`` fraction of returns lost, both from the world's seeded generator. Points are in
-the sensor frame. The body each return hit is kept beside the scan as ground truth (for
-perception scoring and the recording; never given to the stack).
+the sensor frame.
+
+In fog, rain or snow (`Lidar.extinction` alpha > 0, set from the environment:
+`world.environment`) a return's received power follows the LiDAR equation for a target
+filling the beam, P ~ rho exp(-2 alpha d) / d^2 (two-way extinction over the range d). Every
+surface is taken as the reference reflectivity rho (the scene has no per-material
+reflectivity), and the detection threshold is half the power of a return from `max_range` in
+clear air (the sensor's stated range holds with a 3 dB margin), so the margin of a return
+is m = 2 (max_range / d)^2 exp(-2 alpha d): detected surely where m >= 2 (every return in
+clear air), lost where m < 1, and detected with probability log2(m) between (the
+threshold's fluctuation: speckle, noise), drawn from the world's seeded generator. Fog's
+backscatter (spurious near returns) is not modelled. Clear air draws nothing.
+
+The body each return hit is kept beside the scan as ground truth (for perception scoring and
+the recording; never given to the stack).
 
 `Lidar` casts one `LidarInfo` in one client; `LidarSensor` is that LiDAR on the car, a
 `world.sensors.sensor.Sensor` with the profile's rate and latency (`world.core.rates`).
@@ -84,6 +97,7 @@ class Lidar:
         self._actor_of = np.full(max([*actor_bodies, 0]) + 1, -1, dtype=np.int16)
         self._actor_of[actor_bodies] = np.arange(len(actor_bodies), dtype=np.int16)
         self._rng = rng
+        self.extinction = 0.0  # [1/m] the air's extinction coefficient (0: clear air)
         self._dirs, self._ring, self._column = beam_directions(info)
         m = info.mount
         self._mount_xyz = np.array([m.x, m.y, m.z])
@@ -118,6 +132,8 @@ class Lidar:
         body, fraction = self._cast(origin, self._dirs @ rotation.T,
                                     math.atan2(rotation[1, 0], rotation[0, 0]))
         keep = body >= 0
+        if self.extinction > 0.0:
+            keep &= self._detected(fraction * info.max_range, keep)
         if info.dropout > 0.0:
             keep &= self._rng.random(len(body)) >= info.dropout
         ranges = fraction[keep] * info.max_range
@@ -131,6 +147,17 @@ class Lidar:
         known = hit < len(self._actor_of)
         actor[known] = self._actor_of[hit[known]]
         return scan, LidarTruth(actor=actor)
+
+    def _detected(self, ranges: NDArray[np.float64],
+                  hit: NDArray[np.bool_]) -> NDArray[np.bool_]:
+        """Which rays' returns are strong enough after the air's two-way extinction (module
+        doc): one draw per ray that hit something, in ray order."""
+        detected = np.zeros(len(ranges), dtype=bool)
+        d = np.maximum(ranges[hit], 1e-3)
+        log2_margin = (1.0 + 2.0 * np.log2(self.info.max_range / d)
+                       - 2.0 * self.extinction * d / math.log(2.0))
+        detected[hit] = self._rng.random(len(d)) < log2_margin
+        return detected
 
     def _cast(self, origin: NDArray[np.float64], directions: NDArray[np.float64],
               heading: float) -> tuple[NDArray[np.int32], NDArray[np.float64]]:

@@ -16,12 +16,16 @@ Its speed and lane changes and pedal overrides are its driver's inputs (`driver`
 A scripted car under test (`World.scripted`, `world.ego.scripted`) takes every other action
 as an actor does, on its own motion; its controller actions then change nothing. Entity
 actions (add, delete, visibility, lights) are played at once (`entity_player`).
+The environment an EnvironmentAction sets (in the runtime's story state) is handed to the
+world at the check it starts (`avsim.run.environment`): light, fog and precipitation for the
+sensors, the road's friction for the physics.
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterable
 
+from avsim.run.environment import scene_environment
 from avsim.run.storyboard.commands import (
     Commands,
     Follow,
@@ -37,6 +41,7 @@ from avsim.run.storyboard.runtime import StartedAction, StoryRuntime
 from avsim.run.storyboard.snapshot import EntityState, Snapshot
 from avsim.run.storyboard.truth import TruthTracker
 from avsim.scenario.openscenario.actions import engages
+from avsim.scenario.openscenario.environment import Environment
 from avsim.scenario.openscenario.model import (
     ActivateControllerAction,
     AssignControllerAction,
@@ -100,6 +105,7 @@ class Director:
         self.driver = Driver(world, program.ego, program.lane_ids)  # the stack's car's
         self.entities = EntityPlayer(program, world, self.commands,
                                      self.runtime.story_state)  # add, delete, looks
+        self._environment: Environment | None = None  # the one last handed to the world
 
     def _resolve(self, position: Position, snap: Snapshot) -> Resolved:
         """Where a condition's position is now: map (x, y), route (s, offset)."""
@@ -125,6 +131,7 @@ class Director:
                                         (item.entity,), item.action)
                 self._start(started, snap)
         result = self.runtime.step(snap)
+        self._hand_over_environment(snap.time)
         for action_id in result.stopped:
             self._stop(action_id)
         self._collect_finished(snap)
@@ -134,6 +141,17 @@ class Director:
         if result.ended and not self.ended:
             self.ended, self.ended_at = True, snap.time
         return self.ended
+
+    def _hand_over_environment(self, t: float) -> None:
+        """The world takes the environment in effect when an EnvironmentAction set a new one
+        (before or at this check, time `t` [s])."""
+        state = self.runtime.story_state
+        env = state.environment
+        if env is None or env is self._environment:
+            return
+        self._environment = env
+        self.world.set_environment(scene_environment(env, self.world.environment,
+                                                     state.time_of_day(t)))
 
     def _motion(self, entity: str) -> NpcMotion | None:
         """The motion that plays `entity`'s actions: an actor's, or the scripted car under

@@ -107,7 +107,10 @@ PARTLY: dict[str, str] = {
     "ControllerAction.OverrideControllerValueAction": "`Throttle`, `Brake` on the car under "
                                                       "test; the other controls only "
                                                       "inactive; `BrakeForce` not yet",
-    "GlobalAction.EnvironmentAction": "recorded, not rendered; `DomeImage` not yet",
+    "GlobalAction.EnvironmentAction": "rendered: darkness, fog, rain and snow for the "
+                                      "cameras and the LiDAR, `frictionScaleFactor` on the "
+                                      "road; no headlights, a fog box fills the world; "
+                                      "`DomeImage` not yet",
     "GlobalAction.EntityAction": "not in Init, not on the car under test",
     "PrivateAction.VisibilityAction": "`traffic` recorded only; `SensorReferenceSet` not yet",
     "PrivateAction.AppearanceAction": "`LightStateAction` recorded, not drawn (actor bodies "

@@ -2,9 +2,9 @@
 time of day, weather, road condition. SI units: angles in radians, illuminance in lux,
 lengths in metres, temperatures in kelvin, pressures in pascal, precipitation in mm/h.
 
-avsim records the environment in effect (the run's result and its recording); it does not
-render it (the cameras see the same light, no fog, no rain) and the road's friction is not
-changed by it (`docs/openscenario.md`).
+avsim records the environment in effect (the run's result and its recording) and hands it to
+the world (`avsim.run.environment`): light, fog and precipitation for the cameras and the
+LiDAR, the friction scale for the road (`docs/openscenario.md`, "The environment rendered").
 """
 
 from __future__ import annotations
