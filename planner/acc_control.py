@@ -269,7 +269,10 @@ def guard_decel(v: float, v_l: float, d: float, a_lead: float, p: AccControlPara
     faster than v_guard, ``b + restore_decel``; `b` alone for a lead that `entered` the
     lane ahead at any speed (UN R157 gives a cut-in time to restore d_min: its closing is
     the approach's); in full within d_near of d_min, tapering linearly to 0 at d_far above
-    it; 0 when not closing (module doc)."""
+    it; 0 when not closing (module doc). Behind a lead at rest (under v_standstill) UN R157's
+    following distance, which is for a moving lead, and the lead's braking (its estimate
+    still says so as it comes to rest) no longer apply: the stop d_keep behind R157's
+    standstill gap, ``(v - v_l)^2 / (2 (d - d_min(0) - d_keep))``, with the same weight."""
     closing = v - max(v_l, 0.0)
     if closing <= 0.0:
         return 0.0
@@ -277,6 +280,9 @@ def guard_decel(v: float, v_l: float, d: float, a_lead: float, p: AccControlPara
     weight = min(max((p.d_far - above) / (p.d_far - p.d_near), 0.0), 1.0)
     if weight <= 0.0:
         return 0.0
+    if v_l < p.v_standstill:  # a lead at rest: no following distance, no braking to come
+        room = d - r157_min_gap(0.0) - p.d_keep
+        return weight * closing * closing / (2.0 * room) if room > 0.0 else math.inf
     b = lead_braking(a_lead, p)
     if entered:  # a lead that entered the lane ahead: UN R157's cut-in grace
         return weight * b

@@ -407,3 +407,21 @@ def test_a_lead_pulling_away_far_ahead_is_not_fed_forward_past_the_plan() -> Non
     assert fastest <= v_plan + 0.1
     assert trail(v_plan, 36.0, 16.0, 2.1, m.d0, P, 1.5, closing=5.8).accel == pytest.approx(
         1.5 - P.k_gap * 5.8)
+
+
+def test_behind_a_lead_at_rest_the_guard_asks_only_the_stop_behind_it() -> None:
+    """UN R157's following distance is for a moving lead. A lead braking at 4.5 m/s^2 from
+    50 km/h comes to rest 13.2 m ahead of a car at 8.2 m/s (d_min there 10.6 m); its track
+    still says it brakes. The guard asked b + (v - v_l)^2 / (2 (d - d_min(v) - d_keep)),
+    8.7 m/s^2 (a_hard for half a second, the 2 s average 3.8 m/s^2 where a stop at 3.2
+    was left); it now asks the stop d_keep behind R157's 2 m standstill gap, weighted as
+    before."""
+    v, d = 8.18, 13.2
+    weight = min(max((P.d_far - (d - r157_min_gap(v))) / (P.d_far - P.d_near), 0.0), 1.0)
+    assert 0.0 < weight < 1.0
+    stop = v * v / (2.0 * (d - r157_min_gap(0.0) - P.d_keep))
+    assert guard_decel(v, 0.0, d, -4.48, P) == pytest.approx(weight * stop)
+    assert guard_decel(v, 0.3, d, -4.48, P) == pytest.approx(weight * (v - 0.3) ** 2 / (
+        2.0 * (d - r157_min_gap(0.0) - P.d_keep)))  # under v_standstill: at rest
+    assert guard_decel(v, 0.0, 2.5, 0.0, P) == math.inf  # no room left
+    assert guard_decel(v, 1.0, d, -4.48, P) > 4.48  # still moving: its braking and d_min
