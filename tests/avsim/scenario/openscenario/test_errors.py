@@ -42,8 +42,8 @@ def test_malformed_xml_names_the_line() -> None:
 
 def test_unsupported_action_names_its_path() -> None:
     assert message("unsupported_action.xosc") == (
-        f"line 49: {EVENT}/Action[MainAction]/PrivateAction/VisibilityAction: "
-        "not supported yet (VisibilityAction)"
+        f"line 49: {EVENT}/Action[MainAction]/PrivateAction/TrailerAction: "
+        "not supported yet (TrailerAction)"
     )
 
 
@@ -166,8 +166,10 @@ WORLD = '<WorldPosition x="0" y="0" h="0"/>'
         ),
         (
             SPEED_ACTION,
-            '<VisibilityAction graphics="true" traffic="true" sensors="false"/>',
-            "VisibilityAction",
+            "<AppearanceAction><AnimationAction><AnimationType><UserDefinedAnimation "
+            'userDefinedAnimationType="wave"/></AnimationType></AnimationAction>'
+            "</AppearanceAction>",
+            "AnimationAction",
         ),
         (WORLD, "<RoutePosition><RouteRef/><InRoutePosition/></RoutePosition>",
          "RoutePosition"),
