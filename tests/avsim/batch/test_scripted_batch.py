@@ -22,6 +22,7 @@ from avsim.batch.jobs import RunJob
 from avsim.batch.resume import run_key
 from avsim.batch.suite import plan, run_command, suite_entries
 from avsim.scenario.errors import ScenarioError
+from tests.avsim.run.test_scripted_ego import ACTIVATE, OFFSET
 
 ROOT = Path(__file__).parents[3]
 EXAMPLES = ROOT / "docs" / "examples"
@@ -34,15 +35,6 @@ CCFHOS = NCAP / "OpenSCENARIO" / "NCAP" / "AEB_C2C_2023" / "Variations" \
 YAML = ROOT / "scenarios" / "cut_in.yaml"
 CAMPAIGN = ROOT / "scenarios" / "campaigns" / "cut_in.yaml"
 TIMEOUT = 300.0  # [s] a subprocess of two runs of 1 s simulated, no sensors
-ACTIVATE = """<ControllerAction>
-                    <ActivateControllerAction lateral="true" longitudinal="true" />
-                  </ControllerAction>"""
-OFFSET = """<LateralAction>
-                    <LaneOffsetAction continuous="false">
-                      <LaneOffsetActionDynamics dynamicsShape="linear" maxLateralAcc="0.5" />
-                      <LaneOffsetTarget><AbsoluteTargetLaneOffset value="0.5" /></LaneOffsetTarget>
-                    </LaneOffsetAction>
-                  </LateralAction>"""
 
 
 @pytest.fixture
