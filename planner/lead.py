@@ -23,9 +23,9 @@ with its gap, speed and lateral offset from the lane's centre line.
   direction where it is: no yaw of the ego's in it) is taken where it will be
   ``CUT_IN_HORIZON`` later (`cut_in_lateral`; its lateral speed is the track's, which lags
   the move by a few tenths of a second): a car cutting in at 1 m/s has its body
-  0.2 m inside the lane 0.8 s before its centre is within ``half_width``, and UN R157
-  5.2.5.2 counts from that intrusion (taken by its centre alone, a cut-in 30 m ahead at
-  20 km/h slower becomes the lead 0.8 s after its intrusion, too late);
+  0.2 m inside the lane 0.8 s before its centre is within 1.6 m of the centre line, and
+  UN R157 5.2.5.2 counts from that intrusion (taken by its centre alone, a cut-in 30 m ahead
+  at 20 km/h slower becomes the lead 0.8 s after its intrusion, too late);
 - `route_candidates`, through a town junction, where the lane is the map's turn path: the
   tracks (map frame) up to ``path_reach`` ahead along the map lane kept; the gap is along the
   lane, the speed (and the signed velocity) along the lane's heading where the track is.
@@ -34,7 +34,13 @@ Then `LeadSelector` picks the lead, as a production ACC's target selection does,
 car in the next lane that strays near the line for a moment, or a lane's centre drawn a
 little off far ahead, does not make the car brake and release:
 
-- a vehicle enters the lane within ``half_width`` of its centre line and must stay there
+- a vehicle is in the lane when its near side is within ``path`` of the lane's centre
+  line (`Candidate.side`): the car's own half width and a margin, so that a vehicle is the
+  lead before its body reaches the car's path, whatever its width (by its centre within
+  1.6 m, a saloon 1.83 m wide was taken only with its body 0.12 m into the car's path: a
+  cut-in at 0.5 m/s, 23 km/h slower, touched the car 0.6 s after it was taken, and a rigid
+  truck 2.55 m wide, its centre 1.7 m off the centre line, overlapped the car's path by
+  0.4 m without ever being the lead); a vehicle enters the lane and must stay there
   for ``confirm`` before it can become the lead (a new track or one that swerved in),
   unless it is urgent: closing with a time to collision under ``urgent_ttc`` (a cut-in
   close ahead is taken at once), or closing so fast for its gap that waiting out the
@@ -53,9 +59,9 @@ little off far ahead, does not make the car brake and release:
   slower of the two is taken; a new track's velocity alone): a constant-velocity track's
   velocity lags a bend, and a truck keeping the next lane beside the car crossed it by its
   velocity at 0.7 m/s (`LeadSelector._confirmed_cut_in`);
-- the lead stays the lead while it is within ``keep_width`` (hysteresis: a lead swerving
+- the lead stays the lead while its near side is within ``keep`` (hysteresis: a lead swerving
   within its lane, or seen through a curve, is not dropped and taken again), unless another
-  vehicle that qualifies is within ``half_width``: a lead leaving the lane reveals a car
+  vehicle that qualifies is within ``path``: a lead leaving the lane reveals a car
   standing in it, which is the lead as soon as it qualifies (a cut-out at 1.5 m/s: 0.2 s
   earlier, 3 m of a stop from 60 km/h);
 - the lead is the nearest of the vehicles that qualify.
@@ -90,6 +96,12 @@ ONCOMING = 2.0  # [m/s] a vehicle moving against the ego's heading faster than t
 #   cut-in is a vehicle of the ego's direction moving over; an ACC follows no oncoming
 #   vehicle, ISO 15622). A new track's velocity has not settled: an oncoming car's, two
 #   lanes left 48 m ahead, crossed the lane at 3.6 m/s (`tracking` at 12.8 s)
+WALKER_BERTH = 0.2  # [m] a walker is given this much more room beside the car than a
+#   vehicle (its step aside is not signalled): in the lane with its near side within
+#   `LeadParams.path` + this of the centre line (0.6 m wide: its centre within 1.6 m)
+BODY_HALF_WIDTH = (0.25, 1.3)  # [m] a track's half width across the lane is taken within
+#   these (a track's box grows and shrinks with its returns; the widest road vehicle is
+#   2.55 m, Directive 96/53/EC)
 CUT_IN_HORIZON = 1.5  # [s] a vehicle moving into the lane is taken where it will be this
 #   much later (a lane change's lateral move lasts 3 to 6 s)
 CUT_IN_SPEED = 0.4  # [m/s] ... if it moves across faster than this (a car keeping its lane
@@ -98,8 +110,11 @@ CUT_IN_SPEED = 0.4  # [m/s] ... if it moves across faster than this (a car keepi
 
 @dataclass(frozen=True, slots=True)
 class LeadParams:
-    half_width: float = 1.6  # [m] a track enters the lane within this of its centre line
-    keep_width: float = 2.0  # [m] the lead stays the lead within this (hysteresis)
+    path: float = 1.1  # [m] a vehicle is in the lane when its near side is within this of
+    #   the lane's centre line: the car's half width (0.8 m) and 0.3 m (a saloon 1.83 m wide:
+    #   its centre within 2.0 m; a lane 3.5 m wide: the next lane's centre is 3.5 m off)
+    keep: float = 1.4  # [m] the lead stays the lead while its near side is within this
+    #   (hysteresis: 0.3 m wider)
     confirm: float = 0.3  # [s] a vehicle is in the lane this long before it can be the lead
     urgent_ttc: float = 2.5  # [s] ... unless it closes in faster than this
     path_reach: float = 60.0  # [m] along a map path, tracks farther ahead are not looked at
@@ -116,6 +131,20 @@ class Candidate:
     #   moving into the lane: where it will be, `cut_in_lateral`)
     now: float = math.nan  # [m] a vehicle's offset where it is (NaN: as `lateral`)
     across: float = 0.0  # [m/s] its velocity across the lane towards the left, from its track
+    half_width: float = 0.0  # [m] half its box's extent across the lane (`side`)
+    clear: float = math.inf  # [m] how far the car must advance on it for the car's rear to
+    #   pass its front: the gap and both lengths (`LeadSelector._passed_first`)
+
+    @property
+    def side(self) -> float:
+        """[m] how far its near side is from the lane's centre line, at `lateral` (< 0: the
+        body straddles the centre line)."""
+        return abs(self.lateral) - self.half_width
+
+    @property
+    def side_now(self) -> float:
+        """[m] as `side`, where it is (`now`)."""
+        return abs(self.lateral if math.isnan(self.now) else self.now) - self.half_width
 
 
 def far_centre(centre_y: Callable[[float], float], heading_error: float, reach: float,
@@ -194,6 +223,11 @@ def cut_in_lateral(lateral: float, lateral_speed: float, horizon: float = CUT_IN
     return 0.0 if lateral * later <= 0.0 else later
 
 
+def _half_width(tr: Track) -> float:
+    """[m] half a track's box width, within ``BODY_HALF_WIDTH``."""
+    return min(max(0.5 * tr.width, BODY_HALF_WIDTH[0]), BODY_HALF_WIDTH[1])
+
+
 def lane_candidates(tracks: Sequence[Track], centre_y: Callable[[float], float],
                     ego_heading: float, front_overhang: float) -> list[Candidate]:
     """The vehicles and pedestrians ahead; `centre_y(x)` is the lane centre's lateral
@@ -214,11 +248,13 @@ def lane_candidates(tracks: Sequence[Track], centre_y: Callable[[float], float],
         if tr.cls is ObjectClass.PEDESTRIAN and tr.speed <= WALKER_SPEED:  # across the
             #   lane where it is, not the car's axis: 50 m into a 250 m bend, a car keeping
             #   the oncoming lane moves across the car's axis at a fifth of its speed
-            out.append(Candidate(lead, crossing_lateral(lateral, across, gap, -tr.rel_vx)))
+            out.append(Candidate(lead, crossing_lateral(lateral, across, gap, -tr.rel_vx),
+                                 half_width=_half_width(tr) + WALKER_BERTH))
         elif along < -ONCOMING:  # not a cut-in: where it is (`ONCOMING`)
-            out.append(Candidate(lead, lateral))
+            out.append(Candidate(lead, lateral, half_width=_half_width(tr)))
         else:
-            out.append(Candidate(lead, cut_in_lateral(lateral, across), lateral, across))
+            out.append(Candidate(lead, cut_in_lateral(lateral, across), lateral, across,
+                                 _half_width(tr), gap + 2.0 * front_overhang + tr.length))
     return out
 
 
@@ -241,7 +277,8 @@ def route_candidates(tracks: Sequence[Track], lane: Lane, station: float, p: Lea
         heading = float(lane.heading_at(float(s_tr)))
         along = tr.vx * math.cos(heading) + tr.vy * math.sin(heading)
         gap = ahead - front_overhang - 0.5 * tr.length
-        out.append(Candidate(Lead(tr.id, tr.t, gap, max(0.0, along), along), float(r_tr)))
+        out.append(Candidate(Lead(tr.id, tr.t, gap, max(0.0, along), along), float(r_tr),
+                             half_width=_half_width(tr)))
     return out
 
 
@@ -252,18 +289,18 @@ def _nearest(candidates: Sequence[Candidate]) -> Lead | None:
 
 def select_lead(tracks: Sequence[Track], centre_y: Callable[[float], float],
                 ego_heading: float, p: LeadParams, front_overhang: float) -> Lead | None:
-    """The nearest vehicle ahead within ``half_width`` of the lane's centre line, now
+    """The nearest vehicle ahead with its near side within ``path`` of the lane's centre line, now
     (`lane_candidates`; no confirmation)."""
     return _nearest([c for c in lane_candidates(tracks, centre_y, ego_heading, front_overhang)
-                     if abs(c.lateral) <= p.half_width])
+                     if c.side <= p.path])
 
 
 def route_lead(tracks: Sequence[Track], lane: Lane, station: float, p: LeadParams,
                front_overhang: float) -> Lead | None:
-    """The nearest vehicle ahead within ``half_width`` of the map lane `lane`, now
+    """The nearest vehicle ahead with its near side within ``path`` of the map lane `lane`, now
     (`route_candidates`; no confirmation)."""
     return _nearest([c for c in route_candidates(tracks, lane, station, p, front_overhang)
-                     if abs(c.lateral) <= p.half_width])
+                     if c.side <= p.path])
 
 
 def costly_wait(v: float, lead: Lead, age: float, wait: float,
@@ -301,26 +338,25 @@ class LeadSelector:
         """The lead at time `t` [s] from this tick's `candidates`, the ego at `ego_speed`
         [m/s]."""
         p = self.p
-        candidates = [self._confirmed_cut_in(c) for c in candidates]
+        candidates = [self._confirmed_cut_in(c, ego_speed) for c in candidates]
         self._offsets = {c.lead.track_id: self._offsets.get(c.lead.track_id, {})
                          for c in candidates if not math.isnan(c.now)}
-        inside = {c.lead.track_id for c in candidates if abs(c.lateral) <= p.half_width}
+        inside = {c.lead.track_id for c in candidates if c.side <= p.path}
         present = {c.lead.track_id for c in candidates}
         self._outside = {i for i in self._outside if i in present} | {
-            c.lead.track_id for c in candidates
-            if abs(c.lateral if math.isnan(c.now) else c.now) > p.half_width}
+            c.lead.track_id for c in candidates if c.side_now > p.path}
         self._since = {i: self._since.get(i, t) for i in inside}
         qualified = [c for c in candidates if self._qualifies(c, t, ego_speed)]
-        if any(abs(c.lateral) <= p.half_width for c in qualified):  # a lead held by the keep
-            qualified = [c for c in qualified if abs(c.lateral) <= p.half_width]  # band alone
-            #   yields to a vehicle in the lane: the lead leaving it reveals another
+        if any(c.side <= p.path for c in qualified):  # a lead held by the keep band alone
+            qualified = [c for c in qualified if c.side <= p.path]  # yields to a vehicle in
+            #   the lane: the lead leaving it reveals another
         lead = _nearest(qualified)
         self.lead_id = None if lead is None else lead.track_id
         if lead is not None and lead.track_id in self._outside:
             lead = replace(lead, entered=True)
         return lead
 
-    def _confirmed_cut_in(self, c: Candidate) -> Candidate:
+    def _confirmed_cut_in(self, c: Candidate, ego_speed: float) -> Candidate:
         """`c` with its offset history updated, and its cut-in (`cut_in_lateral`) kept only
         where that history agrees: the track's velocity across the lane lags its turns
         (`perception.tracking`: a constant-velocity filter), so a truck keeping the next
@@ -328,7 +364,9 @@ class LeadSelector:
         4.1.3: taken as a cut-in alongside, emergency braking). Its offset from the lane's
         centre line over the last `rate_window`, a least-squares slope, is the second
         measure: the cut-in is taken at the slower of the two when they agree, else not;
-        with too little history (a new track), at the velocity's."""
+        with too little history (a new track), at the velocity's. The lead's cut-in is kept
+        down to half ``CUT_IN_SPEED``; a vehicle the car, at `ego_speed` [m/s], passes before
+        it is in the lane is taken where it is (`_passed_first`)."""
         if math.isnan(c.now):
             return c
         p, i = self.p, c.lead.track_id
@@ -337,12 +375,43 @@ class LeadSelector:
         for old in [k for k in history if k < c.lead.t - p.rate_window]:
             del history[old]
         if len(history) < 3 or max(history) - min(history) < 0.5 * p.rate_window:
-            return c
+            return self._passed_first(c, c.across, ego_speed)
         times = np.fromiter(history, float)
         slope = float(np.polyfit(times - times[-1], np.fromiter(history.values(), float),
                                  1)[0])
         rate = min(c.across, slope, key=abs) if c.across * slope > 0.0 else 0.0
-        return replace(c, lateral=cut_in_lateral(c.now, rate))
+        held = i == self.lead_id  # hysteresis: a cut-in taken as the lead stays one while it
+        #   moves in at half the speed (its measured rate wavers about CUT_IN_SPEED)
+        return self._passed_first(replace(c, lateral=cut_in_lateral(
+            c.now, rate, min_speed=CUT_IN_SPEED * (0.5 if held else 1.0))), rate, ego_speed)
+
+    def _passed_first(self, c: Candidate, rate: float, ego_speed: float) -> Candidate:
+        """`c`, taken where it is (`now`) if it is moving into the lane at `rate` [m/s] but
+        the car, at `ego_speed` [m/s], will have passed it (`clear` at the closing speed)
+        before its near side is within ``path``: braking for a slower car beside the car
+        that moves over keeps the car beside it, in its way (a car at 36 km/h moving in at
+        0.5 m/s with the car's bumper 0.6 m past its rear: the car at 60 km/h is past it in
+        1.3 s, before it is in the lane in 1.4 s; braking hard for it, the car stayed beside
+        it and was struck in the side); or, beside the car (its rear behind the car's
+        front), sooner than braking at ``a_hard`` would put the car behind it. The lead is
+        kept as it is."""
+        p = self.p
+        if c.lead.track_id == self.lead_id or c.side > p.path or c.side_now <= p.path \
+                or rate == 0.0:
+            return c
+        closing = ego_speed - c.lead.along
+        if closing <= 0.0:
+            return c
+        passed = c.clear / closing  # [s]
+        if passed < (c.side_now - p.path) / abs(rate):
+            return replace(c, lateral=c.now)
+        if c.lead.gap < 0.0:  # beside the car: falling back behind it at a_hard takes
+            #   the closing's stop and the way back, gap = closing t - a t^2 / 2
+            a = self.acc.a_hard
+            behind = (closing + math.sqrt(closing**2 - 2.0 * a * c.lead.gap)) / a  # [s]
+            if passed < behind:
+                return replace(c, lateral=c.now)
+        return c
 
     def take(self, lead: Lead | None) -> None:
         """`lead` is the lead by another rule (during a lane change): keep it as the lead."""
@@ -350,7 +419,7 @@ class LeadSelector:
 
     def _qualifies(self, c: Candidate, t: float, ego_speed: float) -> bool:
         p, i = self.p, c.lead.track_id
-        if i == self.lead_id and abs(c.lateral) <= p.keep_width:
+        if i == self.lead_id and c.side <= p.keep:
             return True
         if i not in self._since:
             return False

@@ -24,16 +24,19 @@ from planner.lead import (
     lane_candidates,
     map_bend,
     route_candidates,
+    select_lead,
 )
 from planner.messages import Lead
 from tests.roads import arc, make_map, seg
 
-P = LeadParams()  # half_width 1.6 m, keep_width 2.0 m, confirm 0.3 s, urgent_ttc 2.5 s
+P = LeadParams()  # path 1.1 m, keep 1.4 m, confirm 0.3 s, urgent_ttc 2.5 s
 DT = 0.05  # [s] the planner's tick
+HW = 0.9  # [m] half a car's width: in the lane with its centre within 2.0 m (`P.path`),
+#   held within 2.3 m (`P.keep`)
 
 
 def car(ident: int, gap: float, lateral: float, speed: float = 20.0) -> Candidate:
-    return Candidate(Lead(ident, 0.0, gap, speed), lateral)
+    return Candidate(Lead(ident, 0.0, gap, speed), lateral, half_width=HW)
 
 
 def run(frames: list[list[Candidate]], ego_speed: float = 20.0) -> list[int | None]:
@@ -54,8 +57,9 @@ def test_a_vehicle_is_the_lead_after_it_has_been_in_the_lane_for_the_confirm_tim
 
 
 def test_a_car_in_the_next_lane_straying_near_the_line_for_a_moment_is_no_lead() -> None:
-    """0.1 s within 1.6 m of the centre line (the next lane's car at 3.5 m), then back."""
-    frames = [[car(7, 30.0, 3.5)]] * 5 + [[car(7, 30.0, 1.5)]] * 2 + [[car(7, 30.0, 3.5)]] * 10
+    """0.1 s with its centre within 2.0 m of the centre line (the next lane's car at 3.5 m),
+    then back."""
+    frames = [[car(7, 30.0, 3.5)]] * 5 + [[car(7, 30.0, 1.9)]] * 2 + [[car(7, 30.0, 3.5)]] * 10
     assert run(frames) == [None] * len(frames)
 
 
@@ -120,9 +124,9 @@ def test_a_costly_wait_reads_the_gap_the_track_has_now() -> None:
 
 def test_the_lead_is_held_within_the_keep_band_and_dropped_beyond_it() -> None:
     confirmed = [[car(1, 30.0, 0.0)]] * 8
-    swerve = [[car(1, 30.0, 1.9)]] * 5  # inside keep_width, outside half_width
-    out = [[car(1, 30.0, 2.2)]] * 3  # beyond keep_width (a cut-out)
-    back = [[car(1, 30.0, 1.9)]] * 3  # near again, but must re-enter within half_width
+    swerve = [[car(1, 30.0, 2.2)]] * 5  # its near side within keep, beyond path
+    out = [[car(1, 30.0, 2.5)]] * 3  # beyond keep (a cut-out)
+    back = [[car(1, 30.0, 2.2)]] * 3  # near again, but must re-enter within path
     ids = run(confirmed + swerve + out + back)
     assert ids[7] == 1 and ids[8:13] == [1] * 5
     assert ids[13:] == [None] * 6
@@ -130,14 +134,14 @@ def test_the_lead_is_held_within_the_keep_band_and_dropped_beyond_it() -> None:
 
 def test_a_cut_out_reveals_the_stopped_car_ahead_in_one_transition() -> None:
     """The lead (1) leaves the lane; the stopped car (2) 60 m ahead, in the lane all along
-    and confirmed, is the lead as soon as the first is out of `half_width`, held by the
+    and confirmed, is the lead as soon as the first is out of `path`, held by the
     keep band alone: one change of lead, no gap."""
     frames = ([[car(1, 25.0, 0.1 * k), car(2, 60.0, 0.0, 0.0)] for k in range(25)])
     ids = run(frames)
     changes = [(a, b) for a, b in itertools.pairwise(ids) if a != b]
     assert changes == [(None, 1), (1, 2)]
-    assert ids.index(2) == 17  # the first tick the cut-out car is beyond half_width (1.7 m)
-    #   (it was 21, beyond keep_width, before: 0.2 s and 3 m of the stop later)
+    assert ids.index(2) == 21  # the first tick the cut-out car's near side is beyond path
+    #   (its centre 2.1 m off; beyond keep, 24: 0.15 s and 2.5 m of the stop later)
 
 
 def test_the_nearest_qualified_vehicle_wins() -> None:
@@ -148,7 +152,7 @@ def test_the_nearest_qualified_vehicle_wins() -> None:
 def test_a_lead_taken_during_a_lane_change_is_held_after_it() -> None:
     selector = LeadSelector(P)
     selector.take(Lead(9, 0.0, 20.0, 15.0))
-    lead = selector.select(0.0, 20.0, [car(9, 20.0, 1.8, 15.0)])
+    lead = selector.select(0.0, 20.0, [car(9, 20.0, 2.2, 15.0)])
     assert lead is not None and lead.track_id == 9  # held (keep band), not re-confirmed
 
 
@@ -301,27 +305,33 @@ def test_map_bend_is_the_lane_at_a_distance_ahead_not_along_the_lane() -> None:
     assert math.isnan(hairpin(55.0))  # the bend never reaches 50 m ahead
 
 
-def _moving(ident: int, t: float, gap: float, offset: float, across: float) -> Candidate:
+def _moving(ident: int, t: float, gap: float, offset: float, across: float,
+            half_width: float = HW, speed: float = 16.0, clear: float = math.inf,
+            ) -> Candidate:
     """A vehicle `offset` [m] from the centre line, its track's velocity across the lane
     `across` [m/s] (left +), as `lane_candidates` gives it at the track's time t [s]."""
-    return Candidate(Lead(ident, t, gap, 16.0), cut_in_lateral(offset, across), offset, across)
+    return Candidate(Lead(ident, t, gap, speed), cut_in_lateral(offset, across), offset,
+                     across, half_width, clear)
 
 
-def _frames(offsets: list[float], across: float, gap: float = -3.5) -> list[list[Candidate]]:
+def _frames(offsets: list[float], across: float, gap: float = -3.5,
+            half_width: float = HW) -> list[list[Candidate]]:
     """One candidate per tick, its track updated every other tick (DT 0.05 s: 10 Hz)."""
-    return [[_moving(1, round(k / 2) * 2 * DT, gap, offsets[k], across)]
+    return [[_moving(1, round(k / 2) * 2 * DT, gap, offsets[k], across, half_width)]
             for k in range(len(offsets))]
 
 
 def test_a_cut_in_by_the_tracks_velocity_alone_is_not_taken_while_its_offset_holds() -> None:
     """ALKS 4.1.3: the truck alongside in the next lane, 3.0 m from the centre line, through
     a 250 m bend at 60 km/h; its constant-velocity track's velocity lags the bend and
-    crosses the lane at 0.7 m/s towards the ego (1.5 s later: 1.95 m, under `half_width`
-    with the noise), while its offset from the centre line holds. It is not taken: without
-    the history check it was, at once (gap -3.5 m: urgent), and the car braked hard."""
+    crosses the lane at 0.7 m/s towards the ego (1.5 s later: its near side 0.7 m from the
+    centre line with the noise), while its offset from the centre line holds. It is not
+    taken: without the history check it was, at once (gap -3.5 m: urgent), and the car
+    braked hard."""
     holding = [3.0 + 0.02 * (-1) ** k for k in range(40)]
-    steady = _frames(holding, -0.95)  # 3.0 - 0.95 x 1.5 = 1.58 m by the velocity alone
-    assert steady[0][0].lateral < P.half_width  # the velocity's prediction: inside
+    steady = _frames(holding, -0.95, half_width=1.275)  # 3.0 - 0.95 x 1.5 = 1.58 m by the
+    #   velocity alone; a rigid truck 2.55 m wide
+    assert steady[0][0].side < P.path  # the velocity's prediction: inside
     assert run(steady, ego_speed=16.7)[8:] == [None] * 32  # history after 0.5 s: never
 
 
@@ -329,15 +339,15 @@ def test_a_cut_in_that_its_offset_confirms_is_taken() -> None:
     """A car 40 m ahead moving in at 1 m/s (its offset falls as its velocity says): taken
     where it will be, as the velocity's prediction, once confirmed (beyond UN R157's d_min
     and the d_min guard's band: `costly_wait`)."""
-    offsets = [3.5 - 1.0 * round(k / 2) * 2 * DT for k in range(30)]
+    offsets = [4.0 - 1.0 * round(k / 2) * 2 * DT for k in range(30)]
     ids = run(_frames(offsets, -1.0, gap=40.0), ego_speed=20.0)
     assert ids[-1] == 1
     first = ids.index(1)
     offset_then = offsets[first]
-    assert offset_then > P.half_width + 0.5  # taken while its centre is still 2.1 m out,
+    assert offset_then - HW > P.path + 1.0  # taken while its near side is still 2.3 m out,
     #   as the velocity's prediction of 1.5 s later says: the history did not delay it
     assert first * DT == pytest.approx(P.confirm + 0.5, abs=0.2)  # the velocity's
-    #   prediction crosses half_width at 0.5 s; confirmed 0.3 s later
+    #   prediction crosses path at 0.5 s; confirmed 0.3 s later
 
 
 def test_a_new_track_moving_in_is_taken_on_its_velocity() -> None:
@@ -391,3 +401,60 @@ def test_a_lead_that_was_seen_outside_the_lane_has_entered_it() -> None:
     assert cut_in[-1] is not None and cut_in[-1].entered
     in_lane = leads([[car(4, 25.0, 0.3)]] * 10)
     assert in_lane[-1] is not None and not in_lane[-1].entered
+
+
+def _vehicle(rel_y: float, width: float) -> Track:
+    """A vehicle 30 m ahead, `rel_y` [m] left of the centre line, `width` [m] wide."""
+    return Track(id=2, t=1.0, x=30.0, y=rel_y, vx=15.0, vy=0.0, rel_x=30.0, rel_y=rel_y,
+                 rel_vx=-2.0, rel_vy=0.0, length=4.8, width=width, height=1.5, yaw=0.0,
+                 cls=ObjectClass.CAR, hits=5, misses=0, position_sigma=0.1)
+
+
+@pytest.mark.parametrize(("rel_y", "width", "in_lane"), [
+    (2.2, 2.55, True),  # a rigid truck: its near side 0.93 m off, into the car's margin
+    (2.2, 0.95, False),  # a motorbike there: 1.73 m off, clear of the car's side
+    (1.7, 1.83, True),  # a saloon's body 0.02 m into the car's (by its centre within 1.6 m:
+    #   not in the lane)
+    (2.1, 1.83, False),  # 0.3 m clear of the car's margin
+])
+def test_a_vehicle_is_in_the_lane_by_its_near_side_whatever_its_width(
+        rel_y: float, width: float, in_lane: bool) -> None:
+    lead = select_lead([_vehicle(rel_y, width)], lambda x: 0.0, 0.0, P, 2.4)
+    assert (lead is not None) is in_lane
+
+
+def test_a_slow_cut_in_is_the_lead_before_its_body_reaches_the_cars_path() -> None:
+    """UN R157 cut-in at 0.55 m/s: a saloon (1.83 m) at 23 km/h, 24.8 m ahead of the car at
+    60 km/h, 3.0 m from the centre line. Its body reaches the car's side (1.715 m) in 2.4 s,
+    as the car reaches it. By its centre within 1.6 m 1.5 s ahead, it was taken after 1.1 s,
+    13 m from it: too late for a stop short of it (the campaign's contact)."""
+    closing, rate = 10.2, -0.55
+    frames = []
+    for k in range(40):
+        t = round(k / 2) * 2 * DT  # the track's time: 10 Hz
+        frames.append([_moving(1, t, 24.8 - closing * t, 3.0 + rate * t, rate,
+                               half_width=0.915, speed=6.5)])
+    ids = run(frames, ego_speed=16.7)
+    first = ids.index(1)
+    assert set(ids[first:]) == {1}
+    assert frames[first][0].now > 2.6 and frames[first][0].lead.gap > 19.0
+
+
+def test_a_slower_car_moving_over_beside_the_car_is_passed_not_braked_for() -> None:
+    """A saloon at 36 km/h moving over at 0.52 m/s, its near side 1.9 m from the centre line,
+    with the car's bumper 0.6 m past its rear at 60 km/h: the car is past it in 1.35 s, before
+    it is within `path` (1.5 s), and braking at a_hard would keep the car beside it 2.3 s.
+    It is no lead. The same car 20 m ahead is the lead (4.4 s to pass it)."""
+    ego, speed, rate = 16.67, 10.0, -0.52
+
+    def frames(gap0: float) -> list[list[Candidate]]:
+        out = []
+        for k in range(30):
+            t = round(k / 2) * 2 * DT
+            gap = gap0 - (ego - speed) * t
+            out.append([_moving(1, t, gap, 2.81 + rate * t, rate, half_width=0.915,
+                                speed=speed, clear=gap + 4.8 + 4.77)])
+        return out
+
+    assert run(frames(-0.6), ego_speed=ego) == [None] * 30
+    assert run(frames(20.0), ego_speed=ego)[-1] == 1
