@@ -10,6 +10,7 @@ batch's is `avsim.batch.suite.exit_status`.
 
 from __future__ import annotations
 
+import functools
 import json
 import os
 import re
@@ -127,6 +128,34 @@ ego_option = click.option(
          "sensors (the profile is none).")
 
 
+_STACK_OPTIONS = (
+    ("stack", "A whole stack of one's own: package.module:factory, or an installed stack's "
+              "name (entry point group avsim.stacks); `avsim`: the bundled one."),
+    ("perception", "Replace the bundled perception stage (frames in, PlannerInput out)."),
+    ("planner", "Replace the bundled planner stage (PlannerInput in, Plan out)."),
+    ("controller", "Replace the bundled controller stage (Plan in, VehicleCommand out)."),
+)
+
+
+def stack_options(f: Callable[..., None]) -> Callable[..., None]:
+    """`--stack`, `--perception`, `--planner`, `--controller` (docs/stack-api.md): each
+    given one is the scenario file's `stack.<key>` set for every run (`--set
+    stack.<key>=FACTORY`), so batches pass it to their runs and repro files keep it."""
+    @functools.wraps(f)
+    def command(*args: Any, **kwargs: Any) -> None:
+        chosen = tuple(f"stack.{key}={kwargs.pop(key)}" for key, _ in _STACK_OPTIONS
+                       if kwargs.get(key) is not None)
+        for key, _ in _STACK_OPTIONS:
+            kwargs.pop(key, None)
+        kwargs["sets"] = tuple(kwargs["sets"]) + chosen
+        f(*args, **kwargs)
+
+    for key, text in reversed(_STACK_OPTIONS):
+        command = click.option(f"--{key}", key, default=None, metavar="FACTORY",
+                               help=text)(command)
+    return command
+
+
 class SeedType(click.IntRange):
     """`--seed`: an integer in 0..MAX_SEED (numpy's seed range); a text too long to be one
     is refused by its length, not echoed back."""
@@ -175,6 +204,7 @@ class SeedType(click.IntRange):
                    "--out (default runs/<name>), as a suite.")
 @search_path_option
 @click.pass_context
+@stack_options
 def run(ctx: click.Context, scenario: str, out: Path | None, json_path: Path | None,
         profile: str, sensing: str, seed: int | None, sets: tuple[str, ...], plot: str | None,
         params: tuple[str, ...], criteria: Path | None, no_progress: bool, ego: str,
@@ -429,6 +459,7 @@ def batch_options(f: Callable[..., None]) -> Callable[..., None]:
                    "(default: each file's NAME.criteria.yaml beside it).")
 @batch_options
 @search_path_option
+@stack_options
 def suite(paths: tuple[str, ...], out: Path, sets: tuple[str, ...], params: tuple[str, ...],
           criteria: Path | None, jobs: int | None, executor: str, address: str | None,
           profile: str, snapshots: bool, dry_run: bool, ego: str,
@@ -510,6 +541,7 @@ def _print_plan(planned: Sequence[RunJob]) -> NoReturn:
               help="The heat map's metric (a metric or a criterion of the result).")
 @batch_options
 @search_path_option
+@stack_options
 def sweep(scenario: str, sets: tuple[str, ...], params: tuple[str, ...], out: Path | None,
           metric: str, jobs: int | None, executor: str, address: str | None, profile: str,
           snapshots: bool, dry_run: bool, ego: str, search_paths: tuple[Path, ...]) -> None:
@@ -637,6 +669,7 @@ _campaign_options = [_batch_options[k] for k in (0, 1, 2, 3, 5, 6)]  # no snapsh
               help="Take the result of each run that already finished in --out on the same "
                    "file, values, profile and code; run the others.")
 @_options(_campaign_options)
+@stack_options
 def campaign(files: tuple[str, ...], n: int, seed: int, out: Path | None,
              sets: tuple[str, ...], record: str, shrink: bool, metric: str | None,
              iterations: int, population: int, resume: bool, jobs: int | None,

@@ -33,7 +33,9 @@ from typing import Any
 
 from avsim.run.runner import Runner, RunResult
 from avsim.run.sensor_loop import frames_read
+from avsim.run.stack import ComposedStack
 from avsim.scenario.load import load_scenario
+from perception.perception import Perception
 from world.core.rates import CAR_SENSORS, CONTROL_RATE, PHYSICS_RATE
 from world.sensors.pipeline import InlineSensing, ProcessSensing, Sensing
 from world.sensors.schedule import SensorSchedule
@@ -61,8 +63,9 @@ def full_run(profile: Profile, seconds: float, record: bool) -> tuple[float, Run
     objects: list[float] = []
     with tempfile.TemporaryDirectory() as tmp:
         runner = Runner(scenario, Path(tmp) / "bench.rrd" if record else None, profile=profile)
-        stack = runner.stack
-        assert stack.lane_detector is not None
+        assert isinstance(runner.stack, ComposedStack)
+        stack = runner.stack.perception
+        assert isinstance(stack, Perception) and stack.lane_detector is not None
         stack.lane_detector.detect = _timed(stack.lane_detector.detect, lanes)  # type: ignore[method-assign]
         detect, track = stack.object_detector.detect, stack.tracker.update
         pair: list[float] = []

@@ -15,6 +15,7 @@ from control.command import VehicleCommand
 from control.longitudinal import SpeedCommand, SpeedController, SpeedParams
 from control.pid import Pid, PidParams
 from control.stanley import (
+    MAX_STEER,
     FrontAxleError,
     StanleyParams,
     StanleyPid,
@@ -23,6 +24,7 @@ from control.stanley import (
 from control.vehicle_controller import VehicleController, VehicleControllerParams
 
 __all__ = [
+    "MAX_STEER",
     "FrontAxleError",
     "Pid",
     "PidParams",

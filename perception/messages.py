@@ -1,4 +1,5 @@
-"""What perception hands to the planner. A leaf module: dataclasses only."""
+"""What perception hands to the planner, and the perception stage's interface
+(`PerceptionStage`). A leaf module: dataclasses and a protocol only."""
 
 from __future__ import annotations
 
@@ -6,8 +7,9 @@ import enum
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import Protocol
 
-from world.frames import DriverControls
+from world.frames import DriverControls, Frames
 from world.hdmap import LightColour
 
 
@@ -254,3 +256,38 @@ class PlannerInput:
     #   speed, turn-signal stalk and brake pedal (`planner.planner`)
     flat_tyre: bool = False  # a flat tyre is detected (from the wheel speeds)
     health: SensorHealth = SensorHealth()  # the sensor faults noticed now
+
+
+# ---- the stage -------------------------------------------------------------------------
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class PerceptionReport:
+    """What perception made of one delivery of camera / LiDAR data, for scoring against the
+    truth and for the recording (any field None: not made from this delivery)."""
+
+    t: float  # [s] capture time of the data
+    pose: EgoState  # the stack's pose estimate at that time
+    lane_raw: LaneEstimate | None = None  # the lane camera's detection in this frame
+    lane: LaneEstimate | None = None  # ... filtered
+    detections: tuple[Detection, ...] | None = None  # None: no scan in this delivery
+    tracks: tuple[Track, ...] | None = None  # the tracks after this scan
+
+
+class PerceptionStage(Protocol):
+    """The perception stage: sensor frames in, `PlannerInput` out.
+
+    The runner calls `on_frames` with each delivery, in time order, then `perceive` once
+    per control tick (after that tick's deliveries)."""
+
+    @property
+    def reads(self) -> frozenset[str] | None:
+        """The names of the sensors whose frames it uses (None: all); a camera no stage
+        reads is not rendered unless the recording needs it."""
+
+    def on_frames(self, t: float, frames: Frames) -> PerceptionReport | None:
+        """One delivery: `frames` captured together at time `t` [s], by sensor name; a
+        report for scoring and the recording, or None."""
+
+    def perceive(self, t: float) -> PlannerInput:
+        """The planner's input for the control tick at time `t` [s]."""

@@ -1,4 +1,5 @@
-"""What the planner hands to control: dataclasses and the state enums only.
+"""What the planner hands to control: dataclasses and the state enums, and the planner
+stage's interface (`PlannerStage`).
 
 `Plan.ego` carries the state estimate the plan was made from, so that control needs no
 other input: arrows run one way, world frames -> perception -> planner -> control. Every
@@ -11,11 +12,12 @@ from __future__ import annotations
 import enum
 import math
 from dataclasses import dataclass
+from typing import Protocol
 
 import numpy as np
 from numpy.typing import NDArray
 
-from perception.messages import EgoState
+from perception.messages import EgoState, PlannerInput
 from planner.fsm.acc import AccMode
 from planner.fsm.control import ControlState
 from planner.fsm.hazard import HazardLights
@@ -25,7 +27,8 @@ from planner.fsm.motion import Motion
 from planner.fsm.sensing import Sensing
 
 __all__ = ["MACHINES", "AccMode", "ControlState", "EgoState", "HazardLights", "LaneSource",
-           "Lead", "Motion", "Plan", "ReferencePath", "SpeedSource", "StateChange"]
+           "Lead", "Motion", "Plan", "PlannerStage", "ReferencePath", "SpeedSource",
+           "StateChange"]
 
 
 class SpeedSource(enum.Enum):
@@ -110,3 +113,10 @@ class Plan:
 MACHINES: dict[str, type[enum.Enum]] = {  # the plan's states: machine name -> its states
     "lane_source": LaneSource, "motion": Motion, "acc": AccMode, "control": ControlState,
     "hazard": HazardLights, "sensing": Sensing, "speed_source": SpeedSource}
+
+
+class PlannerStage(Protocol):
+    """The planner stage: `PlannerInput` in, `Plan` out, once per control tick."""
+
+    def update(self, inp: PlannerInput) -> Plan:
+        """The plan for the tick of `inp.ego.t`."""

@@ -97,6 +97,8 @@ from planner.speed_planning import Binding, SpeedPlanner, SpeedPlanningParams, S
 from world.frames import VehicleInfo
 from world.hdmap import SHOULDER, RoadMap
 
+__all__ = ["MotionLayerParams", "Planner", "PlannerParams"]  # the front door
+
 _CAMERA_LANE = frozenset({LaneSource.CAMERA, LaneSource.ONE_LINE})  # the camera's lane is the
 #   path (the lane kept, on both lines or on one)
 

@@ -17,7 +17,8 @@ from pathlib import Path
 import pytest
 
 REPO = Path(__file__).resolve().parent.parent
-OURS = ("vehicle_urdf", "world", "perception", "planner", "control", "avsim", "bench", "tests")
+OURS = ("vehicle_urdf", "world", "perception", "planner", "control", "avsim", "bench", "tests",
+        "examples")
 PYBULLET = ("pybullet", "pybullet_utils", "pybullet_data")
 STATIC_WORLD = ("world.frames", "world.hdmap")  # the sensor data types and the static map
 WORLD_INIT = ("world.core.simd",)  # `world/__init__.py` also pins numpy's dispatch: a leaf
@@ -25,6 +26,7 @@ WORLD_INIT = ("world.core.simd",)  # `world/__init__.py` also pins numpy's dispa
 DYNAMIC_IMPORTS = ("importlib.import_module", "import_module", "__import__")
 STACK = ("perception", "planner", "control")  # the stack under test
 JUDGE = ("avsim/criteria", "avsim/report")  # the judge: imports nothing of `STACK`
+PUBLIC_API = "avsim.stack"  # what a user's stack may import of avsim (and `STATIC_WORLD`)
 
 
 @dataclass(frozen=True)
@@ -40,10 +42,17 @@ class Rule:
 RULES = (
     Rule("perception", ("perception", *STATIC_WORLD), no_pybullet=True),
     Rule("planner", ("planner", "perception.messages", *STATIC_WORLD), no_pybullet=True),
-    Rule("control", ("control", "planner.messages", "world.frames"), no_pybullet=True),
+    Rule("control", ("control", "planner.messages", "perception.messages", "world.frames"),
+         no_pybullet=True),
     Rule("world", ("world", "vehicle_urdf"), no_pybullet=False),
     Rule("vehicle_urdf", ("vehicle_urdf",), no_pybullet=False),
+    Rule("examples", ("examples", PUBLIC_API, *STATIC_WORLD), no_pybullet=True),
 )
+# avsim enters each stage by its front door: perception's (`perception.perception`), the
+# planner's (`planner.planner`), control's (the `control` package), and the messages; the
+# planner's FSM tables are a library the storyboard's state machines share
+FRONT_DOORS = ("perception.perception", "perception.messages", "planner.planner",
+               "planner.messages", "planner.fsm.machine", "control.command")
 
 
 @dataclass(frozen=True)
@@ -190,11 +199,26 @@ def test_the_judge_imports_nothing_of_the_stack() -> None:
     assert not found, "the judge imports the stack:\n" + "\n".join(found)
 
 
+def test_avsim_enters_each_stage_by_its_front_door() -> None:
+    """avsim imports of the stack only the front doors and the messages (`FRONT_DOORS`, or
+    the `control` package itself), so that a stage of one's own replaces a whole stage."""
+    found = []
+    for path in sorted((REPO / "avsim").rglob("*.py")):
+        source = path.read_text(encoding="utf-8")
+        for imp in imports(source, module_name(path), path.name == "__init__.py"):
+            if imp.module.split(".")[0] not in STACK or imp.names_follow:
+                continue
+            module = imp.module.rsplit(".", 1)[0] if imp.from_name else imp.module
+            if module != "control" and not any(_within(module, d) for d in FRONT_DOORS):
+                found.append(f"{path.relative_to(REPO)}:{imp.line}: imports {imp.shown}")
+    assert not found, "avsim reaches into a stage:\n" + "\n".join(found)
+
+
 # ---------------------------------------------------------------------------------------
 # The checker itself catches violations
 # ---------------------------------------------------------------------------------------
 
-PERCEPTION, PLANNER, CONTROL, WORLD, URDF = RULES
+PERCEPTION, PLANNER, CONTROL, WORLD, URDF, EXAMPLES = RULES
 
 
 @pytest.mark.parametrize(

@@ -30,6 +30,7 @@ import enum
 import functools
 import importlib
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from types import ModuleType
 from typing import TypeAlias
@@ -37,8 +38,9 @@ from typing import TypeAlias
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["MPS_PER_KPH", "CameraFrame", "CameraInfo", "GnssFix", "LidarInfo", "LidarScan",
-           "Odometry", "SensorMount", "VehicleInfo", "Wheel", "import_open3d", "kph", "to_kph",
+__all__ = ["MPS_PER_KPH", "CameraFrame", "CameraInfo", "DriverControls", "Frame", "Frames",
+           "GnssFix", "LidarInfo", "LidarScan", "Odometry", "SensorKind", "SensorMount",
+           "SensorSpec", "VehicleInfo", "Wheel", "import_open3d", "kph", "to_kph",
            "wrap_angle"]
 
 MPS_PER_KPH = 1.0 / 3.6  # [m/s per km/h]
@@ -80,6 +82,9 @@ class VehicleInfo:
     track: float  # [m] left to right wheel centre
     front_axle: float  # [m] the car's centre to the front axle
     rear_axle: float  # [m] the car's centre to the rear axle (a positive distance)
+    mass: float  # [kg] total, wheels included
+    wheel_radius: float  # [m] the tyres' rolling radius
+    max_steer: float  # [rad] the largest road-wheel angle of the bicycle model
 
     @property
     def front_overhang(self) -> float:
@@ -272,6 +277,31 @@ class LidarScan:
 
 # What a sensor hands to the stack: one capture of one sensor (`world.sensors.sensor.Sensor`).
 Frame: TypeAlias = CameraFrame | LidarScan | GnssFix | Odometry
+
+# One delivery: the frames of the sensors captured together, by sensor name (`SensorSpec`),
+# in the order the sensors are listed.
+Frames: TypeAlias = Mapping[str, Frame]
+
+
+class SensorKind(enum.Enum):
+    """What a sensor's frames are."""
+
+    CAMERA = "camera"  # `CameraFrame`
+    LIDAR = "lidar"  # `LidarScan`
+    GNSS = "gnss"  # `GnssFix`
+    ODOMETRY = "odometry"  # `Odometry`
+
+
+@dataclass(frozen=True, slots=True)
+class SensorSpec:
+    """A sensor on the car, as the stack is told of it: its name (the key of its frames in
+    a delivery), kind, timing and calibration."""
+
+    name: str  # unique on the car: "front", "left", "right", "lidar", "gnss", "odometry"
+    kind: SensorKind
+    rate: float  # [Hz] captures per second
+    latency: float  # [s] from a capture to its delivery
+    info: CameraInfo | LidarInfo | None = None  # a camera's or LiDAR's calibration
 
 
 # ---- Open3D, shared by the world and perception ----------------------------------------------

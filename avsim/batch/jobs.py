@@ -71,6 +71,8 @@ class RunJob:
     #   written to <out_dir>/<name>.key once its result JSON is (None: no key file)
     ego: str = STACK  # what drives the car under test: avsim's stack, or (`SCRIPTED`, an
     #   OpenSCENARIO file) the file's own actions, no sensors (`EgoSpec.scripted`)
+    stack_code: str = ""  # a digest of the code of the user's stack or stages that drive it
+    #   ("" for the bundled stack: `avsim.stack.choice.code_digest`)
 
     @property
     def scripted(self) -> bool:

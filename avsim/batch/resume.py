@@ -65,13 +65,15 @@ def code_fingerprint() -> str:
 
 def run_key(job: RunJob, fingerprint: str) -> str:
     """The key of `job`'s run: SHA-256 over its scenario file's bytes, name, overrides,
-    profile, car under test (`RunJob.ego`), sidecar and the code's `fingerprint`."""
+    profile, car under test (`RunJob.ego`), sidecar and the code's `fingerprint` (and a user
+    stack's code, `RunJob.stack_code`)."""
     scenario = hashlib.sha256(scenario_path(job.scenario).read_bytes()).hexdigest()
     sidecar = (hashlib.sha256(job.criteria.read_bytes()).hexdigest()
                if job.criteria is not None else None)
     text = json.dumps({"name": job.name, "scenario": scenario, "overrides": job.overrides,
                        "profile": job.profile, "ego": job.ego, "sidecar": sidecar,
-                       "code": fingerprint},
+                       "code": fingerprint, **({"stack": job.stack_code}
+                                               if job.stack_code else {})},
                       sort_keys=True, default=repr)
     return hashlib.sha256(text.encode()).hexdigest()
 

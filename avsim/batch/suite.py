@@ -41,6 +41,7 @@ from avsim.scenario.load import ScenarioError, bundled_scenarios, load_scenario,
 from avsim.scenario.model import grid_paths
 from avsim.scenario.openscenario.sidecar import SUFFIX as SIDECAR_SUFFIX
 from avsim.scenario.profile_fit import check_profile
+from avsim.stack.choice import code_digest
 
 OVERRIDES_FILE = "(overrides)"  # the file a sidecar's override problem names
 SNAPSHOT_DIR = "snapshots"  # the failed runs' pictures, below the batch's folder
@@ -167,7 +168,8 @@ def plan(entries: Sequence[tuple[str | None, str, Mapping[str, object]]], out_di
         sources.update(loaded.sources)
         planned.append(RunJob(job_name, scenario, out_dir, dict(overrides), profile,
                               duration=loaded.duration, criteria=sidecar,
-                              search_paths=tuple(search_paths), ego=ego))
+                              search_paths=tuple(search_paths), ego=ego,
+                              stack_code=code_digest(loaded.stack)))
     _check_not_inputs(planned, sorted(sources))
     return planned
 

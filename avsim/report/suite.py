@@ -151,6 +151,9 @@ def _properties(outcome: RunOutcome) -> dict[str, str]:
         "ego": str(result.get("ego", outcome.job.ego)),
         "status": outcome.status.value,
     }
+    stack = result.get("stack")
+    if isinstance(stack, dict):  # which stack drove it, and its version
+        props["stack"] = f"{stack.get('name')} {stack.get('version')}"
     if "seed" not in result:  # a run that did not finish: its seed is not known here
         del props["seed"]
     for key, value in outcome.job.overrides.items():
@@ -407,8 +410,9 @@ def _run_section(outcome: RunOutcome) -> list[str]:
     props = _properties(outcome)
     values = "".join(f", {_inline_code(k)} = {_inline_code(v)}"
                      for k, v in job.overrides.items())
+    stack = f", stack {_inline_code(props['stack'])}" if "stack" in props else ""
     lines += [f"Scenario `{props['file']}`, seed {props.get('seed', DASH)}, profile "
-              f"{props['profile']}, ego {props['ego']}{values}.", ""]
+              f"{props['profile']}, ego {props['ego']}{stack}{values}.", ""]
     if _in_error(outcome):
         lines += [f"> {_md_text(outcome.error or outcome.status.value)}", ""]
     if outcome.result is None:

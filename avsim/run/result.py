@@ -15,6 +15,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from avsim.run.story_state import state_change_json
+from avsim.stack.choice import identity
+from avsim.stack.context import API_VERSION
 from world.sensors.setup import Localisation, Profile, localisation
 
 if TYPE_CHECKING:
@@ -36,6 +38,7 @@ def result_json(result: RunResult, file: str | Path, recording: Path, profile: s
         "seed": scenario.seed,
         "profile": profile,
         "ego": "scripted" if scenario.world.ego.scripted else "stack",  # what drove the car
+        "stack": identity(scenario.stack, API_VERSION).as_json(),  # which stack that is
         "localisation": run_localisation(result, profile).as_json(),
         "renderer": result.renderer,
         "verdict": result.verdict.value,

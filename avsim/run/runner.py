@@ -27,8 +27,9 @@ speed source, NaN targets, no commands), its truth columns are the script's car.
 from __future__ import annotations
 
 import math
+import re
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from contextlib import suppress
 from dataclasses import dataclass, field
 from functools import partial
@@ -60,13 +61,15 @@ from avsim.run.columns import Column, EnumColumn, Rows, flags, floats, ints
 from avsim.run.holds import shortest_hold
 from avsim.run.sensor_loop import FrameHook, SensorLoop, sensing_mode
 from avsim.run.spill import SpillFile
-from avsim.run.stack import Stack, StackOutput
+from avsim.run.stack import build_stack
 from avsim.run.story import ScriptedStory, StoryboardStory, StoryEntry
 from avsim.run.story_state import state_change_text
 from avsim.run.storyboard.director import Director
 from avsim.run.storyboard.state import StateChange as StoryStateChange
 from avsim.run.verdict import RunError, RunVerdict
 from avsim.scenario.scenario import Scenario
+from avsim.stack.context import StackContext
+from control.command import StackStep
 from planner.messages import MACHINES, AccMode, HazardLights, Motion, Plan, SpeedSource, StateChange
 from world.core.rates import (
     ACTOR_RECORD_RATE,
@@ -78,9 +81,10 @@ from world.core.rates import (
     TRIGGER_RATE,
 )
 from world.core.stopwatch import Stopwatch
+from world.ego.body import vehicle_info
 from world.sensors.lidar import RayBackend
 from world.sensors.pipeline import SensingWorker
-from world.sensors.setup import Profile, sensor_setup
+from world.sensors.setup import Profile, sensor_setup, sensor_specs
 from world.spec import FlatTire
 from world.truth import ego_lane_edges, time_to_collision, touching, vehicles_ahead
 from world.world import World
@@ -203,6 +207,28 @@ class RunResult:
         return self.verdict is RunVerdict.PASS
 
 
+MAX_CHANNELS = 64  # a stack's diagnostic channels, at most
+CHANNEL = re.compile(r"^[A-Za-z][A-Za-z0-9_]{0,63}$")  # a channel's name
+
+
+def stack_channels(channels: Mapping[str, float]) -> dict[str, float]:
+    """A stack's diagnostic channels as the recording's scalars, ``stack/<name>``; a
+    `ValueError` (the run's error) for more than ``MAX_CHANNELS``, a name that is not
+    ``CHANNEL`` or a value that is not a number."""
+    if len(channels) > MAX_CHANNELS:
+        raise ValueError(f"the stack gave {len(channels)} diagnostic channels (at most "
+                         f"{MAX_CHANNELS})")
+    out: dict[str, float] = {}
+    for name, value in channels.items():
+        if not isinstance(name, str) or not CHANNEL.match(name):
+            raise ValueError(f"diagnostic channel {name!r}: a name is a letter, then letters, "
+                             "digits or _ (at most 64)")
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            raise ValueError(f"diagnostic channel {name}: {value!r} is not a number")
+        out[f"stack/{name}"] = float(value)
+    return out
+
+
 class Runner:
     """Runs one scenario to its end (duration, or `completes` reached) and judges it."""
 
@@ -243,9 +269,12 @@ class Runner:
                            lidar_backend=lidar_backend)
         w = self.world
         self.car = w.ego.geometry
-        front = self.setup.camera("front") if self.setup is not None else None
         self.watch = Stopwatch()  # where the run's wall time goes, stage by stage
-        self.stack = Stack(w.road, spec.ego, scenario.driver, self.car, front, self.watch)
+        self.stack = build_stack(scenario.stack, StackContext(
+            road=w.road, vehicle=vehicle_info(self.car), sensors=sensor_specs(self.setup),
+            start_lane=spec.ego.lane, set_speed=scenario.driver.set_speed,
+            max_speed=spec.ego.max_speed, overtake=scenario.driver.overtake, seed=spec.seed,
+            timer=self.watch))
         self.log = TrajectoryLog()
         names = {b: "building or sign" for b in w.scene.obstacle_bodies}
         names.update({b: "kerb" for b in w.scene.kerb_bodies})
@@ -277,7 +306,7 @@ class Runner:
                                   self.watch, worker)
         self.state_changes: list[StateChange] = []
         self._touching: frozenset[int] = frozenset()
-        self._last: StackOutput | None = None
+        self._last: StackStep | None = None
         self._interrupted = False  # a signal asked the run to end
         self._stopped = False  # the run ended early for it (not after its last tick)
         self.error: RunError | None = None  # the exception that ended the run, if one did
@@ -435,47 +464,82 @@ class Runner:
         previous, self._last = self._last, out
         with watch("runner"):
             self._log_tick(out)
-            self.state_changes.extend(out.plan.changes)
+            if out.plan is not None:
+                self.state_changes.extend(out.plan.changes)
         if self.recorder is not None:
             with watch("recording"):
                 self._record_plan(out, previous)
 
-    def _record_plan(self, out: StackOutput, previous: StackOutput | None) -> None:
+    def _record_plan(self, out: StackStep, previous: StackStep | None) -> None:
         """The tick's plan in the recording: the machines' lanes (their initial states at
         the first tick), the tick's series at the recording rate, each state change and the
-        speed source when it changes."""
+        speed source when it changes; a stack that shows no plan, its channels only."""
         rec, w = self.recorder, self.world
         assert rec is not None
-        if previous is None:
-            self._record_machines(out.plan)
+        plan, before = out.plan, previous.plan if previous is not None else None
         if RECORD_RATE.fires(w.clock.step):
             self._record_tick(out)
-        for change in out.plan.changes:
+        if plan is None:
+            return
+        if previous is None:
+            self._record_machines(plan)
+        for change in plan.changes:
             rec.log_state(change.t, change.machine, change.target, change.reason)
-        source = out.plan.speed_source
-        if previous is not None and previous.plan.speed_source is not source:
-            rec.log_state(w.t, "speed_source", source.value, text=False)  # an attribution,
-            #   not a state change
+        if before is not None and before.speed_source is not plan.speed_source:
+            rec.log_state(w.t, "speed_source", plan.speed_source.value, text=False)  # an
+            #   attribution, not a state change
 
-    def _log_tick(self, out: StackOutput) -> None:
-        """The tick's row: the truth (against the lane the plan keeps) and the stack's."""
-        truth = self.world.ego_truth
-        pose_error = math.hypot(out.plan.ego.x - float(truth.position[0]),
-                                out.plan.ego.y - float(truth.position[1]))
-        self._log_truth(out.plan.lane)  # computed and appended first: the row whole or absent
-        log = self.log
-        log.target_speed.append(out.plan.target_speed)
-        log.speed_limit.append(out.plan.speed_limit)
+    def _log_tick(self, out: StackStep) -> None:
+        """The tick's row: the truth (against the lane the plan keeps, else the lane the
+        car is in) and the stack's (NaN, or the function-off states, where it shows no
+        plan)."""
+        plan, w, log = out.plan, self.world, self.log
+        if plan is None:
+            self._log_unplanned(out)
+            return
+        truth = w.ego_truth
+        pose_error = math.hypot(plan.ego.x - float(truth.position[0]),
+                                plan.ego.y - float(truth.position[1]))
+        self._log_truth(plan.lane)  # computed and appended first: the row whole or absent
+        log.target_speed.append(plan.target_speed)
+        log.speed_limit.append(plan.speed_limit)
         log.steering.append(out.command.steering_angle)
         log.drive_torque.append(out.command.drive_torque)
         log.brake_torque.append(out.command.brake_torque)
-        log.acc_mode.append(out.plan.acc_mode)
-        log.hazard.append(out.plan.hazard is HazardLights.ON)
-        log.motion.append(out.plan.motion)
-        log.speed_source.append(out.plan.speed_source)
-        log.lane.append(out.plan.lane)
-        log.changing.append(out.plan.lane != out.plan.origin_lane)
+        log.acc_mode.append(plan.acc_mode)
+        log.hazard.append(plan.hazard is HazardLights.ON)
+        log.motion.append(plan.motion)
+        log.speed_source.append(plan.speed_source)
+        log.lane.append(plan.lane)
+        log.changing.append(plan.lane != plan.origin_lane)
         log.pose_error.append(pose_error)
+
+    def _log_unplanned(self, out: StackStep) -> None:
+        """The row of a stack that shows no plan: the truth against the lane the car is in,
+        its command, and no plan (NaN targets and pose error, no ACC, lane keeping)."""
+        lane = self._lane_in()
+        self._log_truth(lane)
+        log = self.log
+        log.target_speed.append(math.nan)
+        log.speed_limit.append(math.nan)
+        log.steering.append(out.command.steering_angle)
+        log.drive_torque.append(out.command.drive_torque)
+        log.brake_torque.append(out.command.brake_torque)
+        log.acc_mode.append(AccMode.ACC_OFF)
+        log.hazard.append(out.command.hazard_lights)
+        log.motion.append(Motion.LANE_KEEP)
+        log.speed_source.append(SpeedSource.SET_SPEED)
+        log.lane.append(lane)
+        log.changing.append(False)
+        log.pose_error.append(math.nan)
+
+    def _lane_in(self) -> int:
+        """The lane the car's centre is in (the last one logged when it is off the lanes)."""
+        route = self.world.ego_route
+        found = self.world.road.lane_of(route.station, float(route.offsets[0]))[0]
+        if found is not None:
+            return int(found)
+        return self.log.lane[-1] if len(self.log.lane) else self.world.spec.ego.lane
 
     def _log_scripted(self) -> None:
         """A scripted ego's row (module doc): the truth against the lane it is in."""
@@ -653,18 +717,21 @@ class Runner:
             initial = left.get(machine, plan.states[machine].value)
             rec.log_state(0.0, machine, initial, "initial state")
 
-    def _record_tick(self, out: StackOutput) -> None:
+    def _record_tick(self, out: StackStep) -> None:
         rec, w = self.recorder, self.world
         assert rec is not None
         truth, log = w.ego_truth, self.log
         rec.log_ego_pose(w.t, truth.position, truth.quaternion)
         rec.log_scalars(w.t, {
-            "speed": truth.speed, "target_speed": out.plan.target_speed,
-            "speed_limit": out.plan.speed_limit, "steering": out.command.steering_angle,
+            "speed": truth.speed, "target_speed": log.target_speed[-1],
+            "speed_limit": log.speed_limit[-1], "steering": out.command.steering_angle,
             "cross_track_error": log.cross_track[-1],
             "lead_gap": log.lead_gap[-1], "lead_speed": log.lead_speed[-1],  # NaN: no lead
         })
-        rec.log_path(w.t, out.plan.path.xy)
+        if out.channels:
+            rec.log_scalars(w.t, stack_channels(out.channels))
+        if out.plan is not None:
+            rec.log_path(w.t, out.plan.path.xy)
         self._record_actors()
 
     def _record_scripted(self) -> None:

@@ -30,8 +30,8 @@ import numpy as np
 
 from avsim.record.recorder import Recorder
 from avsim.run.scoring import CaptureTruth, PerceptionScore
-from avsim.run.stack import PerceptionOutput, Stack
-from perception.messages import Detection
+from control.command import DrivingStack
+from perception.messages import Detection, PerceptionReport
 from world.core.rates import CONTROL_RATE, SensorTiming
 from world.core.stopwatch import Stopwatch
 from world.frames import CameraFrame, Frame, LidarScan, wrap_angle
@@ -64,20 +64,21 @@ def sensing_mode(requested: str) -> str:
     return requested
 
 
-def frames_read(timings: Iterable[tuple[str, SensorTiming]], reads: Collection[str],
+def frames_read(timings: Iterable[tuple[str, SensorTiming]], reads: Collection[str] | None,
                 recording: bool) -> dict[str, int]:
     """Per sensor, every how many of its frames somebody reads (`SensorSchedule`'s `keep`):
-    all of those of the sensors the stack `reads`, the recording's `record_every` of the
-    others (a side camera renders only what the recording keeps), none without a recording."""
-    return {name: 1 if name in reads else timing.record_every if recording else 0
-            for name, timing in timings}
+    all of those of the sensors the stack `reads` (None: every sensor), the recording's
+    `record_every` of the others (a side camera renders only what the recording keeps), none
+    without a recording."""
+    return {name: 1 if reads is None or name in reads
+            else timing.record_every if recording else 0 for name, timing in timings}
 
 
 class SensorLoop:
     """Sensing pipeline + delivery to the stack + perception scoring + sensor recording for
     one run: every sensor of the car (`setup`'s cameras and LiDAR, if any; GNSS, odometry)."""
 
-    def __init__(self, world: World, setup: SensorSetup | None, stack: Stack, mode: str,
+    def __init__(self, world: World, setup: SensorSetup | None, stack: DrivingStack, mode: str,
                  recorder: Recorder | None = None, frame_hook: FrameHook | None = None,
                  watch: Stopwatch | None = None, worker: SensingWorker | None = None) -> None:
         """`mode`: 'inline' or 'process' (`world.sensors.pipeline`; without cameras there is
@@ -100,7 +101,7 @@ class SensorLoop:
         self.frame_hook = frame_hook
         self.score = PerceptionScore()
         self._truth: dict[Due, CaptureTruth] = {}  # of the captures delivered late, till then
-        self.last: PerceptionOutput | None = None
+        self.last: PerceptionReport | None = None
 
     def tick(self) -> None:
         """At a control tick: the earlier captures due now reach the stack, then those
@@ -130,10 +131,11 @@ class SensorLoop:
     def _deliver(self, captures: tuple[Capture, ...]) -> None:
         for capture in captures:
             truth = self._truth.pop(capture.due, None)
-            frames: tuple[Frame, ...] = capture.frames
+            frames: dict[str, Frame] = {r.sensor: r.frame for r in capture.readings}
             if self.frame_hook is not None:
                 hook = self.frame_hook
-                frames = tuple(hook(f) if isinstance(f, CameraFrame) else f for f in frames)
+                frames = {name: hook(f) if isinstance(f, CameraFrame) else f
+                          for name, f in frames.items()}
             out = self.stack.on_frames(capture.t, frames)
             if out is None:
                 continue
@@ -147,7 +149,7 @@ class SensorLoop:
                     self._record(capture, out)
                     self._record_scores(out, truth)
 
-    def _score(self, capture: Capture, out: PerceptionOutput, truth: CaptureTruth) -> None:
+    def _score(self, capture: Capture, out: PerceptionReport, truth: CaptureTruth) -> None:
         if out.lane_raw is not None:  # a frame of the stack's lane camera was perceived
             self.score.lane(out.lane_raw, out.lane, truth)
         scan_truth = next((r.truth for r in capture.readings
@@ -155,7 +157,7 @@ class SensorLoop:
         if out.detections is not None and out.tracks is not None and scan_truth is not None:
             self.score.objects(out.detections, out.tracks, truth, scan_truth)
 
-    def _record_scores(self, out: PerceptionOutput, truth: CaptureTruth) -> None:
+    def _record_scores(self, out: PerceptionReport, truth: CaptureTruth) -> None:
         """Perception against the truth at the capture instant, as time series."""
         assert self.recorder is not None
         values: dict[str, float] = {}
@@ -195,7 +197,7 @@ class SensorLoop:
         timing = self.schedule.timings[sensor]
         return timing.record_every > 0 and (step // timing.rate.every) % timing.record_every == 0
 
-    def _record(self, capture: Capture, out: PerceptionOutput) -> None:
+    def _record(self, capture: Capture, out: PerceptionReport) -> None:
         rec = self.recorder
         assert rec is not None
         t = capture.t
@@ -215,14 +217,14 @@ class SensorLoop:
         if out.lane is not None:
             self._record_lane(t, out)
 
-    def _record_lidar(self, t: float, scan: LidarScan, out: PerceptionOutput) -> None:
+    def _record_lidar(self, t: float, scan: LidarScan, out: PerceptionReport) -> None:
         assert self.recorder is not None
         stride = max(1, math.ceil(len(scan.points) / RECORD_LIDAR_POINTS))
         local = scan.info.mount.to_vehicle(scan.points[::stride].astype(np.float64))
         colours = _cluster_colours(local, out.detections or ())
         self.recorder.log_lidar(t, _to_map(local, out), colours)
 
-    def _record_tracks(self, t: float, out: PerceptionOutput) -> None:
+    def _record_tracks(self, t: float, out: PerceptionReport) -> None:
         assert self.recorder is not None and out.tracks is not None
         tracks = out.tracks
         centres = np.array([[tr.x, tr.y, 0.5 * tr.height] for tr in tracks]).reshape(-1, 3)
@@ -232,7 +234,7 @@ class SensorLoop:
                                  np.array([[tr.vx, tr.vy] for tr in tracks]).reshape(-1, 2),
                                  [tr.cls.value for tr in tracks])
 
-    def _record_lane(self, t: float, out: PerceptionOutput) -> None:
+    def _record_lane(self, t: float, out: PerceptionReport) -> None:
         assert self.recorder is not None and out.lane is not None
         lane = out.lane
         x = np.linspace(0.0, 30.0, 31)
@@ -243,7 +245,7 @@ class SensorLoop:
                                      [(255, 140, 0), (255, 220, 0), (255, 140, 0)])
 
 
-def _to_map(local: np.ndarray, out: PerceptionOutput) -> np.ndarray:
+def _to_map(local: np.ndarray, out: PerceptionReport) -> np.ndarray:
     """Vehicle-frame points (N, 3) to the map frame with the stack's pose estimate."""
     pose = out.pose
     c, s = math.cos(pose.heading), math.sin(pose.heading)

@@ -38,11 +38,13 @@ from avsim.scenario.model import (
     SensorsModel,
     SpeedBumpFeature,
     SpeedLimitFeature,
+    StackModel,
     StopSignFeature,
     TrafficLightFeature,
     TriggerModel,
 )
 from avsim.scenario.scenario import DriverSettings, Scenario
+from avsim.stack.choice import StackChoice
 from world import frames, hdmap, spec
 from world.actors.catalogue import CATALOGUE, DEFAULT_MODEL, VehicleModel
 from world.frames import MPS_PER_KPH
@@ -300,10 +302,16 @@ def _scenario(model: ScenarioModel, road_spec: spec.RoadSpec,
         duration=float(model.duration),
         world=world,
         driver=DriverSettings(set_speed=_kph(ego.set_speed_kph), overtake=ego.overtake),
+        stack=stack_choice(model.stack),
         criteria=CriteriaSettings.of({key: getattr(model.criteria, key)
                                       for key in setting_keys()}),
         grid=tuple((key, tuple(values)) for key, values in model.grid.items()),
     )
+
+
+def stack_choice(m: StackModel) -> StackChoice:
+    """The file's `stack:` (the model checked its factories' form)."""
+    return StackChoice(m.stack, m.perception, m.planner, m.controller)
 
 
 def _convert_town(model: ScenarioModel) -> Scenario:

@@ -36,6 +36,7 @@ from avsim.scenario.files import (
 from avsim.scenario.overrides import apply_overrides
 from avsim.scenario.scenario import Scenario
 from avsim.scenario.validation import validate
+from avsim.stack.choice import BUNDLED, STAGES, StackChoiceError, resolve
 
 __all__ = ["UNSUPPORTED", "ScenarioError", "bundled_scenarios", "load_scenario", "scenario_path"]
 
@@ -75,7 +76,8 @@ def load_scenario(
     if path.suffix == ".xosc":
         from avsim.scenario.openscenario.convert import load_xosc
 
-        return load_xosc(path, overrides, criteria_file, search_paths, scripted_ego)
+        return _with_stack(load_xosc(path, overrides, criteria_file, search_paths,
+                                     scripted_ego), str(path_or_name))
     if scripted_ego:
         raise ScenarioError(str(path_or_name), "ego", "--ego scripted is for OpenSCENARIO "
                             "files (a YAML scenario scripts no actions for its ego)")
@@ -91,9 +93,24 @@ def load_scenario(
         raw = apply_overrides(read_raw(path), overrides or {})
         model = validate(raw, overrides or {})
         _check_supported(raw)
-        return replace(convert(model), sources=(path,))
+        scenario = replace(convert(model), sources=(path,))
     except LocatedError as problem:
         raise ScenarioError(shown, problem.key, problem.problem) from None
+    return _with_stack(scenario, shown)
+
+
+def _with_stack(scenario: Scenario, shown: str) -> Scenario:
+    """`scenario`, once every factory its stack choice names is found (imported: a stack
+    that cannot be is bad input, refused before anything runs)."""
+    choice = scenario.stack
+    for key in ("stack", *STAGES):
+        spec = getattr(choice, key)
+        if spec not in (None, BUNDLED):
+            try:
+                resolve(key, spec)
+            except StackChoiceError as exc:
+                raise ScenarioError(shown, f"stack.{key}", exc.problem) from None
+    return scenario
 
 
 def _check_supported(raw: dict[str, Any]) -> None:

@@ -40,10 +40,12 @@ from avsim.scenario.fields import (
     Fraction,
     problem,
 )
+from avsim.stack.choice import BUNDLED, MAX_SPEC, SPEC
 from world.actors.catalogue import CATALOGUE, TYPE_CLASSES
 
 FORMAT = "avsim/1"
 NAME_PATTERN = r"^[a-z0-9_]+$"
+StackSpec = Annotated[str, Field(max_length=MAX_SPEC, pattern=SPEC.pattern)]  # a factory
 
 Situation = Literal[
     "normal_driving",
@@ -879,6 +881,36 @@ class DistributionModel(FormatModel):
 # ---------------------------------------------------------------------------------------
 
 
+class StackModel(FormatModel):
+    """Which stack drives the car (`avsim.stack.StackChoice`): each key a factory,
+    `package.module:factory` or an installed stack's name (entry point group
+    `avsim.stacks`); left out or `avsim`: the bundled one."""
+
+    model_config = ConfigDict(extra="forbid")
+
+    stack: StackSpec | None = Field(
+        default=None, description="A whole stack of one's own (every stage); not with the "
+        "stage keys. Default: the bundled stack.")
+    perception: StackSpec | None = Field(
+        default=None, description="The perception stage (frames in, PlannerInput out). "
+        "Default: the bundled one.")
+    planner: StackSpec | None = Field(
+        default=None, description="The planner stage (PlannerInput in, Plan out). Default: "
+        "the bundled one.")
+    controller: StackSpec | None = Field(
+        default=None, description="The controller stage (Plan in, VehicleCommand out). "
+        "Default: the bundled one.")
+
+    @model_validator(mode="after")
+    def _whole_or_stages(self) -> StackModel:
+        if self.stack not in (None, BUNDLED) and any(
+                s not in (None, BUNDLED) for s in (self.perception, self.planner,
+                                                  self.controller)):
+            raise ValueError("a whole stack replaces every stage: give either `stack` or "
+                             "the stages to replace, not both")
+        return self
+
+
 class ScenarioModel(FormatModel):
     """A scenario file, format `avsim/1`: exactly one map (`road` or `town`), the ego, and
     optionally actors, sensors, events and criteria."""
@@ -917,6 +949,12 @@ class ScenarioModel(FormatModel):
         description="What happens to the ego car: an accelerator override, a flat tyre, "
         "sensor faults. Default none.",
     )
+    stack: StackModel = Field(
+        default_factory=StackModel,
+        description="Which stack drives the car: `stack` (a whole stack), or `perception`, "
+        "`planner`, `controller` (stages replaced), each `package.module:factory` or an "
+        "installed stack's name; `--stack` and the stage options override it. Default: the "
+        "bundled stack.")
     criteria: CriteriaModel = Field(
         default_factory=CriteriaModel,
         description="Criteria to add or tune, by key: "

@@ -4,9 +4,9 @@ driver asks of the car, and the criteria it is judged by.
 `avsim.scenario.load.load_scenario` returns one (SI units, radians, every default
 resolved); the runner, the batch jobs, the CLI and the reports take it. The world's part
 (`world.spec.WorldSpec`: roads or a town, the ego car's body, actors, events, sensors, the
-seed) is what `world.World` is built from; the driver's settings configure the driving
-stack (`avsim.run.stack`); the criteria settings choose and tune the criteria
-(`avsim.criteria.registry`).
+seed) is what `world.World` is built from; the stack choice says which driving stack drives
+the car (`avsim.run.stack`) and the driver's settings configure it; the criteria settings
+choose and tune the criteria (`avsim.criteria.registry`).
 """
 
 from __future__ import annotations
@@ -16,6 +16,7 @@ from pathlib import Path
 
 from avsim.criteria.registry import CriteriaSettings
 from avsim.scenario.openscenario.program import StoryProgram
+from avsim.stack.choice import StackChoice
 from world.spec import WorldSpec
 
 
@@ -39,6 +40,8 @@ class Scenario:
     world: WorldSpec  # what the world is built from
     driver: DriverSettings  # what the driver asks of the stack
     criteria: CriteriaSettings = field(default_factory=CriteriaSettings)
+    stack: StackChoice = field(default_factory=StackChoice)  # which stack drives the car
+    #   (the file's `stack:`, `--stack` / `--perception` / `--planner` / `--controller`)
     story: StoryProgram | None = None  # an OpenSCENARIO file's storyboard (its director
     #   plays it: `avsim.run.storyboard`); None: the world spec's own scripted actions
     grid: tuple[tuple[str, tuple[object, ...]], ...] = ()  # the file's test grid: key paths

@@ -1,5 +1,6 @@
-"""control/ imports only planner.messages and the shared conventions of world.frames (plus
-numpy and the standard library), and is clean under ruff and mypy --strict."""
+"""control/ imports only the messages (planner.messages; perception.messages for a whole
+stack's interface beside the command) and the shared conventions of world.frames (plus numpy
+and the standard library), and is clean under ruff and mypy --strict."""
 
 from __future__ import annotations
 
@@ -13,7 +14,7 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
 CONTROL = ROOT / "control"
-ALLOWED_FIRST_PARTY = {"control", "planner.messages", "world.frames"}
+ALLOWED_FIRST_PARTY = {"control", "planner.messages", "perception.messages", "world.frames"}
 ALLOWED_THIRD_PARTY = {"numpy"}
 
 

@@ -350,4 +350,6 @@ def vehicle_info(geometry: CarGeometry) -> VehicleInfo:
     """The stack's view of the car's dimensions (`world.frames.VehicleInfo`), from the URDF's."""
     return VehicleInfo(length=geometry.body_length, width=geometry.body_width,
                        wheelbase=geometry.wheelbase, track=geometry.track,
-                       front_axle=geometry.front_axle, rear_axle=geometry.rear_axle)
+                       front_axle=geometry.front_axle, rear_axle=geometry.rear_axle,
+                       mass=geometry.mass, wheel_radius=geometry.wheel_radius,
+                       max_steer=geometry.max_steer)

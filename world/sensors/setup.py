@@ -42,7 +42,7 @@ from dataclasses import dataclass, replace
 
 from vehicle_urdf import MountPose, read_geometry, read_sensor_mounts
 from world.core.rates import CAR_SENSORS, PROFILE_SENSORS, SensorTiming
-from world.frames import CameraInfo, LidarInfo, SensorMount
+from world.frames import CameraInfo, LidarInfo, SensorKind, SensorMount, SensorSpec
 from world.spec import GNSS_PRESETS, GnssSpec, LidarNoiseSpec
 
 CAMERA_FOV = math.radians(80.0)  # [rad] horizontal
@@ -130,6 +130,20 @@ def sensor_timings(setup: SensorSetup | None) -> tuple[tuple[str, SensorTiming],
     profile's cameras (front first) and LiDAR (none without a profile), then the sensors on
     every car (GNSS, odometry)."""
     return (setup.timings if setup is not None else ()) + tuple(CAR_SENSORS.items())
+
+
+def sensor_specs(setup: SensorSetup | None) -> tuple[SensorSpec, ...]:
+    """Every sensor of the car as the stack is told of it (`world.frames.SensorSpec`), in
+    `sensor_timings`' order."""
+    cameras = {c.name: c for c in setup.cameras} if setup is not None else {}
+    kinds = {LIDAR: SensorKind.LIDAR, "gnss": SensorKind.GNSS, "odometry": SensorKind.ODOMETRY}
+    out = []
+    for name, timing in sensor_timings(setup):
+        kind = SensorKind.CAMERA if name in cameras else kinds[name]
+        info = cameras.get(name) or (setup.lidar if setup is not None and kind is SensorKind.LIDAR
+                                     else None)
+        out.append(SensorSpec(name, kind, timing.rate.hz, timing.latency, info))
+    return tuple(out)
 
 
 @dataclass(frozen=True, slots=True)

@@ -135,7 +135,8 @@ def load_xosc(path: Path, overrides: Mapping[str, object] | None = None,
     _check_spawn(path, world, ego.name, [e.name for e in others], held)
     return Scenario(name=_name(path), description=osc.description, situation="openscenario",
                     duration=side.duration, world=world,
-                    driver=DriverSettings(set_speed=ego_spec.speed), criteria=side.criteria,
+                    driver=DriverSettings(set_speed=ego_spec.speed), stack=side.stack,
+                    criteria=side.criteria,
                     story=program, sources=_sources(path, osc.road_network, side_file))
 
 

@@ -19,21 +19,22 @@ Overrides (`avsim run --set`, `avsim sweep --set`) take the same keys, plus
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Literal
 
 from pydantic import Field
 
 from avsim.criteria.registry import CriteriaSettings, setting_keys
-from avsim.scenario.convert import sensors_spec
+from avsim.scenario.convert import sensors_spec, stack_choice
 from avsim.scenario.errors import FILE_KEY, LocatedError, ScenarioError
 from avsim.scenario.fields import FormatModel, NonNegInt, PosFloat
 from avsim.scenario.files import read_raw
-from avsim.scenario.model import CriteriaModel, SensorsModel
+from avsim.scenario.model import CriteriaModel, SensorsModel, StackModel
 from avsim.scenario.openscenario.references import ReferenceError, Roots
 from avsim.scenario.overrides import apply_overrides
 from avsim.scenario.validation import validate_as
+from avsim.stack.choice import StackChoice
 from world.spec import SensorsSpec
 
 MAX_DURATION = 600.0  # [s] a run whose StopTrigger never fires ends here
@@ -51,6 +52,8 @@ class SidecarModel(FormatModel):
                                   description="Sensor noise, as in the YAML format.")
     duration: PosFloat = Field(default=MAX_DURATION,
                                description="[s] time limit if the StopTrigger never fires.")
+    stack: StackModel = Field(default_factory=StackModel,
+                              description="Which stack drives the car, as in the YAML format.")
     function: Literal["file", "off"] = Field(
         default="file", description="The car under test's automated driving function at the "
         "start: `file` (on unless a story activates its controller later) or `off` (the "
@@ -67,6 +70,7 @@ class Sidecar:
     duration: float  # [s]
     file: Path | None  # the sidecar read, None: the defaults
     function_off: bool = False  # the automated driving function starts off (`function: off`)
+    stack: StackChoice = field(default_factory=StackChoice)  # which stack drives the car
 
 
 SETS = Path(__file__).with_name("sets")  # the bundled criteria sets (`r157`)
@@ -130,4 +134,5 @@ def load_sidecar(path: Path | None, overrides: Mapping[str, object]) -> Sidecar:
     if values.get("completes") is None and values.get("reach_s") is None:
         values["completes"] = False  # the StopTrigger ends the run
     return Sidecar(CriteriaSettings.of(values), model.seed, sensors_spec(model.sensors),
-                   float(model.duration), path, model.function == "off")
+                   float(model.duration), path, model.function == "off",
+                   stack_choice(model.stack))

@@ -19,9 +19,8 @@ import pytest
 import yaml
 
 from avsim.run.runner import Runner, RunResult
-from avsim.run.stack import StackOutput
 from avsim.scenario.load import load_scenario
-from control.command import VehicleCommand
+from control.command import StackStep, VehicleCommand
 from world.frames import MPS_PER_KPH as KPH
 
 Driver = Callable[[float], tuple[float, float]]  # t [s] -> (drive, brake) torque [N m]
@@ -54,12 +53,13 @@ def reckless(path: Path, driver: Driver, steer: Callable[[float], float] = lambd
     runner = Runner(load_scenario(path), None, profile=None)
     stack_tick = runner.stack.tick
 
-    def tick(t: float, dt: float) -> StackOutput:
+    def tick(t: float, dt: float) -> StackStep:
         out = stack_tick(t, dt)
+        assert out.plan is not None
         plan = out.plan if declare is None else dataclasses.replace(
             out.plan, lane=declare[0], origin_lane=declare[1])
         drive, brake = driver(t)
-        return StackOutput(plan, VehicleCommand(steer(t), drive, brake, 0.0))
+        return StackStep(VehicleCommand(steer(t), drive, brake, 0.0), plan)
 
     runner.stack.tick = tick  # type: ignore[method-assign]
     return runner.run()

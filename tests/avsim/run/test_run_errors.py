@@ -21,11 +21,11 @@ from avsim.record import blueprint as bp
 from avsim.record.recorder import Recorder
 from avsim.run.result import dumps, result_json
 from avsim.run.runner import Runner
-from avsim.run.stack import Stack
 from avsim.run.storyboard.director import Director
 from avsim.run.verdict import RunError, RunVerdict
 from avsim.scenario.load import load_scenario
 from control.vehicle_controller import VehicleController
+from perception.perception import Perception
 from planner.planner import Planner
 from tests.avsim.run.test_runner_criteria import column
 from world.world import World
@@ -54,7 +54,7 @@ def raising_on_call(n: int, original: Callable[..., Any], exc: Exception
 
 
 STAGES: dict[str, tuple[type, str, str | Path]] = {  # stage -> (class, method, scenario)
-    "perception": (Stack, "on_frames", "normal_driving"),
+    "perception": (Perception, "on_frames", "normal_driving"),
     "planner": (Planner, "update", "normal_driving"),
     "control": (VehicleController, "update", "normal_driving"),
     "director": (Director, "step", CUT_IN),

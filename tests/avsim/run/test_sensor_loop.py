@@ -4,22 +4,25 @@ each sensor in the recording, and alters only the stack's frames with a frame ho
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
 import pytest
 
 from avsim.run.sensor_loop import SensorLoop
-from avsim.run.stack import PerceptionOutput
 from avsim.scenario.load import load_scenario
-from perception.messages import EgoState
+from perception.messages import EgoState, PerceptionReport
 from world.core.rates import CONTROL_RATE, PHYSICS_RATE
-from world.frames import CameraFrame, Frame, GnssFix, LidarScan, Odometry
+from world.frames import CameraFrame, Frame, Frames, GnssFix, LidarScan, Odometry
 from world.sensors.setup import Profile, sensor_setup
 from world.world import World
 
 KIND = {CameraFrame: "camera", LidarScan: "lidar", GnssFix: "gnss", Odometry: "odometry"}
+
+
+def _sensor_of(frame: Frame) -> str:
+    """The sensor a frame came from, by its own data: a camera's name, else its kind."""
+    return frame.info.name if isinstance(frame, CameraFrame) else KIND[type(frame)]
 
 
 class FakeStack:
@@ -31,17 +34,19 @@ class FakeStack:
         self.reads = reads
         self.calls: list[tuple[int, float, tuple[str, ...]]] = []  # (step, t, frame kinds)
         self.brightest: list[int] = []  # the brightest pixel of each camera frame
+        self.names: list[tuple[str, ...]] = []  # the sensor names of each delivery
         self.step = 0
 
-    def on_frames(self, t: float, frames: Sequence[Frame]) -> PerceptionOutput | None:
-        self.calls.append((self.step, t, tuple(KIND[type(f)] for f in frames)))
-        images = [f for f in frames if isinstance(f, CameraFrame)]
+    def on_frames(self, t: float, frames: Frames) -> PerceptionReport | None:
+        self.calls.append((self.step, t, tuple(KIND[type(f)] for f in frames.values())))
+        self.names.append(tuple((name, _sensor_of(f)) for name, f in frames.items()))
+        images = [f for f in frames.values() if isinstance(f, CameraFrame)]
         self.brightest += [int(f.rgb.max()) for f in images]
         if not images:
             return None
         pose = EgoState(t=t, x=0.0, y=0.0, heading=0.0, speed=0.0, yaw_rate=0.0,
                         steering_angle=0.0, position_sigma=0.0)
-        return PerceptionOutput(t, pose, None, None, None, None)
+        return PerceptionReport(t, pose)
 
 
 class FakeRecorder:
@@ -141,3 +146,11 @@ def test_without_a_recording_a_camera_renders_only_if_the_stack_reads_it(
     assert set(delivered) == cameras
     if len(cameras) == 2:  # the left camera at its 2 Hz: t = 0, 0.5 and 1.0 s
         assert delivered.count(("camera", "camera")) == 3
+
+
+def test_a_delivery_names_each_frame_by_its_sensor(loop: tuple[FakeStack, FakeRecorder]) -> None:
+    """The stack looks frames up by sensor name: each name is its frame's sensor."""
+    stack, _ = loop
+    pairs = [pair for delivery in stack.names for pair in delivery]
+    assert pairs and all(name == sensor for name, sensor in pairs)
+    assert {name for name, _ in pairs} >= {"front", "lidar", "gnss", "odometry"}

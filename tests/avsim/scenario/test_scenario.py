@@ -30,7 +30,7 @@ def test_the_world_spec_is_what_a_world_is_built_from() -> None:
                                     "offset"]
     assert not hasattr(spec, "CriteriaSpec") and not hasattr(spec, "ScenarioSpec")
     assert fields(Scenario) == ["name", "description", "situation", "duration", "world",
-                                "driver", "criteria", "story", "grid", "sources"]
+                                "driver", "criteria", "stack", "story", "grid", "sources"]
     assert fields(DriverSettings) == ["set_speed", "overtake"]
 
 
