@@ -6,7 +6,7 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 PYTEST_ARGS ?=
 
-.PHONY: setup demo test test-quick acceptance fuzz lint golden bench soak campaign clean
+.PHONY: assets setup demo test test-quick acceptance fuzz lint golden bench soak campaign clean
 
 # The virtual environment with the pinned dependencies (pyproject.toml), installed once.
 $(STAMP): pyproject.toml
@@ -84,3 +84,8 @@ campaign: $(STAMP)
 
 clean:
 	rm -rf runs .pytest_cache .mypy_cache .ruff_cache
+
+# The bodies' shapes as OBJ + MTL files (assets/shapes/), made from world/actors/shapes/; a
+# test checks that the committed files are exactly what the code makes.
+assets: $(STAMP)
+	$(BIN)/python -m world.actors.shapes.export assets/shapes

@@ -8,7 +8,7 @@ description into the Bullet shape with the same calls the builders made by hand 
 `createCollisionShape`; several: `createCollisionShapeArray`), remembering it by shape id;
 `placed` then remembers which body carries which shape.
 
-Shapes (all in the part's frame, SI units):
+Shapes (all in the part's frame, SI units; the data types live in the leaf `world.scene.solids`):
 - `Box`: half extents along x, y, z;
 - `Cylinder`: radius and full height along z, centred on the origin;
 - `ConvexHull`: the convex hull of a point set (Bullet: GEOM_MESH with vertices, no indices);
@@ -17,48 +17,22 @@ Shapes (all in the part's frame, SI units):
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
-import numpy as np
 import pybullet
-from numpy.typing import NDArray
 from pybullet_utils.bullet_client import BulletClient
 
-FloatArray = NDArray[np.float64]
-Vec3 = tuple[float, float, float]
+from world.scene.solids import (
+    Box,
+    ConvexHull,
+    Cylinder,
+    FloatArray,
+    Part,
+    Shape,
+    TriangleMesh,
+    Vec3,
+)
 
-
-@dataclass(frozen=True, slots=True)
-class Box:
-    half_extents: Vec3  # [m]
-
-
-@dataclass(frozen=True, slots=True)
-class Cylinder:
-    radius: float  # [m]
-    height: float  # [m] along the part's z, centred on its origin
-
-
-@dataclass(frozen=True, slots=True, eq=False)
-class ConvexHull:
-    points: FloatArray  # (P, 3) [m]
-
-
-@dataclass(frozen=True, slots=True, eq=False)
-class TriangleMesh:
-    vertices: FloatArray  # (V, 3) [m]
-    triangles: NDArray[np.int32]  # (T, 3) vertex indices
-
-
-Shape = Box | Cylinder | ConvexHull | TriangleMesh
-
-
-@dataclass(frozen=True, slots=True)
-class Part:
-    """One shape of a body, at `position` [m] in the body's frame (axes parallel to it)."""
-
-    shape: Shape
-    position: Vec3 = (0.0, 0.0, 0.0)
+__all__ = ["Box", "CollisionShapes", "ConvexHull", "Cylinder", "FloatArray", "Part", "Shape",
+           "TriangleMesh", "Vec3"]
 
 
 class CollisionShapes:

@@ -1,0 +1,170 @@
+"""People: a walking pedestrian as a function of its gait phase, and a seated rider.
+
+Segment lengths are shares of the stature H (Drillis and Contini's proportions, as tabled in
+D. A. Winter, "Biomechanics and Motor Control of Human Movement", ch. 4): shoulder 0.818 H,
+hip joint 0.530 H, knee 0.285 H, ankle 0.039 H, upper arm 0.186 H, forearm 0.146 H, hand
+0.108 H, shoulder width 0.259 H, hip width 0.191 H, foot length 0.152 H.
+
+The gait (ISO 19206-2's articulated-leg pedestrian targets swing their legs at the hip and
+bend the knee of the swinging leg): over one cycle, phase 0 -> 1, the left hip angle is
+``A cos(2 pi phase)`` (forward positive) and the right one its opposite; the leg whose hip
+angle is decreasing stands straight, the other bends its knee by ``K |sin(2 pi phase)|``;
+the arms swing opposite to the legs by ``ARM_SWING`` of the hip angle. The pelvis rides at
+the height that puts the lower foot on the ground, so at phase 0 and 0.5 (double support,
+legs at +-A) both feet are on the ground, and at 0.25 and 0.75 (mid stance: the standing
+leg vertical) the head is at the full stature. The stride (2 A of hip swing) is bounded by
+the targets' published envelope (0.60 m long for the EPTa): `HIP_SWING` and `KNEE_BEND`
+are the largest round figures whose every phase stays inside it, smaller than a free
+walker's (about 20 deg and 60 deg).
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+
+import numpy as np
+
+from world.actors.shapes.parts import BodyPart, hull, points, strut
+from world.scene.solids import Vec3
+
+SHOULDER, HIP, KNEE, ANKLE = 0.818, 0.530, 0.285, 0.039  # [-] heights, shares of stature
+UPPER_ARM, FOREARM, HAND = 0.186, 0.146, 0.108  # [-] lengths, shares of stature
+SHOULDER_WIDTH, HIP_WIDTH, FOOT = 0.259, 0.191, 0.152  # [-] shares of stature
+HIP_SWING = math.radians(8.0)  # [rad] A: the hip angle's amplitude
+KNEE_BEND = math.radians(20.0)  # [rad] K: the swinging knee's largest flexion
+ARM_SWING = 1.0  # [-] shoulder angle per hip angle (opposite side)
+HEEL = 0.25  # [-] share of the foot behind the ankle
+SWEEP_SAMPLES = 64  # [-] gait phases sampled for the sweep's centre
+
+
+def _limb(h: float) -> float:
+    """[m] the radius of a limb's prism for stature `h` [m]."""
+    return 0.028 * h
+
+
+def _leg(name: str, hip: np.ndarray, thigh_angle: float, knee_bend: float,
+         h: float) -> list[BodyPart]:
+    """Thigh, shank and a level foot from the hip joint `hip` [m]; angles [rad] from the
+    vertical, forward positive."""
+    thigh, shank = (HIP - KNEE) * h, (KNEE - ANKLE) * h
+    knee = hip + thigh * np.array([math.sin(thigh_angle), 0.0, -math.cos(thigh_angle)])
+    shank_angle = thigh_angle - knee_bend
+    ankle = knee + shank * np.array([math.sin(shank_angle), 0.0, -math.cos(shank_angle)])
+    r, foot = _limb(h), FOOT * h
+    sole = ankle[2] - ANKLE * h
+    y = ankle[1]
+    return [strut(f"{name}_thigh", "cloth", tuple(hip), tuple(knee), 1.2 * r),
+            strut(f"{name}_shank", "cloth", tuple(knee), tuple(ankle), r),
+            strut(f"{name}_foot", "trim", (ankle[0] - HEEL * foot, y, sole + 0.5 * r),
+                  (ankle[0] + (1 - HEEL) * foot, y, sole + 0.5 * r), 0.5 * r, sides=4)]
+
+
+def _reach(thigh_angle: float, knee_bend: float, h: float) -> float:
+    """[m] how far below the hip joint the leg's sole is."""
+    shank_angle = thigh_angle - knee_bend
+    return ((HIP - KNEE) * h * math.cos(thigh_angle) + (KNEE - ANKLE) * h * math.cos(shank_angle)
+            + ANKLE * h - (0.5 - 0.25 * math.sqrt(2)) * _limb(h))
+
+
+def _upper(h: float, pelvis: float, half_shoulder: float, arm_angles: tuple[float, float],
+           lean: float = 0.0) -> list[BodyPart]:
+    """Torso, head and arms over a hip joint centre at height `pelvis` [m] (x = 0), the torso
+    leaning forward by `lean` [rad]; arms hang at `arm_angles` [rad] (left, right)."""
+    r = _limb(h)
+    up = np.array([math.sin(lean), 0.0, math.cos(lean)])
+    base = np.array([0.0, 0.0, pelvis])
+    shoulder = base + (SHOULDER - HIP) * h * up
+    depth = 0.06 * h
+    torso = [(base + np.array([dx, s * HIP_WIDTH * h / 2, 0.0])) for dx in (-depth, depth)
+             for s in (1, -1)]
+    torso += [(shoulder + np.array([dx, s * half_shoulder, 0.0])) for dx in (-depth, depth)
+              for s in (1, -1)]
+    neck = base + (1.0 - HIP - 0.13) * h * up
+    parts = [hull("torso", "cloth", np.array(torso)),
+             strut("head", "skin", tuple(neck), tuple(neck + 0.13 * h * up), 0.05 * h, sides=8)]
+    for (side, s), angle in zip((("left", 1.0), ("right", -1.0)), arm_angles, strict=True):
+        top = shoulder + np.array([0.0, s * (half_shoulder - r), -r])
+        arm = (UPPER_ARM + FOREARM + 0.6 * HAND) * h - r
+        hand = top + arm * np.array([math.sin(angle), 0.0, -math.cos(angle)])
+        parts.append(strut(f"{side}_arm", "cloth", tuple(top), tuple(hand), r))
+    return parts
+
+
+def pedestrian_parts(height: float, phase: float,
+                     width: float | None = None) -> tuple[BodyPart, ...]:
+    """A pedestrian of stature `height` [m] walking along +x at gait `phase` (0 to 1, 0 = left
+    heel strike), its shoulders (arms included) no wider than `width` [m] if given. The
+    origin is on the ground at the middle of the x range the whole gait cycle sweeps (the
+    feet reach further forward than back), so the envelope is centred on it."""
+    shift = np.array([-_sweep_centre(height, width), 0.0, 0.0])
+    return tuple(hull(p.name, p.material, points(p) + shift)
+                 for p in _walker(height, phase, width))
+
+
+@functools.cache
+def _sweep_centre(height: float, width: float | None) -> float:
+    """[m] the middle of the x range a walker's pelvis-centred parts sweep over a cycle."""
+    xs = np.vstack([points(p) for k in range(SWEEP_SAMPLES)
+                    for p in _walker(height, k / SWEEP_SAMPLES, width)])[:, 0]
+    return 0.5 * float(xs.min() + xs.max())
+
+
+def _walker(height: float, phase: float, width: float | None) -> tuple[BodyPart, ...]:
+    """The walker's parts with the origin under the pelvis."""
+    h = height
+    r = _limb(h)
+    half = 0.5 * SHOULDER_WIDTH * h
+    if width is not None:
+        half = min(half, 0.5 * width)
+    c, s = math.cos(2 * math.pi * phase), math.sin(2 * math.pi * phase)
+    left, right = HIP_SWING * c, -HIP_SWING * c
+    # the leg swinging forward (hip angle increasing) bends its knee
+    bend_left = KNEE_BEND * abs(s) if s < 0 else 0.0
+    bend_right = KNEE_BEND * abs(s) if s > 0 else 0.0
+    pelvis = max(_reach(left, bend_left, h), _reach(right, bend_right, h))
+    hip_y = 0.5 * HIP_WIDTH * h - 1.2 * r
+    return (*_leg("left", np.array([0.0, hip_y, pelvis]), left, bend_left, h),
+            *_leg("right", np.array([0.0, -hip_y, pelvis]), right, bend_right, h),
+            *_upper(h, pelvis, half, (-ARM_SWING * left, -ARM_SWING * right)))
+
+
+def rider_parts(stature: float, seat: Vec3, feet: tuple[Vec3, Vec3],
+                hands: tuple[Vec3, Vec3], lean: float) -> tuple[BodyPart, ...]:
+    """A rider of `stature` [m] sitting with the hip joints over `seat` [m], the soles on
+    `feet`, the hands on `hands` (left, right), the torso leaning forward `lean` [rad]."""
+    h, r = stature, _limb(stature)
+    parts: list[BodyPart] = []
+    hip0 = np.asarray(seat, dtype=np.float64)
+    for (side, s), foot in zip((("left", 1.0), ("right", -1.0)), feet, strict=True):
+        hip = hip0 + np.array([0.0, s * (0.5 * HIP_WIDTH * h - 1.2 * r), 0.0])
+        ankle = np.asarray(foot, dtype=np.float64) + np.array([0.0, 0.0, ANKLE * h])
+        knee = _knee(hip, ankle, (HIP - KNEE) * h, (KNEE - ANKLE) * h)
+        parts += [strut(f"{side}_thigh", "cloth", tuple(hip), tuple(knee), 1.2 * r),
+                  strut(f"{side}_shank", "cloth", tuple(knee), tuple(ankle), r)]
+    upper = _upper(h, 0.0, 0.5 * SHOULDER_WIDTH * h, (0.0, 0.0), lean)
+    shift = hip0
+    for part in upper:
+        if part.name.endswith("_arm"):
+            continue
+        parts.append(hull(part.name, part.material, points(part) + shift))
+    shoulder = hip0 + (SHOULDER - HIP) * h * np.array([math.sin(lean), 0.0, math.cos(lean)])
+    for (side, s), hand in zip((("left", 1.0), ("right", -1.0)), hands, strict=True):
+        top = shoulder + np.array([0.0, s * (0.5 * SHOULDER_WIDTH * h - r), -r])
+        parts.append(strut(f"{side}_arm", "cloth", tuple(top), hand, r))
+    return tuple(parts)
+
+
+def _knee(hip: np.ndarray, ankle: np.ndarray, thigh: float, shank: float) -> np.ndarray:
+    """[m] the knee of a two-link leg from `hip` to `ankle`, bent forward and up."""
+    d = ankle - hip
+    dist = float(np.linalg.norm(d))
+    if dist >= thigh + shank:
+        return np.asarray(hip + d * thigh / (thigh + shank), dtype=np.float64)
+    along = (thigh ** 2 - shank ** 2 + dist ** 2) / (2 * dist)
+    off = math.sqrt(max(thigh ** 2 - along ** 2, 0.0))
+    u = d / dist
+    perp = np.array([-u[2], 0.0, u[0]])
+    if perp[0] < 0:
+        perp = -perp
+    return np.asarray(hip + along * u + off * perp, dtype=np.float64)

@@ -1,0 +1,49 @@
+"""Solid shapes as data, in a body's frame: a leaf (numpy only, no PyBullet), so that code which
+only describes bodies (`world.actors.shapes`) does not load the simulator.
+
+`world.scene.collision` turns these into Bullet shapes and re-exports them; see there for
+what each shape is.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+FloatArray = NDArray[np.float64]
+Vec3 = tuple[float, float, float]
+
+
+@dataclass(frozen=True, slots=True)
+class Box:
+    half_extents: Vec3  # [m]
+
+
+@dataclass(frozen=True, slots=True)
+class Cylinder:
+    radius: float  # [m]
+    height: float  # [m] along the part's z, centred on its origin
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class ConvexHull:
+    points: FloatArray  # (P, 3) [m]
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class TriangleMesh:
+    vertices: FloatArray  # (V, 3) [m]
+    triangles: NDArray[np.int32]  # (T, 3) vertex indices
+
+
+Shape = Box | Cylinder | ConvexHull | TriangleMesh
+
+
+@dataclass(frozen=True, slots=True)
+class Part:
+    """One shape of a body, at `position` [m] in the body's frame (axes parallel to it)."""
+
+    shape: Shape
+    position: Vec3 = (0.0, 0.0, 0.0)
