@@ -139,6 +139,9 @@ class SensorLoop:
             out = self.stack.on_frames(capture.t, frames)
             if out is None:
                 continue
+            if not isinstance(out, PerceptionReport):  # a user's stack: the run's error
+                raise TypeError(f"the stack's on_frames returned a {type(out).__name__}, "
+                                "not a PerceptionReport or None")
             self.last = out
             with self.watch("scoring"):
                 if truth is None:  # delivered at once: the truth is the present's

@@ -149,6 +149,14 @@ def test_an_exception_in_a_users_stack_ends_the_run_in_error(straight: Path) -> 
     assert 0.5 <= result.sim_time < 0.6
 
 
+def test_a_stack_reporting_something_else_ends_the_run_saying_so(straight: Path) -> None:
+    runner = Runner(load_scenario(straight, {"stack.stack": f"{USER}:chatty"}), None,
+                    profile=None)
+    result = runner.run()
+    assert result.verdict is RunVerdict.ERROR and result.error is not None
+    assert "on_frames returned a dict, not a PerceptionReport or None" in result.error.message
+
+
 def test_a_factory_making_something_else_ends_the_run_in_error(straight: Path) -> None:
     """Found at load, its product checked once it is built (after load: the run's error)."""
     scenario = load_scenario(straight, {"stack.stack": f"{USER}:not_a_stack"})

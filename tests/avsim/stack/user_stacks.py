@@ -101,3 +101,15 @@ class Accelerate(Cruise):
 
 def accelerate(ctx: StackContext) -> Accelerate:
     return Accelerate(ctx)
+
+
+class Chatty(Cruise):
+    """`Cruise`, its `on_frames` returning a dict (not a report)."""
+
+    def on_frames(self, t: float, frames: Frames) -> dict[str, float]:  # type: ignore[override]
+        super().on_frames(t, frames)
+        return {"t": t}
+
+
+def chatty(ctx: StackContext) -> Chatty:
+    return Chatty(ctx)
