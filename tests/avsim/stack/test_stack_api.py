@@ -4,6 +4,7 @@ drives the car through the same loop, and the result names the stack."""
 
 from __future__ import annotations
 
+import importlib.metadata
 import json
 import math
 from pathlib import Path
@@ -17,7 +18,7 @@ from avsim.run.stack import ComposedStack
 from avsim.run.unbuilt import build_runner
 from avsim.run.verdict import RunVerdict
 from avsim.scenario.load import ScenarioError, load_scenario
-from avsim.stack import API_VERSION, StackChoice, StackChoiceError, drive_by_wire
+from avsim.stack import API_VERSION, GROUP, StackChoice, StackChoiceError, drive_by_wire
 from avsim.stack.choice import resolve, version_of
 from perception.perception import Perception
 from tests.avsim.stack import user_stacks
@@ -86,6 +87,25 @@ def test_a_factory_that_cannot_be_found_is_refused_in_one_line(spec: str,
     with pytest.raises(StackChoiceError) as err:
         resolve("planner", spec)
     assert problem in str(err.value) and "\n" not in str(err.value)
+
+
+def test_an_installed_stack_is_found_by_its_entry_point_name(
+        straight: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """`pip install my-stack` registers `my-stack = "...:cruise"` in the group avsim.stacks;
+    `--stack my-stack` then runs it (the group's listing stubbed here)."""
+    point = importlib.metadata.EntryPoint("my-stack", f"{USER}:cruise", GROUP)
+    real = importlib.metadata.entry_points
+
+    def entry_points(**select: str) -> object:
+        if select.get("group") == GROUP:
+            return importlib.metadata.EntryPoints([point])
+        return real(**select)
+
+    monkeypatch.setattr(importlib.metadata, "entry_points", entry_points)
+    assert resolve("stack", "my-stack") is user_stacks.cruise
+    assert version_of("my-stack") == "0.0.7"
+    runner, verdict = run(straight, stack="my-stack")
+    assert verdict is not RunVerdict.ERROR and isinstance(runner.stack, user_stacks.Cruise)
 
 
 def test_a_stacks_version_is_its_modules() -> None:
