@@ -120,3 +120,16 @@ def test_a_child_that_never_answers_hello_ends_the_run_in_error_before_it_starts
     assert built.verdict is RunVerdict.ERROR and built.error is not None
     assert "did not answer hello within 0.5 s" in built.error.message
     assert _children() <= before
+
+
+def test_an_interrupted_run_still_says_bye_and_reaps_the_child(tmp_path: Path) -> None:
+    """A run interrupted (a signal's handler calls `interrupt`) closes its stack: the child
+    gets `bye`, exits of itself and is reaped."""
+    runner = _runner(tmp_path, f"{LAUNCH}:make")
+    stack = runner.stack
+    assert isinstance(stack, RemoteStack)
+    runner.interrupt()
+    result = runner.run()
+    assert result.verdict is RunVerdict.INTERRUPTED
+    assert stack.process.returncode == 0
+    assert stack.process.pid not in _children()
