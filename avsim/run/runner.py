@@ -61,7 +61,7 @@ from avsim.run.columns import Column, EnumColumn, Rows, flags, floats, ints
 from avsim.run.holds import shortest_hold
 from avsim.run.sensor_loop import FrameHook, SensorLoop, sensing_mode
 from avsim.run.spill import SpillFile
-from avsim.run.stack import build_stack
+from avsim.run.stack import build_stack, close_stack
 from avsim.run.story import ScriptedStory, StoryboardStory, StoryEntry
 from avsim.run.story_state import state_change_text
 from avsim.run.storyboard.director import Director
@@ -256,6 +256,9 @@ class Runner:
         except BaseException:
             if worker is not None:
                 worker.close()
+            if (stack := getattr(self, "stack", None)) is not None:
+                with suppress(Exception):  # the build's exception is the one to raise
+                    close_stack(stack)  # built before a later part raised: its process ended
             if (world := getattr(self, "world", None)) is not None:
                 with suppress(Exception):  # the build's exception is the one to raise
                     world.close()  # built before a later part raised: its server freed
@@ -398,10 +401,12 @@ class Runner:
 
     def _close(self) -> list[CriterionResult]:
         """Close what the run opened, each even if one before failed: the sensors, the
-        recording (the verdicts and any error logged first, so the file is whole), the
-        world. Returns the criteria's results, judged so far when the run ended early."""
+        stack (its optional `close`), the recording (the verdicts and any error logged first,
+        so the file is whole), the world. Returns the criteria's results, judged so far when
+        the run ended early."""
         self._sim_time, self._closing = self.world.t, True
         self._attempt(self.sensors.close, None)
+        self._attempt(partial(close_stack, self.stack), None)
         criteria: list[CriterionResult] = self._attempt(self._judged, [])
         if self.recorder is not None:
             with self.watch("recording"):

@@ -94,3 +94,11 @@ def build_stack(choice: StackChoice, ctx: StackContext) -> DrivingStack:
                          cast(PlannerStage, stages["planner"]),
                          cast(ControllerStage, stages["controller"]), ctx.timer,
                          perception_timed=choice.perception in (None, BUNDLED))
+
+
+def close_stack(stack: object) -> None:
+    """Call the stack's optional `close()` (what it holds open outside avsim: a child
+    process, a socket) at the run's end; a stack without one has nothing to close."""
+    close = getattr(stack, "close", None)
+    if callable(close):
+        close()

@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 from world.frames import SensorSpec, VehicleInfo
 from world.hdmap import RoadMap
 
-API_VERSION = "1.0"  # the stack API's version: the major number changes when a stack written
+API_VERSION = "1.1"  # the stack API's version: the major number changes when a stack written
 #   for an earlier one may no longer run unchanged, the minor when something is added
 
 Timer = Callable[[str], AbstractContextManager[object]]  # a stage's name -> a span timing it
