@@ -5,7 +5,7 @@ sensors, what the driver asks) and is then driven by the runner:
 
 - a whole stack (`DrivingStack`): `on_frames(t, frames)` with each delivery of sensor
   frames (a mapping from sensor name to `CameraFrame`, `LidarScan`, `GnssFix` or
-  `Odometry`), then `tick(t, dt)` at every control tick, returning a `StackStep`: the
+  `Odometry`; in privileged truth mode also `GroundTruth`), then `tick(t, dt)` at every control tick, returning a `StackStep`: the
   `VehicleCommand`, optionally the `Plan` and named diagnostic channels;
 - or stages, each replacing the bundled one: perception (`PerceptionStage`: frames in,
   `PlannerInput` out), planner (`PlannerStage`: `PlannerInput` in, `Plan` out), controller
@@ -46,12 +46,14 @@ from world.frames import (
     Frame,
     Frames,
     GnssFix,
+    GroundTruth,
     LidarInfo,
     LidarScan,
     Odometry,
     SensorKind,
     SensorMount,
     SensorSpec,
+    TruthObject,
     VehicleInfo,
 )
 
@@ -69,6 +71,7 @@ __all__ = [
     "Frame",
     "Frames",
     "GnssFix",
+    "GroundTruth",
     "LaneEstimate",
     "LaneView",
     "Lead",
@@ -94,6 +97,7 @@ __all__ = [
     "StackStep",
     "Timer",
     "Track",
+    "TruthObject",
     "VehicleCommand",
     "VehicleInfo",
     "drive_by_wire",
