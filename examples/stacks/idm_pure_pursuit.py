@@ -7,9 +7,10 @@ traffic states in empirical observations and microscopic simulations", Phys. Rev
 
 on the nearest object ahead in the car's lane of the HD map (s the bumper-to-bumper gap
 along the lane, dv the closing speed); it brakes harder than B only when the kinematics need
-it (dv^2 / 2 s, the lead at constant speed), and stops and holds behind a standing lead. Lateral, pure pursuit (Coulter 1992, "Implementation
-of the Pure Pursuit Path Tracking Algorithm", CMU-RI-TR-92-01) from the rear axle to the
-lane centre's point one look-ahead L = K v + L0 down the lane. Run it with
+it (dv^2 / 2 s, the lead at constant speed), and stops and holds behind a standing lead.
+Lateral, pure pursuit (Coulter 1992, "Implementation of the Pure Pursuit Path Tracking
+Algorithm", CMU-RI-TR-92-01) from the rear axle to the lane centre's point one look-ahead
+L = K v + L0 down the lane. Run it with
 ``avsim run sudden_stop --stack examples/stacks/idm_pure_pursuit.py:make --privileged``.
 """
 
