@@ -138,18 +138,24 @@ _STACK_OPTIONS = (
 
 
 def stack_options(f: Callable[..., None]) -> Callable[..., None]:
-    """`--stack`, `--perception`, `--planner`, `--controller` (docs/stack-api.md): each
-    given one is the scenario file's `stack.<key>` set for every run (`--set
-    stack.<key>=FACTORY`), so batches pass it to their runs and repro files keep it."""
+    """`--stack`, `--perception`, `--planner`, `--controller`, `--privileged`
+    (docs/stack-api.md): each given one is the scenario file's `stack.<key>` set for every
+    run (`--set stack.<key>=FACTORY`, `--set stack.privileged=true`), so batches pass it to
+    their runs and repro files keep it."""
     @functools.wraps(f)
     def command(*args: Any, **kwargs: Any) -> None:
         chosen = tuple(f"stack.{key}={kwargs.pop(key)}" for key, _ in _STACK_OPTIONS
                        if kwargs.get(key) is not None)
         for key, _ in _STACK_OPTIONS:
             kwargs.pop(key, None)
-        kwargs["sets"] = tuple(kwargs["sets"]) + chosen
+        privileged = ("stack.privileged=true",) if kwargs.pop("privileged") else ()
+        kwargs["sets"] = tuple(kwargs["sets"]) + chosen + privileged
         f(*args, **kwargs)
 
+    command = click.option(
+        "--privileged", is_flag=True, default=False,
+        help="Privileged truth mode: the stack is also given the ground truth (the truth "
+             "sensor: pose and objects); every result says so.")(command)
     for key, text in reversed(_STACK_OPTIONS):
         command = click.option(f"--{key}", key, default=None, metavar="FACTORY",
                                help=text)(command)
@@ -252,7 +258,8 @@ def run(ctx: click.Context, scenario: str, out: Path | None, json_path: Path | N
             result = built
         else:
             note = "the car under test is scripted (the file's actions move it)" if scripted \
-                else localisation(setup, loaded.world.sensors.gnss).note
+                else localisation(setup, loaded.world.sensors.gnss,
+                                  loaded.stack.privileged).note
             click.echo(f"{loaded.name}: {note}")
             stop.on_signal(built.interrupt)
             result = _run_with_progress(built, loaded.duration, not no_progress)

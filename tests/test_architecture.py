@@ -48,11 +48,12 @@ RULES = (
     Rule("vehicle_urdf", ("vehicle_urdf",), no_pybullet=False),
     Rule("examples", ("examples", PUBLIC_API, *STATIC_WORLD), no_pybullet=True),
 )
-# avsim enters each stage by its front door: perception's (`perception.perception`), the
+# avsim enters each stage by its front door: perception's (`perception.perception`, and
+# `perception.truth` for privileged truth mode), the
 # planner's (`planner.planner`), control's (the `control` package), and the messages; the
 # planner's FSM tables are a library the storyboard's state machines share
-FRONT_DOORS = ("perception.perception", "perception.messages", "planner.planner",
-               "planner.messages", "planner.fsm.machine", "control.command")
+FRONT_DOORS = ("perception.perception", "perception.truth", "perception.messages",
+               "planner.planner", "planner.messages", "planner.fsm.machine", "control.command")
 
 
 @dataclass(frozen=True)

@@ -39,9 +39,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 __all__ = ["MPS_PER_KPH", "CameraFrame", "CameraInfo", "DriverControls", "Frame", "Frames",
-           "GnssFix", "LidarInfo", "LidarScan", "Odometry", "SensorKind", "SensorMount",
-           "SensorSpec", "VehicleInfo", "Wheel", "import_open3d", "kph", "to_kph",
-           "wrap_angle"]
+           "GnssFix", "GroundTruth", "LidarInfo", "LidarScan", "Odometry", "SensorKind",
+           "SensorMount", "SensorSpec", "TruthObject", "VehicleInfo", "Wheel", "import_open3d",
+           "kph", "to_kph", "wrap_angle"]
 
 MPS_PER_KPH = 1.0 / 3.6  # [m/s per km/h]
 
@@ -275,8 +275,42 @@ class LidarScan:
     column: NDArray[np.uint16]  # (N,) azimuth step, 0 .. info.azimuth_steps - 1
 
 
+@dataclass(frozen=True, slots=True)
+class TruthObject:
+    """One road user or obstacle as the simulator knows it (privileged truth mode only):
+    its box, exactly, in the map frame."""
+
+    id: str  # the scenario's name of the object (stable over the run)
+    kind: str  # "car", "truck", "pedestrian", "obstacle"
+    x: float  # [m] map frame, the box's centre
+    y: float  # [m] map frame, the box's centre
+    yaw: float  # [rad] map frame, the box's heading, counter-clockwise from +x, in (-pi, pi]
+    vx: float  # [m/s] map frame, velocity over ground (its centre's motion since the last
+    #   capture; at its first, its speed along its heading)
+    vy: float  # [m/s] map frame
+    length: float  # [m] along its heading
+    width: float  # [m]
+    height: float  # [m]
+
+
+@dataclass(frozen=True, slots=True)
+class GroundTruth:
+    """The ground truth at one instant, the frame of the `truth` sensor (privileged truth
+    mode only, `SensorKind.TRUTH`): the car's own state and every object the sensors could
+    see (an object hidden from the sensors is not in it), exactly, in the map frame."""
+
+    t: float  # [s] sim time
+    x: float  # [m] map frame, the car's centre (base link origin)
+    y: float  # [m] map frame
+    heading: float  # [rad] the car's yaw, counter-clockwise from +x, in (-pi, pi]
+    speed: float  # [m/s] forward (body x) speed
+    yaw_rate: float  # [rad/s] counter-clockwise +
+    steering_angle: float  # [rad] road-wheel angle (bicycle equivalent), left +
+    objects: tuple[TruthObject, ...] = ()  # every other road user and obstacle
+
+
 # What a sensor hands to the stack: one capture of one sensor (`world.sensors.sensor.Sensor`).
-Frame: TypeAlias = CameraFrame | LidarScan | GnssFix | Odometry
+Frame: TypeAlias = CameraFrame | LidarScan | GnssFix | Odometry | GroundTruth
 
 # One delivery: the frames of the sensors captured together, by sensor name (`SensorSpec`),
 # in the order the sensors are listed.
@@ -290,6 +324,7 @@ class SensorKind(enum.Enum):
     LIDAR = "lidar"  # `LidarScan`
     GNSS = "gnss"  # `GnssFix`
     ODOMETRY = "odometry"  # `Odometry`
+    TRUTH = "truth"  # `GroundTruth` (privileged truth mode only)
 
 
 @dataclass(frozen=True, slots=True)
@@ -297,7 +332,8 @@ class SensorSpec:
     """A sensor on the car, as the stack is told of it: its name (the key of its frames in
     a delivery), kind, timing and calibration."""
 
-    name: str  # unique on the car: "front", "left", "right", "lidar", "gnss", "odometry"
+    name: str  # unique on the car: "front", "left", "right", "lidar", "gnss", "odometry",
+    #   "truth" (privileged truth mode only)
     kind: SensorKind
     rate: float  # [Hz] captures per second
     latency: float  # [s] from a capture to its delivery

@@ -68,6 +68,7 @@ from world.sensors.odometry import OdometrySensor
 from world.sensors.rig import SensorRig
 from world.sensors.sensor import Sensor
 from world.sensors.setup import LIDAR, SensorSetup
+from world.sensors.truth import TruthSensor
 from world.spec import (
     SceneryObjectSpec,
     SensorFault,
@@ -125,10 +126,12 @@ class World:
 
     def __init__(self, spec: WorldSpec, sensors: SensorSetup | None = None, *,
                  cameras: bool = True, lidar: bool = True,
-                 lidar_backend: RayBackend = RayBackend.EMBREE) -> None:
+                 lidar_backend: RayBackend = RayBackend.EMBREE,
+                 privileged: bool = False) -> None:
         """`sensors`: the profile's cameras (the renderer is attached before anything else,
         as EGL requires) and / or LiDAR join the rig's GNSS and odometry in this client;
-        `lidar_backend`: what casts the LiDAR's rays (`world.sensors.lidar.RayBackend`)."""
+        `lidar_backend`: what casts the LiDAR's rays (`world.sensors.lidar.RayBackend`);
+        `privileged`: the rig also has the `truth` sensor (`world.sensors.truth`)."""
         self.spec = spec
         seeds = np.random.SeedSequence(spec.seed).spawn(4)
         self.client = make_client()
@@ -165,6 +168,10 @@ class World:
         #   `driver`): a storyboard's actions on the car under test set them
         self.throttle = 0.0  # [-] 0..1, the accelerator pedal a storyboard's override holds
         self.rig = self._build_rig(sensors, lidar, seeds, lidar_backend)
+        if privileged:
+            self.rig = SensorRig((*self.rig, TruthSensor(
+                lambda: self.actors.poses,
+                lambda: self.lidar_hidden | set(np.flatnonzero(self.actors.gone).tolist()))))
         self.camera_hidden: set[int] = set()  # actors the cameras do not draw (by index)
         self.lidar_hidden: set[int] = set()  # actors the LiDAR's rays pass through
         self._truth: EgoTruth | None = None

@@ -153,7 +153,8 @@ def _properties(outcome: RunOutcome) -> dict[str, str]:
     }
     stack = result.get("stack")
     if isinstance(stack, dict):  # which stack drove it, and its version
-        props["stack"] = f"{stack.get('name')} {stack.get('version')}"
+        privileged = " (privileged: ground truth)" if stack.get("privileged") is True else ""
+        props["stack"] = f"{stack.get('name')} {stack.get('version')}{privileged}"
     if "seed" not in result:  # a run that did not finish: its seed is not known here
         del props["seed"]
     for key, value in outcome.job.overrides.items():

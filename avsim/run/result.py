@@ -79,7 +79,7 @@ def headline(payload: dict[str, object]) -> str:
 def run_localisation(result: RunResult, profile: str) -> Localisation:
     """The pose's source of a run with sensor profile `profile` ("none": no profile)."""
     return localisation(None if profile == "none" else Profile(profile),
-                        result.scenario.world.sensors.gnss)
+                        result.scenario.world.sensors.gnss, result.scenario.stack.privileged)
 
 
 def dumps(payload: object) -> str:

@@ -268,16 +268,17 @@ class Runner:
                frame_hook: FrameHook | None, lidar_backend: RayBackend,
                worker: SensingWorker | None) -> None:
         spec = scenario.world
+        privileged = scenario.stack.privileged  # the truth sensor is on the car
         self.world = World(spec, self.setup, cameras=mode == "inline",
-                           lidar_backend=lidar_backend)
+                           lidar_backend=lidar_backend, privileged=privileged)
         w = self.world
         self.car = w.ego.geometry
         self.watch = Stopwatch()  # where the run's wall time goes, stage by stage
         self.stack = build_stack(scenario.stack, StackContext(
-            road=w.road, vehicle=vehicle_info(self.car), sensors=sensor_specs(self.setup),
-            start_lane=spec.ego.lane, set_speed=scenario.driver.set_speed,
-            max_speed=spec.ego.max_speed, overtake=scenario.driver.overtake, seed=spec.seed,
-            timer=self.watch))
+            road=w.road, vehicle=vehicle_info(self.car),
+            sensors=sensor_specs(self.setup, privileged), start_lane=spec.ego.lane,
+            set_speed=scenario.driver.set_speed, max_speed=spec.ego.max_speed,
+            overtake=scenario.driver.overtake, seed=spec.seed, timer=self.watch))
         self.log = TrajectoryLog()
         names = {b: "building or sign" for b in w.scene.obstacle_bodies}
         names.update({b: "kerb" for b in w.scene.kerb_bodies})

@@ -45,7 +45,7 @@ from world.sensors.pipeline import (
     SensingWorker,
 )
 from world.sensors.schedule import Due, SensorSchedule
-from world.sensors.setup import SensorSetup, sensor_timings
+from world.sensors.setup import TRUTH_SENSOR, SensorSetup, sensor_timings
 from world.world import World
 
 FrameHook = Callable[[CameraFrame], CameraFrame]
@@ -86,7 +86,7 @@ class SensorLoop:
         captures, the passing of frames, the scoring and the recording; `worker`: the
         sensing worker for 'process', started early (else it starts here)."""
         self.world, self.setup, self.stack = world, setup, stack
-        timings = sensor_timings(setup)
+        timings = sensor_timings(setup, TRUTH_SENSOR in world.rig)
         self.schedule = SensorSchedule(timings, CONTROL_RATE,
                                        frames_read(timings, stack.reads, recorder is not None))
         self.watch = watch if watch is not None else Stopwatch()

@@ -311,7 +311,7 @@ def _scenario(model: ScenarioModel, road_spec: spec.RoadSpec,
 
 def stack_choice(m: StackModel) -> StackChoice:
     """The file's `stack:` (the model checked its factories' form)."""
-    return StackChoice(m.stack, m.perception, m.planner, m.controller)
+    return StackChoice(m.stack, m.perception, m.planner, m.controller, m.privileged)
 
 
 def _convert_town(model: ScenarioModel) -> Scenario:

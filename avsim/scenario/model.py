@@ -40,7 +40,7 @@ from avsim.scenario.fields import (
     Fraction,
     problem,
 )
-from avsim.stack.choice import BUNDLED, MAX_SPEC, SPEC
+from avsim.stack.choice import BUNDLED, MAX_SPEC, SPEC, TRUTH_PERCEPTION
 from world.actors.catalogue import CATALOGUE, TYPE_CLASSES
 
 FORMAT = "avsim/1"
@@ -900,6 +900,10 @@ class StackModel(FormatModel):
     controller: StackSpec | None = Field(
         default=None, description="The controller stage (Plan in, VehicleCommand out). "
         "Default: the bundled one.")
+    privileged: bool = Field(
+        default=False, description="Privileged truth mode: the car also has the `truth` "
+        "sensor, which hands the stack the ground truth (its pose, every object's box) at "
+        "40 Hz; every result of the run says so. Default false.")
 
     @model_validator(mode="after")
     def _whole_or_stages(self) -> StackModel:
@@ -908,6 +912,10 @@ class StackModel(FormatModel):
                                                   self.controller)):
             raise ValueError("a whole stack replaces every stage: give either `stack` or "
                              "the stages to replace, not both")
+        if self.perception == TRUTH_PERCEPTION and not self.privileged:
+            raise problem(f"{TRUTH_PERCEPTION} reads the ground truth: it needs privileged "
+                          "truth mode (stack.privileged: true, or --privileged)",
+                          key="perception")
         return self
 
 

@@ -5,8 +5,9 @@ sensors, what the driver asks) and is then driven by the runner:
 
 - a whole stack (`DrivingStack`): `on_frames(t, frames)` with each delivery of sensor
   frames (a mapping from sensor name to `CameraFrame`, `LidarScan`, `GnssFix` or
-  `Odometry`), then `tick(t, dt)` at every control tick, returning a `StackStep`: the
-  `VehicleCommand`, optionally the `Plan` and named diagnostic channels;
+  `Odometry`; in privileged truth mode also `GroundTruth`), then `tick(t, dt)` at every
+  control tick, returning a `StackStep`: the `VehicleCommand`, optionally the `Plan` and
+  named diagnostic channels;
 - or stages, each replacing the bundled one: perception (`PerceptionStage`: frames in,
   `PlannerInput` out), planner (`PlannerStage`: `PlannerInput` in, `Plan` out), controller
   (`ControllerStage`: `Plan` in, `VehicleCommand` out). `drive_by_wire` makes a command from
@@ -46,12 +47,14 @@ from world.frames import (
     Frame,
     Frames,
     GnssFix,
+    GroundTruth,
     LidarInfo,
     LidarScan,
     Odometry,
     SensorKind,
     SensorMount,
     SensorSpec,
+    TruthObject,
     VehicleInfo,
 )
 
@@ -69,6 +72,7 @@ __all__ = [
     "Frame",
     "Frames",
     "GnssFix",
+    "GroundTruth",
     "LaneEstimate",
     "LaneView",
     "Lead",
@@ -94,6 +98,7 @@ __all__ = [
     "StackStep",
     "Timer",
     "Track",
+    "TruthObject",
     "VehicleCommand",
     "VehicleInfo",
     "drive_by_wire",

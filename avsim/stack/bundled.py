@@ -1,5 +1,7 @@
 """The bundled stack's stages, built from a `StackContext` (the factories `--perception`,
-`--planner` and `--controller` name by default)."""
+`--planner` and `--controller` name by default), and the perception stage of privileged
+truth mode (`truth_perception`: `--perception avsim.stack.bundled:truth_perception
+--privileged`)."""
 
 from __future__ import annotations
 
@@ -12,6 +14,7 @@ from control import (
     VehicleParams,
 )
 from perception.perception import Perception, lane_camera
+from perception.truth import TruthPerception
 from planner.planner import MotionLayerParams, Planner, PlannerParams
 
 
@@ -19,6 +22,13 @@ def perception(ctx: StackContext) -> Perception:
     """Lanes from the front camera, objects from the LiDAR, the pose from GNSS, odometry and
     the lane (`perception.perception`)."""
     return Perception(ctx.road, ctx.vehicle, ctx.sensors, ctx.start_lane, ctx.timer)
+
+
+def truth_perception(ctx: StackContext) -> TruthPerception:
+    """Privileged truth mode only: the ground truth (`perception.truth`), the ego's state
+    exactly and every object as a confirmed track; no camera lane (the planner keeps the
+    map's lane)."""
+    return TruthPerception(ctx.vehicle)
 
 
 def planner(ctx: StackContext) -> Planner:

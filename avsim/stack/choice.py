@@ -22,12 +22,14 @@ import importlib.util
 import re
 import sys
 from collections.abc import Callable
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 from pathlib import Path
 
 BUNDLED = "avsim"  # the bundled stack, or a bundled stage
 GROUP = "avsim.stacks"  # the entry-point group of installed stacks
 STAGES = ("perception", "planner", "controller")
+TRUTH_PERCEPTION = "avsim.stack.bundled:truth_perception"  # the bundled perception stage of
+#   privileged truth mode: it reads the `truth` sensor only
 SPEC = re.compile(r"^(?:(?:[A-Za-z_]\w*(?:\.[A-Za-z_]\w*)*|[\w./-]+\.py)"
                   r":[A-Za-z_]\w*(?:\.[A-Za-z_]\w*)*"
                   r"|[A-Za-z0-9][\w.-]*)$")  # module:attribute, file.py:attribute, or an
@@ -58,12 +60,14 @@ class StackChoice:
     perception: str | None = None
     planner: str | None = None
     controller: str | None = None
+    privileged: bool = False  # privileged truth mode: the car also has the `truth` sensor
+    #   (the ground truth, `world.frames.GroundTruth`), and every result says so
 
     def __post_init__(self) -> None:
-        for f in fields(self):
-            value = getattr(self, f.name)
+        for key in ("stack", *STAGES):
+            value = getattr(self, key)
             if value is not None and (len(value) > MAX_SPEC or not SPEC.match(value)):
-                raise StackChoiceError(f.name, f"{value[:MAX_SPEC]!r} is not a factory: "
+                raise StackChoiceError(key, f"{value[:MAX_SPEC]!r} is not a factory: "
                                        "give package.module:factory or an installed stack's "
                                        f"name (entry point group {GROUP})")
         if self.whole and any(getattr(self, s) not in (None, BUNDLED) for s in STAGES):
@@ -90,7 +94,8 @@ class StackChoice:
                          if getattr(self, s) not in (None, BUNDLED))
 
     def as_json(self) -> dict[str, str]:
-        return {f.name: getattr(self, f.name) or BUNDLED for f in fields(self)}
+        """The factories of the stack and of each stage ("avsim": bundled)."""
+        return {key: getattr(self, key) or BUNDLED for key in ("stack", *STAGES)}
 
 
 def resolve(key: str, spec: str) -> Factory:
@@ -195,10 +200,11 @@ class StackIdentity:
     #   replaced stages' ("perception 1.2, planner 0.3")
     api: str  # the stack API's version (`avsim.stack.API_VERSION`)
     factories: dict[str, str]  # stack and each stage -> its factory ("avsim": bundled)
+    privileged: bool = False  # privileged truth mode: the stack was given the ground truth
 
     def as_json(self) -> dict[str, object]:
         return {"name": self.name, "version": self.version, "api": self.api,
-                "factories": dict(self.factories)}
+                "factories": dict(self.factories), "privileged": self.privileged}
 
 
 def code_digest(choice: StackChoice) -> str:
@@ -228,4 +234,4 @@ def identity(choice: StackChoice, api: str) -> StackIdentity:
     else:
         version = ", ".join(f"{s} {version_of(str(getattr(choice, s)))}" for s in STAGES
                             if getattr(choice, s) not in (None, BUNDLED))
-    return StackIdentity(choice.label(), version, api, choice.as_json())
+    return StackIdentity(choice.label(), version, api, choice.as_json(), choice.privileged)

@@ -24,6 +24,7 @@ from world.frames import (
     Frame,
     Frames,
     GnssFix,
+    GroundTruth,
     LidarInfo,
     LidarScan,
     Odometry,
@@ -103,6 +104,15 @@ def _odometry(frame: Odometry) -> dict[str, Any]:
                        "brake": driver.brake, "activations": driver.activations}}
 
 
+def _truth(frame: GroundTruth) -> dict[str, Any]:
+    return {"kind": "truth", "t": frame.t, "x": frame.x, "y": frame.y,
+            "heading": frame.heading, "speed": frame.speed, "yaw_rate": frame.yaw_rate,
+            "steering_angle": frame.steering_angle,
+            "objects": [{"id": o.id, "kind": o.kind, "x": o.x, "y": o.y, "yaw": o.yaw,
+                         "vx": o.vx, "vy": o.vy, "length": o.length, "width": o.width,
+                         "height": o.height} for o in frame.objects]}
+
+
 def frame_data(frame: Frame) -> dict[str, Any]:
     """One sensor's frame as plain data (its `kind` says which)."""
     if isinstance(frame, Odometry):
@@ -115,6 +125,8 @@ def frame_data(frame: Frame) -> dict[str, Any]:
         height, width = frame.rgb.shape[:2]
         return {"kind": "camera", "t": frame.t, "width": width, "height": height,
                 "rgb": np.ascontiguousarray(frame.rgb, dtype=np.uint8).tobytes()}
+    if isinstance(frame, GroundTruth):
+        return _truth(frame)
     scan: LidarScan = frame
     return {"kind": "lidar", "t": scan.t, "count": len(scan.points),
             "points": np.ascontiguousarray(scan.points, dtype="<f4").tobytes(),

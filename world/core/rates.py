@@ -16,6 +16,7 @@ the program declares a rate; everything reads it from here.
 | recording (actors)  | 10  | NPC boxes logged (at recording ticks)                       |
 | GNSS                | 10  | a position / heading fix, delivered at once                 |
 | odometry            | 40  | wheel, gyro, steering and pedal signals, delivered at once  |
+| truth               | 40  | privileged truth mode only: the ground truth, at once       |
 | cameras, LiDAR      | per profile (`PROFILE_SENSORS`), delivered `FRAME_LATENCY` late |
 
 Each sensor's entry (`SensorTiming`) also says when its capture reaches the stack (the
@@ -96,6 +97,8 @@ GNSS = SensorTiming(Rate("gnss", 10))  # fixes, delivered at once
 ODOMETRY = SensorTiming(Rate("odometry", 40))  # vehicle signals, delivered at once
 CAR_SENSORS: Mapping[str, SensorTiming] = {"gnss": GNSS, "odometry": ODOMETRY}  # on every
 #   car, with or without a sensor profile
+TRUTH = SensorTiming(Rate("truth", 40))  # privileged truth mode only: the ground truth at
+#   the control rate, delivered at once (no latency: it is no sensor's measurement)
 
 _FRONT = SensorTiming(Rate("front", 10), FRAME_LATENCY, record_every=5)  # recorded at 2 Hz
 _LIDAR = SensorTiming(Rate("lidar", 10), FRAME_LATENCY, record_every=10)  # recorded at 1 Hz

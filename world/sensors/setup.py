@@ -28,10 +28,12 @@ Without a profile (`--profile none`) the car has no camera and no LiDAR: the sta
 lane and no object, and its pose is the scenario's GNSS receiver (`sensors.gnss`, the
 `consumer` preset by default: a wandering bias of 1.2 m 1-sigma per axis) + odometry, placed
 on the HD map, never corrected across the lane. The car then keeps its lane only as well as
-the receiver places it. This is no privileged mode: the stack sees only its sensors, and a
-run that checks planning and control without perception names an accurate receiver
-(`sensors.gnss: {preset: rtk}`, 5 cm). `localisation` states the pose's source and its
-expected error for the run's header and result file.
+the receiver places it. The stack sees only its sensors, and a run that checks planning and
+control with its own perception names an accurate receiver (`sensors.gnss: {preset: rtk}`,
+5 cm). Privileged truth mode (`stack: {privileged: true}`) adds the `truth` sensor
+(`world.sensors.truth`): the ground truth, pose and objects, handed to the stack at the
+control rate; every result of such a run says so. `localisation` states the pose's source
+and its expected error for the run's header and result file.
 """
 
 from __future__ import annotations
@@ -41,7 +43,7 @@ import math
 from dataclasses import dataclass, replace
 
 from vehicle_urdf import MountPose, read_geometry, read_sensor_mounts
-from world.core.rates import CAR_SENSORS, PROFILE_SENSORS, SensorTiming
+from world.core.rates import CAR_SENSORS, PROFILE_SENSORS, TRUTH, SensorTiming
 from world.frames import CameraInfo, LidarInfo, SensorKind, SensorMount, SensorSpec
 from world.spec import GNSS_PRESETS, GnssSpec, LidarNoiseSpec
 
@@ -49,6 +51,7 @@ CAMERA_FOV = math.radians(80.0)  # [rad] horizontal
 LIDAR_ELEVATIONS = tuple(math.radians(e) for e in range(-15, 16, 2))  # [rad] 16 channels
 LIDAR_RANGE = 100.0  # [m]
 LIDAR = "lidar"  # the LiDAR's name (a camera's is its `CameraInfo.name`)
+TRUTH_SENSOR = "truth"  # the truth sensor's name (privileged truth mode only)
 
 
 class Profile(enum.Enum):
@@ -125,20 +128,24 @@ def sensor_setup(profile: Profile, lidar_noise: LidarNoiseSpec | None = None) ->
     return SensorSetup(profile, cameras, lidar, tuple((n, table[n]) for n in names))
 
 
-def sensor_timings(setup: SensorSetup | None) -> tuple[tuple[str, SensorTiming], ...]:
+def sensor_timings(setup: SensorSetup | None, privileged: bool = False) -> tuple[
+        tuple[str, SensorTiming], ...]:
     """(name, timing) of every sensor of the car, in the order a capture lists them: the
     profile's cameras (front first) and LiDAR (none without a profile), then the sensors on
-    every car (GNSS, odometry)."""
-    return (setup.timings if setup is not None else ()) + tuple(CAR_SENSORS.items())
+    every car (GNSS, odometry), then, in privileged truth mode only, the `truth` sensor."""
+    truth = ((TRUTH_SENSOR, TRUTH),) if privileged else ()
+    return (setup.timings if setup is not None else ()) + tuple(CAR_SENSORS.items()) + truth
 
 
-def sensor_specs(setup: SensorSetup | None) -> tuple[SensorSpec, ...]:
+def sensor_specs(setup: SensorSetup | None, privileged: bool = False) -> tuple[
+        SensorSpec, ...]:
     """Every sensor of the car as the stack is told of it (`world.frames.SensorSpec`), in
     `sensor_timings`' order."""
     cameras = {c.name: c for c in setup.cameras} if setup is not None else {}
-    kinds = {LIDAR: SensorKind.LIDAR, "gnss": SensorKind.GNSS, "odometry": SensorKind.ODOMETRY}
+    kinds = {LIDAR: SensorKind.LIDAR, "gnss": SensorKind.GNSS, "odometry": SensorKind.ODOMETRY,
+             TRUTH_SENSOR: SensorKind.TRUTH}
     out = []
-    for name, timing in sensor_timings(setup):
+    for name, timing in sensor_timings(setup, privileged):
         kind = SensorKind.CAMERA if name in cameras else kinds[name]
         info = cameras.get(name) or (setup.lidar if setup is not None and kind is SensorKind.LIDAR
                                      else None)
@@ -155,7 +162,7 @@ class Localisation:
     receiver: str  # the GNSS receiver: its preset's name (`world.spec.GNSS_PRESETS`), or custom
     error: float  # [m] the receiver's expected position error per axis: its stated 1-sigma
     #   (white noise and wandering bias) plus the constant bias's size
-    privileged: bool  # the pose is the truth, not the sensors' (never, in this project)
+    privileged: bool  # privileged truth mode: the stack is also given the ground truth
     note: str  # one line for the run's header
 
     def as_json(self) -> dict[str, object]:
@@ -168,9 +175,22 @@ def receiver_name(gnss: GnssSpec) -> str:
     return next((name for name, spec in GNSS_PRESETS.items() if spec == gnss), "custom")
 
 
-def localisation(profile: Profile | None, gnss: GnssSpec) -> Localisation:
-    """The pose's source for a run with `profile` (None: `--profile none`) and the scenario's
-    receiver `gnss` (module doc)."""
+def localisation(profile: Profile | None, gnss: GnssSpec,
+                 privileged: bool = False) -> Localisation:
+    """The pose's source for a run with `profile` (None: `--profile none`), the scenario's
+    receiver `gnss` and, with `privileged`, the ground truth (module doc)."""
+    found = _sensed(profile, gnss)
+    if not privileged:
+        return found
+    return replace(found, privileged=True, note=f"{PRIVILEGED_NOTE}; sensors: {found.note}")
+
+
+PRIVILEGED_NOTE = ("privileged: ground truth (the truth sensor gives the stack the true pose "
+                   "and objects)")
+
+
+def _sensed(profile: Profile | None, gnss: GnssSpec) -> Localisation:
+    """The pose's source from the sensors alone (`localisation`)."""
     receiver = receiver_name(gnss)
     error = gnss.stated_sigma + math.hypot(*gnss.bias)  # [m]
     fix = f"GNSS ({receiver} receiver, {error:.2f} m 1-sigma per axis) + odometry"

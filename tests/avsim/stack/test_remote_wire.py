@@ -24,12 +24,14 @@ from world.frames import (
     CameraInfo,
     DriverControls,
     GnssFix,
+    GroundTruth,
     LidarInfo,
     LidarScan,
     Odometry,
     SensorKind,
     SensorMount,
     SensorSpec,
+    TruthObject,
     VehicleInfo,
 )
 from world.map.road import build_road_map
@@ -113,6 +115,16 @@ def test_each_frame_decodes_to_the_arrays_it_came_from_and_its_keys_are_document
     assert _keys(sent) - DOCUMENTED - set(frames) == set()
     only = wire.frames(1.0, frames, frozenset({"gnss"}))
     assert set(only["frames"]) == {"gnss"}  # a stack gets only the sensors it reads
+
+
+def test_a_truth_frame_goes_over_the_wire_whole_and_its_keys_are_documented() -> None:
+    truth = GroundTruth(2.0, 10.0, 1.0, 0.1, 12.0, 0.01, 0.02, (TruthObject(
+        "lead", "car", 40.0, 1.5, 0.05, 11.0, 0.4, 4.77, 1.83, 1.46),))
+    sent = _over_the_wire(wire.frames(2.0, {"truth": truth}, None))["frames"]["truth"]
+    assert (sent["kind"], sent["speed"], sent["steering_angle"]) == ("truth", 12.0, 0.02)
+    (lead,) = sent["objects"]
+    assert (lead["id"], lead["vy"], lead["width"]) == ("lead", 0.4, 1.83)
+    assert _keys({"truth": sent}) - DOCUMENTED - {"truth"} == set()
 
 
 @pytest.mark.parametrize(("reply", "problem"), [

@@ -8,6 +8,7 @@ import importlib.metadata
 import json
 import math
 from pathlib import Path
+from typing import Any
 
 import pytest
 from click.testing import CliRunner
@@ -62,7 +63,7 @@ def run(path: Path, **stack: str) -> tuple[Runner, RunVerdict]:
     (dict(stack=f"{USER}:cruise", planner=f"{USER}:counting_planner"), "stack",
      "not both"),
 ])
-def test_a_malformed_choice_is_refused_by_its_key(choice: dict[str, str], key: str,
+def test_a_malformed_choice_is_refused_by_its_key(choice: dict[str, Any], key: str,
                                                    problem: str) -> None:
     with pytest.raises(StackChoiceError) as err:
         StackChoice(**choice)
@@ -197,7 +198,7 @@ def test_the_result_names_the_stack(straight: Path, tmp_path: Path,
     assert payload["stack"] == {
         "name": f"{USER}:cruise", "version": "0.0.7", "api": API_VERSION,
         "factories": {"stack": f"{USER}:cruise", "perception": "avsim",
-                      "planner": "avsim", "controller": "avsim"}}
+                      "planner": "avsim", "controller": "avsim"}, "privileged": False}
 
 
 # ---- perception's front door ----------------------------------------------------------------

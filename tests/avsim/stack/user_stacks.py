@@ -113,3 +113,27 @@ class Chatty(Cruise):
 
 def chatty(ctx: StackContext) -> Chatty:
     return Chatty(ctx)
+
+
+class FrameLog(Cruise):
+    """A cruise control that keeps the names of the frames of every delivery and the
+    sensors it was told of."""
+
+    def __init__(self, ctx: StackContext) -> None:
+        super().__init__(ctx)
+        self.ctx = ctx
+        self.deliveries: list[tuple[float, tuple[str, ...]]] = []
+        self.frames: list[object] = []
+        FRAME_LOGS.append(self)
+
+    def on_frames(self, t: float, frames: Frames) -> None:
+        self.deliveries.append((t, tuple(frames)))
+        self.frames.extend(frames.values())
+        super().on_frames(t, frames)
+
+
+FRAME_LOGS: list[FrameLog] = []
+
+
+def frame_log(ctx: StackContext) -> FrameLog:
+    return FrameLog(ctx)
