@@ -15,6 +15,7 @@ from gymnasium.utils.env_checker import check_env
 from gymnasium.vector import SyncVectorEnv
 
 from avsim.gym import ENV_ID, AvsimEnv
+from avsim.gym.agent import AgentStack
 from avsim.gym.reward import FAIL_PENALTY
 
 STRAIGHT = """\
@@ -166,3 +167,22 @@ def test_a_family_draws_its_episodes_scenario_from_the_seed() -> None:
     same, again, other = ((s.world.ego.speed, s.world.seed) for s in drawn)
     assert same == again and same != other
     assert all(s.duration == 2.0 for s in drawn)  # the user's override holds
+
+
+def test_an_error_in_the_run_ends_the_episode_with_its_line(
+        straight: str, monkeypatch: pytest.MonkeyPatch) -> None:
+    ticks = AgentStack.tick
+
+    def tick(self: AgentStack, t: float, dt: float) -> Any:
+        if t > 0.3:
+            raise RuntimeError("the wheel fell off")
+        return ticks(self, t, dt)
+
+    monkeypatch.setattr(AgentStack, "tick", tick)
+    env = AvsimEnv(straight, observation="truth")
+    _, rewards, terminated, truncated, info = _episode(env, seed=0,
+                                                       action=np.zeros(2, np.float32))
+    env.close()
+    assert terminated and not truncated and len(rewards) == 4  # at t 0.325 s, in step 4
+    assert info["verdict"] == "error" and "the wheel fell off" in info["error"]
+    assert rewards[-1] < -FAIL_PENALTY / 2
