@@ -27,6 +27,7 @@ DYNAMIC_IMPORTS = ("importlib.import_module", "import_module", "__import__")
 STACK = ("perception", "planner", "control")  # the stack under test
 JUDGE = ("avsim/criteria", "avsim/report")  # the judge: imports nothing of `STACK`
 PUBLIC_API = "avsim.stack"  # what a user's stack may import of avsim (and `STATIC_WORLD`)
+AGENT = ("avsim/gym",)  # the Gymnasium environment: its agent drives through `PUBLIC_API`
 
 
 @dataclass(frozen=True)
@@ -198,6 +199,14 @@ def test_the_judge_imports_nothing_of_the_stack() -> None:
         assert list((REPO / folder).rglob("*.py")), f"no .py files under {folder}/"
     found = stack_imports()
     assert not found, "the judge imports the stack:\n" + "\n".join(found)
+
+
+def test_the_gym_drives_through_the_public_api_only() -> None:
+    """`avsim/gym/` (the Gymnasium environment) drives the car as a user's stack does,
+    through `avsim.stack`: no import of `perception`, `planner` or `control`."""
+    assert list((REPO / AGENT[0]).rglob("*.py")), f"no .py files under {AGENT[0]}/"
+    found = stack_imports(folders=AGENT)
+    assert not found, "the gym imports the stack:\n" + "\n".join(found)
 
 
 def test_avsim_enters_each_stage_by_its_front_door() -> None:

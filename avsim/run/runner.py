@@ -69,7 +69,7 @@ from avsim.run.storyboard.state import StateChange as StoryStateChange
 from avsim.run.verdict import RunError, RunVerdict
 from avsim.scenario.scenario import Scenario
 from avsim.stack.context import StackContext
-from control.command import StackStep
+from control.command import DrivingStack, StackStep
 from planner.messages import MACHINES, AccMode, HazardLights, Motion, Plan, SpeedSource, StateChange
 from world.core.rates import (
     ACTOR_RECORD_RATE,
@@ -94,6 +94,7 @@ SETTLE_AFTER_DONE = 1.0  # [s] the run goes on this long after it may end: `comp
 #   reached and every required action and event fired
 
 ProgressCallback = Callable[[float, float], None]  # (sim time, duration) [s]
+StackFactory = Callable[[StackContext], DrivingStack]  # builds the stack of a run
 T = TypeVar("T")
 VERDICT_WORDS = {Verdict.PASS: "pass", Verdict.FAIL: "FAIL", Verdict.NOT_APPLICABLE: "n/a"}
 
@@ -235,12 +236,14 @@ class Runner:
     def __init__(self, scenario: Scenario, recording: Path | None = None,
                  profile: Profile | None = Profile.DEFAULT, sensing: str = "auto",
                  frame_hook: FrameHook | None = None,
-                 lidar_backend: RayBackend = RayBackend.EMBREE) -> None:
+                 lidar_backend: RayBackend = RayBackend.EMBREE,
+                 stack: StackFactory | None = None) -> None:
         """`profile`: the sensor set-up (None: no cameras or LiDAR, the stack drives on
         GNSS + odometry and the map); `sensing`: where cameras render ('auto', 'inline' or
         'process', see `world.sensors.pipeline`); `frame_hook`: alters the camera frames the stack
         gets (fault injection in tests); `lidar_backend`: what casts the LiDAR's rays (Embree,
-        or Bullet's own ray test to compare with)."""
+        or Bullet's own ray test to compare with); `stack`: builds the stack that drives
+        the car instead of the one the scenario chooses (an agent's, `avsim.gym`)."""
         self.scenario = scenario
         spec = scenario.world
         self.scripted = spec.ego.scripted  # the script moves the ego: no sensors, no stack
@@ -252,7 +255,7 @@ class Runner:
         worker = SensingWorker(spec, self.setup) \
             if mode == "process" and self.setup is not None and self.setup.cameras else None
         try:
-            self._build(scenario, recording, mode, frame_hook, lidar_backend, worker)
+            self._build(scenario, recording, mode, frame_hook, lidar_backend, worker, stack)
         except BaseException:
             if worker is not None:
                 worker.close()
@@ -266,7 +269,7 @@ class Runner:
 
     def _build(self, scenario: Scenario, recording: Path | None, mode: str,
                frame_hook: FrameHook | None, lidar_backend: RayBackend,
-               worker: SensingWorker | None) -> None:
+               worker: SensingWorker | None, stack: StackFactory | None) -> None:
         spec = scenario.world
         privileged = scenario.stack.privileged  # the truth sensor is on the car
         self.world = World(spec, self.setup, cameras=mode == "inline",
@@ -274,7 +277,8 @@ class Runner:
         w = self.world
         self.car = w.ego.geometry
         self.watch = Stopwatch()  # where the run's wall time goes, stage by stage
-        self.stack = build_stack(scenario.stack, StackContext(
+        make = stack if stack is not None else partial(build_stack, scenario.stack)
+        self.stack = make(StackContext(
             road=w.road, vehicle=vehicle_info(self.car),
             sensors=sensor_specs(self.setup, privileged), start_lane=spec.ego.lane,
             set_speed=scenario.driver.set_speed, max_speed=spec.ego.max_speed,
@@ -316,6 +320,11 @@ class Runner:
         self.error: RunError | None = None  # the exception that ended the run, if one did
         self._sim_time = 0.0  # [s] when the run ended (set as it closes)
         self._closing = False
+        self._steps = round(scenario.duration * PHYSICS_RATE)  # the duration's physics steps
+        self._done_at: float | None = None  # [s] when the run first might end
+        self._started = time.perf_counter()  # [s] wall clock at `start`
+        self._ended = False  # the run is over: `advance` does nothing more
+        self._result: RunResult | None = None  # `finish`'s, once made
 
     def interrupt(self) -> None:
         """End the run at the current tick (safe from a signal handler): `run` closes the
@@ -325,27 +334,64 @@ class Runner:
     # -- the loop ------------------------------------------------------------------------------
 
     def run(self, progress: ProgressCallback | None = None) -> RunResult:
-        """Run to the end (duration, `completes` reached, a StopTrigger) and judge the run.
+        """Run to the end (duration, `completes` reached, a StopTrigger) and judge the run:
+        `start`, `advance` until it says the run is over, `finish`.
 
         Never raises for what a stage does wrong: an exception in any stage (the sensors and
         perception, the planner, control, the storyboard, a criterion, the recorder, the
         world) ends the run at that tick with verdict error (`RunResult.error`: its type,
         message, traceback and sim time [s]); the criteria are those judged so far, the
         recording logs the error as an event at its sim time and is closed whole."""
-        start = time.perf_counter()
         try:
-            self._loop(progress)
+            if self.start():
+                while self.advance(progress):
+                    pass
+        finally:
+            result = self.finish()
+        return result
+
+    def start(self) -> bool:
+        """Begin the run, step-wise: the static recording and the storyboard's first check
+        (t = 0). Returns whether the run may go on (False: it ended in error, `finish`
+        says which)."""
+        self._started = time.perf_counter()
+        try:
+            self._begin()
         except Exception as exc:  # a stage's bug ends this run, not the program
             self._failed(exc)
-        finally:
-            criteria = self._close()
+            self._ended = True
+        return not self._ended
+
+    def advance(self, progress: ProgressCallback | None = None) -> bool:
+        """One control period: decide on this snapshot (`_tick`), then hold the command on
+        the joints for the period's physics steps (`_period`). Returns whether the run may
+        go on; False once it is over (its duration, it settled after it may end, a
+        StopTrigger, `interrupt`, or an exception, kept as the run's error). Each call after
+        the end does nothing and returns False."""
+        if self._ended:
+            return False
+        try:
+            going = self._advance(progress)
+        except Exception as exc:  # a stage's bug ends this run, not the program
+            self._failed(exc)
+            going = False
+        self._ended = not going
+        return going
+
+    def finish(self) -> RunResult:
+        """Close what the run opened and judge it (idempotent: a second call returns the
+        same result)."""
+        if self._result is not None:
+            return self._result
+        self._ended = True
+        criteria = self._close()
         renderer = self.sensors.sensing.renderer
         metrics: dict[str, float] = self._attempt(self._metrics, {})
         story: tuple[StoryEntry, ...] = self._attempt(self.story.now, ())
-        return RunResult(
+        self._result = RunResult(
             scenario=self.scenario, criteria=criteria, metrics=metrics,
-            sim_time=self._sim_time, wall_time=time.perf_counter() - start, log=self.log,
-            recording=self.recorder.path if self.recorder else None,
+            sim_time=self._sim_time, wall_time=time.perf_counter() - self._started,
+            log=self.log, recording=self.recorder.path if self.recorder else None,
             state_changes=tuple(self.state_changes), infractions=tuple(self.infractions),
             profile=self.setup.profile.value if self.setup is not None else None,
             renderer=renderer.value if renderer is not None else None,
@@ -353,6 +399,13 @@ class Runner:
             interrupted=self._stopped, error=self.error,
             storyboard_state=self._story_state(),
         )
+        return self._result
+
+    @property
+    def failed_so_far(self) -> bool:
+        """A criterion has failed by now, or the car has touched something (truth)."""
+        return self.collisions.count > 0 or any(
+            c.first_failure is not None for c in self.criteria.items)
 
     def _story_state(self) -> tuple[StoryStateChange, ...]:
         """The storyboard's state changes so far (none without a storyboard)."""
@@ -360,32 +413,32 @@ class Runner:
             return ()
         return tuple(self.director.runtime.story_state.changes)
 
-    def _loop(self, progress: ProgressCallback | None) -> None:
-        """The static recording, then one control period per pass: decide on this
-        snapshot, then hold the command on the joints for the period's physics steps
-        (contacts watched at their rate); ends early on `interrupt` (the run is then
-        marked interrupted) or once the run may end."""
-        w = self.world
+    def _begin(self) -> None:
+        """The static recording and the storyboard's first check, t = 0."""
         if self.recorder is not None:
             with self.watch("recording"):
                 self._record_static()
-        steps = round(self.scenario.duration * PHYSICS_RATE)
-        done_at: float | None = None
         if self.director is not None:
             with self.watch("runner"):
-                self.director.step()  # the storyboard's first check, t = 0
-        while w.clock.step < steps:
-            if self._interrupted:
-                self._stopped = True
-                break
-            self._tick()
-            self._period(steps)
-            if done_at is None and self._may_end():
-                done_at = w.t
-            if self._over(done_at):
-                break
-            if progress is not None and w.clock.step % PHYSICS_RATE == 0:
-                progress(w.t, self.scenario.duration)
+                self.director.step()
+
+    def _advance(self, progress: ProgressCallback | None) -> bool:
+        """One control period (`advance`), exceptions raised; whether the run goes on."""
+        w = self.world
+        if w.clock.step >= self._steps:
+            return False
+        if self._interrupted:
+            self._stopped = True
+            return False
+        self._tick()
+        self._period(self._steps)
+        if self._done_at is None and self._may_end():
+            self._done_at = w.t
+        if self._over(self._done_at):
+            return False
+        if progress is not None and w.clock.step % PHYSICS_RATE == 0:
+            progress(w.t, self.scenario.duration)
+        return w.clock.step < self._steps
 
     def _failed(self, exc: BaseException) -> None:
         """The run ended in error with `exc` (only the first error is kept)."""
