@@ -83,7 +83,7 @@ from world.core.rates import (
 from world.core.stopwatch import Stopwatch
 from world.ego.body import vehicle_info
 from world.sensors.lidar import RayBackend
-from world.sensors.pipeline import SensingWorker
+from world.sensors.pipeline import SensingError, SensingWorker
 from world.sensors.setup import Profile, sensor_setup, sensor_specs
 from world.spec import FlatTire
 from world.truth import ego_lane_edges, time_to_collision, touching, vehicles_ahead
@@ -358,7 +358,7 @@ class Runner:
         try:
             self._begin()
         except Exception as exc:  # a stage's bug ends this run, not the program
-            self._failed(exc)
+            self._ended_by(exc)
             self._ended = True
         return not self._ended
 
@@ -373,7 +373,7 @@ class Runner:
         try:
             going = self._advance(progress)
         except Exception as exc:  # a stage's bug ends this run, not the program
-            self._failed(exc)
+            self._ended_by(exc)
             going = False
         self._ended = not going
         return going
@@ -439,6 +439,15 @@ class Runner:
         if progress is not None and w.clock.step % PHYSICS_RATE == 0:
             progress(w.t, self.scenario.duration)
         return w.clock.step < self._steps
+
+    def _ended_by(self, exc: Exception) -> None:
+        """The run ended by `exc`: its error, unless it was being interrupted and `exc` is
+        the sensing worker's end (Ctrl-C reaches the whole process group, and a worker
+        still starting, before it ignores the signal, exits on it): then it is interrupted."""
+        if self._interrupted and isinstance(exc, SensingError):
+            self._stopped = True
+            return
+        self._failed(exc)
 
     def _failed(self, exc: BaseException) -> None:
         """The run ended in error with `exc` (only the first error is kept)."""
