@@ -258,8 +258,8 @@ def run(ctx: click.Context, scenario: str, out: Path | None, json_path: Path | N
             result = built
         else:
             note = "the car under test is scripted (the file's actions move it)" if scripted \
-                else localisation(setup, loaded.world.sensors.gnss,
-                                  loaded.stack.privileged).note
+                else localisation(setup, loaded.world.sensors.gnss, loaded.stack.privileged,
+                                  loaded.stack.own_perception).note
             click.echo(f"{loaded.name}: {note}")
             stop.on_signal(built.interrupt)
             result = _run_with_progress(built, loaded.duration, not no_progress)

@@ -78,8 +78,10 @@ def headline(payload: dict[str, object]) -> str:
 
 def run_localisation(result: RunResult, profile: str) -> Localisation:
     """The pose's source of a run with sensor profile `profile` ("none": no profile)."""
+    stack = result.scenario.stack
     return localisation(None if profile == "none" else Profile(profile),
-                        result.scenario.world.sensors.gnss, result.scenario.stack.privileged)
+                        result.scenario.world.sensors.gnss, stack.privileged,
+                        stack.own_perception)
 
 
 def dumps(payload: object) -> str:

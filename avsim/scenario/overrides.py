@@ -3,9 +3,11 @@
 `avsim sweep --set PATH=V` and `avsim run --seed` give them as dotted key paths with list
 indices (`actors.0.speed_kph`). Every mapping and list on the way must exist and list
 indices be in range; the last key may be new (validation then rejects it if the format has
-no such key). A bad path is a `LocatedError` at that path. The one exception: a top-level
-section in ``NEW_SECTIONS`` that the file leaves out is made, empty, on the way (`--stack`
-sets `stack.stack` in a file with no `stack:`).
+no such key). A bad path is a `LocatedError` at that path. The one exception: under a
+top-level section in ``NEW_SECTIONS`` (whole optional sections of the format), mappings the
+file leaves out are made, empty, on the way (`--stack` sets `stack.stack` in a file with no
+`stack:`; `--set sensors.gnss.preset=rtk` in one with no `sensors:`); validation then
+judges every key so made.
 """
 
 from __future__ import annotations
@@ -16,7 +18,8 @@ from typing import Any
 
 from avsim.scenario.errors import LocatedError, show
 
-NEW_SECTIONS = frozenset({"stack"})  # top-level mappings an override may make
+NEW_SECTIONS = frozenset({"stack", "sensors", "criteria"})  # top-level sections under which
+#   an override may make the mappings on its way
 
 
 def apply_overrides(raw: dict[str, Any], overrides: Mapping[str, object]) -> dict[str, Any]:
@@ -36,9 +39,11 @@ def _set_path(data: dict[str, Any], path: str, value: object) -> None:
     if not all(parts):
         raise LocatedError(path or "(override)", "override path is empty or has an empty part")
     node: object = data
-    if len(parts) > 1 and parts[0] in NEW_SECTIONS and data.get(parts[0]) is None:
-        data[parts[0]] = {}
+    making = parts[0] in NEW_SECTIONS  # mappings on the way may be made
     for depth, part in enumerate(parts[:-1]):
+        if making and isinstance(node, dict) and node.get(part) is None \
+                and not part.isdigit():
+            node[part] = {}
         node = _child(node, part, ".".join(parts[: depth + 1]), path)
     last = parts[-1]
     if isinstance(node, list):

@@ -80,6 +80,12 @@ class StackChoice:
         return self.stack not in (None, BUNDLED)
 
     @property
+    def own_perception(self) -> bool:
+        """A user's code perceives and localises: a whole stack, or a perception stage
+        other than the bundled one."""
+        return self.whole or self.perception not in (None, BUNDLED)
+
+    @property
     def bundled(self) -> bool:
         """Every stage is the bundled one."""
         return not self.whole and all(getattr(self, s) in (None, BUNDLED) for s in STAGES)

@@ -176,10 +176,12 @@ def receiver_name(gnss: GnssSpec) -> str:
 
 
 def localisation(profile: Profile | None, gnss: GnssSpec,
-                 privileged: bool = False) -> Localisation:
+                 privileged: bool = False, own: bool = False) -> Localisation:
     """The pose's source for a run with `profile` (None: `--profile none`), the scenario's
-    receiver `gnss` and, with `privileged`, the ground truth (module doc)."""
-    found = _sensed(profile, gnss)
+    receiver `gnss` and, with `privileged`, the ground truth (module doc); `own`: a user's
+    perception localises the car (a whole stack of its own, or its perception stage), and
+    only the car's sensors are known here."""
+    found = _sensed(profile, gnss) if not own else _own(profile, gnss)
     if not privileged:
         return found
     return replace(found, privileged=True, note=f"{PRIVILEGED_NOTE}; sensors: {found.note}")
@@ -187,6 +189,19 @@ def localisation(profile: Profile | None, gnss: GnssSpec,
 
 PRIVILEGED_NOTE = ("privileged: ground truth (the truth sensor gives the stack the true pose "
                    "and objects)")
+
+
+def _own(profile: Profile | None, gnss: GnssSpec) -> Localisation:
+    """A user's perception: its own pose from the car's sensors (`localisation`)."""
+    receiver = receiver_name(gnss)
+    error = gnss.stated_sigma + math.hypot(*gnss.bias)  # [m]
+    sensors = "GNSS and odometry only" if profile is None else \
+        f"profile {profile.value}'s cameras and LiDAR, GNSS and odometry"
+    return Localisation(
+        "own", receiver, error, False,
+        f"{'profile none' if profile is None else f'profile {profile.value}'}: the stack "
+        f"localises the car itself, from {sensors} (GNSS: {receiver} receiver, "
+        f"{error:.2f} m 1-sigma per axis)")
 
 
 def _sensed(profile: Profile | None, gnss: GnssSpec) -> Localisation:

@@ -590,3 +590,19 @@ def test_a_broken_centre_line_paints_the_road_for_a_pass() -> None:
 def test_a_centre_line_of_another_kind_is_refused() -> None:
     error = _error("overtake_two_lane", {"road.centre_line": "dotted"})
     assert error.key == "road.centre_line" and "solid" in error.problem
+
+
+@pytest.mark.parametrize(("path", "value", "check"), [
+    ("sensors.gnss.preset", "rtk", lambda s: s.world.sensors.gnss.sigma < 0.1),
+    ("stack.planner", "avsim", lambda s: s.stack.bundled),
+])
+def test_an_override_makes_the_optional_sections_on_its_way(
+        tmp_path: Path, path: str, value: str, check: Any) -> None:
+    """A file without `sensors:` or `stack:`: `--set sensors.gnss.preset=rtk` and
+    `--planner` make the mappings on the way (validation still judges the keys)."""
+    file = tmp_path / "bare.yaml"
+    file.write_text(MINIMAL, encoding="utf-8")
+    assert check(load_scenario(file, {path: value}))
+    with pytest.raises(ScenarioError) as err:
+        load_scenario(file, {"sensors.gnsss.preset": "rtk"})
+    assert err.value.key.startswith("sensors.gnsss")

@@ -199,6 +199,9 @@ def test_the_result_names_the_stack(straight: Path, tmp_path: Path,
         "name": f"{USER}:cruise", "version": "0.0.7", "api": API_VERSION,
         "factories": {"stack": f"{USER}:cruise", "perception": "avsim",
                       "planner": "avsim", "controller": "avsim"}, "privileged": False}
+    # the header and the result say the stack localises the car itself (not the bundled way)
+    assert payload["localisation"]["source"] == "own"
+    assert "the stack localises the car itself, from GNSS and odometry only" in result.output
 
 
 # ---- perception's front door ----------------------------------------------------------------
