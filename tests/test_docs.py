@@ -8,8 +8,8 @@
   run for real, shortened as a `run`. `view` needs a display: it is checked up to there,
   by its `--help` and by the recording the page names being one an earlier command wrote
   (or `make demo` writes). Commands run in a fresh folder that links the project's
-  `scenarios/`, `docs/` and `tests/` (so the pages' relative paths hold) and takes every
-  output.
+  `scenarios/`, `docs/`, `tests/` and `examples/` (so the pages' relative paths hold) and
+  takes every output.
 - A command in any other fenced block is an error: a page cannot hide one from this test.
 - The minimal OpenSCENARIO example runs in full and passes.
 """
@@ -30,7 +30,8 @@ import pytest
 
 REPO = Path(__file__).resolve().parents[1]
 PAGES = [REPO / "README.md", *sorted((REPO / "docs").glob("*.md"))]
-LINKED = ("scenarios", "docs", "tests")  # the project folders the pages' paths point into
+LINKED = ("scenarios", "docs", "tests", "examples")  # the project folders the pages' paths
+#   point into
 AVSIM = (".venv/bin/avsim", "avsim")  # how a page spells the command
 RUN_EXIT = (0, 1)  # a shortened run may fail a criterion it had no time to meet
 TIMEOUT = 600.0  # [s] per command: a paper-profile run of 2 s stays far below it

@@ -25,6 +25,7 @@ from world.core.rates import (
     PROFILE_SENSORS,
     RECORD_RATE,
     TRIGGER_RATE,
+    TRUTH,
     Rate,
     SensorTiming,
     check_nested,
@@ -80,12 +81,13 @@ def test_every_rate_of_the_table_divides_the_physics_rate() -> None:
     found = list(table_rates())
     assert {r.name for r in found} == {
         "npc_triggers", "npc_motion", "control", "criteria", "contacts", "record",
-        "record_actors", "gnss", "odometry", "front", "left", "right", "lidar"}
+        "record_actors", "gnss", "odometry", "front", "left", "right", "lidar", "truth"}
     for rate in found:
         assert PHYSICS_RATE % rate.hz == 0, rate
         assert rate.every * rate.hz == PHYSICS_RATE, rate
         assert rate.period == rate.every / PHYSICS_RATE
-    for timing in (GNSS, ODOMETRY, *(t for p in PROFILE_SENSORS.values() for t in p.values())):
+    for timing in (GNSS, ODOMETRY, TRUTH,
+                   *(t for p in PROFILE_SENSORS.values() for t in p.values())):
         assert timing.latency_steps / PHYSICS_RATE == pytest.approx(timing.latency, abs=1e-12)
 
 
