@@ -308,3 +308,10 @@ def test_bad_channels_end_the_run_with_what_is_wrong(channels: dict[str, object]
                                                      problem: str) -> None:
     with pytest.raises(ValueError, match=problem):
         stack_channels(channels)  # type: ignore[arg-type]
+
+
+def test_a_deterministic_stack_of_ones_own_runs_the_same_twice(straight: Path) -> None:
+    first, _ = run(straight, stack=f"{USER}:cruise")
+    again, _ = run(straight, stack=f"{USER}:cruise")
+    for column in ("x", "y", "speed", "steering", "drive_torque", "brake_torque"):
+        assert first.log.array(column).tobytes() == again.log.array(column).tobytes()
