@@ -10,7 +10,7 @@ from typing import Protocol
 
 from perception.messages import PerceptionReport
 from planner.messages import Plan
-from world.frames import Frames
+from world.frames import Frames, Indicator
 
 __all__ = ["ControllerStage", "DrivingStack", "StackStep", "VehicleCommand"]
 
@@ -27,6 +27,7 @@ class VehicleCommand:
     brake_torque: float  # [N m] total over all wheels, >= 0
     accel_request: float  # [m/s^2] longitudinal acceleration behind the torques (for logging)
     hazard_lights: bool = False  # the hazard lights flash
+    indicator: Indicator = Indicator.OFF  # the turn indicators
 
 
 class ControllerStage(Protocol):

@@ -23,6 +23,7 @@ from control.command import VehicleCommand
 from control.longitudinal import SpeedController, SpeedParams
 from control.stanley import FrontAxleError, StanleyParams, StanleyPid, front_axle_error
 from planner.messages import ControlState, HazardLights, Plan, ReferencePath
+from world.frames import Indicator
 
 __all__ = ["VehicleController", "VehicleControllerParams"]
 
@@ -93,4 +94,13 @@ class VehicleController:
             brake_torque=torques.brake,
             accel_request=speed_cmd.accel,
             hazard_lights=plan.hazard is HazardLights.ON,
+            indicator=indicator(plan),
         )
+
+
+def indicator(plan: Plan) -> Indicator:
+    """The turn indicator of a lane change in hand (towards a lane of higher index: left;
+    lower, the shoulder included: right), else off."""
+    if plan.lane == plan.origin_lane:
+        return Indicator.OFF
+    return Indicator.LEFT if plan.lane > plan.origin_lane else Indicator.RIGHT

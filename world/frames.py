@@ -113,6 +113,14 @@ class GnssFix:
     valid: bool = True  # False: no fix this epoch (an outage)
 
 
+class Indicator(enum.Enum):
+    """The turn indicators' switch (lamps are truth, like the hazard lights)."""
+
+    OFF = "off"
+    LEFT = "left"
+    RIGHT = "right"
+
+
 @dataclass(frozen=True, slots=True)
 class DriverControls:
     """The driver's controls that the stack reads as vehicle signals besides the accelerator

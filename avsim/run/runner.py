@@ -82,6 +82,7 @@ from world.core.rates import (
 )
 from world.core.stopwatch import Stopwatch
 from world.ego.body import vehicle_info
+from world.frames import Indicator
 from world.sensors.lidar import RayBackend
 from world.sensors.pipeline import SensingError, SensingWorker
 from world.sensors.setup import Profile, sensor_setup, sensor_specs
@@ -135,6 +136,8 @@ class TrajectoryLog:
     motion: EnumColumn[Motion] = field(
         default_factory=partial(EnumColumn, Motion))  # the motion FSM's state
     hazard: Column[int] = field(default_factory=flags)  # the stack's hazard lights are on
+    indicator: EnumColumn[Indicator] = field(
+        default_factory=partial(EnumColumn, Indicator))  # the turn indicators, as commanded
     speed_source: EnumColumn[SpeedSource] = field(
         default_factory=partial(EnumColumn, SpeedSource))  # what set the speed
     lane: Column[int] = field(default_factory=ints)  # the lane the stack keeps (cross_track's)
@@ -529,6 +532,7 @@ class Runner:
         cmd = out.command
         w.ego.apply(cmd.steering_angle, cmd.drive_torque, cmd.brake_torque)
         w.ego.set_hazard_lights(cmd.hazard_lights)
+        w.ego.set_indicator(cmd.indicator)
         previous, self._last = self._last, out
         with watch("runner"):
             self._log_tick(out)
@@ -576,6 +580,7 @@ class Runner:
         log.brake_torque.append(out.command.brake_torque)
         log.acc_mode.append(plan.acc_mode)
         log.hazard.append(plan.hazard is HazardLights.ON)
+        log.indicator.append(out.command.indicator)
         log.motion.append(plan.motion)
         log.speed_source.append(plan.speed_source)
         log.lane.append(plan.lane)
@@ -595,6 +600,7 @@ class Runner:
         log.brake_torque.append(out.command.brake_torque)
         log.acc_mode.append(AccMode.ACC_OFF)
         log.hazard.append(out.command.hazard_lights)
+        log.indicator.append(out.command.indicator)
         log.motion.append(Motion.LANE_KEEP)
         log.speed_source.append(SpeedSource.SET_SPEED)
         log.lane.append(lane)
@@ -622,6 +628,7 @@ class Runner:
         log.steering.append(0.0)
         log.acc_mode.append(AccMode.ACC_OFF)
         log.hazard.append(False)
+        log.indicator.append(Indicator.OFF)
         log.motion.append(Motion.LANE_KEEP)
         log.speed_source.append(SpeedSource.DRIVER)
         log.lane.append(lane)

@@ -22,7 +22,7 @@ where they are defined; docs/stack-api.md is the guide. A stack imports this mod
 
 from __future__ import annotations
 
-from avsim.stack.by_wire import drive_by_wire
+from avsim.stack.by_wire import by_pedals, drive_by_wire
 from avsim.stack.choice import BUNDLED, GROUP, StackChoice, StackChoiceError, StackIdentity
 from avsim.stack.context import API_VERSION, StackContext, Timer, untimed
 from control.command import ControllerStage, DrivingStack, StackStep, VehicleCommand
@@ -48,6 +48,7 @@ from world.frames import (
     Frames,
     GnssFix,
     GroundTruth,
+    Indicator,
     LidarInfo,
     LidarScan,
     Odometry,
@@ -73,6 +74,7 @@ __all__ = [
     "Frames",
     "GnssFix",
     "GroundTruth",
+    "Indicator",
     "LaneEstimate",
     "LaneView",
     "Lead",
@@ -101,6 +103,7 @@ __all__ = [
     "TruthObject",
     "VehicleCommand",
     "VehicleInfo",
+    "by_pedals",
     "drive_by_wire",
     "untimed",
 ]

@@ -133,3 +133,16 @@ def test_an_interrupted_run_still_says_bye_and_reaps_the_child(tmp_path: Path) -
     assert result.verdict is RunVerdict.INTERRUPTED
     assert stack.process.returncode == 0
     assert stack.process.pid not in _children()
+
+
+def test_the_remote_lane_keeper_gets_the_bundled_sudden_stops_verdicts() -> None:
+    """The bundled `sudden_stop` through the protocol (profile none): the run ends with its
+    verdicts, no error; the lead braked to a stop in it. The lane keeper sees no other road
+    user, so it does not stop in time (no_collision fails: counted, as for any stack)."""
+    scenario = load_scenario("sudden_stop", {"stack.stack": f"{LAUNCH}:make"})
+    runner = Runner(scenario, None, profile=None)
+    result = runner.run()
+    assert result.error is None and result.verdict in (RunVerdict.PASS, RunVerdict.FAIL)
+    verdicts = {c.name: c.passed for c in result.criteria}
+    assert verdicts["no_collision"] is False and verdicts["speed_limit"] is True
+    assert any(e.fired_at is not None for e in result.story)  # the lead's braking started

@@ -55,7 +55,7 @@ from pybullet_utils.bullet_client import BulletClient
 
 from vehicle_urdf import URDF_PATH, WHEELS, CarGeometry, read_geometry
 from world.core.client import GRAVITY
-from world.frames import VehicleInfo
+from world.frames import Indicator, VehicleInfo
 
 AIR_DENSITY = 1.2  # [kg/m^3]
 STEER_TORQUE = 4000.0  # [N m] steering hinge servo force limit
@@ -175,6 +175,7 @@ class EgoBody:
         self.brake_torque = 0.0  # [N m] last applied, total
         self.steer_command = 0.0  # [rad] last commanded bicycle angle
         self.hazard_lights = False  # the hazard lights flash (their switch, as commanded)
+        self.indicator = Indicator.OFF  # the turn indicators (their switch, as commanded)
         self._net_torque = 0.0  # [N m] total wheel torque of the last command, + forward
         self._spawn_speed(yaw, speed)
         self.apply(0.0, 0.0, 0.0)
@@ -230,6 +231,10 @@ class EgoBody:
     def set_hazard_lights(self, on: bool) -> None:
         """Switch the hazard lights on or off (held until the next call)."""
         self.hazard_lights = bool(on)
+
+    def set_indicator(self, indicator: Indicator) -> None:
+        """Switch the turn indicators (held until the next call)."""
+        self.indicator = Indicator(indicator)
 
     def puncture(self, wheel: str, t: float) -> None:
         """The tyre of `wheel` (a `vehicle_urdf.WHEELS` name) is punctured at sim time `t`

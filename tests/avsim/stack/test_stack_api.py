@@ -8,8 +8,10 @@ import importlib.metadata
 import json
 import math
 from pathlib import Path
-from typing import Any
+from types import SimpleNamespace
+from typing import Any, cast
 
+import numpy as np
 import pytest
 from click.testing import CliRunner
 
@@ -19,8 +21,18 @@ from avsim.run.stack import ComposedStack
 from avsim.run.unbuilt import build_runner
 from avsim.run.verdict import RunVerdict
 from avsim.scenario.load import ScenarioError, load_scenario
-from avsim.stack import API_VERSION, GROUP, StackChoice, StackChoiceError, drive_by_wire
+from avsim.stack import (
+    API_VERSION,
+    GROUP,
+    Indicator,
+    Plan,
+    StackChoice,
+    StackChoiceError,
+    by_pedals,
+    drive_by_wire,
+)
 from avsim.stack.choice import resolve, version_of
+from control.vehicle_controller import indicator
 from perception.perception import Perception
 from tests.avsim.stack import user_stacks
 from tests.roads import make_map, seg
@@ -248,6 +260,35 @@ def test_drive_by_wire_brakes_for_a_deceleration_and_drives_against_the_resistan
         (car.mass * 3.0 - hold.drive_torque / car.wheel_radius) * car.wheel_radius)
 
 
+def test_pedals_and_indicators_reach_the_car(straight: Path) -> None:
+    """Half throttle, then full brake: the car speeds up, then brakes hard; the indicators the
+    stack switched are the car's (logged)."""
+    runner, verdict = run(straight, stack=f"{USER}:pedals")
+    assert verdict is not RunVerdict.ERROR
+    log = runner.log
+    t, speed = log.array("t"), log.array("speed")
+    assert speed[t < 1.0][-1] > speed[0] + 0.5  # half of 3000 N m: about 2 m/s^2
+    assert speed[t < 1.0][-1] - speed[-1] > 5.0  # 5000 N m: over 5 m/s^2 for its last second
+    assert {log.indicator[int(k)] for k in np.flatnonzero(t < 0.95)} == {Indicator.LEFT}
+    assert log.indicator[len(log.t) - 1] is Indicator.RIGHT
+    assert log.drive_torque[0] == 1500.0 and log.brake_torque[len(log.t) - 1] == 5000.0
+
+
+def test_the_pedals_are_clamped_and_the_brake_wins() -> None:
+    both = by_pedals(0.1, 2.0, 0.5)
+    assert (both.drive_torque, both.brake_torque, both.steering_angle) == (0.0, 2500.0, 0.1)
+    assert by_pedals(0.0, 2.0, -1.0).drive_torque == 3000.0
+
+
+def test_the_bundled_controller_indicates_a_lane_change() -> None:
+    """Towards a lane of higher index (left), lower or the shoulder (right), else off."""
+    plan = cast(Plan, SimpleNamespace(lane=1, origin_lane=0))
+    assert indicator(plan) is Indicator.LEFT
+    assert indicator(cast(Plan, SimpleNamespace(lane=-1000, origin_lane=0))) is \
+        Indicator.RIGHT
+    assert indicator(cast(Plan, SimpleNamespace(lane=1, origin_lane=1))) is Indicator.OFF
+
+
 # ---- diagnostic channels --------------------------------------------------------------------
 
 
@@ -267,3 +308,10 @@ def test_bad_channels_end_the_run_with_what_is_wrong(channels: dict[str, object]
                                                      problem: str) -> None:
     with pytest.raises(ValueError, match=problem):
         stack_channels(channels)  # type: ignore[arg-type]
+
+
+def test_a_deterministic_stack_of_ones_own_runs_the_same_twice(straight: Path) -> None:
+    first, _ = run(straight, stack=f"{USER}:cruise")
+    again, _ = run(straight, stack=f"{USER}:cruise")
+    for column in ("x", "y", "speed", "steering", "drive_torque", "brake_torque"):
+        assert first.log.array(column).tobytes() == again.log.array(column).tobytes()

@@ -6,6 +6,7 @@ from __future__ import annotations
 from avsim.stack import (
     Frames,
     GnssFix,
+    Indicator,
     Odometry,
     Plan,
     PlannerInput,
@@ -13,6 +14,7 @@ from avsim.stack import (
     StackStep,
     VehicleCommand,
     bundled,
+    by_pedals,
     drive_by_wire,
 )
 
@@ -137,3 +139,16 @@ FRAME_LOGS: list[FrameLog] = []
 
 def frame_log(ctx: StackContext) -> FrameLog:
     return FrameLog(ctx)
+
+
+class Pedals(Cruise):
+    """Half throttle for 1 s with the left indicator on, then full brake with the right."""
+
+    def tick(self, t: float, dt: float) -> StackStep:
+        if t < 1.0:
+            return StackStep(by_pedals(0.0, 0.5, 0.0, indicator=Indicator.LEFT))
+        return StackStep(by_pedals(0.0, 0.0, 1.0, indicator=Indicator.RIGHT))
+
+
+def pedals(ctx: StackContext) -> Pedals:
+    return Pedals(ctx)
