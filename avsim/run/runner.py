@@ -69,7 +69,7 @@ from avsim.run.storyboard.state import StateChange as StoryStateChange
 from avsim.run.verdict import RunError, RunVerdict
 from avsim.scenario.scenario import Scenario
 from avsim.stack.context import StackContext
-from control.command import DrivingStack, StackStep
+from control.command import DrivingStack, StackStep, VehicleCommand
 from planner.messages import MACHINES, AccMode, HazardLights, Motion, Plan, SpeedSource, StateChange
 from world.core.rates import (
     ACTOR_RECORD_RATE,
@@ -575,12 +575,9 @@ class Runner:
         self._log_truth(plan.lane)  # computed and appended first: the row whole or absent
         log.target_speed.append(plan.target_speed)
         log.speed_limit.append(plan.speed_limit)
-        log.steering.append(out.command.steering_angle)
-        log.drive_torque.append(out.command.drive_torque)
-        log.brake_torque.append(out.command.brake_torque)
+        self._log_command(out.command)
         log.acc_mode.append(plan.acc_mode)
         log.hazard.append(plan.hazard is HazardLights.ON)
-        log.indicator.append(out.command.indicator)
         log.motion.append(plan.motion)
         log.speed_source.append(plan.speed_source)
         log.lane.append(plan.lane)
@@ -595,17 +592,22 @@ class Runner:
         log = self.log
         log.target_speed.append(math.nan)
         log.speed_limit.append(math.nan)
-        log.steering.append(out.command.steering_angle)
-        log.drive_torque.append(out.command.drive_torque)
-        log.brake_torque.append(out.command.brake_torque)
+        self._log_command(out.command)
         log.acc_mode.append(AccMode.ACC_OFF)
         log.hazard.append(out.command.hazard_lights)
-        log.indicator.append(out.command.indicator)
         log.motion.append(Motion.LANE_KEEP)
         log.speed_source.append(SpeedSource.SET_SPEED)
         log.lane.append(lane)
         log.changing.append(False)
         log.pose_error.append(math.nan)
+
+    def _log_command(self, command: VehicleCommand) -> None:
+        """The command's columns of the tick's row: steering, torques, indicators."""
+        log = self.log
+        log.steering.append(command.steering_angle)
+        log.drive_torque.append(command.drive_torque)
+        log.brake_torque.append(command.brake_torque)
+        log.indicator.append(command.indicator)
 
     def _lane_in(self) -> int:
         """The lane the car's centre is in (the last one logged when it is off the lanes)."""

@@ -9,23 +9,15 @@ command to the ego's joints.
 
 from __future__ import annotations
 
-from collections.abc import Callable
-from contextlib import AbstractContextManager, nullcontext
 from typing import cast
 
 from avsim.stack import bundled as bundled_stages
 from avsim.stack.choice import BUNDLED, STAGES, StackChoice, StackChoiceError, resolve
-from avsim.stack.context import StackContext
+from avsim.stack.context import StackContext, Timer, untimed
 from control.command import ControllerStage, DrivingStack, StackStep
 from perception.messages import PerceptionReport, PerceptionStage
 from planner.messages import PlannerStage
 from world.frames import Frames
-
-Timer = Callable[[str], AbstractContextManager[object]]
-
-
-def _untimed(stage: str) -> AbstractContextManager[object]:
-    return nullcontext()
 
 
 class ComposedStack:
@@ -39,8 +31,8 @@ class ComposedStack:
         self.perception = perception
         self.planner = planner
         self.controller = controller
-        self._timer = timer if timer is not None else _untimed
-        self._perceive_timer = _untimed if perception_timed else self._timer
+        self._timer = timer if timer is not None else untimed
+        self._perceive_timer = untimed if perception_timed else self._timer
 
     @property
     def reads(self) -> frozenset[str] | None:
