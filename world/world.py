@@ -169,9 +169,8 @@ class World:
         self.throttle = 0.0  # [-] 0..1, the accelerator pedal a storyboard's override holds
         self.rig = self._build_rig(sensors, lidar, seeds, lidar_backend)
         if privileged:
-            self.rig = SensorRig((*self.rig, TruthSensor(
-                lambda: self.actors.poses,
-                lambda: self.lidar_hidden | set(np.flatnonzero(self.actors.gone).tolist()))))
+            self.rig = SensorRig((*self.rig, TruthSensor(lambda: self.actors.poses,
+                                                         lambda: self.unsensed)))
         self.camera_hidden: set[int] = set()  # actors the cameras do not draw (by index)
         self.lidar_hidden: set[int] = set()  # actors the LiDAR's rays pass through
         self._truth: EgoTruth | None = None
@@ -566,6 +565,12 @@ class World:
                 sensor.camera.environment = env
             elif isinstance(sensor, LidarSensor):
                 sensor.lidar.extinction = env.extinction
+
+    @property
+    def unsensed(self) -> set[int]:
+        """The indices of the actors no sensor can see now: hidden from the sensors (a
+        VisibilityAction) or out of the world (deleted, or a town driver that arrived)."""
+        return self.lidar_hidden | set(np.flatnonzero(self.actors.gone).tolist())
 
     def set_actor_visibility(self, i: int, cameras: bool, lidar: bool) -> None:
         """Whether the cameras draw actor `i` and the LiDAR's rays meet it. Its body stays

@@ -25,6 +25,7 @@ from avsim.gym.truth import TruthObservation
 from avsim.run.runner import Runner
 from avsim.stack import StackContext
 from vehicle_urdf import read_geometry
+from world.core.rates import CONTROL_RATE
 from world.ego.body import vehicle_info
 from world.frames import CameraFrame
 from world.sensors.setup import Profile, sensor_setup, sensor_specs
@@ -88,7 +89,7 @@ class AvsimEnv(gymnasium.Env[Observation, NDArray[np.float32]]):
         self._seed = seed
         specs = sensor_specs(sensor_setup(self.profile) if self.profile is not None else None)
         self._sensors = SensorObservation(specs)
-        self._truth = TruthObservation(nearest)
+        self._truth = TruthObservation(nearest, action_repeat * CONTROL_RATE.period)
         self.observation_space = cast(spaces.Space[Observation], self._sensors.space
                                       if observation == "sensors" else self._truth.space)
         limit = vehicle_info(read_geometry()).max_steer  # [rad]

@@ -25,11 +25,12 @@ Place = tuple[float, float, float]  # [s, m, m] a capture's time and an object's
 
 
 def truth_objects(poses: ActorPoses, absent: Collection[int], t: float = math.nan,
-                  before: dict[str, Place] | None = None) -> tuple[TruthObject, ...]:
+                  before: dict[str, Place] | None = None,
+                  period: float = TRUTH.rate.period) -> tuple[TruthObject, ...]:
     """Every actor of `poses` at time `t` [s] but those of index in `absent`, as
     `TruthObject`s. Its velocity over ground is its centre's motion since the previous
-    capture (`before`: id -> that capture's time and centre; one capture period back at
-    most), exact for any motion (a walker crossing, a lane change); without one (its first
+    capture (`before`: id -> that capture's time and centre; one capture `period` [s] back
+    at most), exact for any motion (a walker crossing, a lane change); without one (its first
     capture, or shown again), its speed along its yaw. `before` is updated to this capture."""
     out = []
     seen: dict[str, Place] = {}
@@ -41,7 +42,7 @@ def truth_objects(poses: ActorPoses, absent: Collection[int], t: float = math.na
         speed = float(poses.speeds[i])
         vx, vy = speed * math.cos(yaw), speed * math.sin(yaw)
         last = before.get(ident) if before is not None else None
-        if last is not None and 0.0 < t - last[0] <= 1.5 * TRUTH.rate.period:
+        if last is not None and 0.0 < t - last[0] <= 1.5 * period:
             vx, vy = (x - last[1]) / (t - last[0]), (y - last[2]) / (t - last[0])
         seen[ident] = (t, x, y)
         length, width, height = (2.0 * float(h) for h in poses.half_sizes[i])
