@@ -22,6 +22,8 @@ or before it; empty / NaN before its first). The columns, in this order:
 - The actors, one column group per actor in the order they first appear, wide: `<id>.x`,
   `<id>.y`, `<id>.z` [m] (box centre, map frame), `<id>.yaw` [rad], `<id>.kind`; empty
   where the actor is not in the world at that time.
+- A stack's own diagnostic channels (`avsim.stack.StackStep.channels`, recorded as
+  `metrics/stack/<name>`): `stack_<name>`, by name, in the stack's units.
 
 Bounds: at most `MAX_ROWS` rows and `MAX_ACTORS` actors (refused beyond them). A file that
 is missing, not a regular file or not a readable recording, or one without the ego's poses,
@@ -53,6 +55,7 @@ Format = Literal["csv", "parquet"]
 TIMELINE = "sim_time"
 EGO = "/world/ego"
 ACTORS = "/world/actors"
+STACK_CHANNELS = "stack/"  # a stack's diagnostic channels under METRICS
 METRICS = "/metrics/"
 FSM = "/fsm/"
 MAX_ROWS = 2_000_000  # rows: a 27-hour run at 20 Hz
@@ -234,6 +237,9 @@ def run_table(series: dict[str, Series]) -> pa.Table:
     if actors is not None and actors.times:
         for name, column in _actor_columns(actors, grid).items():
             table = table.append_column(name, column)
+    for m in sorted(m for m in metrics if m.startswith(STACK_CHANNELS)):
+        table = table.append_column(f"stack_{m.removeprefix(STACK_CHANNELS)}",
+                                    pa.array(_scalar_column(metrics[m], grid)))
     return table
 
 

@@ -142,3 +142,19 @@ def test_time_to_collision_needs_a_closing_lead(run_dir: Path, tmp_path: Path) -
     table = pa_csv.read_csv(out)
     gap, ttc = _floats(table, "lead_gap"), _floats(table, "ttc")
     assert all(math.isnan(x) for x in ttc[np.isnan(gap)])  # no lead: no TTC
+
+
+def test_a_stacks_own_channels_are_columns(tmp_path: Path) -> None:
+    """A stack of one's own shows `speed_error` as a channel: the export has it as
+    `stack_speed_error` (NaN-free once the stack has ticked), after the other columns."""
+    result = CliRunner().invoke(main, [
+        "run", str(SCENARIO), "--profile", "none", "--set", f"duration={DURATION:g}",
+        "--stack", "tests.avsim.stack.user_stacks:cruise",
+        "--out", str(tmp_path / "run.rrd"), "--no-progress"])
+    assert (tmp_path / "run.rrd").is_file(), (result.output, result.exception)
+    done = _export(str(tmp_path / "run.rrd"), "--csv", "--out", str(tmp_path / "run.csv"))
+    assert done.exit_code == 0, done.output
+    table = pa_csv.read_csv(tmp_path / "run.csv")
+    assert table.column_names[-1] == "stack_speed_error"
+    error = _floats(table, "stack_speed_error")
+    assert np.isfinite(error[1:]).all() and error[1] == pytest.approx(0.0, abs=1.0)
