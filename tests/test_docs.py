@@ -3,13 +3,16 @@
 - No page points outside the project (`../shared/`, `shared/`): users have only the project.
 - Every `avsim` command line in a fenced ```bash block runs, as written but shortened the
   same way for all (`shorten`): a `run` gets `--set duration=2` (last given wins) and, when
-  it names no profile, `--profile none`; a `suite`, `sweep` or `campaign` runs with
-  `--dry-run` (every run loaded and checked, none run), and the first run it prints is then
-  run for real, shortened as a `run`. `view` needs a display: it is checked up to there,
-  by its `--help` and by the recording the page names being one an earlier command wrote
-  (or `make demo` writes). Commands run in a fresh folder that links the project's
-  `scenarios/`, `docs/`, `tests/` and `examples/` (so the pages' relative paths hold) and
-  takes every output.
+  it names no profile, the lightest profile its scenario accepts (`none`, or `fast` where
+  the route has traffic lights for the camera to read); a `suite`, `sweep` or `campaign`
+  runs with `--dry-run` (every run loaded and checked, none run), and the first run it
+  prints is then run for real, shortened as a `run` (the profile it names is the batch's
+  default, not the page's, so it goes too unless the page named one). A command already run
+  as the same words (pages repeat a few) is not run again. `view` needs a display: it is
+  checked up to there, by its `--help` and by the recording the page names being one an
+  earlier command wrote (or `make demo` writes). Commands run in a fresh folder that links
+  the project's `scenarios/`, `docs/`, `tests/` and `examples/` (so the pages' relative
+  paths hold) and takes every output.
 - A command in any other fenced block is an error: a page cannot hide one from this test.
 - The minimal OpenSCENARIO example runs in full and passes.
 """
@@ -27,6 +30,10 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
+
+from avsim.scenario.errors import ScenarioError
+from avsim.scenario.load import load_scenario
+from avsim.scenario.profile_fit import CAMERALESS, check_profile
 
 REPO = Path(__file__).resolve().parents[1]
 PAGES = [REPO / "README.md", *sorted((REPO / "docs").glob("*.md"))]
@@ -111,10 +118,33 @@ def _avsim(words: list[str], cwd: Path) -> subprocess.CompletedProcess[str]:
                           capture_output=True, text=True, timeout=TIMEOUT, check=False)
 
 
-def shorten(words: list[str]) -> list[str]:
-    """A run, shortened (module doc): 2 s simulated, no sensors unless it names a profile."""
-    profile = [] if "--profile" in words else ["--profile", "none"]
+def _lightest_profile(scenario: str, cwd: Path) -> str:
+    """`none` when the scenario accepts it, else `fast` (module doc)."""
+    path = cwd / scenario
+    try:
+        loaded = load_scenario(path if path.exists() else scenario)
+    except ScenarioError:
+        return CAMERALESS  # the run reports its own load error
+    try:
+        check_profile(loaded, CAMERALESS, scenario)
+    except ScenarioError:
+        return "fast"
+    return CAMERALESS
+
+
+def shorten(words: list[str], cwd: Path) -> list[str]:
+    """A run, shortened (module doc): 2 s simulated, the lightest profile its scenario
+    accepts unless it names one."""
+    profile = [] if "--profile" in words else ["--profile", _lightest_profile(words[1], cwd)]
     return [*words, "--set", "duration=2", *profile, "--no-progress"]
+
+
+def _without_profile(words: list[str]) -> list[str]:
+    """`words` without their `--profile X`."""
+    if "--profile" not in words:
+        return words
+    at = words.index("--profile")
+    return words[:at] + words[at + 2:]
 
 
 def _expand(words: tuple[str, ...], cwd: Path) -> list[str]:
@@ -126,7 +156,7 @@ def _expand(words: tuple[str, ...], cwd: Path) -> list[str]:
     return out
 
 
-def _check(command: Command, cwd: Path) -> None:
+def _check(command: Command, cwd: Path, done_before: set[tuple[str, ...]]) -> None:
     words = _expand(command.words, cwd)
     what = f"{command.page}: avsim {' '.join(command.words)}"
     if words[0] == "view":  # needs a display: checked up to it (module doc)
@@ -141,8 +171,13 @@ def _check(command: Command, cwd: Path) -> None:
         planned = done.stdout.splitlines()
         assert planned and all(line.startswith("avsim run ") for line in planned), what
         words = shlex.split(planned[0])[1:]
+        if "--profile" not in command.words:
+            words = _without_profile(words)
     if words[0] == "run":
-        words = shorten(words)
+        words = shorten(words, cwd)
+    if (*words, str(command.stdout_to)) in done_before:
+        return
+    done_before.add((*words, str(command.stdout_to)))
     done = _avsim(words, cwd)
     allowed = RUN_EXIT if words[0] == "run" else (0,)
     assert done.returncode in allowed, (what, words, done.returncode, done.stderr[-2000:])
@@ -153,8 +188,9 @@ def _check(command: Command, cwd: Path) -> None:
 
 @pytest.mark.slow
 def test_every_command_of_the_pages_runs(workdir: Path) -> None:
+    done_before: set[tuple[str, ...]] = set()
     for command in commands():
-        _check(command, workdir)
+        _check(command, workdir, done_before)
     schema = workdir / "scenario.schema.json"
     assert json.loads(schema.read_text(encoding="utf-8"))["$schema"]
 
