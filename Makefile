@@ -66,6 +66,7 @@ bench: $(STAMP)
 	$(BIN)/python -m bench.bench_sensing
 	$(BIN)/python -m bench.bench_stages
 	$(BIN)/python -m bench.bench_batch
+	$(BIN)/python -m bench.bench_campaign
 	$(BIN)/python -m bench.bench_load
 
 # An hour of simulated time on a town loop per profile (none, fast): memory, recording size
