@@ -81,7 +81,7 @@ from dataclasses import dataclass, field, replace
 import cv2
 import numpy as np
 from numpy.typing import NDArray
-from scipy.stats import chi2
+from scipy.special import gammaincinv
 
 from perception.birdseye import BevGrid, BirdseyeView
 from perception.messages import LaneBoundary, LaneEstimate
@@ -555,6 +555,14 @@ DIM = 4
 I_OFFSET, I_HEADING, I_CURVATURE, I_WIDTH = range(DIM)
 
 
+def chi_square_quantile(probability: float, dof: int) -> float:
+    """The chi-square distribution's quantile [-]: the x with P(X <= x) = `probability` for
+    `dof` degrees of freedom, as ``scipy.stats.chi2.ppf`` computes it (2 P^-1(dof/2, p), the
+    regularised lower incomplete gamma function's inverse), without importing scipy.stats
+    (a quarter of a second on every run's start)."""
+    return float(2.0 * gammaincinv(dof / 2, probability))
+
+
 @dataclass(frozen=True, slots=True)
 class LaneFilterParams:
     """Noise (1-sigma), gating and confidence dynamics of `LaneFilter`."""
@@ -616,7 +624,7 @@ class LaneFilter:
         self._r_sigma = np.array([p.offset_sigma, p.heading_sigma, p.curvature_sigma,
                                   p.width_sigma])
         self._walk = np.array([p.offset_walk, p.heading_walk, p.curvature_walk, p.width_walk])
-        self._gate = {n: float(chi2.ppf(p.gate_probability, n)) for n in (3, 4)}
+        self._gate = {n: chi_square_quantile(p.gate_probability, n) for n in (3, 4)}
         self.x = np.zeros(DIM)  # (4,) state, see class doc
         self.P = np.eye(DIM)  # (4, 4) covariance
         self.t = 0.0  # [s] time of the state

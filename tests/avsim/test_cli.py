@@ -1,4 +1,4 @@
-"""Tests of the `avsim` command line (`avsim.cli`) as a user runs it: a subprocess.
+"""Tests of the `avsim` command line (`avsim.cli`) as a user runs it.
 
 SCENARIO_FORMAT.md, "Command line": bad input exits 2 with one line on stderr naming the
 file and the key, no traceback, and no output file; `list`, `schema`; the commands that come
@@ -6,9 +6,12 @@ later say so. No scenario is run here: every `run` below is rejected before the 
 starts: PyBullet prints a "pybullet build time" banner when it is imported (on stderr, from
 C), so bad input must leave stdout empty and stderr one line without that banner.
 
-The subprocesses start at once in a module fixture (each in its own working directory); every
-bad fixture file goes through the command in-process (click's runner), a representative few
-also through a real subprocess (each costs ~0.3 s of imports).
+Every invocation of the module fixture runs in its own working directory. One of each kind
+of refusal (YAML, model, OpenSCENARIO, output path, batch, usage) runs as a real process
+(`REAL`: each costs an interpreter start and avsim's imports, ~1.6 s); the others run in
+one process, one after another, through click's runner (`cli_driver.py`), which reports
+whether each imported PyBullet (what the banner shows of a real process). Every bad fixture
+file also goes through the command in this process.
 """
 
 from __future__ import annotations
@@ -53,14 +56,16 @@ class Outcome:
     returncode: int
     stdout: str
     stderr: str
+    pybullet: bool = False  # it imported PyBullet (in-process; a real process prints BANNER)
 
 
 def _run_args(scenario: str) -> tuple[str, ...]:
     return ("run", scenario, "--out", "tmp/x.rrd", "--json", "tmp/x.json", "--no-progress")
 
 
-# bad_scenarios/ fixtures that also go through a real subprocess: one per kind of check
-# (YAML, file shape, model validation, cross-key checks, unsupported features)
+# bad_scenarios/ fixtures that also go through the module fixture (a fresh interpreter that
+# must not import PyBullet): one per kind of check (YAML, file shape, model validation,
+# cross-key checks, unsupported features)
 SUBPROCESS_FIXTURES = (
     "bad_yaml_syntax", "duplicate_key", "not_a_mapping", "unknown_nested_key", "wrong_type",
     "actor_lane_out_of_range", "after_forward", "town_route_leaves_town",
@@ -152,10 +157,19 @@ def _openscenario_inputs(directory: Path) -> dict[str, Case]:
 
 
 def _launch(case: Case, cwd: Path) -> Outcome:
-    (cwd / "tmp").mkdir()
     proc = subprocess.run([sys.executable, "-m", "avsim.cli", *case.args], cwd=cwd,
                           capture_output=True, text=True, timeout=TIMEOUT, check=False)
     return Outcome(cwd, proc.returncode, proc.stdout, proc.stderr)
+
+
+def _in_one_process(cases: dict[str, Case], dirs: dict[str, Path]) -> dict[str, Outcome]:
+    """`cases` run one after another in one process through click's runner (`cli_driver`)."""
+    todo = [[name, list(case.args), str(dirs[name])] for name, case in cases.items()]
+    proc = subprocess.run([sys.executable, str(HERE / "cli_driver.py")], input=json.dumps(todo),
+                          capture_output=True, text=True, timeout=TIMEOUT * 4, check=False)
+    assert proc.returncode == 0, proc.stderr
+    return {name: Outcome(dirs[name], o["returncode"], o["stdout"], o["stderr"], o["pybullet"])
+            for name, o in json.loads(proc.stdout).items()}
 
 
 OTHER: dict[str, Case] = {
@@ -192,17 +206,26 @@ def cases(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Case]:
 def outcomes(cases: dict[str, Case], tmp_path_factory: pytest.TempPathFactory,
              ) -> dict[str, Outcome]:
     dirs = {name: tmp_path_factory.mktemp(f"cwd_{name}") for name in cases}
-    with ThreadPoolExecutor(max_workers=8) as pool:
-        futures = {name: pool.submit(_launch, case, dirs[name]) for name, case in cases.items()}
-        return {name: future.result() for name, future in futures.items()}
+    for cwd in dirs.values():
+        (cwd / "tmp").mkdir()
+    with ThreadPoolExecutor(max_workers=len(REAL) + 1) as pool:
+        real = {name: pool.submit(_launch, cases[name], dirs[name]) for name in REAL}
+        rest = pool.submit(_in_one_process,
+                           {name: case for name, case in cases.items() if name not in REAL},
+                           dirs)
+        return {**{name: future.result() for name, future in real.items()}, **rest.result()}
 
 
 BANNER = "pybullet build time"  # printed by `import pybullet`
+# the invocations that run as real processes: one of each kind of refusal (module doc)
+REAL = ("fixture_bad_yaml_syntax", "fixture_after_forward", "missing_file",
+        "xosc_unsupported_action", "out_below_a_file", "suite_bad_file", "bogus_profile")
 
 
 def _assert_one_line_error(out: Outcome) -> str:
     assert "Traceback" not in out.stderr, out.stderr
-    assert BANNER not in out.stderr + out.stdout, "PyBullet was imported before the input check"
+    assert BANNER not in out.stderr + out.stdout and not out.pybullet, (
+        "PyBullet was imported before the input check")
     assert out.stderr.endswith("\n") and out.stderr.count("\n") == 1, (
         f"stderr is not exactly one line: {out.stderr!r}"
     )
@@ -213,6 +236,7 @@ def _assert_one_line_error(out: Outcome) -> str:
 
 def test_every_bad_case_is_listed(cases: dict[str, Case]) -> None:
     assert set(BAD_CASE_NAMES) == set(cases) - set(OTHER)
+    assert set(REAL) < set(cases)
 
 
 @pytest.mark.parametrize("name", BAD_CASE_NAMES)
@@ -335,7 +359,7 @@ def test_batch_and_snapshot_bad_input(command: str, names: tuple[str, ...],
 def test_unknown_profile_is_a_usage_error(outcomes: dict[str, Outcome]) -> None:
     out = outcomes["bogus_profile"]
     assert out.returncode == EXIT_BAD_INPUT, (out.returncode, out.stderr)
-    assert "Traceback" not in out.stderr and BANNER not in out.stderr
+    assert "Traceback" not in out.stderr and BANNER not in out.stderr and not out.pybullet
     assert "Usage:" in out.stderr
     assert "--profile" in out.stderr and "bogus" in out.stderr
     assert out.stdout == ""

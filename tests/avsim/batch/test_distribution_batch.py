@@ -1,21 +1,19 @@
 """An OpenSCENARIO ParameterValueDistribution file through the batch engine: its runs as
 suite entries, and `avsim run DIST.xosc` end to end (every run into --out, or one with
---permutation)."""
+--permutation), in this process (`tests.avsim.invoke`)."""
 
 from __future__ import annotations
 
 import json
 import shutil
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
 
 from avsim.batch.suite import BatchError, collect_scenarios, suite_entries
+from tests.avsim.invoke import invoke
 
 EXAMPLES = Path(__file__).parents[3] / "docs" / "examples"
-TIMEOUT = 300.0  # [s] a subprocess of two 1-s runs; a refusal that fails would run longer
 DIST = """<?xml version="1.0" encoding="utf-8"?>
 <OpenSCENARIO>
   <FileHeader revMajor="1" revMinor="2" date="2026-01-01T00:00:00" author="avsim"
@@ -67,14 +65,9 @@ def test_an_override_of_a_distributed_parameter_is_refused(dist: Path) -> None:
         suite_entries([str(dist)], {"parameters.Speed_kph": 30})
 
 
-def _avsim(*args: str, cwd: Path) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([sys.executable, "-m", "avsim.cli", *args], cwd=cwd,
-                          capture_output=True, text=True, timeout=TIMEOUT, check=False)
-
-
 def test_run_a_distribution_runs_every_run_into_out(dist: Path) -> None:
     out = dist.parent / "out"
-    proc = _avsim("run", str(dist), "--profile", "none", "--set", "duration=1",
+    proc = invoke("run", str(dist), "--profile", "none", "--set", "duration=1",
                   "--out", str(out), "--no-progress", cwd=dist.parent)
     assert proc.returncode in (0, 1), proc.stderr
     results = json.loads((out / "results.json").read_text())
@@ -87,7 +80,7 @@ def test_run_a_distribution_runs_every_run_into_out(dist: Path) -> None:
 
 def test_run_one_permutation(dist: Path) -> None:
     out = dist.parent / "one.rrd"
-    proc = _avsim("run", str(dist), "--permutation", "1", "--profile", "none", "--set",
+    proc = invoke("run", str(dist), "--permutation", "1", "--profile", "none", "--set",
                   "duration=1", "--out", str(out), "--no-progress", cwd=dist.parent)
     assert proc.returncode in (0, 1), proc.stderr
     assert "run 1 of 2: Speed_kph=50, Deceleration_mps2=3" in proc.stderr
@@ -101,7 +94,7 @@ def test_run_one_permutation(dist: Path) -> None:
 ])
 def test_run_a_distribution_refuses_in_one_line(dist: Path, args: tuple[str, ...],
                                                 problem: str) -> None:
-    proc = _avsim("run", str(dist), "--profile", "none", *args, cwd=dist.parent)
+    proc = invoke("run", str(dist), "--profile", "none", *args, cwd=dist.parent)
     assert proc.returncode == 2
     assert proc.stderr.startswith("avsim: error: ") and problem in proc.stderr
     assert proc.stderr.count("\n") == 1
@@ -109,7 +102,7 @@ def test_run_a_distribution_refuses_in_one_line(dist: Path, args: tuple[str, ...
 
 
 def test_permutation_is_for_distribution_files(dist: Path) -> None:
-    proc = _avsim("run", str(dist.parent / "minimal.xosc"), "--permutation", "0",
+    proc = invoke("run", str(dist.parent / "minimal.xosc"), "--permutation", "0",
                   cwd=dist.parent)
     assert proc.returncode == 2
     assert "--permutation: is for a ParameterValueDistribution file" in proc.stderr

@@ -14,6 +14,8 @@ from pathlib import Path
 
 import pytest
 
+from tests.avsim.invoke import invoke
+
 pytestmark = pytest.mark.slow
 HERE = Path(__file__).parents[1]
 ALKS = HERE.parent / "data" / "alks" / "logical_scenarios" / "concrete_scenarios"
@@ -63,9 +65,9 @@ def test_a_sweep_over_a_declared_parameter_runs(swept: subprocess.CompletedProce
 
 
 def test_a_value_outside_the_constraint_groups_is_refused_before_any_run(work: Path) -> None:
-    out = avsim("sweep", str(CUT_IN), "--param",
-                "CutInVehicle_HeadwayDistanceTrigger_dx0_m=20,-5", "--profile", "none",
-                "--out", "refused", cwd=work)
+    out = invoke("sweep", str(CUT_IN), "--param",
+                 "CutInVehicle_HeadwayDistanceTrigger_dx0_m=20,-5", "--profile", "none",
+                 "--out", "refused", cwd=work)
     assert out.returncode == 2 and out.stdout == ""
     assert out.stderr.count("\n") == 1
     assert "CutInVehicle_HeadwayDistanceTrigger_dx0_m = -5: breaks greaterOrEqual 0" \

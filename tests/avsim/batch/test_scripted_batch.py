@@ -3,15 +3,14 @@ distribution file's runs load and run each scenario with the file's own actions 
 car under test (`RunJob.ego`), say so in every result and report, replay from `--dry-run`
 and resume only a run of the same ego mode. A YAML scenario is refused before any run.
 
-The runs are short (1 s or less simulated) and read no sensors (profile none)."""
+The runs are short (1 s or less simulated) and read no sensors (profile none). The commands
+run in this process (`tests.avsim.invoke`): the batch's workers are still processes, forked
+from one forkserver for the module instead of one per command."""
 
 from __future__ import annotations
 
 import json
-import os
 import shutil
-import subprocess
-import sys
 import xml.etree.ElementTree as ET
 from dataclasses import replace
 from pathlib import Path
@@ -22,6 +21,7 @@ from avsim.batch.jobs import RunJob
 from avsim.batch.resume import run_key
 from avsim.batch.suite import plan, run_command, suite_entries
 from avsim.scenario.errors import ScenarioError
+from tests.avsim.invoke import invoke
 from tests.avsim.run.test_scripted_ego import ACTIVATE, OFFSET
 
 ROOT = Path(__file__).parents[3]
@@ -34,7 +34,6 @@ CCFHOS = NCAP / "OpenSCENARIO" / "NCAP" / "AEB_C2C_2023" / "Variations" \
     / "NCAP_AEB_C2C_CCFhos_Variation_2023.xosc"  # two runs (two GVT speeds)
 YAML = ROOT / "scenarios" / "cut_in.yaml"
 CAMPAIGN = ROOT / "scenarios" / "campaigns" / "cut_in.yaml"
-TIMEOUT = 300.0  # [s] a subprocess of two runs of 1 s simulated, no sensors
 
 
 @pytest.fixture
@@ -47,12 +46,6 @@ def offset(tmp_path: Path) -> Path:
     path = tmp_path / "ego_offset.xosc"
     path.write_text(text.replace(ACTIVATE, OFFSET), encoding="utf-8")
     return path
-
-
-def _avsim(*args: str, cwd: Path) -> subprocess.CompletedProcess[str]:
-    env = {k: v for k, v in os.environ.items() if k != "RAY_ADDRESS"}
-    return subprocess.run([sys.executable, "-m", "avsim.cli", *args], cwd=cwd, env=env,
-                          capture_output=True, text=True, timeout=TIMEOUT, check=False)
 
 
 # ---- the plan (no run) ----------------------------------------------------------------------
@@ -96,7 +89,7 @@ def test_the_resume_key_tells_a_scripted_run_from_a_stack_run(tmp_path: Path) ->
 ])
 def test_a_yaml_scenario_with_a_scripted_ego_is_refused_before_any_run(
         args: tuple[str, ...], tmp_path: Path) -> None:
-    proc = _avsim(*args, "--ego", "scripted", "--out", "out", cwd=tmp_path)
+    proc = invoke(*args, "--ego", "scripted", "--out", "out", cwd=tmp_path)
     assert proc.returncode == 2, proc.stderr
     assert proc.stderr.startswith("avsim: error: ") and proc.stderr.count("\n") == 1
     assert "ego: --ego scripted is for OpenSCENARIO files" in proc.stderr
@@ -105,7 +98,7 @@ def test_a_yaml_scenario_with_a_scripted_ego_is_refused_before_any_run(
 
 
 def test_suite_dry_run_prints_scripted_runs(offset: Path) -> None:
-    proc = _avsim("suite", str(MINIMAL), str(offset), "--ego", "scripted", "--search-path",
+    proc = invoke("suite", str(MINIMAL), str(offset), "--ego", "scripted", "--search-path",
                   str(ALKS), "--dry-run", "--out", "out", cwd=offset.parent)
     assert proc.returncode == 0, proc.stderr
     lines = proc.stdout.splitlines()
@@ -139,7 +132,7 @@ def _assert_scripted(out: Path, runs: list[dict[str, object]]) -> None:
 
 def test_a_suite_of_two_openscenario_files_runs_scripted(offset: Path) -> None:
     out = offset.parent / "suite"
-    proc = _avsim("suite", str(MINIMAL), str(offset), "--ego", "scripted", "--set",
+    proc = invoke("suite", str(MINIMAL), str(offset), "--ego", "scripted", "--set",
                   "duration=1", "--search-path", str(ALKS), "--jobs", "1", "--no-snapshots",
                   "--out", str(out), cwd=offset.parent)
     assert proc.returncode in (0, 1), proc.stderr
@@ -153,7 +146,7 @@ def test_a_sweep_over_a_parameter_runs_scripted(tmp_path: Path) -> None:
     for name in ("minimal.xosc", "straight.xodr"):
         shutil.copy(EXAMPLES / name, tmp_path / name)
     out = tmp_path / "sweep"
-    proc = _avsim("sweep", str(tmp_path / "minimal.xosc"), "--param", "Speed_kph=40,50",
+    proc = invoke("sweep", str(tmp_path / "minimal.xosc"), "--param", "Speed_kph=40,50",
                   "--set", "duration=1", "--ego", "scripted", "--jobs", "1",
                   "--no-snapshots", "--out", str(out), cwd=tmp_path)
     assert proc.returncode in (0, 1), proc.stderr
@@ -167,7 +160,7 @@ def test_a_sweep_over_a_parameter_runs_scripted(tmp_path: Path) -> None:
 
 def test_a_distribution_file_runs_every_permutation_scripted(tmp_path: Path) -> None:
     out = tmp_path / "dist"
-    proc = _avsim("run", str(CCFHOS), "--ego", "scripted", "--search-path", str(NCAP),
+    proc = invoke("run", str(CCFHOS), "--ego", "scripted", "--search-path", str(NCAP),
                   "--set", "duration=0.5", "--out", str(out), "--no-progress",
                   cwd=tmp_path)
     assert proc.returncode in (0, 1), proc.stderr

@@ -6,7 +6,8 @@ short scenarios (`batch_scenarios/`: `follow` passes, `too_far` fails):
 - results do not depend on the number of workers (1 vs 2) nor on the executor (local vs
   Ray): same verdicts, criteria, metrics and state changes;
 - a 3 x 3 sweep: its CSV and Markdown tables and the heat map, locally; its middle row on
-  Ray gives the same runs.
+  Ray gives the same runs. The sweeps judge the tables and the executors, not what the
+  stack sees: profile none (no camera or LiDAR to simulate), on both executors.
 """
 
 from __future__ import annotations
@@ -72,7 +73,7 @@ def sweep(work: Path, out: str, *extra: str,
     return avsim("sweep", str(SCENARIOS / "follow.yaml"),
                  "--set", f"actors.0.s={','.join(map(str, GAPS))}",
                  "--set", f"actors.0.speed_kph={','.join(map(str, speeds))}",
-                 "--set", "duration=3", "--metric", "min_gap", "--profile", "fast",
+                 "--set", "duration=3", "--metric", "min_gap", "--profile", "none",
                  "--no-snapshots", "--out", out, *extra, cwd=work)
 
 
