@@ -3,8 +3,9 @@ its own working directory, and prints each one's outcome as JSON: what the comma
 judge of a bad input that is not the process boundary, at one interpreter start for all.
 
 Input (stdin): a JSON list of [name, [args...], cwd]. Output (stdout): a JSON object, name ->
-{"returncode", "stdout", "stderr", "pybullet"}; "pybullet" is true when the invocation
-imported PyBullet (the module was absent before it and present after): a bad input must be
+{"returncode", "stdout", "stderr", "pybullet"}; "pybullet" is true when PyBullet is imported
+after the invocation (by it or by one before it: none of the cases may import it, so the
+first that does is flagged, and every one after it, never hidden): a bad input must be
 refused before the simulator is imported, which a real process shows as PyBullet's banner.
 """
 
@@ -24,7 +25,6 @@ def run_all(cases: list[tuple[str, list[str], str]]) -> dict[str, dict[str, obje
     outcomes: dict[str, dict[str, object]] = {}
     for name, args, cwd in cases:
         os.chdir(cwd)
-        before = "pybullet" in sys.modules
         result = CliRunner().invoke(main, args)
         crashed = result.exception is not None and not isinstance(result.exception,
                                                                   SystemExit)
@@ -32,7 +32,7 @@ def run_all(cases: list[tuple[str, list[str], str]]) -> dict[str, dict[str, obje
             "returncode": result.exit_code,
             "stdout": result.stdout,
             "stderr": result.stderr + (f"Traceback: {result.exception!r}" if crashed else ""),
-            "pybullet": not before and "pybullet" in sys.modules,
+            "pybullet": "pybullet" in sys.modules,
         }
     return outcomes
 
