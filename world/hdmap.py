@@ -397,14 +397,19 @@ class ReferenceLine:
             self.s0, self.h0, self.k, self.straight, self.inv_k, self.cx, self.cy,
             self.cos_h0, self.sin_h0)), strict=True))
         self._bounds_list: list[float] = self.bounds.tolist()
+        self._inner_list: list[float] = self.inner_bounds.tolist()
         self._last: _Candidates | None = None  # `_candidates` of the last points projected
 
     def piece_index(self, s: FloatArray) -> IntArray:
         """Internal piece index (0 .. P + 1) of stations s; a joint belongs to the later."""
+        if np.ndim(s) == 0:  # one station: `bisect` finds the same index without numpy's overhead
+            return np.intp(bisect.bisect_right(self._bounds_list, float(s)))  # type: ignore[return-value]
         return np.searchsorted(self.bounds, s, side="right")
 
     def segment_index(self, s: FloatArray) -> IntArray:
         """Route piece (= segment) index 0 .. P - 1 of stations s, clipped at the ends."""
+        if np.ndim(s) == 0:
+            return np.intp(bisect.bisect_right(self._inner_list, float(s)))  # type: ignore[return-value]
         return np.searchsorted(self.inner_bounds, s, side="right")
 
     def heading(self, s: FloatArray) -> FloatArray:

@@ -59,3 +59,15 @@ def test_the_hints_kept_for_a_point_are_bounded() -> None:
     for k in range(3 * MAX_HINTS_KEPT):
         line.project(xy, float(k))
         assert line._last is not None and len(line._last.hinted) <= MAX_HINTS_KEPT
+
+
+def test_one_station_finds_the_index_the_vectorised_search_finds() -> None:
+    line = crossing_loop()
+    joints = line.bounds.tolist()
+    stations = [*joints, -5.0, -0.0, line.length + 3.0, math.nan, math.inf, -math.inf,
+                *np.random.default_rng(5).uniform(-10.0, line.length + 10.0, 50).tolist()]
+    for s in stations:
+        arr = np.array([s])
+        assert line.segment_index(np.array(s)) == line.segment_index(arr)[0]
+        assert line.piece_index(np.array(s)) == line.piece_index(arr)[0]
+        assert line.segment_index(s) == line.segment_index(arr)[0]
