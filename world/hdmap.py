@@ -61,6 +61,7 @@ TWO_PI = 2.0 * np.pi  # [rad]
 NEAR_WINDOW = 30.0  # [m] a projection near a station looks this far either side of it
 #   (`ReferenceLine.project`): more than a car moves between two looks, or its pose estimate
 #   jumps by, and less than the shortest loop of a town route (a block's four sides)
+MAX_HINTS_KEPT = 8  # hints whose choice `ReferenceLine.project` keeps for the last points
 HINT_SLACK = 10.0  # [m] the pass near the hint is kept unless the nearest of all is this
 #   much nearer (then the hint is stale: the car has moved on by more than the window); a car
 #   cutting a junction's corner is a few metres off its own pass, and on the other pass
@@ -335,6 +336,19 @@ class SpeedLimitPosting:
     limit: float  # [m/s]
 
 
+@dataclass(frozen=True, slots=True)
+class _Candidates:
+    """Points (N, 2) projected onto every piece (P + 2): `ReferenceLine._candidates`."""
+
+    key: tuple[tuple[int, ...], str, bytes]  # the points' shape, dtype and bytes
+    cost: FloatArray  # [m^2] (N, P + 2) squared distance to each piece
+    t_clip: FloatArray  # [m] (N, P + 2) station along each piece, clipped to it
+    d: FloatArray  # [m] (N, P + 2) offset from each piece's line, left +
+    rows: IntArray  # (N,) 0 .. N - 1
+    best: IntArray  # (N,) the nearest piece of all (no hint)
+    hinted: dict[tuple[float, float], IntArray]  # the piece kept per (hint, window) [m]
+
+
 class ReferenceLine:
     """The chain of pieces as arrays, with a straight extension before s = 0 and after the
     end. Internal piece index 0 is the extension before the start, 1..P the route's pieces,
@@ -383,13 +397,19 @@ class ReferenceLine:
             self.s0, self.h0, self.k, self.straight, self.inv_k, self.cx, self.cy,
             self.cos_h0, self.sin_h0)), strict=True))
         self._bounds_list: list[float] = self.bounds.tolist()
+        self._inner_list: list[float] = self.inner_bounds.tolist()
+        self._last: _Candidates | None = None  # `_candidates` of the last points projected
 
     def piece_index(self, s: FloatArray) -> IntArray:
         """Internal piece index (0 .. P + 1) of stations s; a joint belongs to the later."""
+        if np.ndim(s) == 0:  # one station: `bisect` finds the same index without numpy's overhead
+            return np.intp(bisect.bisect_right(self._bounds_list, float(s)))  # type: ignore[return-value]
         return np.searchsorted(self.bounds, s, side="right")
 
     def segment_index(self, s: FloatArray) -> IntArray:
         """Route piece (= segment) index 0 .. P - 1 of stations s, clipped at the ends."""
+        if np.ndim(s) == 0:
+            return np.intp(bisect.bisect_right(self._inner_list, float(s)))  # type: ignore[return-value]
         return np.searchsorted(self.inner_bounds, s, side="right")
 
     def heading(self, s: FloatArray) -> FloatArray:
@@ -460,6 +480,19 @@ class ReferenceLine:
         hint: the car has moved on by more than the window since); without a piece in the
         window (a hint off the route), every piece takes part.
         """
+        c = self._candidates(xy)
+        best = c.best if near is None else self._kept(c, near, window)
+        s = self.s0[best] + c.t_clip[c.rows, best]
+        return s, c.d[c.rows, best]
+
+    def _candidates(self, xy: FloatArray) -> _Candidates:
+        """Every piece's projection of points xy (N, 2) and the nearest piece, without a
+        hint. The answer for the last points asked is kept: within a tick the planner, the
+        truth and the criteria project the same point several times (with different hints,
+        which only choose among these candidates), and this is the costly part."""
+        key = (xy.shape, xy.dtype.str, xy.tobytes())
+        if self._last is not None and self._last.key == key:
+            return self._last
         px = xy[:, 0:1]  # (N, 1) against pieces (1, P + 2)
         py = xy[:, 1:2]
         dx = px - self.x0
@@ -478,17 +511,30 @@ class ReferenceLine:
         excess = (t - t_clip) * np.abs(1.0 - self.k * d)
         cost = excess * excess + d * d
         rows = np.arange(xy.shape[0])
-        best = self._nearest_piece(cost, t_clip, rows)
-        if near is not None:
-            nearby = (self.s0 + self.t_lo <= near + window) & (self.s0 + self.t_hi >= near - window)
-            if nearby[1:-1].any():
-                hinted = self._nearest_piece(np.where(nearby, cost, np.inf), t_clip, rows)
-                # the pass near the hint, unless it is much farther than the nearest of all (a
-                # stale hint: the car has moved on since, by more than the window)
-                off = cost[rows, hinted] - cost[rows, best] > HINT_SLACK**2
-                best = np.where(off, best, hinted)
-        s = self.s0[best] + t_clip[rows, best]
-        return s, d[rows, best]
+        self._last = _Candidates(key, cost, t_clip, d, rows,
+                                 self._nearest_piece(cost, t_clip, rows), {})
+        return self._last
+
+    def _kept(self, c: _Candidates, near: float, window: float) -> IntArray:
+        """`_hinted`, once per hint for the same points."""
+        best = c.hinted.get((near, window))
+        if best is None:
+            if len(c.hinted) >= MAX_HINTS_KEPT:
+                c.hinted.clear()
+            best = c.hinted[(near, window)] = self._hinted(c, near, window)
+        return best
+
+    def _hinted(self, c: _Candidates, near: float, window: float) -> IntArray:
+        """Per point, the piece `project` keeps with the hint `near` [m] (its docstring)."""
+        nearby = (self.s0 + self.t_lo <= near + window) & (self.s0 + self.t_hi >= near - window)
+        if not nearby[1:-1].any():
+            return c.best
+        hinted = self._nearest_piece(np.where(nearby, c.cost, np.inf), c.t_clip, c.rows)
+        # the pass near the hint, unless it is much farther than the nearest of all (a
+        # stale hint: the car has moved on since, by more than the window)
+        off = c.cost[c.rows, hinted] - c.cost[c.rows, c.best] > HINT_SLACK**2
+        out: IntArray = np.where(off, c.best, hinted)
+        return out
 
     def _nearest_piece(self, cost: FloatArray, t_clip: FloatArray,
                        rows: IntArray) -> IntArray:

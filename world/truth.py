@@ -124,8 +124,29 @@ def ego_lane_edges(road: RoadMap, station: float, offset: float) -> tuple[float,
     return c0 + (band - 0.5) * w, c0 + (band + 0.5) * w
 
 
+class _LastAhead:
+    """The last question put to `vehicles_ahead` and its answer: the runner's log and the
+    criteria ask the same of each tick's truth (the same poses object and map, the same
+    numbers bit for bit)."""
+
+    objects: tuple[object, ...] = ()  # (poses, road), compared by identity
+    numbers: tuple[str, ...] = ()  # (station, offset, ego_length) as `float.hex`
+    answer: tuple[VehicleAhead, ...] = ()
+
+
 def vehicles_ahead(road: RoadMap, poses: ActorPoses, station: float, offset: float,
                    ego_length: float) -> tuple[VehicleAhead, ...]:
+    """`find_vehicles_ahead`, its last answer given again to the same question."""
+    numbers = (float(station).hex(), float(offset).hex(), float(ego_length).hex())
+    last = _LastAhead.objects
+    if not (last and last[0] is poses and last[1] is road and _LastAhead.numbers == numbers):
+        _LastAhead.objects, _LastAhead.numbers = (poses, road), numbers
+        _LastAhead.answer = find_vehicles_ahead(road, poses, station, offset, ego_length)
+    return _LastAhead.answer
+
+
+def find_vehicles_ahead(road: RoadMap, poses: ActorPoses, station: float, offset: float,
+                        ego_length: float) -> tuple[VehicleAhead, ...]:
     """The vehicles (cars, trucks) ahead of the ego in its lane, nearest first, from the
     truth and the map: their footprint (the box, turned by its heading relative to the
     route) overlaps, across, the lane the ego's centre is in (`ego_lane_edges`), their
