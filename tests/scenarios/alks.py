@@ -13,6 +13,7 @@ from numpy.typing import NDArray
 
 from avsim.criteria.base import CriterionResult, Verdict
 from avsim.run.runner import RunResult
+from tests.scenarios.modes import SENSORS
 from world.sensors.setup import Profile
 
 ALKS = (Path(__file__).parents[1] / "data" / "alks" / "logical_scenarios"
@@ -29,9 +30,11 @@ def path(number: str) -> Path:
     return found
 
 
-def run(run_scenario: Callable[..., RunResult], number: str, **overrides: object) -> RunResult:
+def run(run_scenario: Callable[..., RunResult], number: str, stack: str = SENSORS,
+        **overrides: object) -> RunResult:
+    """ALKS scenario `number` in stack mode `stack` (`tests.scenarios.modes`)."""
     return run_scenario(str(path(number)), record=False, profile=PROFILE, criteria="r157",
-                        **overrides)
+                        stack=stack, **overrides)
 
 
 def run_on_the_map(run_scenario: Callable[..., RunResult], number: str) -> RunResult:

@@ -14,8 +14,8 @@ pytestmark = pytest.mark.slow
 
 
 @pytest.fixture(scope="module")
-def runs(run_scenario: Callable[..., RunResult]) -> dict[str, RunResult]:
-    return {n: alks.run(run_scenario, n) for n in ("4_5_1", "4_5_2")}
+def runs(run_scenario: Callable[..., RunResult], mode: str) -> dict[str, RunResult]:
+    return {n: alks.run(run_scenario, n, stack=mode) for n in ("4_5_1", "4_5_2")}
 
 
 @pytest.mark.parametrize("number", ["4_5_1", "4_5_2"])

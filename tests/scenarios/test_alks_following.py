@@ -15,8 +15,8 @@ pytestmark = pytest.mark.slow
 
 
 @pytest.fixture(scope="module")
-def runs(run_scenario: Callable[..., RunResult]) -> dict[str, RunResult]:
-    return {n: alks.run(run_scenario, n) for n in ("4_1_2", "4_3_1", "4_3_2")}
+def runs(run_scenario: Callable[..., RunResult], mode: str) -> dict[str, RunResult]:
+    return {n: alks.run(run_scenario, n, stack=mode) for n in ("4_1_2", "4_3_1", "4_3_2")}
 
 
 

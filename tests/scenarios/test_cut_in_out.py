@@ -17,8 +17,8 @@ KPH = 1 / 3.6
 
 
 @pytest.fixture(scope="module")
-def result(run_scenario: Callable[..., RunResult]) -> RunResult:
-    return run_scenario("cut_in_out", record=False)
+def result(run_scenario: Callable[..., RunResult], mode: str) -> RunResult:
+    return run_scenario("cut_in_out", record=False, stack=mode)
 
 
 def test_the_cut_in_and_out_happened(result: RunResult) -> None:
@@ -55,5 +55,5 @@ def test_verdict_and_the_r157_figures(result: RunResult) -> None:
     assert len(back) and back[0] - t_cruise <= 15.0
 
 
-def test_result_matches_golden(result: RunResult) -> None:
-    golden.check(result, "cut_in_out")
+def test_result_matches_golden(result: RunResult, mode: str) -> None:
+    golden.check(result, golden.label("cut_in_out", mode))

@@ -26,8 +26,8 @@ FILE = "scenarios/acceptance/cut_out_stopped_pass.yaml"
 
 
 @pytest.fixture(scope="module")
-def result(run_scenario: Callable[..., RunResult]) -> RunResult:
-    return run_scenario(FILE, record=False)
+def result(run_scenario: Callable[..., RunResult], mode: str) -> RunResult:
+    return run_scenario(FILE, record=False, stack=mode)
 
 
 def _actor(result: RunResult, name: str) -> tuple[NDArray[np.float64], NDArray[np.float64]]:

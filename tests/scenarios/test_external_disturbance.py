@@ -21,13 +21,13 @@ KPH = 1 / 3.6
 
 
 @pytest.fixture(scope="module")
-def alone(run_scenario: Callable[..., RunResult]) -> RunResult:
-    return run_scenario("external_disturbance", record=False)
+def alone(run_scenario: Callable[..., RunResult], mode: str) -> RunResult:
+    return run_scenario("external_disturbance", record=False, stack=mode)
 
 
 @pytest.fixture(scope="module")
-def following(run_scenario: Callable[..., RunResult]) -> RunResult:
-    return run_scenario("external_disturbance_following", record=False)
+def following(run_scenario: Callable[..., RunResult], mode: str) -> RunResult:
+    return run_scenario("external_disturbance_following", record=False, stack=mode)
 
 
 def _pressed(r: RunResult) -> np.ndarray:
@@ -71,6 +71,6 @@ def test_following_the_pedal_closes_up_but_never_below_d_min(following: RunResul
     assert gap[-1] == pytest.approx(gaps(v[-1], v[-1], AccParams()).d_des, abs=2.0)  # after
 
 
-def test_results_match_golden(alone: RunResult, following: RunResult) -> None:
-    golden.check(alone, "external_disturbance")
-    golden.check(following, "external_disturbance_following")
+def test_results_match_golden(alone: RunResult, following: RunResult, mode: str) -> None:
+    golden.check(alone, golden.label("external_disturbance", mode))
+    golden.check(following, golden.label("external_disturbance_following", mode))

@@ -28,8 +28,8 @@ FILE = "scenarios/acceptance/overtake_rear_traffic.yaml"
 
 
 @pytest.fixture(scope="module")
-def result(run_scenario: Callable[..., RunResult]) -> RunResult:
-    return run_scenario(FILE, record=False)
+def result(run_scenario: Callable[..., RunResult], mode: str) -> RunResult:
+    return run_scenario(FILE, record=False, stack=mode)
 
 
 def _actor(result: RunResult, name: str) -> tuple[NDArray[np.float64], NDArray[np.float64]]:

@@ -20,8 +20,8 @@ LANE_WIDTH = 3.5  # [m] the scenario's; the road runs along +x from the origin: 
 
 
 @pytest.fixture(scope="module")
-def result(run_scenario: Callable[..., RunResult]) -> RunResult:
-    return run_scenario("overtake_two_lane", record=False)
+def result(run_scenario: Callable[..., RunResult], mode: str) -> RunResult:
+    return run_scenario("overtake_two_lane", record=False, stack=mode)
 
 
 def _actor(result: RunResult, name: str) -> tuple[np.ndarray, np.ndarray]:
@@ -82,5 +82,5 @@ def test_verdicts(result: RunResult) -> None:
     assert result.sim_time is not None and result.sim_time < 40.0
 
 
-def test_result_matches_golden(result: RunResult) -> None:
-    golden.check(result, "overtake_two_lane")
+def test_result_matches_golden(result: RunResult, mode: str) -> None:
+    golden.check(result, golden.label("overtake_two_lane", mode))

@@ -21,9 +21,9 @@ CASES = {"sudden_stop": (1.0, 12.0), "sudden_stop_headway": (3.0, 50 * KPH * 1.5
 
 
 @pytest.fixture(scope="module", params=sorted(CASES))
-def result(request: pytest.FixtureRequest,
-           run_scenario: Callable[..., RunResult]) -> RunResult:
-    return run_scenario(request.param, record=False)
+def result(request: pytest.FixtureRequest, run_scenario: Callable[..., RunResult],
+           mode: str) -> RunResult:
+    return run_scenario(request.param, record=False, stack=mode)
 
 
 def _lead(result: RunResult) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -70,5 +70,5 @@ def test_the_control_fsm_brakes_to_a_stop(result: RunResult) -> None:
         assert result.metrics["max_decel"] > 4.5
 
 
-def test_result_matches_golden(result: RunResult) -> None:
-    golden.check(result, result.scenario.name)
+def test_result_matches_golden(result: RunResult, mode: str) -> None:
+    golden.check(result, golden.label(result.scenario.name, mode))

@@ -20,8 +20,8 @@ KPH = 1 / 3.6
 
 
 @pytest.fixture(scope="module")
-def result(run_scenario: Callable[..., RunResult]) -> RunResult:
-    return run_scenario("traffic_jam", record=False)
+def result(run_scenario: Callable[..., RunResult], mode: str) -> RunResult:
+    return run_scenario("traffic_jam", record=False, stack=mode)
 
 
 def _intervals(mask: np.ndarray, t: np.ndarray) -> list[tuple[float, float]]:
@@ -73,5 +73,5 @@ def test_the_jam_is_taken_gently(result: RunResult) -> None:
     assert c["max_decel"].value <= 1.5  # the lead brakes at 1.0 m/s^2
 
 
-def test_result_matches_golden(result: RunResult) -> None:
-    golden.check(result, "traffic_jam")
+def test_result_matches_golden(result: RunResult, mode: str) -> None:
+    golden.check(result, golden.label("traffic_jam", mode))
