@@ -1,7 +1,8 @@
 """The vendored ASAM/BMW ALKS (UN R157) scenario set as the scenario tests run it: each file
 with its default parameters until its StopTrigger, under the `r157` criteria set, with the
 `default` sensor profile: the `fast` one's LiDAR (half the columns) first sees the standing
-pedestrian of 4.2.1 too late to stop for it from 60 km/h."""
+pedestrian of 4.2.1 too late to stop for it from 60 km/h. `run(..., stack=TRUTH)` runs a file
+on the privileged ground truth instead (profile `none`: `tests.scenarios.modes`)."""
 
 from __future__ import annotations
 

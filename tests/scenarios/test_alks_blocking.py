@@ -1,7 +1,12 @@
 """ALKS (UN R157) 4.2.x blocking targets and 4.5.x cut-outs revealing them: a pedestrian (and
 a bus) standing in the ego's lane 500 m ahead, or crossing it, or behind a lead that changes
 lanes away at the last moment. The ego stops short of them, unless the target crosses into
-its lane too close for its LiDAR to see in time."""
+its lane too close for its LiDAR to see in time.
+
+Each test runs twice (`tests.scenarios.modes`): `[truth]`, the bundled planner and control on
+the privileged ground truth (profile `none`), in `make test`; `[sensors]`, the whole stack on
+the `default` profile's cameras and LiDAR, in `make acceptance`. The LiDAR's
+tracking range of the crossing walker is judged on the sensor run only."""
 
 from __future__ import annotations
 

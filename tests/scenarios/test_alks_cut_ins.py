@@ -1,5 +1,11 @@
 """ALKS (UN R157) scenarios with a vehicle coming in or beside: 4.4.x cut-ins (avoidable and
-unavoidable under 5.2.5.2), 4.6.x detection ranges."""
+unavoidable under 5.2.5.2), 4.6.x detection ranges.
+
+The 4.4.x runs judge the planner and control, twice (`tests.scenarios.modes`): `[truth]`, the
+bundled planner and control on the privileged ground truth (profile `none`), in `make test`;
+`[sensors]`, the whole stack on the `default` profile's cameras and LiDAR, in `make
+acceptance`. The 4.6.x runs judge the LiDAR's detection range: with the sensors, in `make
+test`."""
 
 from __future__ import annotations
 

@@ -1,6 +1,11 @@
 """ICCAS cut in and out, UN R157's cut-in: the car did cut in close ahead and out again; the
 ego braked eased and no harder than 3.5 m/s^2, kept d_min outside the 10 s after the
-cut-in, and regained its set speed within 15 s of the cut-out."""
+cut-in, and regained its set speed within 15 s of the cut-out.
+
+Each test runs twice (`tests.scenarios.modes`): `[truth]`, the bundled planner and control on
+the privileged ground truth (profile `none`), in `make test`; `[sensors]`, the whole stack on
+the `default` profile's cameras and LiDAR, in `make acceptance`. Each run has its own
+golden file (`cut_in_out.truth`, `cut_in_out`)."""
 
 from __future__ import annotations
 

@@ -1,6 +1,11 @@
 """ICCAS external disturbance: the driver holds the accelerator fully down for 5 s. The
 drive-by-wire stack lets the car speed up to the posted limit and no further (limit + 1 km/h),
-keeps it in its lane; following a lead, lets it close up but never below UN R157's d_min."""
+keeps it in its lane; following a lead, lets it close up but never below UN R157's d_min.
+
+Each test runs twice (`tests.scenarios.modes`): `[truth]`, the bundled planner and control on
+the privileged ground truth (profile `none`), in `make test`; `[sensors]`, the whole stack on
+the `default` profile's cameras and LiDAR, in `make acceptance`.
+Each run has its own golden file (`NAME.truth`, `NAME`)."""
 
 from __future__ import annotations
 

@@ -2,7 +2,13 @@
 left to pass it (the motion FSM's decision from the tracks), without contact, taking under
 5 s from leaving its lane to being inside the target lane, at no more than 1 m/s^2 of lateral
 acceleration; once the passed car is 2 s behind it keeps right (issue K, item 7), and ends
-with every tyre inside its lane."""
+with every tyre inside its lane.
+
+Each test runs twice (`tests.scenarios.modes`): `[truth]`, the bundled planner and control on
+the privileged ground truth (profile `none`), in `make test`; `[sensors]`, the whole stack on
+the `default` profile's cameras and LiDAR, in `make acceptance`. The camera's lane is judged
+on the sensor run only. Each run has its own golden file (`lane_change.truth`,
+`lane_change`)."""
 
 from __future__ import annotations
 

@@ -1,8 +1,12 @@
 """A pass through the oncoming lane on a road with one lane each way (30 km/h, a broken
 centre line): a van stands in the ego's lane; the oncoming car comes past first while the
 ego waits behind the van (the reason logged); then the ego passes through the oncoming lane
-and returns to its own lane once the van is behind, with the stack's own perception (the
-default sensor profile)."""
+and returns to its own lane once the van is behind.
+
+Each test runs twice (`tests.scenarios.modes`): `[truth]`, the bundled planner and control on
+the privileged ground truth (profile `none`), in `make test`; `[sensors]`, the whole stack on
+the `default` profile's cameras and LiDAR, in `make acceptance`. Each run has its own
+golden file (`overtake_two_lane.truth`, `overtake_two_lane`)."""
 
 from __future__ import annotations
 

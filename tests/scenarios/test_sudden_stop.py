@@ -1,6 +1,11 @@
 """ICCAS sudden stop: the car ahead brakes at 6 m/s^2 to a stop from 50 km/h, 12 m ahead
 (Euro NCAP CCRb) and 1.5 s ahead (UN R157); the ego stops behind it without contact, at
-least 0.5 m short, in its lane, and follows it off again."""
+least 0.5 m short, in its lane, and follows it off again.
+
+Each test runs twice (`tests.scenarios.modes`): `[truth]`, the bundled planner and control on
+the privileged ground truth (profile `none`), in `make test`; `[sensors]`, the whole stack on
+the `default` profile's cameras and LiDAR, in `make acceptance`. Each run has its own
+golden file (`NAME.truth`, `NAME`)."""
 
 from __future__ import annotations
 

@@ -1,6 +1,11 @@
 """ICCAS traffic jam: the lead brakes to a stop at 1 m/s^2, waits 10 s and drives off,
 twice. The ego stops 2-6 m behind, moves off within 2 s of the lead, keeps UN R157's d_min
-while moving, and is back at its set speed when the jam clears."""
+while moving, and is back at its set speed when the jam clears.
+
+Each test runs twice (`tests.scenarios.modes`): `[truth]`, the bundled planner and control on
+the privileged ground truth (profile `none`), in `make test`; `[sensors]`, the whole stack on
+the `default` profile's cameras and LiDAR, in `make acceptance`. Each run has its own
+golden file (`traffic_jam.truth`, `traffic_jam`)."""
 
 from __future__ import annotations
 
