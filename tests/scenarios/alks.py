@@ -1,7 +1,8 @@
 """The vendored ASAM/BMW ALKS (UN R157) scenario set as the scenario tests run it: each file
 with its default parameters until its StopTrigger, under the `r157` criteria set, with the
 `default` sensor profile: the `fast` one's LiDAR (half the columns) first sees the standing
-pedestrian of 4.2.1 too late to stop for it from 60 km/h."""
+pedestrian of 4.2.1 too late to stop for it from 60 km/h. `run(..., stack=TRUTH)` runs a file
+on the privileged ground truth instead (profile `none`: `tests.scenarios.modes`)."""
 
 from __future__ import annotations
 
@@ -13,6 +14,7 @@ from numpy.typing import NDArray
 
 from avsim.criteria.base import CriterionResult, Verdict
 from avsim.run.runner import RunResult
+from tests.scenarios.modes import SENSORS
 from world.sensors.setup import Profile
 
 ALKS = (Path(__file__).parents[1] / "data" / "alks" / "logical_scenarios"
@@ -29,9 +31,11 @@ def path(number: str) -> Path:
     return found
 
 
-def run(run_scenario: Callable[..., RunResult], number: str, **overrides: object) -> RunResult:
+def run(run_scenario: Callable[..., RunResult], number: str, stack: str = SENSORS,
+        **overrides: object) -> RunResult:
+    """ALKS scenario `number` in stack mode `stack` (`tests.scenarios.modes`)."""
     return run_scenario(str(path(number)), record=False, profile=PROFILE, criteria="r157",
-                        **overrides)
+                        stack=stack, **overrides)
 
 
 def run_on_the_map(run_scenario: Callable[..., RunResult], number: str) -> RunResult:

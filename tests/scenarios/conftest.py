@@ -1,4 +1,10 @@
-"""Closed-loop scenario runs, shared by the tests of one module (runs are slow)."""
+"""Closed-loop scenario runs, shared by the tests of one module (runs are slow).
+
+A module that judges the planner, control or the storyboard and not perception runs its
+scenarios in two stack modes (`mode`): `truth`, the bundled planner and control on the
+privileged ground truth (`avsim.stack.bundled:truth_perception`, profile `none`: nothing
+rendered) in `make test`; and `sensors`, the whole stack on the `default` profile's cameras
+and LiDAR, marked `acceptance` (`make acceptance`)."""
 
 from __future__ import annotations
 
@@ -10,6 +16,7 @@ import pytest
 from avsim.run.runner import Runner, RunResult
 from avsim.run.sensor_loop import FrameHook
 from avsim.scenario.load import load_scenario
+from tests.scenarios.modes import MODES, SENSORS, TRUTH, TRUTH_STACK
 from world.sensors.setup import Profile
 
 SENSING = "inline"  # the cameras render in the test's own process: xdist keeps both cores
@@ -18,21 +25,34 @@ SENSING = "inline"  # the cameras render in the test's own process: xdist keeps 
 #   four processes with it, 18.0 s inline. The two give the same run, bit for bit
 #   (tests/avsim/run/test_speedups.py, tests/world/sensors/test_pipeline.py).
 
+@pytest.fixture(scope="module", params=MODES)
+def mode(request: pytest.FixtureRequest) -> str:
+    """The stack mode of a module's runs: `truth` (make test) or `sensors` (acceptance)."""
+    out: str = request.param
+    return out
+
 
 @pytest.fixture(scope="module")
 def run_scenario(tmp_path_factory: pytest.TempPathFactory) -> Callable[..., RunResult]:
     """`run(name, record=True, profile=Profile.DEFAULT, frame_hook=None, criteria=None,
-    **overrides)`: one run per distinct argument set in this module (`name` a bundled
-    scenario or a file; `criteria` an OpenSCENARIO file's criteria set or sidecar)."""
+    stack=SENSORS, **overrides)`: one run per distinct argument set in this module (`name` a
+    bundled scenario or a file; `criteria` an OpenSCENARIO file's criteria set or sidecar;
+    `stack=TRUTH` the privileged truth stack, which renders nothing: `profile` set aside)."""
     cache: dict[str, RunResult] = {}
 
     def run(name: str, record: bool = True, profile: Profile | None = Profile.DEFAULT,
             frame_hook: FrameHook | None = None, criteria: str | None = None,
-            **overrides: object) -> RunResult:
+            stack: str = SENSORS, **overrides: object) -> RunResult:
+        if stack == TRUTH:
+            profile = None
+            overrides = {**overrides, **TRUTH_STACK}
+        elif stack != SENSORS:
+            raise ValueError(f"stack mode {stack!r}: {TRUTH!r} or {SENSORS!r}")
         key = repr((name, record, profile, frame_hook, criteria, sorted(overrides.items())))
         if key not in cache:
             scenario = load_scenario(name, overrides or None,
                                      Path(criteria) if criteria is not None else None)
+            assert scenario.stack.privileged == (stack == TRUTH)  # the mode asked is the run's
             out: Path | None = (tmp_path_factory.mktemp("runs") / f"{scenario.name}.rrd"
                                 if record else None)
             cache[key] = Runner(scenario, out, profile=profile, frame_hook=frame_hook,

@@ -28,6 +28,7 @@ import numpy as np
 
 from avsim.run.result import dumps, result_json
 from avsim.run.runner import RunResult
+from tests.scenarios.modes import SENSORS
 
 GOLDEN_DIR = Path(__file__).resolve().parent / "golden"
 WRITE = os.environ.get("AVSIM_GOLDEN") == "write"
@@ -113,3 +114,9 @@ def strict_json(text: str) -> object:
     def refuse(constant: str) -> object:
         raise AssertionError(f"the result file is not strict JSON: {constant}")
     return json.loads(text, parse_constant=refuse)
+
+
+def label(name: str, mode: str) -> str:
+    """The golden file of a run in stack mode `mode` (`tests.scenarios.modes`): the sensor
+    run keeps the module's `name`, the privileged truth run is `name.truth`."""
+    return name if mode == SENSORS else f"{name}.truth"

@@ -1,7 +1,12 @@
 """ALKS (UN R157) 4.2.x blocking targets and 4.5.x cut-outs revealing them: a pedestrian (and
 a bus) standing in the ego's lane 500 m ahead, or crossing it, or behind a lead that changes
 lanes away at the last moment. The ego stops short of them, unless the target crosses into
-its lane too close for its LiDAR to see in time."""
+its lane too close for its LiDAR to see in time.
+
+Each test runs twice (`tests.scenarios.modes`): `[truth]`, the bundled planner and control on
+the privileged ground truth (profile `none`), in `make test`; `[sensors]`, the whole stack on
+the `default` profile's cameras and LiDAR, in `make acceptance`. The LiDAR's
+tracking range of the crossing walker is judged on the sensor run only."""
 
 from __future__ import annotations
 
@@ -12,13 +17,14 @@ import pytest
 
 from avsim.run.runner import RunResult
 from tests.scenarios import alks
+from tests.scenarios.modes import SENSORS
 
 pytestmark = pytest.mark.slow
 
 
 @pytest.fixture(scope="module")
-def runs(run_scenario: Callable[..., RunResult]) -> dict[str, RunResult]:
-    return {n: alks.run(run_scenario, n) for n in ("4_2_1", "4_2_2", "4_2_3", "4_2_4")}
+def runs(run_scenario: Callable[..., RunResult], mode: str) -> dict[str, RunResult]:
+    return {n: alks.run(run_scenario, n, stack=mode) for n in ("4_2_1", "4_2_2", "4_2_3", "4_2_4")}
 
 
 @pytest.mark.parametrize("number", ["4_2_1", "4_2_2", "4_2_4"])
@@ -57,12 +63,15 @@ def test_the_pedestrian_crosses_the_ego_lane(runs: dict[str, RunResult]) -> None
     assert alks.in_ego_lane(offset).any()  # it walked into the lane
 
 
-def test_the_ego_does_not_hit_the_crossing_pedestrian(runs: dict[str, RunResult]) -> None:
+def test_the_ego_does_not_hit_the_crossing_pedestrian(runs: dict[str, RunResult],
+                                                      mode: str) -> None:
     """One LiDAR ring crosses the walker beyond 30 m, on two or three columns: it is tracked
     as a pedestrian from about 55 m, on the road's edge, and its walk is seen to cross the
-    car's path: the car slows for it before it steps into the lane, and drives on after."""
+    car's path: the car slows for it before it steps into the lane, and drives on after.
+    On the truth (a track from the start) the tracking range is not judged."""
     result = runs["4_2_3"]
-    assert result.metrics["first_tracked_distance_targetblocking"] > 45.0
+    if mode == SENSORS:
+        assert result.metrics["first_tracked_distance_targetblocking"] > 45.0
     assert not alks.failed(result), alks.failed(result)
     s, offset = alks.actor(result, "TargetBlocking")
     ahead = s - result.log.array("station")

@@ -1,5 +1,11 @@
 """ALKS (UN R157) scenarios with a vehicle coming in or beside: 4.4.x cut-ins (avoidable and
-unavoidable under 5.2.5.2), 4.6.x detection ranges."""
+unavoidable under 5.2.5.2), 4.6.x detection ranges.
+
+The 4.4.x runs judge the planner and control, twice (`tests.scenarios.modes`): `[truth]`, the
+bundled planner and control on the privileged ground truth (profile `none`), in `make test`;
+`[sensors]`, the whole stack on the `default` profile's cameras and LiDAR, in `make
+acceptance`. The 4.6.x runs judge the LiDAR's detection range: with the sensors, in `make
+test`."""
 
 from __future__ import annotations
 
@@ -17,8 +23,14 @@ pytestmark = pytest.mark.slow
 
 
 @pytest.fixture(scope="module")
-def runs(run_scenario: Callable[..., RunResult]) -> dict[str, RunResult]:
-    return {n: alks.run(run_scenario, n) for n in ("4_4_1", "4_4_2", "4_6_1", "4_6_2")}
+def runs(run_scenario: Callable[..., RunResult], mode: str) -> dict[str, RunResult]:
+    return {n: alks.run(run_scenario, n, stack=mode) for n in ("4_4_1", "4_4_2")}
+
+
+@pytest.fixture(scope="module")
+def detection(run_scenario: Callable[..., RunResult]) -> dict[str, RunResult]:
+    """The 4.6.x runs judge the LiDAR's detection range: with the sensors, in `make test`."""
+    return {n: alks.run(run_scenario, n) for n in ("4_6_1", "4_6_2")}
 
 
 @pytest.mark.parametrize("number", ["4_4_1", "4_4_2"])
@@ -69,9 +81,9 @@ def test_a_cut_in_r157_calls_unavoidable_is_not_failed(runs: dict[str, RunResult
     ("4_6_1", "TargetBlocking"),
     ("4_6_2", "SideVehicle"),
 ])
-def test_the_detection_range_is_reported(runs: dict[str, RunResult], number: str,
+def test_the_detection_range_is_reported(detection: dict[str, RunResult], number: str,
                                          entity: str) -> None:
-    result = runs[number]
+    result = detection[number]
     assert alks.ended_by_stop_trigger(result)
     distance = result.metrics[f"first_tracked_distance_{entity.lower()}"]
     assert 0.0 < distance < 100.0  # tracked, within the LiDAR's 100 m
@@ -80,10 +92,11 @@ def test_the_detection_range_is_reported(runs: dict[str, RunResult], number: str
     assert not alks.failed(result), alks.failed(result)
 
 
-def test_the_motorbike_beside_is_detected_as_a_motorcycle(runs: dict[str, RunResult]) -> None:
+def test_the_motorbike_beside_is_detected_as_a_motorcycle(
+        detection: dict[str, RunResult]) -> None:
     """Its 2.2 m side beside the car is boxed as a motorcycle's where it is (a truck's rear
     grown 6.7 m away before the class existed: never matched, never tracked)."""
-    metrics = runs["4_6_2"].metrics
+    metrics = detection["4_6_2"].metrics
     assert metrics["detection_precision_motorcycle"] == 1.0  # called so, and on it
     assert metrics["detection_recall_motorbike"] > 0.9
     assert metrics["track_recall_motorbike"] > 0.9

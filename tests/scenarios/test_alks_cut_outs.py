@@ -1,5 +1,9 @@
 """ALKS (UN R157) 4.5.x cut-outs: a lead changes lanes away 50 m before a pedestrian (and a
-bus) standing in the ego's lane; the ego stops short of them."""
+bus) standing in the ego's lane; the ego stops short of them.
+
+Each test runs twice (`tests.scenarios.modes`): `[truth]`, the bundled planner and control on
+the privileged ground truth (profile `none`), in `make test`; `[sensors]`, the whole stack on
+the `default` profile's cameras and LiDAR, in `make acceptance`."""
 
 from __future__ import annotations
 
@@ -14,8 +18,8 @@ pytestmark = pytest.mark.slow
 
 
 @pytest.fixture(scope="module")
-def runs(run_scenario: Callable[..., RunResult]) -> dict[str, RunResult]:
-    return {n: alks.run(run_scenario, n) for n in ("4_5_1", "4_5_2")}
+def runs(run_scenario: Callable[..., RunResult], mode: str) -> dict[str, RunResult]:
+    return {n: alks.run(run_scenario, n, stack=mode) for n in ("4_5_1", "4_5_2")}
 
 
 @pytest.mark.parametrize("number", ["4_5_1", "4_5_2"])

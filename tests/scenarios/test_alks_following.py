@@ -1,5 +1,9 @@
 """ALKS (UN R157) scenarios following a lead vehicle: 4.1.2 a swerving lead, 4.3.1 a lead
-varying its speed, 4.3.2 a lead braking at 9.81 m/s^2."""
+varying its speed, 4.3.2 a lead braking at 9.81 m/s^2.
+
+Each test runs twice (`tests.scenarios.modes`): `[truth]`, the bundled planner and control on
+the privileged ground truth (profile `none`), in `make test`; `[sensors]`, the whole stack on
+the `default` profile's cameras and LiDAR, in `make acceptance`."""
 
 from __future__ import annotations
 
@@ -15,8 +19,8 @@ pytestmark = pytest.mark.slow
 
 
 @pytest.fixture(scope="module")
-def runs(run_scenario: Callable[..., RunResult]) -> dict[str, RunResult]:
-    return {n: alks.run(run_scenario, n) for n in ("4_1_2", "4_3_1", "4_3_2")}
+def runs(run_scenario: Callable[..., RunResult], mode: str) -> dict[str, RunResult]:
+    return {n: alks.run(run_scenario, n, stack=mode) for n in ("4_1_2", "4_3_1", "4_3_2")}
 
 
 

@@ -1,6 +1,11 @@
 """ICCAS cut in and out, UN R157's cut-in: the car did cut in close ahead and out again; the
 ego braked eased and no harder than 3.5 m/s^2, kept d_min outside the 10 s after the
-cut-in, and regained its set speed within 15 s of the cut-out."""
+cut-in, and regained its set speed within 15 s of the cut-out.
+
+Each test runs twice (`tests.scenarios.modes`): `[truth]`, the bundled planner and control on
+the privileged ground truth (profile `none`), in `make test`; `[sensors]`, the whole stack on
+the `default` profile's cameras and LiDAR, in `make acceptance`. Each run has its own
+golden file (`cut_in_out.truth`, `cut_in_out`)."""
 
 from __future__ import annotations
 
@@ -17,8 +22,8 @@ KPH = 1 / 3.6
 
 
 @pytest.fixture(scope="module")
-def result(run_scenario: Callable[..., RunResult]) -> RunResult:
-    return run_scenario("cut_in_out", record=False)
+def result(run_scenario: Callable[..., RunResult], mode: str) -> RunResult:
+    return run_scenario("cut_in_out", record=False, stack=mode)
 
 
 def test_the_cut_in_and_out_happened(result: RunResult) -> None:
@@ -55,5 +60,5 @@ def test_verdict_and_the_r157_figures(result: RunResult) -> None:
     assert len(back) and back[0] - t_cruise <= 15.0
 
 
-def test_result_matches_golden(result: RunResult) -> None:
-    golden.check(result, "cut_in_out")
+def test_result_matches_golden(result: RunResult, mode: str) -> None:
+    golden.check(result, golden.label("cut_in_out", mode))

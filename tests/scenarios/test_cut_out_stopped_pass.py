@@ -1,11 +1,15 @@
 """A stopped car revealed late by a cut-out, overtaking on (`scenarios/acceptance/
-cut_out_stopped_pass.yaml`, `default` profile): the lead, 2 s ahead at 50 km/h, starts its
+cut_out_stopped_pass.yaml`): the lead, 2 s ahead at 50 km/h, starts its
 lane change 30 m short of a car stopped in the ego's lane. The stop that follows is a hard one;
 the ego ends it where a pass path clears the stopped car (not at the ACC's d0, from where no
 forward path gets around it), passes it through the left lane and keeps right again.
 
 The situation is asserted from the truth (the actors' stations and offsets), then the
-verdicts."""
+verdicts.
+
+Each test runs twice (`tests.scenarios.modes`): `[truth]`, the bundled planner and control on
+the privileged ground truth (profile `none`), in `make test`; `[sensors]`, the whole stack on
+the `default` profile's cameras and LiDAR, in `make acceptance`."""
 
 from __future__ import annotations
 
@@ -26,8 +30,8 @@ FILE = "scenarios/acceptance/cut_out_stopped_pass.yaml"
 
 
 @pytest.fixture(scope="module")
-def result(run_scenario: Callable[..., RunResult]) -> RunResult:
-    return run_scenario(FILE, record=False)
+def result(run_scenario: Callable[..., RunResult], mode: str) -> RunResult:
+    return run_scenario(FILE, record=False, stack=mode)
 
 
 def _actor(result: RunResult, name: str) -> tuple[NDArray[np.float64], NDArray[np.float64]]:

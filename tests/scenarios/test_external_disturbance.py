@@ -1,6 +1,11 @@
 """ICCAS external disturbance: the driver holds the accelerator fully down for 5 s. The
 drive-by-wire stack lets the car speed up to the posted limit and no further (limit + 1 km/h),
-keeps it in its lane; following a lead, lets it close up but never below UN R157's d_min."""
+keeps it in its lane; following a lead, lets it close up but never below UN R157's d_min.
+
+Each test runs twice (`tests.scenarios.modes`): `[truth]`, the bundled planner and control on
+the privileged ground truth (profile `none`), in `make test`; `[sensors]`, the whole stack on
+the `default` profile's cameras and LiDAR, in `make acceptance`.
+Each run has its own golden file (`NAME.truth`, `NAME`)."""
 
 from __future__ import annotations
 
@@ -21,13 +26,13 @@ KPH = 1 / 3.6
 
 
 @pytest.fixture(scope="module")
-def alone(run_scenario: Callable[..., RunResult]) -> RunResult:
-    return run_scenario("external_disturbance", record=False)
+def alone(run_scenario: Callable[..., RunResult], mode: str) -> RunResult:
+    return run_scenario("external_disturbance", record=False, stack=mode)
 
 
 @pytest.fixture(scope="module")
-def following(run_scenario: Callable[..., RunResult]) -> RunResult:
-    return run_scenario("external_disturbance_following", record=False)
+def following(run_scenario: Callable[..., RunResult], mode: str) -> RunResult:
+    return run_scenario("external_disturbance_following", record=False, stack=mode)
 
 
 def _pressed(r: RunResult) -> np.ndarray:
@@ -71,6 +76,6 @@ def test_following_the_pedal_closes_up_but_never_below_d_min(following: RunResul
     assert gap[-1] == pytest.approx(gaps(v[-1], v[-1], AccParams()).d_des, abs=2.0)  # after
 
 
-def test_results_match_golden(alone: RunResult, following: RunResult) -> None:
-    golden.check(alone, "external_disturbance")
-    golden.check(following, "external_disturbance_following")
+def test_results_match_golden(alone: RunResult, following: RunResult, mode: str) -> None:
+    golden.check(alone, golden.label("external_disturbance", mode))
+    golden.check(following, golden.label("external_disturbance_following", mode))

@@ -1,12 +1,16 @@
 """A fast car coming up behind in the lane a slow ego would pass through
-(`scenarios/acceptance/overtake_rear_traffic.yaml`, `default` profile): the ego follows a car
+(`scenarios/acceptance/overtake_rear_traffic.yaml`): the ego follows a car
 at 20 km/h (overtaking on, set speed 35 km/h) when a car at 65 km/h comes up in the left lane,
 in sight and about 40 m back, as the pass is decided. UN R157's rear rule alone (the car
 behind brakes at up to 3 m/s^2) lets the ego move out; the car, which does not brake, would
 close on it during the slow change. The ego waits, then passes once that car has gone by.
 
 The situation is asserted from the truth (the actors' stations and offsets), then the
-verdicts."""
+verdicts.
+
+Each test runs twice (`tests.scenarios.modes`): `[truth]`, the bundled planner and control on
+the privileged ground truth (profile `none`), in `make test`; `[sensors]`, the whole stack on
+the `default` profile's cameras and LiDAR, in `make acceptance`."""
 
 from __future__ import annotations
 
@@ -28,8 +32,8 @@ FILE = "scenarios/acceptance/overtake_rear_traffic.yaml"
 
 
 @pytest.fixture(scope="module")
-def result(run_scenario: Callable[..., RunResult]) -> RunResult:
-    return run_scenario(FILE, record=False)
+def result(run_scenario: Callable[..., RunResult], mode: str) -> RunResult:
+    return run_scenario(FILE, record=False, stack=mode)
 
 
 def _actor(result: RunResult, name: str) -> tuple[NDArray[np.float64], NDArray[np.float64]]:

@@ -1,8 +1,12 @@
 """A pass through the oncoming lane on a road with one lane each way (30 km/h, a broken
 centre line): a van stands in the ego's lane; the oncoming car comes past first while the
 ego waits behind the van (the reason logged); then the ego passes through the oncoming lane
-and returns to its own lane once the van is behind, with the stack's own perception (the
-default sensor profile)."""
+and returns to its own lane once the van is behind.
+
+Each test runs twice (`tests.scenarios.modes`): `[truth]`, the bundled planner and control on
+the privileged ground truth (profile `none`), in `make test`; `[sensors]`, the whole stack on
+the `default` profile's cameras and LiDAR, in `make acceptance`. Each run has its own
+golden file (`overtake_two_lane.truth`, `overtake_two_lane`)."""
 
 from __future__ import annotations
 
@@ -20,8 +24,8 @@ LANE_WIDTH = 3.5  # [m] the scenario's; the road runs along +x from the origin: 
 
 
 @pytest.fixture(scope="module")
-def result(run_scenario: Callable[..., RunResult]) -> RunResult:
-    return run_scenario("overtake_two_lane", record=False)
+def result(run_scenario: Callable[..., RunResult], mode: str) -> RunResult:
+    return run_scenario("overtake_two_lane", record=False, stack=mode)
 
 
 def _actor(result: RunResult, name: str) -> tuple[np.ndarray, np.ndarray]:
@@ -82,5 +86,5 @@ def test_verdicts(result: RunResult) -> None:
     assert result.sim_time is not None and result.sim_time < 40.0
 
 
-def test_result_matches_golden(result: RunResult) -> None:
-    golden.check(result, "overtake_two_lane")
+def test_result_matches_golden(result: RunResult, mode: str) -> None:
+    golden.check(result, golden.label("overtake_two_lane", mode))

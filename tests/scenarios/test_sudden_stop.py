@@ -1,6 +1,11 @@
 """ICCAS sudden stop: the car ahead brakes at 6 m/s^2 to a stop from 50 km/h, 12 m ahead
 (Euro NCAP CCRb) and 1.5 s ahead (UN R157); the ego stops behind it without contact, at
-least 0.5 m short, in its lane, and follows it off again."""
+least 0.5 m short, in its lane, and follows it off again.
+
+Each test runs twice (`tests.scenarios.modes`): `[truth]`, the bundled planner and control on
+the privileged ground truth (profile `none`), in `make test`; `[sensors]`, the whole stack on
+the `default` profile's cameras and LiDAR, in `make acceptance`. Each run has its own
+golden file (`NAME.truth`, `NAME`)."""
 
 from __future__ import annotations
 
@@ -21,9 +26,9 @@ CASES = {"sudden_stop": (1.0, 12.0), "sudden_stop_headway": (3.0, 50 * KPH * 1.5
 
 
 @pytest.fixture(scope="module", params=sorted(CASES))
-def result(request: pytest.FixtureRequest,
-           run_scenario: Callable[..., RunResult]) -> RunResult:
-    return run_scenario(request.param, record=False)
+def result(request: pytest.FixtureRequest, run_scenario: Callable[..., RunResult],
+           mode: str) -> RunResult:
+    return run_scenario(request.param, record=False, stack=mode)
 
 
 def _lead(result: RunResult) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -70,5 +75,5 @@ def test_the_control_fsm_brakes_to_a_stop(result: RunResult) -> None:
         assert result.metrics["max_decel"] > 4.5
 
 
-def test_result_matches_golden(result: RunResult) -> None:
-    golden.check(result, result.scenario.name)
+def test_result_matches_golden(result: RunResult, mode: str) -> None:
+    golden.check(result, golden.label(result.scenario.name, mode))

@@ -1,6 +1,11 @@
 """ICCAS traffic jam: the lead brakes to a stop at 1 m/s^2, waits 10 s and drives off,
 twice. The ego stops 2-6 m behind, moves off within 2 s of the lead, keeps UN R157's d_min
-while moving, and is back at its set speed when the jam clears."""
+while moving, and is back at its set speed when the jam clears.
+
+Each test runs twice (`tests.scenarios.modes`): `[truth]`, the bundled planner and control on
+the privileged ground truth (profile `none`), in `make test`; `[sensors]`, the whole stack on
+the `default` profile's cameras and LiDAR, in `make acceptance`. Each run has its own
+golden file (`traffic_jam.truth`, `traffic_jam`)."""
 
 from __future__ import annotations
 
@@ -20,8 +25,8 @@ KPH = 1 / 3.6
 
 
 @pytest.fixture(scope="module")
-def result(run_scenario: Callable[..., RunResult]) -> RunResult:
-    return run_scenario("traffic_jam", record=False)
+def result(run_scenario: Callable[..., RunResult], mode: str) -> RunResult:
+    return run_scenario("traffic_jam", record=False, stack=mode)
 
 
 def _intervals(mask: np.ndarray, t: np.ndarray) -> list[tuple[float, float]]:
@@ -67,11 +72,12 @@ def test_verdict_and_back_to_set_speed(result: RunResult) -> None:
     "max_decel 1.512 m/s^2: at 54.5 s, trailing the lead braking at 1.0 m/s^2 (a_gentle), "
     "the trail law's d_des'(v) x gap_rate term follows the noise of the lead's estimated "
     "acceleration about the taper at a_gentle and the planned speed dips 0.33 m/s in 0.2 s; "
-    "1.481 before the localiser's rear-axle turn and the pull-away feed-forward"))
+    "1.481 before the localiser's rear-axle turn and the pull-away feed-forward; 1.534 on "
+    "the privileged truth (exact velocities, no estimation noise): the trail law's own"))
 def test_the_jam_is_taken_gently(result: RunResult) -> None:
     c = {r.name: r for r in result.criteria}
     assert c["max_decel"].value <= 1.5  # the lead brakes at 1.0 m/s^2
 
 
-def test_result_matches_golden(result: RunResult) -> None:
-    golden.check(result, "traffic_jam")
+def test_result_matches_golden(result: RunResult, mode: str) -> None:
+    golden.check(result, golden.label("traffic_jam", mode))

@@ -1,0 +1,16 @@
+"""The two stack modes of a scenario test module's runs (`run_scenario(..., stack=mode)`):
+`truth`, the bundled planner and control on the privileged ground truth in `make test`, and
+`sensors`, the whole stack on the cameras and LiDAR in `make acceptance`."""
+
+from __future__ import annotations
+
+import pytest
+
+TRUTH = "truth"  # the privileged truth stack on profile `none`
+SENSORS = "sensors"  # the scenario's own stack and sensors, as asked (`profile`)
+TRUTH_STACK: dict[str, object] = {
+    "stack.perception": "avsim.stack.bundled:truth_perception",
+    "stack.privileged": True,
+}  # the overrides that hand the bundled planner the ground truth
+MODES = [pytest.param(TRUTH, id=TRUTH),
+         pytest.param(SENSORS, id=SENSORS, marks=pytest.mark.acceptance)]
