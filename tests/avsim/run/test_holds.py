@@ -28,10 +28,19 @@ def change(t: float, source: str, target: str, machine: str = "acc") -> StateCha
     # ... and so is a short hold of the braking mode itself
     ([change(0.0, "acc_off", "cruise"), change(5.0, "cruise", "brake"),
       change(5.1, "brake", "trail"), change(8.0, "trail", "cruise")], pytest.approx(2.9)),
+    # the mode switched on in is held until the first choice (a lead confirmed): not counted
+    ([change(0.0, "acc_off", "cruise"), change(0.3, "cruise", "trail"),
+      change(80.0, "trail", "cruise")], pytest.approx(79.7)),
+    # ... also when the machine is switched on again later (a driver's override ends); the
+    # off state is no mode
+    ([change(0.0, "acc_off", "cruise"), change(4.0, "cruise", "trail"),
+      change(9.0, "trail", "acc_off"), change(12.0, "acc_off", "trail"),
+      change(12.2, "trail", "cruise"), change(20.0, "cruise", "trail")],
+     pytest.approx(5.0)),
     # other machines' changes are not this machine's holds
-    ([change(0.0, "acc_off", "cruise"), change(0.2, "keep", "change", "motion"),
-      change(0.3, "change", "keep", "motion"), change(3.0, "cruise", "trail")],
-     pytest.approx(3.0)),
+    ([change(0.0, "acc_off", "cruise"), change(1.0, "cruise", "trail"),
+      change(1.2, "keep", "change", "motion"), change(1.3, "change", "keep", "motion"),
+      change(4.0, "trail", "cruise")], pytest.approx(3.0)),
 ])
 def test_shortest_hold(changes: list[StateChange], expected: object) -> None:
     assert shortest_hold(changes, "acc") == expected
