@@ -12,9 +12,12 @@
   checked up to there, by its `--help` and by the recording the page names being one an
   earlier command wrote (or `make demo` writes). Commands run in a fresh folder that links
   the project's `scenarios/`, `docs/`, `tests/` and `examples/` (so the pages' relative
-  paths hold) and takes every output.
+  paths hold) and takes every output, through the command's entry point in this process
+  (click's runner, `tests.avsim.invoke`: an interpreter start and avsim's imports cost
+  about 2 s a command, most of a shortened run; the exit status, output and files are what
+  is judged); an exception that is not an exit fails the test as a traceback would.
 - A command in any other fenced block is an error: a page cannot hide one from this test.
-- The minimal OpenSCENARIO example runs in full and passes.
+- The minimal OpenSCENARIO example runs in full and passes, as a real process.
 """
 
 from __future__ import annotations
@@ -34,6 +37,7 @@ import pytest
 from avsim.scenario.errors import ScenarioError
 from avsim.scenario.load import load_scenario
 from avsim.scenario.profile_fit import CAMERALESS, check_profile
+from tests.avsim.invoke import invoke
 
 REPO = Path(__file__).resolve().parents[1]
 PAGES = [REPO / "README.md", *sorted((REPO / "docs").glob("*.md"))]
@@ -160,13 +164,13 @@ def _check(command: Command, cwd: Path, done_before: set[tuple[str, ...]]) -> No
     words = _expand(command.words, cwd)
     what = f"{command.page}: avsim {' '.join(command.words)}"
     if words[0] == "view":  # needs a display: checked up to it (module doc)
-        done = _avsim(["view", "--help"], cwd)
+        done = invoke("view", "--help", cwd=cwd)
         assert done.returncode == 0, (what, done.stderr)
         recording = next(w for w in words[1:] if not w.startswith("-"))
         assert (cwd / recording).is_file(), (what, "no earlier command wrote it")
         return
     if words[0] in ("suite", "sweep", "campaign"):
-        done = _avsim([*words, "--dry-run"], cwd)
+        done = invoke(*words, "--dry-run", cwd=cwd)
         assert done.returncode == 0, (what, done.stderr)
         planned = done.stdout.splitlines()
         assert planned and all(line.startswith("avsim run ") for line in planned), what
@@ -178,7 +182,7 @@ def _check(command: Command, cwd: Path, done_before: set[tuple[str, ...]]) -> No
     if (*words, str(command.stdout_to)) in done_before:
         return
     done_before.add((*words, str(command.stdout_to)))
-    done = _avsim(words, cwd)
+    done = invoke(*words, cwd=cwd)
     allowed = RUN_EXIT if words[0] == "run" else (0,)
     assert done.returncode in allowed, (what, words, done.returncode, done.stderr[-2000:])
     assert "Traceback" not in done.stderr, (what, done.stderr[-2000:])
