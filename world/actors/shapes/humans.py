@@ -15,13 +15,19 @@ legs at +-A) both feet are on the ground, and at 0.25 and 0.75 (mid stance: the 
 leg vertical) the head is at the full stature. The stride (2 A of hip swing) is bounded by
 the targets' published envelope (0.60 m long for the EPTa): `HIP_SWING` and `KNEE_BEND`
 are the largest round figures whose every phase stays inside it, smaller than a free
-walker's (about 20 deg and 60 deg).
+walker's (about 20 deg and 60 deg). The phase advances with the distance walked, one cycle
+per `stride_length` (`phase_after`).
+
+`gait`, `segments`, `pelvis_height` and the part makers are the one law that both
+`pedestrian_parts` (the walker's parts at one phase, in one frame) and the articulated model
+of `world.actors.shapes.walker` (the same parts on links, posed by joint angles) use.
 """
 
 from __future__ import annotations
 
 import functools
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -36,6 +42,7 @@ KNEE_BEND = math.radians(20.0)  # [rad] K: the swinging knee's largest flexion
 ARM_SWING = 1.0  # [-] shoulder angle per hip angle (opposite side)
 HEEL = 0.25  # [-] share of the foot behind the ankle
 SWEEP_SAMPLES = 64  # [-] gait phases sampled for the sweep's centre
+SIDES = (("left", 1.0), ("right", -1.0))  # the body's sides and the sign of their y
 
 
 def _limb(h: float) -> float:
@@ -43,21 +50,91 @@ def _limb(h: float) -> float:
     return 0.028 * h
 
 
+@dataclass(frozen=True, slots=True)
+class Gait:
+    """The joint angles at one gait phase, each (left, right) [rad]."""
+
+    hip: tuple[float, float]  # [rad] thigh from the vertical, forward positive
+    knee: tuple[float, float]  # [rad] knee flexion (the shank turns back from the thigh)
+    arm: tuple[float, float]  # [rad] arm from the vertical, forward positive
+
+
+def gait(phase: float) -> Gait:
+    """The gait law's joint angles at `phase` (0 to 1, 0 = left heel strike)."""
+    c, s = math.cos(2 * math.pi * phase), math.sin(2 * math.pi * phase)
+    left, right = HIP_SWING * c, -HIP_SWING * c
+    # the leg swinging forward (hip angle increasing) bends its knee
+    bend_left = KNEE_BEND * abs(s) if s < 0 else 0.0
+    bend_right = KNEE_BEND * abs(s) if s > 0 else 0.0
+    return Gait((left, right), (bend_left, bend_right), (-ARM_SWING * left, -ARM_SWING * right))
+
+
+@dataclass(frozen=True, slots=True)
+class Segments:
+    """A walker's segment lengths and joint places [m] for its stature and width."""
+
+    height: float  # [m] stature
+    limb: float  # [m] a limb prism's circumradius
+    thigh: float  # [m] hip joint to knee
+    shank: float  # [m] knee to ankle
+    ankle: float  # [m] ankle joint above the sole
+    foot: float  # [m] heel to toe
+    hip_y: float  # [m] each hip joint off the centre plane
+    half_shoulder: float  # [m] half the shoulders' width (arms included)
+    shoulder: float  # [m] the shoulder line above the hip joints
+    arm: float  # [m] shoulder joint to the end of the arm's prism
+
+
+def segments(height: float, width: float | None) -> Segments:
+    """The segments of a walker of stature `height` [m], shoulders no wider than `width`
+    [m] if given."""
+    h = height
+    r = _limb(h)
+    half = 0.5 * SHOULDER_WIDTH * h
+    if width is not None:
+        half = min(half, 0.5 * width)
+    return Segments(h, r, (HIP - KNEE) * h, (KNEE - ANKLE) * h, ANKLE * h, FOOT * h,
+                    0.5 * HIP_WIDTH * h - 1.2 * r, half, (SHOULDER - HIP) * h,
+                    (UPPER_ARM + FOREARM + 0.6 * HAND) * h - r)
+
+
+def along(angle: float) -> np.ndarray:
+    """The unit vector down a segment at `angle` [rad] from the vertical, forward positive."""
+    return np.array([math.sin(angle), 0.0, -math.cos(angle)])
+
+
+def thigh_part(name: str, hip: np.ndarray, knee: np.ndarray, seg: Segments) -> BodyPart:
+    """A thigh from the hip joint to the knee [m]."""
+    return strut(f"{name}_thigh", "cloth", tuple(hip), tuple(knee), 1.2 * seg.limb)
+
+
+def shank_part(name: str, knee: np.ndarray, ankle: np.ndarray, seg: Segments) -> BodyPart:
+    """A shank from the knee to the ankle joint [m]."""
+    return strut(f"{name}_shank", "cloth", tuple(knee), tuple(ankle), seg.limb)
+
+
+def foot_part(name: str, ankle: np.ndarray, seg: Segments) -> BodyPart:
+    """A level foot under the ankle joint `ankle` [m], its sole `seg.ankle` below it."""
+    r = seg.limb
+    sole = ankle[2] - seg.ankle
+    y = ankle[1]
+    return strut(f"{name}_foot", "trim", (ankle[0] - HEEL * seg.foot, y, sole + 0.5 * r),
+                 (ankle[0] + (1 - HEEL) * seg.foot, y, sole + 0.5 * r), 0.5 * r, sides=4)
+
+
+def arm_part(side: str, top: np.ndarray, hand: np.ndarray, seg: Segments) -> BodyPart:
+    """An arm from its shoulder joint `top` to the hand's end `hand` [m]."""
+    return strut(f"{side}_arm", "cloth", tuple(top), tuple(hand), seg.limb)
+
+
 def _leg(name: str, hip: np.ndarray, thigh_angle: float, knee_bend: float,
-         h: float) -> list[BodyPart]:
+         seg: Segments) -> list[BodyPart]:
     """Thigh, shank and a level foot from the hip joint `hip` [m]; angles [rad] from the
     vertical, forward positive."""
-    thigh, shank = (HIP - KNEE) * h, (KNEE - ANKLE) * h
-    knee = hip + thigh * np.array([math.sin(thigh_angle), 0.0, -math.cos(thigh_angle)])
-    shank_angle = thigh_angle - knee_bend
-    ankle = knee + shank * np.array([math.sin(shank_angle), 0.0, -math.cos(shank_angle)])
-    r, foot = _limb(h), FOOT * h
-    sole = ankle[2] - ANKLE * h
-    y = ankle[1]
-    return [strut(f"{name}_thigh", "cloth", tuple(hip), tuple(knee), 1.2 * r),
-            strut(f"{name}_shank", "cloth", tuple(knee), tuple(ankle), r),
-            strut(f"{name}_foot", "trim", (ankle[0] - HEEL * foot, y, sole + 0.5 * r),
-                  (ankle[0] + (1 - HEEL) * foot, y, sole + 0.5 * r), 0.5 * r, sides=4)]
+    knee = hip + seg.thigh * along(thigh_angle)
+    ankle = knee + seg.shank * along(thigh_angle - knee_bend)
+    return [thigh_part(name, hip, knee, seg), shank_part(name, knee, ankle, seg),
+            foot_part(name, ankle, seg)]
 
 
 def _reach(thigh_angle: float, knee_bend: float, h: float) -> float:
@@ -67,28 +144,42 @@ def _reach(thigh_angle: float, knee_bend: float, h: float) -> float:
             + ANKLE * h - (0.5 - 0.25 * math.sqrt(2)) * _limb(h))
 
 
-def _upper(h: float, pelvis: float, half_shoulder: float, arm_angles: tuple[float, float],
+def pelvis_height(g: Gait, seg: Segments) -> float:
+    """[m] the hip joints' height that puts the lower sole on the ground."""
+    return max(_reach(g.hip[0], g.knee[0], seg.height), _reach(g.hip[1], g.knee[1], seg.height))
+
+
+def shoulder_joint(seg: Segments, side: float) -> np.ndarray:
+    """[m] the shoulder joint of the left (`side` 1) or right (-1) arm from the middle of
+    the shoulder line."""
+    return np.array([0.0, side * (seg.half_shoulder - seg.limb), -seg.limb])
+
+
+def _upper(seg: Segments, pelvis: float, arm_angles: tuple[float, float],
            lean: float = 0.0) -> list[BodyPart]:
     """Torso, head and arms over a hip joint centre at height `pelvis` [m] (x = 0), the torso
     leaning forward by `lean` [rad]; arms hang at `arm_angles` [rad] (left, right)."""
-    r = _limb(h)
+    h = seg.height
     up = np.array([math.sin(lean), 0.0, math.cos(lean)])
     base = np.array([0.0, 0.0, pelvis])
-    shoulder = base + (SHOULDER - HIP) * h * up
+    shoulder = base + seg.shoulder * up
     depth = 0.06 * h
     torso = [(base + np.array([dx, s * HIP_WIDTH * h / 2, 0.0])) for dx in (-depth, depth)
              for s in (1, -1)]
-    torso += [(shoulder + np.array([dx, s * half_shoulder, 0.0])) for dx in (-depth, depth)
+    torso += [(shoulder + np.array([dx, s * seg.half_shoulder, 0.0])) for dx in (-depth, depth)
               for s in (1, -1)]
     neck = base + (1.0 - HIP - 0.13) * h * up
     parts = [hull("torso", "cloth", np.array(torso)),
              strut("head", "skin", tuple(neck), tuple(neck + 0.13 * h * up), 0.05 * h, sides=8)]
-    for (side, s), angle in zip((("left", 1.0), ("right", -1.0)), arm_angles, strict=True):
-        top = shoulder + np.array([0.0, s * (half_shoulder - r), -r])
-        arm = (UPPER_ARM + FOREARM + 0.6 * HAND) * h - r
-        hand = top + arm * np.array([math.sin(angle), 0.0, -math.cos(angle)])
-        parts.append(strut(f"{side}_arm", "cloth", tuple(top), tuple(hand), r))
+    for (side, s), angle in zip(SIDES, arm_angles, strict=True):
+        top = shoulder + shoulder_joint(seg, s)
+        parts.append(arm_part(side, top, top + seg.arm * along(angle), seg))
     return parts
+
+
+def trunk_parts(seg: Segments) -> tuple[BodyPart, ...]:
+    """A walker's torso and head over its hip joint centre at the origin (upright)."""
+    return tuple(p for p in _upper(seg, 0.0, (0.0, 0.0)) if not p.name.endswith("_arm"))
 
 
 def pedestrian_parts(height: float, phase: float,
@@ -97,60 +188,68 @@ def pedestrian_parts(height: float, phase: float,
     heel strike), its shoulders (arms included) no wider than `width` [m] if given. The
     origin is on the ground at the middle of the x range the whole gait cycle sweeps (the
     feet reach further forward than back), so the envelope is centred on it."""
-    shift = np.array([-_sweep_centre(height, width), 0.0, 0.0])
+    shift = np.array([-sweep_centre(height, width), 0.0, 0.0])
     return tuple(hull(p.name, p.material, points(p) + shift)
                  for p in _walker(height, phase, width))
 
 
 @functools.cache
-def _sweep_centre(height: float, width: float | None) -> float:
+def sweep_centre(height: float, width: float | None) -> float:
     """[m] the middle of the x range a walker's pelvis-centred parts sweep over a cycle."""
     xs = np.vstack([points(p) for k in range(SWEEP_SAMPLES)
                     for p in _walker(height, k / SWEEP_SAMPLES, width)])[:, 0]
     return 0.5 * float(xs.min() + xs.max())
 
 
+def stride_length(height: float) -> float:
+    """[m] the distance a walker of stature `height` [m] covers in one gait cycle (two
+    steps). A step is how far apart the ankles are in double support (both legs straight at
+    +-`HIP_SWING`), so over each stance the pelvis moves by what the standing foot moves
+    back under it: the feet do not slide over a step (within one the standing foot slides
+    to and fro by up to 6 % of the leg's length peak to peak, 5 cm for a 1.80 m walker, as
+    the hip angle is a cosine of the phase, not the arc sine of the distance)."""
+    seg = segments(height, None)
+    return 4.0 * (seg.thigh + seg.shank) * math.sin(HIP_SWING)
+
+
+def phase_after(phase: float, distance: float, height: float) -> float:
+    """The gait phase (0 to 1) of a walker of stature `height` [m] at `phase` once it has
+    walked `distance` [m] (backwards if negative): one cycle per `stride_length`."""
+    return (phase + distance / stride_length(height)) % 1.0
+
+
 def _walker(height: float, phase: float, width: float | None) -> tuple[BodyPart, ...]:
     """The walker's parts with the origin under the pelvis."""
-    h = height
-    r = _limb(h)
-    half = 0.5 * SHOULDER_WIDTH * h
-    if width is not None:
-        half = min(half, 0.5 * width)
-    c, s = math.cos(2 * math.pi * phase), math.sin(2 * math.pi * phase)
-    left, right = HIP_SWING * c, -HIP_SWING * c
-    # the leg swinging forward (hip angle increasing) bends its knee
-    bend_left = KNEE_BEND * abs(s) if s < 0 else 0.0
-    bend_right = KNEE_BEND * abs(s) if s > 0 else 0.0
-    pelvis = max(_reach(left, bend_left, h), _reach(right, bend_right, h))
-    hip_y = 0.5 * HIP_WIDTH * h - 1.2 * r
-    return (*_leg("left", np.array([0.0, hip_y, pelvis]), left, bend_left, h),
-            *_leg("right", np.array([0.0, -hip_y, pelvis]), right, bend_right, h),
-            *_upper(h, pelvis, half, (-ARM_SWING * left, -ARM_SWING * right)))
+    seg = segments(height, width)
+    g = gait(phase)
+    pelvis = pelvis_height(g, seg)
+    return (*_leg("left", np.array([0.0, seg.hip_y, pelvis]), g.hip[0], g.knee[0], seg),
+            *_leg("right", np.array([0.0, -seg.hip_y, pelvis]), g.hip[1], g.knee[1], seg),
+            *_upper(seg, pelvis, g.arm))
 
 
 def rider_parts(stature: float, seat: Vec3, feet: tuple[Vec3, Vec3],
                 hands: tuple[Vec3, Vec3], lean: float) -> tuple[BodyPart, ...]:
     """A rider of `stature` [m] sitting with the hip joints over `seat` [m], the soles on
     `feet`, the hands on `hands` (left, right), the torso leaning forward `lean` [rad]."""
-    h, r = stature, _limb(stature)
+    seg = segments(stature, None)
+    h, r = stature, seg.limb
     parts: list[BodyPart] = []
     hip0 = np.asarray(seat, dtype=np.float64)
-    for (side, s), foot in zip((("left", 1.0), ("right", -1.0)), feet, strict=True):
-        hip = hip0 + np.array([0.0, s * (0.5 * HIP_WIDTH * h - 1.2 * r), 0.0])
+    for (side, s), foot in zip(SIDES, feet, strict=True):
+        hip = hip0 + np.array([0.0, s * seg.hip_y, 0.0])
         ankle = np.asarray(foot, dtype=np.float64) + np.array([0.0, 0.0, ANKLE * h])
-        knee = _knee(hip, ankle, (HIP - KNEE) * h, (KNEE - ANKLE) * h)
-        parts += [strut(f"{side}_thigh", "cloth", tuple(hip), tuple(knee), 1.2 * r),
-                  strut(f"{side}_shank", "cloth", tuple(knee), tuple(ankle), r)]
-    upper = _upper(h, 0.0, 0.5 * SHOULDER_WIDTH * h, (0.0, 0.0), lean)
+        knee = _knee(hip, ankle, seg.thigh, seg.shank)
+        parts += [thigh_part(side, hip, knee, seg), shank_part(side, knee, ankle, seg)]
+    upper = _upper(seg, 0.0, (0.0, 0.0), lean)
     shift = hip0
     for part in upper:
         if part.name.endswith("_arm"):
             continue
         parts.append(hull(part.name, part.material, points(part) + shift))
-    shoulder = hip0 + (SHOULDER - HIP) * h * np.array([math.sin(lean), 0.0, math.cos(lean)])
-    for (side, s), hand in zip((("left", 1.0), ("right", -1.0)), hands, strict=True):
-        top = shoulder + np.array([0.0, s * (0.5 * SHOULDER_WIDTH * h - r), -r])
+    shoulder = hip0 + seg.shoulder * np.array([math.sin(lean), 0.0, math.cos(lean)])
+    for (side, s), hand in zip(SIDES, hands, strict=True):
+        top = shoulder + shoulder_joint(seg, s)
         parts.append(strut(f"{side}_arm", "cloth", tuple(top), hand, r))
     return tuple(parts)
 
