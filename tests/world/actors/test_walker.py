@@ -12,6 +12,7 @@ from world.actors.shapes.humans import pedestrian_parts, phase_after, segments, 
 from world.actors.shapes.parts import points
 from world.actors.shapes.walker import (
     BASE,
+    LINK_NAMES,
     link_frames,
     posed_points,
     walker_model,
@@ -39,19 +40,20 @@ def test_posed_model_is_pedestrian_parts_at_every_phase(height: float,
 def test_the_model_has_a_trunk_and_eight_joints() -> None:
     model = walker_model(targets.EPTA.height, targets.EPTA.width)
     assert [p.name for p in model.base_parts] == ["torso", "head"]
-    assert [link.name for link in model.links] == [
+    assert [link.name for link in model.links] == list(LINK_NAMES) == [
         "left_thigh", "left_shank", "left_foot", "right_thigh", "right_shank", "right_foot",
         "left_arm", "right_arm"]
     for link in model.links:
         assert np.linalg.norm(link.axis) == pytest.approx(1.0)
         assert abs(link.axis[1]) == 1.0  # all joints turn about the body's y
-    assert walker_pose(targets.EPTA.height, 0.3).angles.keys() == {
-        link.name for link in model.links}
+    # the pose's angles come in the links' order (a Bullet body's joint order)
+    assert list(walker_pose(targets.EPTA.height, 0.3).angles) == list(LINK_NAMES)
 
 
 def _frames(phase: float) -> dict[str, tuple[np.ndarray, np.ndarray]]:
     h = targets.EPTA.height
-    return link_frames(walker_model(h, targets.EPTA.width), walker_pose(h, phase))
+    return link_frames(walker_model(h, targets.EPTA.width),
+                       walker_pose(h, phase, targets.EPTA.width))
 
 
 def test_the_legs_move_and_the_swinging_knee_bends() -> None:

@@ -10,8 +10,8 @@ lengths and part makers; only the order of the floating-point sums differs).
 Frames (metres, x forward, y left, z up):
 - the body frame: the pedestrian's, on the ground at the middle of the x range its gait
   cycle sweeps (the frame of `pedestrian_parts` and of the actor's pose);
-- the base frame: at the hip joints' centre, `base_x` ahead of the body origin and
-  `WalkerPose.base_height` above the ground, axes parallel to the body frame (the trunk
+- the base frame: at the hip joints' centre, `WalkerPose.base_x` ahead of the body origin
+  and `WalkerPose.base_height` above the ground, axes parallel to the body frame (the trunk
   stays upright); the base carries the torso and the head;
 - each link's frame: at its joint, in its parent's frame at `origin`; at zero angles its
   axes are the parent's. A link turns about its `axis` (a unit vector in the parent's
@@ -55,6 +55,8 @@ from world.actors.shapes.parts import BodyPart, points
 from world.scene.solids import FloatArray, Vec3
 
 BASE = "base"  # the parent name of the links on the base
+LINK_NAMES = ("left_thigh", "left_shank", "left_foot", "right_thigh", "right_shank",
+              "right_foot", "left_arm", "right_arm")  # the links in the model's order
 FORWARD: Vec3 = (0.0, -1.0, 0.0)  # a joint axis turning a hanging segment's end forward
 BACKWARD: Vec3 = (0.0, 1.0, 0.0)  # ... turning it back
 Frame = tuple[FloatArray, FloatArray]  # (3, 3) rotation to the body frame, (3,) origin [m]
@@ -77,7 +79,6 @@ class WalkerModel:
 
     height: float  # [m] stature
     width: float | None  # [m] the shoulders' largest width, if bounded
-    base_x: float  # [m] the base frame's origin ahead of the body frame's
     base_parts: tuple[BodyPart, ...]  # [m] in the base frame: torso and head
     links: tuple[WalkerLink, ...]
 
@@ -93,8 +94,9 @@ class WalkerModel:
 class WalkerPose:
     """Where a walker's base is and how its joints are turned at one gait phase."""
 
-    base_height: float  # [m] the base frame's origin (the hip joints' centre) above ground
-    angles: Mapping[str, float]  # [rad] each link's joint angle, by link name
+    base_x: float  # [m] the base frame's origin (the hip joints' centre) ahead of the body's
+    base_height: float  # [m] ... above the ground
+    angles: Mapping[str, float]  # [rad] each link's joint angle, by name in `LINK_NAMES` order
 
 
 def _vec(a: FloatArray) -> Vec3:
@@ -126,21 +128,21 @@ def walker_model(height: float, width: float | None = None) -> WalkerModel:
     seg = segments(height, width)
     links = (*_leg("left", seg.hip_y, seg), *_leg("right", -seg.hip_y, seg),
              *(_arm(side, s, seg) for side, s in SIDES))
-    return WalkerModel(height, width, -sweep_centre(height, width), trunk_parts(seg), links)
+    return WalkerModel(height, width, trunk_parts(seg), links)
 
 
 def walker_pose(height: float, phase: float, width: float | None = None) -> WalkerPose:
     """The pose of a walker of stature `height` [m] at gait `phase` (0 to 1, 0 = left heel
-    strike). `width` bounds the shoulders only, so it does not change the pose; it is taken
-    so that calls read as `pedestrian_parts`'s."""
-    del width
+    strike), its shoulders no wider than `width` [m] if given (as its model's: the width
+    moves the body origin, the middle of the x range the gait sweeps)."""
     g = gait(phase)
     angles: dict[str, float] = {}
     for i, (side, _) in enumerate(SIDES):
         hip, knee = g.hip[i], g.knee[i]
         angles |= {f"{side}_thigh": hip, f"{side}_shank": knee, f"{side}_foot": hip - knee,
                    f"{side}_arm": g.arm[i]}
-    return WalkerPose(pelvis_height(g, segments(height, None)), angles)
+    return WalkerPose(-sweep_centre(height, width), pelvis_height(g, segments(height, None)),
+                      {name: angles[name] for name in LINK_NAMES})
 
 
 def axis_rotation(axis: Vec3, angle: float) -> FloatArray:
@@ -154,7 +156,7 @@ def axis_rotation(axis: Vec3, angle: float) -> FloatArray:
 def link_frames(model: WalkerModel, pose: WalkerPose) -> dict[str, Frame]:
     """Forward kinematics: each frame (`BASE` and every link) in the body frame."""
     frames: dict[str, Frame] = {
-        BASE: (np.eye(3), np.array([model.base_x, 0.0, pose.base_height]))}
+        BASE: (np.eye(3), np.array([pose.base_x, 0.0, pose.base_height]))}
     for link in model.links:
         rot, origin = frames[link.parent]
         frames[link.name] = (rot @ axis_rotation(link.axis, pose.angles[link.name]),
