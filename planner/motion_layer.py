@@ -261,6 +261,10 @@ class MotionLayer:
         speed now) and the lane the driver's turn-signal stalk asks for (None: at rest)."""
         s, d = (float(a) for a in self.road.local_coordinates((ego.x, ego.y), self._station))
         self._station = s
+        # the pose the lane checks use, projected while the map still holds this point's
+        # projection (`world.hdmap.ReferenceLine.project` keeps the last points'): the
+        # tracks' come next
+        self._route_pose(ego)
         lanes = self._lanes_around(s, ego.speed, pull_over)
         traffic = lane_traffic(self.road, tracks, ego.t, s, lanes,
                                self.params.occupancy, self.vehicle)
