@@ -45,7 +45,7 @@ from numpy.typing import ArrayLike
 from planner.messages import ReferencePath
 from planner.route import path_stations
 from world.frames import wrap_angle
-from world.hdmap import FloatArray, Lane
+from world.hdmap import FloatArray, Lane, RoadMap
 
 T_STEP = 0.05  # [s] grid of the duration search
 
@@ -197,6 +197,49 @@ def can_start(lane: Lane, x: float, y: float, heading: float,
     return abs(heading_error(lane, x, y, heading, near)[2]) < 0.5 * math.pi
 
 
+@dataclass(frozen=True, slots=True)
+class RoutePose:
+    """A car's pose on the route, from one projection (`route_pose`) that serves every lane:
+    the lanes share the route's reference line, so its station and its heading error (the
+    car's heading minus the reference line's tangent, which `Lane.heading_at` is for every
+    lane) are the same for each; only the offset from a lane's centre differs
+    (`in_lane`). The projection's inputs are kept so that a caller can tell whether it is
+    the pose it wants (`is_for`)."""
+
+    x: float  # [m] map frame, the car's centre
+    y: float  # [m]
+    heading: float  # [rad] map frame
+    near: float | None  # [m] the projection's hint (`RoadMap.local_coordinates`)
+    station: FloatArray  # [m] 0-d: the car's station along the reference line
+    offset: FloatArray  # [m] 0-d: its offset from the reference line, left +
+    heading_error: float  # [rad] heading minus the route's tangent there, in (-pi, pi]
+
+    def is_for(self, x: float, y: float, heading: float, near: float | None) -> bool:
+        """Whether this is the pose of a car at (`x`, `y`) [m] heading `heading` [rad],
+        projected with the hint `near` [m]."""
+        return (self.x, self.y, self.heading, self.near) == (x, y, heading, near)
+
+    def in_lane(self, lane: Lane) -> tuple[float, float, float]:
+        """(s0 [m], r0 [m], psi0 [rad]) in `lane`'s Frenet frame, as `heading_error`."""
+        r = self.offset - lane.offset_at(self.station)
+        return float(self.station), float(np.asarray(r)), self.heading_error
+
+    @property
+    def can_start(self) -> bool:
+        """`can_start` for any lane: the car heads less than 90 degrees off the route."""
+        return abs(self.heading_error) < 0.5 * math.pi
+
+
+def route_pose(road: RoadMap, x: float, y: float, heading: float,
+               near: float | None = None) -> RoutePose:
+    """The car's `RoutePose` (the projection `heading_error` makes, for every lane at once)."""
+    xy = np.array([x, y], dtype=np.float64)
+    s_arr, d_arr = (road.local_coordinates(xy) if near is None
+                    else road.local_coordinates(xy, near))
+    psi = wrap_angle(heading - float(road.heading_at(float(s_arr))))
+    return RoutePose(x, y, heading, near, s_arr, d_arr, psi)
+
+
 def start_lane_change(
     lane: Lane, target_index: int, x: float, y: float, heading: float, speed: float,
     params: LaneChangeParams, near: float | None = None,
@@ -210,7 +253,22 @@ def start_lane_change(
     """
     if lane.index != target_index:
         raise ValueError(f"lane {lane.index} is not the target lane {target_index}")
-    s0, r0, psi0 = heading_error(lane, x, y, heading, near)
+    return _path_from(target_index, *heading_error(lane, x, y, heading, near), speed, params)
+
+
+def start_lane_change_at(lane: Lane, target_index: int, pose: RoutePose, speed: float,
+                         params: LaneChangeParams) -> LaneChangePath:
+    """`start_lane_change` from the car's `RoutePose` (the same path, the projection made
+    once for every lane the car may plan into)."""
+    if lane.index != target_index:
+        raise ValueError(f"lane {lane.index} is not the target lane {target_index}")
+    return _path_from(target_index, *pose.in_lane(lane), speed, params)
+
+
+def _path_from(target_index: int, s0: float, r0: float, psi0: float, speed: float,
+               params: LaneChangeParams) -> LaneChangePath:
+    """The path from station `s0` [m], offset `r0` [m] and heading error `psi0` [rad] in
+    the target lane's frame at `speed` [m/s] (`start_lane_change`)."""
     if abs(psi0) >= 0.5 * math.pi:
         raise ValueError(f"heading error {psi0:.3f} rad: the car does not head along the lane")
     m0 = math.tan(psi0)

@@ -119,10 +119,11 @@ from planner.fsm.motion import (
 from planner.lane_change_path import (
     LaneChangeParams,
     LaneChangePath,
-    can_start,
+    RoutePose,
     path_length,
     plan_duration,
-    start_lane_change,
+    route_pose,
+    start_lane_change_at,
 )
 from planner.lane_occupancy import (
     LaneTraffic,
@@ -235,6 +236,8 @@ class MotionLayer:
         self._turn_end = math.inf  # [m] where the turn in hand ends (its junction's exit)
         self._near: set[int] = set()  # tracks of the lane being left found in the way
         #   (`_leads`)
+        self._pose: RoutePose | None = None  # the car's pose on the route, last projected
+        #   (`_route_pose`)
         self._station: float | None = 0.0  # [m] the car's station last tick (first: the route's
         #   start, `Planner.localise`; a town route crossing itself passes a point twice:
         #   `world.hdmap.ReferenceLine.project`)
@@ -258,6 +261,10 @@ class MotionLayer:
         speed now) and the lane the driver's turn-signal stalk asks for (None: at rest)."""
         s, d = (float(a) for a in self.road.local_coordinates((ego.x, ego.y), self._station))
         self._station = s
+        # the pose the lane checks use, projected while the map still holds this point's
+        # projection (`world.hdmap.ReferenceLine.project` keeps the last points'): the
+        # tracks' come next
+        self._route_pose(ego)
         lanes = self._lanes_around(s, ego.speed, pull_over)
         traffic = lane_traffic(self.road, tracks, ego.t, s, lanes,
                                self.params.occupancy, self.vehicle)
@@ -587,16 +594,26 @@ class MotionLayer:
         # the estimate of a standing car's speed may be a hair below 0; the car's station
         # this tick is the projection's hint (a bend that turns back on itself passes near
         # the car twice)
-        return start_lane_change(self.road.lane(lane), lane, ego.x, ego.y, ego.heading,
-                                 max(ego.speed, 0.0),
-                                 self.params.lane_change if params is None else params,
-                                 self._station)
+        return start_lane_change_at(self.road.lane(lane), lane, self._route_pose(ego),
+                                    max(ego.speed, 0.0),
+                                    self.params.lane_change if params is None else params)
 
     def _can_plan(self, lane: int, ego: EgoState) -> bool:
         """Whether a path into `lane` starts from the car's pose (it heads less than 90
         degrees off the lane, `planner.lane_change_path.can_start`): a car that does not
-        (spun round) holds its lane, and a stop for a flat tyre is made in it."""
-        return can_start(self.road.lane(lane), ego.x, ego.y, ego.heading, self._station)
+        (spun round) holds its lane, and a stop for a flat tyre is made in it. Every lane
+        shares the route's tangent, so the answer is the same for each (`RoutePose`)."""
+        self.road.lane(lane)  # an IndexError for a lane the road does not have
+        return self._route_pose(ego).can_start
+
+    def _route_pose(self, ego: EgoState) -> RoutePose:
+        """The car's pose on the route (`planner.lane_change_path.route_pose`), its station
+        this tick the hint: projected once per pose and hint, for every lane it may plan
+        into or check."""
+        pose = self._pose
+        if pose is None or not pose.is_for(ego.x, ego.y, ego.heading, self._station):
+            pose = self._pose = route_pose(self.road, ego.x, ego.y, ego.heading, self._station)
+        return pose
 
     def _leads(self, traffic: dict[int, LaneTraffic], s: float, d: float,
                v: float) -> tuple[Neighbour, ...]:

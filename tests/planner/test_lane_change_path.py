@@ -11,10 +11,13 @@ from planner.lane_change_path import (
     LaneChangeParams,
     LaneChangePath,
     can_start,
+    heading_error,
     path_length,
     peak_lateral_accel,
     plan_duration,
+    route_pose,
     start_lane_change,
+    start_lane_change_at,
 )
 from tests.roads import W, arc, make_map, seg
 
@@ -200,3 +203,50 @@ def test_a_bend_that_turns_back_plans_from_the_cars_own_pass() -> None:
     change = start_lane_change(road.lane(1), 1, x, y, heading, V, P, near=10.0)
     assert change.s0 == pytest.approx(10.0) and change.m0 == pytest.approx(0.0, abs=1e-9)
     assert change.r0 == pytest.approx(1.0 - W)
+
+
+ROADS = {
+    "straight": make_map(seg(120.0, lanes=3, oncoming=1)),
+    "bends": make_map(seg(40.0, lanes=2, oncoming=1), arc(60.0, 50.0, lanes=2, oncoming=1),
+                      arc(-45.0, -70.0, lanes=2, oncoming=1), seg(40.0, lanes=2, oncoming=1)),
+    "turning back": make_map(seg(60.0, lanes=2, oncoming=0),
+                             arc(-8.0, -200.0, lanes=2, oncoming=0),
+                             seg(60.0, lanes=2, oncoming=0)),
+}
+
+
+@pytest.mark.parametrize("name", list(ROADS))
+def test_route_pose_answers_as_each_lanes_own_projection(name: str) -> None:
+    """One `RoutePose` per car pose and hint gives, for every lane, the very bits of
+    `heading_error` (its own projection onto that lane), and `can_start` for each."""
+    road = ROADS[name]
+    lanes = [road.lane(k) for k in range(len(road.lanes))] + list(road.oncoming)
+    rng = np.random.default_rng(7)
+    checked = 0
+    for _ in range(60):
+        s = float(rng.uniform(-5.0, road.length + 5.0))
+        x, y = (float(v) for v in road.position(s, float(rng.uniform(-4.0, 8.0))))
+        heading = float(rng.uniform(-math.pi, math.pi))
+        for near in (None, s, float(rng.uniform(0.0, road.length))):
+            pose = route_pose(road, x, y, heading, near)
+            assert pose.is_for(x, y, heading, near)
+            for lane in lanes:
+                own = heading_error(lane, x, y, heading, near)
+                assert pose.in_lane(lane) == own  # bit for bit
+                assert pose.can_start is can_start(lane, x, y, heading, near)
+                checked += 1
+    assert checked == 60 * 3 * len(lanes)
+
+
+def test_a_path_from_the_route_pose_is_the_path_from_the_lane() -> None:
+    road = ROADS["bends"]
+    for s in (10.0, 70.0, 120.0):
+        x, y = (float(v) for v in road.position(s, 0.4))
+        heading = float(road.heading_at(s)) + 0.05
+        pose = route_pose(road, x, y, heading, s)
+        for k in (1, -1):
+            lane = road.lane(k)
+            assert start_lane_change_at(lane, k, pose, V, P) == \
+                start_lane_change(lane, k, x, y, heading, V, P, near=s)
+    with pytest.raises(ValueError, match="not the target lane"):
+        start_lane_change_at(road.lane(0), 1, route_pose(road, 0.0, 0.0, 0.0), V, P)
