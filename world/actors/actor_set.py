@@ -1,12 +1,15 @@
 """NPC bodies in the physics world, moved along the route by their scripted behaviour.
 
-NPCs are kinematic: static (mass 0) boxes, placed at `ACTOR_RATE`
+NPCs are kinematic: static (mass 0) bodies, placed at `ACTOR_RATE`
 (`world.core.rates`) from their `NpcMotion` in route coordinates. The ego collides with them
 like with a wall, and contact queries see them. (Only the ego must drive through its joints;
 NPCs are scripted traffic.) A vehicle's box is its catalogue model's (`world.actors.catalogue`:
 the actor's `model`, else its type's default); a pedestrian's and an obstacle's are
-`world.actors.bodies.SIZES`.
-Pedestrians are boxes too, placed by station and offset from
+`world.actors.bodies.SIZES`. The body is the actor's shape where it has one
+(`world.actors.shapes.actors`: the catalogue's vehicles, the Euro NCAP targets), built from its
+convex parts (`world.actors.body_build`), else its box; either way its origin is the box's
+centre, which is what `poses` gives.
+Pedestrians are placed by station and offset from
 their lane's centre like any actor; their speed is a walking speed along the lane, and the
 `walk` action moves them across the road, facing where they walk.
 
@@ -30,19 +33,21 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-import pybullet
 from numpy.typing import NDArray
 from pybullet_utils.bullet_client import BulletClient
 
 from world.actors.all_way_stop import AllWayStop
 from world.actors.behaviour import NpcMotion, TriggerContext
 from world.actors.bodies import VEHICLES, BoxSize, body_size, vehicle_of
+from world.actors.body_build import BodyBuilder
 from world.actors.catalogue import CATALOGUE, DEFAULT_MODEL, VehicleClass
+from world.actors.shapes.actors import pedestrian_shape, vehicle_shape
+from world.actors.shapes.body import Body
 from world.actors.town_traffic import STOP_MARGIN, STOP_SPEED, Others, StopZones, TownDriver
 from world.hdmap import Manoeuvre, RoadMap
 from world.map.road import build_road_map
 from world.map.signals import route_signals
-from world.scene.collision import Box, CollisionShapes, Part
+from world.scene.collision import CollisionShapes
 from world.spec import ActorSpec, ActorType
 
 EGO = "ego"  # the ego's key in the all-way-stop order
@@ -84,6 +89,16 @@ class ActorPoses:
         return CATALOGUE[DEFAULT_MODEL[kind.value]].cls if kind in VEHICLES else None
 
 
+def actor_shape(spec: ActorSpec, size: BoxSize) -> Body | None:
+    """The shape of an actor's body whose box is `size` (None: the box itself)."""
+    model = vehicle_of(spec)
+    if model is not None:
+        return vehicle_shape(model.name, size.length, size.width)
+    if spec.type is ActorType.PEDESTRIAN:
+        return pedestrian_shape(size.length, size.width, size.height)
+    return None
+
+
 class ActorSet:
     """All scripted actors of a world."""
 
@@ -109,8 +124,12 @@ class ActorSet:
                           facing=spec.facing)
             )
         sizes = [body_size(a) for a in specs]
-        self.bodies = [self._make_body(a.type, size)
-                       for a, size in zip(specs, sizes, strict=True)]
+        builder = BodyBuilder(client, self._shapes)
+        self.shapes = [actor_shape(a, size) for a, size in zip(specs, sizes, strict=True)]
+        self.bodies = [
+            builder.box((size.length / 2, size.width / 2, size.height / 2), COLOURS[a.type])
+            if shape is None else builder.shaped(shape, size.height, COLOURS[a.type])
+            for a, size, shape in zip(specs, sizes, self.shapes, strict=True)]
         self.lengths = np.array([size.length for size in sizes])
         self.half_sizes = np.array(
             [[size.length / 2, size.width / 2, size.height / 2] for size in sizes]
@@ -149,16 +168,6 @@ class ActorSet:
         self._xy_prev = self._xy  # [m] ... a step before (velocities over ground)
         self._poses: ActorPoses | None = None
         self._place(force=True)
-
-    def _make_body(self, kind: ActorType, size: BoxSize) -> int:
-        """A static box of `size` in `kind`'s colour, below the ground until placed."""
-        half = (size.length / 2, size.width / 2, size.height / 2)
-        shape = self._shapes.create(self._c, Part(Box(half)))
-        visual = self._c.createVisualShape(
-            pybullet.GEOM_BOX, halfExtents=list(half), rgbaColor=list(COLOURS[kind])
-        )
-        return self._shapes.placed(int(self._c.createMultiBody(
-            0.0, shape, visual, [0.0, 0.0, -10.0], useMaximalCoordinates=True)), shape)
 
     def lane_offset(self, lane: int, s: float) -> float:
         """[m] offset of a route lane's centre at s (the actors on the route's road)."""

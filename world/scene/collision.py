@@ -13,26 +13,37 @@ Shapes (all in the part's frame, SI units; the data types live in the leaf `worl
 - `Cylinder`: radius and full height along z, centred on the origin;
 - `ConvexHull`: the convex hull of a point set (Bullet: GEOM_MESH with vertices, no indices);
 - `TriangleMesh`: a static concave mesh (Bullet: GEOM_MESH with vertices and indices).
+
+Each part sits at its `position` [m], turned by its `orientation` (quaternion x, y, z, w). A
+compound (several parts) takes boxes, cylinders and convex hulls; `createCollisionShapeArray`
+has no vertex list per child, so each hull goes through a Wavefront OBJ file of its points
+and triangles (written to a temporary folder, read by Bullet at once, then deleted). Bullet
+reads the file's coordinates as float32 and builds the hull of those points.
 """
 
 from __future__ import annotations
+
+import tempfile
+from pathlib import Path
 
 import pybullet
 from pybullet_utils.bullet_client import BulletClient
 
 from world.scene.solids import (
+    IDENTITY,
     Box,
     ConvexHull,
     Cylinder,
     FloatArray,
     Part,
+    Quaternion,
     Shape,
     TriangleMesh,
     Vec3,
 )
 
-__all__ = ["Box", "CollisionShapes", "ConvexHull", "Cylinder", "FloatArray", "Part", "Shape",
-           "TriangleMesh", "Vec3"]
+__all__ = ["IDENTITY", "Box", "CollisionShapes", "ConvexHull", "Cylinder", "FloatArray", "Part",
+           "Quaternion", "Shape", "TriangleMesh", "Vec3"]
 
 
 class CollisionShapes:
@@ -48,6 +59,8 @@ class CollisionShapes:
             shape = int(_create_one(client, parts[0]))
         else:
             shape = int(_create_array(client, parts))
+        if shape < 0:
+            raise ValueError(f"Bullet refused the collision shape {parts}")
         self._by_shape[shape] = parts
         return shape
 
@@ -63,8 +76,11 @@ class CollisionShapes:
 
 def _create_one(client: BulletClient, part: Part) -> int:
     s = part.shape
-    frame = {} if part.position == (0.0, 0.0, 0.0) else {
-        "collisionFramePosition": list(part.position)}
+    frame: dict[str, list[float]] = {}
+    if part.position != (0.0, 0.0, 0.0):
+        frame["collisionFramePosition"] = list(part.position)
+    if part.orientation != IDENTITY:
+        frame["collisionFrameOrientation"] = list(part.orientation)
     if isinstance(s, Box):
         return int(client.createCollisionShape(pybullet.GEOM_BOX,
                                                halfExtents=list(s.half_extents), **frame))
@@ -79,22 +95,41 @@ def _create_one(client: BulletClient, part: Part) -> int:
 
 
 def _create_array(client: BulletClient, parts: tuple[Part, ...]) -> int:
-    """A compound of boxes and cylinders (`createCollisionShapeArray`)."""
-    kinds, halves, radii, lengths = [], [], [], []
-    for part in parts:
-        s = part.shape
-        if isinstance(s, Box):
-            kinds.append(pybullet.GEOM_BOX)
-            halves.append(list(s.half_extents))
-            radii.append(0.0)
-            lengths.append(0.0)
-        elif isinstance(s, Cylinder):
-            kinds.append(pybullet.GEOM_CYLINDER)
-            halves.append([0.0, 0.0, 0.0])
-            radii.append(s.radius)
-            lengths.append(s.height)
-        else:
-            raise ValueError(f"a compound shape takes boxes and cylinders, not {s}")
-    return int(client.createCollisionShapeArray(
-        kinds, halfExtents=halves, radii=radii, lengths=lengths,
-        collisionFramePositions=[list(p.position) for p in parts]))
+    """A compound of boxes, cylinders and convex hulls (`createCollisionShapeArray`)."""
+    kinds, halves, radii, lengths, files = [], [], [], [], []
+    with tempfile.TemporaryDirectory(prefix="avsim-hulls-") as folder:
+        for i, part in enumerate(parts):
+            s = part.shape
+            halves.append(list(s.half_extents) if isinstance(s, Box) else [0.0, 0.0, 0.0])
+            radii.append(s.radius if isinstance(s, Cylinder) else 0.0)
+            lengths.append(s.height if isinstance(s, Cylinder) else 0.0)
+            files.append("")
+            if isinstance(s, Box):
+                kinds.append(pybullet.GEOM_BOX)
+            elif isinstance(s, Cylinder):
+                kinds.append(pybullet.GEOM_CYLINDER)
+            elif isinstance(s, ConvexHull):
+                kinds.append(pybullet.GEOM_MESH)
+                files[-1] = str(_write_hull(Path(folder) / f"hull{i}.obj", s))
+            else:
+                raise ValueError(f"a compound shape takes boxes, cylinders and convex hulls, "
+                                 f"not {s}")
+        return int(client.createCollisionShapeArray(
+            kinds, halfExtents=halves, radii=radii, lengths=lengths, fileNames=files,
+            meshScales=[[1.0, 1.0, 1.0]] * len(parts),
+            collisionFramePositions=[list(p.position) for p in parts],
+            collisionFrameOrientations=[list(p.orientation) for p in parts]))
+
+
+def _write_hull(path: Path, hull: ConvexHull) -> Path:
+    """`hull` as an OBJ file at `path` (its points and their hull's triangles: Bullet reads
+    only the points faces use); returns `path`."""
+    # imported here: scipy.spatial takes 0.65 s to import, and most worlds have no compound
+    # with hulls
+    from scipy.spatial import ConvexHull as Qhull
+
+    points = hull.points.tolist()
+    lines = [f"v {x!r} {y!r} {z!r}" for x, y, z in points]
+    lines += [f"f {a + 1} {b + 1} {c + 1}" for a, b, c in Qhull(hull.points).simplices.tolist()]
+    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    return path

@@ -14,6 +14,8 @@ from numpy.typing import NDArray
 
 FloatArray = NDArray[np.float64]
 Vec3 = tuple[float, float, float]
+Quaternion = tuple[float, float, float, float]  # x, y, z, w (PyBullet's order)
+IDENTITY: Quaternion = (0.0, 0.0, 0.0, 1.0)
 
 
 @dataclass(frozen=True, slots=True)
@@ -43,7 +45,9 @@ Shape = Box | Cylinder | ConvexHull | TriangleMesh
 
 @dataclass(frozen=True, slots=True)
 class Part:
-    """One shape of a body, at `position` [m] in the body's frame (axes parallel to it)."""
+    """One shape of a body, at `position` [m] in the body's frame, turned by `orientation`
+    (a unit quaternion x, y, z, w: the shape's frame -> the body's frame)."""
 
     shape: Shape
     position: Vec3 = (0.0, 0.0, 0.0)
+    orientation: Quaternion = IDENTITY

@@ -5,7 +5,9 @@ taken into the box frame (o' = R^T (o - c), d' = R^T d); along each axis it is i
 slab |x| <= h between t = (-h - o') / d' and (h - o') / d'. The ray is in the box between
 the largest entry and the smallest exit; it hits when that span is not empty and its entry
 lies in [0, reach]: the hit is at the entry. A ray parallel to a slab is inside it for all t
-or for none. A ray starting inside a box is not counted as hitting it.
+or for none. A ray starting inside a box is not counted as hitting it (`nearest_box_hits`);
+`rays_through` counts it as passing through (a broad phase: what is inside the box may still
+be ahead of it).
 
 Rays are only tested against a box when they point within its bounding sphere's cone seen
 from the origin, so the cost grows with the rays near a box, not with all rays x all boxes.
@@ -20,6 +22,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 FloatArray = NDArray[np.float64]
+IndexArray = NDArray[np.int64]
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -37,28 +40,51 @@ def nearest_box_hits(origin: FloatArray, directions: FloatArray, reach: float,
     t_best = np.full(len(directions), np.inf)
     which = np.full(len(directions), -1, dtype=np.int32)
     for i, box in enumerate(boxes):
-        to_centre = box.centre - origin
-        distance = float(np.linalg.norm(to_centre))
-        radius = float(np.linalg.norm(box.half_extents))
-        if distance - radius > reach:
-            continue
-        if distance > radius:  # only rays inside the cone of the bounding sphere
-            near = np.flatnonzero(directions @ to_centre
-                                  >= distance * math.sqrt(1.0 - (radius / distance) ** 2))
-        else:
-            near = np.arange(len(directions))
+        near = _in_cone(origin, directions, reach, box)
         if not len(near):
             continue
-        t = _slab_entry(origin, directions[near], reach, box)
+        entry, leave = _slab_span(origin, directions[near], box)
+        hit = (entry <= leave) & (entry >= 0.0) & (entry <= reach)
+        t = np.where(hit, entry, np.inf)
         closer = t < t_best[near]
         t_best[near[closer]] = t[closer]
         which[near[closer]] = i
     return t_best, which
 
 
-def _slab_entry(origin: FloatArray, directions: FloatArray, reach: float,
-                box: OrientedBox) -> FloatArray:
-    """[m] each ray's entry into `box` within [0, reach], +inf when it misses."""
+def rays_through(origin: FloatArray, directions: FloatArray, reach: float,
+                 box: OrientedBox) -> tuple[IndexArray, FloatArray]:
+    """The rays (indices into `directions` (N, 3), unit, world frame, from `origin` (3,) [m])
+    that pass through `box` within [0, reach] [m], those starting inside it included, and
+    where each enters it [m] (0 for a ray starting inside)."""
+    near = _in_cone(origin, directions, reach, box)
+    if not len(near):
+        return near, np.zeros(0)
+    entry, leave = _slab_span(origin, directions[near], box)
+    entry = np.maximum(entry, 0.0)
+    through = (entry <= leave) & (entry <= reach)
+    return near[through], entry[through]
+
+
+def _in_cone(origin: FloatArray, directions: FloatArray, reach: float,
+             box: OrientedBox) -> IndexArray:
+    """The rays pointing within the cone of `box`'s bounding sphere seen from `origin` (all
+    of them when the origin is inside the sphere; none when the sphere is out of reach)."""
+    to_centre = box.centre - origin
+    distance = float(np.linalg.norm(to_centre))
+    radius = float(np.linalg.norm(box.half_extents))
+    if distance - radius > reach:
+        return np.zeros(0, dtype=np.int64)
+    if distance > radius:
+        return np.flatnonzero(directions @ to_centre
+                              >= distance * math.sqrt(1.0 - (radius / distance) ** 2))
+    return np.arange(len(directions))
+
+
+def _slab_span(origin: FloatArray, directions: FloatArray,
+               box: OrientedBox) -> tuple[FloatArray, FloatArray]:
+    """[m] where each ray enters and leaves the box's three slabs (the ray is in the box
+    between them when entry <= leave)."""
     o = (origin - box.centre) @ box.rotation  # box frame (R^T (o - c))
     d = directions @ box.rotation
     h = box.half_extents
@@ -70,7 +96,4 @@ def _slab_entry(origin: FloatArray, directions: FloatArray, reach: float,
     inside = np.abs(o) <= h
     lo = np.where(parallel, np.where(inside, -np.inf, np.inf), np.minimum(t1, t2))
     hi = np.where(parallel, np.where(inside, np.inf, -np.inf), np.maximum(t1, t2))
-    entry = lo.max(axis=1)
-    leave = hi.min(axis=1)
-    hit = (entry <= leave) & (entry >= 0.0) & (entry <= reach)
-    return np.where(hit, entry, np.inf)
+    return lo.max(axis=1), hi.min(axis=1)

@@ -7,8 +7,15 @@ Three sources, the nearest return winning (ties: ground, then static, then actor
   (`world.sensors.tessellate`) in one Embree scene, built once, from the collision shapes the
   world made (`world.scene.collision.CollisionShapes`) at the bodies' poses in Bullet; each
   Embree geometry id maps back to its Bullet body id;
-- the scenario actors, which are boxes, posed from Bullet at every scan, by the slab test
-  (`world.sensors.box_rays`).
+- the scenario actors, posed from Bullet at every scan, each a piece per (body, link) (the
+  base, link -1, is the body's collision shape; a link would be posed by `getLinkState`). A
+  piece that is one box centred on its frame is cast by the slab test in closed form
+  (`world.sensors.box_rays`); any other (a shaped body's convex parts) by a broad phase, the
+  slab test on the piece's bounding box, then a narrow phase: only the rays through that box,
+  taken into the piece's frame, cast against the piece's own Embree scene of its triangles,
+  built once in that frame (pieces of the same shape share one scene). A ray's distance is
+  the same in either frame (a rotation and a shift), and the small coordinates of a body's
+  own frame keep float32 precise.
 
 Precision: Embree casts in float32. The scene's vertices and the rays' origins are stored
 relative to `origin`, the centre of the static scene's bounding box (rounded to 1 m), so the
@@ -21,6 +28,7 @@ split between the `threads` cast threads (0: Open3D's choice).
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -28,13 +36,25 @@ from numpy.typing import NDArray
 from pybullet_utils.bullet_client import BulletClient
 
 from world.frames import import_open3d
-from world.scene.collision import Box, CollisionShapes
-from world.sensors.box_rays import OrientedBox, nearest_box_hits
+from world.scene.collision import IDENTITY, Box, CollisionShapes, Part
+from world.sensors.box_rays import OrientedBox, nearest_box_hits, rays_through
 from world.sensors.ray_culling import ground_distance
 from world.sensors.tessellate import body_triangles
 
-HIDDEN_AT = (1.0e5, 1.0e5, -10.0)  # [m] where a hidden actor's box is cast: out of range
 NO_GEOMETRY = 0xFFFFFFFF  # Open3D's INVALID_ID for a ray that met nothing
+BASE = -1  # the link index of a body's base
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class ActorPiece:
+    """One rigid piece of an actor's body as the rays see it, in the piece's frame."""
+
+    actor: int  # index of the actor (its body in `actor_bodies`)
+    body: int  # Bullet body id
+    link: int  # Bullet link index (`BASE`: the base)
+    centre: NDArray[np.float64]  # (3,) [m] the centre of its bounding box
+    half: NDArray[np.float64]  # (3,) [m] the bounding box's half extents
+    scene: Any  # its Embree scene, None when the piece is that box itself
 
 
 class EmbreeCaster:
@@ -50,7 +70,7 @@ class EmbreeCaster:
         self._max_range = max_range
         self._ground = ground
         self._actors = list(actor_bodies)
-        self._actor_half = [_box(shapes, b) for b in actor_bodies]
+        self._pieces = _actor_pieces(o3d, shapes, actor_bodies)
         meshes = [body_triangles(shapes.parts(b), *_pose(client, b)) for b in static_bodies]
         self.origin = _scene_origin(meshes)  # [m] world frame; the scene's coordinates
         self._scene: Any = o3d.t.geometry.RaycastingScene(nthreads=1)
@@ -87,7 +107,7 @@ class EmbreeCaster:
         closer = (t_static < t_best) & (t_static <= max_range) & (geometry != NO_GEOMETRY)
         t_best = np.where(closer, t_static, t_best)
         body[closer] = self._body_of[geometry[closer]]
-        t_actor, which = nearest_box_hits(origin, directions, max_range, self._actor_boxes())
+        t_actor, which = self._cast_actors(origin, directions)
         closer = t_actor < t_best
         t_best = np.where(closer, t_actor, t_best)
         body[closer] = np.asarray(self._actors, dtype=np.int32)[which[closer]]
@@ -102,32 +122,101 @@ class EmbreeCaster:
                 out["geometry_ids"].numpy().astype(np.int64))
 
     def hide(self, bodies: frozenset[int]) -> None:
-        """The actor bodies the rays pass through (their boxes are cast far away)."""
+        """The actor bodies the rays pass through (their pieces are not cast)."""
         self._hidden = bodies
 
-    def _actor_boxes(self) -> list[OrientedBox]:
-        boxes = []
-        for body, half in zip(self._actors, self._actor_half, strict=True):
-            position, rotation = _pose(self._c, body)
-            if body in self._hidden:
-                position = np.array(HIDDEN_AT)
-            boxes.append(OrientedBox(position, rotation, half))
-        return boxes
+    def _cast_actors(self, origin: NDArray[np.float64], directions: NDArray[np.float64]
+                     ) -> tuple[NDArray[np.float64], NDArray[np.int32]]:
+        """[m] per ray the nearest actor hit within range (+inf: none) and that actor's
+        index (-1: none); equal distances keep the box pieces first, then the shaped
+        pieces in order."""
+        boxes: list[OrientedBox] = []  # the pieces that are boxes, by the slab test
+        box_actor: list[int] = []
+        shaped: list[tuple[ActorPiece, NDArray[np.float64], NDArray[np.float64]]] = []
+        for piece in self._pieces:
+            if piece.body in self._hidden:
+                continue
+            position, rotation = _pose(self._c, piece.body, piece.link)
+            if piece.scene is None:
+                boxes.append(OrientedBox(position, rotation, piece.half))
+                box_actor.append(piece.actor)
+            else:
+                shaped.append((piece, position, rotation))
+        t_best, which = nearest_box_hits(origin, directions, self._max_range, boxes)
+        which = np.where(which >= 0, np.asarray([*box_actor, -1], np.int32)[which], -1)
+        for piece, position, rotation in shaped:
+            idx, t = self._cast_piece(piece, position, rotation, origin, directions)
+            closer = t < t_best[idx]
+            t_best[idx[closer]] = t[closer]
+            which[idx[closer]] = piece.actor
+        return t_best, which.astype(np.int32)
+
+    def _cast_piece(self, piece: ActorPiece, position: NDArray[np.float64],
+                    rotation: NDArray[np.float64], origin: NDArray[np.float64],
+                    directions: NDArray[np.float64]
+                    ) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
+        """The rays through the piece's bounding box (indices) and where each meets the
+        piece [m] (+inf: it passes), within range."""
+        bounds = OrientedBox(position + rotation @ piece.centre, rotation, piece.half)
+        idx, _ = rays_through(origin, directions, self._max_range, bounds)
+        if not len(idx):
+            return idx, np.zeros(0)
+        rays = np.empty((len(idx), 6), np.float32)
+        rays[:, :3] = (origin - position) @ rotation  # the piece's frame: R^T (o - p)
+        rays[:, 3:] = directions[idx] @ rotation
+        out = piece.scene.cast_rays(self._tensor(rays), nthreads=self.threads)
+        t = out["t_hit"].numpy().astype(np.float64)
+        return idx, np.where(t <= self._max_range, t, np.inf)
 
 
-def _pose(client: BulletClient, body: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """A body's base position (3,) [m] and rotation (3, 3) body -> world."""
-    position, quaternion = client.getBasePositionAndOrientation(body)
+def _pose(client: BulletClient, body: int,
+          link: int = BASE) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """A body's base (or link's) position (3,) [m] and rotation (3, 3) its frame -> world."""
+    if link == BASE:
+        position, quaternion = client.getBasePositionAndOrientation(body)
+    else:
+        position, quaternion = client.getLinkState(body, link)[4:6]
     rotation = np.array(client.getMatrixFromQuaternion(quaternion)).reshape(3, 3)
     return np.array(position), rotation
 
 
-def _box(shapes: CollisionShapes, body: int) -> NDArray[np.float64]:
-    """[m] the half extents of an actor's one box, at its body's origin."""
-    parts = shapes.parts(body)
-    if len(parts) != 1 or not isinstance(parts[0].shape, Box) or any(parts[0].position):
-        raise ValueError(f"actor body {body} is not one centred box: {parts}")
-    return np.array(parts[0].shape.half_extents)
+def _actor_pieces(o3d: Any, shapes: CollisionShapes, bodies: list[int]) -> list[ActorPiece]:
+    """Each actor body's pieces: its base's collision shape. A shape that is one box centred
+    on the body's frame stays that box; any other gets an Embree scene of its triangles in
+    the body's frame, one per shape (bodies sharing a shape share it)."""
+    scenes: dict[int, tuple[Any, NDArray[np.float64], NDArray[np.float64]]] = {}
+    pieces = []
+    for actor, body in enumerate(bodies):
+        parts = shapes.parts(body)
+        if _centred_box(parts):
+            box = parts[0].shape
+            assert isinstance(box, Box)
+            pieces.append(ActorPiece(actor, body, BASE, np.zeros(3),
+                                     np.array(box.half_extents), None))
+            continue
+        if id(parts) not in scenes:
+            scenes[id(parts)] = _piece_scene(o3d, parts)
+        scene, centre, half = scenes[id(parts)]
+        pieces.append(ActorPiece(actor, body, BASE, centre, half, scene))
+    return pieces
+
+
+def _centred_box(parts: tuple[Part, ...]) -> bool:
+    return (len(parts) == 1 and isinstance(parts[0].shape, Box) and not any(parts[0].position)
+            and parts[0].orientation == IDENTITY)
+
+
+def _piece_scene(o3d: Any, parts: tuple[Part, ...]
+                 ) -> tuple[Any, NDArray[np.float64], NDArray[np.float64]]:
+    """An Embree scene of `parts`' triangles in their frame, committed (its BVH built on one
+    thread), and the centre and half extents [m] of their bounding box."""
+    vertices, triangles = body_triangles(parts, np.zeros(3), np.eye(3))
+    scene = o3d.t.geometry.RaycastingScene(nthreads=1)
+    scene.add_triangles(o3d.core.Tensor(vertices.astype(np.float32)),
+                        o3d.core.Tensor(triangles.astype(np.uint32)))
+    scene.cast_rays(o3d.core.Tensor(np.array([[0, 0, 0, 1, 0, 0]], np.float32)), nthreads=1)
+    lo, hi = vertices.min(axis=0), vertices.max(axis=0)
+    return scene, 0.5 * (lo + hi), 0.5 * (hi - lo)
 
 
 def _scene_origin(meshes: list[tuple[NDArray[np.float64], Any]]) -> NDArray[np.float64]:

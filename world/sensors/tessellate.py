@@ -8,7 +8,8 @@ most ``r (1 - cos(pi / n)) / (1 + cos(pi / n))``, about ``r (pi / n)^2 / 4``, ou
 corners and inward mid-side. Bullet's own slight rounding of a cylinder's rims (its collision
 margin) is not modelled.
 
-Everything is in the body's frame [m]; triangles are (T, 3) vertex indices, counter-clockwise
+Everything is in the body's frame [m] (each part at its position, turned by its orientation);
+triangles are (T, 3) vertex indices, counter-clockwise
 seen from outside (a ray caster that ignores facing does not need it, but it keeps them
 valid meshes).
 """
@@ -20,7 +21,16 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-from world.scene.collision import Box, ConvexHull, Cylinder, Part, Shape, TriangleMesh
+from world.scene.collision import (
+    IDENTITY,
+    Box,
+    ConvexHull,
+    Cylinder,
+    Part,
+    Quaternion,
+    Shape,
+    TriangleMesh,
+)
 
 FloatArray = NDArray[np.float64]
 IndexArray = NDArray[np.int64]
@@ -76,14 +86,32 @@ def cylinder_triangles(radius: float, height: float, sides: int) -> Triangles:
     return vertices, triangles
 
 
+def quaternion_matrix(q: Quaternion) -> FloatArray:
+    """(3, 3) the rotation matrix of the unit quaternion `q` (x, y, z, w)."""
+    x, y, z, w = q
+    return np.array([
+        [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+        [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+        [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+    ])
+
+
+def part_triangles(part: Part) -> Triangles:
+    """One part's triangles in its body's frame."""
+    v, t = shape_triangles(part.shape)
+    if part.orientation != IDENTITY:
+        v = v @ quaternion_matrix(part.orientation).T
+    return v + np.asarray(part.position), t
+
+
 def body_triangles(parts: tuple[Part, ...], position: FloatArray,
                    rotation: FloatArray) -> Triangles:
     """A body's parts as one triangle set in the world frame, for the body at `position`
     (3,) [m] with `rotation` (3, 3) body -> world."""
     vertices, triangles, base = [], [], 0
     for part in parts:
-        v, t = shape_triangles(part.shape)
-        vertices.append((v + np.asarray(part.position)) @ rotation.T + position)
+        v, t = part_triangles(part)
+        vertices.append(v @ rotation.T + position)
         triangles.append(t + base)
         base += len(v)
     return np.vstack(vertices), np.vstack(triangles)

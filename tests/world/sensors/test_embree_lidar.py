@@ -11,6 +11,12 @@ Where the two differ, and why (the thresholds below follow from it):
   are within float32 rounding and the cylinder tessellation of the exact surface (the
   closed-form checks below). So at least 99.9 % of the common hits agree within 1 mm, and
   every one within `BULLET_CONVEX_SLACK`; the worst figures are printed (`pytest -s`).
+- Shaped actors (the NPC cars: convex hulls and cylinders in a compound): Bullet keeps a
+  1 mm collision margin around a hull, so its ray stops 1 mm / cos(incidence) short of the
+  surface (a glancing ray on a car's flank: centimetres), and its convex cast against a
+  cylinder's flat end (a tyre's side) errs by up to about 2.5 cm near the rim (measured:
+  23 mm). Their hits are held to `BULLET_SHAPE_SLACK` instead; the exact casters' geometry
+  is checked in closed form below (`test_rays_pass_over_a_saloons_bonnet`).
 """
 
 from __future__ import annotations
@@ -25,15 +31,18 @@ from numpy.typing import NDArray
 
 from avsim.scenario.load import load_scenario
 from world.core.client import add_ground, make_client
+from world.frames import import_open3d
 from world.scene.collision import Box, CollisionShapes, Cylinder, Part
 from world.sensors.bullet_caster import BulletCaster
 from world.sensors.embree_caster import EmbreeCaster
 from world.sensors.lidar import Lidar, RayBackend, beam_directions
 from world.sensors.sensor import vehicle_pose
 from world.sensors.setup import Profile, sensor_setup
+from world.sensors.tessellate import body_triangles
 from world.world import World
 
 BULLET_CONVEX_SLACK = 0.010  # [m] Bullet's convex cast falls short by up to this (see above)
+BULLET_SHAPE_SLACK = 0.030  # [m] ... on the shaped actors' hulls and tyres (see above)
 OFFSETS = ((0.0, 0.0), (25.0, -3.0), (60.0, 4.0), (-30.0, 2.0))  # [m] ego frame x, y
 
 
@@ -83,26 +92,32 @@ def _rays(c: Casters, dx: float, dy: float) -> tuple[NDArray[np.float64],
 def test_embree_agrees_with_bullet(scene: str, request: pytest.FixtureRequest) -> None:
     c: Casters = request.getfixturevalue(scene)
     max_range = c.lidar.info.max_range
-    rays = same = hits = within = 0
-    worst = 0.0
+    shaped = [b for b in c.world.actors.bodies if len(c.world.shapes.parts(b)) > 1]
+    rays = same = hits = within = on_shapes = 0
+    worst = worst_shape = 0.0
     for dx, dy in OFFSETS:
         o, dirs, heading = _rays(c, dx, dy)
         b_e, f_e = c.lidar.caster.cast(o, dirs, heading)
         b_b, f_b = c.bullet.cast(o, dirs, heading)
         agree = b_e == b_b
         hit = agree & (b_e >= 0)
-        error = np.abs(f_e - f_b)[hit] * max_range
+        on_shape = hit & np.isin(b_e, shaped)
+        error = np.abs(f_e - f_b) * max_range
         rays += len(b_e)
         same += int(agree.sum())
-        hits += int(hit.sum())
-        within += int((error <= 1e-3).sum())
-        worst = max(worst, float(error.max()))
+        hits += int((hit & ~on_shape).sum())
+        on_shapes += int(on_shape.sum())
+        within += int((error[hit & ~on_shape] <= 1e-3).sum())
+        worst = max(worst, float(error[hit & ~on_shape].max()))
+        worst_shape = max(worst_shape, float(error[on_shape].max(initial=0.0)))
         assert (b_e[hit] != c.world.scene.ground).sum() > 500  # not the ground alone
     print(f"\n{scene}: {rays} rays, same body {same / rays:.5%}, "
-          f"range within 1 mm {within / hits:.5%} of those hit, worst {worst * 1e3:.2f} mm")
+          f"range within 1 mm {within / hits:.5%} of those hit, worst {worst * 1e3:.2f} mm; "
+          f"{on_shapes} hits on shaped actors, worst {worst_shape * 1e3:.2f} mm")
     assert same >= 0.999 * rays
     assert within >= 0.999 * hits
     assert worst <= BULLET_CONVEX_SLACK
+    assert worst_shape <= BULLET_SHAPE_SLACK
 
 
 def _one_body_world(parts: tuple[Part, ...], position: tuple[float, float, float],
@@ -154,13 +169,14 @@ def test_box_faces_are_exact() -> None:
 
 
 def test_an_actor_moved_between_scans_is_seen_where_it_is(highway: Casters) -> None:
+    """The actor moved 12 m and 25 m ahead of the ego: its returns lie on its shape's
+    surface where it now is (within 1 mm: float32), and Bullet sees the same rays hit it."""
     c = highway
     client, actor = c.world.client, c.world.actors.bodies[0]
     saved = client.getBasePositionAndOrientation(actor)
     origin, rotation = vehicle_pose(c.world.ego_truth, c.world.ego.geometry.ride_height)
     quat = client.getQuaternionFromEuler([0.0, 0.0, math.atan2(rotation[1, 0],
                                                                rotation[0, 0])])
-    half_length = float(c.world.actors.half_sizes[0][0])
     try:
         for ahead in (12.0, 25.0):
             centre = origin + rotation @ np.array([ahead, 0.0, 0.0])
@@ -170,14 +186,26 @@ def test_an_actor_moved_between_scans_is_seen_where_it_is(highway: Casters) -> N
             body, fraction = c.lidar.caster.cast(o, dirs, heading)
             b_b, _ = c.bullet.cast(o, dirs, heading)
             on = body == actor
-            assert on.sum() > 40
-            assert np.sum(on != (b_b == actor)) <= 2  # edge rays (module docstring)
+            assert on.sum() >= 30  # a car at 25 m: 40 returns on its shape (more on its box)
+            assert np.sum(on != (b_b == actor)) <= 3  # edge rays (module docstring)
             points = o + dirs[on] * (fraction[on, None] * c.lidar.info.max_range)
-            along = (points - centre) @ rotation[:, 0]
-            # the rear face, seen from behind: 1 mm (float32 and Bullet's slack aside)
-            assert np.median(along) == pytest.approx(-half_length, abs=1e-3)
+            assert np.max(_distance_to_surface(c.world, actor, points)) <= 1e-3
     finally:
         client.resetBasePositionAndOrientation(actor, *saved)
+
+
+def _distance_to_surface(w: World, body: int, points: NDArray[np.float64]
+                         ) -> NDArray[np.float64]:
+    """[m] each point's distance to `body`'s collision shape's surface where it is now."""
+    o3d = import_open3d()
+    position, quaternion = w.client.getBasePositionAndOrientation(body)
+    rotation = np.array(w.client.getMatrixFromQuaternion(quaternion)).reshape(3, 3)
+    vertices, triangles = body_triangles(w.shapes.parts(body), np.array(position), rotation)
+    scene = o3d.t.geometry.RaycastingScene()
+    scene.add_triangles(o3d.core.Tensor(vertices.astype(np.float32)),
+                        o3d.core.Tensor(triangles.astype(np.uint32)))
+    d = scene.compute_distance(o3d.core.Tensor(points.astype(np.float32)))
+    return np.asarray(d.numpy(), dtype=np.float64)
 
 
 def test_repeat_casts_are_bitwise_equal(town: Casters) -> None:
