@@ -119,6 +119,8 @@ class WorldSnapshot:
     actors: tuple[tuple[tuple[float, ...], tuple[float, ...]], ...]  # (position, quaternion)
     camera_hidden: tuple[int, ...] = ()  # the actors the cameras do not draw (by index)
     environment: SceneEnvironment = CLEAR  # the environment in effect
+    # [rad] each actor's body's joint angles (a walker's legs and arms; () for a rigid one)
+    actor_joints: tuple[tuple[float, ...], ...] = ()
 
 
 class World:
@@ -548,7 +550,8 @@ class World:
         com, quat, joints = self.ego.base_state()
         actors = tuple(self.client.getBasePositionAndOrientation(b) for b in self.actors.bodies)
         return WorldSnapshot(self.clock.step, com, quat, joints, actors,
-                             tuple(sorted(self.camera_hidden)), self.environment)
+                             tuple(sorted(self.camera_hidden)), self.environment,
+                             self.actors.joints())
 
     def set_environment(self, env: SceneEnvironment) -> None:
         """The environment in effect from now on: the cameras and the LiDAR see through it,
@@ -596,6 +599,8 @@ class World:
         self.ego.set_base_state(snap.ego_com, snap.ego_quat, snap.ego_joints)
         for body, (position, quat) in zip(self.actors.bodies, snap.actors, strict=True):
             self.client.resetBasePositionAndOrientation(body, position, quat)
+        if snap.actor_joints:
+            self.actors.set_joints(snap.actor_joints)
         if set(snap.camera_hidden) != self.camera_hidden:
             self.camera_hidden = set(snap.camera_hidden)
             self._hide_from_sensors()

@@ -9,6 +9,13 @@ the actor's `model`, else its type's default); a pedestrian's and an obstacle's 
 (`world.actors.shapes.actors`: the catalogue's vehicles, the Euro NCAP targets), built from its
 convex parts (`world.actors.body_build`), else its box; either way its origin is the box's
 centre, which is what `poses` gives.
+Every pedestrian walks: its body is an articulated walker (`world.actors.walker_body`) of
+the stature `world.actors.shapes.actors.walker_stature` gives its box, standing on the
+ground at its box's centre (its body frame's origin, the middle of its gait's sweep), its
+base at the hips. Its gait phase starts at `STAND_PHASE` and advances with the distance its
+body moves over the ground each time it is placed (`phase_after`), so a standing pedestrian
+keeps its pose and a walking one swings its legs; it is posed (base and joints) each time
+it is placed.
 Pedestrians are placed by station and offset from
 their lane's centre like any actor; their speed is a walking speed along the lane, and the
 `walk` action moves them across the road, facing where they walk.
@@ -41,9 +48,12 @@ from world.actors.behaviour import NpcMotion, TriggerContext
 from world.actors.bodies import VEHICLES, BoxSize, body_size, vehicle_of
 from world.actors.body_build import BodyBuilder
 from world.actors.catalogue import CATALOGUE, DEFAULT_MODEL, VehicleClass
-from world.actors.shapes.actors import pedestrian_shape, vehicle_shape
+from world.actors.shapes.actors import vehicle_shape, walker_stature
 from world.actors.shapes.body import Body
+from world.actors.shapes.humans import phase_after
+from world.actors.shapes.walker import WalkerModel, walker_model, walker_pose
 from world.actors.town_traffic import STOP_MARGIN, STOP_SPEED, Others, StopZones, TownDriver
+from world.actors.walker_body import pose_walker
 from world.hdmap import Manoeuvre, RoadMap
 from world.map.road import build_road_map
 from world.map.signals import route_signals
@@ -52,6 +62,8 @@ from world.spec import ActorSpec, ActorType
 
 EGO = "ego"  # the ego's key in the all-way-stop order
 GONE_XY = (1.0e5, 1.0e5)  # [m] where an NPC that has left the town is (below the ground)
+STAND_PHASE = 0.25  # [-] a pedestrian's gait phase before it walks: the hips straight, the
+#   legs side by side (the right knee bent as in mid-swing)
 
 
 COLOURS = {  # [-] RGBA
@@ -90,13 +102,21 @@ class ActorPoses:
 
 
 def actor_shape(spec: ActorSpec, size: BoxSize) -> Body | None:
-    """The shape of an actor's body whose box is `size` (None: the box itself)."""
+    """The rigid shape of an actor's body whose box is `size` (None: the box itself, or a
+    walker: `actor_walker`)."""
     model = vehicle_of(spec)
     if model is not None:
         return vehicle_shape(model.name, size.length, size.width)
-    if spec.type is ActorType.PEDESTRIAN:
-        return pedestrian_shape(size.length, size.width, size.height)
     return None
+
+
+def actor_walker(spec: ActorSpec, size: BoxSize) -> WalkerModel | None:
+    """The articulated walker that is a pedestrian's body whose box is `size` (None: not a
+    pedestrian, or no walker fits its box)."""
+    if spec.type is not ActorType.PEDESTRIAN:
+        return None
+    stature = walker_stature(size.length, size.width, size.height)
+    return None if stature is None else walker_model(stature, size.width)
 
 
 class ActorSet:
@@ -125,11 +145,16 @@ class ActorSet:
             )
         sizes = [body_size(a) for a in specs]
         builder = BodyBuilder(client, self._shapes)
+        self._builder = builder  # keeps the visuals' mesh files while the client draws
         self.shapes = [actor_shape(a, size) for a, size in zip(specs, sizes, strict=True)]
+        self.walkers = [actor_walker(a, size) for a, size in zip(specs, sizes, strict=True)]
         self.bodies = [
-            builder.box((size.length / 2, size.width / 2, size.height / 2), COLOURS[a.type])
+            builder.walker(walker) if walker is not None
+            else builder.box((size.length / 2, size.width / 2, size.height / 2), COLOURS[a.type])
             if shape is None else builder.shaped(shape, size.height, COLOURS[a.type])
-            for a, size, shape in zip(specs, sizes, self.shapes, strict=True)]
+            for a, size, shape, walker in zip(specs, sizes, self.shapes, self.walkers,
+                                              strict=True)]
+        self.phases = [STAND_PHASE] * len(specs)  # [-] each walker's gait phase (0 to 1)
         self.lengths = np.array([size.length for size in sizes])
         self.half_sizes = np.array(
             [[size.length / 2, size.width / 2, size.height / 2] for size in sizes]
@@ -359,8 +384,41 @@ class ActorSet:
             if gone:
                 continue
             if force or m.speed != 0.0 or m.lateral_speed != 0.0 or m.jumped:
-                m.jumped = False
                 x, y, heading = line.pose_one(m.s, m.offset)
+                yaw = heading + flip + m.heading_offset
+                walker = self.walkers[i]
+                if walker is not None:
+                    self._pose_walker(i, walker, x, y, yaw, walked=not (force or m.jumped))
+                else:
+                    half = 0.5 * yaw
+                    self._reset_pose(body, (x, y, z), (0.0, 0.0, math.sin(half), math.cos(half)))
+                m.jumped = False
                 self._xy[i] = (x, y)
-                half = 0.5 * (heading + flip + m.heading_offset)
-                self._reset_pose(body, (x, y, z), (0.0, 0.0, math.sin(half), math.cos(half)))
+
+    def _pose_walker(self, i: int, walker: WalkerModel, x: float, y: float, yaw: float,
+                     walked: bool) -> None:
+        """Pose walker `i` with its body frame at (`x`, `y`) [m] on the ground heading `yaw`
+        [rad]; `walked`: it walked there from where it was last placed, its phase advanced by
+        that distance over the ground (not after a jump: placed first, restored, moved)."""
+        if walked:
+            prev = self._xy[i]
+            distance = math.hypot(x - float(prev[0]), y - float(prev[1]))
+            self.phases[i] = phase_after(self.phases[i], distance, walker.height)
+        pose_walker(self._c, self.bodies[i], x, y, yaw,
+                    walker_pose(walker.height, self.phases[i], walker.width))
+
+    def joints(self) -> tuple[tuple[float, ...], ...]:
+        """[rad] each actor's body's joint angles now, in joint order (() for a rigid body)."""
+        out = []
+        for body, walker in zip(self.bodies, self.walkers, strict=True):
+            n = 0 if walker is None else len(walker.links)
+            out.append(tuple(float(j[0]) for j in self._c.getJointStates(body, list(range(n))))
+                       if n else ())
+        return tuple(out)
+
+    def set_joints(self, joints: tuple[tuple[float, ...], ...]) -> None:
+        """Turn each actor's body's joints to `joints` (as `joints()` gave them)."""
+        for body, angles in zip(self.bodies, joints, strict=True):
+            if angles:
+                self._c.resetJointStatesMultiDof(body, list(range(len(angles))),
+                                                 [[a] for a in angles])

@@ -4,7 +4,9 @@ A shaped body (`world.actors.shapes.actors`) is one kinematic (static, mass 0) b
 collision shape is the compound of its shape's parts (boxes, rotated cylinders, convex hulls:
 `world.scene.collision`) and whose visual is its parts coloured by material: one mesh per
 material (an OBJ file, the only meshes every renderer draws), paint in the actor kind's
-colour. An actor without a shape is one box, collision and visual.
+colour. An actor without a shape is one box, collision and visual. A walking pedestrian is
+an articulated walker (`world.actors.walker_body`), its origin at the hips (posed by
+`pose_walker`, not at its box's centre).
 
 Frame: every body's origin is the centre of its actor's box (the pose the rest of the world
 gives and reads), so a shape, whose origin is on the ground (`world.actors.shapes`), is
@@ -25,6 +27,8 @@ from world.actors.shapes.body import Body
 from world.actors.shapes.materials import MATERIALS
 from world.actors.shapes.mesh import part_mesh
 from world.actors.shapes.parts import BodyPart
+from world.actors.shapes.walker import WalkerModel
+from world.actors.walker_body import build_walker
 from world.scene.collision import Box, CollisionShapes, Part
 from world.scene.traffic_light import write_obj
 
@@ -60,14 +64,25 @@ class BodyBuilder:
                                self._visual(body, drop, paint))
         return self._body(*self._made[key])
 
+    def walker(self, model: WalkerModel) -> int:
+        """An articulated walker of `model`, asleep, below the ground until posed."""
+        body = build_walker(self._c, model, self._files(), shapes=self._shapes)
+        self._c.resetBasePositionAndOrientation(body, list(BELOW), [0.0, 0.0, 0.0, 1.0])
+        return body
+
+    def _files(self) -> Path:
+        """The folder of the visuals' mesh files (kept while the builder lives)."""
+        if self._folder is None:
+            self._folder = tempfile.TemporaryDirectory(prefix="avsim-bodies-")
+        return Path(self._folder.name)
+
     def _body(self, shape: int, visual: int) -> int:
         return self._shapes.placed(int(self._c.createMultiBody(
             0.0, shape, visual, list(BELOW), useMaximalCoordinates=True)), shape)
 
     def _visual(self, body: Body, drop: float, paint: Rgba) -> int:
         """One mesh per material of `body`, lowered by -`drop` [m]."""
-        if self._folder is None:
-            self._folder = tempfile.TemporaryDirectory(prefix="avsim-bodies-")
+        folder = self._files()
         files, colours = [], []
         for name, m in MATERIALS.items():
             meshes = [part_mesh(p) for p in body.parts if p.material == name]
@@ -76,7 +91,7 @@ class BodyBuilder:
             vertices = np.vstack([v for v, _ in meshes]) + np.array([0.0, 0.0, drop])
             starts = np.cumsum([0] + [len(v) for v, _ in meshes[:-1]])
             faces = np.vstack([f + s for (_, f), s in zip(meshes, starts, strict=True)])
-            path = Path(self._folder.name) / f"{body.name}_{len(self._made)}_{name}.obj"
+            path = folder / f"{body.name}_{len(self._made)}_{name}.obj"
             write_obj(path, vertices, faces)
             files.append(str(path))
             colours.append(list(paint) if name == PAINT else [*m.rgb, 1.0])

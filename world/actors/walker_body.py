@@ -7,7 +7,14 @@ link's index; each further base part (the head) rides on a fixed joint after the
 (`bullet_links` names every Bullet link in order). Every link's inertial frame is its link
 frame, so `getLinkState`'s first position is the link frame's origin. Nothing drives the
 joints: `pose_walker` sets the base and every joint angle (`resetBasePositionAndOrientation`,
-`resetJointState`), and a physics step leaves them there (mass-0 links take no forces).
+one `resetJointStatesMultiDof`), and a physics step leaves them there (mass-0 links take no
+forces).
+
+Asleep: the body is put to sleep when built (Bullet's deactivation). A sleeping multibody
+skips the articulated-body pass and its joint motors in every physics step (8 awake walkers
+add ~205 us to a step, 8 asleep ones ~20 us: `python -m bench.bench_walker`), yet a pose
+still moves its links' colliders (PyBullet's resets update them), so contacts, rays and
+drawings follow each pose, and an awake body (the ego) still collides with it.
 
 Collision: each link is one convex hull, its model part's own points (`GEOM_MESH` with
 vertices: no file, no rounding). Visual: the same hull as a flat-shaded OBJ mesh coloured
@@ -29,6 +36,7 @@ from world.actors.shapes.materials import MATERIALS
 from world.actors.shapes.mesh import part_mesh
 from world.actors.shapes.parts import BodyPart
 from world.actors.shapes.walker import BASE, LINK_NAMES, WalkerModel, WalkerPose
+from world.scene.collision import CollisionShapes, Part
 from world.scene.solids import ConvexHull
 from world.scene.traffic_light import write_obj
 
@@ -47,12 +55,10 @@ def bullet_links(model: WalkerModel) -> tuple[str, ...]:
     return (*(link.name for link in model.links), *(p.name for p in model.base_parts[1:]))
 
 
-def _collision(client: BulletClient, part: BodyPart) -> int:
+def _collision(client: BulletClient, shapes: CollisionShapes, part: BodyPart) -> int:
     if not isinstance(part.solid, ConvexHull):
         raise ValueError(f"walker part {part.name!r} is not a convex hull")
-    return int(client.createCollisionShape(pybullet.GEOM_MESH,
-                                           vertices=part.solid.points.tolist(),
-                                           collisionFramePosition=list(part.position)))
+    return shapes.create(client, Part(part.solid, part.position, part.orientation))
 
 
 def _visual(client: BulletClient, part: BodyPart, folder: Path, key: str,
@@ -66,10 +72,13 @@ def _visual(client: BulletClient, part: BodyPart, folder: Path, key: str,
 
 
 def build_walker(client: BulletClient, model: WalkerModel, folder: Path,
-                 rgba: Mapping[str, Rgba] | None = None) -> int:
-    """A walker of `model` in `client`, at zero angles with its body origin at the world's;
-    its id. Mesh files go into `folder`; `rgba` colours the parts by material (each
-    material's own colour when None)."""
+                 rgba: Mapping[str, Rgba] | None = None,
+                 shapes: CollisionShapes | None = None) -> int:
+    """A walker of `model` in `client`, at zero angles with its body origin at the world's,
+    asleep; its id. Mesh files go into `folder`; `rgba` colours the parts by material (each
+    material's own colour when None); `shapes` keeps its base's and links' collision parts
+    (`CollisionShapes.parts`, `.links`; a book of its own when None)."""
+    book = CollisionShapes() if shapes is None else shapes
     colours = material_rgba() if rgba is None else rgba
     key = f"walker-{model.height:.4f}-{'free' if model.width is None else f'{model.width:.4f}'}"
     parts = [(BASE, p) for p in model.base_parts[1:]]
@@ -78,12 +87,13 @@ def build_walker(client: BulletClient, model: WalkerModel, folder: Path,
         raise ValueError("a walker link carries exactly one convex part")
     index = {BASE: 0} | {name: i + 1 for i, name in enumerate(LINK_NAMES)}
     n = len(links)
-    trunk = model.base_parts[0]
-    return int(client.createMultiBody(
-        0.0, _collision(client, trunk), _visual(client, trunk, folder, key, colours),
+    trunk = _collision(client, book, model.base_parts[0])
+    link_shapes = tuple(_collision(client, book, p) for _, p in links)
+    body = int(client.createMultiBody(
+        0.0, trunk, _visual(client, model.base_parts[0], folder, key, colours),
         [0.0, 0.0, 0.0], list(UPRIGHT),
         linkMasses=[0.0] * n,
-        linkCollisionShapeIndices=[_collision(client, p) for _, p in links],
+        linkCollisionShapeIndices=list(link_shapes),
         linkVisualShapeIndices=[_visual(client, p, folder, key, colours) for _, p in links],
         linkPositions=[list(link.origin) for link in model.links] + [[0.0, 0.0, 0.0]] * len(parts),
         linkOrientations=[list(UPRIGHT)] * n,
@@ -93,6 +103,10 @@ def build_walker(client: BulletClient, model: WalkerModel, folder: Path,
         linkJointTypes=[pybullet.JOINT_REVOLUTE] * len(model.links)
         + [pybullet.JOINT_FIXED] * len(parts),
         linkJointAxis=[list(link.axis) for link in model.links] + [[0.0, 0.0, 1.0]] * len(parts)))
+    client.changeDynamics(body, -1, activationState=pybullet.ACTIVATION_STATE_ENABLE_SLEEPING)
+    client.changeDynamics(body, -1, activationState=pybullet.ACTIVATION_STATE_SLEEP)
+    book.placed(body, trunk)
+    return book.placed_links(body, link_shapes)
 
 
 def pose_walker(client: BulletClient, body: int, x: float, y: float, yaw: float,
@@ -103,5 +117,5 @@ def pose_walker(client: BulletClient, body: int, x: float, y: float, yaw: float,
     client.resetBasePositionAndOrientation(
         body, [x + c * pose.base_x, y + s * pose.base_x, z + pose.base_height],
         [0.0, 0.0, math.sin(0.5 * yaw), math.cos(0.5 * yaw)])
-    for joint, angle in enumerate(pose.angles.values()):
-        client.resetJointState(body, joint, angle)
+    angles = list(pose.angles.values())
+    client.resetJointStatesMultiDof(body, list(range(len(angles))), [[a] for a in angles])

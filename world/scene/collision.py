@@ -52,6 +52,7 @@ class CollisionShapes:
     def __init__(self) -> None:
         self._by_shape: dict[int, tuple[Part, ...]] = {}
         self._by_body: dict[int, tuple[Part, ...]] = {}
+        self._links: dict[int, tuple[tuple[Part, ...], ...]] = {}
 
     def create(self, client: BulletClient, *parts: Part) -> int:
         """A Bullet collision shape made of `parts`; its id."""
@@ -72,6 +73,17 @@ class CollisionShapes:
     def parts(self, body: int) -> tuple[Part, ...]:
         """The parts of `body`'s collision shape (KeyError: not made through this book)."""
         return self._by_body[body]
+
+    def placed_links(self, body: int, shapes: tuple[int, ...]) -> int:
+        """Note that link `i` of the articulated `body` carries `shapes[i]` (each made by
+        `create`); returns `body`."""
+        self._links[body] = tuple(self._by_shape[shape] for shape in shapes)
+        return body
+
+    def links(self, body: int) -> tuple[tuple[Part, ...], ...]:
+        """The parts of each link's collision shape of `body`, by link index, each in its
+        link's frame (empty: a body without links)."""
+        return self._links.get(body, ())
 
 
 def _create_one(client: BulletClient, part: Part) -> int:

@@ -3,7 +3,9 @@
 Rays that can only meet the flat ground are solved in closed form and only the others are
 cast (`world.sensors.ray_culling`), in batches of at most 16,383 (`rayTestBatch`'s limit;
 16,384 silently drops a ray), as (N, 3) numpy arrays, on `threads` threads (0: Bullet's
-choice, all cores). The ego's own body is in a collision group the rays skip.
+choice, all cores). The ego's own body is in a collision group the rays skip. An
+articulated actor (a walker) is culled by the box around its base and every link, and hidden
+link by link.
 """
 
 from __future__ import annotations
@@ -39,6 +41,7 @@ class BulletCaster:
         self._columns = columns
         self._ground = ground
         self._actors = list(actor_bodies)
+        self._links = {b: client.getNumJoints(b) for b in actor_bodies}  # [-] links per body
         self._static_boxes = [_aabb(client, b) for b in static_bodies]
         self.threads = 0  # rayTestBatch threads: 0 = Bullet's choice (all cores)
         self._hidden: frozenset[int] = frozenset()
@@ -49,7 +52,8 @@ class BulletCaster:
         for body in self._hidden | bodies:
             group = HIDDEN_RAY_GROUP if body in bodies else STATIC_GROUP
             mask = HIDDEN_MASK if body in bodies else STATIC_MASK
-            self._c.setCollisionFilterGroupMask(body, -1, group, mask)
+            for link in range(-1, self._c.getNumJoints(body)):
+                self._c.setCollisionFilterGroupMask(body, link, group, mask)
         self._hidden = bodies
 
     def cast(self, origin: NDArray[np.float64], directions: NDArray[np.float64],
@@ -60,7 +64,7 @@ class BulletCaster:
         max_range = self._max_range
         ground = ground_distance(origin, directions, max_range)
         reach = np.minimum(ground, max_range)
-        boxes = self._static_boxes + [_aabb(self._c, b) for b in self._actors
+        boxes = self._static_boxes + [_aabb(self._c, b, self._links[b]) for b in self._actors
                                       if b not in self._hidden]
         shape = (len(directions) // self._columns, self._columns)
         need = rays_to_cast(origin, directions.reshape(*shape, 3), reach.reshape(shape),
@@ -81,6 +85,10 @@ class BulletCaster:
         return body, fraction
 
 
-def _aabb(client: BulletClient, body: int) -> Box:
-    lo, hi = client.getAABB(body)
-    return np.array(lo), np.array(hi)
+def _aabb(client: BulletClient, body: int, links: int = 0) -> Box:
+    """The world-axis box around a body's base and its first `links` links."""
+    lo, hi = (np.array(v) for v in client.getAABB(body))
+    for link in range(links):
+        link_lo, link_hi = client.getAABB(body, link)
+        lo, hi = np.minimum(lo, link_lo), np.maximum(hi, link_hi)
+    return lo, hi

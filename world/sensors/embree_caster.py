@@ -7,15 +7,18 @@ Three sources, the nearest return winning (ties: ground, then static, then actor
   (`world.sensors.tessellate`) in one Embree scene, built once, from the collision shapes the
   world made (`world.scene.collision.CollisionShapes`) at the bodies' poses in Bullet; each
   Embree geometry id maps back to its Bullet body id;
-- the scenario actors, posed from Bullet at every scan, each a piece per (body, link) (the
-  base, link -1, is the body's collision shape; a link would be posed by `getLinkState`). A
-  piece that is one box centred on its frame is cast by the slab test in closed form
-  (`world.sensors.box_rays`); any other (a shaped body's convex parts) by a broad phase, the
-  slab test on the piece's bounding box, then a narrow phase: only the rays through that box,
-  taken into the piece's frame, cast against the piece's own Embree scene of its triangles,
-  built once in that frame (pieces of the same shape share one scene). A ray's distance is
-  the same in either frame (a rotation and a shift), and the small coordinates of a body's
-  own frame keep float32 precise.
+- the scenario actors, posed from Bullet at every scan, each a piece per (body, link): the
+  base (link -1, posed by `getBasePositionAndOrientation`) and each link of an articulated
+  body (a walker's legs, arms and head, posed by one `getLinkStates` per body: the link
+  frames Bullet's last pose left, `CollisionShapes.links` giving their parts). A piece that
+  is one box centred on its frame is cast by the slab test in closed form
+  (`world.sensors.box_rays`); any other (a shaped body's convex parts, a link's hull) by a
+  broad phase, the slab test on the piece's bounding box (for an articulated body, first on
+  the box around all its pieces: the rays that miss it skip every link), then a narrow
+  phase: only the rays through that box, taken into the piece's frame, cast against the
+  piece's own Embree scene of its triangles, built once in that frame (pieces of the same
+  parts share one scene). A ray's distance is the same in either frame (a rotation and a
+  shift), and the small coordinates of a body's own frame keep float32 precise.
 
 Precision: Embree casts in float32. The scene's vertices and the rays' origins are stored
 relative to `origin`, the centre of the static scene's bounding box (rounded to 1 m), so the
@@ -70,7 +73,7 @@ class EmbreeCaster:
         self._max_range = max_range
         self._ground = ground
         self._actors = list(actor_bodies)
-        self._pieces = _actor_pieces(o3d, shapes, actor_bodies)
+        self._pieces = _actor_pieces(o3d, shapes, actor_bodies)  # per body, base first
         meshes = [body_triangles(shapes.parts(b), *_pose(client, b)) for b in static_bodies]
         self.origin = _scene_origin(meshes)  # [m] world frame; the scene's coordinates
         self._scene: Any = o3d.t.geometry.RaycastingScene(nthreads=1)
@@ -132,23 +135,32 @@ class EmbreeCaster:
         pieces in order."""
         boxes: list[OrientedBox] = []  # the pieces that are boxes, by the slab test
         box_actor: list[int] = []
-        shaped: list[tuple[ActorPiece, NDArray[np.float64], NDArray[np.float64]]] = []
-        for piece in self._pieces:
-            if piece.body in self._hidden:
+        shaped: list[list[tuple[ActorPiece, NDArray[np.float64], NDArray[np.float64]]]] = []
+        for pieces in self._pieces:
+            if pieces[0].body in self._hidden:
                 continue
-            position, rotation = _pose(self._c, piece.body, piece.link)
-            if piece.scene is None:
-                boxes.append(OrientedBox(position, rotation, piece.half))
-                box_actor.append(piece.actor)
+            posed = _posed(self._c, pieces)
+            if pieces[0].scene is None:
+                boxes.append(OrientedBox(*posed[0], pieces[0].half))
+                box_actor.append(pieces[0].actor)
             else:
-                shaped.append((piece, position, rotation))
+                shaped.append([(piece, *pose) for piece, pose in zip(pieces, posed, strict=True)])
         t_best, which = nearest_box_hits(origin, directions, self._max_range, boxes)
         which = np.where(which >= 0, np.asarray([*box_actor, -1], np.int32)[which], -1)
-        for piece, position, rotation in shaped:
-            idx, t = self._cast_piece(piece, position, rotation, origin, directions)
-            closer = t < t_best[idx]
-            t_best[idx[closer]] = t[closer]
-            which[idx[closer]] = piece.actor
+        for group in shaped:
+            subset = None  # the rays through an articulated body's box (None: all)
+            if len(group) > 1:
+                subset, _ = rays_through(origin, directions, self._max_range, _around(group))
+                if not len(subset):
+                    continue
+            rays = directions if subset is None else directions[subset]
+            for piece, position, rotation in group:
+                idx, t = self._cast_piece(piece, position, rotation, origin, rays)
+                if subset is not None:
+                    idx = subset[idx]
+                closer = t < t_best[idx]
+                t_best[idx[closer]] = t[closer]
+                which[idx[closer]] = piece.actor
         return t_best, which.astype(np.int32)
 
     def _cast_piece(self, piece: ActorPiece, position: NDArray[np.float64],
@@ -157,8 +169,8 @@ class EmbreeCaster:
                     ) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
         """The rays through the piece's bounding box (indices) and where each meets the
         piece [m] (+inf: it passes), within range."""
-        bounds = OrientedBox(position + rotation @ piece.centre, rotation, piece.half)
-        idx, _ = rays_through(origin, directions, self._max_range, bounds)
+        idx, _ = rays_through(origin, directions, self._max_range,
+                              _bounds(piece, position, rotation))
         if not len(idx):
             return idx, np.zeros(0)
         rays = np.empty((len(idx), 6), np.float32)
@@ -167,6 +179,36 @@ class EmbreeCaster:
         out = piece.scene.cast_rays(self._tensor(rays), nthreads=self.threads)
         t = out["t_hit"].numpy().astype(np.float64)
         return idx, np.where(t <= self._max_range, t, np.inf)
+
+
+def _bounds(piece: ActorPiece, position: NDArray[np.float64],
+            rotation: NDArray[np.float64]) -> OrientedBox:
+    """The piece's bounding box posed in the world."""
+    return OrientedBox(position + rotation @ piece.centre, rotation, piece.half)
+
+
+def _around(group: list[tuple[ActorPiece, NDArray[np.float64], NDArray[np.float64]]]
+            ) -> OrientedBox:
+    """A world-axis box around the posed pieces' bounding boxes."""
+    lo, hi = np.full(3, np.inf), np.full(3, -np.inf)
+    for piece, position, rotation in group:
+        centre = position + rotation @ piece.centre
+        reach = np.abs(rotation) @ piece.half
+        lo, hi = np.minimum(lo, centre - reach), np.maximum(hi, centre + reach)
+    return OrientedBox(0.5 * (lo + hi), np.eye(3), 0.5 * (hi - lo))
+
+
+def _posed(client: BulletClient, pieces: tuple[ActorPiece, ...]
+           ) -> list[tuple[NDArray[np.float64], NDArray[np.float64]]]:
+    """Each piece's frame in the world: position (3,) [m] and rotation (3, 3), its base's
+    from the base's pose, its links' from one `getLinkStates` of the body."""
+    out = [_pose(client, pieces[0].body)]
+    links = [piece.link for piece in pieces[1:]]
+    if links:
+        for state in client.getLinkStates(pieces[0].body, links):
+            rotation = np.array(client.getMatrixFromQuaternion(state[5])).reshape(3, 3)
+            out.append((np.array(state[4]), rotation))
+    return out
 
 
 def _pose(client: BulletClient, body: int,
@@ -180,25 +222,33 @@ def _pose(client: BulletClient, body: int,
     return np.array(position), rotation
 
 
-def _actor_pieces(o3d: Any, shapes: CollisionShapes, bodies: list[int]) -> list[ActorPiece]:
-    """Each actor body's pieces: its base's collision shape. A shape that is one box centred
-    on the body's frame stays that box; any other gets an Embree scene of its triangles in
-    the body's frame, one per shape (bodies sharing a shape share it)."""
-    scenes: dict[int, tuple[Any, NDArray[np.float64], NDArray[np.float64]]] = {}
-    pieces = []
+def _actor_pieces(o3d: Any, shapes: CollisionShapes, bodies: list[int]
+                  ) -> list[tuple[ActorPiece, ...]]:
+    """Each actor body's pieces: its base's collision shape, then its links' in link order.
+    A base that is one box centred on the body's frame stays that box; any other piece gets
+    an Embree scene of its triangles in its frame, one per set of parts (pieces of the same
+    parts share it)."""
+    scenes: dict[tuple[object, ...], tuple[Any, NDArray[np.float64], NDArray[np.float64]]] = {}
+
+    def piece(actor: int, body: int, link: int, parts: tuple[Part, ...]) -> ActorPiece:
+        key = tuple((id(p.shape), p.position, p.orientation) for p in parts)
+        if key not in scenes:
+            scenes[key] = _piece_scene(o3d, parts)
+        scene, centre, half = scenes[key]
+        return ActorPiece(actor, body, link, centre, half, scene)
+
+    out: list[tuple[ActorPiece, ...]] = []
     for actor, body in enumerate(bodies):
-        parts = shapes.parts(body)
-        if _centred_box(parts):
+        parts, links = shapes.parts(body), shapes.links(body)
+        if _centred_box(parts) and not links:
             box = parts[0].shape
             assert isinstance(box, Box)
-            pieces.append(ActorPiece(actor, body, BASE, np.zeros(3),
-                                     np.array(box.half_extents), None))
+            out.append((ActorPiece(actor, body, BASE, np.zeros(3),
+                                   np.array(box.half_extents), None),))
             continue
-        if id(parts) not in scenes:
-            scenes[id(parts)] = _piece_scene(o3d, parts)
-        scene, centre, half = scenes[id(parts)]
-        pieces.append(ActorPiece(actor, body, BASE, centre, half, scene))
-    return pieces
+        out.append((piece(actor, body, BASE, parts),
+                    *(piece(actor, body, link, p) for link, p in enumerate(links))))
+    return out
 
 
 def _centred_box(parts: tuple[Part, ...]) -> bool:

@@ -9,7 +9,7 @@ import math
 import numpy as np
 import pybullet
 
-from world.actors.actor_set import actor_shape
+from world.actors.actor_set import actor_shape, actor_walker
 from world.actors.bodies import body_size
 from world.actors.body_build import BodyBuilder
 from world.actors.catalogue import CATALOGUE
@@ -33,10 +33,15 @@ def test_which_actors_have_a_shape() -> None:
     shape = actor_shape(truck, body_size(truck))
     assert shape is not None and shape.name == "bus"
     adult = _spec(ActorType.PEDESTRIAN, size=(0.6, 0.5, 1.8))  # Euro NCAP's EPTa box
-    shape = actor_shape(adult, body_size(adult))
-    assert shape is not None and shape.name == "ncap_epta_phase0"
-    for other in (_spec(ActorType.PEDESTRIAN), _spec(ActorType.OBSTACLE)):
-        assert actor_shape(other, body_size(other)) is None  # their boxes
+    assert actor_shape(adult, body_size(adult)) is None  # a walker, not a rigid shape
+    walker = actor_walker(adult, body_size(adult))
+    assert walker is not None and (walker.height, walker.width) == (1.8, 0.5)
+    generic = _spec(ActorType.PEDESTRIAN)  # 0.5 x 0.6 x 1.75: its walk sweeps 0.57 m
+    walker = actor_walker(generic, body_size(generic))
+    assert walker is not None and 1.5 < walker.height < 1.55  # scaled to the box's length
+    obstacle = _spec(ActorType.OBSTACLE)
+    size = body_size(obstacle)
+    assert actor_shape(obstacle, size) is None and actor_walker(obstacle, size) is None
     assert vehicle_shape("NCAP_GlobalVehicleTarget", 4.023, 1.712) is not None
     assert vehicle_shape("sedan", 4.0, 1.83) is None  # not the shape's footprint
 

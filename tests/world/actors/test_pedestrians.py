@@ -27,6 +27,7 @@ from world.actors.behaviour import (
     NpcMotion,
     TriggerContext,
 )
+from world.actors.shapes.walker import walker_pose
 from world.core.rates import TRIGGER_RATE
 from world.spec import (
     Action,
@@ -333,6 +334,7 @@ class WorldTrace:
     poses: list[ActorPoses] = field(default_factory=list)
     bodies: list[list[tuple[tuple[float, ...], tuple[float, ...]]]] = field(default_factory=list)
     started: list[tuple[float, str, int]] = field(default_factory=list)
+    phases: list[list[float]] = field(default_factory=list)  # [-] each walker's gait phase
 
 
 @pytest.fixture(scope="module")
@@ -352,6 +354,7 @@ def world_run(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[World,
                 trace.poses.append(w.actors.poses)
                 trace.bodies.append([w.client.getBasePositionAndOrientation(b)
                                      for b in w.actors.bodies])
+                trace.phases.append(list(w.actors.phases))
         yield w, trace
     finally:
         w.close()
@@ -394,10 +397,18 @@ def test_pedestrian_truth_while_crossing(world_run: tuple[World, WorldTrace]) ->
 
 
 def test_bodies_are_where_the_truth_says(world_run: tuple[World, WorldTrace]) -> None:
-    _, trace = world_run
-    for p, bodies in zip(trace.poses, trace.bodies, strict=True):
+    """A box's origin is its centre; a walker's base is at its hips, `base_x` ahead of its
+    body frame (on the ground under the centre) and `base_height` above."""
+    w, trace = world_run
+    for p, bodies, phases in zip(trace.poses, trace.bodies, trace.phases, strict=True):
         for i, (position, quat) in enumerate(bodies):
-            np.testing.assert_allclose(position, p.centres[i], atol=1e-6)
+            expected = p.centres[i]
+            walker = w.actors.walkers[i]
+            if walker is not None:
+                pose = walker_pose(walker.height, phases[i], walker.width)
+                expected = [expected[0] + pose.base_x * math.cos(p.yaws[i]),
+                            expected[1] + pose.base_x * math.sin(p.yaws[i]), pose.base_height]
+            np.testing.assert_allclose(position, expected, atol=1e-6)
             yaw = 2.0 * math.atan2(quat[2], quat[3])
             assert math.remainder(yaw - p.yaws[i], 2 * math.pi) == pytest.approx(0.0, abs=1e-6)
 

@@ -174,3 +174,20 @@ def posed_points(model: WalkerModel, pose: WalkerPose) -> dict[str, FloatArray]:
         rot, origin = frames[frame]
         out[part.name] = np.asarray(points(part) @ rot.T + origin, dtype=np.float64)
     return out
+
+
+SWEEP_PHASES = 64  # [-] phases a gait cycle is sampled at for its swept extent (0 and 0.5,
+#   the hips' extremes, among them)
+
+
+@functools.cache
+def swept_half_extents(height: float, width: float | None = None) -> tuple[float, float]:
+    """[m] the largest |x| and |y| of a walker's parts in its body frame over a gait cycle
+    (sampled at `SWEEP_PHASES` phases): the half footprint its walk sweeps."""
+    model = walker_model(height, width)
+    half = np.zeros(2)
+    for k in range(SWEEP_PHASES):
+        posed = posed_points(model, walker_pose(height, k / SWEEP_PHASES, width))
+        for pts in posed.values():
+            half = np.maximum(half, np.abs(pts[:, :2]).max(axis=0))
+    return float(half[0]), float(half[1])
