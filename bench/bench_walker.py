@@ -4,9 +4,9 @@ A walker (`world.actors.walker_body`) is a mass-0 fixed-base multibody of 9 link
 kinematically. Measured in one process on a DIRECT client with the ground plane and the
 ego's URDF car resting on it:
 - a physics step of that scene alone, then with 1 and with 8 walkers standing on the
-  ground (every walker goes through the articulated-body pass and its feet touch the
-  ground plane);
-- posing a walker (`pose_walker`: the base and 8 `resetJointState`);
+  ground, asleep as `build_walker` leaves them, then the 8 woken (every awake walker goes
+  through the articulated-body pass and its feet touch the ground plane);
+- posing a walker (`pose_walker`: the base and one `resetJointStatesMultiDof`);
 - reading all 9 links' world poses (`getLinkStates` with and without
   `computeForwardKinematics`), as a LiDAR placing each link's hull needs every scan;
 - the same poses from the model's own forward kinematics in numpy (`link_frames`).
@@ -24,6 +24,7 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
+import pybullet
 from pybullet_utils.bullet_client import BulletClient
 
 from world.actors.shapes import targets
@@ -74,8 +75,13 @@ def main() -> None:
         figures["step_scene_us"] = _per_call(lambda k: c.stepSimulation())
         walker = _add_walkers(c, Path(tmp), 1, 0)[0]
         figures["step_scene_1_walker_us"] = _per_call(lambda k: c.stepSimulation())
-        _add_walkers(c, Path(tmp), 7, 1)
+        walkers = [walker, *_add_walkers(c, Path(tmp), 7, 1)]
         figures["step_scene_8_walkers_us"] = _per_call(lambda k: c.stepSimulation())
+        for body in walkers:
+            c.changeDynamics(body, -1, activationState=pybullet.ACTIVATION_STATE_WAKE_UP)
+            c.changeDynamics(body, -1,
+                             activationState=pybullet.ACTIVATION_STATE_DISABLE_SLEEPING)
+        figures["step_scene_8_awake_walkers_us"] = _per_call(lambda k: c.stepSimulation())
         figures["pose_walker_us"] = _per_call(
             lambda k: pose_walker(c, walker, 10.0 + 0.01 * k, 3.0, 0.0, poses[k]))
         links = list(range(c.getNumJoints(walker)))

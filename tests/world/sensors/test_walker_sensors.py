@@ -65,7 +65,7 @@ def test_embree_sees_the_legs_move() -> None:
     both = np.isfinite(hits[0]) & np.isfinite(hits[1])
     # where the legs are across the fan, and how far, moves with the phase
     assert np.sum(np.isfinite(hits[0]) != np.isfinite(hits[1])) >= 10
-    assert np.any(np.abs(hits[0] - hits[1])[both] > 0.02)
+    assert np.any(np.abs(hits[0][both] - hits[1][both]) > 0.02)
     client.disconnect()
 
 
