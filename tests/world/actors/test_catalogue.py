@@ -7,6 +7,7 @@ import re
 from collections.abc import Iterator
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from avsim.scenario.load import load_scenario
@@ -27,6 +28,7 @@ from world.actors.catalogue import (
 )
 from world.sensors.sensor import vehicle_pose
 from world.sensors.setup import Profile, sensor_setup
+from world.sensors.tessellate import body_triangles
 from world.world import World
 
 NAMES = ("small_car", "sedan", "suv", "van", "bus", "rigid_truck", "semi_trailer", "motorbike")
@@ -39,6 +41,7 @@ BOUNDS = {
                          (2.8, EU_MAX_HEIGHT)),
     VehicleClass.MOTORBIKE: ((1.8, 2.6), (0.6, 1.1), (1.0, 1.6)),
 }
+HULL_MARGIN = 5e-3  # [m] Bullet's bounding box beyond a hull's points
 SIZE_TOL = 1e-3  # [m] a body's bounding box against its model (boxes are exact)
 
 
@@ -130,17 +133,28 @@ def world(tmp_path_factory: pytest.TempPathFactory) -> Iterator[World]:
 
 def test_bodies_have_their_models_size(world: World) -> None:
     """Each vehicle's PyBullet body spans its model's box (the bodies stand at yaw 0 on a
-    straight road heading east: length along x)."""
+    straight road heading east: length along x): the collision shape's solids, posed where
+    Bullet has the body, exactly; Bullet's own bounding box adds its margin around convex
+    hulls (`test_actor_bodies`: the two agree within 5 mm)."""
     expected = [CATALOGUE["semi_trailer"], CATALOGUE["motorbike"], CATALOGUE["sedan"],
                 CATALOGUE["rigid_truck"]]
     for body, m in zip(world.actors.bodies, expected, strict=False):
-        lo, hi = world.client.getAABB(body)
-        size = [h - low for h, low in zip(hi, lo, strict=True)]
-        assert size == pytest.approx([m.length, m.width, m.height], abs=SIZE_TOL), m.name
+        position, quaternion = world.client.getBasePositionAndOrientation(body)
+        rotation = np.array(world.client.getMatrixFromQuaternion(quaternion)).reshape(3, 3)
+        vertices, _ = body_triangles(world.shapes.parts(body), np.array(position), rotation)
+        lo, hi = vertices.min(axis=0), vertices.max(axis=0)
+        assert (hi - lo).tolist() == pytest.approx([m.length, m.width, m.height],
+                                                   abs=SIZE_TOL), m.name
         assert lo[2] == pytest.approx(0.0, abs=SIZE_TOL)  # standing on the ground
-    walker = SIZES[world.actors.specs[4].type]
-    lo, hi = world.client.getAABB(world.actors.bodies[4])
-    assert hi[2] - lo[2] == pytest.approx(walker.height, abs=SIZE_TOL)
+    box = SIZES[world.actors.specs[4].type]
+    walker = world.actors.walkers[4]
+    assert walker is not None  # a pedestrian is a walker, standing: its head at its stature
+    body = world.actors.bodies[4]
+    bounds = [world.client.getAABB(body, link)
+              for link in range(-1, world.client.getNumJoints(body))]
+    lo_z, hi_z = min(b[0][2] for b in bounds), max(b[1][2] for b in bounds)
+    assert hi_z - lo_z == pytest.approx(walker.height, abs=HULL_MARGIN)
+    assert walker.height <= box.height
 
 
 def test_truth_carries_each_models_size_and_class(world: World) -> None:
