@@ -109,3 +109,16 @@ def test_phase_after_advances_one_cycle_per_stride() -> None:
     assert phase_after(0.1, -0.2 * stride, h) == pytest.approx(0.9)
     assert phase_after(0.3, 7 * stride, h) == pytest.approx(0.3)
     assert stride_length(targets.EPTC.height) < stride  # a child's legs are shorter
+
+
+@pytest.mark.parametrize("height", [1.15, 1.52, 1.8])
+def test_the_silhouette_has_no_gap_from_the_hips_to_the_crown(height: float) -> None:
+    """Torso, neck and head are one column: a LiDAR ring crossing a walker at any height
+    between its hips and its crown hits it (a body has a neck between shoulders and head)."""
+    parts = pedestrian_parts(height, 0.25)
+    spans = sorted((float(points(p)[:, 2].min()), float(points(p)[:, 2].max())) for p in parts)
+    reach = 0.5 * height  # [m] below the hip joints: the thighs
+    for lo, hi in spans:
+        if lo <= reach + 1e-9:
+            reach = max(reach, hi)
+    assert reach == max(hi for _, hi in spans)  # the crown

@@ -36,6 +36,8 @@ from world.scene.solids import Vec3
 
 SHOULDER, HIP, KNEE, ANKLE = 0.818, 0.530, 0.285, 0.039  # [-] heights, shares of stature
 UPPER_ARM, FOREARM, HAND = 0.186, 0.146, 0.108  # [-] lengths, shares of stature
+NECK = 0.065  # [-] the neck's breadth, share of stature (a neck girth of about 0.35 m at a
+#   stature of 1.70 m: 0.35 / pi / 1.70)
 SHOULDER_WIDTH, HIP_WIDTH, FOOT = 0.259, 0.191, 0.152  # [-] shares of stature
 HIP_SWING = math.radians(8.0)  # [rad] A: the hip angle's amplitude
 KNEE_BEND = math.radians(20.0)  # [rad] K: the swinging knee's largest flexion
@@ -169,8 +171,12 @@ def _upper(seg: Segments, pelvis: float, arm_angles: tuple[float, float],
     torso += [(shoulder + np.array([dx, s * seg.half_shoulder, 0.0])) for dx in (-depth, depth)
               for s in (1, -1)]
     neck = base + (1.0 - HIP - 0.13) * h * up
+    head = points(strut("head", "skin", tuple(neck), tuple(neck + 0.13 * h * up), 0.05 * h,
+                        sides=8))
+    # the neck joins the head to the shoulder line: a body's silhouette has no gap there
+    throat = points(strut("neck", "skin", tuple(shoulder), tuple(neck), 0.5 * NECK * h, sides=8))
     parts = [hull("torso", "cloth", np.array(torso)),
-             strut("head", "skin", tuple(neck), tuple(neck + 0.13 * h * up), 0.05 * h, sides=8)]
+             hull("head", "skin", np.vstack([head, throat]))]
     for (side, s), angle in zip(SIDES, arm_angles, strict=True):
         top = shoulder + shoulder_joint(seg, s)
         parts.append(arm_part(side, top, top + seg.arm * along(angle), seg))
