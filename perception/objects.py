@@ -23,13 +23,18 @@ named below are fields of `DetectorParams`.
    the points are averaged per ``voxel`` x ``voxel`` grid cell (each point's cell kept), the
    centroids clustered by Open3D's ``cluster_dbscan`` (eps ``cluster_eps``, ``min_points =
    1``: single-linkage Euclidean clustering), and the labels go back to the points.
-4. **Cluster gate**: clusters with fewer than `fewest_points` returns (``min_points`` up to
-   ``min_points_range``, then falling as 1 / range^2, the solid angle an object fills, to
-   ``min_points_far``: a 16-channel LiDAR's single ring crosses a walker at 50 m on two or
-   three columns; the tracker's M-of-N confirmation over consecutive scans is what rejects
-   lone returns), whose highest point is
+4. **Cluster gate**: clusters with fewer than `fewest_points` returns, whose highest point is
    below ``min_top`` or above ``max_height`` (buildings), or whose axis-aligned extent exceeds
-   ``max_length`` sqrt(2) are dropped before fitting.
+   ``max_length`` sqrt(2) are dropped before fitting. The fewest returns is what one ring
+   leaves across the narrowest side of the smallest object to be found, a pedestrian seen
+   side-on (its trunk ``pedestrian_depth`` deep), at the scan's column step: a 16-channel
+   LiDAR's rings are 0.5 - 1 m apart at 15 - 30 m, so one ring may be all that crosses a
+   walker's body (the ring below meets its feet under ``ground_clearance``); at most
+   ``min_points``, at least ``min_points_far``, and a cluster under ``min_points`` must
+   span two columns (a 0.25 m deep trunk at 0.2 deg leaves 4 returns up to 17.9 m, 3 up to
+   23.9 m, then 2: a 16-channel LiDAR's single ring crosses a walker at 50 m on two
+   columns). The tracker's M-of-N confirmation over consecutive scans is what rejects lone
+   returns.
 5. **Oriented rectangle (L-shape fitting)**: the heading in [0, pi/2) that maximises the
    closeness criterion of Zhang et al. 2017 ("Efficient L-shape fitting for vehicle detection
    using laser scanners"): the points are projected on the two rectangle axes, each axis
@@ -74,10 +79,16 @@ named below are fields of `DetectorParams`.
    decides, e.g., whether a lone face a car wide is a car's rear (grown away: no growth) or
    part of its side (grown sideways). Height: the prior's, or the observed one if larger; z
    is half the height.
-8. **Fragments**: a surface seen at grazing incidence breaks into clusters of one azimuth
-   column each (a truck's side seen from just behind it). Walking the detections from the
-   most points down, one whose points lie mostly (>= 50 %) inside a kept box grown by
-   ``fragment_margin`` is dropped (two objects cannot overlap).
+8. **Coupled trailers and fragments**: a tractor's cab and its semi-trailer are two solids a
+   coupling's clearance apart (the trailer's front swings past the cab's back wall in a
+   turn), farther than ``cluster_eps``: two truck boxes whose clusters lie on one line
+   (their intervals across the one with more points' axis overlap, within
+   ``fragment_margin``) and at most ``coupling_gap`` apart along it are one vehicle, boxed
+   again from their joined points (`couple_trailers`). A surface seen at grazing incidence
+   breaks into clusters of one azimuth column each (a truck's side seen from just behind
+   it). Walking the detections from the most points down, one whose points lie mostly
+   (>= 50 %) inside a kept box grown by ``fragment_margin`` is dropped (two objects cannot
+   overlap).
 
 The yaw is the length axis's heading, wrapped to (-pi/2, pi/2] (front and back are not told
 apart). Limits: a walker shorter than ``pedestrian_adult_height`` hit by one ring only, below
@@ -133,9 +144,16 @@ class DetectorParams:
     voxel: float = 0.15  # [m] horizontal grid cell of the downsampling before clustering
     cluster_eps: float = 0.6  # [m] DBSCAN neighbourhood radius (horizontal): wider than the
     #   column spacing of a 0.4 deg LiDAR at roi range, narrower than two cars a lane apart
-    min_points: int = 4  # [-] fewest returns in a detected cluster, up to min_points_range
-    min_points_range: float = 20.0  # [m] beyond it the fewest returns fall as 1 / range^2 ...
-    min_points_far: int = 2  # [-] ... down to this
+    min_points: int = 4  # [-] fewest returns in a detected cluster, at most (step 4) ...
+    min_points_far: int = 2  # [-] ... and at least
+    pedestrian_depth: float = 0.25  # [m] the narrowest side of a person, its trunk's depth
+    #   (an adult's chest depth, about 0.25 m: Pheasant and Haslegrave, "Bodyspace", 3rd ed.,
+    #   table 2.1), which sets the fewest returns one ring leaves on a walker (step 4)
+    pedestrian_body: float = 0.34  # [m] a person's trunk diameter, the mean of its breadth
+    #   across the shoulders (about 0.43 m) and its depth (same table): the returns on a
+    #   walker lie on its trunk and limbs, not on the corners of its box (`along_sight`)
+    coupling_gap: float = 1.5  # [m] a tractor's cab and its trailer's front stand about
+    #   0.5 - 1.2 m apart; two trucks queued nose to tail keep more (step 8)
     min_top: float = 0.3  # [m] a cluster's highest point must be at least this high
     max_length: float = 18.75  # [m] longer clusters are structures, not objects (the EU's
     #   longest vehicle, a road train, Directive 96/53/EC; an articulated one is 16.5 m)
@@ -279,19 +297,22 @@ def cluster_labels(xy: FloatArray, p: DetectorParams) -> IntArray:
     return out
 
 
-def fewest_points(distance: FloatArray, p: DetectorParams) -> FloatArray:
+def fewest_points(distance: FloatArray, p: DetectorParams, column_step: float) -> FloatArray:
     """(N,) the fewest returns a cluster needs whose nearest point lies ``distance`` (N,)
-    [m] from the car's centre, horizontally (module doc, step 4)."""
-    scaled = np.ceil(p.min_points * (p.min_points_range / np.maximum(distance, 1e-3)) ** 2)
-    out: FloatArray = np.clip(scaled, p.min_points_far, p.min_points)
+    [m] from the car's centre, horizontally, for a LiDAR whose columns are ``column_step``
+    [rad] apart: the columns one ring puts on a pedestrian's narrowest side (step 4)."""
+    columns = np.floor(p.pedestrian_depth / (np.maximum(distance, 1e-3) * column_step))
+    out: FloatArray = np.clip(columns, p.min_points_far, p.min_points)
     return out
 
 
 def gated_clusters(labels: IntArray, xy: FloatArray, heights: FloatArray,
-                   p: DetectorParams, columns: IntArray | None = None) -> list[IntArray]:
+                   p: DetectorParams, column_step: float,
+                   columns: IntArray | None = None) -> list[IntArray]:
     """Point indices of each cluster (label >= 0) that passes the gate of step 4, in label
     order; ``xy`` (N, 2) [m], ``heights`` (N,) [m] and ``columns`` (N,) (the LiDAR's
-    azimuth steps; None: not checked) are the labelled points."""
+    azimuth steps; None: not checked) are the labelled points, ``column_step`` [rad] the
+    LiDAR's azimuth step."""
     if len(labels) == 0:
         return []
     order = np.argsort(labels, kind="stable")
@@ -302,7 +323,7 @@ def gated_clusters(labels: IntArray, xy: FloatArray, heights: FloatArray,
     sxy = xy[order]
     extent = np.max(np.maximum.reduceat(sxy, starts) - np.minimum.reduceat(sxy, starts), axis=1)
     nearest = np.minimum.reduceat(np.hypot(sxy[:, 0], sxy[:, 1]), starts)  # [m]
-    ok = ((sorted_labels[starts] >= 0) & (counts >= fewest_points(nearest, p))
+    ok = ((sorted_labels[starts] >= 0) & (counts >= fewest_points(nearest, p, column_step))
           & (top >= p.min_top)
           & (top <= p.max_height) & (extent <= p.max_length * math.sqrt(2.0)))
     if columns is not None:  # fewer than min_points: across two columns at least
@@ -493,19 +514,22 @@ def hypothesis(fp: Footprint, cls: ObjectClass, axis1_length: bool,
     return Hypothesis(cost, cls, axis1_length, bounds, fp.axes)
 
 
-def along_sight(fp: Footprint, xy: FloatArray, prior: SizePrior) -> Footprint:
+def along_sight(fp: Footprint, xy: FloatArray, prior: SizePrior, body: float) -> Footprint:
     """``fp`` re-expressed on the line of sight and across it: a walker's few returns give
     no heading (an L-shape fit of them turns with every stride), so a pedestrian's box is
-    taken along the ray and grown away from the sensor from a near face placed by a
-    cylinder model (as in Autoware's shape estimation): a round body of the prior's mean
-    diameter D, whose returns (evenly spread across it, as a scanning LiDAR spreads them)
-    lie on average pi D / 8 in front of its centre. The returns' mean range is used, not the
-    nearest return: range noise on a couple of dozen points moves their minimum by
-    centimetres a scan, which a tracker reads as motion."""
+    taken along the ray, centred by a cylinder model (as in Autoware's shape estimation): a
+    round trunk of diameter ``body`` [m] (a person's, not its box's: the box's prior also
+    spans the swing of the arms and of a stride, where few returns land), whose returns
+    (evenly spread across it, as a scanning LiDAR spreads them) lie on average pi D / 8 in
+    front of its centre. Along the ray the interval is the prior's length about that
+    centre (or the returns' span if longer); across it, the returns' own. The returns' mean
+    range is used, not the nearest return: range noise on a couple of dozen points moves
+    their minimum by centimetres a scan, which a tracker reads as motion."""
     proj = xy @ fp.view.T
     lo, hi = proj.min(axis=0), proj.max(axis=0)
-    diameter = 0.5 * (prior.length + prior.width)
-    lo[0] = proj[:, 0].mean() + (math.pi / 8.0 - 0.5) * diameter
+    centre = float(proj[:, 0].mean()) + math.pi / 8.0 * body
+    lo[0] = min(float(lo[0]), centre - 0.5 * prior.length)
+    hi[0] = max(float(hi[0]), centre + 0.5 * prior.length)
     return replace(fp, axes=fp.view, lo=(float(lo[0]), float(lo[1])),
                    hi=(float(hi[0]), float(hi[1])))
 
@@ -531,7 +555,8 @@ def box_from_points(xy: FloatArray, top: float, sensor_xy: tuple[float, float],
     ext = fp.extents
     longer_first = ext[0] >= ext[1]
     classes = candidate_classes(max(ext), min(ext), top, p, gap)
-    sight = along_sight(fp, xy, p.pedestrian) if ObjectClass.PEDESTRIAN in classes else fp
+    sight = (along_sight(fp, xy, p.pedestrian, p.pedestrian_body)
+             if ObjectClass.PEDESTRIAN in classes else fp)
     hyps = [hypothesis(sight if cls is ObjectClass.PEDESTRIAN else fp, cls, axis1_length, p)
             for cls in classes
             for axis1_length in (longer_first, not longer_first)]
@@ -574,6 +599,50 @@ def suppress_fragments(found: list[tuple[Detection, FloatArray]],
         if not any(inside_box(xy, k, margin).mean() >= 0.5 for k in kept):
             kept.append(det)
     return kept
+
+
+def interval_gap(a: FloatArray, b: FloatArray) -> float:
+    """[m] how far apart the (N,) and (M,) projections ``a`` and ``b`` [m] lie (negative:
+    they overlap)."""
+    return max(float(b.min() - a.max()), float(a.min() - b.max()))
+
+
+def coupled(big: Detection, xy_big: FloatArray, small: Detection, xy_small: FloatArray,
+            p: DetectorParams) -> bool:
+    """Whether two truck boxes (each with its cluster's (N, 2) points [m]) are a tractor and
+    its trailer (module doc, step 8): on one line along ``big``'s axis, its cluster's
+    interval across that axis overlapping the other's (within ``fragment_margin``), and at
+    most ``coupling_gap`` apart along it."""
+    if big.cls is not ObjectClass.TRUCK or small.cls is not ObjectClass.TRUCK:
+        return False
+    axis = np.array([math.cos(big.yaw), math.sin(big.yaw)])
+    normal = np.array([-axis[1], axis[0]])
+    across = interval_gap(xy_big @ normal, xy_small @ normal)
+    along = interval_gap(xy_big @ axis, xy_small @ axis)
+    return across <= p.fragment_margin and along <= p.coupling_gap
+
+
+def couple_trailers(found: list[tuple[Detection, IntArray]], xy: FloatArray,
+                    p: DetectorParams) -> list[tuple[Detection | None, IntArray]]:
+    """The boxes and clusters (point indices into (N, 2) ``xy`` [m]) after joining every
+    coupled pair (`coupled`), the one with more points first; a joined cluster's box is
+    None (to be boxed again from its points, once no more joins it)."""
+    groups = sorted(found, key=lambda f: (-f[0].points, f[0].x, f[0].y))
+    merged = [idx for _, idx in groups]
+    boxes = [det for det, _ in groups]
+    joined = [False] * len(merged)
+    i = 0
+    while i < len(merged):
+        j = next((j for j in range(i + 1, len(merged))
+                  if coupled(boxes[i], xy[merged[i]], boxes[j], xy[merged[j]], p)), None)
+        if j is None:
+            i += 1
+            continue
+        merged[i] = np.sort(np.concatenate([merged[i], merged.pop(j)]))
+        boxes.pop(j)
+        joined.pop(j)
+        joined[i] = True
+    return [(None if j else det, idx) for det, idx, j in zip(boxes, merged, joined, strict=True)]
 
 
 @dataclass(frozen=True, slots=True)
@@ -641,13 +710,18 @@ class ObjectDetector:
         pts, heights, rings, columns = self._obstacles(scan)
         xy = pts[:, :2]
         sensor = (scan.info.mount.x, scan.info.mount.y)
-        found: list[tuple[Detection, FloatArray]] = []
-        for idx in gated_clusters(cluster_labels(xy, p), xy, heights, p, columns):
+
+        def boxed(idx: IntArray) -> Detection | None:
             top = float(heights[idx].max())
             gap = ring_gap_top(scan.info, xy[idx], heights[idx], rings[idx], p)
-            det = box_from_points(xy[idx], top, sensor, p, heights[idx], gap)
-            if det is not None:
-                found.append((det, xy[idx]))
+            return box_from_points(xy[idx], top, sensor, p, heights[idx], gap)
+
+        step = 2.0 * math.pi / scan.info.azimuth_steps  # [rad] between columns
+        first = [(det, idx)
+                 for idx in gated_clusters(cluster_labels(xy, p), xy, heights, p, step, columns)
+                 if (det := boxed(idx)) is not None]
+        found = [(det, xy[idx]) for old, idx in couple_trailers(first, xy, p)
+                 if (det := old if old is not None else boxed(idx)) is not None]
         kept = suppress_fragments(found, p.fragment_margin)
         kept.sort(key=lambda d: (math.hypot(d.x - sensor[0], d.y - sensor[1]), d.x, d.y))
         return tuple(kept)

@@ -327,6 +327,24 @@ def test_a_low_object_near_is_not_a_pedestrian(detector: ObjectDetector,
     assert [d.cls for d in found] == [ObjectClass.OTHER]
 
 
+# ---- articulated trucks ------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(("gap", "boxes"), [(0.65, 1), (1.2, 1), (3.0, 2)])
+def test_a_tractor_and_its_trailer_beside_are_one_truck(detector: ObjectDetector, gap: float,
+                                                        boxes: int) -> None:
+    """A cab and a box trailer in the next lane, a coupling's clearance apart (wider than the
+    clustering's reach): one truck as long as both; a truck queued 3 m behind another
+    stays apart."""
+    rear = -8.0  # [m] the trailer's rear (its ends seen at 15 deg or more from its side)
+    trailer = on_ground(rear + 6.8, 3.5, (13.6, 2.55, 4.0))
+    cab = on_ground(rear + 13.6 + gap + 1.15, 3.5, (2.3, 2.5, 3.8))
+    found = [d for d in detect(detector, [trailer, cab]) if d.cls is ObjectClass.TRUCK]
+    assert len(found) == boxes, found
+    if boxes == 1:
+        assert found[0].length == pytest.approx(13.6 + gap + 2.3, abs=0.3), found
+
+
 # ---- motorcycles --------------------------------------------------------------------------------
 
 MOTORBIKE = (CATALOGUE["motorbike"].length, CATALOGUE["motorbike"].width,

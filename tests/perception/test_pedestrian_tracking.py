@@ -3,10 +3,17 @@ default profile's 1800-column VLP-16-like scan), detected by `ObjectDetector` an
 `MultiObjectTracker`.
 
 The scene: a straight two-lane road heading +x (so a crossing's lateral velocity is the
-map's vy), the ego in lane 0, a pedestrian (a 0.5 x 0.6 x 1.75 m body) walking across at
-5 km/h (`walk` action). The tracker is given the ego's true pose: this judges perception
-alone, not localisation. Beyond ~30 m (one ring on a pedestrian) perception cannot class a
-pedestrian (see `perception.objects`), so the cases stay within 10-30 m.
+map's vy), the ego in lane 0, a pedestrian walking across at 5 km/h (`walk` action): its
+0.5 x 0.6 x 1.75 m box holds an articulated walker of 1.52 m (the tallest whose stride fits
+the box), seen side-on, its trunk 0.18 m deep. The truth is the box's centre: the middle of
+the ground the walker's gait sweeps, 3 cm ahead of its hip joints along its walk; the
+detector centres a pedestrian on its trunk (`perception.objects.along_sight`). The tracker
+is given the ego's true pose: this judges perception alone, not localisation. Beyond ~30 m
+(one ring on a pedestrian) perception cannot class a pedestrian (see `perception.objects`),
+so the cases stay within 10-33 m. At 25-33 m one ring crosses the walker's body (the ring
+below meets its feet, under the detector's ground clearance): a scan may leave a single
+return on it, which no detector tells from noise; such a scan finds nothing and the track
+coasts through it.
 """
 
 from __future__ import annotations
@@ -20,7 +27,7 @@ import pytest
 
 from avsim.scenario.load import load_scenario
 from perception.messages import Detection, EgoState, ObjectClass, Track
-from perception.objects import ObjectDetector
+from perception.objects import DetectorParams, ObjectDetector, fewest_points
 from perception.tracking import MultiObjectTracker
 from world.actors.behaviour import LATERAL_ACCEL
 from world.frames import LidarScan
@@ -35,6 +42,7 @@ SCAN_EVERY = 24  # [physics steps] 10 Hz
 POSITION_TOL = 0.3  # [m]
 SPEED_TOL = 0.3  # [m/s]
 TRACKED_FOR = 1.0  # [s] of tracking at walking speed before the errors are judged
+SINGLE_RETURN_RANGE = 25.0  # [m] nearer, every scan leaves two returns on the walker's body
 
 SCENARIO = """\
 format: avsim/1
@@ -83,6 +91,8 @@ class Sample:
     ego: EgoState  # the true pose
     truth: tuple[float, float]  # [m] the pedestrian's centre, map frame
     returns: int  # [-] LiDAR returns on the pedestrian
+    body: int  # [-] of them, those above the detector's ground clearance (not its feet)
+    fewest: int  # [-] the fewest returns the detector's gate asks of a cluster there
     detections: tuple[Detection, ...]
     tracks: tuple[Track, ...]
 
@@ -121,8 +131,15 @@ def run(case: Crossing, tmp_path: Path) -> list[Sample]:
                            steering_angle=0.0, position_sigma=0.0)
             detections = detector.detect(scan)
             centre = world.actors.poses.centres[0]
+            on_it = scan.info.mount.to_vehicle(
+                np.asarray(scan.points, dtype=np.float64)[scan_truth.actor == 0])
+            body = detector.ground.height(on_it) >= detector.params.ground_clearance
+            nearest = float(np.hypot(on_it[:, 0], on_it[:, 1]).min()) if len(on_it) else 0.0
+            step = 2.0 * math.pi / scan.info.azimuth_steps  # [rad]
             samples.append(Sample(t=world.t, ego=ego, truth=(float(centre[0]), float(centre[1])),
-                                  returns=int(np.count_nonzero(scan_truth.actor == 0)),
+                                  returns=len(on_it), body=int(np.count_nonzero(body)),
+                                  fewest=int(fewest_points(np.array([nearest]), detector.params,
+                                                           step)[0]),
                                   detections=detections,
                                   tracks=tracker.update(world.t, ego, detections)))
     finally:
@@ -146,26 +163,41 @@ def crossing(request: pytest.FixtureRequest,
     return case, run(case, tmp_path_factory.mktemp(request.param))
 
 
+def single_returns(samples: list[Sample]) -> list[Sample]:
+    """The scans that left fewer returns on the walker's body than any cluster needs."""
+    return [s for s in samples if s.body < DetectorParams().min_points_far]
+
+
 def test_detected_as_a_pedestrian_in_every_scan(crossing: tuple[Crossing, list[Sample]]) -> None:
-    """Every scan at 10-30 m; the approach starts a little farther, where it is found too."""
+    """Every scan at 10-30 m; the approach starts a little farther, where it is found too.
+    Beyond 25 m a scan may leave a single return on the walker's body: at most one scan in
+    ten, and that one finds nothing (a lone return is no object)."""
     _, samples = crossing
     assert all(10.0 <= s.range <= 33.0 for s in samples)
     assert sum(s.range <= 30.0 for s in samples) >= 20
+    lone = single_returns(samples)
+    assert len(lone) <= len(samples) // 10
+    assert all(s.range > SINGLE_RETURN_RANGE and s.detections == () for s in lone)
     for s in samples:
+        if s in lone:
+            continue
         assert len(s.detections) == 1, (s.t, s.detections)  # nothing else is found
         (det,) = s.detections
         assert det.cls is ObjectClass.PEDESTRIAN, (s.t, det)
         x, y = s.truth_in_vehicle_frame()
         assert math.hypot(det.x - x, det.y - y) < POSITION_TOL, (s.t, det, (x, y))
-        assert det.points >= 4 and s.returns >= det.points
+        assert det.points >= s.fewest and s.body >= det.points
 
 
 def test_one_track_from_the_third_scan(crossing: tuple[Crossing, list[Sample]]) -> None:
+    """Confirmed on the third scan and kept under one id; it misses only the scans that
+    left a single return on the walker (coasting through them)."""
     _, samples = crossing
     assert samples[0].tracks == samples[1].tracks == ()  # tentative: 3 hits of 5
     ids = {tr.id for s in samples[2:] for tr in s.tracks}
     assert ids == {1}
-    assert all(len(s.tracks) == 1 and s.tracks[0].misses == 0 for s in samples[2:])
+    lone = single_returns(samples)
+    assert all(len(s.tracks) == 1 and s.tracks[0].misses == (s in lone) for s in samples[2:])
     assert all(s.tracks[0].cls is ObjectClass.PEDESTRIAN for s in samples[2:])
 
 
