@@ -16,7 +16,7 @@ import pytest
 from avsim.run.runner import Runner, RunResult
 from avsim.run.sensor_loop import FrameHook
 from avsim.scenario.load import load_scenario
-from tests.scenarios.modes import MODES, SENSORS, TRUTH, TRUTH_STACK
+from tests.scenarios.modes import MODES, PROFILES, SENSORS, TRUTH, TRUTH_STACK
 from world.sensors.setup import Profile
 
 SENSING = "inline"  # the cameras render in the test's own process: xdist keeps both cores
@@ -29,6 +29,14 @@ SENSING = "inline"  # the cameras render in the test's own process: xdist keeps 
 def mode(request: pytest.FixtureRequest) -> str:
     """The stack mode of a module's runs: `truth` (make test) or `sensors` (acceptance)."""
     out: str = request.param
+    return out
+
+
+@pytest.fixture(scope="module", params=PROFILES)
+def sensor_profile(request: pytest.FixtureRequest) -> Profile:
+    """The sensor profile of a module's runs that read signs or lights from the camera but
+    do not judge perception's figures: `fast` (make test) or `default` (acceptance)."""
+    out: Profile = request.param
     return out
 
 

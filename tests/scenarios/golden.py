@@ -29,6 +29,7 @@ import numpy as np
 from avsim.run.result import dumps, result_json
 from avsim.run.runner import RunResult
 from tests.scenarios.modes import SENSORS
+from world.sensors.setup import Profile
 
 GOLDEN_DIR = Path(__file__).resolve().parent / "golden"
 WRITE = os.environ.get("AVSIM_GOLDEN") == "write"
@@ -114,6 +115,12 @@ def strict_json(text: str) -> object:
     def refuse(constant: str) -> object:
         raise AssertionError(f"the result file is not strict JSON: {constant}")
     return json.loads(text, parse_constant=refuse)
+
+
+def profile_label(name: str, profile: Profile) -> str:
+    """The golden file of a sensor run on `profile` (`tests.scenarios.modes.PROFILES`): the
+    `default` run keeps the module's `name`, another profile's is `name.<profile>`."""
+    return name if profile is Profile.DEFAULT else f"{name}.{profile.value}"
 
 
 def label(name: str, mode: str) -> str:

@@ -1,4 +1,7 @@
-"""ICCAS normal driving: lane keeping through curves and speed changes, tyres in the lane."""
+"""ICCAS normal driving: lane keeping through curves and speed changes, tyres in the lane;
+and its first 30 s with the front camera gone black from 8 s (it must not drive on as
+before). The 30 s run that sees is shared: the blind run's twin and the short run that must
+drive the full run's first 30 s bit for bit."""
 
 from __future__ import annotations
 
@@ -6,18 +9,34 @@ import itertools
 import subprocess
 import sys
 from collections.abc import Callable
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from avsim.run.runner import RunResult
+from planner.fsm.lane_source import LaneSourceParams
 from tests.scenarios import golden
+from world.frames import CameraFrame
 from world.map.road import build_road_map
 
 pytestmark = pytest.mark.slow
 KPH = 1 / 3.6
 RTK = {"gnss": {"preset": "rtk"}}  # `sensors:` of an RTK-grade receiver
+SHORT = 30.0  # [s] the short runs: up to speed and into the first curve
+BLACK_FROM = 8.0  # [s] the front camera goes black from then on (`black_front`)
+
+
+def seeing(run_scenario: Callable[..., RunResult]) -> RunResult:
+    """The first `SHORT` seconds, not recorded."""
+    return run_scenario("normal_driving", record=False, duration=SHORT)
+
+
+def black_front(frame: CameraFrame) -> CameraFrame:
+    if frame.info.name == "front" and frame.t >= BLACK_FROM:
+        return replace(frame, rgb=np.zeros_like(frame.rgb))
+    return frame
 
 
 @pytest.fixture(scope="module")
@@ -101,10 +120,11 @@ def test_recording_verifies_and_reads_back(result: RunResult) -> None:
 def test_same_seed_gives_bitwise_equal_trajectories(
     result: RunResult, run_scenario: Callable[..., RunResult],
 ) -> None:
-    """A second run, 25 s long and not recorded, drives the first 25 s of the recorded
-    full-length run bit for bit: neither the recording nor the run's length changes what
-    happens (the golden checks it against the runs of earlier commits)."""
-    short = run_scenario("normal_driving", record=False, duration=25)
+    """A second run, 30 s long and not recorded (the front camera's twin below sees), drives
+    the first 30 s of the recorded full-length run bit for bit: neither the recording nor
+    the run's length changes what happens (the golden checks it against the runs of earlier
+    commits)."""
+    short = seeing(run_scenario)
     ticks = len(short.log.t)
     assert ticks > 900 and len(result.log.t) > ticks
     for name in ("t", "x", "y", "yaw", "speed", "steering", "drive_torque", "brake_torque"):
@@ -182,8 +202,6 @@ def test_perception_scores_are_in_the_recording(result: RunResult) -> None:
 def test_results_match_golden(result: RunResult,
                               run_scenario: Callable[..., RunResult]) -> None:
     golden.check(result, "normal_driving")
-    golden.check(run_scenario("normal_driving", record=False, duration=25),
-                 "normal_driving.25s")
     golden.check(run_scenario("normal_driving", record=False, profile=None, sensors=RTK),
                  "normal_driving.profile_none")
 
@@ -211,3 +229,45 @@ def test_each_machine_and_the_speed_source_is_a_lane_in_the_recording(
             changes = [sources[0]] + [b for a, b in itertools.pairwise(sources) if a != b]
             assert [v for _, v in rows] == changes
     assert {s.value for s in result.log.speed_source} >= {"limit", "curve"}
+
+
+# ---- honesty: a front camera that goes black must not leave the car driving as before -------
+
+
+def test_black_camera_slows_then_stops_in_lane(run_scenario: Callable[..., RunResult]) -> None:
+    """Honesty: the lane estimate loses its confidence, the planner says so (lane source
+    MAP_HOLD), slows to the hold speed on the map and the odometry, and after `stop_after`
+    seconds stops in its lane."""
+    seeing_run = seeing(run_scenario)
+    blind = run_scenario("normal_driving", record=False, duration=SHORT,
+                         frame_hook=black_front)
+    p = LaneSourceParams()
+    changes = [(c.t, c.target) for c in blind.state_changes if c.machine == "lane_source"]
+    targets = [c for _, c in changes]
+    assert targets == ["camera", "map_hold", "stop_in_lane"], changes
+    lost_at = changes[1][0]
+    assert BLACK_FROM < lost_at < BLACK_FROM + 1.0  # noticed within a second
+    assert changes[2][0] == pytest.approx(lost_at + p.stop_after, abs=0.05)
+    t, v = blind.log.array("t"), blind.log.array("speed")
+    v_seeing = seeing_run.log.array("speed")
+    # before the blackout both runs are the same; after it the blind car slows, then stops
+    before = t < BLACK_FROM
+    assert np.array_equal(v[before], v_seeing[before])
+    # holding: slowing towards the hold speed at a comfortable rate (1.5 m/s^2 planned)
+    v_lost = float(np.interp(lost_at, t, v))
+    v_later = float(np.interp(lost_at + 4.0, t, v))
+    assert v_lost - v_later >= 4.0 * 1.2
+    assert v_later > p.hold_speed - 0.3
+    holding = (t > lost_at + 4.0) & (t < lost_at + p.stop_after)
+    assert np.min(v_seeing[holding]) > 12.0  # the seeing car drives on at ~50 km/h
+    assert np.max(v[t > lost_at + p.stop_after + 6.0]) < 0.1  # stopped
+    # ... in its lane: the tyres never left it, and the decelerations were comfortable
+    tyres = next(c for c in blind.criteria if c.name == "tyres_in_lane")
+    assert tyres.passed, tyres
+    assert blind.metrics["max_decel"] <= 2.5
+
+
+def test_the_blind_run_matches_golden(run_scenario: Callable[..., RunResult]) -> None:
+    golden.check(seeing(run_scenario), "normal_driving.30s")
+    golden.check(run_scenario("normal_driving", record=False, duration=SHORT,
+                              frame_hook=black_front), "normal_driving.30s_blind_front")

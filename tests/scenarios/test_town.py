@@ -2,7 +2,12 @@
 oncoming traffic at a light, a right turn at an all-way stop, straight through a light, a
 U-turn at the town's corner, back through the light; NPCs on their own routes) and the two
 variants of `town_left_turn` (an oncoming car close: the ego waits for it; far: it turns at
-once). Each test checks that the situation happened as well as the verdict."""
+once). Each test checks that the situation happened as well as the verdict.
+
+The lights and the stop sign are read from the camera (the truth stack has none), and no
+perception figure is judged here: the runs use the `fast` profile in `make test` and the
+`default` one in `make acceptance` (`sensor_profile`), each with its golden file
+(`town_route.fast`, `town_route`)."""
 
 from __future__ import annotations
 
@@ -16,6 +21,7 @@ from tests.scenarios import golden
 from world.hdmap import Junction, LightColour, StopSign
 from world.map.road import build_road_map
 from world.map.signals import light_colour
+from world.sensors.setup import Profile
 from world.spec import TrafficLightSpec
 
 pytestmark = pytest.mark.slow
@@ -23,20 +29,20 @@ FRONT = 2.4  # [m] the ego's centre -> front bumper
 
 
 @pytest.fixture(scope="module")
-def route(run_scenario: Callable[..., RunResult]) -> RunResult:
-    return run_scenario("town_route", record=False)
+def route(run_scenario: Callable[..., RunResult], sensor_profile: Profile) -> RunResult:
+    return run_scenario("town_route", record=False, profile=sensor_profile)
 
 
 @pytest.fixture(scope="module")
-def close_car(run_scenario: Callable[..., RunResult]) -> RunResult:
-    return run_scenario("town_left_turn", record=False)
+def close_car(run_scenario: Callable[..., RunResult], sensor_profile: Profile) -> RunResult:
+    return run_scenario("town_left_turn", record=False, profile=sensor_profile)
 
 
 @pytest.fixture(scope="module")
-def far_car(run_scenario: Callable[..., RunResult]) -> RunResult:
+def far_car(run_scenario: Callable[..., RunResult], sensor_profile: Profile) -> RunResult:
     # two blocks off and at 20 km/h: at green it is still beyond the 6 s gap a left turn
     # waits for (at 30 km/h it came within it, seen since the LiDAR's tracks reach 100 m)
-    return run_scenario("town_left_turn", record=False,
+    return run_scenario("town_left_turn", record=False, profile=sensor_profile,
                         **{"actors.0.start": [3, 1, "west"], "actors.0.speed_kph": 20})
 
 
@@ -175,8 +181,8 @@ def test_with_the_oncoming_car_far_the_left_turn_goes_at_once(far_car: RunResult
     assert "turn_left" in _states(far_car, "motion")
 
 
-def test_results_match_golden(route: RunResult, close_car: RunResult,
-                              far_car: RunResult) -> None:
-    golden.check(route, "town_route")
-    golden.check(close_car, "town_left_turn")
-    golden.check(far_car, "town_left_turn.far_car")
+def test_results_match_golden(route: RunResult, close_car: RunResult, far_car: RunResult,
+                              sensor_profile: Profile) -> None:
+    golden.check(route, golden.profile_label("town_route", sensor_profile))
+    golden.check(close_car, golden.profile_label("town_left_turn", sensor_profile))
+    golden.check(far_car, golden.profile_label("town_left_turn.far_car", sensor_profile))
