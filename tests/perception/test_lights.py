@@ -38,6 +38,7 @@ from perception.messages import EgoState
 from tests.perception.light_scene import LightScene
 from tests.perception.render_scene import front_camera
 from tests.vehicle import VEHICLE
+from world.actors.catalogue import CATALOGUE
 from world.frames import CameraFrame
 from world.hdmap import LightColour, LightHead
 from world.map.road import build_road_map, light_head
@@ -50,13 +51,20 @@ MAP = build_road_map(replace(ROAD, features=(MAIN_LIGHT,)))  # MAIN is the map's
 MAIN = light_head(MAP, MAIN_LIGHT)
 FRONT = VEHICLE.front_overhang  # [m] the car's centre to its front bumper
 AWAY = replace(MAIN, x=MAIN.x + 150.0, facing=0.0)  # lamps point along the route
-LOW = replace(MAIN, x=MAIN.x + 300.0, z=2.8)  # a low post-mounted head, a red car under it
+LOW = replace(MAIN, x=MAIN.x + 300.0, z=2.8)  # a low post-mounted head, a red van under it
+HIDDEN = replace(LOW, x=LOW.x + 200.0)  # the same, the red van in front of it
 LEFT = LightHead(MAIN.x + 30.0, 8.0, 3.5, math.pi)  # left of the road, facing the traffic
 # a town junction's near corner: the head for the cross street, 10.9 m before MAIN (two
 # corners of a one-lane junction apart), lamps facing across the road
 SIDE = replace(MAIN, x=MAIN.x - 10.9, facing=0.5 * math.pi)
-HEADS = (MAIN, AWAY, LOW, LEFT, SIDE)
-CAR = ActorSpec("parked", ActorType.CAR, 0, LOW.x - 3.0, LOW.y, 0.0)  # right under LOW
+HEADS = (MAIN, AWAY, LOW, LEFT, SIDE, HIDDEN)
+# a red panel van (2.36 m high, painted up to its roof) parked under the low head, its rear
+# 0.03 m past the head's post: from the lane it stands right below the housing and fills the
+# lower half of the region searched, its paint touching the housing and the green lamp
+VAN = ActorSpec("parked", ActorType.CAR, 0, LOW.x + 3.0, LOW.y, 0.0, model=CATALOGUE["van"])
+# the same van 3 m before the other low head, between it and the camera: its body hides
+# most of the head's green (bottom) lamp (the lamp is not in the pixels)
+VAN_IN_FRONT = replace(VAN, id="in front", s=HIDDEN.x - 3.0)
 DISTANCES = (10.0, 20.0, 30.0, 40.0, 50.0)  # [m] car centre behind the head
 POSE_ERRORS = (  # (forward [m], left [m], heading [deg]) of the estimate's error
     (0.3, 0.0, 1.0), (0.0, 0.3, -1.0), (-0.3, 0.0, -1.0), (0.0, -0.3, 1.0))
@@ -66,7 +74,7 @@ Render = Callable[[int, float, LightColour], tuple[CameraFrame, EgoState]]
 
 @pytest.fixture(scope="module")
 def scene() -> Iterator[LightScene]:
-    built = LightScene(ROAD, HEADS, (CAR,))
+    built = LightScene(ROAD, HEADS, (VAN, VAN_IN_FRONT))
     yield built
     built.close()
 
@@ -215,23 +223,48 @@ def test_a_light_beyond_max_range_is_not_looked_for(
 
 
 @pytest.mark.parametrize("distance", DISTANCES)
-def test_a_red_car_under_a_green_light_does_not_turn_it_red(
+def test_a_red_van_under_a_green_light_does_not_turn_it_red(
     detector: TrafficLightDetector, render: Render, distance: float,
 ) -> None:
-    """The car is in the region searched and as bright as a lamp (V >= 100), with a red
-    lamp's hue; it is not saturated enough (S ~211 against the lamps' 255)."""
+    """The van's paint is in the region searched, touching the housing and the green lamp,
+    as bright as a lamp (V >= 100) and with a red lamp's hue; it is not saturated enough
+    (S ~211 against the lamps' 255). The van stands past the head: in front of it, its body
+    would hide the green lamp (`test_a_red_van_hiding_the_green_lamp_is_not_read_as_red`)."""
     frame, ego = render(2, distance, LightColour.GREEN)
     view = head_view(detector.camera, ego, LOW, detector.params)
     assert view is not None
     u0, v0, u1, v1 = view.roi
     hsv = cv2.cvtColor(frame.rgb[v0:v1, u0:u1], cv2.COLOR_RGB2HSV)
-    car = (hsv[..., 0] <= 8) & (hsv[..., 1] >= 200) & (hsv[..., 2] >= 100)
-    assert car.sum() > 100
-    assert hsv[..., 1][car].max() < detector.params.min_saturation
+    van = (hsv[..., 0] <= 8) & (hsv[..., 1] >= 200) & (hsv[..., 2] >= 100)
+    assert van.sum() > 100
+    assert hsv[..., 1][van].max() < detector.params.min_saturation
     blobs, _ = detector.lamp_blobs(frame.rgb, view)
     assert {b.colour for b in blobs} == {LightColour.GREEN}
     (found,) = detector.detect_heads(frame, ego, [(2, LOW)])
     assert found.colour is LightColour.GREEN
+
+
+@pytest.mark.parametrize("distance", DISTANCES)
+def test_a_red_van_hiding_the_green_lamp_is_not_read_as_red(
+    detector: TrafficLightDetector, render: Render, distance: float,
+) -> None:
+    """With the van between the camera (1.39 m high) and the head, the line of sight to the
+    green lamp (2.5 m high) meets the van's body (2.36 m high, 5.93 m long): at most half of
+    the lamp's pixels are left (none at 50 m), the rest of the light's region is red paint
+    and sky. The detector reads the green of what is left, or nothing; never the van's red."""
+    frame, ego = render(5, distance, LightColour.GREEN)
+    clear, clear_ego = render(2, distance, LightColour.GREEN)
+    view = head_view(detector.camera, ego, HIDDEN, detector.params)
+    clear_view = head_view(detector.camera, clear_ego, LOW, detector.params)
+    assert view is not None
+    assert clear_view is not None
+    blobs, hsv = detector.lamp_blobs(frame.rgb, view)
+    clear_blobs, _ = detector.lamp_blobs(clear.rgb, clear_view)
+    assert 2 * sum(b.area for b in blobs) <= sum(b.area for b in clear_blobs)
+    van = (hsv[..., 0] <= 8) & (hsv[..., 1] >= 200) & (hsv[..., 2] >= 100)
+    assert van.sum() > 100
+    assert {d.colour for d in detector.detect_heads(frame, ego, [(5, HIDDEN)])} <= {
+        LightColour.GREEN}
 
 
 @pytest.mark.parametrize("distance", (25.0, 35.0, 45.0, 50.0))
