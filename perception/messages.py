@@ -103,6 +103,12 @@ class Detection:
     yaw: float  # [rad] box heading in the vehicle frame, in (-pi/2, pi/2] (no front/back)
     cls: ObjectClass  # coarse class from the box size
     points: int  # [-] LiDAR returns in the cluster
+    # the box's end nearer the sensor along its length was seen on the lower body (or no end
+    #   faces the sensor): that end is where the object ends. False: a car whose returns
+    #   there all lie above its lower body (a bonnet, boot deck or cabin, set back from the
+    #   bumper by an unknown distance; one ring crosses it, the ring below meets the ground
+    #   first): the object's end may lie nearer the sensor than the box's
+    end_seen: bool = True
 
 
 @dataclass(frozen=True, slots=True)

@@ -41,9 +41,15 @@ named below are fields of `DetectorParams`.
    keeps the edge its points are closer to (norm of the distance vector), and the score is
    sum 1 / max(min(d1, d2), ``closeness_d0``). It is searched every ``coarse_step``, then
    every ``fine_step`` within one coarse step of the best, on at most ``fit_max_points``
-   points (an even stride). The points within ``roof_band`` of the cluster's highest point
-   are left out of the heading fit (unless fewer than ``min_points`` would remain): a roof
-   seen from above, close by, fills the rectangle's interior and tilts the refit below.
+   points (an even stride). The heading is fitted to the lower body's returns, those at
+   most ``footprint_top`` high, when there are ``min_points`` of them and at least a
+   ``footprint_share`` of the cluster: a vehicle's footprint is its lower body's outline
+   (bumpers, sides), while its cabin, bonnet and boot deck are set back from the ends and
+   its glass sides lean in, so that they and the bumpers fit no one rectangle (a car in the
+   next lane was tilted 5 - 10 deg). Else the points within ``roof_band`` of the cluster's
+   highest point are left out of the heading fit (unless fewer than ``min_points`` would
+   remain): a roof seen from above, close by, fills the rectangle's interior and tilts the
+   refit below.
    The criterion chases the extreme (noisiest) points, so the
    heading is then refitted ``refine_iterations`` times by least squares: each point goes to
    the nearer of the two kept edges, and the two perpendicular lines minimising the summed
@@ -78,7 +84,11 @@ named below are fields of `DetectorParams`.
    its visible faces), the overshoot [m] how much the seen extents exceed the prior's. This
    decides, e.g., whether a lone face a car wide is a car's rear (grown away: no growth) or
    part of its side (grown sideways). Height: the prior's, or the observed one if larger; z
-   is half the height.
+   is half the height. A car's near end along its length is `Detection.end_seen` when the
+   returns within ``end_band`` of it reach down to ``footprint_top``: else the face seen is
+   a bonnet's, a boot deck's or a cabin's (beyond about 27 m one ring crosses a car ahead,
+   above its boot deck: a saloon's rear screen, 0.9 m before its bumper), the box grown from
+   it lies too far away by that set-back, which the scan cannot tell; the tracker can.
 8. **Coupled trailers and fragments**: a tractor's cab and its semi-trailer are two solids a
    coupling's clearance apart (the trailer's front swings past the cab's back wall in a
    turn), farther than ``cluster_eps``: two truck boxes whose clusters lie on one line
@@ -182,6 +192,13 @@ class DetectorParams:
     refine_iterations: int = 2  # [-] least-squares refits of the L-shape heading
     roof_band: float = 0.15  # [m] points this close below a cluster's top are left out of
     #   the heading fit (a roof seen from above fills the footprint and tilts the refit)
+    footprint_top: float = 0.6  # [m] top of a vehicle's lower body, whose outline is its
+    #   footprint: below its bumpers' top (a car's bumper zone is 0.41 - 0.51 m high, 16 - 20
+    #   in, US 49 CFR Part 581) the ends are the bumpers' faces; above, bonnets, boot decks
+    #   and cabins are set back from them and the sides curve in
+    footprint_share: float = 0.25  # [-] the heading is fitted to the lower body's returns
+    #   when they are at least this share of a cluster's (and min_points)
+    end_band: float = 0.3  # [m] the returns this close to a box's near end are its end face
     fragment_margin: float = 0.2  # [m] a box absorbs smaller clusters within this of it
     # [m] vehicle size priors: generic class sizes, the means of the nuScenes training set's
     #   car and truck boxes (the anchor sizes of mmdetection3d's nuScenes PointPillars), not
@@ -547,11 +564,7 @@ def box_from_points(xy: FloatArray, top: float, sensor_xy: tuple[float, float],
     ``top`` [m] above the ground, sensor position [m], the points' (N,) heights [m] above
     the ground (given: the heading is fitted below the roof band), how tall it may be
     (`ring_gap_top`; None: unknown); None if it is not an object."""
-    fit = None
-    if heights is not None:
-        below = heights < top - p.roof_band
-        fit = xy[below] if below.sum() >= p.min_points else None
-    fp = footprint(xy, sensor_xy, p, fit)
+    fp = footprint(xy, sensor_xy, p, heading_points(xy, top, heights, p))
     ext = fp.extents
     longer_first = ext[0] >= ext[1]
     classes = candidate_classes(max(ext), min(ext), top, p, gap)
@@ -569,10 +582,41 @@ def box_from_points(xy: FloatArray, top: float, sensor_xy: tuple[float, float],
     height = max(top, prior.height) if prior is not None else top
     length, width = (hi1 - lo1, hi2 - lo2) if best.axis1_length else (hi2 - lo2, hi1 - lo1)
     axis = best.axes[0] if best.axis1_length else best.axes[1]
+    end_seen = (best.cls is not ObjectClass.CAR or heights is None
+                or near_end_low(fp, 0 if best.axis1_length else 1, xy, heights, p))
     return Detection(x=float(centre[0]), y=float(centre[1]), z=0.5 * height, length=length,
                      width=width, height=height,
                      yaw=wrap_half_pi(math.atan2(float(axis[1]), float(axis[0]))),
-                     cls=best.cls, points=len(xy))
+                     cls=best.cls, points=len(xy), end_seen=end_seen)
+
+
+def heading_points(xy: FloatArray, top: float, heights: FloatArray | None,
+                   p: DetectorParams) -> FloatArray | None:
+    """The (M, 2) points [m] the heading is fitted to (module doc, step 5): the lower body's
+    (at most ``footprint_top`` high) if there are ``min_points`` of them and at least a
+    ``footprint_share`` of the cluster, else those below the roof band; None (all points)
+    without heights or with fewer than ``min_points`` below the roof band."""
+    if heights is None:
+        return None
+    lower = heights <= p.footprint_top
+    if lower.sum() >= max(p.min_points, p.footprint_share * len(xy)):
+        return xy[lower]
+    below = heights < top - p.roof_band
+    return xy[below] if below.sum() >= p.min_points else None
+
+
+def near_end_low(fp: Footprint, axis: int, xy: FloatArray, heights: FloatArray,
+                 p: DetectorParams) -> bool:
+    """Whether the returns within ``end_band`` of the end of ``fp``'s ``axis`` nearer the
+    sensor reach down to the lower body (``footprint_top``): True too when the sensor lies
+    between the axis's ends (no end faces it). (N, 2) points [m], (N,) heights [m]."""
+    proj = xy @ fp.axes[axis]
+    sensor = float(fp.axes[axis] @ fp.sensor)
+    lo, hi = fp.lo[axis], fp.hi[axis]
+    if lo <= sensor <= hi:
+        return True
+    near = proj <= lo + p.end_band if sensor < lo else proj >= hi - p.end_band
+    return bool(heights[near].min() <= p.footprint_top)
 
 
 # ---- the detector ------------------------------------------------------------------------------

@@ -18,7 +18,16 @@ Model (one linear Kalman filter per track, filterpy's `KalmanFilter`):
   moves with it, the near faces staying (`_away`). A box whose size changes from one scan to
   the next (a car revealed by a cut-out, its first few returns a pedestrian's box, then a
   car's) so moves its far end, not its centre: its velocity stays the object's (the box
-  centre moved away at 0.7 m/s from a standing car before, and the ACC's need with it);
+  centre moved away at 0.7 m/s from a standing car before, and the ACC's need with it).
+  A car whose near end was not seen (`Detection.end_seen` False: only a face above its
+  lower body, a bonnet, boot deck or cabin set back from the bumper) measures no range along
+  its length (noise ``setback_sigma`` along it) when the track is settled (confirmed, and
+  its last detection's near face and length agreed with it within ``setback_margin``, or
+  were set back) and the face lies between ``setback_margin`` and the track's length
+  beyond the end the track predicts: the track's range coasts on its velocity there and
+  the face places it across.
+  A face nearer than that is measured (the car cannot end beyond the body seen: a braking
+  car is followed), and so is every face of a tentative track (nothing else known);
 - a new track starts at its detection with zero velocity, ``init_speed_sigma`` per axis.
 
 Steps of `MultiObjectTracker.update`:
@@ -96,6 +105,10 @@ class TrackerParams:
     #   range: a car found far ahead is tracked from its first detection)
     size_alpha: float = 0.3  # [-] smoothing weight of a new box size / heading
     heading_min_speed: float = 1.0  # [m/s] faster tracks take the yaw closer to the velocity
+    setback_margin: float = 0.45  # [m] an end face seen above the lower body farther than
+    #   this beyond a settled track's predicted end is set back from it (three
+    #   position_sigma)
+    setback_sigma: float = 100.0  # [m] measurement noise of such a face's range: unmeasured
 
 
 def process_noise(dt: float, q: float) -> FloatArray:
@@ -127,6 +140,7 @@ class MapDetection:
     width: float  # [m]
     height: float  # [m]
     cls: ObjectClass  # the detection's class
+    end_seen: bool = True  # `Detection.end_seen`
 
 
 def in_map(ego: EgoState, x: float, y: float) -> tuple[float, float]:
@@ -139,7 +153,8 @@ def to_map(det: Detection, ego: EgoState) -> MapDetection:
     """``det`` (vehicle frame of ``ego``) in the map frame."""
     x, y = in_map(ego, det.x, det.y)
     return MapDetection(x=x, y=y, yaw=det.yaw + ego.heading, length=det.length,
-                        width=det.width, height=det.height, cls=det.cls)
+                        width=det.width, height=det.height, cls=det.cls,
+                        end_seen=det.end_seen)
 
 
 def pose_jump(prev: EgoState, now: EgoState) -> tuple[float, float, float]:
@@ -175,6 +190,9 @@ class _TrackState:
         self.votes = dict.fromkeys(_CLASS_ORDER, 0)
         self.votes[det.cls] = 1
         self.last_cls = det.cls
+        # its end is where its near faces were seen: confirmed, its last detection's near
+        # face and length agreed with it (within setback_margin) or were set back
+        self.settled = False
 
     @property
     def state(self) -> FloatArray:
@@ -203,12 +221,35 @@ class _TrackState:
         self.axis = np.array([[math.cos(2 * dpsi), -math.sin(2 * dpsi)],
                               [math.sin(2 * dpsi), math.cos(2 * dpsi)]]) @ self.axis
 
-    def mahalanobis2(self, z: FloatArray) -> FloatArray:
-        """(D,) squared Mahalanobis distance of (D, 2) map-frame centres [m]."""
-        s = self.kf.P[:2, :2] + self.kf.R
+    def mahalanobis2(self, z: FloatArray, r: FloatArray) -> float:
+        """Squared Mahalanobis distance of a map-frame centre ``z`` (2,) [m] measured with
+        noise ``r`` (2, 2) [m^2]."""
         y = z - self.state[:2]
-        out: FloatArray = np.einsum("ij,jk,ik->i", y, np.linalg.inv(s), y)
-        return out
+        return float(y @ np.linalg.solve(self.kf.P[:2, :2] + r, y))
+
+    def noise(self, det: MapDetection, z: FloatArray, away: FloatArray,
+              p: TrackerParams) -> FloatArray:
+        """(2, 2) [m^2] the noise of the centre ``z`` [m] that ``det`` measures (``away``:
+        `_away`): the filter's R; but along the length, unmeasured (``setback_sigma``) when
+        `set_back` (module doc, measurement)."""
+        if not self.set_back(det, z, away, p):
+            return np.asarray(self.kf.R, dtype=np.float64)
+        u = away[0]
+        return np.asarray(self.kf.R + p.setback_sigma**2 * np.outer(u, u), dtype=np.float64)
+
+    def beyond(self, z: FloatArray, away: FloatArray) -> float:
+        """[m] how far the centre ``z`` [m] measured lies beyond the track's, along the
+        detection's length away from the sensor (0 when no end faces it)."""
+        return float(away[0] @ (z - self.state[:2]))
+
+    def set_back(self, det: MapDetection, z: FloatArray, away: FloatArray,
+                 p: TrackerParams) -> bool:
+        """Whether ``det``'s near end face is set back from the object's end: its end was
+        not seen (`Detection.end_seen`), the track is `settled` and the face lies between
+        ``setback_margin`` and the track's length beyond the end the track predicts."""
+        if det.end_seen or not self.settled or not away[0].any():
+            return False
+        return p.setback_margin < self.beyond(z, away) <= float(self.size.max())
 
     def _axes_along(self, det: MapDetection) -> list[int]:
         """The indices of the track's size (length 0, width 1) along ``det``'s length and
@@ -235,7 +276,12 @@ class _TrackState:
         away = _away(det, sensor)  # (2, 2) per box axis, the direction away from the sensor
         order = self._axes_along(det)
         held = self.size[order]
-        self.kf.update(self.measured_centre(det, away, held))
+        z = self.measured_centre(det, away, held)
+        set_back = self.set_back(det, z, away, p)
+        self.settled = self.confirmed and (set_back or (
+            abs(self.beyond(z, away)) <= p.setback_margin
+            and abs(float(held[0]) - det.length) <= p.setback_margin))
+        self.kf.update(z, R=self.noise(det, z, away, p))
         a = p.size_alpha
         self.size = (1.0 - a) * self.size + a * np.array([det.length, det.width, det.height])
         self.axis = (1.0 - a) * self.axis + a * np.array([math.cos(2.0 * det.yaw),
@@ -294,7 +340,13 @@ def relative(x: float, y: float, vx: float, vy: float,
     return c * dx + s * dy, -s * dx + c * dy, c * dvx + s * dvy, -s * dvx + c * dvy
 
 
-def associate(tracks: list[_TrackState], dets: list[MapDetection], gate: float,
+def _cost(tr: _TrackState, det: MapDetection, away: FloatArray, p: TrackerParams) -> float:
+    """The squared Mahalanobis distance of the centre ``det`` measures for ``tr``."""
+    z = tr.measured_centre(det, away)
+    return tr.mahalanobis2(z, tr.noise(det, z, away, p))
+
+
+def associate(tracks: list[_TrackState], dets: list[MapDetection], p: TrackerParams,
               sensor: tuple[float, float] = (0.0, 0.0)) -> list[tuple[int, int]]:
     """(track index, detection index) pairs of the gated minimum-cost assignment; each
     pair's cost is the distance of the centre the detection measures for that track (its
@@ -302,10 +354,9 @@ def associate(tracks: list[_TrackState], dets: list[MapDetection], gate: float,
     if not tracks or not dets:
         return []
     away = [_away(d, sensor) for d in dets]
-    cost = np.array([tr.mahalanobis2(np.array([tr.measured_centre(d, a)
-                                               for d, a in zip(dets, away, strict=True)]))
+    cost = np.array([[_cost(tr, d, a, p) for d, a in zip(dets, away, strict=True)]
                      for tr in tracks])  # (T, D)
-    cost = np.where(cost <= gate, cost, INFEASIBLE)
+    cost = np.where(cost <= p.gate, cost, INFEASIBLE)
     rows, cols = linear_sum_assignment(cost)
     return [(int(r), int(c)) for r, c in zip(rows, cols, strict=True)
             if cost[r, c] < INFEASIBLE]
@@ -335,7 +386,7 @@ class MultiObjectTracker:
         self._last_ego = ego
         for tr in self._tracks:
             tr.predict(t, p)
-        pairs = associate(self._tracks, dets, p.gate, seen_from)
+        pairs = associate(self._tracks, dets, p, seen_from)
         matched_tracks = {i for i, _ in pairs}
         matched_dets = {j for _, j in pairs}
         for i, j in pairs:

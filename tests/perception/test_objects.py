@@ -28,7 +28,9 @@ from tests.perception.lidar_synth import (
     lidar_info,
     on_ground,
 )
+from world.actors.bodies import SIZES
 from world.actors.catalogue import CATALOGUE
+from world.actors.shapes.targets import EBTA, EMT, EPTA, EPTC, GVT
 from world.frames import LidarScan, SensorMount
 
 DEG = math.pi / 180.0
@@ -371,3 +373,74 @@ def test_a_car_seen_from_behind_is_no_motorcycle(detector: ObjectDetector,
     box = on_ground(distance, -3.5, CAR)
     found = detect(detector, [box])
     assert [d.cls for d in found] == [ObjectClass.CAR]
+
+
+# ---- shaped bodies: a lower body and a cabin set back from its ends ---------------------------
+
+LOWER = 0.9  # [m] top of the lower body (the waist) of a three-box car
+
+
+def shaped_car(x: float, y: float, yaw: float = 0.0, rear_setback: float = 0.9,
+               front_setback: float = 1.5) -> list[Box]:
+    """A three-box car of the simulator's sedan size standing at (x, y) [m]: a lower body
+    to the waist, the full footprint, and a cabin above it, set back from the rear and the
+    front by ``rear_setback`` and ``front_setback`` [m] (the boot deck and the bonnet)."""
+    length, width, height = CAR
+    cabin = length - rear_setback - front_setback
+    shift = 0.5 * (rear_setback - front_setback)  # [m] the cabin's centre, along the car
+    c, s = math.cos(yaw), math.sin(yaw)
+    return [Box(x, y, 0.5 * LOWER, length, width, LOWER, yaw),
+            Box(x + shift * c, y + shift * s, 0.5 * (LOWER + height), cabin, width - 0.1,
+                height - LOWER, yaw)]
+
+
+@pytest.mark.parametrize(("x", "y"), [(12.0, -3.5), (16.0, 3.5), (10.0, 0.0), (-14.0, -3.5)])
+def test_a_shaped_car_is_fitted_on_its_lower_body(detector: ObjectDetector, x: float,
+                                                  y: float) -> None:
+    """A car in the next lane whose cabin, set back from its bumpers, is seen with its lower
+    body: the heading and the near end are the lower body's (the cabin's rear face and its
+    sides, fitted with the bumper, tilted the box by 5 - 10 deg)."""
+    boxes = shaped_car(x, y)
+    (det,) = detect(detector, boxes)
+    assert det.cls is ObjectClass.CAR
+    assert yaw_error(det.yaw, 0.0) <= 1.0 * DEG, det
+    near = det.x - 0.5 * det.length if x > 0 else det.x + 0.5 * det.length
+    assert near == pytest.approx(x - math.copysign(0.5 * CAR[0], x), abs=0.1), det
+    assert det.end_seen
+
+
+@pytest.mark.parametrize("distance", [28.0, 32.0])
+def test_a_car_seen_above_its_lower_body_says_so(detector: ObjectDetector,
+                                                 distance: float) -> None:
+    """Beyond about 27 m one ring crosses a car ahead, above its boot deck: the face seen is
+    the cabin's, 0.9 m before its rear. The box is grown from it (nothing in the scan tells
+    where the bumper is: a box's rear crossed as high gives the same returns), and the
+    detection says that its near end was not seen (`end_seen`), for the tracker."""
+    (det,) = detect(detector, shaped_car(distance, 0.0))
+    assert det.cls is ObjectClass.CAR
+    assert not det.end_seen, det
+    assert det.x - 0.5 * det.length == pytest.approx(distance - 0.5 * CAR[0] + 0.9, abs=0.1)
+
+
+def test_the_end_of_a_car_near_is_seen(detector: ObjectDetector) -> None:
+    """... and a car 8 m ahead shows its bumper to the lower rings."""
+    (det,) = detect(detector, shaped_car(8.0, 0.0))
+    assert det.end_seen and det.x - 0.5 * det.length == pytest.approx(8.0 - 0.5 * CAR[0],
+                                                                      abs=0.1)
+
+
+@pytest.mark.parametrize("cls", [ObjectClass.CAR, ObjectClass.TRUCK, ObjectClass.MOTORCYCLE,
+                                 ObjectClass.PEDESTRIAN])
+def test_no_detector_prior_equals_a_body(cls: ObjectClass) -> None:
+    """Every size prior is its class's generic size (nuScenes' means, `DetectorParams`),
+    none a simulated body: each differs from every catalogue vehicle, Euro NCAP target and
+    box body the world builds by at least 10 cm in some dimension."""
+    prior = DetectorParams().prior(cls)
+    assert prior is not None
+    bodies = [(m.length, m.width, m.height) for m in CATALOGUE.values()]
+    bodies += [(b.length, b.width, b.height) for b in SIZES.values()]
+    bodies += [(t.length, t.width, t.height) for t in (GVT, EPTA, EPTC, EBTA, EMT)]
+    for body in bodies:
+        diff = max(abs(a - b) for a, b in zip((prior.length, prior.width, prior.height), body,
+                                              strict=True))
+        assert diff >= 0.1, (cls, prior, body)

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import pytest
@@ -337,3 +337,54 @@ def test_a_box_that_grows_moves_its_far_end_not_its_velocity() -> None:
     (track,) = tracks
     assert track.cls is ObjectClass.CAR
     assert track.length > 3.5  # smoothed towards the car's
+
+
+def _follow_with_setback(setback: float, from_scan: int,
+                         scans: int = 60) -> list[tuple[Track, ...]]:
+    """The ego at 15 m/s behind a car at 13 m/s, 30 m ahead; from ``from_scan`` on, the
+    detector sees only a face ``setback`` [m] beyond the car's rear (a cabin's, set back
+    from the bumper: its box grown from there, ``end_seen`` False)."""
+    ego, car = Mover(0.0, 0.0, 0.0, 15.0), Mover(30.0, 0.0, 0.0, 13.0)
+    rng = np.random.default_rng(3)
+    tracker = MultiObjectTracker()
+    out = []
+    for k in range(scans):
+        t = k * DT
+        state = ego_state(t, ego)
+        det = observe(state, car, t, rng)
+        if k >= from_scan:
+            det = replace(det, x=det.x + setback, end_seen=False)
+        out.append(tracker.update(t, state, (det,)))
+    return out
+
+
+def test_a_face_set_back_from_a_tracked_car_does_not_move_it() -> None:
+    """A car followed with its rear seen, then for 2 s only above its boot (0.9 m set back):
+    the track does not move to the face (it moved 0.8 m away, its speed with it): the face
+    measures its lateral place only, its range coasts on its velocity (which the filter
+    knows to within about 0.2 m/s here: 0.4 m in 2 s)."""
+    out = _follow_with_setback(0.9, from_scan=20, scans=40)
+    car = Mover(30.0, 0.0, 0.0, 13.0)
+    for k in range(20, 40):
+        (track,) = out[k]
+        x, _ = car.at(k * DT)
+        assert track.x == pytest.approx(x, abs=0.5), k
+        assert track.x - x < 0.1, k  # never towards the face
+        assert track.speed == pytest.approx(13.0, abs=0.3), k
+
+
+def test_a_set_back_face_nearer_than_the_track_is_measured() -> None:
+    """A face above the lower body but nearer than the track's end (the car braking, or the
+    track too far) is taken: the car's end cannot lie beyond the body seen."""
+    out = _follow_with_setback(-0.8, from_scan=20, scans=30)
+    car = Mover(30.0, 0.0, 0.0, 13.0)
+    (track,) = out[-1]
+    assert track.x == pytest.approx(car.at(29 * DT)[0] - 0.8, abs=0.2)
+
+
+def test_a_new_track_takes_a_set_back_face_as_its_end() -> None:
+    """Nothing known of the car yet: its box is the detector's, from the face seen."""
+    out = _follow_with_setback(0.9, from_scan=0, scans=10)
+    car = Mover(30.0, 0.0, 0.0, 13.0)
+    (track,) = out[-1]
+    assert track.x == pytest.approx(car.at(9 * DT)[0] + 0.9, abs=0.2)
