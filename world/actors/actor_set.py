@@ -10,12 +10,12 @@ the actor's `model`, else its type's default); a pedestrian's and an obstacle's 
 convex parts (`world.actors.body_build`), else its box; either way its origin is the box's
 centre, which is what `poses` gives.
 Every pedestrian walks: its body is an articulated walker (`world.actors.walker_body`) of
-the stature `world.actors.shapes.actors.walker_stature` gives its box, standing on the
-ground at its box's centre (its body frame's origin, the middle of its gait's sweep), its
-base at the hips. Its gait phase starts at `STAND_PHASE` and advances with the distance its
-body moves over the ground each time it is placed (`phase_after`), so a standing pedestrian
-keeps its pose and a walking one swings its legs; it is posed (base and joints) each time
-it is placed.
+its box's height, with the gait amplitude `world.actors.shapes.actors.walker_amplitude` fits
+to its box's length, standing on the ground at its box's centre (its body frame's origin,
+the middle of its gait's sweep), its base at the hips. Its gait phase starts at
+`STAND_PHASE` and advances with the distance its body moves over the ground each time it is
+placed (`phase_after`), so a standing pedestrian keeps its pose and a walking one swings its
+legs; it is posed (base and joints) each time it is placed.
 Pedestrians are placed by station and offset from
 their lane's centre like any actor; their speed is a walking speed along the lane, and the
 `walk` action moves them across the road, facing where they walk.
@@ -48,7 +48,7 @@ from world.actors.behaviour import NpcMotion, TriggerContext
 from world.actors.bodies import VEHICLES, BoxSize, body_size, vehicle_of
 from world.actors.body_build import BodyBuilder
 from world.actors.catalogue import CATALOGUE, DEFAULT_MODEL, VehicleClass
-from world.actors.shapes.actors import vehicle_shape, walker_stature
+from world.actors.shapes.actors import vehicle_shape, walker_amplitude
 from world.actors.shapes.body import Body
 from world.actors.shapes.humans import phase_after
 from world.actors.shapes.walker import WalkerModel, walker_model, walker_pose
@@ -111,12 +111,13 @@ def actor_shape(spec: ActorSpec, size: BoxSize) -> Body | None:
 
 
 def actor_walker(spec: ActorSpec, size: BoxSize) -> WalkerModel | None:
-    """The articulated walker that is a pedestrian's body whose box is `size` (None: not a
-    pedestrian, or no walker fits its box)."""
+    """The articulated walker that is a pedestrian's body whose box is `size`: the box's
+    height, its gait's amplitude fitted to the box's length (`walker_amplitude`; None: not a
+    pedestrian)."""
     if spec.type is not ActorType.PEDESTRIAN:
         return None
-    stature = walker_stature(size.length, size.width, size.height)
-    return None if stature is None else walker_model(stature, size.width)
+    amplitude = walker_amplitude(size.length, size.width, size.height)
+    return walker_model(size.height, size.width, amplitude)
 
 
 class ActorSet:
@@ -403,9 +404,10 @@ class ActorSet:
         if walked:
             prev = self._xy[i]
             distance = math.hypot(x - float(prev[0]), y - float(prev[1]))
-            self.phases[i] = phase_after(self.phases[i], distance, walker.height)
+            self.phases[i] = phase_after(self.phases[i], distance, walker.height,
+                                         walker.amplitude)
         pose_walker(self._c, self.bodies[i], x, y, yaw,
-                    walker_pose(walker.height, self.phases[i], walker.width))
+                    walker_pose(walker.height, self.phases[i], walker.width, walker.amplitude))
 
     def joints(self) -> tuple[tuple[float, ...], ...]:
         """[rad] each actor's body's joint angles now, in joint order (() for a rigid body)."""

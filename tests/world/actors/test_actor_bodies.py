@@ -35,10 +35,12 @@ def test_which_actors_have_a_shape() -> None:
     adult = _spec(ActorType.PEDESTRIAN, size=(0.6, 0.5, 1.8))  # Euro NCAP's EPTa box
     assert actor_shape(adult, body_size(adult)) is None  # a walker, not a rigid shape
     walker = actor_walker(adult, body_size(adult))
-    assert walker is not None and (walker.height, walker.width) == (1.8, 0.5)
-    generic = _spec(ActorType.PEDESTRIAN)  # 0.5 x 0.6 x 1.75: its walk sweeps 0.57 m
+    assert walker is not None and (walker.height, walker.width, walker.amplitude) == (1.8, 0.5,
+                                                                                        1.0)
+    generic = _spec(ActorType.PEDESTRIAN)  # 0.5 x 0.6 x 1.75: its full walk sweeps 0.57 m
     walker = actor_walker(generic, body_size(generic))
-    assert walker is not None and 1.5 < walker.height < 1.55  # scaled to the box's length
+    assert walker is not None and walker.height == 1.75  # the box's height, a shorter stride
+    assert 0.0 < walker.amplitude < 1.0
     obstacle = _spec(ActorType.OBSTACLE)
     size = body_size(obstacle)
     assert actor_shape(obstacle, size) is None and actor_walker(obstacle, size) is None

@@ -405,7 +405,7 @@ def test_bodies_are_where_the_truth_says(world_run: tuple[World, WorldTrace]) ->
             expected = p.centres[i]
             walker = w.actors.walkers[i]
             if walker is not None:
-                pose = walker_pose(walker.height, phases[i], walker.width)
+                pose = walker_pose(walker.height, phases[i], walker.width, walker.amplitude)
                 expected = [expected[0] + pose.base_x * math.cos(p.yaws[i]),
                             expected[1] + pose.base_x * math.sin(p.yaws[i]), pose.base_height]
             np.testing.assert_allclose(position, expected, atol=1e-6)

@@ -152,7 +152,10 @@ def test_the_committed_assets_are_what_the_code_makes(tmp_path: Path) -> None:
 def _parse_obj(text: str) -> tuple[np.ndarray, dict[str, list[tuple[int, int, int]]],
                                    dict[str, str]]:
     """Vertices, faces (1-based) by group, and each group's material."""
-    vertices, faces, materials, group = [], {}, {}, ""
+    vertices: list[list[float]] = []
+    faces: dict[str, list[tuple[int, int, int]]] = {}
+    materials: dict[str, str] = {}
+    group = ""
     for line in text.splitlines():
         word, *rest = line.split() or [""]
         if word == "v":

@@ -19,18 +19,20 @@ from world.actors.shapes.walker import (
     walker_pose,
 )
 
-STATURES = [(targets.EPTA.height, targets.EPTA.width), (targets.EPTC.height, targets.EPTC.width),
-            (targets.EPTA.height, None)]
+STATURES = [(targets.EPTA.height, targets.EPTA.width, 1.0),
+            (targets.EPTC.height, targets.EPTC.width, 1.0), (targets.EPTA.height, None, 1.0),
+            (1.8, 0.5, 0.3), (1.75, 0.6, 0.0)]  # (stature [m], width [m], gait amplitude [-])
 PHASES = [k / 40 for k in range(40)] + [0.013, 0.2499, 0.5001, 0.7777, 0.999]
 
 
-@pytest.mark.parametrize(("height", "width"), STATURES)
-def test_posed_model_is_pedestrian_parts_at_every_phase(height: float,
-                                                        width: float | None) -> None:
-    model = walker_model(height, width)
+@pytest.mark.parametrize(("height", "width", "amplitude"), STATURES)
+def test_posed_model_is_pedestrian_parts_at_every_phase(height: float, width: float | None,
+                                                        amplitude: float) -> None:
+    model = walker_model(height, width, amplitude)
+    assert model.amplitude == amplitude
     for phase in PHASES:
-        posed = posed_points(model, walker_pose(height, phase, width))
-        ref = {p.name: points(p) for p in pedestrian_parts(height, phase, width)}
+        posed = posed_points(model, walker_pose(height, phase, width, amplitude))
+        ref = {p.name: points(p) for p in pedestrian_parts(height, phase, width, amplitude)}
         assert posed.keys() == ref.keys()
         for name, pts in ref.items():
             np.testing.assert_allclose(posed[name], pts, rtol=0.0, atol=1e-9,
@@ -83,15 +85,18 @@ def test_the_feet_stay_level_and_the_trunk_upright() -> None:
             np.testing.assert_allclose(frames[name][0], np.eye(3), atol=1e-12)
 
 
-@pytest.mark.parametrize("height", [targets.EPTA.height, targets.EPTC.height])
-def test_the_standing_foot_does_not_slide_over_a_step(height: float) -> None:
+@pytest.mark.parametrize(("height", "amplitude"), [(targets.EPTA.height, 1.0),
+                                                   (targets.EPTC.height, 1.0), (1.8, 0.3)])
+def test_the_standing_foot_does_not_slide_over_a_step(height: float, amplitude: float) -> None:
     """The left leg stands from phase 0 to 0.5: walking half a stride along x, its foot's
-    place on the ground is the same at both ends, and strays little in between."""
-    stride = stride_length(height)
+    place on the ground is the same at both ends, and strays little in between (a smaller
+    gait amplitude, a shorter stride: no more slide)."""
+    stride = stride_length(height, amplitude)
     seg = segments(height, None)
 
     def left_foot_on_ground(phase: float) -> float:
-        foot = next(p for p in pedestrian_parts(height, phase) if p.name == "left_foot")
+        foot = next(p for p in pedestrian_parts(height, phase, None, amplitude)
+                    if p.name == "left_foot")
         return float(points(foot)[:, 0].min()) + stride * phase  # the body has walked on
 
     start, end = left_foot_on_ground(0.0), left_foot_on_ground(0.5)
@@ -109,6 +114,15 @@ def test_phase_after_advances_one_cycle_per_stride() -> None:
     assert phase_after(0.1, -0.2 * stride, h) == pytest.approx(0.9)
     assert phase_after(0.3, 7 * stride, h) == pytest.approx(0.3)
     assert stride_length(targets.EPTC.height) < stride  # a child's legs are shorter
+
+
+def test_a_smaller_gait_has_a_shorter_stride_and_none_stands() -> None:
+    h = targets.EPTA.height
+    assert 0.0 < stride_length(h, 0.3) < 0.35 * stride_length(h)
+    short = stride_length(h, 0.3)
+    assert phase_after(0.1, 0.5 * short, h, 0.3) == pytest.approx(0.6)
+    assert stride_length(h, 0.0) == 0.0
+    assert phase_after(0.25, 3.0, h, 0.0) == 0.25  # no stride: the phase stays
 
 
 @pytest.mark.parametrize("height", [1.15, 1.52, 1.8])

@@ -18,6 +18,12 @@ are the largest round figures whose every phase stays inside it, smaller than a 
 walker's (about 20 deg and 60 deg). The phase advances with the distance walked, one cycle
 per `stride_length` (`phase_after`).
 
+A walker whose box is shorter than its full gait sweeps keeps its stature and walks with a
+smaller gait: one `amplitude` factor in [0, 1] scales the hip swing, the knee bend and (as
+the arms follow the hips) the arm swing; the stride scales with the hip swing's sine, so the
+feet do not slide more than at the full gait. Every function of the gait takes it (1: the
+full gait).
+
 `gait`, `segments`, `pelvis_height` and the part makers are the one law that both
 `pedestrian_parts` (the walker's parts at one phase, in one frame) and the articulated model
 of `world.actors.shapes.walker` (the same parts on links, posed by joint angles) use.
@@ -61,13 +67,15 @@ class Gait:
     arm: tuple[float, float]  # [rad] arm from the vertical, forward positive
 
 
-def gait(phase: float) -> Gait:
-    """The gait law's joint angles at `phase` (0 to 1, 0 = left heel strike)."""
+def gait(phase: float, amplitude: float = 1.0) -> Gait:
+    """The gait law's joint angles at `phase` (0 to 1, 0 = left heel strike), the hip swing,
+    knee bend and arm swing scaled by `amplitude` [-] (0 to 1)."""
     c, s = math.cos(2 * math.pi * phase), math.sin(2 * math.pi * phase)
-    left, right = HIP_SWING * c, -HIP_SWING * c
+    a, k = HIP_SWING * amplitude, KNEE_BEND * amplitude
+    left, right = a * c, -a * c
     # the leg swinging forward (hip angle increasing) bends its knee
-    bend_left = KNEE_BEND * abs(s) if s < 0 else 0.0
-    bend_right = KNEE_BEND * abs(s) if s > 0 else 0.0
+    bend_left = k * abs(s) if s < 0 else 0.0
+    bend_right = k * abs(s) if s > 0 else 0.0
     return Gait((left, right), (bend_left, bend_right), (-ARM_SWING * left, -ARM_SWING * right))
 
 
@@ -188,46 +196,62 @@ def trunk_parts(seg: Segments) -> tuple[BodyPart, ...]:
     return tuple(p for p in _upper(seg, 0.0, (0.0, 0.0)) if not p.name.endswith("_arm"))
 
 
-def pedestrian_parts(height: float, phase: float,
-                     width: float | None = None) -> tuple[BodyPart, ...]:
+def pedestrian_parts(height: float, phase: float, width: float | None = None,
+                     amplitude: float = 1.0) -> tuple[BodyPart, ...]:
     """A pedestrian of stature `height` [m] walking along +x at gait `phase` (0 to 1, 0 = left
-    heel strike), its shoulders (arms included) no wider than `width` [m] if given. The
-    origin is on the ground at the middle of the x range the whole gait cycle sweeps (the
-    feet reach further forward than back), so the envelope is centred on it."""
-    shift = np.array([-sweep_centre(height, width), 0.0, 0.0])
+    heel strike) with the gait `amplitude` [-], its shoulders (arms included) no wider than
+    `width` [m] if given. The origin is on the ground at the middle of the x range the whole
+    gait cycle sweeps (the feet reach further forward than back), so the envelope is centred
+    on it."""
+    shift = np.array([-sweep_centre(height, width, amplitude), 0.0, 0.0])
     return tuple(hull(p.name, p.material, points(p) + shift)
-                 for p in _walker(height, phase, width))
+                 for p in _walker(height, phase, width, amplitude))
+
+
+def swept_range(height: float, width: float | None,
+                amplitude: float = 1.0) -> tuple[float, float, float]:
+    """[m] the least and largest x and the largest |y| of a walker's pelvis-centred parts over
+    a gait cycle (sampled at `SWEEP_SAMPLES` phases, the hips' and knees' extremes among
+    them)."""
+    pts = np.vstack([points(p) for k in range(SWEEP_SAMPLES)
+                     for p in _walker(height, k / SWEEP_SAMPLES, width, amplitude)])
+    return float(pts[:, 0].min()), float(pts[:, 0].max()), float(np.abs(pts[:, 1]).max())
 
 
 @functools.cache
-def sweep_centre(height: float, width: float | None) -> float:
+def sweep_centre(height: float, width: float | None, amplitude: float = 1.0) -> float:
     """[m] the middle of the x range a walker's pelvis-centred parts sweep over a cycle."""
-    xs = np.vstack([points(p) for k in range(SWEEP_SAMPLES)
-                    for p in _walker(height, k / SWEEP_SAMPLES, width)])[:, 0]
-    return 0.5 * float(xs.min() + xs.max())
+    lo, hi, _ = swept_range(height, width, amplitude)
+    return 0.5 * (lo + hi)
 
 
-def stride_length(height: float) -> float:
+def stride_length(height: float, amplitude: float = 1.0) -> float:
     """[m] the distance a walker of stature `height` [m] covers in one gait cycle (two
     steps). A step is how far apart the ankles are in double support (both legs straight at
     +-`HIP_SWING`), so over each stance the pelvis moves by what the standing foot moves
     back under it: the feet do not slide over a step (within one the standing foot slides
     to and fro by up to 6 % of the leg's length peak to peak, 5 cm for a 1.80 m walker, as
-    the hip angle is a cosine of the phase, not the arc sine of the distance)."""
+    the hip angle is a cosine of the phase, not the arc sine of the distance). With the gait
+    `amplitude` [-] the hip swing is `amplitude * HIP_SWING` (0: no stride)."""
     seg = segments(height, None)
-    return 4.0 * (seg.thigh + seg.shank) * math.sin(HIP_SWING)
+    return 4.0 * (seg.thigh + seg.shank) * math.sin(HIP_SWING * amplitude)
 
 
-def phase_after(phase: float, distance: float, height: float) -> float:
-    """The gait phase (0 to 1) of a walker of stature `height` [m] at `phase` once it has
-    walked `distance` [m] (backwards if negative): one cycle per `stride_length`."""
-    return (phase + distance / stride_length(height)) % 1.0
+def phase_after(phase: float, distance: float, height: float, amplitude: float = 1.0) -> float:
+    """The gait phase (0 to 1) of a walker of stature `height` [m] and gait `amplitude` [-] at
+    `phase` once it has walked `distance` [m] (backwards if negative): one cycle per
+    `stride_length` (a walker of amplitude 0 stands still: its phase stays)."""
+    stride = stride_length(height, amplitude)
+    if stride <= 0.0:
+        return phase % 1.0
+    return (phase + distance / stride) % 1.0
 
 
-def _walker(height: float, phase: float, width: float | None) -> tuple[BodyPart, ...]:
+def _walker(height: float, phase: float, width: float | None,
+            amplitude: float = 1.0) -> tuple[BodyPart, ...]:
     """The walker's parts with the origin under the pelvis."""
     seg = segments(height, width)
-    g = gait(phase)
+    g = gait(phase, amplitude)
     pelvis = pelvis_height(g, seg)
     return (*_leg("left", np.array([0.0, seg.hip_y, pelvis]), g.hip[0], g.knee[0], seg),
             *_leg("right", np.array([0.0, -seg.hip_y, pelvis]), g.hip[1], g.knee[1], seg),

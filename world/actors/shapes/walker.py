@@ -75,10 +75,12 @@ class WalkerLink:
 
 @dataclass(frozen=True, slots=True)
 class WalkerModel:
-    """A walker of stature `height` [m]: its base's parts and its links, parents first."""
+    """A walker of stature `height` [m]: its base's parts and its links, parents first, and
+    the gait amplitude it walks with (its parts do not depend on it; its poses do)."""
 
     height: float  # [m] stature
     width: float | None  # [m] the shoulders' largest width, if bounded
+    amplitude: float  # [-] the gait's amplitude, 0 to 1 (`humans.gait`)
     base_parts: tuple[BodyPart, ...]  # [m] in the base frame: torso and head
     links: tuple[WalkerLink, ...]
 
@@ -122,26 +124,31 @@ def _arm(side: str, s: float, seg: Segments) -> WalkerLink:
 
 
 @functools.cache
-def walker_model(height: float, width: float | None = None) -> WalkerModel:
+def walker_model(height: float, width: float | None = None,
+                 amplitude: float = 1.0) -> WalkerModel:
     """The articulated model of a walker of stature `height` [m], its shoulders (arms
-    included) no wider than `width` [m] if given: the parts of `pedestrian_parts`."""
+    included) no wider than `width` [m] if given, walking with the gait `amplitude` [-]:
+    the parts of `pedestrian_parts`."""
     seg = segments(height, width)
     links = (*_leg("left", seg.hip_y, seg), *_leg("right", -seg.hip_y, seg),
              *(_arm(side, s, seg) for side, s in SIDES))
-    return WalkerModel(height, width, trunk_parts(seg), links)
+    return WalkerModel(height, width, amplitude, trunk_parts(seg), links)
 
 
-def walker_pose(height: float, phase: float, width: float | None = None) -> WalkerPose:
+def walker_pose(height: float, phase: float, width: float | None = None,
+                amplitude: float = 1.0) -> WalkerPose:
     """The pose of a walker of stature `height` [m] at gait `phase` (0 to 1, 0 = left heel
-    strike), its shoulders no wider than `width` [m] if given (as its model's: the width
-    moves the body origin, the middle of the x range the gait sweeps)."""
-    g = gait(phase)
+    strike) with the gait `amplitude` [-], its shoulders no wider than `width` [m] if given
+    (as its model's: the width and the amplitude move the body origin, the middle of the x
+    range the gait sweeps)."""
+    g = gait(phase, amplitude)
     angles: dict[str, float] = {}
     for i, (side, _) in enumerate(SIDES):
         hip, knee = g.hip[i], g.knee[i]
         angles |= {f"{side}_thigh": hip, f"{side}_shank": knee, f"{side}_foot": hip - knee,
                    f"{side}_arm": g.arm[i]}
-    return WalkerPose(-sweep_centre(height, width), pelvis_height(g, segments(height, None)),
+    return WalkerPose(-sweep_centre(height, width, amplitude),
+                      pelvis_height(g, segments(height, None)),
                       {name: angles[name] for name in LINK_NAMES})
 
 
@@ -181,13 +188,15 @@ SWEEP_PHASES = 64  # [-] phases a gait cycle is sampled at for its swept extent 
 
 
 @functools.cache
-def swept_half_extents(height: float, width: float | None = None) -> tuple[float, float]:
+def swept_half_extents(height: float, width: float | None = None,
+                       amplitude: float = 1.0) -> tuple[float, float]:
     """[m] the largest |x| and |y| of a walker's parts in its body frame over a gait cycle
-    (sampled at `SWEEP_PHASES` phases): the half footprint its walk sweeps."""
-    model = walker_model(height, width)
+    with the gait `amplitude` [-] (sampled at `SWEEP_PHASES` phases): the half footprint its
+    walk sweeps."""
+    model = walker_model(height, width, amplitude)
     half = np.zeros(2)
     for k in range(SWEEP_PHASES):
-        posed = posed_points(model, walker_pose(height, k / SWEEP_PHASES, width))
+        posed = posed_points(model, walker_pose(height, k / SWEEP_PHASES, width, amplitude))
         for pts in posed.values():
             half = np.maximum(half, np.abs(pts[:, :2]).max(axis=0))
     return float(half[0]), float(half[1])
