@@ -1,11 +1,7 @@
 """The DECS highway-to-city route (its Section IV, Fig. 3), phase by phase: cruise at the set
 speed behind a faster lead, trail it through 60, 50 and 40 km/h above d_min, the exit onto
 the 25 km/h ramp, the 40 km/h city, the stop sign, the pedestrian crossing, the speed bump
-at 5 km/h, and the flat tyre: ease off, pull onto the shoulder, stop, hazard lights on.
-
-The stop sign is read from the camera (the truth stack has none), and no perception figure is
-judged here: the run uses the `fast` profile in `make test` and the `default` one in `make
-acceptance` (`sensor_profile`), each with its golden file (`decs_route.fast`, `decs_route`)."""
+at 5 km/h, and the flat tyre: ease off, pull onto the shoulder, stop, hazard lights on."""
 
 from __future__ import annotations
 
@@ -20,7 +16,6 @@ from avsim.run.runner import RunResult
 from tests.scenarios import golden
 from world.hdmap import SHOULDER
 from world.map.road import build_road_map
-from world.sensors.setup import Profile
 
 pytestmark = pytest.mark.slow
 KPH = 1 / 3.6
@@ -29,8 +24,8 @@ STOP_LINE, CROSSWALK, BUMP = 1900.0, 1980.0, 2060.0  # [m]
 
 
 @pytest.fixture(scope="module")
-def result(run_scenario: Callable[..., RunResult], sensor_profile: Profile) -> RunResult:
-    return run_scenario("decs_route", record=False, profile=sensor_profile)
+def result(run_scenario: Callable[..., RunResult]) -> RunResult:
+    return run_scenario("decs_route", record=False)
 
 
 def _lead(r: RunResult) -> tuple[np.ndarray, np.ndarray]:
@@ -149,5 +144,5 @@ def test_the_plot(result: RunResult, tmp_path: Path) -> None:
     assert 30_000 < png.stat().st_size < 1_000_000
 
 
-def test_result_matches_golden(result: RunResult, sensor_profile: Profile) -> None:
-    golden.check(result, golden.profile_label("decs_route", sensor_profile))
+def test_result_matches_golden(result: RunResult) -> None:
+    golden.check(result, "decs_route")
