@@ -6,7 +6,9 @@ collision at its lane intrusion is under the regulation's bound (5.2.5.2) and th
 excused (`unavoidable: r157`). The runs are at `--profile none` (no camera, so an RTK
 receiver keeps the car in its lane; perception is not what is judged here). Checked: each run
 struck the cutter (the boxes overlapped) and passed; `sweep.csv` and `sweep.md` count the
-contact and the excuse; the summary counts it; JUnit shows `no_collision` as a passed
+contact and the excuse (the crash's first contact is excused and ends the judging; the
+bodies' shapes may part and touch again in the same crash: counted, not judged, so not
+excused); the summary counts it; JUnit shows `no_collision` as a passed
 testcase with the excuse, never `skipped`; the heat map is written.
 """
 
@@ -14,6 +16,7 @@ from __future__ import annotations
 
 import csv
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -56,15 +59,16 @@ def test_every_run_struck_the_cutter_and_passed(sweep: Path) -> None:
         assert float(row["min_lead_gap"]) < 0.0, row  # the boxes overlapped: it did strike
         assert row["status"] == "passed", row
         assert float(row["collisions"]) >= 1.0, row
-        assert float(row["collisions_excused"]) == float(row["collisions"]), row
+        assert float(row["collisions_excused"]) == 1.0, row  # the first, which ended judging
 
 
 def test_the_tables_count_the_contacts(sweep: Path) -> None:
     table = (sweep / "sweep.md").read_text(encoding="utf-8")
     assert "`collisions`" in table and "`collisions_excused`" in table
     summary = (sweep / "summary.md").read_text(encoding="utf-8")
-    assert f"{RUNS} ({RUNS} excused)" in summary  # the scenario's contacts column
-    assert summary.count("Contacts: 1 (1 excused)") == RUNS  # each run's own line
+    contacts = [int(n) for n in re.findall(r"Contacts: (\d+) \(1 excused\)", summary)]
+    assert len(contacts) == RUNS  # each run's own line: its one excused contact
+    assert f"{sum(contacts)} ({RUNS} excused)" in summary  # the scenario's contacts column
     assert (sweep / "heatmap.png").stat().st_size > 0
 
 
