@@ -51,3 +51,13 @@ class Part:
     shape: Shape
     position: Vec3 = (0.0, 0.0, 0.0)
     orientation: Quaternion = IDENTITY
+
+
+def quaternion_matrix(q: Quaternion) -> FloatArray:
+    """(3, 3) the rotation matrix of the unit quaternion `q` (x, y, z, w)."""
+    x, y, z, w = q
+    return np.array([
+        [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+        [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+        [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+    ])

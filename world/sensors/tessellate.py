@@ -27,10 +27,10 @@ from world.scene.collision import (
     ConvexHull,
     Cylinder,
     Part,
-    Quaternion,
     Shape,
     TriangleMesh,
 )
+from world.scene.solids import quaternion_matrix
 
 FloatArray = NDArray[np.float64]
 IndexArray = NDArray[np.int64]
@@ -84,16 +84,6 @@ def cylinder_triangles(radius: float, height: float, sides: int) -> Triangles:
         np.column_stack([np.full(sides, top), sides + k, sides + nxt]),
     ])
     return vertices, triangles
-
-
-def quaternion_matrix(q: Quaternion) -> FloatArray:
-    """(3, 3) the rotation matrix of the unit quaternion `q` (x, y, z, w)."""
-    x, y, z, w = q
-    return np.array([
-        [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-        [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-        [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-    ])
 
 
 def part_triangles(part: Part) -> Triangles:

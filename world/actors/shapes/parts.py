@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from world.actors.shapes.materials import MATERIALS
-from world.scene.solids import Box, ConvexHull, Cylinder, FloatArray, Vec3
+from world.scene.solids import Box, ConvexHull, Cylinder, FloatArray, Vec3, quaternion_matrix
 
 Solid = Box | Cylinder | ConvexHull
 Quaternion = tuple[float, float, float, float]  # x, y, z, w
@@ -47,16 +47,6 @@ class BodyPart:
             raise ValueError(f"part {self.name!r}: unknown material {self.material!r}")
 
 
-def rotation(q: Quaternion) -> FloatArray:
-    """(3, 3) the rotation matrix of the unit quaternion `q` (x, y, z, w)."""
-    x, y, z, w = q
-    return np.array([
-        [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-        [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-        [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-    ])
-
-
 def local_points(solid: Solid) -> FloatArray:
     """(P, 3) [m] the solid's points in its own frame."""
     if isinstance(solid, Box):
@@ -75,7 +65,8 @@ def local_points(solid: Solid) -> FloatArray:
 
 def points(part: BodyPart) -> FloatArray:
     """(P, 3) [m] the part's points in the body frame."""
-    moved = local_points(part.solid) @ rotation(part.orientation).T + np.asarray(part.position)
+    turned = local_points(part.solid) @ quaternion_matrix(part.orientation).T
+    moved = turned + np.asarray(part.position)
     return np.asarray(moved, dtype=np.float64)
 
 
