@@ -62,19 +62,25 @@ named below are fields of `DetectorParams`.
    PEDESTRIAN when a <= ``pedestrian_footprint``, h <= ``pedestrian_max_height`` and h >=
    ``pedestrian_min_height`` or, where only the cluster's top ring could reach it (the ring
    below meets the ground first), the ring above passes over it at ``pedestrian_adult_height``
-   or higher (beyond 30 m one ring crosses a walker, at knee height), else OTHER (obstacles,
-   poles); TRUCK alone if h > ``car.height`` + ``height_margin``, a > ``truck_min_length``
-   or b > ``truck_min_width``; otherwise CAR, then MOTORCYCLE if ``car.width`` < a <=
-   ``motorcycle_max_length``, b <= ``motorcycle_max_width`` and h <=
-   ``motorcycle_max_height`` (a side longer than a car's rear is wide: a car's side or a
-   motorcycle's), then TRUCK unless the ring above passes over it lower than ``car.height``
+   or higher (beyond 30 m one ring crosses a walker, at knee height), else MOTORCYCLE if it
+   is a two-wheeler seen end-on (`two_wheeler_end_on`: on the line of sight, deeper than
+   ``pedestrian_footprint``, no wider than ``motorcycle_max_width`` and
+   ``two_wheeler_elongation`` times as deep as wide; as tall as a walker, at most
+   ``motorcycle_max_height``: a cyclist from behind, its rider's back, bars and front wheel
+   one behind the other), else OTHER (obstacles, poles); TRUCK alone if h > ``car.height``
+   + ``height_margin``, a > ``truck_min_length`` or b > ``truck_min_width``; otherwise CAR,
+   then MOTORCYCLE if ``car.width`` < a <= ``motorcycle_max_length``, b <=
+   ``motorcycle_max_width`` and h <= ``motorcycle_max_height`` (a side longer than a car's
+   rear is wide: a car's side or a motorcycle's) or if it is a two-wheeler seen end-on,
+   then TRUCK unless the ring above passes over it lower than ``car.height``
    + ``height_margin`` (no truck's rear is that low). Of equal costs (step 7) the first
    wins: a car's rear is no motorcycle's side.
 7. **Box completion**: each candidate class's box is grown to its size prior (``car``,
    ``truck``, ``motorcycle``, ``pedestrian``; never shrunk below what was seen; OTHER: a
    square of the longer observed side), with either rectangle axis as the length. A
    pedestrian's rectangle is taken along the line of sight instead of the L-shape fit (see
-   `along_sight`). Each axis grows away from the sensor, so that the faces seen stay where
+   `along_sight`), and a two-wheeler's seen end-on along the line of sight and across it
+   (`sight_footprint`). Each axis grows away from the sensor, so that the faces seen stay where
    they were seen: if the sensor projects onto the axis outside the observed interval, the
    interval's end nearer the sensor is kept; if inside (a face seen head-on, both its ends
    visible), the interval grows symmetrically. The hypothesis of least cost = silhouette
@@ -183,6 +189,11 @@ class DetectorParams:
     motorcycle_max_width: float = 1.2  # [m] its shortest seen side, at most (handlebars and
     #   mirrors about 0.8 - 1.0 m wide; EU category L3e, Regulation (EU) No 168/2013)
     motorcycle_max_height: float = 1.9  # [m] its highest point with a seated rider, at most
+    two_wheeler_elongation: float = 1.5  # [-] a two-wheeler seen end-on (from behind or
+    #   ahead) is at least this many times as deep along the line of sight as wide across
+    #   it: bicycles and motorcycles are 2 - 3 times as long as their bars are wide, and
+    #   from behind the rider's back, the bars and the front wheel are seen one behind the
+    #   other; a car's rear or an obstacle's face is wider than deep
     overshoot_weight: float = 2.0  # [-] cost per metre seen beyond a prior's size
     truck_bias: float = 0.1  # [m] cost added to truck boxes (a car when equally likely)
     coarse_step: float = 3.0 * DEG  # [rad] L-shape heading search, coarse
@@ -409,29 +420,60 @@ def refine_heading(xy: FloatArray, theta: float) -> float:
 
 
 def candidate_classes(long_side: float, short_side: float, top: float,
-                      p: DetectorParams, gap: RingGap | None = None
-                      ) -> tuple[ObjectClass, ...]:
+                      p: DetectorParams, gap: RingGap | None = None,
+                      end_on: bool = False) -> tuple[ObjectClass, ...]:
     """The classes observed extents [m] and highest point [m] allow (module doc, step 6);
     empty: not an object. ``gap``: how tall the object may be (`ring_gap_top`; None:
-    unknown)."""
+    unknown); ``end_on``: the points are a two-wheeler's seen end-on (`two_wheeler_end_on`)."""
     if long_side > p.max_length or top > p.max_height:
         return ()
     if long_side <= p.small_footprint:
-        hidden = gap is not None and gap.alone and gap.above >= p.pedestrian_adult_height
-        is_ped = (long_side <= p.pedestrian_footprint and top <= p.pedestrian_max_height
-                  and (top >= p.pedestrian_min_height or hidden))
-        return (ObjectClass.PEDESTRIAN,) if is_ped else (ObjectClass.OTHER,)
+        return _small_classes(long_side, top, p, gap, end_on)
     truck_height = p.car.height + p.height_margin
     if top > truck_height or long_side > p.truck_min_length or short_side > p.truck_min_width:
         return (ObjectClass.TRUCK,)
     classes = [ObjectClass.CAR]
-    if (p.car.width < long_side <= p.motorcycle_max_length  # longer than a car's rear:
-            and short_side <= p.motorcycle_max_width  # a side, of a car or of a motorcycle
-            and top <= p.motorcycle_max_height):
+    if ((end_on or p.car.width < long_side <= p.motorcycle_max_length)  # longer than a
+            and short_side <= p.motorcycle_max_width  # car's rear is wide: a side, of a car
+            and top <= p.motorcycle_max_height):  # or of a motorcycle; or one seen end-on
         classes.append(ObjectClass.MOTORCYCLE)
     if gap is None or gap.above >= truck_height:  # the ring above may pass over a truck's
         classes.append(ObjectClass.TRUCK)  # rear only if it is that high
     return tuple(classes)
+
+
+def _small_classes(long_side: float, top: float, p: DetectorParams, gap: RingGap | None,
+                   end_on: bool) -> tuple[ObjectClass, ...]:
+    """`candidate_classes` of a footprint up to ``small_footprint`` long: a pedestrian, a
+    two-wheeler seen end-on as tall as a rider, or an obstacle."""
+    hidden = gap is not None and gap.alone and gap.above >= p.pedestrian_adult_height
+    tall = top >= p.pedestrian_min_height or hidden  # as tall as a person may be
+    if long_side <= p.pedestrian_footprint and top <= p.pedestrian_max_height and tall:
+        return (ObjectClass.PEDESTRIAN,)
+    if end_on and tall and top <= p.motorcycle_max_height:
+        return (ObjectClass.MOTORCYCLE,)
+    return (ObjectClass.OTHER,)
+
+
+def sight_footprint(fp: Footprint, xy: FloatArray) -> Footprint:
+    """``fp`` re-expressed on the line of sight (first axis) and across it: the observed
+    intervals of (N, 2) points [m] along the ray from the sensor to them and across it."""
+    proj = xy @ fp.view.T
+    lo, hi = proj.min(axis=0), proj.max(axis=0)
+    return replace(fp, axes=fp.view, lo=(float(lo[0]), float(lo[1])),
+                   hi=(float(hi[0]), float(hi[1])))
+
+
+def two_wheeler_end_on(sight: Footprint, p: DetectorParams) -> bool:
+    """Whether a cluster's extents on the line of sight (`sight_footprint`) [m] are a
+    two-wheeler's seen from behind or ahead: deeper along the ray than a walker's stride
+    (``pedestrian_footprint``), no longer than a motorcycle, no wider than its bars
+    (``motorcycle_max_width``), and ``two_wheeler_elongation`` times as deep as wide (the
+    rider's back, the bars and the far wheel lie one behind the other, where a car's rear
+    or an obstacle's face is wider than deep)."""
+    along, across = sight.extents
+    return (p.pedestrian_footprint < along <= p.motorcycle_max_length
+            and across <= p.motorcycle_max_width and along >= p.two_wheeler_elongation * across)
 
 
 def grow_interval(lo: float, hi: float, size: float, sensor: float) -> tuple[float, float]:
@@ -567,10 +609,13 @@ def box_from_points(xy: FloatArray, top: float, sensor_xy: tuple[float, float],
     fp = footprint(xy, sensor_xy, p, heading_points(xy, top, heights, p))
     ext = fp.extents
     longer_first = ext[0] >= ext[1]
-    classes = candidate_classes(max(ext), min(ext), top, p, gap)
-    sight = (along_sight(fp, xy, p.pedestrian, p.pedestrian_body)
-             if ObjectClass.PEDESTRIAN in classes else fp)
-    hyps = [hypothesis(sight if cls is ObjectClass.PEDESTRIAN else fp, cls, axis1_length, p)
+    ray = sight_footprint(fp, xy)
+    end_on = two_wheeler_end_on(ray, p)
+    classes = candidate_classes(max(ext), min(ext), top, p, gap, end_on)
+    base = {ObjectClass.PEDESTRIAN: (along_sight(fp, xy, p.pedestrian, p.pedestrian_body)
+                                     if ObjectClass.PEDESTRIAN in classes else fp),
+            ObjectClass.MOTORCYCLE: ray if end_on else fp}
+    hyps = [hypothesis(base.get(cls, fp), cls, axis1_length, p)
             for cls in classes
             for axis1_length in (longer_first, not longer_first)]
     if not hyps:

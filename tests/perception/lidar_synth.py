@@ -8,7 +8,9 @@ oriented boxes (yaw about z). Rays are the `LidarInfo` beams (same layout as
 ``max_range`` is returned, with optional Gaussian range noise and dropout from a seeded
 generator. Points are in the SENSOR frame, like a real `LidarScan`.
 
-The box intersection is the slab method, vectorised over the rays, one box at a time.
+The box intersection is the slab method, vectorised over the rays, one box at a time; a
+triangle mesh (a shaped body's parts, `world.actors.shapes.mesh.part_mesh`) is cast by
+Open3D's ray casting scene.
 """
 
 from __future__ import annotations
@@ -21,7 +23,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from world.actors.catalogue import CATALOGUE
-from world.frames import LidarInfo, LidarScan, SensorMount
+from world.frames import LidarInfo, LidarScan, SensorMount, import_open3d
 from world.sensors.lidar import beam_directions
 
 FloatArray = NDArray[np.float64]
@@ -102,9 +104,28 @@ def box_hits(origin: FloatArray, dirs: FloatArray, box: Box) -> FloatArray:
     return np.where(hit, t_near, np.inf)
 
 
+Mesh = tuple[FloatArray, NDArray[np.int64]]  # vertices (V, 3) [m], vehicle frame; triangles
+
+
+def mesh_hits(origin: FloatArray, dirs: FloatArray, meshes: Sequence[Mesh]) -> FloatArray:
+    """(rays,) ray parameter [m] of the nearest hit on ``meshes``, inf on a miss."""
+    if not meshes:
+        return np.full(len(dirs), np.inf)
+    o3d = import_open3d()
+    scene = o3d.t.geometry.RaycastingScene()
+    for vertices, triangles in meshes:
+        scene.add_triangles(o3d.core.Tensor(vertices.astype(np.float32)),
+                            o3d.core.Tensor(triangles.astype(np.uint32)))
+    rays = np.column_stack([np.broadcast_to(origin, dirs.shape), dirs]).astype(np.float32)
+    t_hit = scene.cast_rays(o3d.core.Tensor(rays))["t_hit"].numpy().astype(np.float64)
+    out: FloatArray = np.where(np.isfinite(t_hit), t_hit, np.inf)
+    return out
+
+
 def cast(info: LidarInfo, boxes: Sequence[Box] = (), ground: Ground | None = FLAT,
-         t: float = 0.0, seed: int | None = 0) -> LidarScan:
-    """One scan of the scene; ``ground=None`` for no ground; ``seed=None`` for no noise."""
+         t: float = 0.0, seed: int | None = 0, meshes: Sequence[Mesh] = ()) -> LidarScan:
+    """One scan of the scene (``meshes``: triangle meshes, vehicle frame); ``ground=None``
+    for no ground; ``seed=None`` for no noise."""
     dirs_sensor, ring, column = beam_directions(info)
     mount = info.mount
     origin = np.array([mount.x, mount.y, mount.z])
@@ -114,6 +135,7 @@ def cast(info: LidarInfo, boxes: Sequence[Box] = (), ground: Ground | None = FLA
         rng = np.minimum(rng, ground_hits(origin, dirs, ground))
     for box in boxes:
         rng = np.minimum(rng, box_hits(origin, dirs, box))
+    rng = np.minimum(rng, mesh_hits(origin, dirs, meshes))
     keep = rng <= info.max_range
     if seed is not None:
         gen = np.random.default_rng(seed)
