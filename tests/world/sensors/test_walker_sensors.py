@@ -12,6 +12,7 @@ from numpy.typing import NDArray
 from pybullet_utils.bullet_client import BulletClient
 
 from avsim.scenario.load import load_scenario
+from tests.world.sensors.ray_fans import ray_fan
 from world.actors.body_build import BodyBuilder
 from world.actors.shapes import targets
 from world.actors.shapes.walker import LINK_NAMES, walker_model, walker_pose
@@ -80,11 +81,7 @@ def test_embree_and_bullet_agree_on_a_walker() -> None:
     embree = EmbreeCaster(client, shapes, REACH, [body], ground, [])
     bullet = BulletCaster(client, REACH, columns, [body], ground, [])
     origin = np.array([0.0, 0.0, 1.0])
-    elevation = np.radians(np.linspace(-5.0, 4.0, 24))[:, None]
-    azimuth = 2.0 * np.pi * np.arange(columns)[None, :] / columns
-    dirs = np.stack(np.broadcast_arrays(np.cos(elevation) * np.cos(azimuth),
-                                        np.cos(elevation) * np.sin(azimuth),
-                                        np.sin(elevation)), axis=-1).reshape(-1, 3)
+    dirs = ray_fan(-5.0, 4.0, 24, columns)
     b_e, f_e = embree.cast(origin, dirs, 0.0)
     b_b, f_b = bullet.cast(origin, dirs, 0.0)
     on_e, on_b = b_e == body, b_b == body
